@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages PE-SLAM Bench builds and runs with.
+# Run as root on a fresh Debian 12 machine.  Idempotent.
+set -euo pipefail
+PKGS=(
+  build-essential cmake pkg-config ccache git
+  libeigen3-dev libopencv-dev libceres-dev libyaml-cpp-dev libcli11-dev
+  libmujoco-dev libqhull-dev
+  libegl-dev libegl-mesa0 libgl-dev libgles-dev libosmesa6-dev libgl1-mesa-dri
+  libopenni2-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+missing=()
+for p in "${PKGS[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PKGS[@]} packages present"
+  exit 0
+fi
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update
+$SUDO apt-get install -y --no-install-recommends "${missing[@]}"

@@ -1,0 +1,70 @@
+#include "pvb/common/text.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "pvb/common/error.hpp"
+
+namespace pvb {
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path, std::string("cannot open for reading: ") + std::strerror(errno));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_file(const std::string& path, const std::string& content) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw IoError(path, std::string("cannot open for writing: ") + std::strerror(errno));
+    out << content;
+    out.flush();
+    if (!out) throw IoError(path, "write failed");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw IoError(path, std::string("cannot rename temporary file: ") + std::strerror(errno));
+}
+
+std::vector<std::string> split_ws(const std::string& line, const char* seps) {
+  std::vector<std::string> out;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && std::strchr(seps, line[i]) != nullptr) ++i;
+    std::size_t j = i;
+    while (j < line.size() && std::strchr(seps, line[j]) == nullptr) ++j;
+    if (j > i) out.push_back(line.substr(i, j - i));
+    i = j;
+  }
+  return out;
+}
+
+std::string json_escape(const std::string& s) {
+  std::string out;
+  out.reserve(s.size() + 8);
+  for (char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      case '\r': out += "\\r"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out;
+}
+
+}  // namespace pvb

@@ -1,0 +1,38 @@
+// pvbench: simulation-in-the-loop test bench for visual SLAM on solar farms.
+#include <cstdio>
+#include <exception>
+#include <vector>
+
+#include "command.hpp"
+#include "pvb/common/error.hpp"
+
+namespace pvb::cli {
+// Sub-commands register here (one line each).
+std::vector<Command> add_all_commands(CLI::App& app) {
+  std::vector<Command> cmds;
+  return cmds;
+}
+}  // namespace pvb::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{"pvbench: simulation-in-the-loop test bench for visual SLAM on solar farms"};
+  app.set_version_flag("--version", std::string("pvbench ") + pvb::version());
+  app.require_subcommand(1);
+  std::vector<pvb::cli::Command> cmds = pvb::cli::add_all_commands(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    for (auto& c : cmds)
+      if (c.app->parsed()) return c.run();
+  } catch (const pvb::Error& e) {
+    std::fprintf(stderr, "pvbench: error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pvbench: internal error: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}
