@@ -2,6 +2,7 @@
 // Pinhole camera without distortion, in pixel units.  Pixel centres are at
 // integer coordinates: the centre of the top-left pixel is (0, 0).
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <optional>
 
 namespace pvb::geom {

@@ -1,0 +1,94 @@
+#pragma once
+// TUM RGB-D sequence folders: rgb/*.png (8-bit), depth/*.png (16-bit,
+// metres = value / factor, 0 = invalid), rgb.txt, depth.txt,
+// groundtruth.txt, associations.txt.  The layout ORB-SLAM2 and the TUM tools
+// read unchanged.
+#include <cstdint>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "pvb/geometry/pinhole.hpp"
+#include "pvb/geometry/se3.hpp"
+#include "pvb/sensor/frame_source.hpp"
+
+namespace pvb::dataset {
+
+/// ORB-SLAM2 RGB-D settings (the Camera.* / ThDepth / DepthMapFactor /
+/// ORBextractor.* keys of its YAML files).
+struct OrbSlamSettings {
+  geom::PinholeIntrinsics K;
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
+  double fps = 30;
+  double bf = 40.0;            ///< baseline (m) x fx
+  int rgb_order = 1;           ///< Camera.RGB: 1 = RGB, 0 = BGR
+  double th_depth = 40.0;      ///< close/far threshold in baselines
+  double depth_map_factor = 5000.0;
+  int n_features = 1000;
+  double scale_factor = 1.2;
+  int n_levels = 8;
+  int ini_th_fast = 20;
+  int min_th_fast = 7;
+};
+
+/// Writes settings as an OpenCV FileStorage YAML file ORB-SLAM2 reads.
+void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s);
+
+/// Writes a sequence frame by frame; every text file is flushed after each
+/// frame so an interrupted run keeps what it wrote.
+class TumSequenceWriter {
+ public:
+  /// Creates `dir` (and parents), rgb/ and depth/.  Throws IoError when it cannot.
+  TumSequenceWriter(const std::string& dir, double depth_factor = 5000.0, const std::string& source = "pvbench");
+  /// Writes one frame and its ground-truth camera pose.
+  void write(const sensor::RgbdFrame& frame, const geom::SE3d& T_w_c);
+  int frames_written() const { return frames_; }
+  const std::string& dir() const { return dir_; }
+
+ private:
+  std::string dir_;
+  double depth_factor_;
+  std::ofstream rgb_txt_, depth_txt_, gt_txt_, assoc_txt_;
+  int frames_ = 0;
+};
+
+/// Creates a folder and its parents; throws IoError naming it on failure.
+void make_dirs(const std::string& dir);
+
+/// Converts metric depth to the 16-bit PNG encoding (0 where invalid or
+/// beyond 65535 / factor).
+cv::Mat depth_to_u16(const cv::Mat& depth_m, double factor);
+
+/// Reads a TUM RGB-D folder as a frame source.  Pairs come from
+/// associations.txt when present, else rgb.txt and depth.txt are associated
+/// one to one by nearest timestamp within max_diff_s.
+class TumSequenceReader : public sensor::FrameSource {
+ public:
+  struct Entry {
+    std::int64_t t_ns = 0;       ///< rgb time stamp
+    std::string rgb;             ///< path relative to the folder
+    std::int64_t depth_t_ns = 0;
+    std::string depth;
+  };
+  explicit TumSequenceReader(const std::string& dir, double depth_factor = 5000.0, double max_diff_s = 0.02);
+  std::optional<sensor::RgbdFrame> next() override;
+  std::size_t size_hint() const override { return entries_.size(); }
+  std::string describe() const override { return "tum:" + dir_; }
+  const std::vector<Entry>& entries() const { return entries_; }
+  /// Loads frame i (throws IoError for a missing or unreadable image).
+  sensor::RgbdFrame load(std::size_t i) const;
+  /// Number of frames skipped because an image was missing or corrupt.
+  std::size_t skipped() const { return skipped_; }
+
+ private:
+  std::string dir_;
+  double depth_factor_;
+  std::vector<Entry> entries_;
+  std::size_t pos_ = 0;
+  std::size_t skipped_ = 0;
+};
+
+/// Parses a TUM list file (rgb.txt / depth.txt): "t path" lines, # comments.
+std::vector<std::pair<std::int64_t, std::string>> read_tum_list(const std::string& path);
+
+}  // namespace pvb::dataset

@@ -1,0 +1,219 @@
+#include "pvb/dataset/tum_sequence.hpp"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+#include "pvb/geometry/stamped_pose.hpp"
+#include "pvb/geometry/time.hpp"
+
+namespace pvb::dataset {
+
+void make_dirs(const std::string& dir) {
+  std::string path;
+  std::stringstream ss(dir);
+  std::string part;
+  if (!dir.empty() && dir[0] == '/') path = "/";
+  while (std::getline(ss, part, '/')) {
+    if (part.empty()) continue;
+    path += part;
+    if (::mkdir(path.c_str(), 0755) != 0 && errno != EEXIST)
+      throw IoError(dir, std::string("cannot create folder: ") + std::strerror(errno));
+    path += "/";
+  }
+  struct stat st {};
+  if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) throw IoError(dir, "not a folder");
+  if (::access(dir.c_str(), W_OK) != 0) throw IoError(dir, std::string("folder is not writable: ") + std::strerror(errno));
+}
+
+void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s) {
+  char buf[4096];
+  std::snprintf(buf, sizeof buf,
+                "%%YAML:1.0\n"
+                "# ORB-SLAM2 RGB-D settings written by pvbench\n"
+                "\n"
+                "# Camera calibration and distortion parameters (OpenCV)\n"
+                "Camera.fx: %.6f\nCamera.fy: %.6f\nCamera.cx: %.6f\nCamera.cy: %.6f\n\n"
+                "Camera.k1: %.6f\nCamera.k2: %.6f\nCamera.p1: %.6f\nCamera.p2: %.6f\nCamera.k3: %.6f\n\n"
+                "Camera.width: %d\nCamera.height: %d\n\n"
+                "# Camera frames per second\nCamera.fps: %.1f\n\n"
+                "# IR projector baseline times fx (approx.)\nCamera.bf: %.6f\n\n"
+                "# Color order of the images (0: BGR, 1: RGB. It is ignored if images are grayscale)\n"
+                "Camera.RGB: %d\n\n"
+                "# Close/Far threshold. Baseline times.\nThDepth: %.1f\n\n"
+                "# Depthmap values factor\nDepthMapFactor: %.1f\n\n"
+                "# ORB Parameters\n"
+                "ORBextractor.nFeatures: %d\nORBextractor.scaleFactor: %.2f\nORBextractor.nLevels: %d\n"
+                "ORBextractor.iniThFAST: %d\nORBextractor.minThFAST: %d\n\n"
+                "# Viewer Parameters (ORB-SLAM2 reads these too)\n"
+                "Viewer.KeyFrameSize: 0.05\nViewer.KeyFrameLineWidth: 1\nViewer.GraphLineWidth: 0.9\n"
+                "Viewer.PointSize: 2\nViewer.CameraSize: 0.08\nViewer.CameraLineWidth: 3\n"
+                "Viewer.ViewpointX: 0\nViewer.ViewpointY: -0.7\nViewer.ViewpointZ: -1.8\nViewer.ViewpointF: 500\n",
+                s.K.fx, s.K.fy, s.K.cx, s.K.cy, s.k1, s.k2, s.p1, s.p2, s.k3, s.K.width, s.K.height, s.fps, s.bf,
+                s.rgb_order, s.th_depth, s.depth_map_factor, s.n_features, s.scale_factor, s.n_levels,
+                s.ini_th_fast, s.min_th_fast);
+  write_file(path, buf);
+}
+
+cv::Mat depth_to_u16(const cv::Mat& depth_m, double factor) {
+  cv::Mat out(depth_m.size(), CV_16UC1);
+  for (int r = 0; r < depth_m.rows; ++r) {
+    const float* d = depth_m.ptr<float>(r);
+    auto* o = out.ptr<std::uint16_t>(r);
+    for (int c = 0; c < depth_m.cols; ++c) {
+      const double v = std::round(static_cast<double>(d[c]) * factor);
+      o[c] = (d[c] > 0 && v <= 65535.0) ? static_cast<std::uint16_t>(v) : 0;
+    }
+  }
+  return out;
+}
+
+namespace {
+void open_list(std::ofstream* f, const std::string& path, const char* header) {
+  f->open(path, std::ios::trunc);
+  if (!*f) throw IoError(path, std::string("cannot open for writing: ") + std::strerror(errno));
+  *f << header;
+  f->flush();
+}
+}  // namespace
+
+TumSequenceWriter::TumSequenceWriter(const std::string& dir, double depth_factor, const std::string& source)
+    : dir_(dir), depth_factor_(depth_factor) {
+  make_dirs(dir_);
+  make_dirs(dir_ + "/rgb");
+  make_dirs(dir_ + "/depth");
+  const std::string tag = "# written by " + source + "\n";
+  open_list(&rgb_txt_, dir_ + "/rgb.txt", ("# color images\n" + tag + "# timestamp filename\n").c_str());
+  open_list(&depth_txt_, dir_ + "/depth.txt", ("# depth maps\n" + tag + "# timestamp filename\n").c_str());
+  open_list(&gt_txt_, dir_ + "/groundtruth.txt",
+            ("# ground truth trajectory: camera optical frame in the world\n" + tag +
+             "# timestamp tx ty tz qx qy qz qw\n").c_str());
+  open_list(&assoc_txt_, dir_ + "/associations.txt", "");
+}
+
+void TumSequenceWriter::write(const sensor::RgbdFrame& frame, const geom::SE3d& T_w_c) {
+  const std::string t = geom::format_tum_time(frame.t_ns);
+  const std::string rgb_rel = "rgb/" + t + ".png", depth_rel = "depth/" + t + ".png";
+  cv::Mat bgr;
+  cv::cvtColor(frame.rgb, bgr, cv::COLOR_RGB2BGR);
+  if (!cv::imwrite(dir_ + "/" + rgb_rel, bgr)) throw IoError(dir_ + "/" + rgb_rel, "cannot write image");
+  if (!cv::imwrite(dir_ + "/" + depth_rel, depth_to_u16(frame.depth_m, depth_factor_)))
+    throw IoError(dir_ + "/" + depth_rel, "cannot write image");
+  rgb_txt_ << t << " " << rgb_rel << "\n";
+  depth_txt_ << t << " " << depth_rel << "\n";
+  gt_txt_ << geom::format_tum_line({frame.t_ns, T_w_c}) << "\n";
+  assoc_txt_ << t << " " << rgb_rel << " " << t << " " << depth_rel << "\n";
+  for (std::ofstream* f : {&rgb_txt_, &depth_txt_, &gt_txt_, &assoc_txt_}) {
+    f->flush();
+    if (!*f) throw IoError(dir_, "write failed (disk full?)");
+  }
+  ++frames_;
+}
+
+std::vector<std::pair<std::int64_t, std::string>> read_tum_list(const std::string& path) {
+  const std::string text = read_file(path);
+  std::vector<std::pair<std::int64_t, std::string>> out;
+  std::istringstream in(text);
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    const auto fields = split_ws(line, " \t\r");
+    if (fields.empty() || fields[0][0] == '#') continue;
+    char* end = nullptr;
+    const double t = std::strtod(fields[0].c_str(), &end);
+    if (fields.size() < 2 || end == fields[0].c_str() || *end != '\0' || !std::isfinite(t))
+      throw IoError(path, "expected 'timestamp filename', got '" + line + "'", n);
+    out.emplace_back(geom::seconds_to_ns(t), fields[1]);
+  }
+  if (out.empty()) throw IoError(path, "no entries");
+  return out;
+}
+
+TumSequenceReader::TumSequenceReader(const std::string& dir, double depth_factor, double max_diff_s)
+    : dir_(dir), depth_factor_(depth_factor) {
+  const std::string assoc = dir + "/associations.txt";
+  if (::access(assoc.c_str(), R_OK) == 0) {
+    std::istringstream in(read_file(assoc));
+    std::string line;
+    int n = 0;
+    while (std::getline(in, line)) {
+      ++n;
+      const auto f = split_ws(line, " \t\r");
+      if (f.empty() || f[0][0] == '#') continue;
+      if (f.size() < 4) throw IoError(assoc, "expected 't_rgb rgb_file t_depth depth_file', got '" + line + "'", n);
+      char* e1 = nullptr;
+      char* e2 = nullptr;
+      const double t1 = std::strtod(f[0].c_str(), &e1), t2 = std::strtod(f[2].c_str(), &e2);
+      if (*e1 != '\0' || *e2 != '\0') throw IoError(assoc, "malformed timestamp in '" + line + "'", n);
+      entries_.push_back({geom::seconds_to_ns(t1), f[1], geom::seconds_to_ns(t2), f[3]});
+    }
+    if (!entries_.empty()) return;
+  }
+  const auto rgb = read_tum_list(dir + "/rgb.txt");
+  const auto depth = read_tum_list(dir + "/depth.txt");
+  // One-to-one nearest-time association, closest pairs first.
+  const auto max_diff_ns = geom::seconds_to_ns(max_diff_s);
+  std::vector<std::tuple<std::int64_t, std::size_t, std::size_t>> cand;
+  for (std::size_t i = 0; i < rgb.size(); ++i) {
+    auto it = std::lower_bound(depth.begin(), depth.end(), rgb[i].first - max_diff_ns,
+                               [](const auto& a, std::int64_t t) { return a.first < t; });
+    for (; it != depth.end() && it->first <= rgb[i].first + max_diff_ns; ++it)
+      cand.emplace_back(std::llabs(it->first - rgb[i].first), i, static_cast<std::size_t>(it - depth.begin()));
+  }
+  std::sort(cand.begin(), cand.end());
+  std::vector<bool> used_r(rgb.size()), used_d(depth.size());
+  for (const auto& [d, i, j] : cand) {
+    if (used_r[i] || used_d[j]) continue;
+    used_r[i] = used_d[j] = true;
+    entries_.push_back({rgb[i].first, rgb[i].second, depth[j].first, depth[j].second});
+  }
+  std::sort(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) { return a.t_ns < b.t_ns; });
+  if (entries_.empty())
+    throw IoError(dir + "/rgb.txt", "no colour image has a depth image within " + std::to_string(max_diff_s) + " s");
+}
+
+sensor::RgbdFrame TumSequenceReader::load(std::size_t i) const {
+  const Entry& e = entries_.at(i);
+  sensor::RgbdFrame f;
+  f.t_ns = e.t_ns;
+  f.index = i;
+  f.rgb_name = e.rgb;
+  const std::string rgb_path = dir_ + "/" + e.rgb, depth_path = dir_ + "/" + e.depth;
+  const cv::Mat bgr = cv::imread(rgb_path, cv::IMREAD_COLOR);
+  if (bgr.empty()) throw IoError(rgb_path, "missing or unreadable colour image");
+  cv::cvtColor(bgr, f.rgb, cv::COLOR_BGR2RGB);
+  const cv::Mat d16 = cv::imread(depth_path, cv::IMREAD_ANYDEPTH);
+  if (d16.empty()) throw IoError(depth_path, "missing or unreadable depth image");
+  if (d16.type() != CV_16UC1) throw IoError(depth_path, "expected a 16-bit single-channel depth image");
+  if (d16.size() != f.rgb.size()) throw IoError(depth_path, "depth and colour images differ in size");
+  d16.convertTo(f.depth_m, CV_32FC1, 1.0 / depth_factor_);
+  return f;
+}
+
+std::optional<sensor::RgbdFrame> TumSequenceReader::next() {
+  while (pos_ < entries_.size()) {
+    const std::size_t i = pos_++;
+    try {
+      return load(i);
+    } catch (const IoError& e) {
+      ++skipped_;
+      std::fprintf(stderr, "pvbench: warning: skipping frame %zu: %s\n", i, e.what());
+      if (skipped_ > std::max<std::size_t>(10, entries_.size() / 10))
+        throw IoError(dir_, "too many missing or corrupt images (" + std::to_string(skipped_) + ")");
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace pvb::dataset

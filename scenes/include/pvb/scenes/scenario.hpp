@@ -1,0 +1,153 @@
+#pragma once
+// A scenario: everything needed to simulate one run of the robot in a
+// photovoltaic station.  Loaded from YAML (see scenes/SCHEMA.md) and
+// validated on load: unknown keys, wrong types and out-of-range values are
+// ConfigErrors naming the file, the line, the key and what was expected.
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pvb::scenes {
+
+enum class GroundType { kSoil, kGravel };
+enum class PanelOrientation { kPortrait, kLandscape };
+enum class RoutePattern { kWaypoints, kAlongRow, kLawnmower, kLoop };
+enum class DepthNoiseModel { kNone, kKinect };
+enum class OnLoss { kWait, kAbort };
+
+struct Ground {
+  GroundType type = GroundType::kSoil;
+  Eigen::Vector2d size_m{60.0, 60.0};  ///< extent along x and y, centred at origin
+};
+
+/// Rows of tilted PV tables.  Array frame: u along the rows (azimuth_deg,
+/// counter-clockwise from world x), v across them; rows stack towards +v and
+/// panels face -v (tilted up by tilt_deg).
+struct PvArray {
+  Eigen::Vector2d origin_m{0.0, 0.0};  ///< front-left corner of the first row
+  double azimuth_deg = 0.0;
+  int rows = 2;
+  int tables_per_row = 3;
+  int panels_per_table = 8;  ///< panels side by side along the row, per line
+  int panel_lines = 2;       ///< lines of panels up the slope
+  PanelOrientation orientation = PanelOrientation::kPortrait;
+  int cells = 72;            ///< 60, 72 or 144 (half-cut)
+  double tilt_deg = 25.0;
+  double row_pitch_m = 6.0;  ///< distance between the front edges of two rows
+  double table_gap_m = 1.0;
+  double clearance_m = 0.6;  ///< height of the lowest panel edge
+  bool posts = true;
+  bool rails = true;
+  double dirt = 0.2;         ///< 0 clean .. 1 very dusty
+
+  // Derived panel size (m) from cells and orientation.
+  double panel_width_m() const;   ///< along the row
+  double panel_height_m() const;  ///< up the slope
+  double table_length_m() const;  ///< along the row
+  double table_depth_m() const;   ///< slope length of a table
+};
+
+struct Wall {
+  Eigen::Vector2d start_m{0.0, 0.0};
+  Eigen::Vector2d end_m{10.0, 0.0};
+  double height_m = 2.0;
+  double thickness_m = 0.24;
+};
+
+struct Vegetation {
+  int shrubs = 0;
+  Eigen::Vector2d shrub_size_m{0.3, 0.9};  ///< min, max diameter
+  int trees = 0;
+  Eigen::Vector2d tree_height_m{2.0, 4.0};
+  Eigen::Vector4d area_m{-10, -10, 10, 10};  ///< xmin, ymin, xmax, ymax
+  double keep_out_m = 1.0;                   ///< clearance from route, walls and arrays
+};
+
+struct Light {
+  double sun_azimuth_deg = 135.0;   ///< direction the sun is in, CCW from world x
+  double sun_elevation_deg = 45.0;
+  double intensity = 0.8;           ///< diffuse of the sun light, 0..1
+  double ambient = 0.35;            ///< ambient light, 0..1
+  bool shadows = true;
+};
+
+struct Route {
+  RoutePattern pattern = RoutePattern::kWaypoints;
+  std::vector<Eigen::Vector2d> waypoints_m;  ///< for kWaypoints
+  int array = 0;                             ///< pattern routes: which array
+  int aisle = 0;                             ///< along_row: aisle in front of this row
+  int aisles = 2;                            ///< lawnmower: number of aisles driven
+  double offset_m = 1.5;                     ///< distance from the table edges
+  double margin_m = 2.0;                     ///< run-out beyond the row ends
+  double speed_mps = 0.5;
+  double lookahead_m = 0.6;                  ///< pure pursuit lookahead
+  OnLoss on_loss = OnLoss::kWait;            ///< closed loop: what to do when tracking is lost
+};
+
+struct DepthNoise {
+  DepthNoiseModel model = DepthNoiseModel::kKinect;
+  double baseline_m = 0.075;         ///< IR projector-camera baseline
+  double disparity_step_px = 0.125;  ///< disparity quantisation (1/8 px)
+  double lateral_sigma_px = 0.5;     ///< pixel jitter of the depth sampling
+  double axial_scale = 1.0;          ///< multiplies sigma_z = 0.0012 + 0.0019 (z - 0.4)^2
+  double max_incidence_deg = 80.0;   ///< invalid beyond this view/normal angle
+};
+
+struct RgbNoise {
+  double sigma = 1.5;     ///< additive Gaussian noise, 8-bit levels
+  double exposure = 1.0;  ///< gain applied before noise
+  double glare = 0.0;     ///< strength of sun glare when the sun is in view, 0..1
+};
+
+struct Camera {
+  int width = 640;
+  int height = 480;
+  double fx = 525.0;  ///< MuJoCo 2.2.2 renders square pixels: fx must equal fy
+  double fy = 525.0;
+  double fps = 30.0;
+  double mount_height_m = 0.8;
+  double mount_forward_m = 0.15;
+  double pitch_deg = -12.0;  ///< negative looks down
+  double yaw_deg = 0.0;      ///< relative to the robot's heading, positive left
+  Eigen::Vector2d depth_range_m{0.5, 4.5};
+  DepthNoise depth_noise;
+  RgbNoise rgb;
+  // Principal point of MuJoCo's symmetric frustum, pixel-centre convention.
+  double cx() const { return 0.5 * width - 0.5; }
+  double cy() const { return 0.5 * height - 0.5; }
+};
+
+struct Robot {
+  double wheel_radius_m = 0.1;
+  double track_m = 0.42;  ///< distance between the wheel contact points
+  double max_wheel_speed_radps = 12.0;
+};
+
+struct Scenario {
+  std::string source_file;  ///< where it was loaded from ("" if built in code)
+  std::string name = "unnamed";
+  std::string description;
+  std::uint64_t seed = 0;
+  double duration_s = 20.0;
+  Ground ground;
+  std::vector<PvArray> pv_arrays;
+  std::vector<Wall> walls;
+  Vegetation vegetation;
+  Light light;
+  Route route;
+  Robot robot;
+  Camera camera;
+};
+
+/// Loads and validates a scenario file.  Throws ConfigError or IoError.
+Scenario load_scenario(const std::string& path);
+/// Same, from YAML text; `origin` names the source in error messages.
+Scenario parse_scenario(const std::string& yaml_text, const std::string& origin);
+
+/// Frames the scenario yields: floor(duration_s * fps) + 1, capped by max_frames if > 0.
+int frame_count(const Scenario& s, int max_frames = 0);
+
+const char* to_string(RoutePattern p);
+
+}  // namespace pvb::scenes

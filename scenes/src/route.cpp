@@ -1,0 +1,121 @@
+#include "pvb/scenes/route.hpp"
+
+#include <cmath>
+
+namespace pvb::scenes {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+void append_segment(std::vector<Eigen::Vector2d>* out, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                    double spacing) {
+  const double len = (b - a).norm();
+  const int n = std::max(1, static_cast<int>(std::ceil(len / spacing)));
+  for (int i = out->empty() ? 0 : 1; i <= n; ++i) out->push_back(a + (b - a) * (static_cast<double>(i) / n));
+}
+
+// Arc around `centre` from angle a0 to a1 (radians, either direction).
+void append_arc(std::vector<Eigen::Vector2d>* out, const Eigen::Vector2d& centre, double radius, double a0, double a1,
+                double spacing) {
+  const double len = std::abs(a1 - a0) * radius;
+  const int n = std::max(2, static_cast<int>(std::ceil(len / spacing)));
+  for (int i = 1; i <= n; ++i) {
+    const double a = a0 + (a1 - a0) * (static_cast<double>(i) / n);
+    out->push_back(centre + radius * Eigen::Vector2d(std::cos(a), std::sin(a)));
+  }
+}
+
+// v coordinate of aisle k's centre line.
+double aisle_v(const PvArray& a, int k, double offset) {
+  const double depth = row_footprint_m(a);
+  if (k == 0) return -offset;
+  const double back_of_prev = (k - 1) * a.row_pitch_m + depth;
+  if (k >= a.rows) return back_of_prev + offset;
+  const double width = a.row_pitch_m - depth;
+  return k * a.row_pitch_m - std::min(offset, 0.5 * width);
+}
+
+}  // namespace
+
+Eigen::Vector2d array_to_world(const PvArray& a, double u, double v) {
+  const double az = a.azimuth_deg * kDegToRad;
+  const Eigen::Vector2d eu(std::cos(az), std::sin(az));
+  const Eigen::Vector2d ev(-std::sin(az), std::cos(az));
+  return a.origin_m + u * eu + v * ev;
+}
+
+double row_length_m(const PvArray& a) {
+  return a.tables_per_row * a.table_length_m() + (a.tables_per_row - 1) * a.table_gap_m;
+}
+
+double row_footprint_m(const PvArray& a) { return a.table_depth_m() * std::cos(a.tilt_deg * kDegToRad); }
+
+double polyline_length(const std::vector<Eigen::Vector2d>& pts) {
+  double len = 0;
+  for (std::size_t i = 1; i < pts.size(); ++i) len += (pts[i] - pts[i - 1]).norm();
+  return len;
+}
+
+std::vector<Eigen::Vector2d> route_polyline(const Scenario& s, double spacing_m) {
+  const Route& rt = s.route;
+  std::vector<Eigen::Vector2d> uv;  // in the array frame for patterns
+  std::vector<Eigen::Vector2d> out;
+  if (rt.pattern == RoutePattern::kWaypoints) {
+    for (std::size_t i = 1; i < rt.waypoints_m.size(); ++i)
+      append_segment(&out, rt.waypoints_m[i - 1], rt.waypoints_m[i], spacing_m);
+    return out;
+  }
+  const PvArray& a = s.pv_arrays.at(static_cast<std::size_t>(rt.array));
+  const double u0 = -rt.margin_m;
+  const double u1 = row_length_m(a) + rt.margin_m;
+  switch (rt.pattern) {
+    case RoutePattern::kAlongRow: {
+      const double v = aisle_v(a, rt.aisle, rt.offset_m);
+      append_segment(&uv, {u0, v}, {u1, v}, spacing_m);
+      break;
+    }
+    case RoutePattern::kLawnmower: {
+      for (int k = 0; k < rt.aisles; ++k) {
+        const double v = aisle_v(a, k, rt.offset_m);
+        const bool forward = k % 2 == 0;
+        const Eigen::Vector2d start(forward ? u0 : u1, v), end(forward ? u1 : u0, v);
+        append_segment(&uv, start, end, spacing_m);
+        if (k + 1 < rt.aisles) {
+          const double v_next = aisle_v(a, k + 1, rt.offset_m);
+          const double radius = 0.5 * (v_next - v);
+          const Eigen::Vector2d centre(end.x(), v + radius);
+          // forward pass ends at u1 and turns through +u; backward through -u
+          if (forward)
+            append_arc(&uv, centre, radius, -M_PI / 2, M_PI / 2, spacing_m);
+          else
+            append_arc(&uv, centre, radius, -M_PI / 2, -3 * M_PI / 2, spacing_m);
+        }
+      }
+      break;
+    }
+    case RoutePattern::kLoop: {
+      const double v0 = -rt.offset_m;
+      const double v1 = (a.rows - 1) * a.row_pitch_m + row_footprint_m(a) + rt.offset_m;
+      const double r = std::min({1.5, 0.45 * (v1 - v0), 0.45 * (u1 - u0)});
+      const double um = 0.5 * (u0 + u1);
+      // counter-clockwise from the middle of the front side
+      append_segment(&uv, {um, v0}, {u1 - r, v0}, spacing_m);
+      append_arc(&uv, {u1 - r, v0 + r}, r, -M_PI / 2, 0, spacing_m);
+      append_segment(&uv, {u1, v0 + r}, {u1, v1 - r}, spacing_m);
+      append_arc(&uv, {u1 - r, v1 - r}, r, 0, M_PI / 2, spacing_m);
+      append_segment(&uv, {u1 - r, v1}, {u0 + r, v1}, spacing_m);
+      append_arc(&uv, {u0 + r, v1 - r}, r, M_PI / 2, M_PI, spacing_m);
+      append_segment(&uv, {u0, v1 - r}, {u0, v0 + r}, spacing_m);
+      append_arc(&uv, {u0 + r, v0 + r}, r, M_PI, 1.5 * M_PI, spacing_m);
+      append_segment(&uv, {u0 + r, v0}, {um, v0}, spacing_m);
+      break;
+    }
+    case RoutePattern::kWaypoints:
+      break;
+  }
+  out.reserve(uv.size());
+  for (const auto& p : uv) out.push_back(array_to_world(a, p.x(), p.y()));
+  return out;
+}
+
+}  // namespace pvb::scenes

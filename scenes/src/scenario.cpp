@@ -1,0 +1,388 @@
+#include "pvb/scenes/scenario.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+
+namespace pvb::scenes {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Strict reader over one YAML map: every key read is recorded, and finish()
+// rejects any key that was not read.  Errors name file:line and the full key.
+class MapReader {
+ public:
+  MapReader(const YAML::Node& node, std::string origin, std::string path)
+      : node_(node), origin_(std::move(origin)), path_(std::move(path)) {
+    if (!node_.IsMap()) fail(path_.empty() ? "(top level)" : path_, node_, "a mapping of keys");
+  }
+
+  bool has(const std::string& key) const { return node_[key].IsDefined() && !node_[key].IsNull(); }
+
+  double number(const std::string& key, double def, double lo, double hi) {
+    const YAML::Node n = take(key);
+    if (!n) return def;
+    double v = 0;
+    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
+      fail(full(key), n, "a number", scalar_text(n));
+    check_range(key, n, v, lo, hi);
+    return v;
+  }
+
+  int integer(const std::string& key, int def, int lo, int hi) {
+    const YAML::Node n = take(key);
+    if (!n) return def;
+    long long v = 0;
+    if (!n.IsScalar() || !YAML::convert<long long>::decode(n, v)) fail(full(key), n, "an integer", scalar_text(n));
+    check_range(key, n, static_cast<double>(v), lo, hi);
+    return static_cast<int>(v);
+  }
+
+  std::uint64_t seed(const std::string& key, std::uint64_t def) {
+    const YAML::Node n = take(key);
+    if (!n) return def;
+    unsigned long long v = 0;
+    if (!n.IsScalar() || n.Scalar().empty() || n.Scalar()[0] == '-' ||
+        !YAML::convert<unsigned long long>::decode(n, v))
+      fail(full(key), n, "a non-negative integer", scalar_text(n));
+    return v;
+  }
+
+  bool boolean(const std::string& key, bool def) {
+    const YAML::Node n = take(key);
+    if (!n) return def;
+    bool v = false;
+    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v)) fail(full(key), n, "true or false", scalar_text(n));
+    return v;
+  }
+
+  std::string string(const std::string& key, const std::string& def) {
+    const YAML::Node n = take(key);
+    if (!n) return def;
+    if (!n.IsScalar()) fail(full(key), n, "a string");
+    return n.Scalar();
+  }
+
+  template <typename Enum>
+  Enum choice(const std::string& key, Enum def, const std::vector<std::pair<std::string, Enum>>& options) {
+    const YAML::Node n = take(key);
+    if (!n) return def;
+    std::string names;
+    for (const auto& o : options) names += (names.empty() ? "" : ", ") + o.first;
+    if (!n.IsScalar()) fail(full(key), n, "one of " + names);
+    for (const auto& o : options)
+      if (o.first == n.Scalar()) return o.second;
+    fail(full(key), n, "one of " + names, n.Scalar());
+  }
+
+  /// A list of `size` numbers each in [lo, hi].
+  std::vector<double> numbers(const std::string& key, std::size_t size, double lo, double hi) {
+    const YAML::Node n = take(key);
+    if (!n) return {};
+    const std::string what = "a list of " + std::to_string(size) + " numbers";
+    if (!n.IsSequence() || n.size() != size) fail(full(key), n, what);
+    std::vector<double> out;
+    for (std::size_t i = 0; i < size; ++i) {
+      double v = 0;
+      if (!n[i].IsScalar() || !YAML::convert<double>::decode(n[i], v) || !std::isfinite(v))
+        fail(full(key) + "[" + std::to_string(i) + "]", n[i], "a number", scalar_text(n[i]));
+      check_range(key + "[" + std::to_string(i) + "]", n[i], v, lo, hi);
+      out.push_back(v);
+    }
+    return out;
+  }
+
+  Eigen::Vector2d vec2(const std::string& key, const Eigen::Vector2d& def, double lo, double hi) {
+    const auto v = numbers(key, 2, lo, hi);
+    return v.empty() ? def : Eigen::Vector2d(v[0], v[1]);
+  }
+
+  /// A (min, max) pair with min <= max.
+  Eigen::Vector2d range(const std::string& key, const Eigen::Vector2d& def, double lo, double hi) {
+    const YAML::Node n = node_[key];
+    const Eigen::Vector2d v = vec2(key, def, lo, hi);
+    if (v.x() > v.y()) fail(full(key), n, "[min, max] with min <= max");
+    return v;
+  }
+
+  /// Sub-map reader (empty node -> absent).
+  YAML::Node child(const std::string& key) { return take(key); }
+  std::string full(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  const std::string& origin() const { return origin_; }
+
+  /// Rejects keys that were never read.
+  void finish() const {
+    for (const auto& kv : node_) {
+      const std::string key = kv.first.as<std::string>();
+      if (read_.count(key) == 0) {
+        std::string known;
+        for (const auto& k : read_) known += (known.empty() ? "" : ", ") + k;
+        fail(full(key), kv.first, "a known key (" + known + ")", "unknown key");
+      }
+    }
+  }
+
+  [[noreturn]] void fail(const std::string& key, const YAML::Node& at, const std::string& expected,
+                         const std::string& got = {}) const {
+    const YAML::Mark m = at.Mark();
+    const std::string where = m.line >= 0 ? origin_ + ":" + std::to_string(m.line + 1) : origin_;
+    throw ConfigError(where, key, expected, got);
+  }
+
+ private:
+  YAML::Node take(const std::string& key) {
+    read_.insert(key);
+    const YAML::Node n = node_[key];
+    if (!n.IsDefined() || n.IsNull()) return YAML::Node(YAML::NodeType::Undefined);
+    return n;
+  }
+  static std::string scalar_text(const YAML::Node& n) { return n.IsScalar() ? n.Scalar() : "a non-scalar"; }
+  void check_range(const std::string& key, const YAML::Node& n, double v, double lo, double hi) const {
+    if (v < lo || v > hi) {
+      std::ostringstream ss;
+      if (hi == kInf)
+        ss << "a value >= " << lo;
+      else if (lo == -kInf)
+        ss << "a value <= " << hi;
+      else
+        ss << "a value in [" << lo << ", " << hi << "]";
+      fail(full(key), n, ss.str(), n.IsScalar() ? n.Scalar() : std::string());
+    }
+  }
+
+  const YAML::Node node_;  // a handle; const so operator[] never inserts keys
+  std::string origin_;
+  std::string path_;
+  std::set<std::string> read_;
+};
+
+// Runs `fn` on the map under `key` of `parent` if present.
+void with_map(MapReader& parent, const std::string& key, const std::function<void(MapReader&)>& fn) {
+  const YAML::Node n = parent.child(key);
+  if (!n) return;
+  MapReader r(n, parent.origin(), parent.full(key));
+  fn(r);
+  r.finish();
+}
+
+PvArray read_array(MapReader& r) {
+  PvArray a;
+  a.origin_m = r.vec2("origin_m", a.origin_m, -1e4, 1e4);
+  a.azimuth_deg = r.number("azimuth_deg", a.azimuth_deg, -360, 360);
+  a.rows = r.integer("rows", a.rows, 1, 50);
+  a.tables_per_row = r.integer("tables_per_row", a.tables_per_row, 1, 50);
+  a.panels_per_table = r.integer("panels_per_table", a.panels_per_table, 1, 60);
+  a.panel_lines = r.integer("panel_lines", a.panel_lines, 1, 4);
+  a.orientation = r.choice<PanelOrientation>("orientation", a.orientation,
+                                              {{"portrait", PanelOrientation::kPortrait},
+                                               {"landscape", PanelOrientation::kLandscape}});
+  a.cells = r.integer("cells", a.cells, 60, 144);
+  if (a.cells != 60 && a.cells != 72 && a.cells != 144)
+    r.fail(r.full("cells"), YAML::Node(), "one of 60, 72, 144", std::to_string(a.cells));
+  a.tilt_deg = r.number("tilt_deg", a.tilt_deg, 0, 60);
+  a.table_gap_m = r.number("table_gap_m", a.table_gap_m, 0, 50);
+  a.clearance_m = r.number("clearance_m", a.clearance_m, 0.1, 5);
+  a.posts = r.boolean("posts", a.posts);
+  a.rails = r.boolean("rails", a.rails);
+  a.dirt = r.number("dirt", a.dirt, 0, 1);
+  const double min_pitch = a.table_depth_m() * std::cos(a.tilt_deg * M_PI / 180.0) + 0.5;
+  a.row_pitch_m = r.number("row_pitch_m", std::max(a.row_pitch_m, min_pitch), min_pitch, 100);
+  return a;
+}
+
+}  // namespace
+
+double PvArray::panel_width_m() const {
+  // Typical module sizes: 60 cells 1.65 x 0.99 m, 72 cells 1.96 x 0.99 m,
+  // 144 half-cut cells 2.27 x 1.13 m (long side x short side).
+  const double long_m = cells == 60 ? 1.65 : cells == 72 ? 1.96 : 2.27;
+  const double short_m = cells == 144 ? 1.13 : 0.99;
+  return orientation == PanelOrientation::kPortrait ? short_m : long_m;
+}
+double PvArray::panel_height_m() const {
+  const double long_m = cells == 60 ? 1.65 : cells == 72 ? 1.96 : 2.27;
+  const double short_m = cells == 144 ? 1.13 : 0.99;
+  return orientation == PanelOrientation::kPortrait ? long_m : short_m;
+}
+constexpr double kPanelGapM = 0.02;
+double PvArray::table_length_m() const { return panels_per_table * (panel_width_m() + kPanelGapM) - kPanelGapM; }
+double PvArray::table_depth_m() const { return panel_lines * (panel_height_m() + kPanelGapM) - kPanelGapM; }
+
+Scenario parse_scenario(const std::string& yaml_text, const std::string& origin) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(origin + ":" + std::to_string(e.mark.line + 1), "(syntax)", "valid YAML", e.msg);
+  }
+  if (!root.IsDefined() || root.IsNull()) throw ConfigError(origin, "(top level)", "a scenario mapping", "an empty file");
+  Scenario s;
+  s.source_file = origin;
+  MapReader top(root, origin, "");
+  s.name = top.string("name", s.name);
+  s.description = top.string("description", s.description);
+  s.seed = top.seed("seed", s.seed);
+  s.duration_s = top.number("duration_s", s.duration_s, 0.1, 3600);
+
+  with_map(top, "ground", [&](MapReader& r) {
+    s.ground.type = r.choice<GroundType>("type", s.ground.type, {{"soil", GroundType::kSoil}, {"gravel", GroundType::kGravel}});
+    s.ground.size_m = r.vec2("size_m", s.ground.size_m, 5, 2000);
+  });
+
+  if (const YAML::Node arrays = top.child("pv_arrays")) {
+    if (!arrays.IsSequence()) top.fail("pv_arrays", arrays, "a list of arrays");
+    for (std::size_t i = 0; i < arrays.size(); ++i) {
+      MapReader r(arrays[i], origin, "pv_arrays[" + std::to_string(i) + "]");
+      s.pv_arrays.push_back(read_array(r));
+      r.finish();
+    }
+  }
+  if (const YAML::Node walls = top.child("walls")) {
+    if (!walls.IsSequence()) top.fail("walls", walls, "a list of walls");
+    for (std::size_t i = 0; i < walls.size(); ++i) {
+      MapReader r(walls[i], origin, "walls[" + std::to_string(i) + "]");
+      Wall w;
+      w.start_m = r.vec2("start_m", w.start_m, -1e4, 1e4);
+      w.end_m = r.vec2("end_m", w.end_m, -1e4, 1e4);
+      w.height_m = r.number("height_m", w.height_m, 0.2, 10);
+      w.thickness_m = r.number("thickness_m", w.thickness_m, 0.05, 2);
+      if ((w.end_m - w.start_m).norm() < 0.2) r.fail(r.full("end_m"), walls[i]["end_m"], "an end at least 0.2 m from start_m");
+      r.finish();
+      s.walls.push_back(w);
+    }
+  }
+  with_map(top, "vegetation", [&](MapReader& r) {
+    Vegetation& v = s.vegetation;
+    v.shrubs = r.integer("shrubs", v.shrubs, 0, 500);
+    v.shrub_size_m = r.range("shrub_size_m", v.shrub_size_m, 0.05, 5);
+    v.trees = r.integer("trees", v.trees, 0, 200);
+    v.tree_height_m = r.range("tree_height_m", v.tree_height_m, 0.5, 30);
+    const auto area = r.numbers("area_m", 4, -1e4, 1e4);
+    if (!area.empty()) {
+      v.area_m = Eigen::Vector4d(area[0], area[1], area[2], area[3]);
+      if (area[0] >= area[2] || area[1] >= area[3])
+        r.fail(r.full("area_m"), YAML::Node(), "[xmin, ymin, xmax, ymax] with xmin < xmax and ymin < ymax");
+    }
+    v.keep_out_m = r.number("keep_out_m", v.keep_out_m, 0, 50);
+  });
+  with_map(top, "light", [&](MapReader& r) {
+    Light& l = s.light;
+    l.sun_azimuth_deg = r.number("sun_azimuth_deg", l.sun_azimuth_deg, -360, 360);
+    l.sun_elevation_deg = r.number("sun_elevation_deg", l.sun_elevation_deg, 1, 90);
+    l.intensity = r.number("intensity", l.intensity, 0, 1);
+    l.ambient = r.number("ambient", l.ambient, 0, 1);
+    l.shadows = r.boolean("shadows", l.shadows);
+  });
+  with_map(top, "route", [&](MapReader& r) {
+    Route& rt = s.route;
+    rt.pattern = r.choice<RoutePattern>("pattern", rt.pattern,
+                                         {{"waypoints", RoutePattern::kWaypoints},
+                                          {"along_row", RoutePattern::kAlongRow},
+                                          {"lawnmower", RoutePattern::kLawnmower},
+                                          {"loop", RoutePattern::kLoop}});
+    if (const YAML::Node wps = r.child("waypoints_m")) {
+      if (!wps.IsSequence() || wps.size() < 2) r.fail(r.full("waypoints_m"), wps, "a list of at least 2 [x, y] points");
+      for (std::size_t i = 0; i < wps.size(); ++i) {
+        double x = 0, y = 0;
+        if (!wps[i].IsSequence() || wps[i].size() != 2 || !YAML::convert<double>::decode(wps[i][0], x) ||
+            !YAML::convert<double>::decode(wps[i][1], y))
+          r.fail(r.full("waypoints_m") + "[" + std::to_string(i) + "]", wps[i], "[x, y] in metres");
+        rt.waypoints_m.emplace_back(x, y);
+      }
+    }
+    rt.array = r.integer("array", rt.array, 0, 1000);
+    rt.aisle = r.integer("aisle", rt.aisle, 0, 1000);
+    rt.aisles = r.integer("aisles", rt.aisles, 1, 100);
+    rt.offset_m = r.number("offset_m", rt.offset_m, 0.3, 20);
+    rt.margin_m = r.number("margin_m", rt.margin_m, 0, 50);
+    rt.speed_mps = r.number("speed_mps", rt.speed_mps, 0.05, 3);
+    rt.lookahead_m = r.number("lookahead_m", rt.lookahead_m, 0.1, 5);
+    rt.on_loss = r.choice<OnLoss>("on_loss", rt.on_loss, {{"wait", OnLoss::kWait}, {"abort", OnLoss::kAbort}});
+  });
+  with_map(top, "robot", [&](MapReader& r) {
+    Robot& rb = s.robot;
+    rb.wheel_radius_m = r.number("wheel_radius_m", rb.wheel_radius_m, 0.03, 0.5);
+    rb.track_m = r.number("track_m", rb.track_m, 0.1, 2);
+    rb.max_wheel_speed_radps = r.number("max_wheel_speed_radps", rb.max_wheel_speed_radps, 1, 100);
+  });
+  with_map(top, "camera", [&](MapReader& r) {
+    Camera& c = s.camera;
+    c.width = r.integer("width", c.width, 32, 4096);
+    c.height = r.integer("height", c.height, 32, 4096);
+    const bool has_fx = r.has("fx");
+    c.fy = r.number("fy", c.fy, 10, 1e5);
+    c.fx = r.number("fx", has_fx ? c.fx : c.fy, 10, 1e5);
+    if (std::abs(c.fx - c.fy) > 1e-9)
+      r.fail(r.full("fx"), YAML::Node(), "fx equal to fy (MuJoCo 2.2.2 renders square pixels)");
+    c.fps = r.number("fps", c.fps, 1, 240);
+    c.mount_height_m = r.number("mount_height_m", c.mount_height_m, 0.1, 5);
+    c.mount_forward_m = r.number("mount_forward_m", c.mount_forward_m, -1, 1);
+    c.pitch_deg = r.number("pitch_deg", c.pitch_deg, -89, 89);
+    c.yaw_deg = r.number("yaw_deg", c.yaw_deg, -180, 180);
+    c.depth_range_m = r.range("depth_range_m", c.depth_range_m, 0.05, 100);
+    with_map(r, "depth_noise", [&](MapReader& n) {
+      DepthNoise& d = c.depth_noise;
+      d.model = n.choice<DepthNoiseModel>("model", d.model, {{"none", DepthNoiseModel::kNone}, {"kinect", DepthNoiseModel::kKinect}});
+      d.baseline_m = n.number("baseline_m", d.baseline_m, 0.01, 1);
+      d.disparity_step_px = n.number("disparity_step_px", d.disparity_step_px, 0, 1);
+      d.lateral_sigma_px = n.number("lateral_sigma_px", d.lateral_sigma_px, 0, 5);
+      d.axial_scale = n.number("axial_scale", d.axial_scale, 0, 100);
+      d.max_incidence_deg = n.number("max_incidence_deg", d.max_incidence_deg, 1, 90);
+    });
+    with_map(r, "rgb", [&](MapReader& n) {
+      RgbNoise& g = c.rgb;
+      g.sigma = n.number("sigma", g.sigma, 0, 100);
+      g.exposure = n.number("exposure", g.exposure, 0.05, 10);
+      g.glare = n.number("glare", g.glare, 0, 1);
+    });
+  });
+  top.finish();
+
+  // Cross-field checks.
+  const Route& rt = s.route;
+  if (rt.pattern == RoutePattern::kWaypoints && rt.waypoints_m.size() < 2)
+    throw ConfigError(origin, "route.waypoints_m", "at least 2 points when route.pattern is waypoints");
+  if (rt.pattern != RoutePattern::kWaypoints) {
+    if (s.pv_arrays.empty())
+      throw ConfigError(origin, "route.pattern", "a waypoints route when the scenario has no pv_arrays",
+                        to_string(rt.pattern));
+    if (rt.array >= static_cast<int>(s.pv_arrays.size()))
+      throw ConfigError(origin, "route.array", "an index below " + std::to_string(s.pv_arrays.size()),
+                        std::to_string(rt.array));
+    const PvArray& a = s.pv_arrays[static_cast<std::size_t>(rt.array)];
+    if (rt.pattern == RoutePattern::kAlongRow && rt.aisle > a.rows)
+      throw ConfigError(origin, "route.aisle", "an aisle in [0, " + std::to_string(a.rows) + "]",
+                        std::to_string(rt.aisle));
+    if (rt.pattern == RoutePattern::kLawnmower && rt.aisles > a.rows + 1)
+      throw ConfigError(origin, "route.aisles", "at most rows + 1 = " + std::to_string(a.rows + 1),
+                        std::to_string(rt.aisles));
+  }
+  return s;
+}
+
+Scenario load_scenario(const std::string& path) { return parse_scenario(read_file(path), path); }
+
+int frame_count(const Scenario& s, int max_frames) {
+  const int n = static_cast<int>(std::floor(s.duration_s * s.camera.fps + 1e-9)) + 1;
+  return max_frames > 0 ? std::min(n, max_frames) : n;
+}
+
+const char* to_string(RoutePattern p) {
+  switch (p) {
+    case RoutePattern::kWaypoints: return "waypoints";
+    case RoutePattern::kAlongRow: return "along_row";
+    case RoutePattern::kLawnmower: return "lawnmower";
+    case RoutePattern::kLoop: return "loop";
+  }
+  return "?";
+}
+
+}  // namespace pvb::scenes

@@ -1,0 +1,59 @@
+#pragma once
+// Off-screen RGB-D rendering of a MuJoCo camera.
+#include <mujoco/mujoco.h>
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "pvb/sim/gl_context.hpp"
+
+namespace pvb::sim {
+
+/// Renders one fixed camera of a model into RGB and metric depth.
+///
+/// Depth comes from the depth buffer of the same (single-sample) pass as the
+/// colour image.  MuJoCo 2.2.2 uses a standard Z buffer, so with
+/// n = vis.map.znear * stat.extent and f = vis.map.zfar * stat.extent a
+/// buffer value d in [0, 1] is the optical-axis depth z = n f / (f - d (f - n)).
+/// Rows are flipped (OpenGL's origin is bottom-left); sky (d == 1) is 0.
+class Renderer {
+ public:
+  /// Creates the GL context (one per process backend) and MuJoCo's render
+  /// context.  The model's offscreen buffer must be at least width x height
+  /// and single-sampled (vis.quality.offsamples = 0) for exact depth.
+  Renderer(const mjModel* model, GlBackend backend, int width, int height);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  /// Renders camera `camera_id` for the state in `data`.  rgb becomes CV_8UC3
+  /// (R, G, B order), depth_m CV_32FC1 metres (0 = nothing within zfar).
+  void render(const mjModel* model, mjData* data, int camera_id, cv::Mat* rgb, cv::Mat* depth_m);
+
+  /// Turns shadows on or off for the following renders.
+  void set_shadows(bool on);
+  const std::string& description() const { return gl_->description(); }
+  GlBackend backend() const { return gl_->backend(); }
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+ private:
+  std::unique_ptr<GlContext> gl_;
+  mjrContext con_;
+  mjvScene scene_;
+  mjvOption option_;
+  mjvCamera camera_;
+  int width_;
+  int height_;
+  std::vector<unsigned char> rgb_buf_;
+  std::vector<float> depth_buf_;
+};
+
+/// Converts one standard-Z-buffer value to metric depth (0 for d >= 1).
+inline float depth_from_buffer(float d, double znear_m, double zfar_m) {
+  if (d >= 1.0f) return 0.0f;
+  return static_cast<float>(znear_m * zfar_m / (zfar_m - static_cast<double>(d) * (zfar_m - znear_m)));
+}
+
+}  // namespace pvb::sim

@@ -1,0 +1,30 @@
+#pragma once
+// RGB-D sensor model applied to rendered images.  Every random draw comes
+// from a generator seeded by (scenario seed, frame index), so a frame's noise
+// does not depend on what was rendered before it.
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <optional>
+
+#include "pvb/geometry/pinhole.hpp"
+#include "pvb/scenes/scenario.hpp"
+
+namespace pvb::sim {
+
+/// Axial noise of a Kinect v1 (Nguyen et al. 2012): sigma_z(z) in metres.
+inline double kinect_axial_sigma_m(double z_m) { return 0.0012 + 0.0019 * (z_m - 0.4) * (z_m - 0.4); }
+
+/// Turns ground-truth depth into sensor depth (CV_32FC1, metres, 0 invalid).
+/// Model kinect, after ICL-NUIM: lateral jitter of the sampling position,
+/// axial Gaussian noise, disparity d = b f / z quantised to the step, invalid
+/// pixels at grazing angles and outside the depth range.  Model none: ground
+/// truth cut to the depth range.
+cv::Mat apply_depth_model(const cv::Mat& depth_gt_m, const geom::PinholeIntrinsics& K, const scenes::Camera& cam,
+                          std::uint64_t seed, std::uint64_t frame);
+
+/// Exposure gain, sun glare (when `sun_px` is given: the sun's projection,
+/// possibly outside the image) and additive Gaussian noise on an RGB image.
+void apply_rgb_model(cv::Mat* rgb, const scenes::RgbNoise& params, const std::optional<cv::Point2d>& sun_px,
+                     std::uint64_t seed, std::uint64_t frame);
+
+}  // namespace pvb::sim

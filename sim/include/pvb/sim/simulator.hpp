@@ -1,0 +1,101 @@
+#pragma once
+// The simulated station: physics of the robot following its route, and the
+// RGB-D camera on its mast.  Ground truth is read from here by the harness;
+// it never travels with the frames.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <opencv2/core.hpp>
+
+#include "pvb/geometry/pinhole.hpp"
+#include "pvb/geometry/se3.hpp"
+#include "pvb/scenes/scenario.hpp"
+#include "pvb/sensor/rgbd_frame.hpp"
+#include "pvb/sim/renderer.hpp"
+#include "pvb/sim/robot.hpp"
+#include "pvb/sim/scene_builder.hpp"
+
+namespace pvb::sim {
+
+class Simulator {
+ public:
+  /// Generates and compiles the scene, calibrates the drive kinematics and
+  /// lets the robot settle on the ground.  Frame 0 is the settled state.
+  explicit Simulator(scenes::Scenario scenario);
+
+  /// Frames in the scenario (duration x fps + 1).
+  int frame_count() const { return scenes::frame_count(scenario_); }
+  /// Index of the frame the current state belongs to.
+  int frame_index() const { return frame_; }
+  /// Time of the current frame: exactly frame_index / fps.
+  std::int64_t t_ns() const;
+  /// Advances the physics by one camera period, steering at camera rate.
+  void advance();
+
+  /// Ground truth: camera optical frame (x right, y down, z forward) in the world.
+  geom::SE3d T_w_c() const;
+  /// Ground truth planar pose of the robot's axle centre.
+  Pose2d base_pose() const;
+  geom::PinholeIntrinsics intrinsics() const;
+  /// The sun's projection in the image (may lie outside it) when it is in
+  /// front of the camera.
+  std::optional<cv::Point2d> sun_pixel() const;
+
+  /// Steer from this pose instead of ground truth (closed loop), or from
+  /// ground truth again with nullopt.
+  void set_steering_pose(const std::optional<Pose2d>& pose) { steering_pose_ = pose; }
+  /// Stops the robot while true (for example while tracking is lost).
+  void set_hold(bool hold) { hold_ = hold; }
+  /// Overrides the route follower with fixed wheel speeds (rad/s); nullopt restores it.
+  void set_wheel_override(const std::optional<Eigen::Vector2d>& left_right) { wheel_override_ = left_right; }
+
+  const scenes::Scenario& scenario() const { return scenario_; }
+  const SceneAssets& assets() const { return assets_; }
+  const DriveKinematics& kinematics() const { return kinematics_; }
+  const RouteFollower& follower() const { return *follower_; }
+  const mjModel* model() const { return model_.get(); }
+  mjData* data() { return data_.get(); }
+  const mjData* data() const { return data_.get(); }
+  int camera_id() const { return camera_id_; }
+
+ private:
+  void step_physics(int steps);
+  scenes::Scenario scenario_;
+  SceneAssets assets_;
+  ModelPtr model_;
+  DataPtr data_;
+  DriveKinematics kinematics_;
+  std::unique_ptr<RouteFollower> follower_;
+  std::optional<Pose2d> steering_pose_;
+  std::optional<Eigen::Vector2d> wheel_override_;
+  bool hold_ = false;
+  int frame_ = 0;
+  int camera_id_ = -1;
+  int free_qpos_ = 0;
+  int act_left_ = -1, act_right_ = -1;
+};
+
+/// One captured frame with its ground truth.
+struct Capture {
+  sensor::RgbdFrame frame;   ///< what the sensor delivers (noisy)
+  cv::Mat depth_gt_m;        ///< rendered depth, exact, sky = 0
+  geom::SE3d T_w_c;          ///< ground-truth camera pose
+};
+
+/// Renders the simulator's camera and applies the sensor model.
+class RgbdCamera {
+ public:
+  RgbdCamera(const Simulator& sim, GlBackend backend);
+  Capture capture(Simulator& sim);
+  const std::string& description() const { return renderer_.description(); }
+  GlBackend backend() const { return renderer_.backend(); }
+
+ private:
+  Renderer renderer_;
+};
+
+/// Installs MuJoCo error/warning handlers that throw pvb::Error instead of
+/// printing and exiting (idempotent).
+void install_mujoco_handlers();
+
+}  // namespace pvb::sim

@@ -1,0 +1,28 @@
+#pragma once
+// Procedural textures for the photovoltaic station, generated from a seed.
+// All images are CV_8UC3 in R, G, B order.
+#include <cstdint>
+#include <opencv2/core.hpp>
+
+#include "pvb/scenes/scenario.hpp"
+
+namespace pvb::sim {
+
+/// One PV module seen from the front: an aluminium frame, cells with
+/// busbars on dark glass, and seeded dust (denser towards the lower edge)
+/// and stains.  The image's top row is the panel's upper edge.
+cv::Mat make_panel_texture(const scenes::PvArray& array, double dirt, std::uint64_t seed);
+/// Grey bricks of high similarity in running bond; the image covers
+/// kBrickTileWidthM x kBrickTileHeightM of wall.
+cv::Mat make_brick_texture(std::uint64_t seed);
+constexpr double kBrickTileWidthM = 0.90;   // 4 bricks of 0.215 m + 10 mm joints
+constexpr double kBrickTileHeightM = 0.75;  // 10 courses of 0.065 m + 10 mm joints
+/// Soil or gravel; the image covers kGroundTileM x kGroundTileM.
+cv::Mat make_ground_texture(scenes::GroundType type, std::uint64_t seed);
+constexpr double kGroundTileM = 3.0;
+/// Leaves for shrubs and tree crowns.
+cv::Mat make_foliage_texture(std::uint64_t seed);
+/// Tree bark.
+cv::Mat make_bark_texture(std::uint64_t seed);
+
+}  // namespace pvb::sim

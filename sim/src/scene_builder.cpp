@@ -1,0 +1,370 @@
+#include "pvb/sim/scene_builder.hpp"
+
+#include <sys/stat.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <random>
+#include <sstream>
+
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+#include "pvb/scenes/route.hpp"
+#include "pvb/sim/textures.hpp"
+
+namespace pvb::sim {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr int kDirtVariants = 4;
+constexpr double kPanelHalfThicknessM = 0.02;
+
+// Fixed-precision number formatting so the XML is byte-identical everywhere.
+std::string f(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", std::abs(v) < 1e-12 ? 0.0 : v);
+  return buf;
+}
+std::string v3(double a, double b, double c) { return f(a) + " " + f(b) + " " + f(c); }
+std::string v3(const Eigen::Vector3d& v) { return v3(v.x(), v.y(), v.z()); }
+
+std::vector<unsigned char> png(const cv::Mat& rgb_img) {
+  cv::Mat bgr;
+  cv::cvtColor(rgb_img, bgr, cv::COLOR_RGB2BGR);
+  std::vector<unsigned char> out;
+  cv::imencode(".png", bgr, out, {cv::IMWRITE_PNG_COMPRESSION, 6});
+  return out;
+}
+
+// Deterministic uniform numbers for placement.
+struct Placer {
+  explicit Placer(std::uint64_t seed) : gen(seed * 0xD1B54A32D192ED03ull + 17) {}
+  double uniform(double a, double b) { return a + (b - a) * (static_cast<double>(gen() >> 11) / 9007199254740992.0); }
+  std::mt19937_64 gen;
+};
+
+double dist_to_segment(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
+  return (p - (a + t * ab)).norm();
+}
+
+class XmlWriter {
+ public:
+  std::ostringstream os;
+  int indent = 0;
+  void line(const std::string& s) { os << std::string(static_cast<std::size_t>(indent) * 2, ' ') << s << "\n"; }
+  void open(const std::string& s) {
+    line(s);
+    ++indent;
+  }
+  void close(const std::string& s) {
+    --indent;
+    line(s);
+  }
+};
+
+void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t seed) {
+  const double az = a.azimuth_deg * kDeg, tilt = a.tilt_deg * kDeg;
+  const Eigen::Vector3d eu(std::cos(az), std::sin(az), 0), ev(-std::sin(az), std::cos(az), 0);
+  const Eigen::Vector3d up_slope = std::cos(tilt) * ev + std::sin(tilt) * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d normal = eu.cross(up_slope);  // faces -v and up
+  const std::string axes = v3(eu) + " " + v3(up_slope);
+  const double pw = a.panel_width_m(), ph = a.panel_height_m(), gap = 0.02;
+  const double tl = a.table_length_m(), td = a.table_depth_m();
+  Placer rng(seed ^ (0xA11A + static_cast<std::uint64_t>(index)));
+  const std::string pre = "a" + std::to_string(index);
+  for (int row = 0; row < a.rows; ++row) {
+    for (int t = 0; t < a.tables_per_row; ++t) {
+      const double u_start = t * (tl + a.table_gap_m);
+      const double v0 = row * a.row_pitch_m;
+      // table centre on the slope: s = td/2
+      auto slope_point = [&](double u, double s) {
+        const Eigen::Vector2d g = scenes::array_to_world(a, u, v0 + s * std::cos(tilt));
+        return Eigen::Vector3d(g.x(), g.y(), a.clearance_m + s * std::sin(tilt));
+      };
+      const std::string tname = pre + "r" + std::to_string(row) + "t" + std::to_string(t);
+      for (int line = 0; line < a.panel_lines; ++line) {
+        for (int c = 0; c < a.panels_per_table; ++c) {
+          const double u = u_start + c * (pw + gap) + pw / 2;
+          const double s = line * (ph + gap) + ph / 2;
+          const int variant = static_cast<int>(rng.uniform(0, kDirtVariants)) % kDirtVariants;
+          x.line("<geom name=\"" + tname + "p" + std::to_string(line) + "_" + std::to_string(c) +
+                 "\" class=\"scenery\" type=\"box\" size=\"" + v3(pw / 2, ph / 2, kPanelHalfThicknessM) + "\" pos=\"" +
+                 v3(slope_point(u, s)) + "\" xyaxes=\"" + axes + "\" material=\"" + pre + "panel" +
+                 std::to_string(variant) + "\"/>");
+        }
+      }
+      // backsheet and frame structure under the panels, one box per table
+      const Eigen::Vector3d centre = slope_point(u_start + tl / 2, td / 2);
+      x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2, td / 2, 0.015) + "\" pos=\"" +
+             v3(centre - normal * (kPanelHalfThicknessM + 0.016)) + "\" xyaxes=\"" + axes +
+             "\" material=\"backsheet\"/>");
+      if (a.rails) {
+        for (double sf : {0.22, 0.78}) {
+          const Eigen::Vector3d p = slope_point(u_start + tl / 2, td * sf) - normal * 0.09;
+          x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2 + 0.05, 0.03, 0.025) + "\" pos=\"" + v3(p) +
+                 "\" xyaxes=\"" + axes + "\" material=\"steel\"/>");
+        }
+      }
+      if (a.posts) {
+        for (double uf : {0.12, 0.88}) {
+          for (double sf : {0.22, 0.78}) {
+            const Eigen::Vector3d top = slope_point(u_start + tl * uf, td * sf) - normal * 0.11;
+            const double h = top.z();
+            x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(0.04, 0.04, h / 2) + "\" pos=\"" +
+                   v3(top.x(), top.y(), h / 2) + "\" euler=\"0 0 " + f(a.azimuth_deg) +
+                   "\" material=\"steel\"/>");
+          }
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+SceneAssets build_scene(const scenes::Scenario& s) {
+  SceneAssets out;
+  const scenes::Camera& cam = s.camera;
+  // Physics step: the largest step <= 2 ms that divides the frame period, so
+  // frame i is rendered at exactly i / fps.
+  out.substeps = std::max(1, static_cast<int>(std::ceil(1.0 / cam.fps / 0.002 - 1e-9)));
+  out.timestep_s = 1.0 / (cam.fps * out.substeps);
+
+  // Scene size: the ground's diagonal bounds every distance in the scene.
+  const double diag = std::hypot(s.ground.size_m.x(), s.ground.size_m.y()) + 20.0;
+  out.max_scene_depth_m = 1.05 * diag;
+  // Depth mapping: z_far = 2.5 * diag keeps the skybox (drawn beyond ~0.6 z_far)
+  // separable from geometry; z_near 0.05 m.
+  const double extent = diag / 2;
+  const double znear_m = 0.05, zfar_m = 2.5 * diag;
+
+  const std::vector<Eigen::Vector2d> route = scenes::route_polyline(s);
+  for (const auto& p : route) {
+    out.route_xy.push_back(p.x());
+    out.route_xy.push_back(p.y());
+  }
+
+  // ---- textures
+  const std::uint64_t seed = s.seed;
+  out.files.emplace_back("textures/ground.png", png(make_ground_texture(s.ground.type, seed)));
+  out.files.emplace_back("textures/brick.png", png(make_brick_texture(seed)));
+  out.files.emplace_back("textures/foliage.png", png(make_foliage_texture(seed)));
+  out.files.emplace_back("textures/bark.png", png(make_bark_texture(seed)));
+  for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) {
+    for (int k = 0; k < kDirtVariants; ++k) {
+      // variant 0 is the cleanest; dirt grows with k up to the array's level
+      const double dirt = s.pv_arrays[i].dirt * (0.55 + 0.15 * k);
+      out.files.emplace_back("textures/a" + std::to_string(i) + "panel" + std::to_string(k) + ".png",
+                             png(make_panel_texture(s.pv_arrays[i], dirt, seed * 131 + i * 17 + k)));
+    }
+  }
+
+  XmlWriter x;
+  x.open("<mujoco model=\"" + s.name + "\">");
+  x.line("<!-- generated by pvbench from " + (s.source_file.empty() ? std::string("code") : s.source_file) +
+         ", seed " + std::to_string(s.seed) + " -->");
+  x.line("<compiler angle=\"degree\" autolimits=\"true\"/>");
+  x.line("<option timestep=\"" + f(out.timestep_s) + "\" integrator=\"implicit\" cone=\"elliptic\"/>");
+  x.line("<statistic extent=\"" + f(extent) + "\" center=\"0 0 0\"/>");
+  x.open("<visual>");
+  const double fovy_deg = 2.0 * std::atan(0.5 * cam.height / cam.fy) / kDeg;
+  x.line("<global offwidth=\"" + std::to_string(cam.width) + "\" offheight=\"" + std::to_string(cam.height) +
+         "\" fovy=\"" + f(fovy_deg) + "\"/>");
+  x.line("<quality shadowsize=\"2048\" offsamples=\"0\"/>");
+  x.line("<map znear=\"" + f(znear_m / extent) + "\" zfar=\"" + f(zfar_m / extent) + "\" shadowclip=\"" +
+         f(9.0 / extent) + "\" shadowscale=\"0.6\"/>");
+  const double amb = s.light.ambient;
+  x.line("<headlight ambient=\"" + v3(amb, amb, amb) + "\" diffuse=\"0 0 0\" specular=\"0 0 0\"/>");
+  x.close("</visual>");
+
+  x.open("<default>");
+  x.open("<default class=\"scenery\">");
+  x.line("<geom contype=\"0\" conaffinity=\"0\" group=\"1\"/>");
+  x.close("</default>");
+  x.close("</default>");
+
+  x.open("<asset>");
+  x.line("<texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"0.50 0.66 0.90\" rgb2=\"0.93 0.95 0.98\" "
+         "width=\"512\" height=\"512\"/>");
+  for (const auto& file : out.files) {
+    const std::string name = file.first.substr(9, file.first.size() - 13);  // textures/NAME.png
+    x.line("<texture name=\"" + name + "\" type=\"2d\" file=\"" + file.first + "\"/>");
+  }
+  x.line("<material name=\"ground\" texture=\"ground\" texuniform=\"true\" texrepeat=\"" +
+         f(1.0 / kGroundTileM) + " " + f(1.0 / kGroundTileM) + "\" specular=\"0.02\" shininess=\"0.05\"/>");
+  x.line("<material name=\"brick\" texture=\"brick\" texuniform=\"true\" texrepeat=\"" + f(1.0 / kBrickTileWidthM) +
+         " " + f(1.0 / kBrickTileHeightM) + "\" specular=\"0.05\" shininess=\"0.1\"/>");
+  x.line("<material name=\"foliage\" texture=\"foliage\" texuniform=\"true\" texrepeat=\"2 2\" specular=\"0.05\"/>");
+  x.line("<material name=\"bark\" texture=\"bark\" texuniform=\"true\" texrepeat=\"4 4\" specular=\"0.02\"/>");
+  for (std::size_t i = 0; i < s.pv_arrays.size(); ++i)
+    for (int k = 0; k < kDirtVariants; ++k) {
+      const std::string n = "a" + std::to_string(i) + "panel" + std::to_string(k);
+      // glass: strong, tight specular highlight
+      x.line("<material name=\"" + n + "\" texture=\"" + n + "\" specular=\"" + f(0.9 - 0.4 * s.pv_arrays[i].dirt) +
+             "\" shininess=\"0.85\"/>");
+    }
+  x.line("<material name=\"backsheet\" rgba=\"0.80 0.81 0.82 1\" specular=\"0.1\"/>");
+  x.line("<material name=\"steel\" rgba=\"0.58 0.60 0.62 1\" specular=\"0.4\" shininess=\"0.4\"/>");
+  x.line("<material name=\"robot\" rgba=\"0.95 0.55 0.10 1\" specular=\"0.3\"/>");
+  x.line("<material name=\"tyre\" rgba=\"0.08 0.08 0.08 1\"/>");
+  x.close("</asset>");
+
+  x.open("<worldbody>");
+  x.line("<geom name=\"ground\" type=\"plane\" size=\"" + v3(s.ground.size_m.x() / 2, s.ground.size_m.y() / 2, 1) +
+         "\" material=\"ground\" condim=\"3\" friction=\"1 0.005 0.0001\"/>");
+  for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) add_array(x, s.pv_arrays[i], static_cast<int>(i), seed);
+  for (std::size_t i = 0; i < s.walls.size(); ++i) {
+    const scenes::Wall& w = s.walls[i];
+    const Eigen::Vector2d d = (w.end_m - w.start_m).normalized();
+    const Eigen::Vector2d mid = 0.5 * (w.start_m + w.end_m);
+    const double len = (w.end_m - w.start_m).norm();
+    // local x along the wall, local y up: the brick texture maps onto the face
+    x.line("<geom name=\"wall" + std::to_string(i) + "\" class=\"scenery\" type=\"box\" size=\"" +
+           v3(len / 2, w.height_m / 2, w.thickness_m / 2) + "\" pos=\"" + v3(mid.x(), mid.y(), w.height_m / 2) +
+           "\" xyaxes=\"" + v3(d.x(), d.y(), 0) + " 0 0 1\" material=\"brick\"/>");
+  }
+  // Vegetation: rejection sampling away from the route, walls and arrays.
+  {
+    const scenes::Vegetation& veg = s.vegetation;
+    Placer rng(seed ^ 0x5EED5EED);
+    auto clear_of_everything = [&](const Eigen::Vector2d& p, double radius) {
+      const double keep = veg.keep_out_m + radius;
+      for (std::size_t i = 1; i < route.size(); i += 4)
+        if (dist_to_segment(p, route[i - 1], route[std::min(i + 3, route.size() - 1)]) < keep) return false;
+      for (const auto& w : s.walls)
+        if (dist_to_segment(p, w.start_m, w.end_m) < keep + w.thickness_m / 2) return false;
+      for (const auto& a : s.pv_arrays) {
+        // inverse of array_to_world
+        const double az = a.azimuth_deg * kDeg;
+        const Eigen::Vector2d q = p - a.origin_m;
+        const double u = q.x() * std::cos(az) + q.y() * std::sin(az);
+        const double v = -q.x() * std::sin(az) + q.y() * std::cos(az);
+        const double len = scenes::row_length_m(a);
+        const double depth = (a.rows - 1) * a.row_pitch_m + scenes::row_footprint_m(a);
+        if (u > -keep && u < len + keep && v > -keep && v < depth + keep) return false;
+      }
+      return true;
+    };
+    int placed = 0;
+    const int total = veg.shrubs + veg.trees;
+    for (int attempt = 0; attempt < 200 * std::max(total, 1) && placed < total; ++attempt) {
+      const bool tree = placed >= veg.shrubs;
+      const double size = tree ? rng.uniform(veg.tree_height_m.x(), veg.tree_height_m.y())
+                               : rng.uniform(veg.shrub_size_m.x(), veg.shrub_size_m.y());
+      const Eigen::Vector2d p(rng.uniform(veg.area_m[0], veg.area_m[2]), rng.uniform(veg.area_m[1], veg.area_m[3]));
+      const double radius = tree ? 0.3 * size : 0.5 * size;
+      if (!clear_of_everything(p, radius)) continue;
+      const std::string n = (tree ? "tree" : "shrub") + std::to_string(placed);
+      if (tree) {
+        const double trunk_h = 0.45 * size, crown = 0.3 * size;
+        x.line("<geom name=\"" + n + "_trunk\" class=\"scenery\" type=\"cylinder\" size=\"" + v3(0.06 + 0.02 * size, trunk_h / 2, 0) +
+               "\" pos=\"" + v3(p.x(), p.y(), trunk_h / 2) + "\" material=\"bark\"/>");
+        x.line("<geom name=\"" + n + "_crown\" class=\"scenery\" type=\"ellipsoid\" size=\"" +
+               v3(crown, crown * rng.uniform(0.8, 1.1), 0.55 * size * 0.6) + "\" pos=\"" +
+               v3(p.x(), p.y(), trunk_h + 0.25 * size) + "\" euler=\"0 0 " + f(rng.uniform(0, 180)) +
+               "\" material=\"foliage\"/>");
+      } else {
+        const double r = size / 2;
+        x.line("<geom name=\"" + n + "\" class=\"scenery\" type=\"ellipsoid\" size=\"" +
+               v3(r, r * rng.uniform(0.7, 1.0), r * rng.uniform(0.6, 0.9)) + "\" pos=\"" + v3(p.x(), p.y(), r * 0.55) +
+               "\" euler=\"0 0 " + f(rng.uniform(0, 180)) + "\" material=\"foliage\"/>");
+        const Eigen::Vector2d q = p + Eigen::Vector2d(rng.uniform(-r, r), rng.uniform(-r, r)) * 0.6;
+        x.line("<geom name=\"" + n + "b\" class=\"scenery\" type=\"ellipsoid\" size=\"" + v3(r * 0.7, r * 0.6, r * 0.55) +
+               "\" pos=\"" + v3(q.x(), q.y(), r * 0.5) + "\" material=\"foliage\"/>");
+      }
+      ++placed;
+    }
+  }
+
+  // ---- robot: differential drive, two driven wheels and a caster
+  const scenes::Robot& rb = s.robot;
+  const double r = rb.wheel_radius_m;
+  const Eigen::Vector2d start = route.empty() ? Eigen::Vector2d::Zero() : route.front();
+  double yaw0 = 0;
+  if (route.size() >= 2) {
+    const Eigen::Vector2d d = route[std::min<std::size_t>(10, route.size() - 1)] - route.front();
+    yaw0 = std::atan2(d.y(), d.x());
+  }
+  x.open("<body name=\"" + std::string(kRobotBody) + "\" pos=\"" + v3(start.x(), start.y(), r + 0.002) +
+         "\" euler=\"0 0 " + f(yaw0 / kDeg) + "\">");
+  x.line("<freejoint name=\"robot_free\"/>");
+  x.line("<geom name=\"chassis\" type=\"box\" size=\"0.30 " + f(0.5 * rb.track_m - 0.05) + " 0.07\" pos=\"-0.12 0 0.05\" "
+         "mass=\"18\" material=\"robot\"/>");
+  x.line("<geom name=\"caster\" type=\"sphere\" size=\"0.04\" pos=\"" + v3(-0.36, 0, 0.04 - r) +
+         "\" mass=\"0.3\" condim=\"1\" priority=\"1\" friction=\"0 0 0\" rgba=\"0.2 0.2 0.2 1\"/>");
+  for (int side = 0; side < 2; ++side) {
+    const double y = (side == 0 ? 1 : -1) * 0.5 * rb.track_m;
+    const std::string n = side == 0 ? kLeftActuator : kRightActuator;
+    x.open("<body name=\"" + n + "\" pos=\"" + v3(0, y, 0) + "\">");
+    x.line("<joint name=\"" + n + "\" type=\"hinge\" axis=\"0 1 0\" armature=\"0.01\" damping=\"0.02\"/>");
+    x.line("<geom type=\"cylinder\" size=\"" + f(r) + " 0.025\" euler=\"90 0 0\" mass=\"1.5\" condim=\"3\" "
+           "friction=\"1.2 0.01 0.001\" material=\"tyre\"/>");
+    x.close("</body>");
+  }
+  const double mast_h = cam.mount_height_m - r;
+  x.line("<geom name=\"mast\" type=\"cylinder\" size=\"0.02 " + f(mast_h / 2) + "\" pos=\"" +
+         v3(cam.mount_forward_m - 0.05, 0, mast_h / 2) + "\" mass=\"0.5\" rgba=\"0.3 0.3 0.3 1\"/>");
+  // Camera: MuJoCo cameras look along -z with y up.  Forward direction from
+  // yaw (left positive) and pitch (up positive) in the robot frame.
+  const double p = cam.pitch_deg * kDeg, yw = cam.yaw_deg * kDeg;
+  const Eigen::Vector3d fwd(std::cos(p) * std::cos(yw), std::cos(p) * std::sin(yw), std::sin(p));
+  const Eigen::Vector3d right(std::sin(yw), -std::cos(yw), 0);
+  const Eigen::Vector3d up = right.cross(fwd);
+  x.line("<camera name=\"" + std::string(kCameraName) + "\" pos=\"" + v3(cam.mount_forward_m, 0, mast_h) +
+         "\" xyaxes=\"" + v3(right) + " " + v3(up) + "\" fovy=\"" + f(fovy_deg) + "\"/>");
+  // The sun follows the robot (mode track: fixed offset and orientation in
+  // the world frame) so its shadow map always covers what the camera sees.
+  const double az = s.light.sun_azimuth_deg * kDeg, el = s.light.sun_elevation_deg * kDeg;
+  const Eigen::Vector3d to_sun(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+  const double I = s.light.intensity;
+  x.line("<light name=\"sun\" mode=\"track\" directional=\"true\" castshadow=\"" +
+         std::string(s.light.shadows ? "true" : "false") + "\" pos=\"" + v3(to_sun * 20.0) + "\" dir=\"" +
+         v3(-to_sun) + "\" diffuse=\"" + v3(I, I, I * 0.96) + "\" specular=\"" + v3(0.5 * I, 0.5 * I, 0.5 * I) + "\"/>");
+  x.close("</body>");
+  x.close("</worldbody>");
+
+  x.open("<actuator>");
+  for (const char* n : {kLeftActuator, kRightActuator})
+    x.line("<velocity name=\"" + std::string(n) + "\" joint=\"" + n + "\" kv=\"25\" ctrlrange=\"" +
+           f(-rb.max_wheel_speed_radps) + " " + f(rb.max_wheel_speed_radps) + "\" forcerange=\"-40 40\"/>");
+  x.close("</actuator>");
+  x.close("</mujoco>");
+  out.xml = x.os.str();
+  return out;
+}
+
+ModelPtr compile_scene(const SceneAssets& assets) {
+  mjVFS vfs;
+  mj_defaultVFS(&vfs);
+  auto add = [&](const std::string& name, const void* data, std::size_t size) {
+    if (mj_makeEmptyFileVFS(&vfs, name.c_str(), static_cast<int>(size)) != 0) {
+      mj_deleteVFS(&vfs);
+      throw Error("MuJoCo VFS: cannot add " + name);
+    }
+    std::memcpy(vfs.filedata[vfs.nfile - 1], data, size);
+  };
+  add("scene.xml", assets.xml.data(), assets.xml.size());
+  for (const auto& file : assets.files) add(file.first, file.second.data(), file.second.size());
+  char err[1024] = {0};
+  mjModel* m = mj_loadXML("scene.xml", &vfs, err, sizeof err);
+  mj_deleteVFS(&vfs);
+  if (m == nullptr) throw Error(std::string("MuJoCo could not compile the generated scene: ") + err);
+  return ModelPtr(m);
+}
+
+void write_scene(const SceneAssets& assets, const std::string& dir) {
+  ::mkdir(dir.c_str(), 0755);
+  ::mkdir((dir + "/textures").c_str(), 0755);
+  write_file(dir + "/scene.xml", assets.xml);
+  for (const auto& file : assets.files)
+    write_file(dir + "/" + file.first, std::string(file.second.begin(), file.second.end()));
+}
+
+}  // namespace pvb::sim

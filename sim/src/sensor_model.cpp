@@ -1,0 +1,123 @@
+#include "pvb/sim/sensor_model.hpp"
+
+#include <array>
+#include <cmath>
+
+namespace pvb::sim {
+namespace {
+
+// splitmix64: a fast generator whose output is fully specified, so noise is
+// identical on every platform.
+struct SplitMix {
+  explicit SplitMix(std::uint64_t seed, std::uint64_t stream)
+      : s(seed * 0x9E3779B97F4A7C15ull ^ (stream + 0x2545F4914F6CDD1Dull) * 0xBF58476D1CE4E5B9ull) {}
+  std::uint64_t next() {
+    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  std::uint64_t s;
+};
+
+// Standard normal quantiles at 4096 evenly spaced probabilities: a table
+// lookup per draw keeps per-pixel noise cheap.
+const std::array<float, 4096>& normal_table() {
+  static const std::array<float, 4096> table = [] {
+    std::array<float, 4096> t{};
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      const double p = (static_cast<double>(i) + 0.5) / t.size();
+      // inverse error function by Newton iterations on erf
+      double x = 0;
+      for (int it = 0; it < 60; ++it) {
+        const double cdf = 0.5 * std::erfc(-x / std::sqrt(2.0));
+        const double pdf = std::exp(-0.5 * x * x) / std::sqrt(2.0 * M_PI);
+        x -= (cdf - p) / std::max(pdf, 1e-300);
+      }
+      t[i] = static_cast<float>(x);
+    }
+    return t;
+  }();
+  return table;
+}
+
+}  // namespace
+
+cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, const scenes::Camera& cam,
+                          std::uint64_t seed, std::uint64_t frame) {
+  CV_Assert(gt.type() == CV_32FC1);
+  const float zmin = static_cast<float>(cam.depth_range_m.x()), zmax = static_cast<float>(cam.depth_range_m.y());
+  cv::Mat out(gt.size(), CV_32FC1, cv::Scalar(0));
+  const int W = gt.cols, H = gt.rows;
+  if (cam.depth_noise.model == scenes::DepthNoiseModel::kNone) {
+    for (int r = 0; r < H; ++r) {
+      const float* g = gt.ptr<float>(r);
+      float* o = out.ptr<float>(r);
+      for (int c = 0; c < W; ++c) o[c] = (g[c] >= zmin && g[c] <= zmax) ? g[c] : 0.0f;
+    }
+    return out;
+  }
+  const scenes::DepthNoise& p = cam.depth_noise;
+  const auto& nt = normal_table();
+  SplitMix rng(seed, frame * 2 + 1);
+  const double bf = p.baseline_m * K.fx;
+  const double cos_max = std::cos(p.max_incidence_deg * M_PI / 180.0);
+  auto gt_at = [&](int r, int c) { return gt.ptr<float>(std::clamp(r, 0, H - 1))[std::clamp(c, 0, W - 1)]; };
+  for (int r = 0; r < H; ++r) {
+    float* o = out.ptr<float>(r);
+    for (int c = 0; c < W; ++c) {
+      const std::uint64_t bits = rng.next();
+      // lateral jitter: sample a neighbouring pixel (nearest, so no mixing at edges)
+      const int dc = static_cast<int>(std::lround(nt[bits & 4095] * p.lateral_sigma_px));
+      const int dr = static_cast<int>(std::lround(nt[(bits >> 12) & 4095] * p.lateral_sigma_px));
+      const int rr = std::clamp(r + dr, 1, H - 2), cc = std::clamp(c + dc, 1, W - 2);
+      const float z = gt_at(rr, cc);
+      if (z <= 0.0f) continue;
+      // incidence angle from the local surface normal
+      const float zl = gt_at(rr, cc - 1), zr = gt_at(rr, cc + 1), zu = gt_at(rr - 1, cc), zd = gt_at(rr + 1, cc);
+      if (zl <= 0 || zr <= 0 || zu <= 0 || zd <= 0) continue;  // silhouette edge: no return
+      const Eigen::Vector3d px_l = K.unproject(cc - 1, rr, zl), px_r = K.unproject(cc + 1, rr, zr);
+      const Eigen::Vector3d px_u = K.unproject(cc, rr - 1, zu), px_d = K.unproject(cc, rr + 1, zd);
+      const Eigen::Vector3d n = (px_r - px_l).cross(px_d - px_u);
+      const Eigen::Vector3d ray = K.unproject(cc, rr, z);
+      const double nn = n.norm() * ray.norm();
+      if (nn <= 0 || std::abs(n.dot(ray)) / nn < cos_max) continue;
+      // axial noise, then disparity quantisation
+      double zn = z + nt[(bits >> 24) & 4095] * kinect_axial_sigma_m(z) * p.axial_scale;
+      if (p.disparity_step_px > 0 && zn > 0) {
+        const double d = bf / zn;
+        const double dq = std::round(d / p.disparity_step_px) * p.disparity_step_px;
+        zn = dq > 0 ? bf / dq : 0.0;
+      }
+      if (zn >= zmin && zn <= zmax) o[c] = static_cast<float>(zn);
+    }
+  }
+  return out;
+}
+
+void apply_rgb_model(cv::Mat* rgb, const scenes::RgbNoise& params, const std::optional<cv::Point2d>& sun_px,
+                     std::uint64_t seed, std::uint64_t frame) {
+  CV_Assert(rgb->type() == CV_8UC3);
+  const bool glare = params.glare > 0 && sun_px.has_value();
+  if (params.sigma <= 0 && params.exposure == 1.0 && !glare) return;
+  const auto& nt = normal_table();
+  SplitMix rng(seed, frame * 2);
+  const double sigma_px = 0.35 * rgb->cols;
+  for (int r = 0; r < rgb->rows; ++r) {
+    auto* px = rgb->ptr<cv::Vec3b>(r);
+    for (int c = 0; c < rgb->cols; ++c) {
+      double add = 0;
+      if (glare) {
+        const double dx = c - sun_px->x, dy = r - sun_px->y;
+        add = 255.0 * params.glare * std::exp(-(dx * dx + dy * dy) / (2 * sigma_px * sigma_px));
+      }
+      const std::uint64_t bits = rng.next();
+      for (int k = 0; k < 3; ++k) {
+        const double n = params.sigma > 0 ? nt[(bits >> (12 * k)) & 4095] * params.sigma : 0.0;
+        px[c][k] = cv::saturate_cast<uchar>(px[c][k] * params.exposure + add + n);
+      }
+    }
+  }
+}
+
+}  // namespace pvb::sim

@@ -1,0 +1,164 @@
+#include "pvb/sim/simulator.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "pvb/common/error.hpp"
+#include "pvb/geometry/time.hpp"
+#include "pvb/scenes/route.hpp"
+#include "pvb/sim/sensor_model.hpp"
+
+namespace pvb::sim {
+namespace {
+
+constexpr double kSettleS = 0.3;
+
+void mujoco_error(const char* msg) { throw Error(std::string("MuJoCo: ") + msg); }
+void mujoco_warning(const char* msg) { std::fprintf(stderr, "pvbench: warning: MuJoCo: %s\n", msg); }
+
+double yaw_of(const mjtNum* q) {  // MuJoCo quaternion w, x, y, z
+  return std::atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]));
+}
+
+int actuator(const mjModel* m, const char* name) {
+  const int id = mj_name2id(m, mjOBJ_ACTUATOR, name);
+  if (id < 0) throw Error(std::string("generated model lacks actuator ") + name);
+  return id;
+}
+
+}  // namespace
+
+void install_mujoco_handlers() {
+  mju_user_error = mujoco_error;
+  mju_user_warning = mujoco_warning;
+}
+
+Simulator::Simulator(scenes::Scenario scenario) : scenario_(std::move(scenario)) {
+  install_mujoco_handlers();
+  assets_ = build_scene(scenario_);
+  model_ = compile_scene(assets_);
+  data_.reset(mj_makeData(model_.get()));
+  const mjModel* m = model_.get();
+  camera_id_ = mj_name2id(m, mjOBJ_CAMERA, kCameraName);
+  const int body = mj_name2id(m, mjOBJ_BODY, kRobotBody);
+  if (camera_id_ < 0 || body < 0) throw Error("generated model lacks the robot or its camera");
+  free_qpos_ = m->jnt_qposadr[m->body_jntadr[body]];
+  act_left_ = actuator(m, kLeftActuator);
+  act_right_ = actuator(m, kRightActuator);
+
+  // Calibrate the drive on scratch data: the effective rolling radius from a
+  // straight run and the effective track from turning on the spot.
+  kinematics_.wheel_radius_m = scenario_.robot.wheel_radius_m;
+  kinematics_.track_m = scenario_.robot.track_m;
+  kinematics_.max_wheel_radps = scenario_.robot.max_wheel_speed_radps;
+  {
+    DataPtr scratch(mj_makeData(m));
+    const int settle = static_cast<int>(kSettleS / m->opt.timestep);
+    const int second = static_cast<int>(1.0 / m->opt.timestep);
+    auto run = [&](double wl, double wr, int steps) {
+      scratch->ctrl[act_left_] = wl;
+      scratch->ctrl[act_right_] = wr;
+      for (int i = 0; i < steps; ++i) mj_step(m, scratch.get());
+    };
+    const double w = std::min(scenario_.route.speed_mps / kinematics_.wheel_radius_m, 0.8 * kinematics_.max_wheel_radps);
+    run(0, 0, settle);
+    run(w, w, second / 2);
+    const Eigen::Vector2d p0(scratch->qpos[free_qpos_], scratch->qpos[free_qpos_ + 1]);
+    run(w, w, second);
+    const Eigen::Vector2d p1(scratch->qpos[free_qpos_], scratch->qpos[free_qpos_ + 1]);
+    const double v = (p1 - p0).norm();
+    if (v > 1e-3) kinematics_.wheel_radius_m = v / w;
+    run(0, 0, second / 2);
+    const double wt = std::min(3.0, 0.8 * kinematics_.max_wheel_radps);
+    run(-wt, wt, second / 2);
+    const double y0 = yaw_of(scratch->qpos + free_qpos_ + 3);
+    run(-wt, wt, second);
+    double dyaw = yaw_of(scratch->qpos + free_qpos_ + 3) - y0;
+    while (dyaw < 0) dyaw += 2 * M_PI;
+    if (dyaw > 1e-3) kinematics_.track_m = 2.0 * kinematics_.wheel_radius_m * wt / dyaw;
+  }
+
+  std::vector<Eigen::Vector2d> path;
+  for (std::size_t i = 0; i + 1 < assets_.route_xy.size(); i += 2)
+    path.emplace_back(assets_.route_xy[i], assets_.route_xy[i + 1]);
+  follower_ = std::make_unique<RouteFollower>(std::move(path), scenario_.route.speed_mps, scenario_.route.lookahead_m);
+
+  // Settle: the robot starts 2 mm above the ground.
+  step_physics(static_cast<int>(kSettleS / m->opt.timestep));
+  mj_forward(m, data_.get());
+}
+
+std::int64_t Simulator::t_ns() const { return geom::frame_time_ns(0, frame_, scenario_.camera.fps); }
+
+void Simulator::step_physics(int steps) {
+  for (int i = 0; i < steps; ++i) mj_step(model_.get(), data_.get());
+}
+
+void Simulator::advance() {
+  Eigen::Vector2d lr = Eigen::Vector2d::Zero();
+  if (wheel_override_) {
+    lr = *wheel_override_;
+  } else if (!hold_) {
+    const Eigen::Vector2d vw = follower_->command(steering_pose_ ? *steering_pose_ : base_pose());
+    lr = kinematics_.wheel_speeds(vw.x(), vw.y());
+  }
+  data_->ctrl[act_left_] = lr.x();
+  data_->ctrl[act_right_] = lr.y();
+  step_physics(assets_.substeps);
+  mj_forward(model_.get(), data_.get());  // camera poses for the new state
+  ++frame_;
+}
+
+geom::SE3d Simulator::T_w_c() const {
+  const mjtNum* x = data_->cam_xpos + 3 * camera_id_;
+  const mjtNum* R = data_->cam_xmat + 9 * camera_id_;
+  Eigen::Matrix3d R_w_mj;
+  R_w_mj << R[0], R[1], R[2], R[3], R[4], R[5], R[6], R[7], R[8];
+  // MuJoCo camera: x right, y up, looking along -z.  Optical: y down, z forward.
+  const Eigen::Matrix3d R_mj_optical = Eigen::Vector3d(1, -1, -1).asDiagonal();
+  return geom::make_se3(R_w_mj * R_mj_optical, Eigen::Vector3d(x[0], x[1], x[2]));
+}
+
+Pose2d Simulator::base_pose() const {
+  const mjtNum* q = data_->qpos + free_qpos_;
+  return {q[0], q[1], yaw_of(q + 3)};
+}
+
+geom::PinholeIntrinsics Simulator::intrinsics() const {
+  const scenes::Camera& c = scenario_.camera;
+  return {c.fx, c.fy, c.cx(), c.cy(), c.width, c.height};
+}
+
+std::optional<cv::Point2d> Simulator::sun_pixel() const {
+  const double az = scenario_.light.sun_azimuth_deg * M_PI / 180, el = scenario_.light.sun_elevation_deg * M_PI / 180;
+  const Eigen::Vector3d to_sun_w(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+  const Eigen::Vector3d d = T_w_c().linear().transpose() * to_sun_w;
+  if (d.z() <= 0.05) return std::nullopt;
+  const auto K = intrinsics();
+  return cv::Point2d(K.fx * d.x() / d.z() + K.cx, K.fy * d.y() / d.z() + K.cy);
+}
+
+RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
+    : renderer_(sim.model(), backend, sim.scenario().camera.width, sim.scenario().camera.height) {
+  renderer_.set_shadows(sim.scenario().light.shadows);
+}
+
+Capture RgbdCamera::capture(Simulator& sim) {
+  Capture out;
+  cv::Mat rgb;
+  renderer_.render(sim.model(), sim.data(), sim.camera_id(), &rgb, &out.depth_gt_m);
+  // Sky: beyond every scene distance (the skybox is drawn far away).
+  const float sky = static_cast<float>(sim.assets().max_scene_depth_m);
+  out.depth_gt_m.setTo(0.0f, out.depth_gt_m > sky);
+  const scenes::Scenario& s = sim.scenario();
+  const auto frame = static_cast<std::uint64_t>(sim.frame_index());
+  out.frame.depth_m = apply_depth_model(out.depth_gt_m, sim.intrinsics(), s.camera, s.seed, frame);
+  apply_rgb_model(&rgb, s.camera.rgb, sim.sun_pixel(), s.seed, frame);
+  out.frame.rgb = rgb;
+  out.frame.t_ns = sim.t_ns();
+  out.frame.index = frame;
+  out.T_w_c = sim.T_w_c();
+  return out;
+}
+
+}  // namespace pvb::sim
