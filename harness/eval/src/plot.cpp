@@ -147,11 +147,9 @@ Figure make_error_figure(const EvalResult& r, const std::string& title) {
     err_line.points.emplace_back(err.px(geom::ns_to_seconds(r.t_ns[i] - r.t_ns.front())), err.py(r.ate_m[i]));
   f.polylines.push_back(err_line);
   f.lines.push_back({err.left, err.py(r.ate.rmse), err.left + err.width, err.py(r.ate.rmse), kBlue, 1.0});
-  char rm[64];
-  std::snprintf(rm, sizeof rm, "rmse %.4f m", r.ate.rmse);
-  f.texts.push_back({err.left + err.width - 6, err.py(r.ate.rmse) - 6, rm, kTickFont, TextAnchor::kEnd, false, kBlue});
-  f.texts.push_back({f.width_px / 2.0, err.top - 14, "absolute trajectory error over time", 17.0, TextAnchor::kMiddle,
-                     false, kBlack});
+  char rm[120];
+  std::snprintf(rm, sizeof rm, "absolute trajectory error over time (blue line: rmse %.4f m)", r.ate.rmse);
+  f.texts.push_back({f.width_px / 2.0, err.top - 14, rm, 17.0, TextAnchor::kMiddle, false, kBlack});
   return f;
 }
 
