@@ -1,0 +1,59 @@
+#pragma once
+// The trajectory error figure (top view + error over time) as a list of
+// drawing primitives in pixel coordinates, and its SVG serialisation.  The
+// PNG renderer lives in pvb::plot (it needs OpenCV; this library does not).
+#include <string>
+#include <vector>
+
+#include "pvb/eval/evaluate.hpp"
+
+namespace pvb::eval {
+
+struct Rgb {
+  unsigned char r = 0, g = 0, b = 0;
+};
+
+/// Drawing primitives; coordinates are pixels, origin top-left, y down.
+struct FigLine {
+  double x0, y0, x1, y1;
+  Rgb color;
+  double width_px;
+};
+struct FigPolyline {
+  std::vector<std::pair<double, double>> points;
+  Rgb color;
+  double width_px;
+};
+enum class TextAnchor { kStart, kMiddle, kEnd };
+struct FigText {
+  double x, y;  ///< anchor point on the text baseline
+  std::string text;
+  double size_px;
+  TextAnchor anchor = TextAnchor::kStart;
+  bool vertical = false;  ///< rotated 90 degrees counter-clockwise about (x, y)
+  Rgb color;
+};
+
+struct Figure {
+  int width_px = 0, height_px = 0;
+  std::vector<FigLine> lines;          ///< drawn first
+  std::vector<FigPolyline> polylines;  ///< drawn over lines, in order
+  std::vector<FigText> texts;          ///< drawn last
+};
+
+/// Lays out the trajectory error figure for one result: a top view (x-y
+/// plane, equal axes, metres) with ground truth in black, the aligned
+/// estimate in blue and a red segment from each estimated position to its
+/// ground truth; below it the ATE over time (seconds since the first pair).
+Figure make_error_figure(const EvalResult& result, const std::string& title);
+
+/// Serialises a figure as a standalone SVG document.
+std::string format_svg(const Figure& figure);
+
+/// "1.5", "0.25", "-2": a tick label without trailing zeros.
+std::string tick_label(double v, double step);
+
+/// Tick positions covering [lo, hi] with a 1-2-5 step giving about `target` ticks.
+std::vector<double> nice_ticks(double lo, double hi, int target, double* step);
+
+}  // namespace pvb::eval

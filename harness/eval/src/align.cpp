@@ -1,0 +1,121 @@
+#include "pvb/eval/align.hpp"
+
+#include <Eigen/SVD>
+#include <cstdio>
+
+#include "pvb/common/error.hpp"
+#include "pvb/eval/trajectory.hpp"
+
+namespace pvb::eval {
+namespace {
+// A point set whose second principal spread is below this fraction of the
+// first is treated as collinear.
+constexpr double kCollinearRatio = 1e-6;
+
+void check_not_collinear(const std::vector<geom::Vec3d>& pts, const geom::Vec3d& mean, const char* which) {
+  geom::Mat3d cov = geom::Mat3d::Zero();
+  for (const geom::Vec3d& p : pts) cov += (p - mean) * (p - mean).transpose();
+  const Eigen::JacobiSVD<geom::Mat3d> svd(cov);
+  const geom::Vec3d sv = svd.singularValues();  // variances along principal axes, descending
+  if (sv(0) <= 1e-18)
+    throw EvalError(std::string("cannot align: all ") + which + " positions are the same point");
+  if (sv(1) <= kCollinearRatio * sv(0))
+    throw EvalError(std::string("cannot align: the ") + which +
+                    " positions are collinear (degenerate), so the rotation about that line is "
+                    "undetermined; use --align origin or --align none");
+}
+}  // namespace
+
+Alignment parse_alignment(const std::string& name) {
+  if (name == "se3") return Alignment::kSe3;
+  if (name == "sim3") return Alignment::kSim3;
+  if (name == "none") return Alignment::kNone;
+  if (name == "origin") return Alignment::kOrigin;
+  throw ConfigError("command line", "--align", "one of se3, sim3, none, origin", name);
+}
+
+const char* alignment_name(Alignment a) {
+  switch (a) {
+    case Alignment::kSe3: return "se3";
+    case Alignment::kSim3: return "sim3";
+    case Alignment::kNone: return "none";
+    case Alignment::kOrigin: return "origin";
+  }
+  return "?";
+}
+
+Sim3Transform umeyama(const std::vector<geom::Vec3d>& est, const std::vector<geom::Vec3d>& gt,
+                      bool with_scale) {
+  if (est.size() != gt.size()) throw EvalError("cannot align: point sets differ in size");
+  const std::size_t n = est.size();
+  if (n < 3)
+    throw EvalError("cannot align: " + std::to_string(n) +
+                    " associated pose pair(s), at least 3 are needed for se3/sim3 alignment");
+  geom::Vec3d mu_est = geom::Vec3d::Zero(), mu_gt = geom::Vec3d::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    mu_est += est[i];
+    mu_gt += gt[i];
+  }
+  mu_est /= static_cast<double>(n);
+  mu_gt /= static_cast<double>(n);
+  check_not_collinear(est, mu_est, "estimated");
+  check_not_collinear(gt, mu_gt, "ground-truth");
+
+  // Cross-covariance Sigma = 1/n sum (gt_i - mu_gt)(est_i - mu_est)^T.
+  geom::Mat3d sigma = geom::Mat3d::Zero();
+  double var_est = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const geom::Vec3d de = est[i] - mu_est;
+    sigma += (gt[i] - mu_gt) * de.transpose();
+    var_est += de.squaredNorm();
+  }
+  sigma /= static_cast<double>(n);
+  var_est /= static_cast<double>(n);
+
+  const Eigen::JacobiSVD<geom::Mat3d> svd(sigma, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  geom::Mat3d S = geom::Mat3d::Identity();
+  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) S(2, 2) = -1.0;
+  Sim3Transform out;
+  out.R = svd.matrixU() * S * svd.matrixV().transpose();
+  out.s = with_scale ? (svd.singularValues().asDiagonal() * S).trace() / var_est : 1.0;
+  out.t = mu_gt - out.s * out.R * mu_est;
+  return out;
+}
+
+Sim3Transform compute_alignment(const std::vector<geom::SE3d>& est, const std::vector<geom::SE3d>& gt,
+                                Alignment kind) {
+  if (est.size() != gt.size()) throw EvalError("cannot align: pose lists differ in size");
+  switch (kind) {
+    case Alignment::kNone: return {};
+    case Alignment::kOrigin: {
+      if (est.empty()) throw EvalError("cannot align: no associated pose pairs");
+      // T such that T * est_0 == gt_0.
+      const geom::SE3d T = gt.front() * est.front().inverse();
+      Sim3Transform out;
+      out.R = T.linear();
+      out.t = T.translation();
+      return out;
+    }
+    case Alignment::kSe3:
+    case Alignment::kSim3: {
+      std::vector<geom::Vec3d> p_est, p_gt;
+      p_est.reserve(est.size());
+      p_gt.reserve(gt.size());
+      for (std::size_t i = 0; i < est.size(); ++i) {
+        p_est.push_back(est[i].translation());
+        p_gt.push_back(gt[i].translation());
+      }
+      return umeyama(p_est, p_gt, kind == Alignment::kSim3);
+    }
+  }
+  return {};
+}
+
+std::vector<geom::SE3d> apply_alignment(const Sim3Transform& transform, const std::vector<geom::SE3d>& poses) {
+  std::vector<geom::SE3d> out;
+  out.reserve(poses.size());
+  for (const geom::SE3d& T : poses) out.push_back(transform.apply(T));
+  return out;
+}
+
+}  // namespace pvb::eval
