@@ -18,6 +18,12 @@ RouteFollower::RouteFollower(std::vector<Eigen::Vector2d> path, double speed_mps
   arc_.resize(path_.size(), 0.0);
   for (std::size_t i = 1; i < path_.size(); ++i) arc_[i] = arc_[i - 1] + (path_[i] - path_[i - 1]).norm();
   finished_ = path_.size() < 2;
+  for (std::size_t i = 1; i + 1 < path_.size(); ++i) {
+    const Eigen::Vector2d a = path_[i] - path_[i - 1], b = path_[i + 1] - path_[i];
+    if (a.norm() < 1e-9 || b.norm() < 1e-9) continue;
+    const double cos_turn = a.dot(b) / (a.norm() * b.norm());
+    if (cos_turn < std::cos(20.0 * M_PI / 180.0)) corners_.push_back(i);
+  }
 }
 
 double RouteFollower::cross_track_error_m(const Pose2d& pose) const {
@@ -45,6 +51,11 @@ Eigen::Vector2d RouteFollower::command(const Pose2d& pose) {
     }
   }
   progress_ = best;
+  while (next_corner_ < corners_.size() &&
+         (progress_ > corners_[next_corner_] || (path_[corners_[next_corner_]] - p).norm() < kCornerReachedM)) {
+    progress_ = std::max(progress_, corners_[next_corner_]);
+    ++next_corner_;
+  }
   const double remaining = arc_.back() - arc_[progress_];
   if (remaining < 0.05) {
     finished_ = true;
@@ -53,17 +64,23 @@ Eigen::Vector2d RouteFollower::command(const Pose2d& pose) {
   // Lookahead point: lookahead_ m further along the path (or its end).
   std::size_t target = progress_;
   while (target + 1 < path_.size() && arc_[target] - arc_[progress_] < lookahead_) ++target;
+  if (next_corner_ < corners_.size()) target = std::min(target, corners_[next_corner_]);
   const Eigen::Vector2d d = path_[target] - p;
   const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
   const double xl = c * d.x() + s * d.y();
   const double yl = -s * d.x() + c * d.y();
   const double l2 = std::max(xl * xl + yl * yl, 1e-6);
   const double curvature = 2.0 * yl / l2;
-  // Slow down in tight turns and near the end; turn in place if the target
-  // is behind.
+  // Turn on the spot when the target is far off the heading (behind, or a
+  // sharp corner just reached); slow down in tight turns, before corners and
+  // near the end.
+  const double heading_error = std::atan2(yl, xl);
+  if (std::abs(heading_error) > 50.0 * M_PI / 180.0)
+    return Eigen::Vector2d(0.0, std::copysign(std::min(1.0, 2.0 * speed_), heading_error));
   double v = speed_ / (1.0 + 0.6 * std::abs(curvature));
-  v = std::min(v, std::max(0.08, 0.8 * remaining));
-  if (xl < 0) return Eigen::Vector2d(0.0, std::copysign(std::min(1.0, 2.0 * speed_), yl));
+  double slow_for = remaining;
+  if (next_corner_ < corners_.size()) slow_for = std::min(slow_for, (path_[corners_[next_corner_]] - p).norm());
+  v = std::min(v, std::max(0.08, 0.8 * slow_for));
   return Eigen::Vector2d(v, v * curvature);
 }
 

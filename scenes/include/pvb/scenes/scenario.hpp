@@ -116,6 +116,9 @@ struct Camera {
   // Principal point of MuJoCo's symmetric frustum, pixel-centre convention.
   double cx() const { return 0.5 * width - 0.5; }
   double cy() const { return 0.5 * height - 0.5; }
+  /// MuJoCo's vertical field of view giving focal length fy: the image spans
+  /// height pixels, so tan(fovy / 2) = (height / 2) / fy.
+  double fovy_deg() const;
 };
 
 struct Robot {

@@ -25,8 +25,13 @@ struct DriveKinematics {
 
 /// Pure pursuit along a polyline.  Progress along the path only moves
 /// forward, so closed loops and lawnmower turns are followed in order.
+/// Sharp corners (where the path turns by more than 20 degrees) are driven
+/// to, not cut: the lookahead point stops at the next corner until the robot
+/// is within kCornerReachedM of it, and the robot turns on the spot when its
+/// next target lies behind it.
 class RouteFollower {
  public:
+  static constexpr double kCornerReachedM = 0.08;
   RouteFollower(std::vector<Eigen::Vector2d> path, double speed_mps, double lookahead_m);
 
   /// Body speed command (v, w) for the given pose; (0, 0) once finished.
@@ -41,6 +46,8 @@ class RouteFollower {
  private:
   std::vector<Eigen::Vector2d> path_;
   std::vector<double> arc_;  ///< cumulative length at each point
+  std::vector<std::size_t> corners_;  ///< indices where the path turns sharply: reached, not cut
+  std::size_t next_corner_ = 0;       ///< first corner not yet reached
   double speed_;
   double lookahead_;
   std::size_t progress_ = 0;

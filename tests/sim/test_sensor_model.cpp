@@ -1,0 +1,98 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pvb/sim/sensor_model.hpp"
+
+using namespace pvb;
+
+namespace {
+scenes::Camera kinect() {
+  scenes::Camera c;
+  c.depth_noise.model = scenes::DepthNoiseModel::kKinect;
+  return c;
+}
+geom::PinholeIntrinsics K() { return {525, 525, 319.5, 239.5, 640, 480}; }
+}  // namespace
+
+TEST(SensorModel, AxialSigmaFollowsNguyen) {
+  EXPECT_DOUBLE_EQ(sim::kinect_axial_sigma_m(0.4), 0.0012);
+  EXPECT_NEAR(sim::kinect_axial_sigma_m(2.4), 0.0012 + 0.0019 * 4.0, 1e-15);
+}
+
+TEST(SensorModel, KinectNoiseOnAPlaneHasTheModelledSpreadAndQuantisation) {
+  const double z = 3.0;
+  const cv::Mat gt(480, 640, CV_32FC1, cv::Scalar(z));
+  const scenes::Camera cam = kinect();
+  const cv::Mat out = sim::apply_depth_model(gt, K(), cam, 1, 0);
+  double sum = 0, sum2 = 0;
+  int n = 0;
+  const double bf = cam.depth_noise.baseline_m * 525.0;
+  for (int r = 10; r < 470; ++r)
+    for (int c = 10; c < 630; ++c) {
+      const double v = out.at<float>(r, c);
+      ASSERT_GT(v, 0);
+      // every value sits on the 1/8-pixel disparity grid
+      const double disparity_steps = bf / v / 0.125;
+      ASSERT_NEAR(disparity_steps, std::round(disparity_steps), 1e-3);
+      sum += v;
+      sum2 += v * v;
+      ++n;
+    }
+  const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+  // axial sigma 0.0012 + 0.0019 * 2.6^2 = 0.0140 m; quantisation at 3 m adds
+  // a uniform error of step z^2 / bf = 0.0343 m width (sd 0.0099 m)
+  const double expected = std::hypot(sim::kinect_axial_sigma_m(z), 0.125 * z * z / bf / std::sqrt(12.0));
+  EXPECT_NEAR(sd, expected, 0.15 * expected);
+  EXPECT_NEAR(mean, z, 0.003);
+}
+
+TEST(SensorModel, InvalidOutsideRangeAndAtGrazingAngles) {
+  scenes::Camera cam = kinect();
+  cv::Mat gt(480, 640, CV_32FC1, cv::Scalar(6.0));  // beyond 4.5 m
+  EXPECT_EQ(cv::countNonZero(sim::apply_depth_model(gt, K(), cam, 1, 0)), 0);
+  gt.setTo(0.3);  // closer than 0.5 m
+  EXPECT_EQ(cv::countNonZero(sim::apply_depth_model(gt, K(), cam, 1, 0)), 0);
+  // a floor seen at a grazing angle: depth grows quickly with row
+  for (int r = 0; r < 480; ++r) gt.row(r).setTo(1.0 + r * 0.5);
+  const cv::Mat out = sim::apply_depth_model(gt, K(), cam, 1, 0);
+  EXPECT_EQ(cv::countNonZero(out.rowRange(2, 8)), 0);
+}
+
+TEST(SensorModel, NoiseIsSeededPerFrame) {
+  const cv::Mat gt(60, 80, CV_32FC1, cv::Scalar(2.0));
+  const scenes::Camera cam = kinect();
+  const geom::PinholeIntrinsics k{525, 525, 39.5, 29.5, 80, 60};
+  const cv::Mat a = sim::apply_depth_model(gt, k, cam, 5, 10);
+  const cv::Mat b = sim::apply_depth_model(gt, k, cam, 5, 10);
+  const cv::Mat c = sim::apply_depth_model(gt, k, cam, 5, 11);
+  EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::norm(a, c, cv::NORM_INF), 0.0);
+}
+
+TEST(SensorModel, NoneModelKeepsGroundTruthInRange) {
+  scenes::Camera cam;
+  cam.depth_noise.model = scenes::DepthNoiseModel::kNone;
+  cv::Mat gt(4, 4, CV_32FC1, cv::Scalar(2.345f));
+  gt.at<float>(0, 0) = 9.0f;
+  const cv::Mat out = sim::apply_depth_model(gt, K(), cam, 1, 0);
+  EXPECT_EQ(out.at<float>(1, 1), 2.345f);
+  EXPECT_EQ(out.at<float>(0, 0), 0.0f);
+}
+
+TEST(SensorModel, RgbExposureAndNoise) {
+  cv::Mat img(100, 100, CV_8UC3, cv::Scalar(100, 100, 100));
+  scenes::RgbNoise p;
+  p.sigma = 0;
+  p.exposure = 1.5;
+  sim::apply_rgb_model(&img, p, std::nullopt, 1, 0);
+  EXPECT_EQ(img.at<cv::Vec3b>(5, 5)[0], 150);
+  p.exposure = 1.0;
+  p.sigma = 4.0;
+  cv::Mat n(200, 200, CV_8UC3, cv::Scalar(100, 100, 100));
+  sim::apply_rgb_model(&n, p, std::nullopt, 1, 0);
+  cv::Scalar mean, sd;
+  cv::meanStdDev(n.reshape(1), mean, sd);
+  EXPECT_NEAR(sd[0], 4.0, 0.3);
+  EXPECT_NEAR(mean[0], 100.0, 0.2);
+}

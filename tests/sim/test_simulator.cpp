@@ -1,0 +1,145 @@
+// The simulated robot and camera: pose conventions, driving, route
+// following and determinism, on scenes built by the generator.
+#include <gtest/gtest.h>
+
+#include "pvb/scenes/scenario.hpp"
+#include "pvb/sim/simulator.hpp"
+
+using namespace pvb;
+
+namespace {
+
+// A wall at an angle in front of the robot, noise-free sensor.
+scenes::Scenario wall_scenario() {
+  return scenes::parse_scenario(R"(
+name: wall_test
+seed: 3
+duration_s: 4
+ground: {size_m: [20, 20]}
+walls: [{start_m: [2.5, -3], end_m: [4.0, 3], height_m: 3, thickness_m: 0.2}]
+route: {waypoints_m: [[0, 0], [1, 0]], speed_mps: 0.3}
+camera: {pitch_deg: -5, yaw_deg: 8, depth_noise: {model: none}, rgb: {sigma: 0}}
+)",
+                                "wall_test.yaml");
+}
+
+double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+
+}  // namespace
+
+TEST(Simulator, OpticalFramePoseAndDepthAgreeWithTheWallPlane) {
+  sim::Simulator sim(wall_scenario());
+  sim::RgbdCamera camera(sim, sim::GlBackend::kAuto);
+  const sim::Capture cap = camera.capture(sim);
+  const geom::SE3d& T_w_c = cap.T_w_c;
+
+  // Optical convention: z forward along the robot heading (yaw 8 deg, pitch
+  // -5 deg), y down, x right.
+  const Eigen::Vector3d z_w = T_w_c.linear().col(2), y_w = T_w_c.linear().col(1), x_w = T_w_c.linear().col(0);
+  const double yaw = sim.base_pose().yaw + 8.0 * M_PI / 180;
+  EXPECT_NEAR(z_w.x(), std::cos(-5.0 * M_PI / 180) * std::cos(yaw), 0.01);
+  EXPECT_NEAR(z_w.z(), std::sin(-5.0 * M_PI / 180), 0.01);
+  EXPECT_LT(y_w.z(), -0.99);  // y points down
+  EXPECT_LT(x_w.dot(Eigen::Vector3d(-std::sin(yaw), std::cos(yaw), 0)), -0.99);  // x points right
+  EXPECT_NEAR(T_w_c.translation().z(), 0.8, 0.01);  // mount height
+
+  // Wall face towards the robot.
+  const Eigen::Vector2d a(2.5, -3), b(4.0, 3);
+  const Eigen::Vector2d d = (b - a).normalized();
+  Eigen::Vector2d n(d.y(), -d.x());
+  if (n.dot(-a) < 0) n = -n;  // towards the origin
+  const Eigen::Vector3d n3(n.x(), n.y(), 0);
+  const Eigen::Vector3d p0(a.x() + 0.1 * n.x(), a.y() + 0.1 * n.y(), 0);
+  const geom::PinholeIntrinsics K = sim.intrinsics();
+  int checked = 0;
+  double worst = 0;
+  for (int r = 0; r < K.height; r += 5)
+    for (int c = 0; c < K.width; c += 5) {
+      // predicted depth: intersect the pixel's ray with the face plane
+      const Eigen::Vector3d ray_c((c - K.cx) / K.fx, (r - K.cy) / K.fy, 1.0);
+      const Eigen::Vector3d ray_w = T_w_c.linear() * ray_c;
+      const double t = n3.dot(p0 - T_w_c.translation()) / n3.dot(ray_w);
+      const Eigen::Vector3d hit = T_w_c.translation() + t * ray_w;
+      const double along = (Eigen::Vector2d(hit.x(), hit.y()) - a).dot(d);
+      if (t <= 0 || hit.z() < 0.1 || hit.z() > 2.8 || along < 0.3 || along > (b - a).norm() - 0.3) continue;
+      const float z = cap.depth_gt_m.at<float>(r, c);
+      ASSERT_GT(z, 0) << r << "," << c;
+      worst = std::max(worst, std::abs(z - t));
+      ++checked;
+    }
+  EXPECT_GT(checked, 2000);
+  EXPECT_LT(worst, 2e-4);
+  // noise-free model within range: sensor depth equals ground truth there
+  EXPECT_EQ(cap.frame.depth_m.at<float>(240, 320), cap.depth_gt_m.at<float>(240, 320));
+}
+
+TEST(Simulator, DrivesStraight) {
+  sim::Simulator sim(wall_scenario());
+  const sim::Pose2d p0 = sim.base_pose();
+  const double w = 4.0;
+  sim.set_wheel_override(Eigen::Vector2d(w, w));
+  for (int i = 0; i < 90; ++i) sim.advance();  // 3 s
+  const sim::Pose2d p1 = sim.base_pose();
+  const Eigen::Vector2d dir(std::cos(p0.yaw), std::sin(p0.yaw));
+  const Eigen::Vector2d delta(p1.x - p0.x, p1.y - p0.y);
+  const double along = delta.dot(dir);
+  const double lateral = std::abs(delta.x() * dir.y() - delta.y() * dir.x());
+  // accelerates from rest: close to the calibrated speed over 3 s
+  EXPECT_GT(along, 0.9 * 3.0 * w * sim.kinematics().wheel_radius_m);
+  EXPECT_LT(along, 1.01 * 3.0 * w * sim.kinematics().wheel_radius_m);
+  EXPECT_LT(lateral, 0.01);
+  EXPECT_LT(std::abs(wrap(p1.yaw - p0.yaw)), 0.5 * M_PI / 180);
+}
+
+TEST(Simulator, TurnsAtTheCalibratedRate) {
+  sim::Simulator sim(wall_scenario());
+  const sim::DriveKinematics& k = sim.kinematics();
+  // calibration sees the scrub: the effective track is wider than the geometric one
+  EXPECT_GT(k.track_m, 0.42);
+  EXPECT_LT(k.track_m, 0.42 * 1.5);
+  const double v = 0.2, omega = 0.5;  // arc of radius 0.4 m
+  sim.set_wheel_override(k.wheel_speeds(v, omega));
+  for (int i = 0; i < 15; ++i) sim.advance();  // reach steady state
+  const double yaw0 = sim.base_pose().yaw;
+  for (int i = 0; i < 60; ++i) sim.advance();  // 2 s
+  const double turned = wrap(sim.base_pose().yaw - yaw0);
+  EXPECT_NEAR(turned, omega * 2.0, 0.05 * omega * 2.0);
+}
+
+TEST(Simulator, RouteFollowerReachesItsWaypoints) {
+  scenes::Scenario s = scenes::parse_scenario(
+      "duration_s: 40\nground: {size_m: [30, 30]}\n"
+      "route: {waypoints_m: [[0, 0], [4, 0], [5, 2.5], [2, 4], [-1, 2]], speed_mps: 0.5, lookahead_m: 0.6}\n",
+      "route_test.yaml");
+  sim::Simulator sim(s);
+  std::vector<double> closest(s.route.waypoints_m.size(), 1e9);
+  double worst_cross_track = 0;
+  for (int i = 1; i < sim.frame_count() && !sim.follower().finished(); ++i) {
+    sim.advance();
+    const sim::Pose2d p = sim.base_pose();
+    for (std::size_t w = 0; w < closest.size(); ++w)
+      closest[w] = std::min(closest[w], (Eigen::Vector2d(p.x, p.y) - s.route.waypoints_m[w]).norm());
+    worst_cross_track = std::max(worst_cross_track, sim.follower().cross_track_error_m(p));
+  }
+  EXPECT_TRUE(sim.follower().finished());
+  for (std::size_t w = 0; w < closest.size(); ++w) EXPECT_LT(closest[w], 0.15) << "waypoint " << w;
+  EXPECT_LT(worst_cross_track, 0.25);
+}
+
+TEST(Simulator, FrameTimesAreExactMultiplesOfThePeriod) {
+  sim::Simulator sim(wall_scenario());
+  for (int i = 0; i < 4; ++i) sim.advance();
+  EXPECT_EQ(sim.t_ns(), 133'333'333);  // 4 / 30 s
+  EXPECT_NEAR(sim.assets().timestep_s * sim.assets().substeps, 1.0 / 30.0, 1e-15);
+}
+
+TEST(Simulator, PhysicsIsDeterministic) {
+  sim::Simulator a(wall_scenario()), b(wall_scenario());
+  for (int i = 0; i < 60; ++i) {
+    a.advance();
+    b.advance();
+  }
+  EXPECT_EQ(a.base_pose().x, b.base_pose().x);
+  EXPECT_EQ(a.base_pose().yaw, b.base_pose().yaw);
+  EXPECT_TRUE(a.T_w_c().matrix() == b.T_w_c().matrix());
+}
