@@ -7,9 +7,12 @@
 #include "pvb/common/error.hpp"
 
 namespace pvb::cli {
+Command add_match_command(CLI::App& app);
+
 // Sub-commands register here (one line each).
 std::vector<Command> add_all_commands(CLI::App& app) {
   std::vector<Command> cmds;
+  cmds.push_back(add_match_command(app));
   return cmds;
 }
 }  // namespace pvb::cli
