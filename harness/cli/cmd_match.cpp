@@ -15,6 +15,7 @@ struct MatchOptions {
   std::string img1, img2, homography;
   std::string depth1, depth2, pose1, pose2, settings;
   std::string sequence, frames;
+  double gt_time_offset_s = 0.0;
   std::string method = "all";
   int runs = 10;
   unsigned seed = 1;
@@ -83,7 +84,9 @@ int run_match(const MatchOptions& o) {
       d1 = frames[i].depth_path;
       d2 = frames[j].depth_path;
       const std::string gtf = o.sequence + "/groundtruth.txt";
-      gt.T_c2_c1 = tum_pose_at(gtf, frames[j].t_s).inverse() * tum_pose_at(gtf, frames[i].t_s);
+      // Poses at the rgb stamps (+ offset), up to 0.1 s from a ground-truth sample.
+      const double dt = o.gt_time_offset_s;
+      gt.T_c2_c1 = tum_pose_at(gtf, frames[j].t_s + dt, 0.1).inverse() * tum_pose_at(gtf, frames[i].t_s + dt, 0.1);
     } else {
       if (o.img1.empty() || o.img2.empty() || o.depth1.empty() || o.depth2.empty() || o.pose1.empty() ||
           o.pose2.empty() || o.settings.empty())
@@ -154,6 +157,9 @@ Command add_match_command(CLI::App& app) {
                   "overrides DIR/camera.yaml");
   sub->add_option("--sequence", opts->sequence, "TUM-layout folder (rgb.txt, depth.txt, groundtruth.txt)");
   sub->add_option("--frames", opts->frames, "I,J: rgb.txt entries (0-based) to match with --sequence");
+  sub->add_option("--gt-time-offset", opts->gt_time_offset_s,
+                  "with --sequence: seconds added to the rgb stamps before looking up ground-truth poses "
+                  "(camera/mocap clock offset; default 0)");
   sub->add_option("--method", opts->method, "all|orb|hamming|ransac|magsac|pe|pe-refined (comma list allowed)");
   sub->add_option("--runs", opts->runs, "repetitions with seeds S, S+1, ... (default 10)");
   sub->add_option("--seed", opts->seed, "first seed (default 1)");

@@ -9,16 +9,20 @@
 namespace pvb::slam {
 namespace {
 
-/// Relative size below which the 8th pivot of the 8x9 system counts as zero
+/// Relative size below which a pivot of the 8x9 system counts as zero
 /// (null space of dimension >= 2: degenerate sample).
 constexpr double kDegenerateRelPivot = 1e-9;
 
 /// Zeroes the smallest singular value of F (rank-2 constraint, sec. 4.1).
+/// With F = U S V^T and v3 the right singular vector of the smallest
+/// singular value s3, F v3 = s3 u3, so F (I - v3 v3^T) = F - s3 u3 v3^T is
+/// the nearest rank-2 matrix (Frobenius).  v3 is the eigenvector of F^T F
+/// with the smallest eigenvalue, from the closed-form 3x3 solver.
 Eigen::Matrix3d enforce_rank2(const Eigen::Matrix3d& F) {
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Vector3d s = svd.singularValues();
-  s(2) = 0.0;
-  return svd.matrixU() * s.asDiagonal() * svd.matrixV().transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(F.transpose() * F);
+  const Eigen::Vector3d v3 = es.eigenvectors().col(0);
+  return F - (F * v3) * v3.transpose();
 }
 
 /// One row of eq. 5 for normalised (x1, y1) <-> (x2, y2).
@@ -45,18 +49,54 @@ Normalization hartley_normalization(const Eigen::Vector2d* pts, std::size_t n, s
 
 bool solve_fundamental_8_normalized(const Eigen::Matrix<double, 8, 2>& x1, const Eigen::Matrix<double, 8, 2>& x2,
                                     Eigen::Matrix3d& F) {
-  // A^T (9x8) = Q R P^T; the last column of Q spans the null space of A.
-  Eigen::Matrix<double, 9, 8> At;
-  for (int i = 0; i < 8; ++i) fill_row(At.col(i).transpose(), x1(i, 0), x1(i, 1), x2(i, 0), x2(i, 1));
-  if (!At.allFinite()) return false;
-  Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 9, 8>> qr(At);
-  const auto& R = qr.matrixQR();
-  const double r0 = std::abs(R(0, 0));
-  if (!(r0 > 0.0) || std::abs(R(7, 7)) < kDegenerateRelPivot * r0) return false;
-  Eigen::Matrix<double, 9, 9> Q = qr.householderQ();
-  const Eigen::Matrix<double, 9, 1> f = Q.col(8);
+  // Null vector of the 8x9 system of eq. 5 by Gaussian elimination with full
+  // pivoting (rank-revealing, fixed size, ~200 flops).
+  Eigen::Matrix<double, 8, 9> A;
+  for (int i = 0; i < 8; ++i) fill_row(A.row(i), x1(i, 0), x1(i, 1), x2(i, 0), x2(i, 1));
+  if (!A.allFinite()) return false;
+  int col[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};  // column permutation
+  double first_pivot = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    int pr = k, pc = k;
+    double best = -1.0;
+    for (int r = k; r < 8; ++r)
+      for (int c = k; c < 9; ++c) {
+        const double v = std::abs(A(r, c));
+        if (v > best) {
+          best = v;
+          pr = r;
+          pc = c;
+        }
+      }
+    if (k == 0) first_pivot = best;
+    // Null space of dimension >= 2: degenerate sample (e.g. collinear points).
+    if (!(best > kDegenerateRelPivot * first_pivot) || !(first_pivot > 0.0)) return false;
+    if (pr != k) A.row(pr).swap(A.row(k));
+    if (pc != k) {
+      A.col(pc).swap(A.col(k));
+      std::swap(col[pc], col[k]);
+    }
+    const double inv = 1.0 / A(k, k);
+    for (int r = k + 1; r < 8; ++r) {
+      const double f = A(r, k) * inv;
+      if (f == 0.0) continue;
+      for (int c = k + 1; c < 9; ++c) A(r, c) -= f * A(k, c);
+      A(r, k) = 0.0;
+    }
+  }
+  // Back-substitution with the free (9th permuted) unknown set to 1.
+  double y[9];
+  y[8] = 1.0;
+  for (int k = 7; k >= 0; --k) {
+    double s = A(k, 8);
+    for (int c = k + 1; c < 8; ++c) s += A(k, c) * y[c];
+    y[k] = -s / A(k, k);
+  }
+  double f[9];
+  for (int c = 0; c < 9; ++c) f[col[c]] = y[c];
   Eigen::Matrix3d Fn;
-  Fn << f(0), f(1), f(2), f(3), f(4), f(5), f(6), f(7), f(8);
+  Fn << f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8];
+  Fn /= Fn.norm();
   F = enforce_rank2(Fn);
   return F.allFinite();
 }
