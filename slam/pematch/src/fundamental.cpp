@@ -50,47 +50,69 @@ Normalization hartley_normalization(const Eigen::Vector2d* pts, std::size_t n, s
 bool solve_fundamental_8_normalized(const Eigen::Matrix<double, 8, 2>& x1, const Eigen::Matrix<double, 8, 2>& x2,
                                     Eigen::Matrix3d& F) {
   // Null vector of the 8x9 system of eq. 5 by Gaussian elimination with full
-  // pivoting (rank-revealing, fixed size, ~200 flops).
-  Eigen::Matrix<double, 8, 9> A;
-  for (int i = 0; i < 8; ++i) fill_row(A.row(i), x1(i, 0), x1(i, 1), x2(i, 0), x2(i, 1));
-  if (!A.allFinite()) return false;
+  // pivoting (rank-revealing, fixed size, ~200 flops), on a row-major array.
+  double A[8][9];
+  for (int i = 0; i < 8; ++i) {
+    const double u1 = x1(i, 0), v1 = x1(i, 1), u2 = x2(i, 0), v2 = x2(i, 1);
+    double* r = A[i];
+    r[0] = u2 * u1; r[1] = u2 * v1; r[2] = u2;
+    r[3] = v2 * u1; r[4] = v2 * v1; r[5] = v2;
+    r[6] = u1;      r[7] = v1;      r[8] = 1.0;
+    for (int c = 0; c < 9; ++c)
+      if (!std::isfinite(r[c])) return false;
+  }
   int col[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};  // column permutation
   double first_pivot = 0.0;
   for (int k = 0; k < 8; ++k) {
+    // Partial (row) pivoting on column k; only when that column has no
+    // usable pivot left, search the whole remaining block (column pivoting).
     int pr = k, pc = k;
     double best = -1.0;
-    for (int r = k; r < 8; ++r)
-      for (int c = k; c < 9; ++c) {
-        const double v = std::abs(A(r, c));
-        if (v > best) {
-          best = v;
-          pr = r;
-          pc = c;
-        }
+    for (int r = k; r < 8; ++r) {
+      const double v = std::abs(A[r][k]);
+      if (v > best) {
+        best = v;
+        pr = r;
       }
-    if (k == 0) first_pivot = best;
+    }
+    if (k == 0) {
+      // Scale reference for the degeneracy test: the largest entry of A.
+      for (int r = 0; r < 8; ++r)
+        for (int c = 0; c < 9; ++c) first_pivot = std::max(first_pivot, std::abs(A[r][c]));
+    }
+    if (!(best > kDegenerateRelPivot * first_pivot)) {
+      for (int r = k; r < 8; ++r)
+        for (int c = k; c < 9; ++c) {
+          const double v = std::abs(A[r][c]);
+          if (v > best) {
+            best = v;
+            pr = r;
+            pc = c;
+          }
+        }
+    }
     // Null space of dimension >= 2: degenerate sample (e.g. collinear points).
-    if (!(best > kDegenerateRelPivot * first_pivot) || !(first_pivot > 0.0)) return false;
-    if (pr != k) A.row(pr).swap(A.row(k));
+    if (!(first_pivot > 0.0) || !(best > kDegenerateRelPivot * first_pivot)) return false;
+    if (pr != k)
+      for (int c = 0; c < 9; ++c) std::swap(A[pr][c], A[k][c]);
     if (pc != k) {
-      A.col(pc).swap(A.col(k));
+      for (int r = 0; r < 8; ++r) std::swap(A[r][pc], A[r][k]);
       std::swap(col[pc], col[k]);
     }
-    const double inv = 1.0 / A(k, k);
+    const double inv = 1.0 / A[k][k];
     for (int r = k + 1; r < 8; ++r) {
-      const double f = A(r, k) * inv;
-      if (f == 0.0) continue;
-      for (int c = k + 1; c < 9; ++c) A(r, c) -= f * A(k, c);
-      A(r, k) = 0.0;
+      const double f = A[r][k] * inv;
+      for (int c = k + 1; c < 9; ++c) A[r][c] -= f * A[k][c];
+      A[r][k] = 0.0;
     }
   }
   // Back-substitution with the free (9th permuted) unknown set to 1.
   double y[9];
   y[8] = 1.0;
   for (int k = 7; k >= 0; --k) {
-    double s = A(k, 8);
-    for (int c = k + 1; c < 8; ++c) s += A(k, c) * y[c];
-    y[k] = -s / A(k, k);
+    double s = A[k][8];
+    for (int c = k + 1; c < 8; ++c) s += A[k][c] * y[c];
+    y[k] = -s / A[k][k];
   }
   double f[9];
   for (int c = 0; c < 9; ++c) f[col[c]] = y[c];

@@ -129,6 +129,9 @@ void PeMatcher::match(const PointMatch* matches, std::size_t n, PeMatchResult& o
   pbest_.resize(pop);
   pbest_fit_.resize(pop);
   pbest_F_.resize(pop);
+  last_pos_.resize(pop);
+  last_fit_.resize(pop);
+  last_F_.resize(pop);
 
   std::array<int, 8> idx{};
   Eigen::Matrix3d F;
@@ -156,6 +159,9 @@ void PeMatcher::match(const PointMatch* matches, std::size_t n, PeMatchResult& o
     pe_repair_position(pos_[i], &vel_[i], idx, N);  // sorts
     pbest_[i] = pos_[i];
     pbest_fit_[i] = evaluate(idx, pbest_F_[i]);
+    last_pos_[i] = pos_[i];
+    last_fit_[i] = pbest_fit_[i];
+    last_F_[i] = pbest_F_[i];
     ++out.evaluations;
     if (pbest_fit_[i] > gbest_fit) {
       gbest_fit = pbest_fit_[i];
@@ -187,9 +193,19 @@ void PeMatcher::match(const PointMatch* matches, std::size_t n, PeMatchResult& o
         x[c] += v[c];
       }
       pe_repair_position(x, &v, idx, N);
-      // Steps 3-4: fitness, Pbest and Gbest.
-      const int fit = evaluate(idx, F);
-      ++out.evaluations;
+      // Steps 3-4: fitness, Pbest and Gbest.  A particle that did not move
+      // keeps its fitness (the j-sample is fixed per call): no re-solve.
+      int fit;
+      if (x == last_pos_[i]) {
+        fit = last_fit_[i];
+        F = last_F_[i];
+      } else {
+        fit = evaluate(idx, F);
+        ++out.evaluations;
+        last_pos_[i] = x;
+        last_fit_[i] = fit;
+        last_F_[i] = F;
+      }
       if (fit > pbest_fit_[i]) {
         pbest_[i] = x;
         pbest_fit_[i] = fit;
@@ -235,6 +251,7 @@ void PeMatcher::match(const PointMatch* matches, std::size_t n, PeMatchResult& o
         }
         if (!changed) continue;
         pe_repair_position(trial, nullptr, idx, N);
+        if (trial == pbest_[i]) continue;  // same indices after repair: nothing to try
         const int fit = evaluate(idx, F);
         ++out.evaluations;
         if (!P.greedy_pbest || fit >= pbest_fit_[i]) {

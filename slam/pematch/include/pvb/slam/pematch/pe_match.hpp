@@ -128,6 +128,9 @@ class PeMatcher {
   std::vector<ParticlePos> pos_, vel_, pbest_;
   std::vector<int> pbest_fit_;
   std::vector<Eigen::Matrix3d> pbest_F_;
+  std::vector<ParticlePos> last_pos_;       ///< position last evaluated per particle
+  std::vector<int> last_fit_;               ///< its fitness
+  std::vector<Eigen::Matrix3d> last_F_;     ///< its F
 };
 
 }  // namespace pvb::slam
