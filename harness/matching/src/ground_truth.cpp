@@ -117,7 +117,7 @@ geom::SE3d tum_pose_at(const std::string& path, double t_s, double max_gap_s) {
         if (t - t_s > max_gap_s) break;
         return geom::make_se3(q, p);
       }
-      if (t - t_prev > max_gap_s) break;
+      if (std::min(t - t_s, t_s - t_prev) > max_gap_s) break;
       const double a = (t - t_prev) > 0 ? (t_s - t_prev) / (t - t_prev) : 0.0;
       return geom::make_se3(q_prev.slerp(a, q), (1 - a) * p_prev + a * p);
     }

@@ -49,8 +49,9 @@ geom::SE3d parse_tum_pose(const std::string& text, const std::string& what);
 
 /// Pose T_w_c at time t_s from a TUM groundtruth.txt, interpolated
 /// (translation linear, rotation slerp) between the bracketing stamps.
-/// Throws IoError when the file cannot be read or t_s is outside it by
-/// more than max_gap_s.
+/// Throws IoError when the file cannot be read or when the nearest sample
+/// is further than max_gap_s from t_s (outside the trajectory, the nearest
+/// end pose is used if it is within max_gap_s).
 geom::SE3d tum_pose_at(const std::string& groundtruth_path, double t_s, double max_gap_s = 0.05);
 
 /// RGB-D ground truth for a pair of frames.
