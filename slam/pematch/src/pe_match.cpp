@@ -37,7 +37,7 @@ double pe_difference_degree(const ParticlePos* const* a, const ParticlePos* cons
 void pe_repair_position(ParticlePos& pos, ParticlePos* vel, std::array<int, 8>& idx, int num_matches) {
   assert(num_matches >= kDim);
   for (int c = 0; c < kDim; ++c) {
-    const double r = std::round(pos[c]);
+    const double r = std::floor(pos[c] + 0.5);  // round half up
     // Guard against non-finite or huge values before the integer cast.
     const long long v = std::isfinite(r) ? static_cast<long long>(std::clamp(r, -1e15, 1e15)) : 0;
     int k = wrap_index(v, num_matches);
@@ -77,7 +77,7 @@ int PeMatcher::evaluate(const std::array<int, 8>& idx, Eigen::Matrix3d& F) {
   // Step 3(b)-(c): eq. 8 inliers among the j sampled coarse matches.
   int fit = 0;
   const double thr = params_.inlier_threshold_px;
-  for (int s : sample_) fit += within_epipolar_threshold(F, matches_[s].p1, matches_[s].p2, thr) ? 1 : 0;
+  for (const PointMatch& m : sample_pts_) fit += within_epipolar_threshold(F, m.p1, m.p2, thr) ? 1 : 0;
   return fit;
 }
 
@@ -96,7 +96,7 @@ void PeMatcher::match(const PointMatch* matches, std::size_t n, PeMatchResult& o
   matches_ = matches;
   num_matches_ = n;
   rng_.seed(P.seed);
-  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  auto uni = [](PeRng& g) { return g.uniform(); };
 
   // Hartley normalisation computed once over all coarse matches (our choice:
   // same conditioning as per-sample normalisation for the 8-point solve of
@@ -123,6 +123,8 @@ void PeMatcher::match(const PointMatch* matches, std::size_t n, PeMatchResult& o
     std::swap(shuffle_[k], shuffle_[std::min(r, N - 1)]);
     sample_[k] = shuffle_[k];
   }
+  sample_pts_.resize(j);
+  for (int k = 0; k < j; ++k) sample_pts_[k] = matches[sample_[k]];
 
   pos_.resize(pop);
   vel_.resize(pop);

@@ -64,6 +64,37 @@ struct PeMatchResult {
   int evaluations = 0;                    ///< fitness evaluations (F solves)
 };
 
+/// Small fast seeded generator (xoshiro256**, Blackman & Vigna 2018),
+/// seeded through splitmix64.  uniform() is in [0, 1).
+class PeRng {
+ public:
+  void seed(std::uint64_t s) {
+    for (auto& w : s_) {
+      s += 0x9e3779b97f4a7c15ULL;
+      std::uint64_t z = s;
+      z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+      z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+      w = z ^ (z >> 31);
+    }
+  }
+  std::uint64_t next() {
+    const std::uint64_t result = rotl(s_[1] * 5, 7) * 9;
+    const std::uint64_t t = s_[1] << 17;
+    s_[2] ^= s_[0];
+    s_[3] ^= s_[1];
+    s_[1] ^= s_[2];
+    s_[0] ^= s_[3];
+    s_[2] ^= t;
+    s_[3] = rotl(s_[3], 45);
+    return result;
+  }
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+
+ private:
+  static std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+  std::uint64_t s_[4] = {1, 2, 3, 4};
+};
+
 /// A particle: eight distinct indices into the coarse matches, stored as
 /// reals (eq. 9 moves them continuously) and kept sorted ascending.
 using ParticlePos = std::array<double, 8>;
@@ -118,12 +149,13 @@ class PeMatcher {
   int evaluate(const std::array<int, 8>& idx, Eigen::Matrix3d& F);
 
   PeMatchParams params_;
-  std::mt19937 rng_;
+  PeRng rng_;
   const PointMatch* matches_ = nullptr;
   std::size_t num_matches_ = 0;
   Normalization norm1_, norm2_;
   std::vector<Eigen::Vector2d> x1n_, x2n_;  ///< normalised coordinates of all matches
   std::vector<int> sample_;                 ///< the j matches scored by the fitness
+  std::vector<PointMatch> sample_pts_;      ///< their pixels, contiguous
   std::vector<int> shuffle_;                ///< scratch for drawing the sample
   std::vector<ParticlePos> pos_, vel_, pbest_;
   std::vector<int> pbest_fit_;
