@@ -3,6 +3,7 @@
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -35,7 +36,7 @@ void run(benchmark::State& state, pvb::slam::PeMatchParams params) {
   pvb::slam::PeMatcher pm(params);
   pvb::slam::PeMatchResult r;
   unsigned seed = 1;
-  double iters = 0, evals = 0, calls = 0;
+  double iters = 0, evals = 0, calls = 0, inliers = 0, min_inliers = 1e9;
   for (auto _ : state) {
     pm.params().seed = seed++;
     pm.match(m.data(), m.size(), r);
@@ -43,10 +44,13 @@ void run(benchmark::State& state, pvb::slam::PeMatchParams params) {
     iters += r.iterations;
     evals += r.evaluations;
     calls += 1;
+    inliers += r.num_inliers;
+    min_inliers = std::min<double>(min_inliers, r.num_inliers);
   }
   state.counters["iterations"] = iters / calls;
   state.counters["evaluations"] = evals / calls;
-  state.counters["inliers"] = r.num_inliers;
+  state.counters["inliers_mean"] = inliers / calls;
+  state.counters["inliers_min"] = min_inliers;
 }
 
 void BM_PeMatchPairs(benchmark::State& state) { run(state, pvb::slam::PeMatchParams::for_pairs()); }
