@@ -9,12 +9,14 @@
 namespace pvb::cli {
 Command add_record_command(CLI::App& app);
 Command add_eval_command(CLI::App& app);
+Command add_match_command(CLI::App& app);
 
 // Sub-commands register here (one line each).
 std::vector<Command> add_all_commands(CLI::App& app) {
   std::vector<Command> cmds;
   cmds.push_back(add_record_command(app));
   cmds.push_back(add_eval_command(app));
+  cmds.push_back(add_match_command(app));
   return cmds;
 }
 }  // namespace pvb::cli

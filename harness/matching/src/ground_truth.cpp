@@ -1,0 +1,231 @@
+#include "pvb/harness/matching/ground_truth.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+
+namespace pvb::harness {
+
+Eigen::Matrix3d load_homography(const std::string& path) {
+  const std::string text = read_file(path);
+  std::istringstream in(text);
+  Eigen::Matrix3d H;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      if (!(in >> H(r, c))) throw IoError(path, "expected a 3x3 homography (nine numbers)");
+  return H;
+}
+
+std::vector<MatchLabel> label_by_homography(const std::vector<slam::PointMatch>& m, const Eigen::Matrix3d& H,
+                                            double threshold_px) {
+  std::vector<MatchLabel> out(m.size(), MatchLabel::kWrong);
+  for (size_t i = 0; i < m.size(); ++i) {
+    const Eigen::Vector3d h = H * m[i].p1.homogeneous();
+    if (!(std::abs(h.z()) > 1e-12)) continue;
+    if ((h.hnormalized() - m[i].p2).norm() <= threshold_px) out[i] = MatchLabel::kCorrect;
+  }
+  return out;
+}
+
+CameraSettings load_camera_settings(const std::string& path) {
+  cv::FileStorage fs;
+  try {
+    fs.open(path, cv::FileStorage::READ);
+  } catch (const cv::Exception& e) {
+    throw IoError(path, std::string("cannot parse settings: ") + e.what());
+  }
+  if (!fs.isOpened()) throw IoError(path, "cannot open camera settings (ORB-SLAM2 yaml)");
+  auto req = [&](const char* key) {
+    const cv::FileNode n = fs[key];
+    if (n.empty() || (!n.isReal() && !n.isInt())) throw ConfigError(path, key, "a number");
+    return static_cast<double>(n);
+  };
+  auto opt = [&](const char* key, double def) {
+    const cv::FileNode n = fs[key];
+    if (n.empty()) return def;
+    if (!n.isReal() && !n.isInt()) throw ConfigError(path, key, "a number");
+    return static_cast<double>(n);
+  };
+  CameraSettings s;
+  s.K.fx = req("Camera.fx");
+  s.K.fy = req("Camera.fy");
+  s.K.cx = req("Camera.cx");
+  s.K.cy = req("Camera.cy");
+  s.K.width = static_cast<int>(opt("Camera.width", 640));
+  s.K.height = static_cast<int>(opt("Camera.height", 480));
+  const double k[5] = {opt("Camera.k1", 0), opt("Camera.k2", 0), opt("Camera.p1", 0), opt("Camera.p2", 0),
+                       opt("Camera.k3", 0)};
+  if (std::any_of(k, k + 5, [](double v) { return v != 0.0; })) s.dist_coeffs = cv::Mat(1, 5, CV_64F, (void*)k).clone();
+  s.depth_map_factor = opt("DepthMapFactor", 5000.0);
+  if (!(s.depth_map_factor > 0)) throw ConfigError(path, "DepthMapFactor", "a positive number");
+  return s;
+}
+
+cv::Mat load_depth_m(const std::string& path, double depth_map_factor) {
+  const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (raw.empty()) throw IoError(path, "cannot read depth image");
+  if (raw.channels() != 1 || (raw.depth() != CV_16U && raw.depth() != CV_32F))
+    throw IoError(path, "expected a single-channel 16-bit (or float) depth image");
+  cv::Mat d;
+  raw.convertTo(d, CV_32F, raw.depth() == CV_16U ? 1.0 / depth_map_factor : 1.0);
+  return d;
+}
+
+geom::SE3d parse_tum_pose(const std::string& text, const std::string& what) {
+  const std::vector<std::string> f = split_ws(text);
+  double v[7];
+  bool ok = f.size() == 7;
+  for (size_t i = 0; ok && i < 7; ++i) {
+    char* end = nullptr;
+    v[i] = std::strtod(f[i].c_str(), &end);
+    ok = end && *end == '\0' && std::isfinite(v[i]);
+  }
+  if (!ok) throw ConfigError("<command line>", what, "\"tx ty tz qx qy qz qw\" or FILE@TIMESTAMP", text);
+  const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+  if (q.norm() < 1e-6) throw ConfigError("<command line>", what, "a non-zero quaternion", text);
+  return geom::make_se3(q, Eigen::Vector3d(v[0], v[1], v[2]));
+}
+
+geom::SE3d tum_pose_at(const std::string& path, double t_s, double max_gap_s) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path, "cannot open ground truth");
+  std::string line;
+  int line_no = 0;
+  bool have_prev = false;
+  double t_prev = 0;
+  Eigen::Vector3d p_prev = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_prev = Eigen::Quaterniond::Identity();
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ls(line);
+    double t, tx, ty, tz, qx, qy, qz, qw;
+    if (!(ls >> t >> tx >> ty >> tz >> qx >> qy >> qz >> qw))
+      throw IoError(path, "expected 'timestamp tx ty tz qx qy qz qw'", line_no);
+    const Eigen::Vector3d p(tx, ty, tz);
+    const Eigen::Quaterniond q = Eigen::Quaterniond(qw, qx, qy, qz).normalized();
+    if (t >= t_s) {
+      if (!have_prev) {
+        if (t - t_s > max_gap_s) break;
+        return geom::make_se3(q, p);
+      }
+      if (std::min(t - t_s, t_s - t_prev) > max_gap_s) break;
+      const double a = (t - t_prev) > 0 ? (t_s - t_prev) / (t - t_prev) : 0.0;
+      return geom::make_se3(q_prev.slerp(a, q), (1 - a) * p_prev + a * p);
+    }
+    have_prev = true;
+    t_prev = t;
+    p_prev = p;
+    q_prev = q;
+  }
+  if (have_prev && t_s - t_prev <= max_gap_s) return geom::make_se3(q_prev, p_prev);
+  std::ostringstream msg;
+  msg.precision(17);
+  msg << "no ground-truth pose within " << max_gap_s << " s of t = " << t_s;
+  throw IoError(path, msg.str());
+}
+
+std::vector<slam::PointMatch> undistort_matches(const std::vector<slam::PointMatch>& raw,
+                                                const geom::PinholeIntrinsics& K, const cv::Mat& dist) {
+  if (dist.empty() || raw.empty()) return raw;
+  std::vector<cv::Point2d> a, b, ua, ub;
+  for (const auto& m : raw) {
+    a.emplace_back(m.p1.x(), m.p1.y());
+    b.emplace_back(m.p2.x(), m.p2.y());
+  }
+  cv::Mat Kcv = (cv::Mat_<double>(3, 3) << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
+  cv::undistortPoints(a, ua, Kcv, dist, cv::noArray(), Kcv);
+  cv::undistortPoints(b, ub, Kcv, dist, cv::noArray(), Kcv);
+  std::vector<slam::PointMatch> out(raw.size());
+  for (size_t i = 0; i < raw.size(); ++i) out[i] = {{ua[i].x, ua[i].y}, {ub[i].x, ub[i].y}};
+  return out;
+}
+
+namespace {
+/// Depth at the pixel nearest to p, 0 when outside or invalid.
+float depth_at(const cv::Mat& d, const Eigen::Vector2d& p) {
+  const int u = static_cast<int>(std::lround(p.x())), v = static_cast<int>(std::lround(p.y()));
+  if (u < 0 || v < 0 || u >= d.cols || v >= d.rows) return 0.0f;
+  const float z = d.at<float>(v, u);
+  return std::isfinite(z) && z > 0 ? z : 0.0f;
+}
+}  // namespace
+
+std::vector<MatchLabel> label_by_rgbd(const std::vector<slam::PointMatch>& raw,
+                                      const std::vector<slam::PointMatch>& undist, const RgbdGroundTruth& gt) {
+  std::vector<MatchLabel> out(raw.size(), MatchLabel::kUnknown);
+  for (size_t i = 0; i < raw.size(); ++i) {
+    const float z1 = depth_at(gt.depth1_m, raw[i].p1);
+    if (z1 <= 0) continue;
+    const Eigen::Vector3d P_c1 = gt.K.unproject(undist[i].p1.x(), undist[i].p1.y(), z1);
+    const Eigen::Vector3d P_c2 = gt.T_c2_c1 * P_c1;
+    out[i] = MatchLabel::kWrong;
+    const auto uv = gt.K.project(P_c2);
+    if (!uv || (*uv - undist[i].p2).norm() > gt.threshold_px) continue;
+    const float z2 = depth_at(gt.depth2_m, raw[i].p2);
+    if (z2 > 0 && std::abs(P_c2.z() - z2) > gt.depth_tol_rel * P_c2.z() + gt.depth_tol_abs_m) continue;
+    out[i] = MatchLabel::kCorrect;
+  }
+  return out;
+}
+
+namespace {
+struct Stamped {
+  double t;
+  std::string path;
+};
+std::vector<Stamped> read_list(const std::string& dir, const std::string& name) {
+  const std::string path = dir + "/" + name;
+  std::ifstream in(path);
+  if (!in) throw IoError(path, "cannot open (TUM layout expects rgb.txt and depth.txt)");
+  std::vector<Stamped> out;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ls(line);
+    Stamped s;
+    if (!(ls >> s.t >> s.path)) throw IoError(path, "expected 'timestamp filename'", line_no);
+    if (s.path.empty() || s.path[0] != '/') s.path = dir + "/" + s.path;
+    out.push_back(s);
+  }
+  if (out.empty()) throw IoError(path, "no entries");
+  return out;
+}
+}  // namespace
+
+std::vector<TumFrame> load_tum_frames(const std::string& dir, double max_dt_s) {
+  const auto rgb = read_list(dir, "rgb.txt");
+  const auto depth = read_list(dir, "depth.txt");
+  std::vector<TumFrame> out;
+  for (const auto& r : rgb) {
+    const Stamped* best = nullptr;
+    double best_dt = std::numeric_limits<double>::infinity();
+    for (const auto& d : depth) {
+      const double dt = std::abs(d.t - r.t);
+      if (dt < best_dt) {
+        best_dt = dt;
+        best = &d;
+      }
+    }
+    if (best_dt > max_dt_s) {
+      std::ostringstream msg;
+      msg.precision(17);
+      msg << "no depth image within " << max_dt_s << " s of rgb t = " << r.t;
+      throw IoError(dir + "/depth.txt", msg.str());
+    }
+    out.push_back({r.t, r.path, best->path, best_dt});
+  }
+  return out;
+}
+
+}  // namespace pvb::harness

@@ -1,0 +1,327 @@
+#include "pvb/slam/features/orb_extractor.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace pvb::slam {
+namespace {
+
+constexpr int kPatchSize = 31;       ///< rBRIEF / orientation patch diameter, px
+constexpr int kHalfPatchSize = 15;   ///< orientation patch radius, px
+constexpr int kEdgeThreshold = 19;   ///< pyramid border, px (ORB-SLAM2 EDGE_THRESHOLD)
+constexpr int kCellSizePx = 30;      ///< FAST grid cell size, px (ORB-SLAM2 W)
+constexpr int kFastBorderPx = 3;     ///< FAST circle radius, px
+
+const int kBitPattern31[256 * 4] = {
+#include "orb_pattern.inc"
+};
+
+/// A quadtree node over a rectangle of the detection area.
+struct QuadNode {
+  cv::Point2f ul, br;         ///< upper-left and bottom-right corners
+  std::vector<int> keys;      ///< indices into the level's corner list
+};
+
+/// Splits a node into its four quadrants; empty children are dropped.
+void split_node(const QuadNode& n, const std::vector<cv::KeyPoint>& kps, std::vector<QuadNode>& out) {
+  const float hx = 0.5f * (n.ul.x + n.br.x);
+  const float hy = 0.5f * (n.ul.y + n.br.y);
+  QuadNode c[4];
+  c[0].ul = n.ul;               c[0].br = {hx, hy};
+  c[1].ul = {hx, n.ul.y};       c[1].br = {n.br.x, hy};
+  c[2].ul = {n.ul.x, hy};       c[2].br = {hx, n.br.y};
+  c[3].ul = {hx, hy};           c[3].br = n.br;
+  for (int k : n.keys) {
+    const cv::Point2f& p = kps[k].pt;
+    const int q = (p.x < hx ? 0 : 1) + (p.y < hy ? 0 : 2);
+    c[q].keys.push_back(k);
+  }
+  for (auto& ch : c)
+    if (!ch.keys.empty()) out.push_back(std::move(ch));
+}
+
+/// ORB-SLAM2's DistributeOctTree: splits the detection area in a quadtree
+/// until there are at least `num_wanted` non-empty nodes (or nothing can be
+/// split any more) and keeps the strongest corner of every node.
+std::vector<cv::KeyPoint> distribute_quadtree(const std::vector<cv::KeyPoint>& kps, float min_x,
+                                              float max_x, float min_y, float max_y,
+                                              int num_wanted) {
+  if (kps.empty() || num_wanted <= 0) return {};
+  const float width = max_x - min_x;
+  const float height = max_y - min_y;
+  const int num_ini = std::max(1, static_cast<int>(std::lround(width / height)));
+  const float hx = width / num_ini;
+
+  std::vector<QuadNode> nodes(num_ini);
+  for (int i = 0; i < num_ini; ++i) {
+    nodes[i].ul = {min_x + hx * i, min_y};
+    nodes[i].br = {min_x + hx * (i + 1), max_y};
+  }
+  for (int k = 0; k < static_cast<int>(kps.size()); ++k) {
+    const int i = std::clamp(static_cast<int>((kps[k].pt.x - min_x) / hx), 0, num_ini - 1);
+    nodes[i].keys.push_back(k);
+  }
+  nodes.erase(std::remove_if(nodes.begin(), nodes.end(), [](const QuadNode& n) { return n.keys.empty(); }),
+              nodes.end());
+
+  auto splittable = [](const QuadNode& n) {
+    // A node with one corner, or one too small to split further, stays.
+    return n.keys.size() > 1 && (n.br.x - n.ul.x) > 1.0f && (n.br.y - n.ul.y) > 1.0f;
+  };
+
+  bool finished = false;
+  std::vector<QuadNode> next;
+  while (!finished) {
+    const size_t prev_size = nodes.size();
+    next.clear();
+    int to_expand = 0;
+    for (const QuadNode& n : nodes) {
+      if (!splittable(n)) {
+        next.push_back(n);
+        continue;
+      }
+      const size_t before = next.size();
+      split_node(n, kps, next);
+      for (size_t c = before; c < next.size(); ++c)
+        if (splittable(next[c])) ++to_expand;
+    }
+    nodes.swap(next);
+    if (static_cast<int>(nodes.size()) >= num_wanted || nodes.size() == prev_size) {
+      finished = true;
+    } else if (static_cast<int>(nodes.size()) + 3 * to_expand > num_wanted) {
+      // Near the target: split the most populated nodes first, one at a time.
+      while (!finished) {
+        const size_t size_before = nodes.size();
+        std::vector<size_t> order;
+        for (size_t i = 0; i < nodes.size(); ++i)
+          if (splittable(nodes[i])) order.push_back(i);
+        std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+          return nodes[a].keys.size() > nodes[b].keys.size();
+        });
+        std::vector<bool> removed(nodes.size(), false);
+        std::vector<QuadNode> added;
+        int count = static_cast<int>(nodes.size());
+        for (size_t i : order) {
+          const size_t before = added.size();
+          split_node(nodes[i], kps, added);
+          removed[i] = true;
+          count += static_cast<int>(added.size() - before) - 1;
+          if (count >= num_wanted) break;
+        }
+        next.clear();
+        for (size_t i = 0; i < nodes.size(); ++i)
+          if (!removed[i]) next.push_back(std::move(nodes[i]));
+        for (auto& a : added) next.push_back(std::move(a));
+        nodes.swap(next);
+        if (static_cast<int>(nodes.size()) >= num_wanted || nodes.size() == size_before) finished = true;
+      }
+    }
+  }
+
+  std::vector<cv::KeyPoint> out;
+  out.reserve(nodes.size());
+  for (const QuadNode& n : nodes) {
+    int best = n.keys.front();
+    for (int k : n.keys)
+      if (kps[k].response > kps[best].response) best = k;
+    out.push_back(kps[best]);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<int> circular_patch_umax(int half_patch) {
+  std::vector<int> umax(half_patch + 1);
+  const int vmax = static_cast<int>(std::floor(half_patch * std::sqrt(2.0) / 2 + 1));
+  const int vmin = static_cast<int>(std::ceil(half_patch * std::sqrt(2.0) / 2));
+  const double hp2 = static_cast<double>(half_patch) * half_patch;
+  for (int v = 0; v <= std::min(vmax, half_patch); ++v) umax[v] = static_cast<int>(std::lround(std::sqrt(hp2 - v * v)));
+  // Make the circle symmetric about the diagonal.
+  for (int v = half_patch, v0 = 0; v >= vmin; --v) {
+    while (umax[v0] == umax[v0 + 1]) ++v0;
+    umax[v] = v0;
+    ++v0;
+  }
+  return umax;
+}
+
+float ic_angle_deg(const cv::Mat& image, cv::Point2f pt, const std::vector<int>& umax) {
+  const int half = static_cast<int>(umax.size()) - 1;
+  const uchar* center = &image.at<uchar>(cvRound(pt.y), cvRound(pt.x));
+  const int step = static_cast<int>(image.step1());
+  int m01 = 0, m10 = 0;
+  for (int u = -half; u <= half; ++u) m10 += u * center[u];
+  for (int v = 1; v <= half; ++v) {
+    int v_sum = 0;
+    const int d = umax[v];
+    for (int u = -d; u <= d; ++u) {
+      const int plus = center[u + v * step], minus = center[u - v * step];
+      v_sum += plus - minus;
+      m10 += u * (plus + minus);
+    }
+    m01 += v * v_sum;
+  }
+  return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
+}
+
+void compute_rbrief(const cv::Mat& image, const cv::KeyPoint& kp, unsigned char* desc32) {
+  assert(image.type() == CV_8UC1);
+  const float angle_rad = kp.angle * static_cast<float>(CV_PI / 180.0);
+  const float a = std::cos(angle_rad), b = std::sin(angle_rad);
+  const uchar* center = &image.at<uchar>(cvRound(kp.pt.y), cvRound(kp.pt.x));
+  const int step = static_cast<int>(image.step);
+  // Value at pattern point (x, y) rotated by the keypoint angle.
+  auto value = [&](int px, int py) {
+    const int ix = cvRound(px * a - py * b);
+    const int iy = cvRound(px * b + py * a);
+    return center[iy * step + ix];
+  };
+  const int* p = kBitPattern31;
+  for (int byte = 0; byte < 32; ++byte) {
+    int val = 0;
+    for (int bit = 0; bit < 8; ++bit, p += 4) val |= (value(p[0], p[1]) < value(p[2], p[3])) << bit;
+    desc32[byte] = static_cast<unsigned char>(val);
+  }
+}
+
+OrbExtractor::OrbExtractor(const OrbParams& params) : params_(params) {
+  const int n = params_.num_levels;
+  scales_.resize(n);
+  scales_[0] = 1.0;
+  for (int l = 1; l < n; ++l) scales_[l] = scales_[l - 1] * params_.scale_factor;
+
+  // Geometric split of the features over the levels (ORB-SLAM2).
+  features_per_level_.resize(n);
+  const double factor = 1.0 / params_.scale_factor;
+  double per_scale = params_.num_features * (1 - factor) / (1 - std::pow(factor, n));
+  int sum = 0;
+  for (int l = 0; l < n - 1; ++l) {
+    features_per_level_[l] = static_cast<int>(std::lround(per_scale));
+    sum += features_per_level_[l];
+    per_scale *= factor;
+  }
+  features_per_level_[n - 1] = std::max(params_.num_features - sum, 0);
+  umax_ = circular_patch_umax(kHalfPatchSize);
+  pyramid_.resize(n);
+  padded_.resize(n);
+}
+
+void OrbExtractor::build_pyramid(const cv::Mat& grey) {
+  for (int l = 0; l < params_.num_levels; ++l) {
+    const double s = 1.0 / scales_[l];
+    const cv::Size sz(static_cast<int>(std::lround(grey.cols * s)), static_cast<int>(std::lround(grey.rows * s)));
+    cv::Mat level;
+    if (l == 0)
+      level = grey;
+    else
+      cv::resize(pyramid_[l - 1], level, sz, 0, 0, cv::INTER_LINEAR);
+    cv::copyMakeBorder(level, padded_[l], kEdgeThreshold, kEdgeThreshold, kEdgeThreshold, kEdgeThreshold,
+                       cv::BORDER_REFLECT_101);
+    pyramid_[l] = padded_[l](cv::Rect(kEdgeThreshold, kEdgeThreshold, sz.width, sz.height));
+  }
+}
+
+std::vector<cv::KeyPoint> OrbExtractor::detect_level(int level, int num_wanted) const {
+  const cv::Mat& img = pyramid_[level];
+  const int min_x = kEdgeThreshold - kFastBorderPx, min_y = min_x;
+  const int max_x = img.cols - kEdgeThreshold + kFastBorderPx;
+  const int max_y = img.rows - kEdgeThreshold + kFastBorderPx;
+  const int width = max_x - min_x, height = max_y - min_y;
+  if (width <= 2 * kFastBorderPx || height <= 2 * kFastBorderPx) return {};
+  const int num_cols = std::max(1, width / kCellSizePx);
+  const int num_rows = std::max(1, height / kCellSizePx);
+  const int w_cell = (width + num_cols - 1) / num_cols;
+  const int h_cell = (height + num_rows - 1) / num_rows;
+
+  std::vector<cv::KeyPoint> all, cell;
+  all.reserve(static_cast<size_t>(num_wanted) * 10);
+  for (int i = 0; i < num_rows; ++i) {
+    const int y0 = min_y + i * h_cell;
+    int y1 = y0 + h_cell + 2 * kFastBorderPx;
+    if (y0 >= max_y - kFastBorderPx) continue;
+    y1 = std::min(y1, max_y);
+    for (int j = 0; j < num_cols; ++j) {
+      const int x0 = min_x + j * w_cell;
+      int x1 = x0 + w_cell + 2 * kFastBorderPx;
+      if (x0 >= max_x - kFastBorderPx) continue;
+      x1 = std::min(x1, max_x);
+      const cv::Mat roi = img(cv::Range(y0, y1), cv::Range(x0, x1));
+      cell.clear();
+      cv::FAST(roi, cell, params_.ini_fast_threshold, true);
+      if (cell.empty()) cv::FAST(roi, cell, params_.min_fast_threshold, true);
+      for (auto& kp : cell) {
+        kp.pt.x += static_cast<float>(x0);
+        kp.pt.y += static_cast<float>(y0);
+        all.push_back(kp);
+      }
+    }
+  }
+  std::vector<cv::KeyPoint> kept = distribute_quadtree(all, static_cast<float>(min_x), static_cast<float>(max_x),
+                                                       static_cast<float>(min_y), static_cast<float>(max_y), num_wanted);
+  const float size = static_cast<float>(kPatchSize * scales_[level]);
+  for (auto& kp : kept) {
+    kp.octave = level;
+    kp.size = size;
+    kp.angle = ic_angle_deg(img, kp.pt, umax_);
+  }
+  return kept;
+}
+
+OrbFeatures OrbExtractor::extract(const cv::Mat& image) {
+  cv::Mat grey;
+  if (image.channels() == 3)
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  else if (image.channels() == 4)
+    cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
+  else
+    grey = image;
+  assert(grey.type() == CV_8UC1);
+  build_pyramid(grey);
+
+  OrbFeatures out;
+  std::vector<std::vector<cv::KeyPoint>> per_level(params_.num_levels);
+  int total = 0;
+  for (int l = 0; l < params_.num_levels; ++l) {
+    per_level[l] = detect_level(l, features_per_level_[l]);
+    total += static_cast<int>(per_level[l].size());
+  }
+  // The quadtree may return a few more nodes than asked; ORB-SLAM2 keeps them
+  // all, we cap at num_features by dropping the weakest of the excess.
+  out.keypoints.reserve(total);
+  out.descriptors.create(total, 32, CV_8U);
+  int row = 0;
+  cv::Mat blurred;
+  for (int l = 0; l < params_.num_levels; ++l) {
+    if (per_level[l].empty()) continue;
+    cv::GaussianBlur(padded_[l], blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+    const cv::Mat view = blurred(cv::Rect(kEdgeThreshold, kEdgeThreshold, pyramid_[l].cols, pyramid_[l].rows));
+    const float s = static_cast<float>(scales_[l]);
+    for (cv::KeyPoint kp : per_level[l]) {
+      compute_rbrief(view, kp, out.descriptors.ptr<uchar>(row++));
+      kp.pt *= s;
+      out.keypoints.push_back(kp);
+    }
+  }
+  if (total > params_.num_features) {
+    std::vector<int> order(total);
+    for (int i = 0; i < total; ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return out.keypoints[a].response > out.keypoints[b].response; });
+    order.resize(params_.num_features);
+    std::sort(order.begin(), order.end());
+    OrbFeatures capped;
+    capped.descriptors.create(params_.num_features, 32, CV_8U);
+    for (int i = 0; i < params_.num_features; ++i) {
+      capped.keypoints.push_back(out.keypoints[order[i]]);
+      out.descriptors.row(order[i]).copyTo(capped.descriptors.row(i));
+    }
+    return capped;
+  }
+  return out;
+}
+
+}  // namespace pvb::slam

@@ -1,0 +1,124 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "pvb/slam/features/coarse_match.hpp"
+#include "pvb/slam/features/orb_extractor.hpp"
+
+namespace pvb::slam {
+namespace {
+
+const std::string kOxford = std::string(PVB_SHARED_DIR) + "/data/oxford/";
+
+cv::Mat load_grey(const std::string& path) {
+  cv::Mat img = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  EXPECT_FALSE(img.empty()) << path;
+  return img;
+}
+
+cv::Matx33d load_h(const std::string& path) {
+  std::ifstream f(path);
+  cv::Matx33d H;
+  for (int i = 0; i < 9; ++i) f >> H.val[i];
+  EXPECT_TRUE(f.good() || f.eof()) << path;
+  return H;
+}
+
+TEST(OrbExtractor, AtMostThousandWellDistributedFeatures) {
+  const cv::Mat img = load_grey(kOxford + "wall/img1.ppm");
+  OrbExtractor ex;
+  const OrbFeatures f = ex.extract(img);
+  EXPECT_LE(f.keypoints.size(), 1000u);
+  EXPECT_GE(f.keypoints.size(), 900u);  // the wall is textured everywhere
+  EXPECT_EQ(f.descriptors.rows, static_cast<int>(f.keypoints.size()));
+  EXPECT_EQ(f.descriptors.cols, 32);
+  EXPECT_EQ(f.descriptors.type(), CV_8U);
+  // Every level is used and every cell of a 4x4 grid holds features.
+  std::vector<int> per_level(8, 0), per_cell(16, 0);
+  for (const auto& kp : f.keypoints) {
+    ASSERT_GE(kp.octave, 0);
+    ASSERT_LT(kp.octave, 8);
+    ++per_level[kp.octave];
+    ASSERT_GE(kp.pt.x, 0);
+    ASSERT_GE(kp.pt.y, 0);
+    ASSERT_LT(kp.pt.x, img.cols);
+    ASSERT_LT(kp.pt.y, img.rows);
+    const int cx = std::min(3, static_cast<int>(4 * kp.pt.x / img.cols));
+    const int cy = std::min(3, static_cast<int>(4 * kp.pt.y / img.rows));
+    ++per_cell[cy * 4 + cx];
+    EXPECT_NEAR(kp.size, 31.0 * ex.level_scale(kp.octave), 1e-3);
+  }
+  for (int l = 0; l < 8; ++l) EXPECT_GT(per_level[l], 0) << "level " << l;
+  // More features on fine levels (geometric split, factor 1/1.2).
+  EXPECT_GT(per_level[0], per_level[7]);
+  for (int c = 0; c < 16; ++c) EXPECT_GE(per_cell[c], 20) << "cell " << c;
+}
+
+TEST(OrbExtractor, OrientationAndDescriptorMatchOpenCvOrb) {
+  // cv::ORB uses the same learned pattern and intensity centroid; on level 0
+  // with its own keypoints our functions must reproduce its output.
+  const cv::Mat img = load_grey(kOxford + "trees/img1.ppm");
+  auto orb = cv::ORB::create(500, 1.2f, 1, 31, 0, 2, cv::ORB::FAST_SCORE, 31, 20);
+  std::vector<cv::KeyPoint> kps;
+  cv::Mat desc_cv;
+  orb->detectAndCompute(img, cv::noArray(), kps, desc_cv);
+  ASSERT_GT(kps.size(), 100u);
+  cv::Mat padded, blurred;
+  cv::copyMakeBorder(img, padded, 40, 40, 40, 40, cv::BORDER_REFLECT_101);
+  cv::GaussianBlur(padded, blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+  const cv::Mat view = blurred(cv::Rect(40, 40, img.cols, img.rows));
+  const cv::Mat raw = padded(cv::Rect(40, 40, img.cols, img.rows));
+  const std::vector<int> umax = circular_patch_umax(15);
+  long equal_bits = 0, total_bits = 0;
+  int angle_ok = 0;
+  for (size_t i = 0; i < kps.size(); ++i) {
+    const float a = ic_angle_deg(raw, kps[i].pt, umax);
+    angle_ok += std::abs(a - kps[i].angle) < 1e-3f;
+    unsigned char d[32];
+    compute_rbrief(view, kps[i], d);
+    for (int b = 0; b < 32; ++b) {
+      equal_bits += 8 - __builtin_popcount(d[b] ^ desc_cv.at<uchar>(static_cast<int>(i), b));
+      total_bits += 8;
+    }
+  }
+  std::vector<int> per_bit(256, 0);
+  for (size_t i = 0; i < kps.size(); ++i) {
+    unsigned char d[32];
+    compute_rbrief(view, kps[i], d);
+    for (int b = 0; b < 256; ++b) per_bit[b] += ((d[b / 8] ^ desc_cv.at<uchar>(static_cast<int>(i), b / 8)) >> (b % 8)) & 1;
+  }
+  // A wrong pattern row would flip its bit on a large share of keypoints;
+  // the rare scattered flips come from smoothing/rounding ties at patch
+  // pixels (cv::ORB blurs its bordered pyramid buffer, we blur ours).
+  for (int b = 0; b < 256; ++b) EXPECT_LE(per_bit[b], 0.02 * kps.size()) << "bit " << b;
+  EXPECT_EQ(angle_ok, static_cast<int>(kps.size()));
+  EXPECT_GE(static_cast<double>(equal_bits) / total_bits, 0.995);
+}
+
+TEST(CoarseMatch, WallPairOneTwoMostlyCorrect) {
+  const cv::Mat a = load_grey(kOxford + "wall/img1.ppm");
+  const cv::Mat b = load_grey(kOxford + "wall/img2.ppm");
+  const cv::Matx33d H = load_h(kOxford + "wall/H1to2p");
+  OrbExtractor ex;
+  const OrbFeatures fa = ex.extract(a);
+  const OrbFeatures fb = ex.extract(b);
+  const auto m = match_hamming_ratio(fa, fb, 0.9);
+  ASSERT_GT(m.size(), 200u);
+  int correct = 0;
+  std::vector<bool> used(fb.keypoints.size(), false);
+  for (const auto& mm : m) {
+    ASSERT_FALSE(used[mm.i2]) << "feature of image 2 matched twice";
+    used[mm.i2] = true;
+    const cv::Point2f p = fa.keypoints[mm.i1].pt, q = fb.keypoints[mm.i2].pt;
+    const cv::Vec3d h = H * cv::Vec3d(p.x, p.y, 1.0);
+    const double dx = h[0] / h[2] - q.x, dy = h[1] / h[2] - q.y;
+    correct += dx * dx + dy * dy <= 9.0;
+  }
+  EXPECT_GE(static_cast<double>(correct) / m.size(), 0.5);
+}
+
+}  // namespace
+}  // namespace pvb::slam
