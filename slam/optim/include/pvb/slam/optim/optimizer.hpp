@@ -1,0 +1,99 @@
+#pragma once
+// Pose-only optimisation and local bundle adjustment for RGB-D SLAM (the
+// parts of ORB-SLAM2's g2o Optimizer that tracking and local mapping use),
+// written on Ceres.  Inputs in, result out: no map types here, so the
+// optimiser is tested on synthetic problems and the SLAM core converts its
+// map into these structs.
+//
+// Conventions: T_c_w maps world points into the camera (optical) frame.
+// An observation with u_right >= 0 is "stereo" (RGB-D: u_right = u - bf / z),
+// with a 3-D residual (u, v, u_right); else monocular (u, v).
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "pvb/geometry/se3.hpp"
+
+namespace pvb::slam {
+
+/// Pinhole intrinsics plus the RGB-D virtual baseline (bf = baseline x fx).
+struct StereoIntrinsics {
+  double fx = 525, fy = 525, cx = 319.5, cy = 239.5;
+  double bf = 40.0;
+};
+
+/// One keypoint measurement of a 3-D point.
+struct Observation {
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();  ///< pixel (undistorted)
+  double u_right = -1.0;                         ///< < 0: monocular
+  double inv_sigma2 = 1.0;                       ///< 1 / sigma^2 of its pyramid level (ORB-SLAM2: 1 / 1.2^(2 level))
+};
+
+struct PoseOptimizerOptions {
+  int rounds = 4;                  ///< ORB-SLAM2: 4 rounds of 10 iterations, re-classifying outliers
+  int iterations_per_round = 10;
+  double chi2_mono = 5.991;        ///< chi-square 95 %, 2 DoF
+  double chi2_stereo = 7.815;      ///< chi-square 95 %, 3 DoF
+  bool robust = true;              ///< Huber loss (delta = sqrt(chi2)) in the first rounds
+};
+
+struct PoseOptimizerResult {
+  geom::SE3d T_c_w;                 ///< optimised pose
+  std::vector<std::uint8_t> inlier; ///< per observation, after the last round
+  int num_inliers = 0;
+  double final_cost = 0;
+};
+
+/// Optimises one camera pose against fixed 3-D points (ORB-SLAM2's
+/// Optimizer::PoseOptimization).  points_w[i] is observed by obs[i].
+/// Outliers (chi2 above the threshold) are excluded from the next round and
+/// reported in `inlier`.  Deterministic (single-threaded Ceres).
+PoseOptimizerResult optimize_pose(const geom::SE3d& T_c_w_init, const std::vector<Eigen::Vector3d>& points_w,
+                                  const std::vector<Observation>& obs, const StereoIntrinsics& K,
+                                  const PoseOptimizerOptions& options = {});
+
+/// A local bundle-adjustment problem (ORB-SLAM2's Optimizer::LocalBundleAdjustment).
+struct BaKeyframe {
+  std::uint64_t id = 0;
+  geom::SE3d T_c_w;
+  bool fixed = false;  ///< fixed keyframes observe local points but do not move
+};
+struct BaPoint {
+  std::uint64_t id = 0;
+  Eigen::Vector3d p_w = Eigen::Vector3d::Zero();
+};
+struct BaEdge {
+  std::size_t keyframe = 0;  ///< index into BaProblem::keyframes
+  std::size_t point = 0;     ///< index into BaProblem::points
+  Observation obs;
+};
+struct BaProblem {
+  std::vector<BaKeyframe> keyframes;
+  std::vector<BaPoint> points;
+  std::vector<BaEdge> edges;
+};
+
+struct BaOptions {
+  int iterations_first = 5;   ///< with Huber loss
+  int iterations_second = 10; ///< without the outliers of the first pass
+  double chi2_mono = 5.991;
+  double chi2_stereo = 7.815;
+  const bool* abort_flag = nullptr;  ///< optional: stop early when it becomes true
+};
+
+struct BaResult {
+  std::vector<std::size_t> outlier_edges;  ///< edges to erase from the map (chi2 too big or point behind camera)
+  int iterations = 0;
+  bool converged = false;
+};
+
+/// Optimises the non-fixed keyframe poses and all points in place.
+BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, const BaOptions& options = {});
+
+/// Reprojection residual helpers (also used by tests and by map-point culling).
+Eigen::Vector2d project(const StereoIntrinsics& K, const Eigen::Vector3d& p_c);
+/// chi2 of one observation of p_w seen from T_c_w (weighted by inv_sigma2).
+double observation_chi2(const StereoIntrinsics& K, const geom::SE3d& T_c_w, const Eigen::Vector3d& p_w,
+                        const Observation& obs);
+
+}  // namespace pvb::slam
