@@ -1,6 +1,7 @@
 // pvbench record: render a scenario into a TUM RGB-D sequence folder.
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -11,6 +12,8 @@
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
+#include "pvb/geometry/time.hpp"
+#include "pvb/plot/contact_sheet.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/simulator.hpp"
 
@@ -58,6 +61,8 @@ int run_record(const RecordOptions& opt) {
 
   const int n = scenes::frame_count(scenario, opt.frames);
   double physics_ms = 0, render_ms = 0, write_ms = 0;
+  const std::vector<int> sheet_frames = plot::spread_indices(n, 12);
+  std::vector<plot::Thumbnail> thumbs;
   const auto t_loop = Clock::now();
   {
     ProgressBar bar("record " + scenario.name, static_cast<std::size_t>(n));
@@ -73,6 +78,11 @@ int run_record(const RecordOptions& opt) {
       t0 = Clock::now();
       writer.write(cap.frame, cap.T_w_c);
       write_ms += ms_since(t0);
+      if (std::find(sheet_frames.begin(), sheet_frames.end(), i) != sheet_frames.end()) {
+        char label[64];
+        std::snprintf(label, sizeof label, "frame %d  t=%.2f s", i, geom::ns_to_seconds(cap.frame.t_ns));
+        thumbs.push_back({cap.frame.rgb.clone(), label});
+      }
       bar.update(static_cast<std::size_t>(i + 1));
     }
   }
@@ -100,6 +110,7 @@ int run_record(const RecordOptions& opt) {
                 sim.kinematics().track_m, total_s, setup_ms, gl_ms, physics_ms / n, render_ms / n, write_ms / n,
                 n / loop_s);
   write_file(opt.out + "/meta.json", meta);
+  plot::write_rgb_png(plot::make_contact_sheet(thumbs, 4, 320), opt.out + "/contact_sheet.png");
   std::printf("recorded %d frames of %s to %s (%s; %.1f frames/s, render %.1f ms/frame)\n", n, scenario.name.c_str(),
               opt.out.c_str(), camera.description().c_str(), n / loop_s, render_ms / n);
   return 0;
