@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <opencv2/core/utility.hpp>
 
 namespace pvb::sim {
 namespace {
@@ -59,11 +60,14 @@ cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, c
   }
   const scenes::DepthNoise& p = cam.depth_noise;
   const auto& nt = normal_table();
-  SplitMix rng(seed, frame * 2 + 1);
   const double bf = p.baseline_m * K.fx;
   const double cos_max = std::cos(p.max_incidence_deg * M_PI / 180.0);
   auto gt_at = [&](int r, int c) { return gt.ptr<float>(std::clamp(r, 0, H - 1))[std::clamp(c, 0, W - 1)]; };
-  for (int r = 0; r < H; ++r) {
+  // Rows run in parallel; each row has its own generator seeded by (seed,
+  // frame, row), so the result does not depend on the number of threads.
+  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
+  for (int r = rows.start; r < rows.end; ++r) {
+    SplitMix rng(seed, (frame << 21) + 2 * static_cast<std::uint64_t>(r) + 1);
     float* o = out.ptr<float>(r);
     for (int c = 0; c < W; ++c) {
       const std::uint64_t bits = rng.next();
@@ -92,6 +96,7 @@ cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, c
       if (zn >= zmin && zn <= zmax) o[c] = static_cast<float>(zn);
     }
   }
+  });
   return out;
 }
 
@@ -101,9 +106,10 @@ void apply_rgb_model(cv::Mat* rgb, const scenes::RgbNoise& params, const std::op
   const bool glare = params.glare > 0 && sun_px.has_value();
   if (params.sigma <= 0 && params.exposure == 1.0 && !glare) return;
   const auto& nt = normal_table();
-  SplitMix rng(seed, frame * 2);
   const double sigma_px = 0.35 * rgb->cols;
-  for (int r = 0; r < rgb->rows; ++r) {
+  cv::parallel_for_(cv::Range(0, rgb->rows), [&](const cv::Range& rows) {
+  for (int r = rows.start; r < rows.end; ++r) {
+    SplitMix rng(seed, (frame << 21) + 2 * static_cast<std::uint64_t>(r));
     auto* px = rgb->ptr<cv::Vec3b>(r);
     for (int c = 0; c < rgb->cols; ++c) {
       double add = 0;
@@ -118,6 +124,7 @@ void apply_rgb_model(cv::Mat* rgb, const scenes::RgbNoise& params, const std::op
       }
     }
   }
+  });
 }
 
 }  // namespace pvb::sim
