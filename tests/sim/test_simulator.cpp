@@ -143,3 +143,25 @@ TEST(Simulator, PhysicsIsDeterministic) {
   EXPECT_EQ(a.base_pose().yaw, b.base_pose().yaw);
   EXPECT_TRUE(a.T_w_c().matrix() == b.T_w_c().matrix());
 }
+
+TEST(Simulator, ShippedScenariosAreDrivenToTheEndOfTheirRoutes) {
+  // Physics only: every shipped route is followed closely and finished
+  // within the scenario's duration (turns and U-turns included).
+  for (const char* name : {"pv_station", "along_row", "lawnmower", "loop"}) {
+    sim::Simulator sim(scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + name + ".yaml"));
+    double worst = 0;
+    int finished_at = -1;
+    for (int i = 1; i < sim.frame_count(); ++i) {
+      sim.advance();
+      worst = std::max(worst, sim.follower().cross_track_error_m(sim.base_pose()));
+      if (finished_at < 0 && sim.follower().finished()) finished_at = i;
+    }
+    std::printf("%s: route finished at frame %d of %d, worst cross-track error %.3f m\n", name, finished_at,
+                sim.frame_count(), worst);
+    EXPECT_TRUE(sim.follower().finished()) << name << ": route not finished in time";
+    EXPECT_LT(worst, 0.3) << name;
+    const sim::Pose2d end = sim.base_pose();
+    const Eigen::Vector2d goal = sim.follower().path().back();
+    EXPECT_LT((Eigen::Vector2d(end.x, end.y) - goal).norm(), 0.2) << name;
+  }
+}
