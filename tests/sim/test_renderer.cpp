@@ -85,6 +85,7 @@ void check_plane_depth(sim::GlBackend backend) {
         worst = std::max(worst, std::abs(z - d));
       }
     EXPECT_LT(worst, 1e-4) << "plane at " << d << " m";
+    std::printf("%s: plane at %.1f m, worst depth error %.2e m\n", sim::to_string(backend), d, worst);
   }
 }
 
@@ -112,6 +113,8 @@ void check_projection(sim::GlBackend backend) {
         }
       }
     ASSERT_GT(n, 20) << name;
+    std::printf("%s: %s projects %.3f px, %.3f px from the pinhole model\n", sim::to_string(backend), name,
+                su / n - uv->x(), sv / n - uv->y());
     EXPECT_NEAR(su / n, uv->x(), 0.2) << name;
     EXPECT_NEAR(sv / n, uv->y(), 0.2) << name;
   }
