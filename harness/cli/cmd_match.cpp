@@ -4,6 +4,8 @@
 #include <string>
 
 #include "command.hpp"
+#include "pvb/dataset/tum_sequence.hpp"
+#include "pvb/geometry/time.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/harness/matching/experiment.hpp"
@@ -67,7 +69,8 @@ int run_match(const MatchOptions& o) {
     CameraSettings cam;
     std::string d1, d2;
     if (by_seq) {
-      const auto frames = load_tum_frames(o.sequence);
+      const dataset::TumSequenceReader seq(o.sequence, 5000.0, 0.05);
+      const auto& frames = seq.entries();
       const std::vector<std::string> ij = split_ws(o.frames, ",");
       int i = -1, j = -1;
       if (ij.size() == 2) {
@@ -79,14 +82,15 @@ int run_match(const MatchOptions& o) {
                           o.frames);
       const std::string yaml = o.settings.empty() ? o.sequence + "/camera.yaml" : o.settings;
       cam = load_camera_settings(yaml);
-      img1 = read_image(frames[i].rgb_path);
-      img2 = read_image(frames[j].rgb_path);
-      d1 = frames[i].depth_path;
-      d2 = frames[j].depth_path;
+      img1 = read_image(o.sequence + "/" + frames[i].rgb);
+      img2 = read_image(o.sequence + "/" + frames[j].rgb);
+      d1 = o.sequence + "/" + frames[i].depth;
+      d2 = o.sequence + "/" + frames[j].depth;
       const std::string gtf = o.sequence + "/groundtruth.txt";
       // Poses at the rgb stamps (+ offset), up to 0.1 s from a ground-truth sample.
       const double dt = o.gt_time_offset_s;
-      gt.T_c2_c1 = tum_pose_at(gtf, frames[j].t_s + dt, 0.1).inverse() * tum_pose_at(gtf, frames[i].t_s + dt, 0.1);
+      const double t1_s = geom::ns_to_seconds(frames[i].t_ns), t2_s = geom::ns_to_seconds(frames[j].t_ns);
+      gt.T_c2_c1 = tum_pose_at(gtf, t2_s + dt, 0.1).inverse() * tum_pose_at(gtf, t1_s + dt, 0.1);
     } else {
       if (o.img1.empty() || o.img2.empty() || o.depth1.empty() || o.depth2.empty() || o.pose1.empty() ||
           o.pose2.empty() || o.settings.empty())

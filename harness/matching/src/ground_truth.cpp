@@ -10,6 +10,8 @@
 #include <sstream>
 
 #include "pvb/common/error.hpp"
+#include "pvb/eval/trajectory.hpp"
+#include "pvb/geometry/time.hpp"
 #include "pvb/common/text.hpp"
 
 namespace pvb::harness {
@@ -95,38 +97,27 @@ geom::SE3d parse_tum_pose(const std::string& text, const std::string& what) {
 }
 
 geom::SE3d tum_pose_at(const std::string& path, double t_s, double max_gap_s) {
-  std::ifstream in(path);
-  if (!in) throw IoError(path, "cannot open ground truth");
-  std::string line;
-  int line_no = 0;
-  bool have_prev = false;
-  double t_prev = 0;
-  Eigen::Vector3d p_prev = Eigen::Vector3d::Zero();
-  Eigen::Quaterniond q_prev = Eigen::Quaterniond::Identity();
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream ls(line);
-    double t, tx, ty, tz, qx, qy, qz, qw;
-    if (!(ls >> t >> tx >> ty >> tz >> qx >> qy >> qz >> qw))
-      throw IoError(path, "expected 'timestamp tx ty tz qx qy qz qw'", line_no);
-    const Eigen::Vector3d p(tx, ty, tz);
-    const Eigen::Quaterniond q = Eigen::Quaterniond(qw, qx, qy, qz).normalized();
-    if (t >= t_s) {
-      if (!have_prev) {
-        if (t - t_s > max_gap_s) break;
-        return geom::make_se3(q, p);
-      }
-      if (std::min(t - t_s, t_s - t_prev) > max_gap_s) break;
-      const double a = (t - t_prev) > 0 ? (t_s - t_prev) / (t - t_prev) : 0.0;
-      return geom::make_se3(q_prev.slerp(a, q), (1 - a) * p_prev + a * p);
+  const eval::Trajectory gt = eval::read_tum(path);
+  const std::int64_t t_ns = geom::seconds_to_ns(t_s);
+  const auto max_gap_ns = geom::seconds_to_ns(max_gap_s);
+  const auto& p = gt.poses;
+  const auto after = std::lower_bound(p.begin(), p.end(), t_ns,
+                                      [](const geom::StampedPose& a, std::int64_t t) { return a.t_ns < t; });
+  if (after != p.end() && after->t_ns == t_ns) return after->T_w_c;
+  if (after == p.begin()) {
+    if (after->t_ns - t_ns <= max_gap_ns) return after->T_w_c;
+  } else if (after == p.end()) {
+    if (t_ns - p.back().t_ns <= max_gap_ns) return p.back().T_w_c;
+  } else {
+    const auto before = after - 1;
+    if (std::min(after->t_ns - t_ns, t_ns - before->t_ns) <= max_gap_ns) {
+      // linear in position, slerp in rotation
+      const double a = static_cast<double>(t_ns - before->t_ns) / static_cast<double>(after->t_ns - before->t_ns);
+      const Eigen::Quaterniond q0(before->T_w_c.linear()), q1(after->T_w_c.linear());
+      return geom::make_se3(q0.slerp(a, q1),
+                            (1 - a) * before->T_w_c.translation() + a * after->T_w_c.translation());
     }
-    have_prev = true;
-    t_prev = t;
-    p_prev = p;
-    q_prev = q;
   }
-  if (have_prev && t_s - t_prev <= max_gap_s) return geom::make_se3(q_prev, p_prev);
   std::ostringstream msg;
   msg.precision(17);
   msg << "no ground-truth pose within " << max_gap_s << " s of t = " << t_s;
@@ -173,57 +164,6 @@ std::vector<MatchLabel> label_by_rgbd(const std::vector<slam::PointMatch>& raw,
     const float z2 = depth_at(gt.depth2_m, raw[i].p2);
     if (z2 > 0 && std::abs(P_c2.z() - z2) > gt.depth_tol_rel * P_c2.z() + gt.depth_tol_abs_m) continue;
     out[i] = MatchLabel::kCorrect;
-  }
-  return out;
-}
-
-namespace {
-struct Stamped {
-  double t;
-  std::string path;
-};
-std::vector<Stamped> read_list(const std::string& dir, const std::string& name) {
-  const std::string path = dir + "/" + name;
-  std::ifstream in(path);
-  if (!in) throw IoError(path, "cannot open (TUM layout expects rgb.txt and depth.txt)");
-  std::vector<Stamped> out;
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream ls(line);
-    Stamped s;
-    if (!(ls >> s.t >> s.path)) throw IoError(path, "expected 'timestamp filename'", line_no);
-    if (s.path.empty() || s.path[0] != '/') s.path = dir + "/" + s.path;
-    out.push_back(s);
-  }
-  if (out.empty()) throw IoError(path, "no entries");
-  return out;
-}
-}  // namespace
-
-std::vector<TumFrame> load_tum_frames(const std::string& dir, double max_dt_s) {
-  const auto rgb = read_list(dir, "rgb.txt");
-  const auto depth = read_list(dir, "depth.txt");
-  std::vector<TumFrame> out;
-  for (const auto& r : rgb) {
-    const Stamped* best = nullptr;
-    double best_dt = std::numeric_limits<double>::infinity();
-    for (const auto& d : depth) {
-      const double dt = std::abs(d.t - r.t);
-      if (dt < best_dt) {
-        best_dt = dt;
-        best = &d;
-      }
-    }
-    if (best_dt > max_dt_s) {
-      std::ostringstream msg;
-      msg.precision(17);
-      msg << "no depth image within " << max_dt_s << " s of rgb t = " << r.t;
-      throw IoError(dir + "/depth.txt", msg.str());
-    }
-    out.push_back({r.t, r.path, best->path, best_dt});
   }
   return out;
 }

@@ -71,15 +71,6 @@ TEST(MatchGroundTruth, TumPoseParsingAndInterpolation) {
   EXPECT_THROW(tum_pose_at(path + ".missing", 10.0), IoError);
 }
 
-TEST(MatchGroundTruth, TumFolderAssociatesNearestDepth) {
-  const auto frames = load_tum_frames(kShared + "/data/tum/fr1_xyz_pair");
-  ASSERT_EQ(frames.size(), 2u);
-  EXPECT_NE(frames[0].rgb_path.find("1305031102.175304.png"), std::string::npos);
-  EXPECT_NE(frames[0].depth_path.find("1305031102.160407.png"), std::string::npos);
-  EXPECT_NE(frames[1].depth_path.find("1305031102.262886.png"), std::string::npos);
-  EXPECT_LT(frames[0].depth_dt_s, 0.02);
-  EXPECT_THROW(load_tum_frames(kShared + "/data/tum/does_not_exist"), IoError);
-}
 
 TEST(MatchGroundTruth, SettingsFromOrbSlamYaml) {
   const CameraSettings s = load_camera_settings(kShared + "/data/tum/TUM1.yaml");

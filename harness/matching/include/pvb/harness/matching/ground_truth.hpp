@@ -79,18 +79,4 @@ std::vector<MatchLabel> label_by_rgbd(const std::vector<slam::PointMatch>& raw,
 std::vector<slam::PointMatch> undistort_matches(const std::vector<slam::PointMatch>& raw,
                                                 const geom::PinholeIntrinsics& K, const cv::Mat& dist);
 
-/// One frame of a TUM-layout sequence folder.
-struct TumFrame {
-  double t_s = 0;           ///< rgb time stamp, seconds
-  std::string rgb_path;     ///< absolute or DIR-relative path of the colour image
-  std::string depth_path;   ///< depth image nearest in time
-  double depth_dt_s = 0;    ///< |t_depth - t_rgb|
-};
-
-/// Reads DIR/rgb.txt and DIR/depth.txt and associates each rgb image with
-/// the depth image nearest in time (each depth used at most once is not
-/// required: nearest wins).  Throws IoError when a file is missing or a
-/// depth is further than max_dt_s.
-std::vector<TumFrame> load_tum_frames(const std::string& dir, double max_dt_s = 0.05);
-
 }  // namespace pvb::harness
