@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Reproduces docs/matching.md: the paper's matching experiment (Figs. 11-12,
-# Table 1) on the Oxford wall/trees pairs and the TUM RGB-D pairs.
+# Table 1) on the Oxford wall/trees pairs, the TUM RGB-D pairs and pairs of a
+# simulated PV station sequence.
 # Usage: scripts/matching_experiment.sh [BUILD_DIR] [OUT_DIR] [RUNS]
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
@@ -22,6 +23,15 @@ done
   --gt-time-offset -0.02 --runs "$runs" --json "$out/tum_fr1_xyz_offset-0.02.json" >/dev/null
 "$pv" match --sequence "$data/tum/fr3_long_office_household_pair" --frames 0,1 \
   --settings "$here/configs/tum/TUM3.yaml" --runs "$runs" --json "$out/tum_fr3_office.json" >/dev/null
+# Simulated PV station (default scenario, seed 7): pairs at 1, 5 and 10 frames.
+seq="$out/pv_station_seq"
+[ -f "$seq/groundtruth.txt" ] || "$pv" record --scenario "$here/scenes/pv_station.yaml" --out "$seq" --frames 160 --seed 7 >/dev/null
+for base in 40 120; do
+  for d in 1 5 10; do
+    "$pv" match --sequence "$seq" --frames "$base,$((base + d))" --runs "$runs" \
+      --json "$out/sim_pv_station_${base}+${d}.json" >/dev/null
+  done
+done
 python3 - "$out" <<'PY'
 import json, sys, glob, os
 out = sys.argv[1]
