@@ -25,14 +25,14 @@ StereoIntrinsics hand_intrinsics() {
   return K;
 }
 
-TEST(Chi2Helper, ProjectHandComputed) {
+TEST(OptimChi2Helper, ProjectHandComputed) {
   // u = 500 * 0.2 / 2 + 320 = 370, v = 400 * -0.1 / 2 + 240 = 220
   const Eigen::Vector2d uv = project(hand_intrinsics(), Eigen::Vector3d(0.2, -0.1, 2.0));
   EXPECT_DOUBLE_EQ(uv.x(), 370.0);
   EXPECT_DOUBLE_EQ(uv.y(), 220.0);
 }
 
-TEST(Chi2Helper, StereoAndMonoHandComputed) {
+TEST(OptimChi2Helper, StereoAndMonoHandComputed) {
   // Camera 1 m behind the world origin along z: p_c = p_w + (0, 0, 1).
   const geom::SE3d T_c_w = geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 1));
   const Eigen::Vector3d p_w(0.2, -0.1, 1.0);  // p_c = (0.2, -0.1, 2): u 370, v 220, u_r 370 - 40 / 2 = 350
@@ -45,7 +45,7 @@ TEST(Chi2Helper, StereoAndMonoHandComputed) {
   EXPECT_DOUBLE_EQ(observation_chi2(hand_intrinsics(), T_c_w, p_w, o), 0.5 * (1 + 4));  // 2.5
 }
 
-TEST(Chi2Helper, RotatedCamera) {
+TEST(OptimChi2Helper, RotatedCamera) {
   // 90 deg about z: R maps x to y.  p_w (0.1, 0, 2) -> p_c (0, 0.1, 2): u 320, v 260.
   const geom::SE3d T_c_w = geom::make_se3(geom::so3_exp(Eigen::Vector3d(0, 0, std::acos(-1.0) / 2)), Eigen::Vector3d::Zero());
   Observation o;
@@ -54,7 +54,7 @@ TEST(Chi2Helper, RotatedCamera) {
   EXPECT_NEAR(observation_chi2(hand_intrinsics(), T_c_w, Eigen::Vector3d(0.1, 0, 2), o), 9.0 / 1.44, 1e-9);
 }
 
-TEST(Chi2Helper, BehindCameraIsInfinite) {
+TEST(OptimChi2Helper, BehindCameraIsInfinite) {
   Observation o;
   o.uv = {320, 240};
   const double chi2 =
@@ -79,7 +79,7 @@ struct FunctorCase {
   }
 };
 
-TEST(CostFunctors, ResidualNormMatchesChi2Helper) {
+TEST(OptimCostFunctors, ResidualNormMatchesChi2Helper) {
   for (bool stereo : {false, true}) {
     FunctorCase s(stereo);
     const int rows = stereo ? 3 : 2;
@@ -105,7 +105,7 @@ TEST(CostFunctors, ResidualNormMatchesChi2Helper) {
   }
 }
 
-TEST(CostFunctors, AutomaticJacobianMatchesNumeric) {
+TEST(OptimCostFunctors, AutomaticJacobianMatchesNumeric) {
   // The functors use automatic derivatives; this guards the Jet code path
   // (e.g. a stray cast to double) against central differences.
   FunctorCase s(true);
@@ -126,7 +126,7 @@ TEST(CostFunctors, AutomaticJacobianMatchesNumeric) {
   }
 }
 
-TEST(CostFunctors, PointBehindCameraIsRejected) {
+TEST(OptimCostFunctors, PointBehindCameraIsRejected) {
   FunctorCase s(false);
   const Eigen::Vector3d behind = s.T_c_w.inverse() * Eigen::Vector3d(0.1, 0.1, -1.0);
   std::unique_ptr<ceres::CostFunction> ba(optim_detail::make_ba_cost(s.K, s.obs));
