@@ -1,6 +1,8 @@
 #include "pvb/sim/sensor_model.hpp"
 
 #include <array>
+#include <vector>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <opencv2/core/utility.hpp>
 
@@ -61,7 +63,10 @@ cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, c
   const scenes::DepthNoise& p = cam.depth_noise;
   const auto& nt = normal_table();
   const double bf = p.baseline_m * K.fx;
-  const double cos_max = std::cos(p.max_incidence_deg * M_PI / 180.0);
+  const float cos2_max = static_cast<float>(std::pow(std::cos(p.max_incidence_deg * M_PI / 180.0), 2));
+  std::vector<float> xn(static_cast<std::size_t>(W)), yn(static_cast<std::size_t>(H));
+  for (int c = 0; c < W; ++c) xn[static_cast<std::size_t>(c)] = static_cast<float>((c - K.cx) / K.fx);
+  for (int r = 0; r < H; ++r) yn[static_cast<std::size_t>(r)] = static_cast<float>((r - K.cy) / K.fy);
   auto gt_at = [&](int r, int c) { return gt.ptr<float>(std::clamp(r, 0, H - 1))[std::clamp(c, 0, W - 1)]; };
   // Rows run in parallel; each row has its own generator seeded by (seed,
   // frame, row), so the result does not depend on the number of threads.
@@ -80,12 +85,16 @@ cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, c
       // incidence angle from the local surface normal
       const float zl = gt_at(rr, cc - 1), zr = gt_at(rr, cc + 1), zu = gt_at(rr - 1, cc), zd = gt_at(rr + 1, cc);
       if (zl <= 0 || zr <= 0 || zu <= 0 || zd <= 0) continue;  // silhouette edge: no return
-      const Eigen::Vector3d px_l = K.unproject(cc - 1, rr, zl), px_r = K.unproject(cc + 1, rr, zr);
-      const Eigen::Vector3d px_u = K.unproject(cc, rr - 1, zu), px_d = K.unproject(cc, rr + 1, zd);
-      const Eigen::Vector3d n = (px_r - px_l).cross(px_d - px_u);
-      const Eigen::Vector3d ray = K.unproject(cc, rr, z);
-      const double nn = n.norm() * ray.norm();
-      if (nn <= 0 || std::abs(n.dot(ray)) / nn < cos_max) continue;
+      // P(u, v) = z (xn(u), yn(v), 1); n = dP/du x dP/dv by central
+      // differences; compare squared cosines to avoid square roots.
+      const float xl = xn[cc - 1], xc = xn[cc], xr = xn[cc + 1];
+      const float yu = yn[rr - 1], yc = yn[rr], yd = yn[rr + 1];
+      const Eigen::Vector3f du(xr * zr - xl * zl, yc * (zr - zl), zr - zl);
+      const Eigen::Vector3f dv(xc * (zd - zu), yd * zd - yu * zu, zd - zu);
+      const Eigen::Vector3f n = du.cross(dv);
+      const Eigen::Vector3f ray(xc, yc, 1.0f);
+      const float dot = n.dot(ray);
+      if (dot * dot < cos2_max * n.squaredNorm() * ray.squaredNorm()) continue;
       // axial noise, then disparity quantisation
       double zn = z + nt[(bits >> 24) & 4095] * kinect_axial_sigma_m(z) * p.axial_scale;
       if (p.disparity_step_px > 0 && zn > 0) {
