@@ -15,7 +15,7 @@
 #include "pvb/geometry/time.hpp"
 #include "pvb/plot/contact_sheet.hpp"
 #include "pvb/scenes/scenario.hpp"
-#include "pvb/sim/simulator.hpp"
+#include "pvb/sim/sim_frame_source.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -49,39 +49,34 @@ int run_record(const RecordOptions& opt) {
   dataset::make_dirs(opt.out);  // fail early on an unwritable folder
 
   const auto t_start = Clock::now();
-  sim::Simulator sim(scenario);
+  const int n = scenes::frame_count(scenario, opt.frames);
+  geom::StampedPose gt;  // ground truth arrives through its own sink
+  sim::SimFrameSource source(scenario, backend, n, [&gt](const geom::StampedPose& p) { gt = p; });
   const double setup_ms = ms_since(t_start);
-  const auto t_gl = Clock::now();
-  sim::RgbdCamera camera(sim, backend);
-  const double gl_ms = ms_since(t_gl);
+  const sim::Simulator& sim = source.simulator();
 
   sim::write_scene(sim.assets(), opt.out);
   dataset::write_orbslam_settings(opt.out + "/camera.yaml", settings_for(scenario));
   dataset::TumSequenceWriter writer(opt.out, 5000.0, std::string("pvbench ") + pvb::version());
 
-  const int n = scenes::frame_count(scenario, opt.frames);
-  double physics_ms = 0, render_ms = 0, write_ms = 0;
+  double capture_ms = 0, write_ms = 0;
   const std::vector<int> sheet_frames = plot::spread_indices(n, 12);
   std::vector<plot::Thumbnail> thumbs;
   const auto t_loop = Clock::now();
   {
     ProgressBar bar("record " + scenario.name, static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i) {
-      if (i > 0) {
-        const auto t0 = Clock::now();
-        sim.advance();
-        physics_ms += ms_since(t0);
-      }
       auto t0 = Clock::now();
-      const sim::Capture cap = camera.capture(sim);
-      render_ms += ms_since(t0);
+      const std::optional<sensor::RgbdFrame> frame = source.next();
+      capture_ms += ms_since(t0);
+      if (!frame) break;
       t0 = Clock::now();
-      writer.write(cap.frame, cap.T_w_c);
+      writer.write(*frame, gt.T_w_c);
       write_ms += ms_since(t0);
       if (std::find(sheet_frames.begin(), sheet_frames.end(), i) != sheet_frames.end()) {
         char label[64];
-        std::snprintf(label, sizeof label, "frame %d  t=%.2f s", i, geom::ns_to_seconds(cap.frame.t_ns));
-        thumbs.push_back({cap.frame.rgb.clone(), label});
+        std::snprintf(label, sizeof label, "frame %d  t=%.2f s", i, geom::ns_to_seconds(frame->t_ns));
+        thumbs.push_back({frame->rgb.clone(), label});
       }
       bar.update(static_cast<std::size_t>(i + 1));
     }
@@ -100,19 +95,20 @@ int run_record(const RecordOptions& opt) {
                 "  \"renderer\": {\"backend\": \"%s\", \"description\": \"%s\"},\n"
                 "  \"physics\": {\"timestep_s\": %.9g, \"substeps_per_frame\": %d},\n"
                 "  \"kinematics\": {\"wheel_radius_m\": %.6f, \"track_m\": %.6f},\n"
-                "  \"timings\": {\"total_s\": %.3f, \"setup_ms\": %.1f, \"gl_init_ms\": %.1f, \"physics_ms_per_frame\": %.3f, "
-                "\"render_ms_per_frame\": %.3f, \"write_ms_per_frame\": %.3f, \"frames_per_s\": %.2f}\n"
+                "  \"timings\": {\"total_s\": %.3f, \"setup_ms\": %.1f, \"capture_ms_per_frame\": %.3f, "
+                "\"write_ms_per_frame\": %.3f, \"frames_per_s\": %.2f}\n"
                 "}\n",
                 json_escape(scenario.name).c_str(), json_escape(opt.scenario).c_str(),
                 static_cast<unsigned long long>(scenario.seed), n, scenario.camera.fps, pvb::version(),
-                mj_versionString(), sim::to_string(camera.backend()), json_escape(camera.description()).c_str(),
+                mj_versionString(), sim::to_string(source.camera().backend()),
+                json_escape(source.camera().description()).c_str(),
                 sim.assets().timestep_s, sim.assets().substeps, sim.kinematics().wheel_radius_m,
-                sim.kinematics().track_m, total_s, setup_ms, gl_ms, physics_ms / n, render_ms / n, write_ms / n,
-                n / loop_s);
+                sim.kinematics().track_m, total_s, setup_ms, capture_ms / n, write_ms / n, n / loop_s);
   write_file(opt.out + "/meta.json", meta);
   plot::write_rgb_png(plot::make_contact_sheet(thumbs, 4, 320), opt.out + "/contact_sheet.png");
-  std::printf("recorded %d frames of %s to %s (%s; %.1f frames/s, render %.1f ms/frame)\n", n, scenario.name.c_str(),
-              opt.out.c_str(), camera.description().c_str(), n / loop_s, render_ms / n);
+  std::printf("recorded %d frames of %s to %s (%s; %.1f frames/s, capture %.1f ms/frame)\n", n,
+              scenario.name.c_str(), opt.out.c_str(), source.camera().description().c_str(), n / loop_s,
+              capture_ms / n);
   return 0;
 }
 

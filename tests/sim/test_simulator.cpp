@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "pvb/scenes/scenario.hpp"
+#include "pvb/geometry/time.hpp"
+#include "pvb/sim/sim_frame_source.hpp"
 #include "pvb/sim/simulator.hpp"
 
 using namespace pvb;
@@ -164,4 +166,24 @@ TEST(Simulator, ShippedScenariosAreDrivenToTheEndOfTheirRoutes) {
     const Eigen::Vector2d goal = sim.follower().path().back();
     EXPECT_LT((Eigen::Vector2d(end.x, end.y) - goal).norm(), 0.2) << name;
   }
+}
+
+TEST(SimFrameSource, StreamsFramesWithGroundTruthThroughItsOwnSink) {
+  std::vector<geom::StampedPose> gt;
+  sim::SimFrameSource src(wall_scenario(), sim::GlBackend::kAuto, 5,
+                          [&gt](const geom::StampedPose& p) { gt.push_back(p); });
+  EXPECT_EQ(src.size_hint(), 5u);
+  std::vector<sensor::RgbdFrame> frames;
+  while (auto f = src.next()) frames.push_back(*f);
+  ASSERT_EQ(frames.size(), 5u);
+  ASSERT_EQ(gt.size(), 5u);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(frames[i].index, i);
+    EXPECT_EQ(frames[i].t_ns, gt[i].t_ns);
+    EXPECT_EQ(frames[i].t_ns, geom::frame_time_ns(0, static_cast<std::int64_t>(i), 30.0));
+    EXPECT_EQ(frames[i].rgb.type(), CV_8UC3);
+    EXPECT_EQ(frames[i].depth_m.type(), CV_32FC1);
+  }
+  EXPECT_FALSE(src.next().has_value());
+  EXPECT_NE(src.describe().find("sim:wall_test"), std::string::npos);
 }

@@ -1,0 +1,44 @@
+#pragma once
+// The simulator as a live frame source: frames go to SLAM in memory through
+// the same FrameSource interface as recorded datasets.  Ground truth does not
+// travel with the frames: it goes to a separate sink the harness provides.
+#include <functional>
+#include <memory>
+
+#include "pvb/geometry/stamped_pose.hpp"
+#include "pvb/sensor/frame_source.hpp"
+#include "pvb/sim/simulator.hpp"
+
+namespace pvb::sim {
+
+class SimFrameSource : public sensor::FrameSource {
+ public:
+  /// Receives the ground-truth camera pose of each frame, before next()
+  /// returns that frame.
+  using GroundTruthSink = std::function<void(const geom::StampedPose& T_w_c)>;
+
+  /// Builds the simulator and its camera.  max_frames > 0 caps the stream.
+  SimFrameSource(scenes::Scenario scenario, GlBackend backend, int max_frames = 0, GroundTruthSink sink = {});
+
+  /// Advances the physics by one camera period (not before frame 0),
+  /// renders and applies the sensor model.  nullopt after the last frame.
+  std::optional<sensor::RgbdFrame> next() override;
+  std::size_t size_hint() const override { return static_cast<std::size_t>(frames_); }
+  std::string describe() const override;
+
+  /// The simulator, for closed-loop steering and reports.
+  Simulator& simulator() { return sim_; }
+  const RgbdCamera& camera() const { return camera_; }
+  /// Rendered (noise-free) depth of the last frame, for diagnostics.
+  const cv::Mat& last_depth_gt_m() const { return last_depth_gt_m_; }
+
+ private:
+  Simulator sim_;
+  RgbdCamera camera_;
+  int frames_;
+  int next_index_ = 0;
+  GroundTruthSink sink_;
+  cv::Mat last_depth_gt_m_;
+};
+
+}  // namespace pvb::sim

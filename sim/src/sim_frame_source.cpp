@@ -1,0 +1,26 @@
+#include "pvb/sim/sim_frame_source.hpp"
+
+namespace pvb::sim {
+
+SimFrameSource::SimFrameSource(scenes::Scenario scenario, GlBackend backend, int max_frames, GroundTruthSink sink)
+    : sim_(std::move(scenario)),
+      camera_(sim_, backend),
+      frames_(scenes::frame_count(sim_.scenario(), max_frames)),
+      sink_(std::move(sink)) {}
+
+std::optional<sensor::RgbdFrame> SimFrameSource::next() {
+  if (next_index_ >= frames_) return std::nullopt;
+  if (next_index_ > 0) sim_.advance();
+  ++next_index_;
+  Capture cap = camera_.capture(sim_);
+  if (sink_) sink_({cap.frame.t_ns, cap.T_w_c});
+  last_depth_gt_m_ = cap.depth_gt_m;
+  return std::move(cap.frame);
+}
+
+std::string SimFrameSource::describe() const {
+  return "sim:" + sim_.scenario().name + " (seed " + std::to_string(sim_.scenario().seed) + ", " +
+         camera_.description() + ")";
+}
+
+}  // namespace pvb::sim
