@@ -179,7 +179,7 @@ SceneAssets build_scene(const scenes::Scenario& s) {
   const double fovy_deg = cam.fovy_deg();
   x.line("<global offwidth=\"" + std::to_string(cam.width) + "\" offheight=\"" + std::to_string(cam.height) +
          "\" fovy=\"" + f(fovy_deg) + "\"/>");
-  x.line("<quality shadowsize=\"1024\" offsamples=\"0\"/>");
+  x.line("<quality shadowsize=\"" + std::to_string(s.light.shadow_map_px) + "\" offsamples=\"0\"/>");
   x.line("<map znear=\"" + f(znear_m / extent) + "\" zfar=\"" + f(zfar_m / extent) + "\" shadowclip=\"" +
          f(9.0 / extent) + "\" shadowscale=\"0.6\"/>");
   const double amb = s.light.ambient;

@@ -70,6 +70,7 @@ struct Light {
   double intensity = 0.8;           ///< diffuse of the sun light, 0..1
   double ambient = 0.35;            ///< ambient light, 0..1
   bool shadows = true;
+  int shadow_map_px = 1024;  ///< shadow map resolution; the map covers 18 m around the robot
 };
 
 struct Route {
