@@ -214,3 +214,19 @@ TEST(Report, ComparisonShowsReduction) {
                           "\"R\"", "\"t\"", "\"s\""})
     EXPECT_NE(json.find(key), std::string::npos) << key;
 }
+
+TEST(Align, NearlyStraightDriveStillAligns) {
+  // A robot along a 20 m PV row: 2 mm of lateral and vertical wobble.  The
+  // estimate is the ground truth moved rigidly; SE(3) alignment must undo it.
+  std::vector<Vec3d> gt, est;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.3, Vec3d(0.2, 0.3, 0.9).normalized()).toRotationMatrix();
+  for (int i = 0; i < 600; ++i) {
+    const double x = i * 20.0 / 600;
+    gt.push_back(Vec3d(x, 0.002 * std::sin(i * 0.05), 1.1 + 0.002 * std::cos(i * 0.11)));
+    est.push_back(R * gt.back() + Vec3d(1, -2, 0.5));
+  }
+  const Sim3Transform a = umeyama(est, gt, false);
+  double worst = 0;
+  for (std::size_t i = 0; i < gt.size(); ++i) worst = std::max(worst, (a.apply(est[i]) - gt[i]).norm());
+  EXPECT_LT(worst, 1e-6);
+}
