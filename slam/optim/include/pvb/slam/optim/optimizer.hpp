@@ -35,6 +35,8 @@ struct PoseOptimizerOptions {
   double chi2_mono = 5.991;        ///< chi-square 95 %, 2 DoF
   double chi2_stereo = 7.815;      ///< chi-square 95 %, 3 DoF
   bool robust = true;              ///< Huber loss (delta = sqrt(chi2)) in the first rounds
+  int robust_rounds = 2;           ///< rounds [0, robust_rounds) use Huber (ORB-SLAM2 drops it from round 2)
+  bool restart_from_initial = true; ///< ORB-SLAM2 restarts every round from T_c_w_init
 };
 
 struct PoseOptimizerResult {
@@ -93,6 +95,7 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
 /// Reprojection residual helpers (also used by tests and by map-point culling).
 Eigen::Vector2d project(const StereoIntrinsics& K, const Eigen::Vector3d& p_c);
 /// chi2 of one observation of p_w seen from T_c_w (weighted by inv_sigma2).
+/// +infinity when p_w is not in front of the camera (z_c <= 0).
 double observation_chi2(const StereoIntrinsics& K, const geom::SE3d& T_c_w, const Eigen::Vector3d& p_w,
                         const Observation& obs);
 

@@ -1,0 +1,302 @@
+// Pose-only optimisation and local bundle adjustment (ORB-SLAM2's
+// Optimizer::PoseOptimization and Optimizer::LocalBundleAdjustment) on Ceres.
+#include "pvb/slam/optim/optimizer.hpp"
+
+#include <ceres/ceres.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "residuals.hpp"
+
+namespace pvb::slam {
+namespace {
+
+using optim_detail::is_stereo;
+
+/// A camera pose as Ceres parameter blocks (see residuals.hpp): q_c_w in
+/// Eigen's (x, y, z, w) order and t_c_w.
+struct PoseBlocks {
+  double q_c_w[4] = {0, 0, 0, 1};
+  double t_c_w[3] = {0, 0, 0};
+
+  static PoseBlocks from_se3(const geom::SE3d& T_c_w) {
+    PoseBlocks b;
+    const Eigen::Quaterniond q(Eigen::Matrix3d(T_c_w.linear()));
+    Eigen::Map<Eigen::Quaterniond>(b.q_c_w) = q.normalized();
+    Eigen::Map<Eigen::Vector3d>(b.t_c_w) = T_c_w.translation();
+    return b;
+  }
+  geom::SE3d to_se3() const {
+    return geom::make_se3(Eigen::Quaterniond(Eigen::Map<const Eigen::Quaterniond>(q_c_w)),
+                          Eigen::Vector3d(Eigen::Map<const Eigen::Vector3d>(t_c_w)));
+  }
+};
+
+double chi2_threshold(const Observation& obs, double chi2_mono, double chi2_stereo) {
+  return is_stereo(obs) ? chi2_stereo : chi2_mono;
+}
+
+/// Problem options shared by all solves: the cost functions, losses and the
+/// manifold are owned by the caller so that they survive across rounds.
+ceres::Problem::Options borrowed_problem_options() {
+  ceres::Problem::Options o;
+  o.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  o.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  o.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  return o;
+}
+
+/// Stops a bundle-adjustment pass once *flag becomes true (ORB-SLAM2's
+/// pbStopFlag).  Returns SOLVER_TERMINATE_SUCCESSFULLY rather than
+/// SOLVER_ABORT: g2o's force-stop keeps the estimate reached so far, and
+/// SOLVER_ABORT would make Ceres discard the whole pass.
+class AbortCallback : public ceres::IterationCallback {
+ public:
+  explicit AbortCallback(const bool* flag) : flag_(flag) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& /*summary*/) override {
+    return (flag_ != nullptr && *flag_) ? ceres::SOLVER_TERMINATE_SUCCESSFULLY : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const bool* flag_;
+};
+
+bool aborted(const bool* flag) { return flag != nullptr && *flag; }
+
+}  // namespace
+
+Eigen::Vector2d project(const StereoIntrinsics& K, const Eigen::Vector3d& p_c) {
+  const double inv_z = 1.0 / p_c.z();
+  return {K.fx * p_c.x() * inv_z + K.cx, K.fy * p_c.y() * inv_z + K.cy};
+}
+
+double observation_chi2(const StereoIntrinsics& K, const geom::SE3d& T_c_w, const Eigen::Vector3d& p_w,
+                        const Observation& obs) {
+  const Eigen::Vector3d p_c = T_c_w * p_w;
+  if (!(p_c.z() > 0.0)) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector2d uv = project(K, p_c);
+  double e2 = (obs.uv - uv).squaredNorm();
+  if (is_stereo(obs)) {
+    const double e_r = obs.u_right - (uv.x() - K.bf / p_c.z());
+    e2 += e_r * e_r;
+  }
+  return obs.inv_sigma2 * e2;
+}
+
+// ---------------------------------------------------------------------------
+// Pose-only optimisation
+// ---------------------------------------------------------------------------
+PoseOptimizerResult optimize_pose(const geom::SE3d& T_c_w_init, const std::vector<Eigen::Vector3d>& points_w,
+                                  const std::vector<Observation>& obs, const StereoIntrinsics& K,
+                                  const PoseOptimizerOptions& options) {
+  if (points_w.size() != obs.size()) {
+    throw std::invalid_argument("optimize_pose: " + std::to_string(points_w.size()) + " points but " +
+                                std::to_string(obs.size()) + " observations");
+  }
+  const std::size_t n = obs.size();
+  PoseOptimizerResult result;
+  result.T_c_w = T_c_w_init;
+  result.inlier.assign(n, 0);
+
+  const auto classify = [&](const geom::SE3d& T_c_w) {
+    int count = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double chi2 = observation_chi2(K, T_c_w, points_w[i], obs[i]);
+      result.inlier[i] = chi2 <= chi2_threshold(obs[i], options.chi2_mono, options.chi2_stereo) ? 1 : 0;
+      count += result.inlier[i];
+    }
+    result.num_inliers = count;
+  };
+
+  // ORB-SLAM2 does not optimise on fewer than 3 correspondences; we still
+  // report which observations agree with the initial pose.
+  if (n < 3 || options.rounds <= 0) {
+    classify(T_c_w_init);
+    return result;
+  }
+
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs(n);
+  for (std::size_t i = 0; i < n; ++i) costs[i].reset(optim_detail::make_pose_only_cost(K, obs[i], points_w[i]));
+  ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
+  ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
+  ceres::EigenQuaternionManifold quaternion_manifold;
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;  // one 6-DoF block
+  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  solver_options.max_num_iterations = options.iterations_per_round;
+  solver_options.num_threads = 1;  // deterministic
+  solver_options.logging_type = ceres::SILENT;
+
+  // Round 0 uses every observation in front of the initial camera.
+  std::vector<std::uint8_t> use(n, 0);
+  for (std::size_t i = 0; i < n; ++i) use[i] = (T_c_w_init * points_w[i]).z() > 0.0 ? 1 : 0;
+
+  PoseBlocks pose = PoseBlocks::from_se3(T_c_w_init);
+  const PoseBlocks pose_init = pose;
+  for (int round = 0; round < options.rounds; ++round) {
+    if (options.restart_from_initial) pose = pose_init;
+    const geom::SE3d T_start = pose.to_se3();
+    const bool robust = options.robust && round < options.robust_rounds;
+
+    ceres::Problem problem(borrowed_problem_options());
+    problem.AddParameterBlock(pose.q_c_w, 4, &quaternion_manifold);
+    problem.AddParameterBlock(pose.t_c_w, 3);
+    int num_used = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      // A residual must be defined at the starting pose (point in front).
+      if (!use[i] || !((T_start * points_w[i]).z() > 0.0)) continue;
+      ceres::LossFunction* loss = nullptr;
+      if (robust) loss = is_stereo(obs[i]) ? &huber_stereo : &huber_mono;
+      problem.AddResidualBlock(costs[i].get(), loss, pose.q_c_w, pose.t_c_w);
+      ++num_used;
+    }
+    if (num_used == 0) break;  // nothing left to optimise against; keep the pose
+
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &problem, &summary);
+    result.final_cost = summary.final_cost;
+
+    // Classify every observation (outliers too: they may come back).
+    classify(pose.to_se3());
+    use = result.inlier;
+    if (n < 10) break;  // ORB-SLAM2: too few edges for re-classification rounds
+  }
+  result.T_c_w = pose.to_se3();
+  return result;
+}
+
+// ---------------------------------------------------------------------------
+// Local bundle adjustment
+// ---------------------------------------------------------------------------
+BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, const BaOptions& options) {
+  if (problem == nullptr) throw std::invalid_argument("local_bundle_adjustment: null problem");
+  BaProblem& ba = *problem;
+  const std::size_t num_edges = ba.edges.size();
+  for (std::size_t e = 0; e < num_edges; ++e) {
+    if (ba.edges[e].keyframe >= ba.keyframes.size() || ba.edges[e].point >= ba.points.size()) {
+      throw std::invalid_argument("local_bundle_adjustment: edge " + std::to_string(e) +
+                                  " refers to a missing keyframe or point");
+    }
+  }
+  BaResult result;
+  if (num_edges == 0) {
+    result.converged = true;  // nothing to optimise
+    return result;
+  }
+
+  std::vector<PoseBlocks> poses(ba.keyframes.size());
+  for (std::size_t k = 0; k < ba.keyframes.size(); ++k) poses[k] = PoseBlocks::from_se3(ba.keyframes[k].T_c_w);
+  std::vector<Eigen::Vector3d> points(ba.points.size());
+  for (std::size_t p = 0; p < ba.points.size(); ++p) points[p] = ba.points[p].p_w;
+
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs(num_edges);
+  for (std::size_t e = 0; e < num_edges; ++e) costs[e].reset(optim_detail::make_ba_cost(K, ba.edges[e].obs));
+  ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
+  ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
+  ceres::EigenQuaternionManifold quaternion_manifold;
+
+  const auto edge_chi2 = [&](std::size_t e) {
+    const BaEdge& edge = ba.edges[e];
+    return observation_chi2(K, poses[edge.keyframe].to_se3(), points[edge.point], edge.obs);
+  };
+  const auto edge_bad = [&](std::size_t e) {
+    // chi2 is +inf for a point behind the camera (ORB-SLAM2's isDepthPositive).
+    return !(edge_chi2(e) <= chi2_threshold(ba.edges[e].obs, options.chi2_mono, options.chi2_stereo));
+  };
+
+  // Edges whose point is behind the camera have no defined residual; they
+  // never enter the problem and are reported as outliers.
+  std::vector<std::uint8_t> active(num_edges, 0);
+  for (std::size_t e = 0; e < num_edges; ++e) active[e] = std::isfinite(edge_chi2(e)) ? 1 : 0;
+
+  std::vector<std::uint8_t> keyframe_used(ba.keyframes.size(), 0), point_used(ba.points.size(), 0);
+  AbortCallback abort_callback(options.abort_flag);
+
+  const auto solve_pass = [&](int iterations, bool robust) {
+    ceres::Problem prob(borrowed_problem_options());
+    std::vector<std::uint8_t> kf_in(ba.keyframes.size(), 0), pt_in(ba.points.size(), 0);
+    for (std::size_t e = 0; e < num_edges; ++e) {
+      if (!active[e]) continue;
+      const BaEdge& edge = ba.edges[e];
+      PoseBlocks& pose = poses[edge.keyframe];
+      if (!kf_in[edge.keyframe]) {
+        prob.AddParameterBlock(pose.q_c_w, 4, &quaternion_manifold);
+        prob.AddParameterBlock(pose.t_c_w, 3);
+        // Fixed keyframes (ORB-SLAM2: covisible keyframes outside the local
+        // window) anchor the gauge and the scale of the local map; they
+        // constrain the local points but must not move.
+        if (ba.keyframes[edge.keyframe].fixed) {
+          prob.SetParameterBlockConstant(pose.q_c_w);
+          prob.SetParameterBlockConstant(pose.t_c_w);
+        }
+        kf_in[edge.keyframe] = 1;
+      }
+      pt_in[edge.point] = 1;
+      ceres::LossFunction* loss = nullptr;
+      if (robust) loss = is_stereo(edge.obs) ? &huber_stereo : &huber_mono;
+      prob.AddResidualBlock(costs[e].get(), loss, pose.q_c_w, pose.t_c_w, points[edge.point].data());
+    }
+    if (prob.NumResidualBlocks() == 0) return;
+
+    // Schur ordering: points (group 0) are eliminated first, then poses.
+    // Every block must be listed, the constant ones included.
+    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    for (std::size_t p = 0; p < points.size(); ++p) {
+      if (pt_in[p]) ordering->AddElementToGroup(points[p].data(), 0);
+    }
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      if (!kf_in[k]) continue;
+      ordering->AddElementToGroup(poses[k].q_c_w, 1);
+      ordering->AddElementToGroup(poses[k].t_c_w, 1);
+    }
+
+    ceres::Solver::Options solver_options;
+    solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
+    solver_options.linear_solver_ordering = ordering;
+    solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+    solver_options.max_num_iterations = iterations;
+    solver_options.num_threads = 1;  // deterministic
+    solver_options.logging_type = ceres::SILENT;
+    if (options.abort_flag != nullptr) solver_options.callbacks.push_back(&abort_callback);
+
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &prob, &summary);
+    result.iterations += static_cast<int>(summary.iterations.size()) - 1;  // entry 0 is the initial state
+    result.converged = summary.termination_type == ceres::CONVERGENCE;
+    for (std::size_t k = 0; k < kf_in.size(); ++k) keyframe_used[k] |= kf_in[k];
+    for (std::size_t p = 0; p < pt_in.size(); ++p) point_used[p] |= pt_in[p];
+  };
+
+  // Pass 1: all edges, Huber loss.
+  solve_pass(options.iterations_first, true);
+  if (!aborted(options.abort_flag)) {
+    // Pass 2: without the outliers of pass 1 and without robust kernel.
+    for (std::size_t e = 0; e < num_edges; ++e) {
+      if (active[e] && edge_bad(e)) active[e] = 0;
+    }
+    solve_pass(options.iterations_second, false);
+  }
+
+  // Outliers: excluded from the last pass, or chi2 too big / behind the
+  // camera at the final estimate.
+  for (std::size_t e = 0; e < num_edges; ++e) {
+    if (!active[e] || edge_bad(e)) result.outlier_edges.push_back(e);
+  }
+
+  // Write back only what was optimised, so untouched keyframes keep their
+  // exact input pose (no quaternion round trip).
+  for (std::size_t k = 0; k < ba.keyframes.size(); ++k) {
+    if (keyframe_used[k] && !ba.keyframes[k].fixed) ba.keyframes[k].T_c_w = poses[k].to_se3();
+  }
+  for (std::size_t p = 0; p < ba.points.size(); ++p) {
+    if (point_used[p]) ba.points[p].p_w = points[p];
+  }
+  return result;
+}
+
+}  // namespace pvb::slam
