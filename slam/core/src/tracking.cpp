@@ -56,7 +56,8 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
   state_ = ok ? TrackingState::kOk : TrackingState::kLost;
 
   if (ok) {
-    velocity_ = f.T_c_w * last_.T_c_w.inverse();
+    if (last_.has_pose) velocity_ = f.T_c_w * last_.T_c_w.inverse();
+    else velocity_.reset();
     // drop visual-odometry points (not in the map) and outliers
     for (std::size_t i = 0; i < f.size(); ++i) {
       const auto& mp = f.map_points[i];

@@ -75,5 +75,36 @@ TEST(KinectPairs, Fr3LongOfficeWithin2cmAnd1deg) {
   }
 }
 
+// Loss is a state, and relocalisation (PnP RANSAC against keyframe map
+// points) brings tracking back: frame 1, then a black frame (nothing to
+// track: lost), then frame 2 again found within 2 cm / 1 deg.
+TEST(KinectPairs, LostOnABlankFrameThenRelocalised) {
+  const std::string name = "fr1_xyz_pair";
+  Settings settings = read_settings(kData + "TUM1.yaml");
+  dataset::TumSequenceReader reader(kData + name, settings.depth_map_factor);
+  SystemOptions options;
+  options.synchronous = true;
+  System system(settings, options);
+  const sensor::RgbdFrame f1 = *reader.next();
+  const sensor::RgbdFrame f2 = *reader.next();
+  sensor::RgbdFrame blank = f1;
+  blank.rgb = cv::Mat(f1.rgb.size(), f1.rgb.type(), cv::Scalar::all(0));  // new buffer: f1 keeps its pixels
+  blank.t_ns = (f1.t_ns + f2.t_ns) / 2;
+  const FrameResult r1 = system.track(f1);
+  ASSERT_EQ(r1.state, TrackingState::kOk);
+  const FrameResult rb = system.track(blank);
+  EXPECT_EQ(rb.state, TrackingState::kLost);
+  EXPECT_FALSE(rb.T_w_c.has_value());
+  const FrameResult r2 = system.track(f2);
+  ASSERT_EQ(r2.state, TrackingState::kOk);
+  EXPECT_EQ(r2.tracking.method, TrackingMethod::kRelocalization);
+  const eval::Trajectory gt = eval::read_tum(kData + name + "/groundtruth.txt");
+  const auto off = static_cast<std::int64_t>(-0.02 * 1e9);
+  const geom::SE3d gt_rel = gt_at(gt, f1.t_ns + off).inverse() * gt_at(gt, f2.t_ns + off);
+  const geom::SE3d err = gt_rel.inverse() * (r1.T_w_c->inverse() * *r2.T_w_c);
+  EXPECT_LT(err.translation().norm(), 0.02);
+  EXPECT_LT(geom::rotation_angle_rad(err.linear()) * 180.0 / M_PI, 1.0);
+}
+
 }  // namespace
 }  // namespace pvb::slam
