@@ -272,10 +272,17 @@ bool KeyFrame::set_bad() {
   if (parent) {
     for (const auto& [cid, child] : kids) child->change_parent(parent);
     parent->erase_child(id_);
+    removed_parent_ = parent;
+    T_c_parent_ = frame_.T_c_w * parent->T_c_w().inverse();
   }
   children_.clear();
   bad_ = true;
   return true;
+}
+
+geom::SE3d KeyFrame::T_c_w_via_tree() const {
+  if (!bad_ || !removed_parent_) return frame_.T_c_w;
+  return T_c_parent_ * removed_parent_->T_c_w_via_tree();
 }
 
 // Map -----------------------------------------------------------------------

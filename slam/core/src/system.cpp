@@ -50,12 +50,19 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
   else grey = in.rgb;
   OrbFeatures features = extractor_.extract(grey);
   out.num_features = static_cast<int>(features.keypoints.size());
+  out.orb_ms = ms_since(t0);
   Frame frame(next_frame_id_++, in.t_ns, std::move(features), in.depth_m, cam_);
   std::shared_ptr<KeyFrame> kf = tracking_->track(std::move(frame), mapping_->idle(), mapping_->queue_size());
   out.tracking_ms = ms_since(t0);
   out.state = tracking_->state();
   out.tracking = tracking_->stats();
-  if (out.state == TrackingState::kOk) out.T_w_c = tracking_->last_frame().T_c_w.inverse();
+  if (out.state == TrackingState::kOk) {
+    out.T_w_c = tracking_->last_frame().T_c_w.inverse();
+    if (auto ref = tracking_->reference_keyframe()) {
+      std::lock_guard<std::mutex> lock(map_.mutex());
+      records_.push_back({in.t_ns, ref, tracking_->last_frame().T_c_w * ref->T_c_w().inverse()});
+    }
+  }
   if (kf) {
     const auto t1 = std::chrono::steady_clock::now();
     mapping_->insert(kf);
@@ -69,6 +76,14 @@ std::vector<geom::StampedPose> System::keyframe_trajectory() {
   std::vector<geom::StampedPose> out;
   for (const auto& [id, kf] : map_.keyframes())
     if (!kf->bad()) out.push_back({kf->t_ns(), kf->T_c_w().inverse()});
+  return out;
+}
+
+std::vector<geom::StampedPose> System::refined_trajectory() {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::vector<geom::StampedPose> out;
+  out.reserve(records_.size());
+  for (const FrameRecord& r : records_) out.push_back({r.t_ns, (r.T_c_r * r.ref->T_c_w_via_tree()).inverse()});
   return out;
 }
 

@@ -133,6 +133,9 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   /// children are re-attached in the spanning tree (ORB-SLAM2 SetBadFlag).
   /// The first keyframe (id 0) is never removed; returns false then.
   bool set_bad();
+  /// World-to-camera pose, for a removed keyframe composed through the
+  /// spanning tree from its pose relative to its parent at removal time.
+  geom::SE3d T_c_w_via_tree() const;
 
  private:
   void update_order();
@@ -145,6 +148,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   std::weak_ptr<KeyFrame> parent_;
   std::map<std::uint64_t, std::weak_ptr<KeyFrame>> children_;
   bool bad_ = false;
+  std::shared_ptr<KeyFrame> removed_parent_;          ///< parent at removal (kept alive for trajectories)
+  geom::SE3d T_c_parent_ = geom::SE3d::Identity();  ///< pose relative to it at removal
 };
 
 /// All keyframes and map points of a run.

@@ -26,6 +26,7 @@ struct FrameResult {
   std::optional<geom::SE3d> T_w_c;  ///< when state == kOk
   TrackingStats tracking;
   double tracking_ms = 0;           ///< extraction + tracking (not inline mapping)
+  double orb_ms = 0;                ///< of which ORB extraction
   double mapping_ms = 0;            ///< inline local mapping (synchronous mode)
   int num_features = 0;
 };
@@ -41,6 +42,9 @@ class System {
   /// Lets local mapping finish its queue and stops the worker.
   void shutdown();
 
+  /// Every tracked frame's pose recomputed from its reference keyframe's
+  /// current (bundle-adjusted) pose, as ORB-SLAM2 saves its trajectory.
+  std::vector<geom::StampedPose> refined_trajectory();
   /// Poses of the keyframes still in the map, by id (T_w_c).
   std::vector<geom::StampedPose> keyframe_trajectory();
   std::size_t num_keyframes();
@@ -56,6 +60,13 @@ class System {
   std::unique_ptr<Tracking> tracking_;
   std::unique_ptr<LocalMapping> mapping_;
   std::uint64_t next_frame_id_ = 0;
+  /// Per tracked frame: time, reference keyframe and T_c_r (for refined_trajectory()).
+  struct FrameRecord {
+    std::int64_t t_ns;
+    std::shared_ptr<KeyFrame> ref;
+    geom::SE3d T_c_r;
+  };
+  std::vector<FrameRecord> records_;
 };
 
 }  // namespace pvb::slam

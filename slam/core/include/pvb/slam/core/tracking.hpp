@@ -54,6 +54,8 @@ class Tracking {
   const TrackingStats& stats() const { return stats_; }
   /// Pose of the last frame tracked (valid when state() == kOk).
   const Frame& last_frame() const { return last_; }
+  /// Reference keyframe of the last frame tracked.
+  std::shared_ptr<KeyFrame> reference_keyframe() const { return ref_kf_; }
 
  private:
   bool initialize(Frame& f);
