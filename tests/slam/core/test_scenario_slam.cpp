@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <regex>
+#include <sstream>
+#include <vector>
 #include <unistd.h>
 
 #include "pvb/common/text.hpp"
@@ -84,6 +86,60 @@ TEST(SlamScenario, SyncModeIsBitIdentical) {
   EXPECT_GT(ta.size(), 1000u);
   EXPECT_EQ(ta, pvb::read_file(b + "/CameraTrajectory.txt"));
   EXPECT_EQ(pvb::read_file(a + "/KeyFrameTrajectory.txt"), pvb::read_file(b + "/KeyFrameTrajectory.txt"));
+}
+
+// Local mapping on its worker thread (the default mode): same accuracy
+// bounds on the first 150 frames, and a clean shutdown.
+TEST(SlamScenario, WorkerThreadModeTracks) {
+  const std::string seq = station_sequence();
+  const std::string out = dir("async");
+  const Result r = run("slam --sequence " + seq + " --settings " + seq + "/camera.yaml --max-frames 150 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string stats = pvb::read_file(out + "/stats.json");
+  EXPECT_EQ(json_number(stats, "frames"), 150);
+  EXPECT_EQ(json_number(stats, "lost_frames"), 0) << stats;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(stats, m, std::regex("\"ate\": *\\{[^}]*\"rmse\": *([-0-9.eE+]+)"))) << stats;
+  EXPECT_LT(std::stod(m[1]), 0.02);
+}
+
+// Baseline mode (--no-pe-match) runs the same pipeline without PE-match.
+TEST(SlamScenario, BaselineModeReportsNoPeMatch) {
+  const std::string seq = station_sequence();
+  const std::string out = dir("base");
+  const Result r = run("slam --sequence " + seq + " --settings " + seq +
+                       "/camera.yaml --sync --no-pe-match --max-frames 60 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string stats = pvb::read_file(out + "/stats.json");
+  EXPECT_NE(stats.find("\"pe_match\": false"), std::string::npos);
+  EXPECT_EQ(json_number(stats, "lost_frames"), 0) << stats;
+  // every motion-model frame keeps all its coarse matches
+  const std::string timing = pvb::read_file(out + "/timing.csv");
+  std::istringstream in(timing);
+  std::string line;
+  std::getline(in, line);
+  int motion = 0;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
+    ASSERT_GE(f.size(), 11u);
+    if (f[3] != "motion") continue;
+    ++motion;
+    EXPECT_EQ(f[8], f[9]) << line;
+  }
+  EXPECT_GT(motion, 50);
+}
+
+TEST(SlamCli, MissingSettingsKeyIsOneClearError) {
+  const std::string seq = station_sequence();
+  const std::string bad = ::testing::TempDir() + "pvb_slam_bad_" + std::to_string(::getpid()) + ".yaml";
+  std::string text = pvb::read_file(seq + "/camera.yaml");
+  text = std::regex_replace(text, std::regex("Camera\\.fy:[^\\n]*\\n"), "");
+  pvb::write_file(bad, text);
+  const Result r = run("slam --sequence " + seq + " --settings " + bad + " --out " + dir("bad"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("Camera.fy"), std::string::npos) << r.output;
 }
 
 }  // namespace
