@@ -31,3 +31,4 @@ TEST(OrientationHistogram, EmptyInput) { EXPECT_TRUE(orientation_consistent({}).
 
 }  // namespace
 }  // namespace pvb::slam
+
