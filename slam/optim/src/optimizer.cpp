@@ -266,7 +266,9 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
 
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &prob, &summary);
-    result.iterations += static_cast<int>(summary.iterations.size()) - 1;  // entry 0 is the initial state
+    // summary.iterations[0] (also counted in num_successful_steps) is the
+    // initial state, not a step.
+    result.iterations += static_cast<int>(summary.iterations.size()) - 1;
     result.converged = summary.termination_type == ceres::CONVERGENCE;
     for (std::size_t k = 0; k < kf_in.size(); ++k) keyframe_used[k] |= kf_in[k];
     for (std::size_t p = 0; p < pt_in.size(); ++p) point_used[p] |= pt_in[p];

@@ -43,7 +43,7 @@ struct PoseOptimizerResult {
   geom::SE3d T_c_w;                 ///< optimised pose
   std::vector<std::uint8_t> inlier; ///< per observation, after the last round
   int num_inliers = 0;
-  double final_cost = 0;
+  double final_cost = 0;            ///< Ceres cost (0.5 sum of rho(chi2)) at the end of the last round
 };
 
 /// Optimises one camera pose against fixed 3-D points (ORB-SLAM2's
