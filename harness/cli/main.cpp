@@ -10,6 +10,7 @@ namespace pvb::cli {
 Command add_record_command(CLI::App& app);
 Command add_eval_command(CLI::App& app);
 Command add_match_command(CLI::App& app);
+Command add_slam_command(CLI::App& app);
 
 // Sub-commands register here (one line each).
 std::vector<Command> add_all_commands(CLI::App& app) {
@@ -17,6 +18,7 @@ std::vector<Command> add_all_commands(CLI::App& app) {
   cmds.push_back(add_record_command(app));
   cmds.push_back(add_eval_command(app));
   cmds.push_back(add_match_command(app));
+  cmds.push_back(add_slam_command(app));
   return cmds;
 }
 }  // namespace pvb::cli

@@ -1,0 +1,92 @@
+#pragma once
+// A tracked image: ORB features with undistorted positions, depth and
+// virtual right coordinate per keypoint, their map-point associations and
+// the camera pose.  A value type: copying shares map points (shared_ptr)
+// and descriptor pixels (cv::Mat), which are never modified in place.
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "pvb/geometry/se3.hpp"
+#include "pvb/slam/features/orb_extractor.hpp"
+#include "pvb/slam/optim/optimizer.hpp"
+
+namespace pvb::slam {
+
+class MapPoint;
+
+/// Camera model shared by all frames of a run (immutable after creation).
+struct CameraModel {
+  StereoIntrinsics K;          ///< fx, fy, cx, cy, bf
+  int width = 640, height = 480;
+  cv::Mat K_cv;                ///< 3x3 CV_64F, for OpenCV calls
+  cv::Mat dist_cv;             ///< 1x5 CV_64F (k1 k2 p1 p2 k3); empty: no distortion
+  double th_depth_m = 3.0;     ///< close/far threshold, metres
+  /// Undistorted image bounds (ORB-SLAM2 ComputeImageBounds).
+  double min_x = 0, max_x = 640, min_y = 0, max_y = 480;
+  /// Scale pyramid: scale_factor^level, its square and inverse square.
+  std::vector<double> scale, level_sigma2, inv_level_sigma2;
+  double log_scale_factor = std::log(1.2);
+  int num_levels = 8;
+  /// Grid for the area search (ORB-SLAM2: 64 x 48 cells over the bounds).
+  static constexpr int kGridCols = 64, kGridRows = 48;
+  double grid_inv_w = 0, grid_inv_h = 0;
+
+  /// Builds the model; dist may be all zero.
+  static CameraModel make(const StereoIntrinsics& K, int width, int height, const std::vector<double>& dist,
+                          double th_depth_m, double scale_factor, int num_levels);
+  bool in_bounds(double u, double v) const { return u >= min_x && u < max_x && v >= min_y && v < max_y; }
+  /// Projection (u, v) of p_c (no check on z).
+  Eigen::Vector2d project(const Eigen::Vector3d& p_c) const {
+    return {K.fx * p_c.x() / p_c.z() + K.cx, K.fy * p_c.y() / p_c.z() + K.cy};
+  }
+  /// Predicted pyramid level of a point at `dist_m` with max distance `max_dist_m`.
+  int predict_scale(double dist_m, double max_dist_m) const;
+};
+
+class Frame {
+ public:
+  Frame() = default;
+  /// Builds a frame from features extracted on the image and the depth map
+  /// (metres, 0 = invalid).
+  Frame(std::uint64_t id, std::int64_t t_ns, OrbFeatures features, const cv::Mat& depth_m,
+        std::shared_ptr<const CameraModel> cam);
+
+  std::size_t size() const { return keys_un.size(); }
+  /// Indices of keypoints within radius_px of (u, v) with octave in
+  /// [min_level, max_level] (max_level < 0: any).
+  std::vector<std::size_t> features_in_area(double u, double v, double radius_px, int min_level = -1,
+                                            int max_level = -1) const;
+  /// World point of keypoint i from its depth; precondition depth_m[i] > 0.
+  Eigen::Vector3d unproject_world(std::size_t i) const;
+  /// Observation of keypoint i for the optimiser.
+  Observation observation(std::size_t i) const;
+  Eigen::Vector3d camera_center_w() const { return T_c_w.inverse().translation(); }
+  /// Number of keypoints with a map point.
+  int num_tracked() const;
+
+  std::uint64_t id = 0;
+  std::int64_t t_ns = 0;
+  std::shared_ptr<const CameraModel> cam;
+  std::vector<cv::KeyPoint> keys;     ///< as detected (distorted)
+  std::vector<cv::KeyPoint> keys_un;  ///< undistorted
+  cv::Mat descriptors;                ///< N x 32 CV_8U
+  std::vector<float> depth_m;         ///< per keypoint, <= 0 invalid
+  std::vector<float> u_right;         ///< u - bf / depth, < 0 when no depth
+  std::vector<std::shared_ptr<MapPoint>> map_points;  ///< per keypoint, may be null
+  std::vector<std::uint8_t> outlier;  ///< per keypoint, set by pose optimisation
+  geom::SE3d T_c_w = geom::SE3d::Identity();
+  bool has_pose = false;
+
+ private:
+  std::vector<std::vector<std::uint32_t>> grid_;  ///< keypoint indices per cell, row-major
+};
+
+/// Hamming distance of two 32-byte descriptors.
+int descriptor_distance(const cv::Mat& a, const cv::Mat& b);
+int descriptor_distance(const unsigned char* a, const unsigned char* b);
+
+}  // namespace pvb::slam

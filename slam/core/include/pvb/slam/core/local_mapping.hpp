@@ -1,0 +1,123 @@
+#pragma once
+// Local mapping (ORB-SLAM2 LocalMapping): keyframe insertion, culling of
+// recent map points, new points by triangulation with neighbours, fusion
+// of duplicates, local bundle adjustment and culling of redundant
+// keyframes.  Synchronous mode runs each keyframe inline on the caller's
+// thread; otherwise a worker thread started with start() takes keyframes
+// from a closable blocking queue until stop().
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <list>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "pvb/slam/core/map.hpp"
+
+namespace pvb::slam {
+
+/// A blocking FIFO that can be closed: pop() waits for an item and returns
+/// nullopt once the queue is closed and drained.
+template <typename T>
+class ClosableQueue {
+ public:
+  /// Returns false (and drops the item) when the queue is closed.
+  bool push(T item) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (closed_) return false;
+      items_.push_back(std::move(item));
+    }
+    cv_.notify_one();
+    return true;
+  }
+  std::optional<T> pop() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait(lock, [&] { return closed_ || !items_.empty(); });
+    if (items_.empty()) return std::nullopt;
+    T item = std::move(items_.front());
+    items_.pop_front();
+    return item;
+  }
+  void close() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      closed_ = true;
+    }
+    cv_.notify_all();
+  }
+  std::size_t size() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return items_.size();
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<T> items_;
+  bool closed_ = false;
+};
+
+struct LocalMappingOptions {
+  int covisible_for_triangulation = 10;  ///< neighbours searched for new points (RGB-D: 10)
+  double redundant_ratio = 0.9;          ///< keyframe culling: share of points seen by >= 3 others
+  int redundant_observers = 3;
+  bool local_ba = true;
+};
+
+/// Map-point culling rule (ORB-SLAM2 MapPointCulling, RGB-D): returns
+/// kErase for a point to remove, kKeep to keep watching, kDone when it has
+/// survived its trial period.
+enum class CullDecision { kKeep, kErase, kDone };
+CullDecision recent_point_rule(double found_ratio, int num_observations, std::uint64_t first_kf_id,
+                               std::uint64_t current_kf_id);
+
+/// Keyframe culling rule: a keyframe is redundant when more than `ratio` of
+/// its close points (depth in (0, th_depth]) with more than 3 observations
+/// are seen by at least `observers` other keyframes at the same or a finer
+/// scale.  Exposed for tests.
+bool is_redundant_keyframe(const KeyFrame& kf, double th_depth_m, double ratio = 0.9, int observers = 3);
+
+class LocalMapping {
+ public:
+  LocalMapping(Map& map, std::shared_ptr<const CameraModel> cam, const LocalMappingOptions& options = {});
+  ~LocalMapping();
+  LocalMapping(const LocalMapping&) = delete;
+  LocalMapping& operator=(const LocalMapping&) = delete;
+
+  /// Starts the worker thread (asynchronous mode).
+  void start();
+  /// Processes the keyframes still queued, then joins the worker.
+  void stop();
+  bool running() const { return worker_.joinable(); }
+
+  /// Hands a keyframe over: processed now (synchronous) or queued.
+  void insert(std::shared_ptr<KeyFrame> kf);
+  /// True when no keyframe is waiting or being processed.
+  bool idle() const { return pending_.load() == 0; }
+  std::size_t queue_size() const { return queue_.size(); }
+
+  /// Processes one keyframe (takes the map lock as needed).
+  void process(const std::shared_ptr<KeyFrame>& kf);
+
+ private:
+  void run();
+  void process_new_keyframe(const std::shared_ptr<KeyFrame>& kf);
+  void cull_recent_points(const std::shared_ptr<KeyFrame>& kf);
+  void create_new_points(const std::shared_ptr<KeyFrame>& kf);
+  void fuse_with_neighbors(const std::shared_ptr<KeyFrame>& kf);
+  void local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf);
+  void cull_keyframes(const std::shared_ptr<KeyFrame>& kf);
+
+  Map& map_;
+  std::shared_ptr<const CameraModel> cam_;
+  LocalMappingOptions options_;
+  std::list<std::shared_ptr<MapPoint>> recent_points_;  ///< points on trial
+  ClosableQueue<std::shared_ptr<KeyFrame>> queue_;
+  std::atomic<int> pending_{0};  ///< keyframes inserted and not yet processed
+  std::thread worker_;
+};
+
+}  // namespace pvb::slam

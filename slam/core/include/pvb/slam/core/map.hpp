@@ -1,0 +1,183 @@
+#pragma once
+// The sparse map: map points, keyframes, the covisibility graph and the
+// spanning tree.  The Map owns both kinds (shared_ptr); keyframes hold their
+// map points (shared_ptr) and map points refer back weakly (weak_ptr), so
+// nothing leaks.  Containers are ordered by id so that every traversal is
+// deterministic.  Per-run scratch state (which frame last saw a point, which
+// keyframes are in the current local BA) lives in the algorithm objects.
+//
+// Thread safety: the tracker and the local mapper take Map::mutex() around
+// every read or write of map data; the objects themselves have no locks.
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "pvb/slam/core/frame.hpp"
+
+namespace pvb::slam {
+
+class KeyFrame;
+
+/// A 3-D landmark.
+class MapPoint {
+ public:
+  MapPoint(std::uint64_t id, const Eigen::Vector3d& p_w, const std::shared_ptr<KeyFrame>& ref_kf);
+
+  std::uint64_t id() const { return id_; }
+  const Eigen::Vector3d& p_w() const { return p_w_; }
+  void set_p_w(const Eigen::Vector3d& p) { p_w_ = p; }
+  bool bad() const { return bad_; }
+  /// The point that replaced this one after fusion (null when none);
+  /// follows the chain to the newest.
+  std::shared_ptr<MapPoint> replaced() const;
+
+  /// Observations: keyframe id -> (keyframe, keypoint index), ordered by id.
+  struct Obs {
+    std::weak_ptr<KeyFrame> kf;
+    std::size_t idx = 0;
+  };
+  const std::map<std::uint64_t, Obs>& observations() const { return obs_; }
+  int num_observations() const { return num_obs_; }
+  void add_observation(const std::shared_ptr<KeyFrame>& kf, std::size_t idx);
+  /// Removes the observation of keyframe kf_id; marks the point bad (and
+  /// detaches it) when two or fewer observations remain (RGB-D counts 2 each).
+  void erase_observation(std::uint64_t kf_id);
+  /// Keypoint index in keyframe kf_id, or -1.
+  long index_in(std::uint64_t kf_id) const;
+  /// Marks bad and removes it from all observing keyframes (not from the Map:
+  /// Map::erase_point does both).
+  void set_bad();
+  /// Replaces this point by `other` in every observing keyframe.
+  void replace(const std::shared_ptr<MapPoint>& other, const std::shared_ptr<MapPoint>& self);
+
+  const cv::Mat& descriptor() const { return descriptor_; }
+  /// Chooses the observation descriptor with the least median distance to
+  /// the others (ORB-SLAM2 ComputeDistinctiveDescriptors).
+  void compute_distinctive_descriptor();
+  /// Mean viewing direction and the scale-invariance distance range.
+  void update_normal_and_depth();
+  const Eigen::Vector3d& normal() const { return normal_; }
+  double min_distance() const { return 0.8 * min_dist_m_; }
+  double max_distance() const { return 1.2 * max_dist_m_; }
+
+  std::shared_ptr<KeyFrame> reference_keyframe() const { return ref_kf_.lock(); }
+  std::uint64_t first_kf_id() const { return first_kf_id_; }
+
+  /// Tracking statistics: frames where the point was predicted visible and
+  /// where it was matched (ORB-SLAM2 mnVisible, mnFound).
+  void increase_visible(int n = 1) { visible_ += n; }
+  void increase_found(int n = 1) { found_ += n; }
+  double found_ratio() const { return visible_ > 0 ? static_cast<double>(found_) / visible_ : 0.0; }
+  int visible() const { return visible_; }
+  int found() const { return found_; }
+
+ private:
+  std::uint64_t id_;
+  Eigen::Vector3d p_w_;
+  std::map<std::uint64_t, Obs> obs_;
+  int num_obs_ = 0;
+  cv::Mat descriptor_;
+  Eigen::Vector3d normal_ = Eigen::Vector3d::Zero();
+  double min_dist_m_ = 0, max_dist_m_ = 0;
+  std::weak_ptr<KeyFrame> ref_kf_;
+  std::uint64_t first_kf_id_ = 0;
+  int visible_ = 1, found_ = 1;
+  bool bad_ = false;
+  std::shared_ptr<MapPoint> replaced_;
+};
+
+/// A keyframe: a frozen frame plus its place in the covisibility graph and
+/// the spanning tree.
+class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
+ public:
+  KeyFrame(std::uint64_t id, const Frame& frame);
+
+  std::uint64_t id() const { return id_; }
+  std::uint64_t frame_id() const { return frame_.id; }
+  std::int64_t t_ns() const { return frame_.t_ns; }
+  const Frame& frame() const { return frame_; }
+  const geom::SE3d& T_c_w() const { return frame_.T_c_w; }
+  void set_T_c_w(const geom::SE3d& T) { frame_.T_c_w = T; }
+  Eigen::Vector3d camera_center_w() const { return frame_.camera_center_w(); }
+  bool bad() const { return bad_; }
+
+  /// Map points per keypoint (null where none).
+  const std::vector<std::shared_ptr<MapPoint>>& map_points() const { return frame_.map_points; }
+  void set_map_point(std::size_t idx, std::shared_ptr<MapPoint> mp) { frame_.map_points[idx] = std::move(mp); }
+  /// Good points with at least min_obs observations.
+  int num_tracked_points(int min_obs) const;
+
+  // Covisibility graph ------------------------------------------------------
+  /// Recomputes the edges from shared map points (weight >= 15, or the best
+  /// one), updates the other ends, and on first call attaches this keyframe
+  /// to the spanning tree under its strongest neighbour.
+  void update_connections();
+  void add_connection(const std::shared_ptr<KeyFrame>& kf, int weight);
+  void erase_connection(std::uint64_t kf_id);
+  /// Neighbours sorted by weight (descending, then id ascending); at most n (n < 0: all).
+  std::vector<std::shared_ptr<KeyFrame>> best_covisibles(int n) const;
+  int weight(std::uint64_t kf_id) const;
+
+  // Spanning tree -----------------------------------------------------------
+  std::shared_ptr<KeyFrame> parent() const { return parent_.lock(); }
+  std::vector<std::shared_ptr<KeyFrame>> children() const;
+  void add_child(const std::shared_ptr<KeyFrame>& kf);
+  void erase_child(std::uint64_t kf_id);
+  void change_parent(const std::shared_ptr<KeyFrame>& kf);
+
+  /// Removes the keyframe from the graph: its map points forget it, its
+  /// children are re-attached in the spanning tree (ORB-SLAM2 SetBadFlag).
+  /// The first keyframe (id 0) is never removed; returns false then.
+  bool set_bad();
+  /// World-to-camera pose, for a removed keyframe composed through the
+  /// spanning tree from its pose relative to its parent at removal time.
+  geom::SE3d T_c_w_via_tree() const;
+
+ private:
+  void update_order();
+
+  std::uint64_t id_;
+  Frame frame_;
+  std::map<std::uint64_t, std::pair<std::weak_ptr<KeyFrame>, int>> connections_;
+  std::vector<std::pair<int, std::uint64_t>> ordered_;  ///< (weight, id) sorted
+  bool first_connection_ = true;
+  std::weak_ptr<KeyFrame> parent_;
+  std::map<std::uint64_t, std::weak_ptr<KeyFrame>> children_;
+  bool bad_ = false;
+  std::shared_ptr<KeyFrame> removed_parent_;          ///< parent at removal (kept alive for trajectories)
+  geom::SE3d T_c_parent_ = geom::SE3d::Identity();  ///< pose relative to it at removal
+};
+
+/// All keyframes and map points of a run.
+class Map {
+ public:
+  std::mutex& mutex() { return mutex_; }
+
+  std::shared_ptr<KeyFrame> create_keyframe(const Frame& frame);
+  std::shared_ptr<MapPoint> create_point(const Eigen::Vector3d& p_w, const std::shared_ptr<KeyFrame>& ref_kf);
+  /// Marks a point bad and removes it from the map.
+  void erase_point(const std::shared_ptr<MapPoint>& mp);
+  /// Marks a keyframe bad and removes it from the map (not the first one).
+  bool erase_keyframe(const std::shared_ptr<KeyFrame>& kf);
+  /// Drops points that were marked bad elsewhere (e.g. by erase_observation).
+  void remove_bad_points();
+
+  const std::map<std::uint64_t, std::shared_ptr<KeyFrame>>& keyframes() const { return keyframes_; }
+  const std::map<std::uint64_t, std::shared_ptr<MapPoint>>& points() const { return points_; }
+  std::size_t num_keyframes() const { return keyframes_.size(); }
+  std::size_t num_points() const { return points_.size(); }
+  void clear();
+
+ private:
+  std::mutex mutex_;
+  std::map<std::uint64_t, std::shared_ptr<KeyFrame>> keyframes_;
+  std::map<std::uint64_t, std::shared_ptr<MapPoint>> points_;
+  std::uint64_t next_kf_id_ = 0;
+  std::uint64_t next_point_id_ = 0;
+};
+
+}  // namespace pvb::slam

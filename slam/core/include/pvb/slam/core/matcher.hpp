@@ -1,0 +1,69 @@
+#pragma once
+// Descriptor matching guided by geometry (ORB-SLAM2 ORBmatcher, without the
+// bag of words): projection of the last frame's points under the motion
+// model, projection of local map points, brute force against a keyframe,
+// fusion of duplicates and the epipolar search for triangulation.
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "pvb/slam/core/map.hpp"
+
+namespace pvb::slam {
+
+constexpr int kThHigh = 100;     ///< ORB-SLAM2 TH_HIGH, bits
+constexpr int kThLow = 50;       ///< ORB-SLAM2 TH_LOW, bits
+constexpr int kHistoLength = 30; ///< orientation histogram bins
+
+/// A match between keypoint `i1` of one image and `i2` of another.
+struct IndexMatch {
+  std::size_t i1 = 0;
+  std::size_t i2 = 0;
+};
+
+/// Orientation consistency (paper sec. 3 step 4): histogram of the angle
+/// differences in 30 bins; matches outside the three largest bins (the
+/// second and third only if >= 10 % of the largest) are flagged false.
+std::vector<std::uint8_t> orientation_consistent(const std::vector<float>& angle_diff_deg);
+
+/// Motion-model search (paper sec. 3 steps 1-4): projects the map points of
+/// `last` into `cur` (whose T_c_w is the predicted pose), searches a window
+/// of th x scale(octave) px, keeps the best candidate when its distance is
+/// <= TH_HIGH and < ratio x the second best, then applies the orientation
+/// check.  Sets cur.map_points and returns the matches (last idx, cur idx).
+std::vector<IndexMatch> search_by_projection(Frame& cur, const Frame& last, double th, double ratio);
+
+/// Per-point data of a local map point predicted visible in a frame.
+struct ProjectedPoint {
+  std::shared_ptr<MapPoint> mp;
+  double u = 0, v = 0, u_right = 0;  ///< predicted projection
+  int level = 0;                     ///< predicted pyramid level
+  double view_cos = 1;               ///< cosine of the viewing angle to the mean normal
+};
+/// Predicts where a map point appears in `frame` (ORB-SLAM2 isInFrustum with
+/// the 0.5 viewing-cosine limit); false when it cannot be seen.
+bool project_in_frustum(const Frame& frame, const std::shared_ptr<MapPoint>& mp, ProjectedPoint* out);
+
+/// Local map search: matches the projected points into free keypoints of
+/// `cur` within th x (2.5 or 4) x scale px, ratio 0.8 between candidates of
+/// the same level.  Returns the number of new matches.
+int search_local_points(Frame& cur, const std::vector<ProjectedPoint>& points, double th);
+
+/// Brute force between the map points of `kf` and the keypoints of `cur`
+/// (replaces ORB-SLAM2's bag-of-words search): best <= max_distance and
+/// < ratio x second best, orientation check.  Sets cur.map_points.
+int search_keyframe_bruteforce(const KeyFrame& kf, Frame& cur, int max_distance, double ratio);
+
+/// Projects `points` into keyframe kf and fuses: an empty keypoint gets the
+/// observation, an occupied one keeps the point with more observations.
+/// Returns the number of fused points.
+int fuse(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::vector<std::shared_ptr<MapPoint>>& points,
+         double th = 3.0);
+
+/// Epipolar search between the unmatched keypoints of kf1 and kf2 for
+/// triangulation: descriptor distance <= TH_LOW, distance to the epipolar
+/// line within the 95 % chi-square bound, not too close to the epipole,
+/// orientation check.
+std::vector<IndexMatch> search_for_triangulation(const KeyFrame& kf1, const KeyFrame& kf2);
+
+}  // namespace pvb::slam

@@ -1,0 +1,49 @@
+#pragma once
+// SLAM settings: ORB-SLAM2 RGB-D YAML files read unchanged (Camera.*,
+// ThDepth, DepthMapFactor, ORBextractor.*) plus an optional PEMatch.*
+// section.  A missing required key is a pvb::ConfigError naming it; an
+// unknown key is a warning (returned, not printed: the app prints it).
+#include <string>
+#include <vector>
+
+#include "pvb/geometry/pinhole.hpp"
+#include "pvb/slam/features/orb_extractor.hpp"
+
+namespace pvb::slam {
+
+/// PEMatch.* section; defaults are the paper's SLAM values (sec. 5.2.2).
+struct PeMatchSettings {
+  bool enabled = true;             ///< PEMatch.enabled (0/1): off = ORB-SLAM2 baseline motion model
+  int population = 20;             ///< PEMatch.population: particles
+  int num_fitness_samples = 50;    ///< PEMatch.j: matches scored per fitness evaluation
+  int stall_iterations = 6;        ///< PEMatch.stallIterations: stop after this many without improvement
+  double threshold_px = 3.0;       ///< PEMatch.threshold: epipolar distance threshold, pixels
+  bool refine = false;             ///< PEMatch.refine (0/1): IRLS refinement of gbest's F
+};
+
+/// Everything the SLAM system reads from its settings file.
+struct Settings {
+  std::string source;               ///< file it came from
+  geom::PinholeIntrinsics K;        ///< Camera.fx/fy/cx/cy/width/height
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;  ///< OpenCV radial-tangential distortion
+  double fps = 30.0;                ///< Camera.fps
+  double bf = 40.0;                 ///< Camera.bf: virtual baseline (m) x fx (pixels)
+  bool rgb_order = true;            ///< Camera.RGB: true = colour images are R,G,B
+  double th_depth = 40.0;           ///< ThDepth: close/far threshold in baselines
+  double depth_map_factor = 5000.0; ///< DepthMapFactor: raw depth units per metre
+  OrbParams orb;                    ///< ORBextractor.*
+  PeMatchSettings pe_match;         ///< PEMatch.* (optional section)
+  std::vector<std::string> warnings;  ///< unknown keys and similar, one line each
+
+  /// Close/far depth threshold in metres (ORB-SLAM2: bf * ThDepth / fx).
+  double th_depth_m() const { return bf * th_depth / K.fx; }
+  /// True when any distortion coefficient is non-zero.
+  bool has_distortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }
+};
+
+/// Reads an ORB-SLAM2 RGB-D settings file.  Throws IoError when the file
+/// cannot be opened or parsed and ConfigError naming the first missing or
+/// invalid key.
+Settings read_settings(const std::string& path);
+
+}  // namespace pvb::slam

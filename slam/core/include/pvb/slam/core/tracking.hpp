@@ -1,0 +1,98 @@
+#pragma once
+// Tracking (ORB-SLAM2 Tracking for RGB-D) with PE-match in the motion model
+// (paper sec. 3).  Runs on the caller's thread; takes Map::mutex() while it
+// reads or writes the map.  Loss of tracking is a state, never an error.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <set>
+#include <vector>
+
+#include "pvb/slam/core/map.hpp"
+#include "pvb/slam/core/matcher.hpp"
+#include "pvb/slam/core/settings.hpp"
+#include "pvb/slam/pematch/pe_match.hpp"
+
+namespace pvb::slam {
+
+enum class TrackingState { kNotInitialized, kOk, kLost };
+const char* to_string(TrackingState s);
+
+/// How the pose of a frame was found.
+enum class TrackingMethod { kNone, kInitialization, kMotionModel, kReferenceKeyFrame, kRelocalization };
+
+/// Per-frame figures for timing.csv and the tests.
+struct TrackingStats {
+  TrackingMethod method = TrackingMethod::kNone;
+  int coarse_matches = 0;       ///< motion-model matches after the orientation check
+  int matches_kept = 0;         ///< after PE-match (== coarse without it)
+  double pe_match_ms = 0;       ///< time in PE-match
+  int inliers = 0;              ///< map-point inliers after the local-map optimisation
+  bool new_keyframe = false;
+};
+
+struct TrackingOptions {
+  bool use_pe_match = true;    ///< false: ORB-SLAM2 baseline motion model
+  PeMatchParams pe_match = PeMatchParams::for_slam();
+  double motion_th = 7.0;      ///< ORB-SLAM2 window for stereo / RGB-D, x scale of the octave
+  double motion_ratio = 0.9;   ///< paper sec. 3 step 1
+  int min_init_points = 500;   ///< keypoints with depth needed to initialise
+  int max_frames = 30;         ///< keyframe spacing limit (= fps)
+  int min_frames = 0;
+};
+
+class Tracking {
+ public:
+  Tracking(Map& map, std::shared_ptr<const CameraModel> cam, const TrackingOptions& options);
+
+  /// Tracks one frame (features extracted).  `mapping_idle` and
+  /// `mapping_queue` describe the local mapper for the keyframe decision.
+  /// Returns the new keyframe when one was created (for the local mapper).
+  std::shared_ptr<KeyFrame> track(Frame frame, bool mapping_idle, std::size_t mapping_queue);
+
+  TrackingState state() const { return state_; }
+  const TrackingStats& stats() const { return stats_; }
+  /// Pose of the last frame tracked (valid when state() == kOk).
+  const Frame& last_frame() const { return last_; }
+  /// Reference keyframe of the last frame tracked.
+  std::shared_ptr<KeyFrame> reference_keyframe() const { return ref_kf_; }
+
+ private:
+  bool initialize(Frame& f);
+  bool track_with_motion_model(Frame& f);
+  bool track_reference_keyframe(Frame& f);
+  bool relocalize(Frame& f);
+  bool track_local_map(Frame& f);
+  void update_last_frame();
+  void update_local_map(const Frame& f);
+  bool need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue) const;
+  std::shared_ptr<KeyFrame> create_keyframe(Frame& f);
+  /// Pose-only optimisation of f against its map points; marks outliers and
+  /// returns the inlier count.
+  int optimize(Frame& f);
+  void discard_outliers(Frame& f, int* map_matches);
+  void replace_in_last_frame();
+
+  Map& map_;
+  std::shared_ptr<const CameraModel> cam_;
+  TrackingOptions options_;
+  PeMatcher pe_matcher_;
+  TrackingState state_ = TrackingState::kNotInitialized;
+  TrackingStats stats_;
+
+  Frame last_;
+  bool last_is_keyframe_ = false;
+  std::optional<geom::SE3d> velocity_;          ///< T_c_w(k) * T_c_w(k-1)^-1
+  std::shared_ptr<KeyFrame> ref_kf_;
+  geom::SE3d T_last_ref_ = geom::SE3d::Identity();  ///< last frame relative to its reference keyframe
+  std::uint64_t last_kf_frame_id_ = 0;
+  std::uint64_t last_reloc_frame_id_ = 0;
+  int matches_inliers_ = 0;
+  std::uint64_t next_temp_point_id_ = std::uint64_t(1) << 62;  ///< ids of visual-odometry points (not in the map)
+
+  // Local map (scratch state of this algorithm, rebuilt per frame)
+  std::vector<std::shared_ptr<KeyFrame>> local_kfs_;
+  std::vector<std::shared_ptr<MapPoint>> local_points_;
+};
+
+}  // namespace pvb::slam

@@ -1,0 +1,146 @@
+#include "pvb/slam/core/frame.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <opencv2/calib3d.hpp>
+
+#include "pvb/slam/core/map.hpp"
+
+namespace pvb::slam {
+
+CameraModel CameraModel::make(const StereoIntrinsics& K, int width, int height, const std::vector<double>& dist,
+                              double th_depth_m, double scale_factor, int num_levels) {
+  CameraModel c;
+  c.K = K;
+  c.width = width;
+  c.height = height;
+  c.th_depth_m = th_depth_m;
+  c.K_cv = (cv::Mat_<double>(3, 3) << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
+  const bool distorted = std::any_of(dist.begin(), dist.end(), [](double d) { return d != 0; });
+  if (distorted) c.dist_cv = cv::Mat(dist, true).reshape(1, 1);
+  c.min_x = 0;
+  c.max_x = width;
+  c.min_y = 0;
+  c.max_y = height;
+  if (distorted) {
+    std::vector<cv::Point2f> corners = {{0, 0}, {float(width), 0}, {0, float(height)}, {float(width), float(height)}};
+    std::vector<cv::Point2f> un;
+    cv::undistortPoints(corners, un, c.K_cv, c.dist_cv, cv::noArray(), c.K_cv);
+    c.min_x = std::min(un[0].x, un[2].x);
+    c.max_x = std::max(un[1].x, un[3].x);
+    c.min_y = std::min(un[0].y, un[1].y);
+    c.max_y = std::max(un[2].y, un[3].y);
+  }
+  c.grid_inv_w = kGridCols / (c.max_x - c.min_x);
+  c.grid_inv_h = kGridRows / (c.max_y - c.min_y);
+  c.num_levels = num_levels;
+  c.log_scale_factor = std::log(scale_factor);
+  double s = 1.0;
+  for (int l = 0; l < num_levels; ++l) {
+    c.scale.push_back(s);
+    c.level_sigma2.push_back(s * s);
+    c.inv_level_sigma2.push_back(1.0 / (s * s));
+    s *= scale_factor;
+  }
+  return c;
+}
+
+int CameraModel::predict_scale(double dist_m, double max_dist_m) const {
+  const double ratio = max_dist_m / dist_m;
+  int level = static_cast<int>(std::ceil(std::log(ratio) / log_scale_factor));
+  return std::clamp(level, 0, num_levels - 1);
+}
+
+Frame::Frame(std::uint64_t frame_id, std::int64_t time_ns, OrbFeatures features, const cv::Mat& depth,
+             std::shared_ptr<const CameraModel> camera)
+    : id(frame_id), t_ns(time_ns), cam(std::move(camera)) {
+  keys = std::move(features.keypoints);
+  descriptors = features.descriptors;
+  const std::size_t n = keys.size();
+  keys_un = keys;
+  if (!cam->dist_cv.empty() && n > 0) {
+    std::vector<cv::Point2f> pts(n), un;
+    for (std::size_t i = 0; i < n; ++i) pts[i] = keys[i].pt;
+    cv::undistortPoints(pts, un, cam->K_cv, cam->dist_cv, cv::noArray(), cam->K_cv);
+    for (std::size_t i = 0; i < n; ++i) keys_un[i].pt = un[i];
+  }
+  depth_m.assign(n, -1.0f);
+  u_right.assign(n, -1.0f);
+  for (std::size_t i = 0; i < n; ++i) {
+    // depth is read at the distorted (image) position, as ORB-SLAM2 does
+    const int u = static_cast<int>(std::lround(keys[i].pt.x));
+    const int v = static_cast<int>(std::lround(keys[i].pt.y));
+    if (u < 0 || v < 0 || u >= depth.cols || v >= depth.rows) continue;
+    const float d = depth.at<float>(v, u);
+    if (d > 0 && std::isfinite(d)) {
+      depth_m[i] = d;
+      u_right[i] = static_cast<float>(keys_un[i].pt.x - cam->K.bf / d);
+    }
+  }
+  map_points.assign(n, nullptr);
+  outlier.assign(n, 0);
+  grid_.assign(CameraModel::kGridCols * CameraModel::kGridRows, {});
+  for (std::size_t i = 0; i < n; ++i) {
+    const int cx = static_cast<int>(std::floor((keys_un[i].pt.x - cam->min_x) * cam->grid_inv_w));
+    const int cy = static_cast<int>(std::floor((keys_un[i].pt.y - cam->min_y) * cam->grid_inv_h));
+    if (cx < 0 || cy < 0 || cx >= CameraModel::kGridCols || cy >= CameraModel::kGridRows) continue;
+    grid_[cy * CameraModel::kGridCols + cx].push_back(static_cast<std::uint32_t>(i));
+  }
+}
+
+std::vector<std::size_t> Frame::features_in_area(double u, double v, double r, int min_level, int max_level) const {
+  std::vector<std::size_t> out;
+  const int c0 = std::max(0, static_cast<int>(std::floor((u - cam->min_x - r) * cam->grid_inv_w)));
+  const int c1 = std::min(CameraModel::kGridCols - 1, static_cast<int>(std::ceil((u - cam->min_x + r) * cam->grid_inv_w)));
+  const int r0 = std::max(0, static_cast<int>(std::floor((v - cam->min_y - r) * cam->grid_inv_h)));
+  const int r1 = std::min(CameraModel::kGridRows - 1, static_cast<int>(std::ceil((v - cam->min_y + r) * cam->grid_inv_h)));
+  if (c0 > c1 || r0 > r1 || grid_.empty()) return out;
+  for (int gy = r0; gy <= r1; ++gy)
+    for (int gx = c0; gx <= c1; ++gx)
+      for (std::uint32_t i : grid_[gy * CameraModel::kGridCols + gx]) {
+        const cv::KeyPoint& k = keys_un[i];
+        if (min_level >= 0 && k.octave < min_level) continue;
+        if (max_level >= 0 && k.octave > max_level) continue;
+        const double dx = k.pt.x - u, dy = k.pt.y - v;
+        if (std::abs(dx) < r && std::abs(dy) < r) out.push_back(i);
+      }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+Eigen::Vector3d Frame::unproject_world(std::size_t i) const {
+  const double z = depth_m[i];
+  const Eigen::Vector3d p_c((keys_un[i].pt.x - cam->K.cx) * z / cam->K.fx, (keys_un[i].pt.y - cam->K.cy) * z / cam->K.fy,
+                            z);
+  return T_c_w.inverse() * p_c;
+}
+
+Observation Frame::observation(std::size_t i) const {
+  Observation o;
+  o.uv = Eigen::Vector2d(keys_un[i].pt.x, keys_un[i].pt.y);
+  o.u_right = u_right[i];
+  o.inv_sigma2 = cam->inv_level_sigma2[keys_un[i].octave];
+  return o;
+}
+
+int Frame::num_tracked() const {
+  int n = 0;
+  for (const auto& mp : map_points) n += (mp != nullptr);
+  return n;
+}
+
+int descriptor_distance(const unsigned char* a, const unsigned char* b) {
+  int d = 0;
+  for (int k = 0; k < 32; k += 8) {
+    std::uint64_t x, y;
+    std::memcpy(&x, a + k, 8);
+    std::memcpy(&y, b + k, 8);
+    d += __builtin_popcountll(x ^ y);
+  }
+  return d;
+}
+
+int descriptor_distance(const cv::Mat& a, const cv::Mat& b) { return descriptor_distance(a.ptr<unsigned char>(0), b.ptr<unsigned char>(0)); }
+
+}  // namespace pvb::slam

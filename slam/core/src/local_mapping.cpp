@@ -1,0 +1,296 @@
+#include "pvb/slam/core/local_mapping.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "pvb/slam/core/matcher.hpp"
+#include "pvb/slam/optim/optimizer.hpp"
+
+namespace pvb::slam {
+
+CullDecision recent_point_rule(double found_ratio, int num_observations, std::uint64_t first_kf_id,
+                               std::uint64_t current_kf_id) {
+  constexpr int kThObs = 3;  // stereo / RGB-D
+  if (found_ratio < 0.25) return CullDecision::kErase;
+  if (current_kf_id >= first_kf_id + 2 && num_observations <= kThObs) return CullDecision::kErase;
+  if (current_kf_id >= first_kf_id + 3) return CullDecision::kDone;
+  return CullDecision::kKeep;
+}
+
+bool is_redundant_keyframe(const KeyFrame& kf, double th_depth_m, double ratio, int observers) {
+  const Frame& f = kf.frame();
+  int num_points = 0, redundant = 0;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    const auto& mp = f.map_points[i];
+    if (!mp || mp->bad()) continue;
+    if (f.depth_m[i] > th_depth_m || f.depth_m[i] <= 0) continue;
+    ++num_points;
+    if (mp->num_observations() <= observers) continue;
+    const int level = f.keys_un[i].octave;
+    int n = 0;
+    for (const auto& [kid, o] : mp->observations()) {
+      if (kid == kf.id()) continue;
+      auto other = o.kf.lock();
+      if (!other || other->bad()) continue;
+      if (other->frame().keys_un[o.idx].octave <= level + 1 && ++n >= observers) break;
+    }
+    if (n >= observers) ++redundant;
+  }
+  return num_points > 0 && redundant > ratio * num_points;
+}
+
+LocalMapping::LocalMapping(Map& map, std::shared_ptr<const CameraModel> cam, const LocalMappingOptions& options)
+    : map_(map), cam_(std::move(cam)), options_(options) {}
+
+LocalMapping::~LocalMapping() { stop(); }
+
+void LocalMapping::start() {
+  if (worker_.joinable()) return;
+  worker_ = std::thread([this] { run(); });
+}
+
+void LocalMapping::stop() {
+  queue_.close();
+  if (worker_.joinable()) worker_.join();
+}
+
+void LocalMapping::insert(std::shared_ptr<KeyFrame> kf) {
+  ++pending_;
+  if (worker_.joinable()) {
+    if (!queue_.push(std::move(kf))) --pending_;
+  } else {
+    process(kf);
+  }
+}
+
+void LocalMapping::run() {
+  while (auto kf = queue_.pop()) process(*kf);
+}
+
+void LocalMapping::process(const std::shared_ptr<KeyFrame>& kf) {
+  {
+    std::lock_guard<std::mutex> lock(map_.mutex());
+    process_new_keyframe(kf);
+    cull_recent_points(kf);
+    create_new_points(kf);
+    if (queue_.size() == 0) fuse_with_neighbors(kf);
+  }
+  if (queue_.size() == 0) {
+    if (options_.local_ba) local_bundle_adjustment(kf);
+    std::lock_guard<std::mutex> lock(map_.mutex());
+    cull_keyframes(kf);
+  }
+  --pending_;
+}
+
+void LocalMapping::process_new_keyframe(const std::shared_ptr<KeyFrame>& kf) {
+  const auto& pts = kf->map_points();
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const auto mp = pts[i];
+    if (!mp) continue;
+    if (mp->bad()) {
+      kf->set_map_point(i, nullptr);
+      continue;
+    }
+    if (mp->index_in(kf->id()) < 0) {
+      mp->add_observation(kf, i);
+      mp->update_normal_and_depth();
+      mp->compute_distinctive_descriptor();
+    } else if (mp->first_kf_id() == kf->id()) {
+      recent_points_.push_back(mp);  // created from this keyframe's depth
+    }
+  }
+  kf->update_connections();
+}
+
+void LocalMapping::cull_recent_points(const std::shared_ptr<KeyFrame>& kf) {
+  for (auto it = recent_points_.begin(); it != recent_points_.end();) {
+    const auto& mp = *it;
+    if (mp->bad()) {
+      it = recent_points_.erase(it);
+      continue;
+    }
+    switch (recent_point_rule(mp->found_ratio(), mp->num_observations(), mp->first_kf_id(), kf->id())) {
+      case CullDecision::kErase:
+        map_.erase_point(mp);
+        it = recent_points_.erase(it);
+        break;
+      case CullDecision::kDone: it = recent_points_.erase(it); break;
+      case CullDecision::kKeep: ++it; break;
+    }
+  }
+}
+
+void LocalMapping::create_new_points(const std::shared_ptr<KeyFrame>& kf) {
+  const CameraModel& cam = *cam_;
+  const Frame& f1 = kf->frame();
+  const Eigen::Vector3d o1 = kf->camera_center_w();
+  const double baseline_m = cam.K.bf / cam.K.fx;
+  for (const auto& kf2 : kf->best_covisibles(options_.covisible_for_triangulation)) {
+    const Frame& f2 = kf2->frame();
+    const Eigen::Vector3d o2 = kf2->camera_center_w();
+    if ((o2 - o1).norm() < baseline_m) continue;  // RGB-D: too little parallax to gain anything
+    const std::vector<IndexMatch> matches = search_for_triangulation(*kf, *kf2);
+    for (const IndexMatch& m : matches) {
+      if (kf->map_points()[m.i1] || kf2->map_points()[m.i2]) continue;
+      const cv::KeyPoint& k1 = f1.keys_un[m.i1];
+      const cv::KeyPoint& k2 = f2.keys_un[m.i2];
+      const Eigen::Vector3d ray1 = kf->T_c_w().linear().transpose() *
+                                   Eigen::Vector3d((k1.pt.x - cam.K.cx) / cam.K.fx, (k1.pt.y - cam.K.cy) / cam.K.fy, 1);
+      const Eigen::Vector3d ray2 = kf2->T_c_w().linear().transpose() *
+                                   Eigen::Vector3d((k2.pt.x - cam.K.cx) / cam.K.fx, (k2.pt.y - cam.K.cy) / cam.K.fy, 1);
+      const double cos_parallax = ray1.dot(ray2) / (ray1.norm() * ray2.norm());
+      const double cos_stereo1 = f1.depth_m[m.i1] > 0 ? std::cos(2 * std::atan2(baseline_m / 2, f1.depth_m[m.i1])) : 2.0;
+      const double cos_stereo2 = f2.depth_m[m.i2] > 0 ? std::cos(2 * std::atan2(baseline_m / 2, f2.depth_m[m.i2])) : 2.0;
+      const double cos_stereo = std::min(cos_stereo1, cos_stereo2);
+      Eigen::Vector3d p_w;
+      if (cos_parallax > 0 && cos_parallax < cos_stereo && cos_parallax < 0.9998) {
+        // linear triangulation (DLT) of the two views
+        Eigen::Matrix<double, 4, 4> A;
+        const Eigen::Matrix<double, 3, 4> P1 = kf->T_c_w().matrix().topRows<3>();
+        const Eigen::Matrix<double, 3, 4> P2 = kf2->T_c_w().matrix().topRows<3>();
+        const double x1 = (k1.pt.x - cam.K.cx) / cam.K.fx, y1 = (k1.pt.y - cam.K.cy) / cam.K.fy;
+        const double x2 = (k2.pt.x - cam.K.cx) / cam.K.fx, y2 = (k2.pt.y - cam.K.cy) / cam.K.fy;
+        A.row(0) = x1 * P1.row(2) - P1.row(0);
+        A.row(1) = y1 * P1.row(2) - P1.row(1);
+        A.row(2) = x2 * P2.row(2) - P2.row(0);
+        A.row(3) = y2 * P2.row(2) - P2.row(1);
+        Eigen::JacobiSVD<Eigen::Matrix4d> svd(A, Eigen::ComputeFullV);
+        const Eigen::Vector4d X = svd.matrixV().col(3);
+        if (std::abs(X(3)) < 1e-12) continue;
+        p_w = X.head<3>() / X(3);
+      } else if (f1.depth_m[m.i1] > 0 && cos_stereo1 < cos_stereo2) {
+        p_w = f1.unproject_world(m.i1);
+      } else if (f2.depth_m[m.i2] > 0) {
+        p_w = f2.unproject_world(m.i2);
+      } else {
+        continue;
+      }
+      // in front of both, reprojection error within chi2 bounds
+      bool good = true;
+      for (int v = 0; v < 2 && good; ++v) {
+        const Frame& fv = v == 0 ? f1 : f2;
+        const std::size_t iv = v == 0 ? m.i1 : m.i2;
+        const Eigen::Vector3d p_c = fv.T_c_w * p_w;
+        if (p_c.z() <= 0) {
+          good = false;
+          break;
+        }
+        good = observation_chi2(cam.K, fv.T_c_w, p_w, fv.observation(iv)) <
+               (fv.u_right[iv] >= 0 ? 7.8 : 5.991);
+      }
+      if (!good) continue;
+      const double d1 = (p_w - o1).norm(), d2 = (p_w - o2).norm();
+      if (d1 == 0 || d2 == 0) continue;
+      const double ratio_dist = d2 / d1;
+      const double ratio_octave = cam.scale[k1.octave] / cam.scale[k2.octave];
+      const double factor = 1.5 * cam.scale[1];
+      if (ratio_dist * factor < ratio_octave || ratio_dist > ratio_octave * factor) continue;
+      auto mp = map_.create_point(p_w, kf);
+      mp->add_observation(kf, m.i1);
+      mp->add_observation(kf2, m.i2);
+      kf->set_map_point(m.i1, mp);
+      kf2->set_map_point(m.i2, mp);
+      mp->compute_distinctive_descriptor();
+      mp->update_normal_and_depth();
+      recent_points_.push_back(mp);
+    }
+  }
+}
+
+void LocalMapping::fuse_with_neighbors(const std::shared_ptr<KeyFrame>& kf) {
+  std::vector<std::shared_ptr<KeyFrame>> targets;
+  std::set<std::uint64_t> seen = {kf->id()};
+  for (const auto& n : kf->best_covisibles(10)) {
+    if (!seen.insert(n->id()).second) continue;
+    targets.push_back(n);
+    for (const auto& n2 : n->best_covisibles(5))
+      if (seen.insert(n2->id()).second) targets.push_back(n2);
+  }
+  for (const auto& t : targets) fuse(map_, t, kf->map_points());
+  std::vector<std::shared_ptr<MapPoint>> candidates;
+  std::set<std::uint64_t> cand_ids;
+  for (const auto& t : targets)
+    for (const auto& mp : t->map_points())
+      if (mp && !mp->bad() && cand_ids.insert(mp->id()).second) candidates.push_back(mp);
+  fuse(map_, kf, candidates);
+  for (const auto& mp : kf->map_points())
+    if (mp && !mp->bad()) {
+      mp->compute_distinctive_descriptor();
+      mp->update_normal_and_depth();
+    }
+  kf->update_connections();
+}
+
+void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) {
+  BaProblem problem;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  std::vector<std::shared_ptr<MapPoint>> pts;
+  {
+    std::lock_guard<std::mutex> lock(map_.mutex());
+    if (kf->bad()) return;
+    std::map<std::uint64_t, std::size_t> kf_index, pt_index;
+    auto add_kf = [&](const std::shared_ptr<KeyFrame>& k, bool fixed) {
+      kf_index[k->id()] = problem.keyframes.size();
+      problem.keyframes.push_back({k->id(), k->T_c_w(), fixed || k->id() == 0});
+      kfs.push_back(k);
+    };
+    add_kf(kf, false);
+    for (const auto& n : kf->best_covisibles(-1)) add_kf(n, false);
+    const std::size_t num_local = kfs.size();
+    for (std::size_t k = 0; k < num_local; ++k)
+      for (const auto& mp : kfs[k]->map_points())
+        if (mp && !mp->bad() && !pt_index.count(mp->id())) {
+          pt_index[mp->id()] = problem.points.size();
+          problem.points.push_back({mp->id(), mp->p_w()});
+          pts.push_back(mp);
+        }
+    // Keyframes that see local points but are not local: fixed, they anchor the gauge.
+    for (const auto& mp : pts)
+      for (const auto& [kid, o] : mp->observations()) {
+        if (kf_index.count(kid)) continue;
+        auto k = o.kf.lock();
+        if (k && !k->bad()) add_kf(k, true);
+      }
+    if (problem.keyframes.size() < 2) problem.keyframes[0].fixed = true;
+    for (std::size_t p = 0; p < pts.size(); ++p)
+      for (const auto& [kid, o] : pts[p]->observations()) {
+        auto it = kf_index.find(kid);
+        if (it == kf_index.end()) continue;
+        problem.edges.push_back({it->second, p, kfs[it->second]->frame().observation(o.idx)});
+      }
+  }
+  if (problem.edges.empty()) return;
+  // Optimise without holding the map: tracking goes on with the old poses.
+  const BaResult result = slam::local_bundle_adjustment(&problem, cam_->K);
+
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  for (std::size_t e : result.outlier_edges) {
+    const BaEdge& edge = problem.edges[e];
+    const auto& k = kfs[edge.keyframe];
+    const auto& mp = pts[edge.point];
+    const long idx = mp->index_in(k->id());
+    if (idx < 0) continue;
+    if (k->map_points()[static_cast<std::size_t>(idx)] == mp) k->set_map_point(static_cast<std::size_t>(idx), nullptr);
+    mp->erase_observation(k->id());
+  }
+  for (std::size_t k = 0; k < kfs.size(); ++k)
+    if (!problem.keyframes[k].fixed && !kfs[k]->bad()) kfs[k]->set_T_c_w(problem.keyframes[k].T_c_w);
+  for (std::size_t p = 0; p < pts.size(); ++p)
+    if (!pts[p]->bad()) {
+      pts[p]->set_p_w(problem.points[p].p_w);
+      pts[p]->update_normal_and_depth();
+    }
+  map_.remove_bad_points();
+}
+
+void LocalMapping::cull_keyframes(const std::shared_ptr<KeyFrame>& kf) {
+  for (const auto& n : kf->best_covisibles(-1)) {
+    if (n->id() == 0 || n->bad()) continue;
+    if (is_redundant_keyframe(*n, cam_->th_depth_m, options_.redundant_ratio, options_.redundant_observers))
+      map_.erase_keyframe(n);
+  }
+}
+
+}  // namespace pvb::slam

@@ -1,0 +1,100 @@
+#include "pvb/slam/core/system.hpp"
+
+#include <chrono>
+#include <opencv2/imgproc.hpp>
+
+namespace pvb::slam {
+namespace {
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+System::System(const Settings& settings, const SystemOptions& options)
+    : settings_(settings), options_(options), extractor_(settings.orb) {
+  StereoIntrinsics K;
+  K.fx = settings.K.fx;
+  K.fy = settings.K.fy;
+  K.cx = settings.K.cx;
+  K.cy = settings.K.cy;
+  K.bf = settings.bf;
+  cam_ = std::make_shared<const CameraModel>(CameraModel::make(
+      K, settings.K.width, settings.K.height, {settings.k1, settings.k2, settings.p1, settings.p2, settings.k3},
+      settings.th_depth_m(), settings.orb.scale_factor, settings.orb.num_levels));
+  TrackingOptions topt;
+  topt.use_pe_match = settings.pe_match.enabled;
+  topt.pe_match.population = settings.pe_match.population;
+  topt.pe_match.num_fitness_samples = settings.pe_match.num_fitness_samples;
+  topt.pe_match.stall_iterations = settings.pe_match.stall_iterations;
+  topt.pe_match.inlier_threshold_px = settings.pe_match.threshold_px;
+  topt.pe_match.refine = settings.pe_match.refine;
+  topt.pe_match.seed = options.seed;
+  topt.max_frames = static_cast<int>(settings.fps);
+  tracking_ = std::make_unique<Tracking>(map_, cam_, topt);
+  mapping_ = std::make_unique<LocalMapping>(map_, cam_);
+  if (!options.synchronous) mapping_->start();
+}
+
+System::~System() { shutdown(); }
+
+void System::shutdown() {
+  if (mapping_) mapping_->stop();
+}
+
+FrameResult System::track(const sensor::RgbdFrame& in) {
+  FrameResult out;
+  out.t_ns = in.t_ns;
+  const auto t0 = std::chrono::steady_clock::now();
+  cv::Mat grey;
+  if (in.rgb.channels() == 3) cv::cvtColor(in.rgb, grey, cv::COLOR_RGB2GRAY);  // RgbdFrame is R,G,B
+  else grey = in.rgb;
+  OrbFeatures features = extractor_.extract(grey);
+  out.num_features = static_cast<int>(features.keypoints.size());
+  out.orb_ms = ms_since(t0);
+  Frame frame(next_frame_id_++, in.t_ns, std::move(features), in.depth_m, cam_);
+  std::shared_ptr<KeyFrame> kf = tracking_->track(std::move(frame), mapping_->idle(), mapping_->queue_size());
+  out.tracking_ms = ms_since(t0);
+  out.state = tracking_->state();
+  out.tracking = tracking_->stats();
+  if (out.state == TrackingState::kOk) {
+    out.T_w_c = tracking_->last_frame().T_c_w.inverse();
+    if (auto ref = tracking_->reference_keyframe()) {
+      std::lock_guard<std::mutex> lock(map_.mutex());
+      records_.push_back({in.t_ns, ref, tracking_->last_frame().T_c_w * ref->T_c_w().inverse()});
+    }
+  }
+  if (kf) {
+    const auto t1 = std::chrono::steady_clock::now();
+    mapping_->insert(kf);
+    out.mapping_ms = ms_since(t1);
+  }
+  return out;
+}
+
+std::vector<geom::StampedPose> System::keyframe_trajectory() {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::vector<geom::StampedPose> out;
+  for (const auto& [id, kf] : map_.keyframes())
+    if (!kf->bad()) out.push_back({kf->t_ns(), kf->T_c_w().inverse()});
+  return out;
+}
+
+std::vector<geom::StampedPose> System::refined_trajectory() {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::vector<geom::StampedPose> out;
+  out.reserve(records_.size());
+  for (const FrameRecord& r : records_) out.push_back({r.t_ns, (r.T_c_r * r.ref->T_c_w_via_tree()).inverse()});
+  return out;
+}
+
+std::size_t System::num_keyframes() {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  return map_.num_keyframes();
+}
+
+std::size_t System::num_map_points() {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  return map_.num_points();
+}
+
+}  // namespace pvb::slam

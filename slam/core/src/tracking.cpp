@@ -1,0 +1,433 @@
+#include "pvb/slam/core/tracking.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+namespace pvb::slam {
+
+const char* to_string(TrackingState s) {
+  switch (s) {
+    case TrackingState::kNotInitialized: return "not_initialized";
+    case TrackingState::kOk: return "ok";
+    case TrackingState::kLost: return "lost";
+  }
+  return "?";
+}
+
+Tracking::Tracking(Map& map, std::shared_ptr<const CameraModel> cam, const TrackingOptions& options)
+    : map_(map), cam_(std::move(cam)), options_(options), pe_matcher_(options.pe_match) {}
+
+std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_t mapping_queue) {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  stats_ = {};
+  std::shared_ptr<KeyFrame> new_kf;
+  if (state_ == TrackingState::kNotInitialized) {
+    if (initialize(f)) {
+      stats_.method = TrackingMethod::kInitialization;
+      new_kf = ref_kf_;
+      stats_.new_keyframe = true;
+      state_ = TrackingState::kOk;
+      last_kf_frame_id_ = f.id;
+      last_is_keyframe_ = true;
+      T_last_ref_ = geom::SE3d::Identity();
+      last_ = f;
+    }
+    return new_kf;
+  }
+
+  bool ok = false;
+  if (state_ == TrackingState::kOk) {
+    replace_in_last_frame();
+    if (velocity_ && f.id >= last_reloc_frame_id_ + 2) {
+      ok = track_with_motion_model(f);
+      if (ok) stats_.method = TrackingMethod::kMotionModel;
+    }
+    if (!ok) {
+      ok = track_reference_keyframe(f);
+      if (ok) stats_.method = TrackingMethod::kReferenceKeyFrame;
+    }
+  } else {
+    ok = relocalize(f);
+    if (ok) stats_.method = TrackingMethod::kRelocalization;
+  }
+  if (ok) ok = track_local_map(f);
+  state_ = ok ? TrackingState::kOk : TrackingState::kLost;
+
+  if (ok) {
+    if (last_.has_pose) velocity_ = f.T_c_w * last_.T_c_w.inverse();
+    else velocity_.reset();
+    // drop visual-odometry points (not in the map) and outliers
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      const auto& mp = f.map_points[i];
+      if (mp && mp->num_observations() < 1) {
+        f.map_points[i] = nullptr;
+        f.outlier[i] = 0;
+      }
+    }
+    if (need_new_keyframe(f, mapping_idle, mapping_queue)) {
+      new_kf = create_keyframe(f);
+      stats_.new_keyframe = true;
+    }
+    for (std::size_t i = 0; i < f.size(); ++i)
+      if (f.map_points[i] && f.outlier[i]) f.map_points[i] = nullptr;
+  } else {
+    velocity_.reset();
+  }
+  last_is_keyframe_ = static_cast<bool>(new_kf);
+  if (ok && ref_kf_) T_last_ref_ = f.T_c_w * ref_kf_->T_c_w().inverse();
+  last_ = std::move(f);
+  if (!ok) last_.has_pose = false;
+  return new_kf;
+}
+
+bool Tracking::initialize(Frame& f) {
+  int with_depth = 0;
+  for (float d : f.depth_m) with_depth += d > 0;
+  if (with_depth <= options_.min_init_points) return false;
+  f.T_c_w = geom::SE3d::Identity();
+  f.has_pose = true;
+  auto kf = map_.create_keyframe(f);
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (f.depth_m[i] <= 0) continue;
+    auto mp = map_.create_point(f.unproject_world(i), kf);
+    mp->add_observation(kf, i);
+    kf->set_map_point(i, mp);
+    mp->compute_distinctive_descriptor();
+    mp->update_normal_and_depth();
+    f.map_points[i] = mp;
+  }
+  ref_kf_ = kf;
+  local_kfs_ = {kf};
+  return true;
+}
+
+void Tracking::replace_in_last_frame() {
+  for (auto& mp : last_.map_points)
+    if (mp)
+      if (auto r = mp->replaced()) mp = r;
+}
+
+void Tracking::update_last_frame() {
+  // The reference keyframe may have moved in local BA since.
+  if (ref_kf_ && !ref_kf_->bad()) last_.T_c_w = T_last_ref_ * ref_kf_->T_c_w();
+  if (last_is_keyframe_) return;
+  // Visual-odometry points: the closest keypoints with depth that have no map
+  // point get a temporary point (ORB-SLAM2 UpdateLastFrame for RGB-D).
+  std::vector<std::pair<float, std::size_t>> by_depth;
+  for (std::size_t i = 0; i < last_.size(); ++i)
+    if (last_.depth_m[i] > 0) by_depth.emplace_back(last_.depth_m[i], i);
+  std::sort(by_depth.begin(), by_depth.end());
+  int n = 0;
+  for (const auto& [d, i] : by_depth) {
+    const auto& mp = last_.map_points[i];
+    if (!mp || mp->num_observations() < 1) {
+      auto tmp = std::make_shared<MapPoint>(next_temp_point_id_++, last_.unproject_world(i), nullptr);
+      last_.map_points[i] = tmp;
+    }
+    ++n;
+    if (d > cam_->th_depth_m && n > 100) break;
+  }
+}
+
+int Tracking::optimize(Frame& f) {
+  std::vector<Eigen::Vector3d> pts;
+  std::vector<Observation> obs;
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (!f.map_points[i]) continue;
+    pts.push_back(f.map_points[i]->p_w());
+    obs.push_back(f.observation(i));
+    idx.push_back(i);
+  }
+  std::fill(f.outlier.begin(), f.outlier.end(), 0);
+  if (pts.size() < 3) return 0;
+  const PoseOptimizerResult r = optimize_pose(f.T_c_w, pts, obs, cam_->K);
+  f.T_c_w = r.T_c_w;
+  f.has_pose = true;
+  for (std::size_t k = 0; k < idx.size(); ++k) f.outlier[idx[k]] = r.inlier[k] ? 0 : 1;
+  return r.num_inliers;
+}
+
+void Tracking::discard_outliers(Frame& f, int* map_matches) {
+  int n = 0;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (!f.map_points[i]) continue;
+    if (f.outlier[i]) {
+      f.map_points[i] = nullptr;
+      f.outlier[i] = 0;
+    } else if (f.map_points[i]->num_observations() > 0) {
+      ++n;
+    }
+  }
+  *map_matches = n;
+}
+
+bool Tracking::track_with_motion_model(Frame& f) {
+  update_last_frame();
+  f.T_c_w = *velocity_ * last_.T_c_w;
+  std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
+  std::vector<IndexMatch> m = search_by_projection(f, last_, options_.motion_th, options_.motion_ratio);
+  if (m.size() < 20) {
+    std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
+    m = search_by_projection(f, last_, 2 * options_.motion_th, options_.motion_ratio);
+  }
+  stats_.coarse_matches = static_cast<int>(m.size());
+  stats_.matches_kept = stats_.coarse_matches;
+  if (m.size() < 20) return false;
+
+  if (options_.use_pe_match) {
+    // PE-match on the pixel pairs (last keypoint, current keypoint), paper sec. 3.
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<PointMatch> pairs(m.size());
+    for (std::size_t k = 0; k < m.size(); ++k) {
+      const cv::Point2f& a = last_.keys_un[m[k].i1].pt;
+      const cv::Point2f& b = f.keys_un[m[k].i2].pt;
+      pairs[k] = {Eigen::Vector2d(a.x, a.y), Eigen::Vector2d(b.x, b.y)};
+    }
+    PeMatchResult r;
+    pe_matcher_.match(pairs.data(), pairs.size(), r);
+    if (r.F) {
+      int kept = 0;
+      for (std::size_t k = 0; k < m.size(); ++k) {
+        if (r.inlier_mask[k]) ++kept;
+        else f.map_points[m[k].i2] = nullptr;
+      }
+      stats_.matches_kept = kept;
+    }
+    stats_.pe_match_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (stats_.matches_kept < 10) return false;
+  }
+
+  optimize(f);
+  int map_matches = 0;
+  discard_outliers(f, &map_matches);
+  return map_matches >= 10;
+}
+
+bool Tracking::track_reference_keyframe(Frame& f) {
+  if (!ref_kf_ || ref_kf_->bad()) return false;
+  std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
+  const int n = search_keyframe_bruteforce(*ref_kf_, f, kThLow, 0.7);
+  if (n < 15) return false;
+  f.T_c_w = last_.has_pose ? last_.T_c_w : ref_kf_->T_c_w();
+  optimize(f);
+  int map_matches = 0;
+  discard_outliers(f, &map_matches);
+  return map_matches >= 10;
+}
+
+bool Tracking::relocalize(Frame& f) {
+  // Candidates: the most recent keyframes and the covisibility neighbours of
+  // the last reference keyframe (no bag of words yet).
+  std::vector<std::shared_ptr<KeyFrame>> cands;
+  std::set<std::uint64_t> seen;
+  const auto& kfs = map_.keyframes();
+  int k = 0;
+  for (auto it = kfs.rbegin(); it != kfs.rend() && k < 10; ++it, ++k) {
+    cands.push_back(it->second);
+    seen.insert(it->first);
+  }
+  if (ref_kf_ && !ref_kf_->bad())
+    for (const auto& c : ref_kf_->best_covisibles(10))
+      if (seen.insert(c->id()).second) cands.push_back(c);
+
+  for (const auto& kf : cands) {
+    if (kf->bad()) continue;
+    std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
+    const int n = search_keyframe_bruteforce(*kf, f, kThLow, 0.75);
+    if (n < 15) continue;
+    std::vector<cv::Point3d> obj;
+    std::vector<cv::Point2d> img;
+    std::vector<std::size_t> idx;
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      if (!f.map_points[i]) continue;
+      const Eigen::Vector3d& p = f.map_points[i]->p_w();
+      obj.emplace_back(p.x(), p.y(), p.z());
+      img.emplace_back(f.keys_un[i].pt.x, f.keys_un[i].pt.y);
+      idx.push_back(i);
+    }
+    cv::Mat rvec, tvec;
+    std::vector<int> inliers;
+    cv::setRNGSeed(0);
+    const bool solved = cv::solvePnPRansac(obj, img, cam_->K_cv, cv::noArray(), rvec, tvec, false, 300, 4.0f, 0.99,
+                                           inliers, cv::SOLVEPNP_EPNP);
+    if (!solved || inliers.size() < 10) continue;
+    cv::Mat R_cv;
+    cv::Rodrigues(rvec, R_cv);
+    Eigen::Matrix3d R;
+    Eigen::Vector3d t;
+    cv::cv2eigen(R_cv, R);
+    cv::cv2eigen(tvec, t);
+    f.T_c_w = geom::make_se3(R, t);
+    std::vector<std::uint8_t> is_inlier(idx.size(), 0);
+    for (int i : inliers) is_inlier[static_cast<std::size_t>(i)] = 1;
+    for (std::size_t q = 0; q < idx.size(); ++q)
+      if (!is_inlier[q]) f.map_points[idx[q]] = nullptr;
+    int good = optimize(f);
+    if (good < 10) continue;
+    int map_matches = 0;
+    discard_outliers(f, &map_matches);
+    if (good < 50) {
+      // more matches by projection of the candidate's points with a wide window
+      std::vector<ProjectedPoint> proj;
+      for (const auto& mp : kf->map_points()) {
+        if (!mp || mp->bad()) continue;
+        if (std::find(f.map_points.begin(), f.map_points.end(), mp) != f.map_points.end()) continue;
+        ProjectedPoint p;
+        if (project_in_frustum(f, mp, &p)) proj.push_back(p);
+      }
+      search_local_points(f, proj, 10.0 / 4.0);
+      good = optimize(f);
+      discard_outliers(f, &map_matches);
+    }
+    if (good >= 50) {
+      last_reloc_frame_id_ = f.id;
+      return true;
+    }
+  }
+  std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
+  return false;
+}
+
+void Tracking::update_local_map(const Frame& f) {
+  // Local keyframes: those observing the frame's points, their best
+  // covisibles, children and parent (ORB-SLAM2 UpdateLocalKeyFrames).
+  std::map<std::uint64_t, std::pair<std::shared_ptr<KeyFrame>, int>> counter;
+  for (const auto& mp : f.map_points) {
+    if (!mp || mp->bad()) continue;
+    for (const auto& [kid, o] : mp->observations()) {
+      auto kf = o.kf.lock();
+      if (!kf || kf->bad()) continue;
+      auto& c = counter[kid];
+      c.first = kf;
+      ++c.second;
+    }
+  }
+  local_kfs_.clear();
+  std::set<std::uint64_t> in_local;
+  std::shared_ptr<KeyFrame> best;
+  int best_n = 0;
+  for (const auto& [kid, c] : counter) {
+    local_kfs_.push_back(c.first);
+    in_local.insert(kid);
+    if (c.second > best_n) {
+      best_n = c.second;
+      best = c.first;
+    }
+  }
+  const std::size_t direct = local_kfs_.size();
+  for (std::size_t k = 0; k < direct && local_kfs_.size() < 80; ++k) {
+    const auto kf = local_kfs_[k];
+    for (const auto& n : kf->best_covisibles(10))
+      if (in_local.insert(n->id()).second) {
+        local_kfs_.push_back(n);
+        break;
+      }
+    for (const auto& c : kf->children())
+      if (!c->bad() && in_local.insert(c->id()).second) {
+        local_kfs_.push_back(c);
+        break;
+      }
+    if (auto p = kf->parent())
+      if (!p->bad() && in_local.insert(p->id()).second) local_kfs_.push_back(p);
+  }
+  if (best) ref_kf_ = best;
+
+  local_points_.clear();
+  std::set<std::uint64_t> seen;
+  for (const auto& kf : local_kfs_)
+    for (const auto& mp : kf->map_points())
+      if (mp && !mp->bad() && seen.insert(mp->id()).second) local_points_.push_back(mp);
+}
+
+bool Tracking::track_local_map(Frame& f) {
+  update_local_map(f);
+  std::set<std::uint64_t> in_frame;
+  for (const auto& mp : f.map_points)
+    if (mp && !mp->bad()) {
+      mp->increase_visible();
+      in_frame.insert(mp->id());
+    }
+  std::vector<ProjectedPoint> proj;
+  for (const auto& mp : local_points_) {
+    if (in_frame.count(mp->id())) continue;
+    ProjectedPoint p;
+    if (project_in_frustum(f, mp, &p)) {
+      mp->increase_visible();
+      proj.push_back(p);
+    }
+  }
+  const double th = f.id < last_reloc_frame_id_ + 2 ? 5.0 : 3.0;
+  search_local_points(f, proj, th);
+  optimize(f);
+  matches_inliers_ = 0;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    const auto& mp = f.map_points[i];
+    if (!mp || f.outlier[i]) continue;
+    mp->increase_found();
+    if (mp->num_observations() > 0) ++matches_inliers_;
+  }
+  stats_.inliers = matches_inliers_;
+  if (f.id < last_reloc_frame_id_ + static_cast<std::uint64_t>(options_.max_frames) && last_reloc_frame_id_ > 0 &&
+      matches_inliers_ < 50)
+    return false;
+  return matches_inliers_ >= 30;
+}
+
+bool Tracking::need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue) const {
+  const std::size_t num_kfs = map_.num_keyframes();
+  const auto max_frames = static_cast<std::uint64_t>(options_.max_frames);
+  if (last_reloc_frame_id_ > 0 && f.id < last_reloc_frame_id_ + max_frames && num_kfs > max_frames) return false;
+  const int min_obs = num_kfs <= 2 ? 2 : 3;
+  const int ref_matches = ref_kf_ ? ref_kf_->num_tracked_points(min_obs) : 0;
+  int tracked_close = 0, non_tracked_close = 0;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (f.depth_m[i] > 0 && f.depth_m[i] < cam_->th_depth_m) {
+      if (f.map_points[i] && !f.outlier[i]) ++tracked_close;
+      else ++non_tracked_close;
+    }
+  }
+  const bool need_close = tracked_close < 100 && non_tracked_close > 70;
+  const double ref_ratio = num_kfs < 2 ? 0.4 : 0.75;
+  const bool c1a = f.id >= last_kf_frame_id_ + max_frames;
+  const bool c1b = f.id >= last_kf_frame_id_ + static_cast<std::uint64_t>(options_.min_frames) && mapping_idle;
+  const bool c1c = matches_inliers_ < ref_matches * 0.25 || need_close;
+  const bool c2 = (matches_inliers_ < ref_matches * ref_ratio || need_close) && matches_inliers_ > 15;
+  if (!((c1a || c1b || c1c) && c2)) return false;
+  return mapping_idle || mapping_queue < 3;
+}
+
+std::shared_ptr<KeyFrame> Tracking::create_keyframe(Frame& f) {
+  auto kf = map_.create_keyframe(f);
+  ref_kf_ = kf;
+  // New points from depth: the closest keypoints first, all nearer than the
+  // close/far threshold and at least 100 (ORB-SLAM2 CreateNewKeyFrame).
+  std::vector<std::pair<float, std::size_t>> by_depth;
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (f.depth_m[i] > 0) by_depth.emplace_back(f.depth_m[i], i);
+  std::sort(by_depth.begin(), by_depth.end());
+  int n = 0;
+  for (const auto& [d, i] : by_depth) {
+    const auto& existing = f.map_points[i];
+    if (!existing || existing->num_observations() < 1) {
+      auto mp = map_.create_point(f.unproject_world(i), kf);
+      mp->add_observation(kf, i);
+      kf->set_map_point(i, mp);
+      mp->compute_distinctive_descriptor();
+      mp->update_normal_and_depth();
+      f.map_points[i] = mp;
+      f.outlier[i] = 0;
+    }
+    ++n;
+    if (d > cam_->th_depth_m && n > 100) break;
+  }
+  // Outliers are not handed to the keyframe.
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (f.outlier[i]) kf->set_map_point(i, nullptr);
+  last_kf_frame_id_ = f.id;
+  return kf;
+}
+
+}  // namespace pvb::slam

@@ -1,0 +1,158 @@
+// Map-point culling and keyframe culling rules, and the covisibility graph /
+// spanning tree bookkeeping, on small hand-built maps.
+#include <gtest/gtest.h>
+
+#include "pvb/slam/core/local_mapping.hpp"
+#include "pvb/slam/core/map.hpp"
+
+namespace pvb::slam {
+namespace {
+
+std::shared_ptr<const CameraModel> camera() {
+  static auto cam = std::make_shared<const CameraModel>(
+      CameraModel::make(StereoIntrinsics{}, 640, 480, {}, 3.0, 1.2, 8));
+  return cam;
+}
+
+/// A frame with n keypoints on a row, all at `octave`, depth 1 m everywhere.
+Frame make_frame(std::uint64_t id, int n, int octave = 0) {
+  OrbFeatures f;
+  for (int i = 0; i < n; ++i) {
+    cv::KeyPoint k(cv::Point2f(100.0f + 5.0f * i, 100.0f), 31.0f, 0.0f, 0.0f, octave);
+    f.keypoints.push_back(k);
+  }
+  f.descriptors = cv::Mat::zeros(n, 32, CV_8U);
+  const cv::Mat depth(480, 640, CV_32F, cv::Scalar(1.0f));
+  Frame fr(id, static_cast<std::int64_t>(id) * 1000, f, depth, camera());
+  fr.has_pose = true;
+  return fr;
+}
+
+/// n keyframes sharing `n_points` points, each point observed by the
+/// keyframes listed in observers (indices into the returned vector).
+struct SmallMap {
+  Map map;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  std::vector<std::shared_ptr<MapPoint>> pts;
+};
+
+void observe(const std::shared_ptr<MapPoint>& mp, const std::shared_ptr<KeyFrame>& kf, std::size_t idx) {
+  mp->add_observation(kf, idx);
+  kf->set_map_point(idx, mp);
+}
+
+TEST(MapPointCulling, RecentPointRule) {
+  // found / visible below 25 %: erase at once
+  EXPECT_EQ(recent_point_rule(0.2, 10, 5, 5), CullDecision::kErase);
+  // two keyframes after creation with <= 3 observations (RGB-D: 2 per keyframe): erase
+  EXPECT_EQ(recent_point_rule(0.9, 3, 5, 7), CullDecision::kErase);
+  EXPECT_EQ(recent_point_rule(0.9, 4, 5, 7), CullDecision::kKeep);
+  // one keyframe after creation: still on trial
+  EXPECT_EQ(recent_point_rule(0.9, 2, 5, 6), CullDecision::kKeep);
+  // three keyframes after creation with enough observations: survived
+  EXPECT_EQ(recent_point_rule(0.9, 6, 5, 8), CullDecision::kDone);
+}
+
+TEST(MapPointCulling, PointWithTooFewObservationsBecomesBad) {
+  Map map;
+  auto kf0 = map.create_keyframe(make_frame(0, 4));
+  auto kf1 = map.create_keyframe(make_frame(1, 4));
+  auto mp = map.create_point(Eigen::Vector3d(0, 0, 1), kf0);
+  observe(mp, kf0, 0);
+  observe(mp, kf1, 0);
+  EXPECT_EQ(mp->num_observations(), 4);  // two RGB-D observations count 2 each
+  mp->erase_observation(kf1->id());
+  EXPECT_TRUE(mp->bad());
+  EXPECT_EQ(kf0->map_points()[0], nullptr);
+  map.remove_bad_points();
+  EXPECT_EQ(map.num_points(), 0u);
+}
+
+class KeyFrameCulling : public ::testing::Test {
+ protected:
+  // kf0..kf4, 20 points all seen by kf1; `shared` of them also by kf0, kf2, kf3.
+  void build(int shared, int other_octave = 0) {
+    for (std::uint64_t i = 0; i < 5; ++i)
+      kfs.push_back(map.create_keyframe(make_frame(i, 20, i == 1 ? 0 : other_octave)));
+    for (int p = 0; p < 20; ++p) {
+      auto mp = map.create_point(Eigen::Vector3d(0, 0, 1), kfs[1]);
+      observe(mp, kfs[1], p);
+      if (p < shared)
+        for (int k : {0, 2, 3}) observe(mp, kfs[static_cast<std::size_t>(k)], p);
+      else
+        observe(mp, kfs[4], p);
+      mp->compute_distinctive_descriptor();
+      pts.push_back(mp);
+    }
+  }
+  Map map;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  std::vector<std::shared_ptr<MapPoint>> pts;
+};
+
+TEST_F(KeyFrameCulling, RedundantAbove90Percent) {
+  build(19);  // 95 % seen by three others
+  EXPECT_TRUE(is_redundant_keyframe(*kfs[1], 3.0));
+}
+
+TEST_F(KeyFrameCulling, KeptAt90PercentOrBelow) {
+  build(18);  // exactly 90 %: the rule needs more than 90 %
+  EXPECT_FALSE(is_redundant_keyframe(*kfs[1], 3.0));
+}
+
+TEST_F(KeyFrameCulling, CoarserObservationsDoNotCount) {
+  build(20, /*other_octave=*/2);  // the others see the points two levels coarser
+  EXPECT_FALSE(is_redundant_keyframe(*kfs[1], 3.0));
+}
+
+TEST_F(KeyFrameCulling, FarPointsAreIgnored) {
+  build(19);
+  // with a close/far threshold below every depth there are no close points
+  EXPECT_FALSE(is_redundant_keyframe(*kfs[1], 0.5));
+}
+
+TEST_F(KeyFrameCulling, ErasingAKeyFrameRepairsGraphAndTree) {
+  build(19);
+  for (auto& kf : kfs) kf->update_connections();
+  // kf1 was attached under kf0; kf2, kf3, kf4 connect to kf1 or kf0
+  ASSERT_EQ(kfs[1]->parent(), kfs[0]);
+  EXPECT_GE(kfs[2]->weight(kfs[1]->id()), 15);
+  EXPECT_TRUE(map.erase_keyframe(kfs[1]));
+  EXPECT_TRUE(kfs[1]->bad());
+  EXPECT_EQ(map.num_keyframes(), 4u);
+  EXPECT_EQ(kfs[2]->weight(kfs[1]->id()), 0);
+  for (std::size_t k : {2u, 3u, 4u}) {
+    auto p = kfs[k]->parent();
+    ASSERT_NE(p, nullptr) << k;
+    EXPECT_FALSE(p->bad()) << k;
+  }
+  for (const auto& mp : pts) EXPECT_LT(mp->index_in(kfs[1]->id()), 0);
+  // the first keyframe is never erased
+  EXPECT_FALSE(map.erase_keyframe(kfs[0]));
+}
+
+TEST(Covisibility, OrderedByWeightThenIdWithThreshold15) {
+  Map map;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  for (std::uint64_t i = 0; i < 5; ++i) kfs.push_back(map.create_keyframe(make_frame(i, 40)));
+  // kf0 shares 30 points with kf1, 20 with kf2, 20 with kf3 and 10 with kf4
+  for (int p = 0; p < 40; ++p) {
+    auto mp = map.create_point(Eigen::Vector3d(0, 0, 1), kfs[0]);
+    observe(mp, kfs[0], p);
+    if (p < 30) observe(mp, kfs[1], p);
+    if (p < 20) observe(mp, kfs[2], p);
+    if (p >= 20) observe(mp, kfs[3], p);
+    if (p >= 30) observe(mp, kfs[4], p);
+  }
+  kfs[0]->update_connections();
+  const auto best = kfs[0]->best_covisibles(-1);
+  ASSERT_EQ(best.size(), 3u);  // kf4 (10 shared) is below the threshold of 15
+  EXPECT_EQ(best[0], kfs[1]);
+  EXPECT_EQ(best[1], kfs[2]);  // 20 shared, lower id first
+  EXPECT_EQ(best[2], kfs[3]);
+  EXPECT_EQ(kfs[1]->weight(0), 30);  // the other end learns the edge
+  EXPECT_EQ(kfs[0]->best_covisibles(1).size(), 1u);
+}
+
+}  // namespace
+}  // namespace pvb::slam

@@ -1,0 +1,145 @@
+// End to end: record ~300 frames of the default PV station with pvbench,
+// run `pvbench slam --sync` on them and check accuracy (ATE RMSE < 2 cm, no
+// lost frames); and check that synchronous mode gives a bit-identical
+// trajectory twice.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <regex>
+#include <sstream>
+#include <vector>
+#include <unistd.h>
+
+#include "pvb/common/text.hpp"
+
+namespace {
+
+const std::string kBin = std::string(PVB_BINARY_DIR) + "/bin/pvbench";
+const std::string kStation = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
+
+struct Result {
+  int code;
+  std::string output;
+};
+
+Result run(const std::string& args) {
+  const std::string log = ::testing::TempDir() + "pvb_slam_out_" + std::to_string(::getpid()) + ".txt";
+  const int status = std::system((kBin + " " + args + " > " + log + " 2>&1").c_str());
+  return {WEXITSTATUS(status), pvb::read_file(log)};
+}
+
+std::string dir(const std::string& name) {
+  const std::string d = ::testing::TempDir() + "pvb_slam_" + name + "_" + std::to_string(::getpid());
+  std::system(("rm -rf " + d).c_str());
+  return d;
+}
+
+// Recorded once per build tree and shared by the test processes: recorded
+// into a private folder, then renamed into place (a loser of a race keeps
+// the winner's copy, which is byte-identical).
+const std::string& station_sequence() {
+  static const std::string d = [] {
+    const std::string final_dir = std::string(PVB_BINARY_DIR) + "/test_data/slam_pv_station_300";
+    if (::access((final_dir + "/groundtruth.txt").c_str(), F_OK) == 0) return final_dir;
+    std::system(("mkdir -p " + std::string(PVB_BINARY_DIR) + "/test_data").c_str());
+    const std::string tmp = final_dir + ".tmp" + std::to_string(::getpid());
+    const Result r = run("record --scenario " + kStation + " --out " + tmp + " --frames 300 --seed 7");
+    EXPECT_EQ(r.code, 0) << r.output;
+    if (std::rename(tmp.c_str(), final_dir.c_str()) != 0) std::system(("rm -rf " + tmp).c_str());
+    return final_dir;
+  }();
+  return d;
+}
+
+double json_number(const std::string& json, const std::string& key) {
+  std::smatch m;
+  if (!std::regex_search(json, m, std::regex("\"" + key + "\": *([-0-9.eE+]+)"))) return -1;
+  return std::stod(m[1]);
+}
+
+TEST(SlamScenario, PvStationSyncAccurateAndNeverLost) {
+  const std::string seq = station_sequence();
+  const std::string out = dir("run");
+  const Result r = run("slam --sequence " + seq + " --settings " + seq + "/camera.yaml --out " + out + " --sync");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string stats = pvb::read_file(out + "/stats.json");
+  EXPECT_EQ(json_number(stats, "frames"), 300);
+  EXPECT_EQ(json_number(stats, "lost_frames"), 0) << stats;
+  EXPECT_EQ(json_number(stats, "not_initialized_frames"), 0) << stats;
+  // "ate": {"rmse": ...
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(stats, m, std::regex("\"ate\": *\\{[^}]*\"rmse\": *([-0-9.eE+]+)"))) << stats;
+  const double ate = std::stod(m[1]);
+  std::printf("PE-SLAM on 300 frames of pv_station: ATE RMSE %.2f mm\n", ate * 1000);
+  EXPECT_LT(ate, 0.02);
+  EXPECT_GT(json_number(stats, "keyframes"), 1);
+}
+
+TEST(SlamScenario, SyncModeIsBitIdentical) {
+  const std::string seq = station_sequence();
+  const std::string a = dir("det_a"), b = dir("det_b");
+  const std::string common = "slam --sequence " + seq + " --settings " + seq + "/camera.yaml --sync --max-frames 120 --out ";
+  ASSERT_EQ(run(common + a).code, 0);
+  ASSERT_EQ(run(common + b).code, 0);
+  const std::string ta = pvb::read_file(a + "/CameraTrajectory.txt");
+  EXPECT_GT(ta.size(), 1000u);
+  EXPECT_EQ(ta, pvb::read_file(b + "/CameraTrajectory.txt"));
+  EXPECT_EQ(pvb::read_file(a + "/KeyFrameTrajectory.txt"), pvb::read_file(b + "/KeyFrameTrajectory.txt"));
+}
+
+// Local mapping on its worker thread (the default mode): same accuracy
+// bounds on the first 150 frames, and a clean shutdown.
+TEST(SlamScenario, WorkerThreadModeTracks) {
+  const std::string seq = station_sequence();
+  const std::string out = dir("async");
+  const Result r = run("slam --sequence " + seq + " --settings " + seq + "/camera.yaml --max-frames 150 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string stats = pvb::read_file(out + "/stats.json");
+  EXPECT_EQ(json_number(stats, "frames"), 150);
+  EXPECT_EQ(json_number(stats, "lost_frames"), 0) << stats;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(stats, m, std::regex("\"ate\": *\\{[^}]*\"rmse\": *([-0-9.eE+]+)"))) << stats;
+  EXPECT_LT(std::stod(m[1]), 0.02);
+}
+
+// Baseline mode (--no-pe-match) runs the same pipeline without PE-match.
+TEST(SlamScenario, BaselineModeReportsNoPeMatch) {
+  const std::string seq = station_sequence();
+  const std::string out = dir("base");
+  const Result r = run("slam --sequence " + seq + " --settings " + seq +
+                       "/camera.yaml --sync --no-pe-match --max-frames 60 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string stats = pvb::read_file(out + "/stats.json");
+  EXPECT_NE(stats.find("\"pe_match\": false"), std::string::npos);
+  EXPECT_EQ(json_number(stats, "lost_frames"), 0) << stats;
+  // every motion-model frame keeps all its coarse matches
+  const std::string timing = pvb::read_file(out + "/timing.csv");
+  std::istringstream in(timing);
+  std::string line;
+  std::getline(in, line);
+  int motion = 0;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
+    ASSERT_GE(f.size(), 11u);
+    if (f[3] != "motion") continue;
+    ++motion;
+    EXPECT_EQ(f[8], f[9]) << line;
+  }
+  EXPECT_GT(motion, 50);
+}
+
+TEST(SlamCli, MissingSettingsKeyIsOneClearError) {
+  const std::string seq = station_sequence();
+  const std::string bad = ::testing::TempDir() + "pvb_slam_bad_" + std::to_string(::getpid()) + ".yaml";
+  std::string text = pvb::read_file(seq + "/camera.yaml");
+  text = std::regex_replace(text, std::regex("Camera\\.fy:[^\\n]*\\n"), "");
+  pvb::write_file(bad, text);
+  const Result r = run("slam --sequence " + seq + " --settings " + bad + " --out " + dir("bad"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("Camera.fy"), std::string::npos) << r.output;
+}
+
+}  // namespace

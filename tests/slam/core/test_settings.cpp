@@ -1,0 +1,93 @@
+// The settings reader on ORB-SLAM2's own TUM1.yaml and on broken copies.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <regex>
+#include <unistd.h>
+
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+#include "pvb/slam/core/settings.hpp"
+
+namespace pvb::slam {
+namespace {
+
+const std::string kTum1 = std::string(PVB_SHARED_DIR) + "/data/tum/TUM1.yaml";
+
+std::string temp_copy(const std::string& name, const std::string& content) {
+  const std::string path = ::testing::TempDir() + "pvb_settings_" + name + "_" + std::to_string(::getpid()) + ".yaml";
+  write_file(path, content);
+  return path;
+}
+
+TEST(Settings, ReadsTum1Unchanged) {
+  const Settings s = read_settings(kTum1);
+  EXPECT_DOUBLE_EQ(s.K.fx, 517.306408);
+  EXPECT_DOUBLE_EQ(s.K.fy, 516.469215);
+  EXPECT_DOUBLE_EQ(s.K.cx, 318.643040);
+  EXPECT_DOUBLE_EQ(s.K.cy, 255.313989);
+  EXPECT_DOUBLE_EQ(s.k1, 0.262383);
+  EXPECT_DOUBLE_EQ(s.k3, 1.163314);
+  EXPECT_EQ(s.K.width, 640);
+  EXPECT_EQ(s.K.height, 480);
+  EXPECT_DOUBLE_EQ(s.bf, 40.0);
+  EXPECT_TRUE(s.rgb_order);
+  EXPECT_DOUBLE_EQ(s.depth_map_factor, 5000.0);
+  EXPECT_NEAR(s.th_depth_m(), 40.0 * 40.0 / 517.306408, 1e-12);
+  EXPECT_EQ(s.orb.num_features, 1000);
+  EXPECT_EQ(s.orb.num_levels, 8);
+  EXPECT_EQ(s.orb.ini_fast_threshold, 20);
+  EXPECT_EQ(s.orb.min_fast_threshold, 7);
+  // No PEMatch section: the paper's SLAM defaults.
+  EXPECT_TRUE(s.pe_match.enabled);
+  EXPECT_EQ(s.pe_match.num_fitness_samples, 50);
+  EXPECT_EQ(s.pe_match.stall_iterations, 6);
+  // Viewer.* keys are ORB-SLAM2's own: no warnings.
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+}
+
+TEST(Settings, ReadsPeMatchSection) {
+  const std::string path = temp_copy("pe", read_file(kTum1) +
+                                               "\nPEMatch.enabled: 0\nPEMatch.population: 30\nPEMatch.j: 80\n"
+                                               "PEMatch.stallIterations: 9\nPEMatch.threshold: 2.5\nPEMatch.refine: 1\n");
+  const Settings s = read_settings(path);
+  EXPECT_FALSE(s.pe_match.enabled);
+  EXPECT_EQ(s.pe_match.population, 30);
+  EXPECT_EQ(s.pe_match.num_fitness_samples, 80);
+  EXPECT_EQ(s.pe_match.stall_iterations, 9);
+  EXPECT_DOUBLE_EQ(s.pe_match.threshold_px, 2.5);
+  EXPECT_TRUE(s.pe_match.refine);
+}
+
+TEST(Settings, MissingKeyIsAnErrorNamingIt) {
+  const std::string text = std::regex_replace(read_file(kTum1), std::regex("Camera\\.bf: 40\\.0"), "");
+  const std::string path = temp_copy("missing", text);
+  try {
+    read_settings(path);
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "Camera.bf");
+    EXPECT_NE(std::string(e.what()).find("Camera.bf"), std::string::npos);
+  }
+}
+
+TEST(Settings, UnknownKeyIsAWarning) {
+  const std::string path = temp_copy("unknown", read_file(kTum1) + "\nCamera.fxx: 500.0\n");
+  const Settings s = read_settings(path);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("Camera.fxx"), std::string::npos);
+}
+
+TEST(Settings, WrongTypeAndBadValuesAreErrors) {
+  EXPECT_THROW(read_settings(temp_copy("type", std::regex_replace(read_file(kTum1), std::regex("Camera.fx: 517.306408"),
+                                                                        "Camera.fx: \"abc\""))),
+               ConfigError);
+  EXPECT_THROW(read_settings(temp_copy("lev", std::regex_replace(read_file(kTum1), std::regex("nLevels: 8"),
+                                                                       "nLevels: 0"))),
+               ConfigError);
+}
+
+TEST(Settings, MissingFileIsAnIoError) { EXPECT_THROW(read_settings("/nonexistent/settings.yaml"), IoError); }
+
+}  // namespace
+}  // namespace pvb::slam
