@@ -4,6 +4,8 @@
 // trajectory twice.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include <cstdio>
 #include <cstdlib>
 #include <regex>
@@ -35,12 +37,19 @@ std::string dir(const std::string& name) {
   return d;
 }
 
-// Recorded once per build tree and shared by the test processes: recorded
-// into a private folder, then renamed into place (a loser of a race keeps
-// the winner's copy, which is byte-identical).
+// Recorded once per build of pvbench and shared by the test processes: the
+// folder name carries a fingerprint of the scenario file and of the pvbench
+// binary, so a changed simulator or scenario never reuses a stale recording.
+// Recorded into a private folder, then renamed into place (a loser of a race
+// keeps the winner's copy, which is byte-identical).
 const std::string& station_sequence() {
   static const std::string d = [] {
-    const std::string final_dir = std::string(PVB_BINARY_DIR) + "/test_data/slam_pv_station_300";
+    const std::string bin = std::string(PVB_BINARY_DIR) + "/bin/pvbench";
+    const auto stamp = std::filesystem::last_write_time(bin).time_since_epoch().count();
+    const std::size_t key = std::hash<std::string>{}(pvb::read_file(kStation) + std::to_string(stamp) +
+                                                     std::to_string(std::filesystem::file_size(bin)));
+    const std::string final_dir =
+        std::string(PVB_BINARY_DIR) + "/test_data/slam_pv_station_300_" + std::to_string(key % 1000000007);
     if (::access((final_dir + "/groundtruth.txt").c_str(), F_OK) == 0) return final_dir;
     std::system(("mkdir -p " + std::string(PVB_BINARY_DIR) + "/test_data").c_str());
     const std::string tmp = final_dir + ".tmp" + std::to_string(::getpid());
