@@ -27,7 +27,7 @@ struct Result {
 };
 
 Result run(const std::string& args) {
-  const std::string log = ::testing::TempDir() + "pvb_cli_out.txt";
+  const std::string log = ::testing::TempDir() + "pvb_cli_out_" + std::to_string(::getpid()) + ".txt";
   const int status = std::system((kBin + " " + args + " > " + log + " 2>&1").c_str());
   return {WEXITSTATUS(status), read_file(log)};
 }
@@ -42,7 +42,7 @@ std::string fresh(const std::string& name) {
 
 // All files below dir, relative paths, sorted.
 std::vector<std::string> list_files(const std::string& dir) {
-  const std::string list = ::testing::TempDir() + "pvb_list.txt";
+  const std::string list = ::testing::TempDir() + "pvb_list_" + std::to_string(::getpid()) + ".txt";
   std::system(("cd " + dir + " && find . -type f | sort > " + list).c_str());
   std::vector<std::string> out;
   std::ifstream in(list);
@@ -132,18 +132,18 @@ TEST(RecordCli, SameScenarioSeedAndBackendGiveIdenticalFiles) {
 }
 
 TEST(RecordCli, BadScenarioGivesOneClearLine) {
-  const std::string bad = ::testing::TempDir() + "pvb_bad_scenario.yaml";
+  const std::string bad = ::testing::TempDir() + "pvb_bad_scenario_" + std::to_string(::getpid()) + ".yaml";
   write_file(bad, "route: {waypoints_m: [[0, 0], [5, 0]]}\ncamera:\n  fps: -30\n");
   const Result r = run("record --scenario " + bad + " --out " + fresh("bad") + " --frames 2");
   EXPECT_EQ(r.code, 1);
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
-  EXPECT_NE(r.output.find("pvb_bad_scenario.yaml:3: camera.fps: expected a value in [1, 240], got -30"),
+  EXPECT_NE(r.output.find(bad + ":3: camera.fps: expected a value in [1, 240], got -30"),
             std::string::npos)
       << r.output;
 }
 
 TEST(RecordCli, UnwritableOutputGivesOneClearLine) {
-  const std::string file = ::testing::TempDir() + "pvb_plain_file";
+  const std::string file = ::testing::TempDir() + "pvb_plain_file_" + std::to_string(::getpid());
   write_file(file, "x");
   const Result r = run("record --scenario " + kStation + " --out " + file + "/seq --frames 2");
   EXPECT_EQ(r.code, 1);
