@@ -77,6 +77,20 @@ std::string base_name(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
+// Column label of an estimate: its file name, or "folder/file" when several
+// estimates share a file name (runs writing CameraTrajectory.txt each).
+std::string column_label(const std::vector<EvalResult>& results, std::size_t k) {
+  const std::string& path = results[k].est_source;
+  const std::string name = base_name(path);
+  bool shared = false;
+  for (std::size_t j = 0; j < results.size(); ++j)
+    shared = shared || (j != k && base_name(results[j].est_source) == name);
+  if (!shared) return name;
+  const std::size_t slash = path.find_last_of('/');
+  if (slash == std::string::npos || slash == 0) return name;
+  return base_name(path.substr(0, slash)) + "/" + name;
+}
+
 }  // namespace
 
 EvalResult evaluate(const Trajectory& gt, const Trajectory& est, const EvalOptions& options) {
@@ -147,7 +161,7 @@ std::string format_comparison(const std::vector<EvalResult>& results) {
   std::snprintf(cell, sizeof cell, "%-22s", "metric");
   out += cell;
   for (std::size_t k = 0; k < results.size(); ++k) {
-    std::string name = "[" + std::to_string(k + 1) + "] " + base_name(results[k].est_source);
+    std::string name = "[" + std::to_string(k + 1) + "] " + column_label(results, k);
     if (name.size() > kCol - 1) name = name.substr(0, kCol - 2) + "~";
     std::snprintf(cell, sizeof cell, "%*s", kCol, name.c_str());
     out += cell;

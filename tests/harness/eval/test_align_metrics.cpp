@@ -205,8 +205,14 @@ TEST(Report, ComparisonShowsReduction) {
   const Trajectory gt = loop(60);
   Trajectory est = transformed(gt, kOffset);
   for (std::size_t i = 0; i < est.size(); ++i) est.poses[i].T_w_c.translation().x() += (i % 3) * 0.01;
-  const EvalResult a = evaluate(gt, est, {});
-  const std::string table = format_comparison({a, a});
+  EvalResult a = evaluate(gt, est, {});
+  EvalResult b = a;
+  a.est_source = "runs/pe_slam/CameraTrajectory.txt";
+  b.est_source = "runs/baseline/CameraTrajectory.txt";
+  const std::string table = format_comparison({a, b});
+  // same file names: the columns name their folders
+  EXPECT_NE(table.find("[1] pe_slam/CameraTraj"), std::string::npos) << table;
+  EXPECT_NE(table.find("[2] baseline/CameraTra"), std::string::npos) << table;
   EXPECT_NE(table.find("ATE rmse"), std::string::npos);
   EXPECT_NE(table.find("+0.0%"), std::string::npos) << table;
   const std::string json = format_json(a);
