@@ -109,6 +109,14 @@ std::vector<std::size_t> Frame::features_in_area(double u, double v, double r, i
   return out;
 }
 
+std::vector<std::pair<float, std::size_t>> Frame::keypoints_by_depth() const {
+  std::vector<std::pair<float, std::size_t>> by_depth;
+  for (std::size_t i = 0; i < size(); ++i)
+    if (depth_m[i] > 0) by_depth.emplace_back(depth_m[i], i);
+  std::sort(by_depth.begin(), by_depth.end());
+  return by_depth;
+}
+
 Eigen::Vector3d Frame::unproject_world(std::size_t i) const {
   const double z = depth_m[i];
   const Eigen::Vector3d p_c((keys_un[i].pt.x - cam->K.cx) * z / cam->K.fx, (keys_un[i].pt.y - cam->K.cy) * z / cam->K.fy,

@@ -115,10 +115,7 @@ void Tracking::update_last_frame() {
   if (last_is_keyframe_) return;
   // Visual-odometry points: the closest keypoints with depth that have no map
   // point get a temporary point (ORB-SLAM2 UpdateLastFrame for RGB-D).
-  std::vector<std::pair<float, std::size_t>> by_depth;
-  for (std::size_t i = 0; i < last_.size(); ++i)
-    if (last_.depth_m[i] > 0) by_depth.emplace_back(last_.depth_m[i], i);
-  std::sort(by_depth.begin(), by_depth.end());
+  const auto by_depth = last_.keypoints_by_depth();
   int n = 0;
   for (const auto& [d, i] : by_depth) {
     const auto& mp = last_.map_points[i];
@@ -404,10 +401,7 @@ std::shared_ptr<KeyFrame> Tracking::create_keyframe(Frame& f) {
   ref_kf_ = kf;
   // New points from depth: the closest keypoints first, all nearer than the
   // close/far threshold and at least 100 (ORB-SLAM2 CreateNewKeyFrame).
-  std::vector<std::pair<float, std::size_t>> by_depth;
-  for (std::size_t i = 0; i < f.size(); ++i)
-    if (f.depth_m[i] > 0) by_depth.emplace_back(f.depth_m[i], i);
-  std::sort(by_depth.begin(), by_depth.end());
+  const auto by_depth = f.keypoints_by_depth();
   int n = 0;
   for (const auto& [d, i] : by_depth) {
     const auto& existing = f.map_points[i];

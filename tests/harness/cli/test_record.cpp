@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "pvb/common/text.hpp"
+#include "run_pvbench.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/trajectory.hpp"
 
@@ -21,16 +22,8 @@ namespace {
 const std::string kBin = std::string(PVB_BINARY_DIR) + "/bin/pvbench";
 const std::string kStation = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
 
-struct Result {
-  int code;
-  std::string output;
-};
-
-Result run(const std::string& args) {
-  const std::string log = ::testing::TempDir() + "pvb_cli_out_" + std::to_string(::getpid()) + ".txt";
-  const int status = std::system((kBin + " " + args + " > " + log + " 2>&1").c_str());
-  return {WEXITSTATUS(status), read_file(log)};
-}
+using Result = pvb::test::RunResult;
+Result run(const std::string& args) { return pvb::test::run_pvbench(args); }
 
 // ctest runs each test in its own process, possibly in parallel: folders
 // carry the process id.

@@ -14,22 +14,15 @@
 #include <unistd.h>
 
 #include "pvb/common/text.hpp"
+#include "run_pvbench.hpp"
 
 namespace {
 
 const std::string kBin = std::string(PVB_BINARY_DIR) + "/bin/pvbench";
 const std::string kStation = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
 
-struct Result {
-  int code;
-  std::string output;
-};
-
-Result run(const std::string& args) {
-  const std::string log = ::testing::TempDir() + "pvb_slam_out_" + std::to_string(::getpid()) + ".txt";
-  const int status = std::system((kBin + " " + args + " > " + log + " 2>&1").c_str());
-  return {WEXITSTATUS(status), pvb::read_file(log)};
-}
+using Result = pvb::test::RunResult;
+Result run(const std::string& args) { return pvb::test::run_pvbench(args); }
 
 std::string dir(const std::string& name) {
   const std::string d = ::testing::TempDir() + "pvb_slam_" + name + "_" + std::to_string(::getpid());

@@ -62,6 +62,8 @@ class Frame {
                                             int max_level = -1) const;
   /// World point of keypoint i from its depth; precondition depth_m[i] > 0.
   Eigen::Vector3d unproject_world(std::size_t i) const;
+  /// (depth, keypoint index) of the keypoints with depth, nearest first.
+  std::vector<std::pair<float, std::size_t>> keypoints_by_depth() const;
   /// Observation of keypoint i for the optimiser.
   Observation observation(std::size_t i) const;
   Eigen::Vector3d camera_center_w() const { return T_c_w.inverse().translation(); }
