@@ -148,8 +148,9 @@ int run_slam(const SlamArgs& a) {
       try {
         res = eval::evaluate(gt, est, eo);
       } catch (const eval::EvalError& e) {
-        // A straight drive leaves the rotation about the line undetermined;
-        // the SLAM estimate starts at its first frame, so align that instead.
+        // Only a numerically degenerate set lands here (a robot that never
+        // moved, fewer than 3 poses); nearly straight drives align with se3.
+        // The SLAM estimate starts at its first frame, so align that instead.
         std::fprintf(stderr, "pvbench slam: note: se3 alignment impossible (%s); using origin alignment\n", e.what());
         eo.alignment = eval::Alignment::kOrigin;
         res = eval::evaluate(gt, est, eo);

@@ -8,6 +8,26 @@
 namespace pvb::slam {
 namespace {
 
+// The best and second-best descriptor distances seen so far, with the
+// candidate (and its pyramid level) that gave the best.
+struct BestTwo {
+  int best = INT_MAX, second = INT_MAX;
+  int best_level = -1, second_level = -1;
+  std::size_t best_idx = 0;
+  void offer(int d, std::size_t j, int level = -1) {
+    if (d < best) {
+      second = best;
+      second_level = best_level;
+      best = d;
+      best_level = level;
+      best_idx = j;
+    } else if (d < second) {
+      second = d;
+      second_level = level;
+    }
+  }
+};
+
 const unsigned char* desc_row(const cv::Mat& d, std::size_t i) { return d.ptr<unsigned char>(static_cast<int>(i)); }
 
 int angle_bin(float diff_deg) {
@@ -63,20 +83,14 @@ std::vector<IndexMatch> search_by_projection(Frame& cur, const Frame& last, doub
     if (cands.empty()) continue;
     const double ur = uv.x() - cam.K.bf / p_c.z();
     const unsigned char* d_mp = mp->descriptor().empty() ? desc_row(last.descriptors, i) : mp->descriptor().ptr<unsigned char>(0);
-    int best = INT_MAX, second = INT_MAX;
-    std::size_t best_idx = 0;
+    BestTwo b;
     for (std::size_t j : cands) {
       if (cur.map_points[j] && cur.map_points[j]->num_observations() > 0) continue;
       if (cur.u_right[j] > 0 && std::abs(ur - cur.u_right[j]) > radius) continue;
-      const int d = descriptor_distance(d_mp, desc_row(cur.descriptors, j));
-      if (d < best) {
-        second = best;
-        best = d;
-        best_idx = j;
-      } else if (d < second) {
-        second = d;
-      }
+      b.offer(descriptor_distance(d_mp, desc_row(cur.descriptors, j)), j);
     }
+    const int best = b.best, second = b.second;
+    const std::size_t best_idx = b.best_idx;
     if (best > kThHigh) continue;
     if (second != INT_MAX && best >= ratio * second) continue;
     if (cur.map_points[best_idx]) continue;  // taken by another point of this search
@@ -123,25 +137,15 @@ int search_local_points(Frame& cur, const std::vector<ProjectedPoint>& points, d
     const std::vector<std::size_t> cands = cur.features_in_area(p.u, p.v, r, p.level - 1, p.level);
     if (cands.empty()) continue;
     const unsigned char* d_mp = p.mp->descriptor().ptr<unsigned char>(0);
-    int best = INT_MAX, second = INT_MAX, best_level = -1, second_level = -1;
-    std::size_t best_idx = 0;
+    BestTwo b;
     for (std::size_t j : cands) {
       if (cur.map_points[j] && cur.map_points[j]->num_observations() > 0) continue;
       if (cur.u_right[j] > 0 && std::abs(p.u_right - cur.u_right[j]) > r) continue;
-      const int d = descriptor_distance(d_mp, desc_row(cur.descriptors, j));
-      if (d < best) {
-        second = best;
-        second_level = best_level;
-        best = d;
-        best_level = cur.keys_un[j].octave;
-        best_idx = j;
-      } else if (d < second) {
-        second = d;
-        second_level = cur.keys_un[j].octave;
-      }
+      b.offer(descriptor_distance(d_mp, desc_row(cur.descriptors, j)), j, cur.keys_un[j].octave);
     }
-    if (best > kThHigh) continue;
-    if (best_level == second_level && best > kRatio * second) continue;
+    if (b.best > kThHigh) continue;
+    if (b.best_level == b.second_level && b.best > kRatio * b.second) continue;
+    const std::size_t best_idx = b.best_idx;
     cur.map_points[best_idx] = p.mp;
     ++n;
   }
@@ -158,19 +162,13 @@ int search_keyframe_bruteforce(const KeyFrame& kf, Frame& cur, int max_distance,
     const auto& mp = kff.map_points[i];
     if (!mp || mp->bad()) continue;
     const unsigned char* d_mp = desc_row(kff.descriptors, i);
-    int best = INT_MAX, second = INT_MAX;
-    std::size_t best_idx = 0;
+    BestTwo b;
     for (std::size_t j = 0; j < cur.size(); ++j) {
       if (cur.map_points[j]) continue;
-      const int d = descriptor_distance(d_mp, desc_row(cur.descriptors, j));
-      if (d < best) {
-        second = best;
-        best = d;
-        best_idx = j;
-      } else if (d < second) {
-        second = d;
-      }
+      b.offer(descriptor_distance(d_mp, desc_row(cur.descriptors, j)), j);
     }
+    const int best = b.best, second = b.second;
+    const std::size_t best_idx = b.best_idx;
     if (best > max_distance || (second != INT_MAX && best >= ratio * second)) continue;
     if (best >= taken_dist[best_idx]) continue;
     if (taken_by[best_idx] >= 0) matches[static_cast<std::size_t>(taken_by[best_idx])].i1 = SIZE_MAX;
