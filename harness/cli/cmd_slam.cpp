@@ -1,6 +1,7 @@
 // pvbench slam: runs PE-SLAM (or its ORB-SLAM2 baseline) on a TUM RGB-D
 // folder and writes trajectories, per-frame timing and run statistics; with
-// a groundtruth.txt in the folder it also evaluates ATE and RPE.
+// a groundtruth.txt in the folder it also evaluates ATE and RPE.  Unless
+// disabled, the dense map goes to PointCloud.ply.
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -19,6 +20,7 @@
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
+#include "pvb/slam/dense/point_cloud.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -29,6 +31,7 @@ struct SlamArgs {
   std::string out;
   bool no_pe_match = false;
   bool sync = false;
+  bool no_dense = false;
   std::uint32_t seed = 1;
   std::size_t max_frames = 0;
   double max_missing = 0.1;
@@ -65,6 +68,7 @@ int run_slam(const SlamArgs& a) {
   slam::Settings settings = slam::read_settings(a.settings);
   for (const std::string& w : settings.warnings) std::fprintf(stderr, "pvbench slam: warning: %s\n", w.c_str());
   if (a.no_pe_match) settings.pe_match.enabled = false;
+  if (a.no_dense) settings.dense.enabled = false;
   dataset::TumSequenceReader reader(a.sequence, settings.depth_map_factor);
   dataset::make_dirs(a.out);
 
@@ -121,6 +125,9 @@ int run_slam(const SlamArgs& a) {
   // ORB-SLAM2's way of saving: each frame relative to its (refined) reference keyframe.
   write_tum_file(a.out + "/CameraTrajectoryRefined.txt", system.refined_trajectory());
   cam_traj.close();
+  std::size_t cloud_points = 0;
+  if (system.dense_enabled()) cloud_points = system.write_point_cloud(a.out + "/PointCloud.ply");
+  const slam::dense::DenseMapperStats dense_stats = system.dense_stats();
 
   const double mean = tracking_ms.empty() ? 0 : std::accumulate(tracking_ms.begin(), tracking_ms.end(), 0.0) /
                                                       static_cast<double>(tracking_ms.size());
@@ -133,6 +140,15 @@ int run_slam(const SlamArgs& a) {
      << ",\n  \"tracking_ms\": {\"median\": " << fmt(percentile(tracking_ms, 0.5)) << ", \"mean\": " << fmt(mean)
      << ", \"p95\": " << fmt(percentile(tracking_ms, 0.95)) << "},\n  \"pe_match_ms\": {\"median\": "
      << fmt(percentile(pe_ms, 0.5)) << ", \"p95\": " << fmt(percentile(pe_ms, 0.95)) << "}";
+  if (system.dense_enabled()) {
+    const double per_kf_ms =
+        dense_stats.keyframes ? dense_stats.total_ms / static_cast<double>(dense_stats.keyframes) : 0.0;
+    js << ",\n  \"dense\": {\"keyframes\": " << dense_stats.keyframes << ", \"points\": " << cloud_points
+       << ", \"keyframe_points\": " << dense_stats.points << ", \"ms_per_keyframe\": " << fmt(per_kf_ms)
+       << ", \"resolution_m\": " << fmt(settings.dense.resolution_m) << "}";
+    std::printf("dense map: %zu points from %zu keyframes (%.1f ms per keyframe) -> %s/PointCloud.ply\n",
+                cloud_points, dense_stats.keyframes, per_kf_ms, a.out.c_str());
+  }
   std::printf("frames %zu, lost %zu, keyframes %zu, map points %zu\n", frames, lost, system.num_keyframes(),
               system.num_map_points());
   std::printf("tracking ms: median %.2f, mean %.2f, p95 %.2f; PE-match ms: median %.2f\n",
@@ -191,6 +207,7 @@ Command add_slam_command(CLI::App& app) {
       ->required();
   sub->add_option("--out", args->out, "output folder")->required();
   sub->add_flag("--no-pe-match", args->no_pe_match, "baseline: ORB-SLAM2 motion model without PE-match");
+  sub->add_flag("--no-dense", args->no_dense, "skip the dense point-cloud map (PointCloud.ply)");
   sub->add_flag("--sync", args->sync, "synchronous mode: no worker threads, bit-identical runs");
   sub->add_option("--seed", args->seed, "PE-match seed")->capture_default_str();
   sub->add_option("--max-frames", args->max_frames, "stop after this many frames (0: all)")->capture_default_str();

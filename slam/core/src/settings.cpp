@@ -109,6 +109,20 @@ Settings read_settings(const std::string& path) {
   r.positive("PEMatch.stallIterations", pe.stall_iterations);
   r.positive("PEMatch.threshold", pe.threshold_px);
 
+  PointCloudMappingSettings& pc = s.dense;
+  pc.enabled = r.flag("PointCloudMapping.Enabled", pc.enabled);
+  pc.resolution_m = r.real("PointCloudMapping.Resolution", false, pc.resolution_m);
+  pc.stride_px = r.integer("PointCloudMapping.Stride", false, pc.stride_px);
+  pc.min_depth_m = r.real("PointCloudMapping.MinDepth", false, pc.min_depth_m);
+  pc.max_depth_m = r.real("PointCloudMapping.MaxDepth", false, pc.max_depth_m);
+  r.positive("PointCloudMapping.Resolution", pc.resolution_m);
+  r.positive("PointCloudMapping.Stride", pc.stride_px);
+  if (!(pc.min_depth_m >= 0))
+    throw ConfigError(path, "PointCloudMapping.MinDepth", "a value >= 0", std::to_string(pc.min_depth_m));
+  if (!(pc.max_depth_m > pc.min_depth_m))
+    throw ConfigError(path, "PointCloudMapping.MaxDepth", "a value > PointCloudMapping.MinDepth",
+                      std::to_string(pc.max_depth_m));
+
   const cv::FileNode root = fs.root();
   for (auto it = root.begin(); it != root.end(); ++it) {
     const std::string key = (*it).name();

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <opencv2/imgproc.hpp>
 
+#include "pvb/slam/dense/ply.hpp"
+
 namespace pvb::slam {
 namespace {
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -33,12 +35,23 @@ System::System(const Settings& settings, const SystemOptions& options)
   tracking_ = std::make_unique<Tracking>(map_, cam_, topt);
   mapping_ = std::make_unique<LocalMapping>(map_, cam_);
   if (!options.synchronous) mapping_->start();
+  if (settings.dense.enabled) {
+    dense::DenseMapperOptions dopt;
+    dopt.K = settings.K;
+    dopt.back_projection.stride_px = settings.dense.stride_px;
+    dopt.back_projection.min_depth_m = settings.dense.min_depth_m;
+    dopt.back_projection.max_depth_m = settings.dense.max_depth_m;
+    dopt.leaf_m = settings.dense.resolution_m;
+    dense_ = std::make_unique<dense::DenseMapper>(dopt);
+    if (!options.synchronous) dense_->start();
+  }
 }
 
 System::~System() { shutdown(); }
 
 void System::shutdown() {
   if (mapping_) mapping_->stop();
+  if (dense_) dense_->stop();
 }
 
 FrameResult System::track(const sensor::RgbdFrame& in) {
@@ -63,6 +76,21 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
       records_.push_back({in.t_ns, ref, tracking_->last_frame().T_c_w * ref->T_c_w().inverse()});
     }
   }
+  if (kf && dense_) {
+    // Only keyframes keep their images.  The worker gets its own copy (a
+    // source may reuse its buffers); inline processing reads them in place.
+    dense::DenseKeyFrame dkf;
+    dkf.id = kf->id();
+    dkf.t_ns = in.t_ns;
+    dkf.rgb = dense_->running() ? in.rgb.clone() : in.rgb;
+    dkf.depth_m = dense_->running() ? in.depth_m.clone() : in.depth_m;
+    {
+      std::lock_guard<std::mutex> lock(map_.mutex());
+      dkf.T_w_c = kf->T_c_w().inverse();
+    }
+    dense_keyframes_[kf->id()] = kf;
+    dense_->insert(std::move(dkf));
+  }
   if (kf) {
     const auto t1 = std::chrono::steady_clock::now();
     mapping_->insert(kf);
@@ -86,6 +114,24 @@ std::vector<geom::StampedPose> System::refined_trajectory() {
   for (const FrameRecord& r : records_) out.push_back({r.t_ns, (r.T_c_r * r.ref->T_c_w_via_tree()).inverse()});
   return out;
 }
+
+dense::PointCloud System::point_cloud() {
+  if (!dense_) return {};
+  std::map<std::uint64_t, geom::SE3d> T_w_c_by_id;
+  {
+    std::lock_guard<std::mutex> lock(map_.mutex());
+    for (const auto& [id, kf] : dense_keyframes_) T_w_c_by_id[id] = kf->T_c_w_via_tree().inverse();
+  }
+  return dense_->global_cloud(T_w_c_by_id);
+}
+
+std::size_t System::write_point_cloud(const std::string& path) {
+  const dense::PointCloud cloud = point_cloud();
+  dense::write_ply(path, cloud);
+  return cloud.size();
+}
+
+dense::DenseMapperStats System::dense_stats() const { return dense_ ? dense_->stats() : dense::DenseMapperStats{}; }
 
 std::size_t System::num_keyframes() {
   std::lock_guard<std::mutex> lock(map_.mutex());

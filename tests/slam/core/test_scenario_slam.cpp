@@ -15,11 +15,10 @@
 
 #include "pvb/common/text.hpp"
 #include "run_pvbench.hpp"
+#include "station_sequence.hpp"
 
 namespace {
 
-const std::string kBin = std::string(PVB_BINARY_DIR) + "/bin/pvbench";
-const std::string kStation = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
 
 using Result = pvb::test::RunResult;
 Result run(const std::string& args) { return pvb::test::run_pvbench(args); }
@@ -30,29 +29,7 @@ std::string dir(const std::string& name) {
   return d;
 }
 
-// Recorded once per build of pvbench and shared by the test processes: the
-// folder name carries a fingerprint of the scenario file and of the pvbench
-// binary, so a changed simulator or scenario never reuses a stale recording.
-// Recorded into a private folder, then renamed into place (a loser of a race
-// keeps the winner's copy, which is byte-identical).
-const std::string& station_sequence() {
-  static const std::string d = [] {
-    const std::string bin = std::string(PVB_BINARY_DIR) + "/bin/pvbench";
-    const auto stamp = std::filesystem::last_write_time(bin).time_since_epoch().count();
-    const std::size_t key = std::hash<std::string>{}(pvb::read_file(kStation) + std::to_string(stamp) +
-                                                     std::to_string(std::filesystem::file_size(bin)));
-    const std::string final_dir =
-        std::string(PVB_BINARY_DIR) + "/test_data/slam_pv_station_300_" + std::to_string(key % 1000000007);
-    if (::access((final_dir + "/groundtruth.txt").c_str(), F_OK) == 0) return final_dir;
-    std::system(("mkdir -p " + std::string(PVB_BINARY_DIR) + "/test_data").c_str());
-    const std::string tmp = final_dir + ".tmp" + std::to_string(::getpid());
-    const Result r = run("record --scenario " + kStation + " --out " + tmp + " --frames 300 --seed 7");
-    EXPECT_EQ(r.code, 0) << r.output;
-    if (std::rename(tmp.c_str(), final_dir.c_str()) != 0) std::system(("rm -rf " + tmp).c_str());
-    return final_dir;
-  }();
-  return d;
-}
+using pvb::test::station_sequence;
 
 double json_number(const std::string& json, const std::string& key) {
   std::smatch m;

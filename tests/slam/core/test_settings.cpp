@@ -3,6 +3,8 @@
 
 #include <fstream>
 #include <regex>
+#include <utility>
+#include <vector>
 #include <unistd.h>
 
 #include "pvb/common/error.hpp"
@@ -85,6 +87,42 @@ TEST(Settings, WrongTypeAndBadValuesAreErrors) {
   EXPECT_THROW(read_settings(temp_copy("lev", std::regex_replace(read_file(kTum1), std::regex("nLevels: 8"),
                                                                        "nLevels: 0"))),
                ConfigError);
+}
+
+TEST(Settings, PointCloudMappingSection) {
+  // absent: enabled with the documented defaults
+  const Settings d = read_settings(kTum1);
+  EXPECT_TRUE(d.dense.enabled);
+  EXPECT_DOUBLE_EQ(d.dense.resolution_m, 0.02);
+  EXPECT_EQ(d.dense.stride_px, 3);
+  EXPECT_DOUBLE_EQ(d.dense.max_depth_m, 4.0);
+  const Settings s = read_settings(temp_copy("pc", read_file(kTum1) +
+                                                       "\nPointCloudMapping.Enabled: 0\nPointCloudMapping.Resolution: 0.05\n"
+                                                       "PointCloudMapping.Stride: 2\nPointCloudMapping.MinDepth: 0.3\n"
+                                                       "PointCloudMapping.MaxDepth: 6.5\n"));
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_FALSE(s.dense.enabled);
+  EXPECT_DOUBLE_EQ(s.dense.resolution_m, 0.05);
+  EXPECT_EQ(s.dense.stride_px, 2);
+  EXPECT_DOUBLE_EQ(s.dense.min_depth_m, 0.3);
+  EXPECT_DOUBLE_EQ(s.dense.max_depth_m, 6.5);
+  // unknown key in the section: a warning naming it
+  const Settings w = read_settings(temp_copy("pcw", read_file(kTum1) + "\nPointCloudMapping.Resolutoin: 0.05\n"));
+  ASSERT_EQ(w.warnings.size(), 1u);
+  EXPECT_NE(w.warnings[0].find("PointCloudMapping.Resolutoin"), std::string::npos);
+  // wrong type or value: an error naming the key
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"PointCloudMapping.Resolution", "\"fine\""}, {"PointCloudMapping.Resolution", "0"},
+      {"PointCloudMapping.Stride", "1.5"},          {"PointCloudMapping.Enabled", "2"},
+      {"PointCloudMapping.MaxDepth", "0.05"}};
+  for (const auto& [key, value] : bad) {
+    try {
+      read_settings(temp_copy("pcbad", read_file(kTum1) + "\n" + key + ": " + value + "\n"));
+      ADD_FAILURE() << key << ": " << value << " accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), key) << e.what();
+    }
+  }
 }
 
 TEST(Settings, MissingFileIsAnIoError) { EXPECT_THROW(read_settings("/nonexistent/settings.yaml"), IoError); }

@@ -1,7 +1,7 @@
 #pragma once
 // SLAM settings: ORB-SLAM2 RGB-D YAML files read unchanged (Camera.*,
-// ThDepth, DepthMapFactor, ORBextractor.*) plus an optional PEMatch.*
-// section.  A missing required key is a pvb::ConfigError naming it; an
+// ThDepth, DepthMapFactor, ORBextractor.*) plus optional PEMatch.* and
+// PointCloudMapping.* sections.  A missing required key is a pvb::ConfigError naming it; an
 // unknown key is a warning (returned, not printed: the app prints it).
 #include <string>
 #include <vector>
@@ -21,6 +21,18 @@ struct PeMatchSettings {
   bool refine = false;             ///< PEMatch.refine (0/1): IRLS refinement of gbest's F
 };
 
+/// PointCloudMapping.* section: the dense point-cloud mapping thread (paper
+/// sec. 3).  The paper gives no values; these follow the ORB-SLAM2
+/// point-cloud forks (every 3rd pixel) with a 2 cm voxel and a depth limit
+/// where the Kinect's depth noise is still below about 3 cm.
+struct PointCloudMappingSettings {
+  bool enabled = true;         ///< PointCloudMapping.Enabled (0/1)
+  double resolution_m = 0.02;  ///< PointCloudMapping.Resolution: voxel leaf size, metres
+  int stride_px = 3;           ///< PointCloudMapping.Stride: every n-th pixel in rows and columns
+  double min_depth_m = 0.1;    ///< PointCloudMapping.MinDepth, metres
+  double max_depth_m = 4.0;    ///< PointCloudMapping.MaxDepth, metres
+};
+
 /// Everything the SLAM system reads from its settings file.
 struct Settings {
   std::string source;               ///< file it came from
@@ -33,6 +45,7 @@ struct Settings {
   double depth_map_factor = 5000.0; ///< DepthMapFactor: raw depth units per metre
   OrbParams orb;                    ///< ORBextractor.*
   PeMatchSettings pe_match;         ///< PEMatch.* (optional section)
+  PointCloudMappingSettings dense;  ///< PointCloudMapping.* (optional section)
   std::vector<std::string> warnings;  ///< unknown keys and similar, one line each
 
   /// Close/far depth threshold in metres (ORB-SLAM2: bf * ThDepth / fx).

@@ -1,9 +1,12 @@
 #pragma once
 // The PE-SLAM RGB-D system: ORB extraction and tracking on the caller's
-// thread, local mapping inline (synchronous mode) or on a worker thread.
+// thread, local mapping and dense point-cloud mapping inline (synchronous
+// mode) or on worker threads.
 #include <cstdint>
 #include <memory>
+#include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "pvb/geometry/stamped_pose.hpp"
@@ -11,6 +14,7 @@
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/tracking.hpp"
+#include "pvb/slam/dense/dense_mapper.hpp"
 
 namespace pvb::slam {
 
@@ -39,7 +43,7 @@ class System {
   System& operator=(const System&) = delete;
 
   FrameResult track(const sensor::RgbdFrame& frame);
-  /// Lets local mapping finish its queue and stops the worker.
+  /// Lets local and dense mapping finish their queues and stops the workers.
   void shutdown();
 
   /// Every tracked frame's pose recomputed from its reference keyframe's
@@ -51,6 +55,20 @@ class System {
   std::size_t num_map_points();
   TrackingState state() const { return tracking_->state(); }
 
+  // Dense point-cloud mapping (Settings::dense; off: the functions below
+  // return empty results) ----------------------------------------------------
+  bool dense_enabled() const { return dense_ != nullptr; }
+  /// The global coloured cloud, rebuilt from every keyframe the dense
+  /// mapper has processed, each at its current (bundle-adjusted) pose;
+  /// culled keyframes at their pose through the spanning tree.  Call after
+  /// shutdown() for the complete map.
+  dense::PointCloud point_cloud();
+  /// Writes point_cloud() as binary PLY; returns the number of points.
+  /// Throws pvb::IoError when the file cannot be written.
+  std::size_t write_point_cloud(const std::string& path);
+  /// Keyframes processed, points and time spent (empty when disabled).
+  dense::DenseMapperStats dense_stats() const;
+
  private:
   Settings settings_;
   SystemOptions options_;
@@ -59,6 +77,9 @@ class System {
   Map map_;
   std::unique_ptr<Tracking> tracking_;
   std::unique_ptr<LocalMapping> mapping_;
+  std::unique_ptr<dense::DenseMapper> dense_;  ///< null when dense mapping is disabled
+  /// Keyframes handed to the dense mapper, by id (for their current poses).
+  std::map<std::uint64_t, std::shared_ptr<KeyFrame>> dense_keyframes_;
   std::uint64_t next_frame_id_ = 0;
   /// Per tracked frame: time, reference keyframe and T_c_r (for refined_trajectory()).
   struct FrameRecord {

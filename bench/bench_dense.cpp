@@ -1,0 +1,65 @@
+// Dense mapping cost per keyframe at 640x480: back-projection (stride 3,
+// the default, and 1) plus the keyframe voxel filter, and the global
+// rebuild (transform + voxel filter) for a map of N keyframes.  The scene
+// is a tilted plane with a ripple (an analytic surface),
+// so every pixel has depth in [1, 4] m: the worst case for the filter.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "pvb/slam/dense/dense_mapper.hpp"
+
+namespace {
+
+namespace dn = pvb::slam::dense;
+
+struct Images {
+  cv::Mat rgb, depth_m;
+};
+
+Images make_images() {
+  Images im{cv::Mat(480, 640, CV_8UC3), cv::Mat(480, 640, CV_32FC1)};
+  for (int v = 0; v < 480; ++v)
+    for (int u = 0; u < 640; ++u) {
+      im.depth_m.at<float>(v, u) = static_cast<float>(1.0 + 3.0 * v / 480.0 + 0.05 * std::sin(0.1 * u));
+      im.rgb.at<cv::Vec3b>(v, u) = cv::Vec3b(static_cast<unsigned char>(u), static_cast<unsigned char>(v), 90);
+    }
+  return im;
+}
+
+void BM_KeyframeCloud(benchmark::State& state) {
+  const Images im = make_images();
+  const pvb::geom::PinholeIntrinsics K;  // 525, 640x480
+  dn::BackProjectionParams p;
+  p.stride_px = static_cast<int>(state.range(0));
+  std::size_t points = 0;
+  for (auto _ : state) {
+    const dn::PointCloud c = dn::voxel_filter(dn::back_project(im.rgb, im.depth_m, K, p), 0.02);
+    points = c.size();
+    benchmark::DoNotOptimize(c.data());
+  }
+  state.counters["points"] = static_cast<double>(points);
+}
+BENCHMARK(BM_KeyframeCloud)->Arg(3)->Arg(1)->Unit(benchmark::kMillisecond);
+
+void BM_GlobalRebuild(benchmark::State& state) {
+  const Images im = make_images();
+  dn::DenseMapperOptions o;
+  dn::DenseMapper mapper(o);
+  const int n = static_cast<int>(state.range(0));
+  for (int i = 0; i < n; ++i)
+    mapper.insert({static_cast<std::uint64_t>(i), i, im.rgb, im.depth_m,
+                   pvb::geom::make_se3(pvb::geom::Mat3d::Identity(), Eigen::Vector3d(0.1 * i, 0, 0))});
+  std::size_t points = 0;
+  for (auto _ : state) {
+    const dn::PointCloud c = mapper.global_cloud();
+    points = c.size();
+    benchmark::DoNotOptimize(c.data());
+  }
+  state.counters["points"] = static_cast<double>(points);
+}
+BENCHMARK(BM_GlobalRebuild)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,21 @@
+#pragma once
+// PLY files for coloured clouds: binary little endian, one `vertex` element
+// with properties x y z (float) and red green blue (uchar), which
+// CloudCompare, MeshLab and Open3D read.
+#include <string>
+
+#include "pvb/slam/dense/point_cloud.hpp"
+
+namespace pvb::slam::dense {
+
+/// Writes the cloud; throws pvb::IoError when the file cannot be written.
+void write_ply(const std::string& path, const PointCloud& cloud);
+
+/// Reads a PLY file as write_ply() writes it (binary_little_endian 1.0, a
+/// vertex element whose properties are float x y z and uchar red green blue
+/// in that order; comments allowed, no other elements).  Throws
+/// pvb::IoError naming the file and the header line that is not understood,
+/// or a truncated body.
+PointCloud read_ply(const std::string& path);
+
+}  // namespace pvb::slam::dense
