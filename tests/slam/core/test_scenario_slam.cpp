@@ -65,6 +65,9 @@ TEST(SlamScenario, SyncModeIsBitIdentical) {
   EXPECT_GT(ta.size(), 1000u);
   EXPECT_EQ(ta, pvb::read_file(b + "/CameraTrajectory.txt"));
   EXPECT_EQ(pvb::read_file(a + "/KeyFrameTrajectory.txt"), pvb::read_file(b + "/KeyFrameTrajectory.txt"));
+  const std::string cloud = pvb::read_file(a + "/PointCloud.ply");  // dense map, processed inline
+  EXPECT_GT(cloud.size(), 10000u);
+  EXPECT_EQ(cloud, pvb::read_file(b + "/PointCloud.ply"));
 }
 
 // Local mapping on its worker thread (the default mode): same accuracy

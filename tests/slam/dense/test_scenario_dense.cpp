@@ -164,4 +164,14 @@ TEST(DenseScenario, CloudLiesOnTheRenderedGeometry) {
   EXPECT_LT(p95, p95_bound);
 }
 
+TEST(DenseScenario, NoDenseFlagWritesNoCloud) {
+  const std::string seq = pvb::test::station_sequence(), out = scratch("nodense");
+  const auto r = pvb::test::run_pvbench("slam --sequence " + seq + " --settings " + seq + "/camera.yaml --out " + out +
+                                        " --sync --no-dense --max-frames 30");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.find("dense map"), std::string::npos) << r.output;
+  EXPECT_EQ(::access((out + "/PointCloud.ply").c_str(), F_OK), -1);
+  EXPECT_EQ(pvb::read_file(out + "/stats.json").find("\"dense\""), std::string::npos);
+}
+
 }  // namespace
