@@ -22,7 +22,8 @@ Images make_images() {
   for (int v = 0; v < 480; ++v)
     for (int u = 0; u < 640; ++u) {
       im.depth_m.at<float>(v, u) = static_cast<float>(1.0 + 3.0 * v / 480.0 + 0.05 * std::sin(0.1 * u));
-      im.rgb.at<cv::Vec3b>(v, u) = cv::Vec3b(static_cast<unsigned char>(u), static_cast<unsigned char>(v), 90);
+      im.rgb.at<cv::Vec3b>(v, u) =
+          cv::Vec3b(static_cast<unsigned char>(u), static_cast<unsigned char>(v), 90);
     }
   return im;
 }

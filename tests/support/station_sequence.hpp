@@ -37,8 +37,9 @@ inline const std::string& station_sequence() {
     if (::access((final_dir + "/groundtruth.txt").c_str(), F_OK) == 0) return final_dir;
     std::system(("mkdir -p " + std::string(PVB_BINARY_DIR) + "/test_data").c_str());
     const std::string tmp = final_dir + ".tmp" + std::to_string(::getpid());
-    const RunResult r = run_pvbench("record --scenario " + station_scenario() + " --out " + tmp + " --frames " +
-                                    std::to_string(kStationFrames) + " --seed " + std::to_string(kStationSeed));
+    const RunResult r =
+        run_pvbench("record --scenario " + station_scenario() + " --out " + tmp + " --frames " +
+                    std::to_string(kStationFrames) + " --seed " + std::to_string(kStationSeed));
     EXPECT_EQ(r.code, 0) << r.output;
     if (std::rename(tmp.c_str(), final_dir.c_str()) != 0) std::system(("rm -rf " + tmp).c_str());
     return final_dir;

@@ -37,7 +37,8 @@ void DenseMapper::process(const DenseKeyFrame& kf) {
   Entry e;
   e.t_ns = kf.t_ns;
   e.T_w_c = kf.T_w_c;
-  e.cloud_c = voxel_filter(back_project(kf.rgb, kf.depth_m, options_.K, options_.back_projection), options_.leaf_m);
+  e.cloud_c =
+      voxel_filter(back_project(kf.rgb, kf.depth_m, options_.K, options_.back_projection), options_.leaf_m);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = entries_.find(kf.id);

@@ -32,7 +32,8 @@ float get_float_le(const unsigned char* src) {
 void write_ply(const std::string& path, const PointCloud& cloud) {
   std::ofstream f(path, std::ios::binary);
   if (!f) throw IoError(path, "cannot open for writing");
-  f << "ply\nformat binary_little_endian 1.0\ncomment PE-SLAM Bench dense map (T_w_c of the keyframes), metres\n"
+  f << "ply\nformat binary_little_endian 1.0\ncomment PE-SLAM Bench dense map (T_w_c of the keyframes), "
+       "metres\n"
     << "element vertex " << cloud.size() << "\n"
     << "property float x\nproperty float y\nproperty float z\n"
     << "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
@@ -61,8 +62,8 @@ void write_ply(const std::string& path, const PointCloud& cloud) {
 PointCloud read_ply(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
   if (!f) throw IoError(path, "cannot open");
-  static const char* kProps[] = {"property float x",      "property float y",       "property float z",
-                                 "property uchar red",    "property uchar green",   "property uchar blue"};
+  static const char* kProps[] = {"property float x",   "property float y",     "property float z",
+                                 "property uchar red", "property uchar green", "property uchar blue"};
   std::string line;
   int line_no = 0;
   auto next_line = [&]() {
@@ -91,11 +92,14 @@ PointCloud read_ply(const std::string& path) {
       continue;
     }
     if (!have_vertex || prop >= 6 || line != kProps[prop])
-      throw IoError(path, std::string("expected '") + (prop < 6 ? kProps[prop] : "end_header") + "', got '" + line +
-                              "'", line_no);
+      throw IoError(
+          path,
+          std::string("expected '") + (prop < 6 ? kProps[prop] : "end_header") + "', got '" + line + "'",
+          line_no);
     ++prop;
   }
-  if (!have_vertex || prop != 6) throw IoError(path, "header lacks the vertex element or its x y z red green blue", line_no);
+  if (!have_vertex || prop != 6)
+    throw IoError(path, "header lacks the vertex element or its x y z red green blue", line_no);
   std::vector<unsigned char> body(count * kVertexBytes);
   f.read(reinterpret_cast<char*>(body.data()), static_cast<std::streamsize>(body.size()));
   if (static_cast<std::size_t>(f.gcount()) != body.size())

@@ -10,7 +10,8 @@ namespace pvb::slam::dense {
 PointCloud back_project(const cv::Mat& rgb, const cv::Mat& depth_m, const geom::PinholeIntrinsics& K,
                         const BackProjectionParams& params) {
   if (depth_m.type() != CV_32FC1) throw Error("back_project: depth image must be CV_32FC1 (metres)");
-  if (rgb.type() != CV_8UC3 && rgb.type() != CV_8UC1) throw Error("back_project: colour image must be CV_8UC3 or CV_8UC1");
+  if (rgb.type() != CV_8UC3 && rgb.type() != CV_8UC1)
+    throw Error("back_project: colour image must be CV_8UC3 or CV_8UC1");
   if (rgb.size() != depth_m.size()) throw Error("back_project: colour and depth images differ in size");
   if (params.stride_px < 1) throw Error("back_project: stride must be >= 1");
   const int step = params.stride_px;
@@ -45,7 +46,9 @@ PointCloud back_project(const cv::Mat& rgb, const cv::Mat& depth_m, const geom::
 }
 
 PointCloud voxel_filter(const PointCloud& in, double leaf_m) {
-  auto finite = [](const CloudPoint& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); };
+  auto finite = [](const CloudPoint& p) {
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+  };
   if (!(leaf_m > 0)) {
     PointCloud out;
     out.reserve(in.size());
@@ -63,7 +66,8 @@ PointCloud voxel_filter(const PointCloud& in, double leaf_m) {
   for (std::size_t i = 0; i < in.size(); ++i) {
     const CloudPoint& p = in[i];
     if (!finite(p)) continue;
-    keys.push_back({static_cast<std::int64_t>(std::floor(p.x * inv)), static_cast<std::int64_t>(std::floor(p.y * inv)),
+    keys.push_back({static_cast<std::int64_t>(std::floor(p.x * inv)),
+                    static_cast<std::int64_t>(std::floor(p.y * inv)),
                     static_cast<std::int64_t>(std::floor(p.z * inv)), static_cast<std::uint32_t>(i)});
   }
   std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
@@ -76,7 +80,9 @@ PointCloud voxel_filter(const PointCloud& in, double leaf_m) {
   for (std::size_t i = 0; i < keys.size();) {
     std::size_t j = i;
     double sx = 0, sy = 0, sz = 0, sr = 0, sg = 0, sb = 0;
-    for (; j < keys.size() && keys[j].ix == keys[i].ix && keys[j].iy == keys[i].iy && keys[j].iz == keys[i].iz; ++j) {
+    for (;
+         j < keys.size() && keys[j].ix == keys[i].ix && keys[j].iy == keys[i].iy && keys[j].iz == keys[i].iz;
+         ++j) {
       const CloudPoint& p = in[keys[j].idx];
       sx += p.x;
       sy += p.y;
@@ -111,6 +117,8 @@ PointCloud transform(const PointCloud& cloud_b, const geom::SE3d& T_a_b) {
   return out;
 }
 
-void append(PointCloud& cloud, const PointCloud& tail) { cloud.insert(cloud.end(), tail.begin(), tail.end()); }
+void append(PointCloud& cloud, const PointCloud& tail) {
+  cloud.insert(cloud.end(), tail.begin(), tail.end());
+}
 
 }  // namespace pvb::slam::dense

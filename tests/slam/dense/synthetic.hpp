@@ -17,8 +17,8 @@ struct PlaneView {
   cv::Mat depth_m;
 };
 
-inline PlaneView render_plane(const geom::PinholeIntrinsics& K, const geom::SE3d& T_w_c, const Eigen::Vector3d& n,
-                              double d) {
+inline PlaneView render_plane(const geom::PinholeIntrinsics& K, const geom::SE3d& T_w_c,
+                              const Eigen::Vector3d& n, double d) {
   PlaneView v{cv::Mat(K.height, K.width, CV_8UC3), cv::Mat(K.height, K.width, CV_32FC1, cv::Scalar(0))};
   const Eigen::Matrix3d R = T_w_c.linear();
   const Eigen::Vector3d o = T_w_c.translation();
@@ -28,7 +28,8 @@ inline PlaneView render_plane(const geom::PinholeIntrinsics& K, const geom::SE3d
       const double denom = n.dot(R * ray_c);
       const double s = std::abs(denom) > 1e-12 ? (d - n.dot(o)) / denom : -1.0;  // s = depth (ray_c.z = 1)
       v.depth_m.at<float>(r, c) = s > 0 ? static_cast<float>(s) : 0.0f;
-      v.rgb.at<cv::Vec3b>(r, c) = cv::Vec3b(static_cast<unsigned char>(c % 256), static_cast<unsigned char>(r % 256), 7);
+      v.rgb.at<cv::Vec3b>(r, c) =
+          cv::Vec3b(static_cast<unsigned char>(c % 256), static_cast<unsigned char>(r % 256), 7);
     }
   return v;
 }

@@ -57,7 +57,8 @@ TEST(DenseMapper, ViewsOfAPlaneGiveACloudOnThePlane) {
   const PointCloud cloud = mapper.global_cloud();
   ASSERT_GT(cloud.size(), 1000u);
   double worst = 0;
-  for (const CloudPoint& p : cloud) worst = std::max(worst, std::abs(kNormal.dot(Eigen::Vector3d(p.x, p.y, p.z)) - kPlaneD));
+  for (const CloudPoint& p : cloud)
+    worst = std::max(worst, std::abs(kNormal.dot(Eigen::Vector3d(p.x, p.y, p.z)) - kPlaneD));
   EXPECT_LT(worst, 1e-4);  // voxel means of coplanar points stay on the plane (float rounding only)
   // the global voxel filter merged the overlapping views: fewer points than all keyframe clouds together
   EXPECT_LT(cloud.size(), mapper.stats().points);
@@ -129,7 +130,8 @@ TEST(DenseMapper, RePosingAKeyframeMovesItsPoints) {
   const PointCloud kf1_c = mapper.keyframe_cloud(1);
   ASSERT_FALSE(kf1_c.empty());
   // a bundle adjustment moved keyframe 1 by 0.5 m along x_w and turned it a little
-  const SE3d corrected = make_se3(so3_exp(Eigen::Vector3d(0, 0, 0.05)), Eigen::Vector3d(0.5, 0, 0)) * poses[1];
+  const SE3d corrected =
+      make_se3(so3_exp(Eigen::Vector3d(0, 0, 0.05)), Eigen::Vector3d(0.5, 0, 0)) * poses[1];
   const PointCloud moved = mapper.global_cloud({{1, corrected}});
   // expected: keyframe 0 as inserted, keyframe 1 at its new pose
   PointCloud expect = pvb::slam::dense::transform(mapper.keyframe_cloud(0), poses[0]);
@@ -141,7 +143,8 @@ TEST(DenseMapper, RePosingAKeyframeMovesItsPoints) {
   const PointCloud old = mapper.global_cloud();
   Eigen::Vector3d c_old = Eigen::Vector3d::Zero(), c_new = Eigen::Vector3d::Zero();
   for (const CloudPoint& p : old) c_old += Eigen::Vector3d(p.x, p.y, p.z) / static_cast<double>(old.size());
-  for (const CloudPoint& p : moved) c_new += Eigen::Vector3d(p.x, p.y, p.z) / static_cast<double>(moved.size());
+  for (const CloudPoint& p : moved)
+    c_new += Eigen::Vector3d(p.x, p.y, p.z) / static_cast<double>(moved.size());
   EXPECT_GT((c_new - c_old).x(), 0.1);
   // the moved keyframe's points, taken back through the corrected pose, are its camera-frame cloud
   const PointCloud only1 = [&] {

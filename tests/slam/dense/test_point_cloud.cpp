@@ -64,12 +64,13 @@ TEST(BackProjection, EveryPixelMatchesThePinholeModel) {
 
 TEST(BackProjection, StrideAndDepthLimits) {
   const auto K = camera();
-  cv::Mat depth(K.height, K.width, CV_32FC1, cv::Scalar(2.0f)), rgb(K.height, K.width, CV_8UC3, cv::Scalar(1, 2, 3));
-  depth.at<float>(0, 0) = 0.0f;                                  // invalid
-  depth.at<float>(0, 3) = 0.05f;                                 // too close
-  depth.at<float>(3, 3) = 9.0f;                                  // too far
+  cv::Mat depth(K.height, K.width, CV_32FC1, cv::Scalar(2.0f)),
+      rgb(K.height, K.width, CV_8UC3, cv::Scalar(1, 2, 3));
+  depth.at<float>(0, 0) = 0.0f;   // invalid
+  depth.at<float>(0, 3) = 0.05f;  // too close
+  depth.at<float>(3, 3) = 9.0f;   // too far
   depth.at<float>(6, 6) = std::numeric_limits<float>::quiet_NaN();
-  depth.at<float>(1, 1) = 0.05f;                                 // skipped by the stride anyway
+  depth.at<float>(1, 1) = 0.05f;  // skipped by the stride anyway
   BackProjectionParams p;
   p.stride_px = 3;
   p.min_depth_m = 0.1;
@@ -91,7 +92,8 @@ TEST(BackProjection, StrideAndDepthLimits) {
 
 TEST(BackProjection, GreyImagesAndBadTypes) {
   const auto K = camera();
-  cv::Mat depth(K.height, K.width, CV_32FC1, cv::Scalar(1.0f)), grey(K.height, K.width, CV_8UC1, cv::Scalar(77));
+  cv::Mat depth(K.height, K.width, CV_32FC1, cv::Scalar(1.0f)),
+      grey(K.height, K.width, CV_8UC1, cv::Scalar(77));
   const PointCloud cloud = back_project(grey, depth, K, BackProjectionParams{});
   ASSERT_FALSE(cloud.empty());
   EXPECT_EQ(cloud[0].r, 77);
@@ -105,9 +107,9 @@ TEST(BackProjection, GreyImagesAndBadTypes) {
 
 TEST(VoxelFilter, CountsAndAverages) {
   // Two points in voxel (0,0,0), three in (1,0,0), one in (-1,-1,-1), leaf 0.1.
-  const PointCloud in = {{0.01f, 0.02f, 0.03f, 10, 20, 30},  {0.15f, 0.05f, 0.05f, 0, 0, 0},
-                         {0.09f, 0.08f, 0.07f, 20, 41, 50},  {0.11f, 0.01f, 0.01f, 3, 3, 3},
-                         {-0.05f, -0.01f, -0.09f, 9, 9, 9},  {0.19f, 0.09f, 0.09f, 6, 6, 6}};
+  const PointCloud in = {{0.01f, 0.02f, 0.03f, 10, 20, 30}, {0.15f, 0.05f, 0.05f, 0, 0, 0},
+                         {0.09f, 0.08f, 0.07f, 20, 41, 50}, {0.11f, 0.01f, 0.01f, 3, 3, 3},
+                         {-0.05f, -0.01f, -0.09f, 9, 9, 9}, {0.19f, 0.09f, 0.09f, 6, 6, 6}};
   const PointCloud out = voxel_filter(in, 0.1);
   ASSERT_EQ(out.size(), 3u);
   // sorted by voxel index: (-1,-1,-1), (0,0,0), (1,0,0)

@@ -25,9 +25,9 @@
 
 #include "pvb/common/text.hpp"
 #include "pvb/eval/evaluate.hpp"
-#include "pvb/slam/core/settings.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/simulator.hpp"
+#include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/dense/ply.hpp"
 #include "run_pvbench.hpp"
 #include "station_sequence.hpp"
@@ -51,7 +51,8 @@ class Grid {
     return ((i + (1 << 20)) << 42) | ((j + (1 << 20)) << 21) | (k + (1 << 20));
   }
   static std::array<std::int64_t, 3> index(const Eigen::Vector3d& p, double cell_m) {
-    return {static_cast<std::int64_t>(std::floor(p.x() / cell_m)), static_cast<std::int64_t>(std::floor(p.y() / cell_m)),
+    return {static_cast<std::int64_t>(std::floor(p.x() / cell_m)),
+            static_cast<std::int64_t>(std::floor(p.y() / cell_m)),
             static_cast<std::int64_t>(std::floor(p.z() / cell_m))};
   }
   void add(const Eigen::Vector3d& p) {
@@ -70,7 +71,8 @@ class Grid {
             if (r > 1 && std::abs(i - c[0]) < r && std::abs(j - c[1]) < r && std::abs(k - c[2]) < r) continue;
             const auto it = cells_.find(key(i, j, k));
             if (it == cells_.end()) continue;
-            for (const Eigen::Vector3f& q : it->second) best2 = std::min(best2, (q.cast<double>() - p).squaredNorm());
+            for (const Eigen::Vector3f& q : it->second)
+              best2 = std::min(best2, (q.cast<double>() - p).squaredNorm());
           }
       // every point closer than r cells has been seen
       if (std::sqrt(best2) <= r * cell_) break;
@@ -91,8 +93,8 @@ double quantile(std::vector<double> v, double q) {
 
 TEST(DenseScenario, CloudLiesOnTheRenderedGeometry) {
   const std::string seq = pvb::test::station_sequence(), out = scratch("slam");
-  auto r = pvb::test::run_pvbench("slam --sequence " + seq + " --settings " + seq + "/camera.yaml --out " + out +
-                                  " --sync --max-frames " + std::to_string(kFrames));
+  auto r = pvb::test::run_pvbench("slam --sequence " + seq + " --settings " + seq + "/camera.yaml --out " +
+                                  out + " --sync --max-frames " + std::to_string(kFrames));
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("dense map: "), std::string::npos) << r.output;
   const std::string stats = pvb::read_file(out + "/stats.json");
@@ -124,12 +126,14 @@ TEST(DenseScenario, CloudLiesOnTheRenderedGeometry) {
     if (i % kReferenceEvery != 0) continue;
     const pvb::sim::Capture cap = camera.capture(sim);
     // the recording's ground truth is this simulation's
-    ASSERT_LT((cap.T_w_c.translation() - gt.poses[static_cast<std::size_t>(i)].T_w_c.translation()).norm(), 1e-6);
+    ASSERT_LT((cap.T_w_c.translation() - gt.poses[static_cast<std::size_t>(i)].T_w_c.translation()).norm(),
+              1e-6);
     for (int v = 0; v < cap.depth_gt_m.rows; v += 2)
       for (int u = 0; u < cap.depth_gt_m.cols; u += 2) {
         const double z = cap.depth_gt_m.at<float>(v, u);
         if (!(z > 0)) continue;
-        const Eigen::Vector3d p_w = cap.T_w_c * Eigen::Vector3d((u - K.cx) / K.fx * z, (v - K.cy) / K.fy * z, z);
+        const Eigen::Vector3d p_w =
+            cap.T_w_c * Eigen::Vector3d((u - K.cx) / K.fx * z, (v - K.cy) / K.fy * z, z);
         const auto c = Grid::index(p_w, kThinCell);
         if (taken.insert(Grid::key(c[0], c[1], c[2])).second) surface.add(p_w);
       }
@@ -157,10 +161,12 @@ TEST(DenseScenario, CloudLiesOnTheRenderedGeometry) {
   for (const auto& p : cloud)
     dist.push_back(surface.nearest(ev.alignment.apply(Eigen::Vector3d(p.x, p.y, p.z)), 2 * p95_bound));
   const double median = quantile(dist, 0.5), p95 = quantile(dist, 0.95);
-  std::printf("dense map, %d frames: %zu points, ATE (origin-aligned) %.1f mm; distance to the rendered surface: median %.1f mm "
-              "(bound %.1f), 95 %% %.1f mm (bound %.1f)\n",
-              kFrames, cloud.size(), ev.ate.rmse * 1000, median * 1000, median_bound * 1000, p95 * 1000,
-              p95_bound * 1000);
+  std::printf(
+      "dense map, %d frames: %zu points, ATE (origin-aligned) %.1f mm; distance to the rendered surface: "
+      "median %.1f mm "
+      "(bound %.1f), 95 %% %.1f mm (bound %.1f)\n",
+      kFrames, cloud.size(), ev.ate.rmse * 1000, median * 1000, median_bound * 1000, p95 * 1000,
+      p95_bound * 1000);
   EXPECT_LT(median, median_bound);
   EXPECT_LT(p95, p95_bound);
 
@@ -177,8 +183,8 @@ TEST(DenseScenario, CloudLiesOnTheRenderedGeometry) {
 
 TEST(DenseScenario, NoDenseFlagWritesNoCloud) {
   const std::string seq = pvb::test::station_sequence(), out = scratch("nodense");
-  const auto r = pvb::test::run_pvbench("slam --sequence " + seq + " --settings " + seq + "/camera.yaml --out " + out +
-                                        " --sync --no-dense --max-frames 30");
+  const auto r = pvb::test::run_pvbench("slam --sequence " + seq + " --settings " + seq +
+                                        "/camera.yaml --out " + out + " --sync --no-dense --max-frames 30");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(r.output.find("dense map"), std::string::npos) << r.output;
   EXPECT_EQ(::access((out + "/PointCloud.ply").c_str(), F_OK), -1);

@@ -29,24 +29,24 @@ namespace pvb::slam::dense {
 /// What the mapper needs of a keyframe.  The images must not be written to
 /// after insert() (clone them when the source reuses its buffers).
 struct DenseKeyFrame {
-  std::uint64_t id = 0;     ///< keyframe id (unique, orders the global cloud)
-  std::int64_t t_ns = 0;    ///< capture time
-  cv::Mat rgb;              ///< CV_8UC3 R, G, B (or CV_8UC1 grey)
-  cv::Mat depth_m;          ///< CV_32FC1 metres, 0 = invalid
+  std::uint64_t id = 0;                       ///< keyframe id (unique, orders the global cloud)
+  std::int64_t t_ns = 0;                      ///< capture time
+  cv::Mat rgb;                                ///< CV_8UC3 R, G, B (or CV_8UC1 grey)
+  cv::Mat depth_m;                            ///< CV_32FC1 metres, 0 = invalid
   geom::SE3d T_w_c = geom::SE3d::Identity();  ///< pose when the keyframe was made
 };
 
 struct DenseMapperOptions {
-  geom::PinholeIntrinsics K;         ///< camera of the depth (registered) images
+  geom::PinholeIntrinsics K;  ///< camera of the depth (registered) images
   BackProjectionParams back_projection;
-  double leaf_m = 0.02;              ///< voxel size of the keyframe and global clouds
+  double leaf_m = 0.02;  ///< voxel size of the keyframe and global clouds
 };
 
 /// Figures for reports.
 struct DenseMapperStats {
-  std::size_t keyframes = 0;         ///< keyframes processed
-  std::size_t points = 0;            ///< points over all keyframe clouds (before the global filter)
-  double total_ms = 0;               ///< back-projection + voxel filter, summed over keyframes
+  std::size_t keyframes = 0;  ///< keyframes processed
+  std::size_t points = 0;     ///< points over all keyframe clouds (before the global filter)
+  double total_ms = 0;        ///< back-projection + voxel filter, summed over keyframes
 };
 
 class DenseMapper {
@@ -90,7 +90,7 @@ class DenseMapper {
   void process(const DenseKeyFrame& kf);
 
   DenseMapperOptions options_;
-  mutable std::mutex mutex_;             ///< guards entries_ and stats_
+  mutable std::mutex mutex_;  ///< guards entries_ and stats_
   std::map<std::uint64_t, Entry> entries_;
   DenseMapperStats stats_;
   ClosableQueue<DenseKeyFrame> queue_;

@@ -26,9 +26,9 @@ using PointCloud = std::vector<CloudPoint>;
 
 /// Which pixels become points.
 struct BackProjectionParams {
-  int stride_px = 3;          ///< every stride-th pixel in both directions, from (0, 0)
-  double min_depth_m = 0.1;   ///< depth below this (and 0 = invalid) is skipped
-  double max_depth_m = 4.0;   ///< depth above this is skipped (noise grows as z^2)
+  int stride_px = 3;         ///< every stride-th pixel in both directions, from (0, 0)
+  double min_depth_m = 0.1;  ///< depth below this (and 0 = invalid) is skipped
+  double max_depth_m = 4.0;  ///< depth above this is skipped (noise grows as z^2)
 };
 
 /// Back-projects the depth image (CV_32FC1, metres along the optical axis,
