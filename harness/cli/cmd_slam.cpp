@@ -94,9 +94,12 @@ int run_slam(const SlamArgs& a) {
   while (frames < total || total == 0) {
     std::optional<sensor::RgbdFrame> frame = reader.next();
     if (!frame) break;
-    if (reader.skipped() > max_missing)
+    if (reader.skipped() > max_missing) {
+      system.shutdown();  // keep the partial dense map too
+      if (system.dense_enabled()) system.write_point_cloud(a.out + "/PointCloud.ply");
       throw IoError(a.sequence, std::to_string(reader.skipped()) + " frames missing or corrupt (more than " +
                                     std::to_string(max_missing) + "); the trajectory so far is in " + a.out);
+    }
     const slam::FrameResult r = system.track(*frame);
     ++frames;
     if (r.state == slam::TrackingState::kLost) ++lost;

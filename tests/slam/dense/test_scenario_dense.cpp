@@ -19,6 +19,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <regex>
+#include <sstream>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
@@ -189,6 +191,30 @@ TEST(DenseScenario, NoDenseFlagWritesNoCloud) {
   EXPECT_EQ(r.output.find("dense map"), std::string::npos) << r.output;
   EXPECT_EQ(::access((out + "/PointCloud.ply").c_str(), F_OK), -1);
   EXPECT_EQ(pvb::read_file(out + "/stats.json").find("\"dense\""), std::string::npos);
+}
+
+// A run that stops on too many missing images keeps its partial dense map.
+TEST(DenseScenario, StoppedRunKeepsItsPartialCloud) {
+  const std::string seq = pvb::test::station_sequence(), cut = scratch("cut"), out = scratch("cutrun");
+  std::system(("mkdir -p " + cut + " && ln -s " + seq + "/rgb " + cut + "/rgb && ln -s " + seq + "/depth " +
+               cut + "/depth")
+                  .c_str());
+  // 40 frames; 20..27 point at missing files (more than the 10 % pvbench slam tolerates)
+  std::istringstream in(pvb::read_file(seq + "/associations.txt"));
+  std::string assoc, line;
+  for (int i = 0; i < 40 && std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    if (i >= 20 && i < 28) line = std::regex_replace(line, std::regex("\\.png"), "_missing.png");
+    assoc += line + "\n";
+    ++i;
+  }
+  pvb::write_file(cut + "/associations.txt", assoc);
+  const auto r = pvb::test::run_pvbench("slam --sequence " + cut + " --settings " + seq +
+                                        "/camera.yaml --out " + out + " --sync");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("missing or corrupt"), std::string::npos) << r.output;
+  ASSERT_EQ(::access((out + "/PointCloud.ply").c_str(), F_OK), 0) << r.output;
+  EXPECT_GT(pvb::slam::dense::read_ply(out + "/PointCloud.ply").size(), 1000u);
 }
 
 }  // namespace
