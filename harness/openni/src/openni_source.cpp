@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstring>
+#include <filesystem>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -281,7 +282,16 @@ std::optional<RecordingSummary> OpenniSource::Impl::stop() {
     recorder.stop();
     recorder.destroy();
     recording = false;
-    const OniFileSummary s = scan_oni_file(options.record_path);
+    OniFileSummary s = scan_oni_file(options.record_path);
+    // Debian's OpenNI2 2.2 recorder leaves the file about twice as long as
+    // its records, the rest zeros (its final truncate extends the file).
+    // Trim it, so that a cut-short copy is recognisably truncated.
+    if (s.has_end && s.end_bytes < s.size_bytes) {
+      std::error_code ec;
+      std::filesystem::resize_file(options.record_path, s.end_bytes, ec);
+      if (ec) throw IoError(options.record_path, "cannot trim the recording: " + ec.message());
+      s = scan_oni_file(options.record_path);
+    }
     summary = RecordingSummary{options.record_path, s.frames_of(kOniNodeDepth), s.frames_of(kOniNodeImage)};
   }
   if (depth.isValid()) {

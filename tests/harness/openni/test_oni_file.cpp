@@ -101,7 +101,19 @@ TEST(OniFile, CountsFramesPerStream) {
   EXPECT_EQ(s.nodes_begun(), 2u);
   EXPECT_TRUE(s.has_end);
   EXPECT_EQ(s.broken_at, 0u);
+  EXPECT_EQ(s.end_bytes, s.size_bytes);
   EXPECT_NO_THROW(check_oni_complete(path, s));
+}
+
+TEST(OniFile, ZerosAfterTheEndRecordAreNotRecords) {
+  Bytes f = recording(3, true);
+  const std::size_t end = f.b.size();
+  f.b.resize(2 * end, 0);  // what Debian's recorder leaves behind
+  const OniFileSummary s = scan_oni_file(write(f, "padded"));
+  EXPECT_TRUE(s.has_end);
+  EXPECT_EQ(s.end_bytes, end);
+  EXPECT_EQ(s.size_bytes, 2 * end);
+  EXPECT_EQ(s.frames_of(kOniNodeImage), 3u);
 }
 
 TEST(OniFile, TruncatedFileIsReportedWithTheBrokenRecord) {

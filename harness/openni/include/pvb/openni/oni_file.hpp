@@ -33,6 +33,7 @@ struct OniFileSummary {
   std::uint64_t size_bytes = 0;
   std::map<std::uint32_t, OniNode> nodes;  ///< by node id
   bool has_end = false;            ///< the END record closes the file
+  std::uint64_t end_bytes = 0;     ///< offset just past the END record (when has_end)
   /// Byte offset where the records stop making sense (a record running past
   /// the end of the file or a bad magic), or 0 when every record is whole.
   std::uint64_t broken_at = 0;
