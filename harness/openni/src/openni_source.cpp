@@ -169,11 +169,13 @@ void OpenniSource::Impl::open() {
   }
   pairer = std::make_unique<FramePairer>(500'000'000LL / std::max(1, fps));
 
+  // The recorder first: a live camera starts delivering as soon as its
+  // streams start, and every frame read must be in the recording.
+  if (!options.record_path.empty()) start_recorder();
   if (depth.start() != ::openni::STATUS_OK)
     throw UnavailableError("OpenNI2 '" + source_name + "': cannot start the depth stream: " + oni_error());
   if (colour.start() != ::openni::STATUS_OK)
     throw UnavailableError("OpenNI2 '" + source_name + "': cannot start the colour stream: " + oni_error());
-  if (!options.record_path.empty()) start_recorder();
 }
 
 void OpenniSource::Impl::start_recorder() {
