@@ -164,6 +164,16 @@ TEST(PVB_CAMERA_SUITE, UnpluggedCameraKeepsTheTrajectorySoFar) {
   EXPECT_TRUE(std::ifstream(d + "/map.ply").good());
 }
 
+// Without --frames the run ends when the device reports the end of its
+// stream (DEVICE_STATE_EOF after the URI's frame count), with exit 0.
+TEST(PVB_CAMERA_SUITE, DeviceEndOfStreamEndsTheRun) {
+  const std::string d = fresh("eof");
+  const Result r = run("camera --uri 'sim://scenes/pv_station.yaml?frames=8' --sync --timeout-ms 60000 --out " + d);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(json_number(pvb::read_file(d + "/stats.json"), "frames"), 8) << r.output;
+  EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 8u);
+}
+
 TEST(PVB_CAMERA_SUITE, BadUriIsOneErrorLine) {
   const std::string d = fresh("baduri");
   expect_one_error_line(run("camera --uri sim://scenes/no_such_scenario.yaml --out " + d), "no_such_scenario.yaml");
