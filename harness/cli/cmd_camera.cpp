@@ -93,8 +93,8 @@ scenes::Scenario sim_scenario(const openni::SimUri& uri) {
 
 void write_map_ply(const std::string& path, const std::vector<Eigen::Vector3d>& points) {
   std::ostringstream s;
-  s << "ply\nformat ascii 1.0\ncomment PE-SLAM sparse map, world frame, metres\nelement vertex " << points.size()
-    << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  s << "ply\nformat ascii 1.0\ncomment PE-SLAM sparse map, world frame, metres\nelement vertex "
+    << points.size() << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
   for (const Eigen::Vector3d& p : points) s << fmt(p.x()) << " " << fmt(p.y()) << " " << fmt(p.z()) << "\n";
   write_file(path, s.str());
 }
@@ -130,11 +130,13 @@ int run_camera(const CameraArgs& a) {
     o.depth_map_factor = 1000.0;  // OpenNI2 depth is in millimetres
     dataset::write_orbslam_settings(settings_path, o);
   } else {
-    throw ConfigError("pvbench camera", "--settings",
-                      "a settings file with the camera's calibrated intrinsics (only sim:// devices have their own)");
+    throw ConfigError(
+        "pvbench camera", "--settings",
+        "a settings file with the camera's calibrated intrinsics (only sim:// devices have their own)");
   }
   slam::Settings settings = slam::read_settings(settings_path);
-  for (const std::string& w : settings.warnings) std::fprintf(stderr, "pvbench camera: warning: %s\n", w.c_str());
+  for (const std::string& w : settings.warnings)
+    std::fprintf(stderr, "pvbench camera: warning: %s\n", w.c_str());
   if (a.no_pe_match) settings.pe_match.enabled = false;
 
   openni::OpenniOptions so;
@@ -178,9 +180,10 @@ int run_camera(const CameraArgs& a) {
         std::optional<sensor::RgbdFrame> frame = source.next();
         if (!frame) break;
         if (frame->rgb.cols != settings.K.width || frame->rgb.rows != settings.K.height)
-          throw ConfigError(settings_path, "Camera.width/height",
-                            std::to_string(frame->rgb.cols) + "x" + std::to_string(frame->rgb.rows) + " (the stream)",
-                            std::to_string(settings.K.width) + "x" + std::to_string(settings.K.height));
+          throw ConfigError(
+              settings_path, "Camera.width/height",
+              std::to_string(frame->rgb.cols) + "x" + std::to_string(frame->rgb.rows) + " (the stream)",
+              std::to_string(settings.K.width) + "x" + std::to_string(settings.K.height));
         if (gt_sim) {
           while (gt_sim->frame_index() < static_cast<int>(frame->index)) gt_sim->advance();
           gt_file << geom::format_tum_line({frame->t_ns, gt_sim->T_w_c()}) << "\n" << std::flush;
@@ -219,19 +222,22 @@ int run_camera(const CameraArgs& a) {
 
   const double fps = elapsed_s > 0 ? static_cast<double>(frames) / elapsed_s : 0.0;
   std::ostringstream js;
-  js << "{\n  \"source\": \"" << json_escape(source.describe()) << "\",\n  \"pe_match\": "
-     << (settings.pe_match.enabled ? "true" : "false") << ",\n  \"sync\": " << (a.sync ? "true" : "false")
-     << ",\n  \"seed\": " << a.seed << ",\n  \"frames\": " << frames << ",\n  \"lost_frames\": " << lost
-     << ",\n  \"dropped_colour\": " << source.dropped_colour() << ",\n  \"dropped_depth\": " << source.dropped_depth()
+  js << "{\n  \"source\": \"" << json_escape(source.describe())
+     << "\",\n  \"pe_match\": " << (settings.pe_match.enabled ? "true" : "false")
+     << ",\n  \"sync\": " << (a.sync ? "true" : "false") << ",\n  \"seed\": " << a.seed
+     << ",\n  \"frames\": " << frames << ",\n  \"lost_frames\": " << lost
+     << ",\n  \"dropped_colour\": " << source.dropped_colour()
+     << ",\n  \"dropped_depth\": " << source.dropped_depth()
      << ",\n  \"keyframes\": " << system.num_keyframes() << ",\n  \"map_points\": " << system.num_map_points()
      << ",\n  \"fps\": " << fmt(fps);
   std::printf("camera: %zu frames (%.1f fps), lost %zu, keyframes %zu, map points %zu%s\n", frames, fps, lost,
-              system.num_keyframes(), system.num_map_points(), g_stop_requested ? " (stopped by a signal)" : "");
+              system.num_keyframes(), system.num_map_points(),
+              g_stop_requested ? " (stopped by a signal)" : "");
   if (rec) {
     std::printf("recorded %u depth and %u colour frames to %s\n", rec->depth_frames, rec->colour_frames,
                 rec->path.c_str());
-    js << ",\n  \"recorded\": {\"depth_frames\": " << rec->depth_frames << ", \"colour_frames\": " << rec->colour_frames
-       << "}";
+    js << ",\n  \"recorded\": {\"depth_frames\": " << rec->depth_frames
+       << ", \"colour_frames\": " << rec->colour_frames << "}";
   }
 
   if (gt_sim && frames > 0) {
@@ -241,7 +247,8 @@ int run_camera(const CameraArgs& a) {
       const eval::Trajectory est = eval::read_tum(a.out + "/CameraTrajectory.txt");
       const eval::EvalResult res = eval::evaluate(gt, est, eval::EvalOptions{});
       std::printf("ATE RMSE %.4f m over %zu poses\n", res.ate.rmse, est.size());
-      js << ",\n  \"ate_rmse_m\": " << fmt(res.ate.rmse) << ",\n  \"rpe_trans_rmse_m\": " << fmt(res.rpe_trans_m.rmse);
+      js << ",\n  \"ate_rmse_m\": " << fmt(res.ate.rmse)
+         << ",\n  \"rpe_trans_rmse_m\": " << fmt(res.rpe_trans_m.rmse);
     } catch (const Error& e) {
       std::fprintf(stderr, "pvbench camera: warning: no evaluation: %s\n", e.what());
     }
@@ -252,9 +259,9 @@ int run_camera(const CameraArgs& a) {
               a.out.c_str(), gt_sim ? ",groundtruth.txt" : "");
   if (stream_error) throw IoError(*stream_error);
   if (rec && (rec->depth_frames < frames || rec->colour_frames < frames))
-    throw IoError(rec->path, "the recording lost frames: " + std::to_string(rec->depth_frames) + " depth and " +
-                                 std::to_string(rec->colour_frames) + " colour for " + std::to_string(frames) +
-                                 " tracked");
+    throw IoError(rec->path, "the recording lost frames: " + std::to_string(rec->depth_frames) +
+                                 " depth and " + std::to_string(rec->colour_frames) + " colour for " +
+                                 std::to_string(frames) + " tracked");
   return 0;
 }
 
@@ -262,17 +269,22 @@ int run_camera(const CameraArgs& a) {
 
 Command add_camera_command(CLI::App& app) {
   auto args = std::make_shared<CameraArgs>();
-  CLI::App* sub = app.add_subcommand("camera", "run PE-SLAM live on an OpenNI2 camera, an .oni file or sim://scenario");
-  auto* uri = sub->add_option("--uri", args->uri,
-                              "OpenNI2 device URI: sim://<scenario.yaml>[?seed=S&frames=N&gl=egl], a camera's URI, "
-                              "or 'any' for the first device");
+  CLI::App* sub =
+      app.add_subcommand("camera", "run PE-SLAM live on an OpenNI2 camera, an .oni file or sim://scenario");
+  auto* uri =
+      sub->add_option("--uri", args->uri,
+                      "OpenNI2 device URI: sim://<scenario.yaml>[?seed=S&frames=N&gl=egl], a camera's URI, "
+                      "or 'any' for the first device");
   auto* oni = sub->add_option("--oni", args->oni, "play back an .oni recording (in lockstep)");
   uri->excludes(oni);
   sub->add_option("--settings", args->settings,
-                  "ORB-SLAM2 RGB-D settings YAML with the calibrated intrinsics (default for sim://: the scenario's camera)");
+                  "ORB-SLAM2 RGB-D settings YAML with the calibrated intrinsics (default for sim://: the "
+                  "scenario's camera)");
   sub->add_option("--out", args->out, "output folder")->required();
-  sub->add_option("--record", args->record, "record the depth and colour streams to this .oni while tracking");
-  sub->add_option("--frames", args->frames, "stop after N frames (0: until the stream ends)")->capture_default_str();
+  sub->add_option("--record", args->record,
+                  "record the depth and colour streams to this .oni while tracking");
+  sub->add_option("--frames", args->frames, "stop after N frames (0: until the stream ends)")
+      ->capture_default_str();
   sub->add_flag("--sync", args->sync, "synchronous mode: no worker threads, bit-identical runs");
   sub->add_option("--seed", args->seed, "PE-match seed")->capture_default_str();
   sub->add_flag("--no-pe-match", args->no_pe_match, "baseline: ORB-SLAM2 motion model without PE-match");

@@ -143,7 +143,8 @@ class SimStream : public StreamBase {
     const int row_bytes = mode_.resolutionX * bpp;
     auto* dst = static_cast<unsigned char*>(frame->data);
     for (int y = 0; y < mode_.resolutionY; ++y)
-      std::memcpy(dst + static_cast<std::size_t>(y) * row_bytes, image.ptr(y), static_cast<std::size_t>(row_bytes));
+      std::memcpy(dst + static_cast<std::size_t>(y) * row_bytes, image.ptr(y),
+                  static_cast<std::size_t>(row_bytes));
     frame->dataSize = row_bytes * mode_.resolutionY;
     frame->sensorType = type_;
     frame->timestamp = t_us;
@@ -295,11 +296,11 @@ SimDevice::SimDevice(SimDriver& driver, const OniDeviceInfo& info, const pvb::op
       depth_mode_{ONI_PIXEL_FORMAT_DEPTH_1_MM, source_.simulator().scenario().camera.width,
                   source_.simulator().scenario().camera.height,
                   static_cast<int>(std::lround(source_.simulator().scenario().camera.fps))},
-      colour_mode_{ONI_PIXEL_FORMAT_RGB888, depth_mode_.resolutionX, depth_mode_.resolutionY, depth_mode_.fps},
+      colour_mode_{ONI_PIXEL_FORMAT_RGB888, depth_mode_.resolutionX, depth_mode_.resolutionY,
+                   depth_mode_.fps},
       sensors_{{ONI_SENSOR_DEPTH, 1, &depth_mode_}, {ONI_SENSOR_COLOR, 1, &colour_mode_}},
       depth_(ONI_SENSOR_DEPTH, depth_mode_, source_.simulator().scenario().camera.fx,
-             source_.simulator().scenario().camera.fy,
-             0xFFFF),
+             source_.simulator().scenario().camera.fy, 0xFFFF),
       colour_(ONI_SENSOR_COLOR, colour_mode_, source_.simulator().scenario().camera.fx,
               source_.simulator().scenario().camera.fy, 0) {}
 

@@ -95,7 +95,9 @@ void check_oni_complete(const std::string& path, const OniFileSummary& s) {
   if (s.broken_at != 0)
     throw IoError(path, "truncated or corrupt recording: the record at byte " + std::to_string(s.broken_at) +
                             " runs past the end of the file (" + std::to_string(s.size_bytes) + " bytes)");
-  if (!s.has_end) throw IoError(path, "truncated or incomplete recording: no end record (was the recorder stopped cleanly?)");
+  if (!s.has_end)
+    throw IoError(path,
+                  "truncated or incomplete recording: no end record (was the recorder stopped cleanly?)");
   if (s.frames_of(kOniNodeDepth) == 0 || s.frames_of(kOniNodeImage) == 0)
     throw IoError(path, "the recording needs depth and colour frames (has " +
                             std::to_string(s.frames_of(kOniNodeDepth)) + " depth, " +

@@ -4,10 +4,10 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cstring>
-#include <filesystem>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <thread>
 #include <vector>
@@ -36,14 +36,22 @@ std::string oni_error() {
 
 const char* pixel_format_name(::openni::PixelFormat f) {
   switch (f) {
-    case ::openni::PIXEL_FORMAT_DEPTH_1_MM: return "depth 1 mm";
-    case ::openni::PIXEL_FORMAT_DEPTH_100_UM: return "depth 100 um";
-    case ::openni::PIXEL_FORMAT_RGB888: return "RGB888";
-    case ::openni::PIXEL_FORMAT_YUV422: return "YUV422";
-    case ::openni::PIXEL_FORMAT_GRAY8: return "gray8";
-    case ::openni::PIXEL_FORMAT_GRAY16: return "gray16";
-    case ::openni::PIXEL_FORMAT_JPEG: return "JPEG";
-    default: return "other";
+    case ::openni::PIXEL_FORMAT_DEPTH_1_MM:
+      return "depth 1 mm";
+    case ::openni::PIXEL_FORMAT_DEPTH_100_UM:
+      return "depth 100 um";
+    case ::openni::PIXEL_FORMAT_RGB888:
+      return "RGB888";
+    case ::openni::PIXEL_FORMAT_YUV422:
+      return "YUV422";
+    case ::openni::PIXEL_FORMAT_GRAY8:
+      return "gray8";
+    case ::openni::PIXEL_FORMAT_GRAY16:
+      return "gray16";
+    case ::openni::PIXEL_FORMAT_JPEG:
+      return "JPEG";
+    default:
+      return "other";
   }
 }
 
@@ -57,28 +65,30 @@ void set_video_mode(::openni::VideoStream& stream, ::openni::PixelFormat format,
     if (m.getResolutionX() == o.width && m.getResolutionY() == o.height && m.getFps() == o.fps &&
         m.getPixelFormat() == format) {
       if (stream.setVideoMode(m) != ::openni::STATUS_OK)
-        throw UnavailableError("OpenNI2 device '" + uri + "': cannot set the " + what + " mode: " + oni_error());
+        throw UnavailableError("OpenNI2 device '" + uri + "': cannot set the " + what +
+                               " mode: " + oni_error());
       return;
     }
     offered += (offered.empty() ? "" : ", ") + std::to_string(m.getResolutionX()) + "x" +
                std::to_string(m.getResolutionY()) + "@" + std::to_string(m.getFps()) + " " +
                pixel_format_name(m.getPixelFormat());
   }
-  throw UnavailableError("OpenNI2 device '" + uri + "': no " + what + " mode " + std::to_string(o.width) + "x" +
-                         std::to_string(o.height) + "@" + std::to_string(o.fps) + " " + pixel_format_name(format) +
-                         " (offered: " + offered + ")");
+  throw UnavailableError("OpenNI2 device '" + uri + "': no " + what + " mode " + std::to_string(o.width) +
+                         "x" + std::to_string(o.height) + "@" + std::to_string(o.fps) + " " +
+                         pixel_format_name(format) + " (offered: " + offered + ")");
 }
 
 }  // namespace
 
-struct OpenniSource::Impl : ::openni::OpenNI::DeviceDisconnectedListener, ::openni::OpenNI::DeviceStateChangedListener {
+struct OpenniSource::Impl : ::openni::OpenNI::DeviceDisconnectedListener,
+                            ::openni::OpenNI::DeviceStateChangedListener {
   OpenniOptions options;
   bool initialized = false;
   bool listening = false;
   bool stopped = false;
   bool is_file = false;
-  std::string uri;           ///< as OpenNI2 reports it
-  std::string source_name;   ///< for messages: the file or the URI
+  std::string uri;          ///< as OpenNI2 reports it
+  std::string source_name;  ///< for messages: the file or the URI
   ::openni::Device device;
   ::openni::VideoStream depth, colour;
   ::openni::Recorder recorder;
@@ -108,7 +118,8 @@ struct OpenniSource::Impl : ::openni::OpenNI::DeviceDisconnectedListener, ::open
 
 void OpenniSource::Impl::open() {
   is_file = !options.oni_path.empty();
-  source_name = is_file ? options.oni_path : (options.uri.empty() ? std::string("first OpenNI2 device") : options.uri);
+  source_name =
+      is_file ? options.oni_path : (options.uri.empty() ? std::string("first OpenNI2 device") : options.uri);
   if (is_file) {
     std::ifstream probe(options.oni_path);
     if (!probe) throw IoError(options.oni_path, "no such file (or it cannot be read)");
@@ -121,7 +132,8 @@ void OpenniSource::Impl::open() {
   ::openni::OpenNI::addDeviceStateChangedListener(this);
   listening = true;
 
-  const char* open_uri = is_file ? options.oni_path.c_str() : (options.uri.empty() ? ::openni::ANY_DEVICE : options.uri.c_str());
+  const char* open_uri =
+      is_file ? options.oni_path.c_str() : (options.uri.empty() ? ::openni::ANY_DEVICE : options.uri.c_str());
   if (device.open(open_uri) != ::openni::STATUS_OK) {
     if (is_file) throw IoError(options.oni_path, "OpenNI2 cannot play it back: " + oni_error());
     throw UnavailableError("cannot open OpenNI2 device '" + source_name + "': " + oni_error());
@@ -143,29 +155,36 @@ void OpenniSource::Impl::open() {
     depth_total = playback->getNumberOfFrames(depth);
     colour_total = playback->getNumberOfFrames(colour);
     if (depth_total <= 0 || colour_total <= 0)
-      throw IoError(options.oni_path, "the recording reports no frames (depth " + std::to_string(depth_total) +
-                                          ", colour " + std::to_string(colour_total) + ")");
+      throw IoError(options.oni_path, "the recording reports no frames (depth " +
+                                          std::to_string(depth_total) + ", colour " +
+                                          std::to_string(colour_total) + ")");
     const ::openni::VideoMode dm = depth.getVideoMode(), cm = colour.getVideoMode();
-    if (dm.getPixelFormat() != ::openni::PIXEL_FORMAT_DEPTH_1_MM && dm.getPixelFormat() != ::openni::PIXEL_FORMAT_DEPTH_100_UM)
-      throw IoError(options.oni_path, std::string("depth stream is ") + pixel_format_name(dm.getPixelFormat()) +
+    if (dm.getPixelFormat() != ::openni::PIXEL_FORMAT_DEPTH_1_MM &&
+        dm.getPixelFormat() != ::openni::PIXEL_FORMAT_DEPTH_100_UM)
+      throw IoError(options.oni_path, std::string("depth stream is ") +
+                                          pixel_format_name(dm.getPixelFormat()) +
                                           ", expected depth in 1 mm or 100 um units");
     if (cm.getPixelFormat() != ::openni::PIXEL_FORMAT_RGB888)
-      throw IoError(options.oni_path, std::string("colour stream is ") + pixel_format_name(cm.getPixelFormat()) +
-                                          ", expected RGB888");
+      throw IoError(options.oni_path, std::string("colour stream is ") +
+                                          pixel_format_name(cm.getPixelFormat()) + ", expected RGB888");
     if (cm.getFps() > 0) fps = cm.getFps();
   } else {
     set_video_mode(depth, ::openni::PIXEL_FORMAT_DEPTH_1_MM, options, "depth", source_name);
     set_video_mode(colour, ::openni::PIXEL_FORMAT_RGB888, options, "colour", source_name);
     if (device.isImageRegistrationModeSupported(::openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR)) {
       if (device.setImageRegistrationMode(::openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR) != ::openni::STATUS_OK)
-        throw UnavailableError("OpenNI2 device '" + source_name + "': cannot register depth to colour: " + oni_error());
+        throw UnavailableError("OpenNI2 device '" + source_name +
+                               "': cannot register depth to colour: " + oni_error());
     } else {
-      std::fprintf(stderr, "pvbench: warning: %s cannot register depth to colour; depth and colour pixels will not line up\n",
-                   source_name.c_str());
+      std::fprintf(
+          stderr,
+          "pvbench: warning: %s cannot register depth to colour; depth and colour pixels will not line up\n",
+          source_name.c_str());
     }
     for (::openni::VideoStream* s : {&depth, &colour})
       if (s->getMirroringEnabled() && s->setMirroringEnabled(false) != ::openni::STATUS_OK)
-        throw UnavailableError("OpenNI2 device '" + source_name + "': cannot turn mirroring off: " + oni_error());
+        throw UnavailableError("OpenNI2 device '" + source_name +
+                               "': cannot turn mirroring off: " + oni_error());
   }
   pairer = std::make_unique<FramePairer>(500'000'000LL / std::max(1, fps));
 
@@ -180,10 +199,12 @@ void OpenniSource::Impl::open() {
 
 void OpenniSource::Impl::start_recorder() {
   const std::string& path = options.record_path;
-  if (recorder.create(path.c_str()) != ::openni::STATUS_OK) throw IoError(path, "cannot record: " + oni_error());
+  if (recorder.create(path.c_str()) != ::openni::STATUS_OK)
+    throw IoError(path, "cannot record: " + oni_error());
   // Lossless: depth goes through 16z, colour uncompressed, so a replay feeds
   // SLAM the very same pixels.
-  if (recorder.attach(depth, false) != ::openni::STATUS_OK || recorder.attach(colour, false) != ::openni::STATUS_OK)
+  if (recorder.attach(depth, false) != ::openni::STATUS_OK ||
+      recorder.attach(colour, false) != ::openni::STATUS_OK)
     throw IoError(path, "cannot attach the streams to the recorder: " + oni_error());
   if (recorder.start() != ::openni::STATUS_OK) throw IoError(path, "cannot start recording: " + oni_error());
   recording = true;
@@ -199,7 +220,8 @@ void OpenniSource::Impl::start_recorder() {
       // the recorder's thread has not written the file header yet
     }
     if (std::chrono::steady_clock::now() > deadline)
-      throw IoError(path, "the OpenNI2 recorder did not start within " + std::to_string(options.timeout_ms) + " ms");
+      throw IoError(
+          path, "the OpenNI2 recorder did not start within " + std::to_string(options.timeout_ms) + " ms");
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
 }
@@ -222,7 +244,8 @@ std::optional<sensor::RgbdFrame> OpenniSource::Impl::next() {
     }
     if (file_done() || end_of_stream) return std::nullopt;
     if (unplugged)
-      throw IoError(source_name, "the camera was disconnected after " + std::to_string(next_index) + " frames");
+      throw IoError(source_name,
+                    "the camera was disconnected after " + std::to_string(next_index) + " frames");
 
     std::vector<::openni::VideoStream*> wait;
     if (!is_file || depth_read < depth_total) wait.push_back(&depth);
@@ -233,12 +256,12 @@ std::optional<sensor::RgbdFrame> OpenniSource::Impl::next() {
     if (rc == ::openni::STATUS_TIME_OUT) {
       waited_ms += kSliceMs;
       if (waited_ms >= options.timeout_ms && !end_of_stream && !unplugged) {
-        const std::string what = is_file ? "the recording stopped delivering frames (depth " +
-                                               std::to_string(depth_read) + "/" + std::to_string(depth_total) +
-                                               ", colour " + std::to_string(colour_read) + "/" +
-                                               std::to_string(colour_total) + ")"
-                                         : "no frame for " + std::to_string(options.timeout_ms) +
-                                               " ms after " + std::to_string(next_index) + " frames (unplugged?)";
+        const std::string what =
+            is_file ? "the recording stopped delivering frames (depth " + std::to_string(depth_read) + "/" +
+                          std::to_string(depth_total) + ", colour " + std::to_string(colour_read) + "/" +
+                          std::to_string(colour_total) + ")"
+                    : "no frame for " + std::to_string(options.timeout_ms) + " ms after " +
+                          std::to_string(next_index) + " frames (unplugged?)";
         throw IoError(source_name, what);
       }
       continue;
@@ -341,12 +364,16 @@ std::size_t OpenniSource::size_hint() const {
   return impl_->is_file ? static_cast<std::size_t>(std::min(impl_->depth_total, impl_->colour_total)) : 0;
 }
 
-std::string OpenniSource::describe() const { return (impl_->is_file ? "oni:" : "openni:") + impl_->source_name; }
+std::string OpenniSource::describe() const {
+  return (impl_->is_file ? "oni:" : "openni:") + impl_->source_name;
+}
 
 std::optional<RecordingSummary> OpenniSource::stop() { return impl_->stop(); }
 
 const std::string& OpenniSource::device_uri() const { return impl_->uri; }
-std::size_t OpenniSource::dropped_colour() const { return impl_->pairer ? impl_->pairer->dropped_colour() : 0; }
+std::size_t OpenniSource::dropped_colour() const {
+  return impl_->pairer ? impl_->pairer->dropped_colour() : 0;
+}
 std::size_t OpenniSource::dropped_depth() const { return impl_->pairer ? impl_->pairer->dropped_depth() : 0; }
 
 }  // namespace pvb::openni

@@ -7,7 +7,8 @@
 namespace pvb::openni {
 namespace {
 
-long long parse_int(const std::string& uri, const std::string& key, const std::string& value, long long min_value) {
+long long parse_int(const std::string& uri, const std::string& key, const std::string& value,
+                    long long min_value) {
   char* end = nullptr;
   const long long v = std::strtoll(value.c_str(), &end, 10);
   if (value.empty() || *end != '\0' || v < min_value)

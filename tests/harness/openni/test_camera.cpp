@@ -34,7 +34,8 @@ struct Result {
 // in the command line).
 Result run(const std::string& args) {
   const std::string log = ::testing::TempDir() + "pvb_cam_" + std::to_string(::getpid()) + ".txt";
-  const std::string cmd = "cd " + std::string(PVB_SOURCE_DIR) + " && " + kBin + " " + args + " > " + log + " 2>&1";
+  const std::string cmd =
+      "cd " + std::string(PVB_SOURCE_DIR) + " && " + kBin + " " + args + " > " + log + " 2>&1";
   const int status = std::system(cmd.c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, pvb::read_file(log)};
 }
@@ -80,12 +81,13 @@ void expect_one_error_line(const Result& r, const std::string& must_contain) {
 // A settings file for runs that must get past the settings check.
 std::string settings_file(const std::string& dir) {
   const std::string path = dir + "/settings.yaml";
-  std::ofstream(path) << "%YAML:1.0\nCamera.fx: 525.0\nCamera.fy: 525.0\nCamera.cx: 319.5\nCamera.cy: 239.5\n"
-                         "Camera.k1: 0.0\nCamera.k2: 0.0\nCamera.p1: 0.0\nCamera.p2: 0.0\nCamera.k3: 0.0\n"
-                         "Camera.width: 640\nCamera.height: 480\nCamera.fps: 30.0\nCamera.bf: 40.0\nCamera.RGB: 1\n"
-                         "ThDepth: 40.0\nDepthMapFactor: 1000.0\nORBextractor.nFeatures: 1000\n"
-                         "ORBextractor.scaleFactor: 1.2\nORBextractor.nLevels: 8\nORBextractor.iniThFAST: 20\n"
-                         "ORBextractor.minThFAST: 7\n";
+  std::ofstream(path)
+      << "%YAML:1.0\nCamera.fx: 525.0\nCamera.fy: 525.0\nCamera.cx: 319.5\nCamera.cy: 239.5\n"
+         "Camera.k1: 0.0\nCamera.k2: 0.0\nCamera.p1: 0.0\nCamera.p2: 0.0\nCamera.k3: 0.0\n"
+         "Camera.width: 640\nCamera.height: 480\nCamera.fps: 30.0\nCamera.bf: 40.0\nCamera.RGB: 1\n"
+         "ThDepth: 40.0\nDepthMapFactor: 1000.0\nORBextractor.nFeatures: 1000\n"
+         "ORBextractor.scaleFactor: 1.2\nORBextractor.nLevels: 8\nORBextractor.iniThFAST: 20\n"
+         "ORBextractor.minThFAST: 7\n";
   return path;
 }
 
@@ -103,8 +105,8 @@ TEST(PVB_CAMERA_SUITE, SimDeviceTracksRecordsAndReplaysIdentically) {
   ASSERT_EQ(live.code, 0) << live.output;
 
   // Outputs and accuracy.
-  for (const char* f : {"camera.yaml", "CameraTrajectory.txt", "KeyFrameTrajectory.txt", "map.ply", "stats.json",
-                        "groundtruth.txt"})
+  for (const char* f : {"camera.yaml", "CameraTrajectory.txt", "KeyFrameTrajectory.txt", "map.ply",
+                        "stats.json", "groundtruth.txt"})
     EXPECT_TRUE(std::ifstream(out + "/" + f).good()) << f;
   EXPECT_EQ(data_lines(out + "/groundtruth.txt").size(), static_cast<std::size_t>(kFrames));
   const std::size_t tracked = data_lines(out + "/CameraTrajectory.txt").size();
@@ -130,7 +132,8 @@ TEST(PVB_CAMERA_SUITE, SimDeviceTracksRecordsAndReplaysIdentically) {
 
   // The replay gives the same poses, bit for bit (same text).
   const std::string rep = dir + "/replay";
-  const Result replay = run("camera --oni " + oni + " --settings " + out + "/camera.yaml --sync --out " + rep);
+  const Result replay =
+      run("camera --oni " + oni + " --settings " + out + "/camera.yaml --sync --out " + rep);
   ASSERT_EQ(replay.code, 0) << replay.output;
   EXPECT_EQ(json_number(pvb::read_file(rep + "/stats.json"), "frames"), kFrames) << replay.output;
   const std::vector<std::string> a = data_lines(out + "/CameraTrajectory.txt");
@@ -147,14 +150,15 @@ TEST(PVB_CAMERA_SUITE, SimDeviceTracksRecordsAndReplaysIdentically) {
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     std::ofstream(cut, std::ios::binary)
         .write(bytes.data(), static_cast<std::streamsize>(static_cast<double>(bytes.size()) * share));
-    expect_one_error_line(run("camera --oni " + cut + " --settings " + out + "/camera.yaml --out " + dir + "/c"),
-                          "truncated");
+    expect_one_error_line(
+        run("camera --oni " + cut + " --settings " + out + "/camera.yaml --out " + dir + "/c"), "truncated");
   }
 }
 
 TEST(PVB_CAMERA_SUITE, UnpluggedCameraKeepsTheTrajectorySoFar) {
   const std::string d = fresh("unplug");
-  const Result r = run("camera --uri 'sim://scenes/pv_station.yaml?unplug_after=12' --frames 40 --sync --out " + d);
+  const Result r =
+      run("camera --uri 'sim://scenes/pv_station.yaml?unplug_after=12' --frames 40 --sync --out " + d);
   expect_one_error_line(r, "disconnected");
   const std::vector<std::string> poses = data_lines(d + "/CameraTrajectory.txt");
   EXPECT_GT(poses.size(), 5u) << r.output;
@@ -168,7 +172,8 @@ TEST(PVB_CAMERA_SUITE, UnpluggedCameraKeepsTheTrajectorySoFar) {
 // stream (DEVICE_STATE_EOF after the URI's frame count), with exit 0.
 TEST(PVB_CAMERA_SUITE, DeviceEndOfStreamEndsTheRun) {
   const std::string d = fresh("eof");
-  const Result r = run("camera --uri 'sim://scenes/pv_station.yaml?frames=8' --sync --timeout-ms 60000 --out " + d);
+  const Result r =
+      run("camera --uri 'sim://scenes/pv_station.yaml?frames=8' --sync --timeout-ms 60000 --out " + d);
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(json_number(pvb::read_file(d + "/stats.json"), "frames"), 8) << r.output;
   EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 8u);
@@ -176,10 +181,12 @@ TEST(PVB_CAMERA_SUITE, DeviceEndOfStreamEndsTheRun) {
 
 TEST(PVB_CAMERA_SUITE, BadUriIsOneErrorLine) {
   const std::string d = fresh("baduri");
-  expect_one_error_line(run("camera --uri sim://scenes/no_such_scenario.yaml --out " + d), "no_such_scenario.yaml");
+  expect_one_error_line(run("camera --uri sim://scenes/no_such_scenario.yaml --out " + d),
+                        "no_such_scenario.yaml");
   expect_one_error_line(run("camera --uri 'sim://scenes/pv_station.yaml?fps=3' --out " + d), "fps");
-  expect_one_error_line(run("camera --uri 'nonsense://device' --settings " + settings_file(d) + " --out " + d),
-                        "nonsense://device");
+  expect_one_error_line(
+      run("camera --uri 'nonsense://device' --settings " + settings_file(d) + " --out " + d),
+      "nonsense://device");
   // a real camera needs calibrated intrinsics
   expect_one_error_line(run("camera --uri 'nonsense://device' --out " + d), "--settings");
 }

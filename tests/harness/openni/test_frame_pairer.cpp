@@ -34,8 +34,8 @@ TEST(FramePairer, TakesTheNearestDepthAndWaitsUntilItIsDecided) {
   FramePairer p(kPeriod / 2);
   p.push_colour(img(1'000'000'000, 1));
   p.push_depth(img(1'000'000'000 - 10'000'000, 2));  // 10 ms early: within tolerance
-  EXPECT_FALSE(p.pop());                              // a nearer one may still come
-  p.push_depth(img(1'000'000'000 + 4'000'000, 3));    // 4 ms late: nearer, and decides
+  EXPECT_FALSE(p.pop());                             // a nearer one may still come
+  p.push_depth(img(1'000'000'000 + 4'000'000, 3));   // 4 ms late: nearer, and decides
   auto pair = p.pop();
   ASSERT_TRUE(pair);
   EXPECT_EQ(tag(pair->depth), 3);

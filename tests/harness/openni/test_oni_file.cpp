@@ -18,15 +18,24 @@ namespace {
 struct Bytes {
   std::vector<unsigned char> b;
   void u8(std::uint8_t v) { b.push_back(v); }
-  void u16(std::uint16_t v) { for (int i = 0; i < 2; ++i) b.push_back(static_cast<unsigned char>(v >> (8 * i))); }
-  void u32(std::uint32_t v) { for (int i = 0; i < 4; ++i) b.push_back(static_cast<unsigned char>(v >> (8 * i))); }
-  void u64(std::uint64_t v) { for (int i = 0; i < 8; ++i) b.push_back(static_cast<unsigned char>(v >> (8 * i))); }
+  void u16(std::uint16_t v) {
+    for (int i = 0; i < 2; ++i) b.push_back(static_cast<unsigned char>(v >> (8 * i)));
+  }
+  void u32(std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) b.push_back(static_cast<unsigned char>(v >> (8 * i)));
+  }
+  void u64(std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) b.push_back(static_cast<unsigned char>(v >> (8 * i)));
+  }
   void str(const std::string& s) { b.insert(b.end(), s.begin(), s.end()); }
 };
 
 void file_header(Bytes& f) {
   f.str("NI10");
-  f.u8(1); f.u8(0); f.u16(1); f.u32(0);
+  f.u8(1);
+  f.u8(0);
+  f.u16(1);
+  f.u32(0);
   f.u64(~0ull);
   f.u32(2);
 }
@@ -85,9 +94,11 @@ Bytes recording(int frames, bool with_end) {
 }
 
 std::string write(const Bytes& f, const std::string& name, std::size_t keep = SIZE_MAX) {
-  const std::string path = ::testing::TempDir() + "pvb_oni_" + name + "_" + std::to_string(::getpid()) + ".oni";
+  const std::string path =
+      ::testing::TempDir() + "pvb_oni_" + name + "_" + std::to_string(::getpid()) + ".oni";
   std::ofstream out(path, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(f.b.data()), static_cast<std::streamsize>(std::min(keep, f.b.size())));
+  out.write(reinterpret_cast<const char*>(f.b.data()),
+            static_cast<std::streamsize>(std::min(keep, f.b.size())));
   return path;
 }
 

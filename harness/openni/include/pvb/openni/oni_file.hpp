@@ -24,16 +24,16 @@ enum class OniRecordType : std::uint32_t {
 
 /// One stream (a "node") of the file.
 struct OniNode {
-  std::uint32_t node_type = 0;    ///< 2 depth, 3 image (colour), 5 IR
-  std::uint32_t frames = 0;       ///< NEW_DATA records seen
-  bool data_begun = false;        ///< a NODE_DATA_BEGIN record was seen
+  std::uint32_t node_type = 0;  ///< 2 depth, 3 image (colour), 5 IR
+  std::uint32_t frames = 0;     ///< NEW_DATA records seen
+  bool data_begun = false;      ///< a NODE_DATA_BEGIN record was seen
 };
 
 struct OniFileSummary {
   std::uint64_t size_bytes = 0;
   std::map<std::uint32_t, OniNode> nodes;  ///< by node id
-  bool has_end = false;            ///< the END record closes the file
-  std::uint64_t end_bytes = 0;     ///< offset just past the END record (when has_end)
+  bool has_end = false;                    ///< the END record closes the file
+  std::uint64_t end_bytes = 0;             ///< offset just past the END record (when has_end)
   /// Byte offset where the records stop making sense (a record running past
   /// the end of the file or a bad magic), or 0 when every record is whole.
   std::uint64_t broken_at = 0;

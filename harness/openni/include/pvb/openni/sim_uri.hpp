@@ -15,11 +15,11 @@
 namespace pvb::openni {
 
 struct SimUri {
-  std::string scenario_path;              ///< as written in the URI
+  std::string scenario_path;  ///< as written in the URI
   std::optional<std::uint64_t> seed;
-  int frames = 0;                         ///< 0: the scenario's duration
+  int frames = 0;  ///< 0: the scenario's duration
   std::string gl = "auto";
-  int unplug_after = 0;                   ///< 0: never
+  int unplug_after = 0;  ///< 0: never
 };
 
 inline constexpr const char* kSimScheme = "sim://";
