@@ -11,6 +11,9 @@ Command add_record_command(CLI::App& app);
 Command add_eval_command(CLI::App& app);
 Command add_match_command(CLI::App& app);
 Command add_slam_command(CLI::App& app);
+#ifdef PVB_HAVE_OPENNI2
+Command add_camera_command(CLI::App& app);
+#endif
 
 // Sub-commands register here (one line each).
 std::vector<Command> add_all_commands(CLI::App& app) {
@@ -19,6 +22,9 @@ std::vector<Command> add_all_commands(CLI::App& app) {
   cmds.push_back(add_eval_command(app));
   cmds.push_back(add_match_command(app));
   cmds.push_back(add_slam_command(app));
+#ifdef PVB_HAVE_OPENNI2
+  cmds.push_back(add_camera_command(app));
+#endif
   return cmds;
 }
 }  // namespace pvb::cli

@@ -143,4 +143,13 @@ std::size_t System::num_map_points() {
   return map_.num_points();
 }
 
+std::vector<Eigen::Vector3d> System::map_point_positions() {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(map_.num_points());
+  for (const auto& [id, mp] : map_.points())
+    if (!mp->bad()) out.push_back(mp->p_w());
+  return out;
+}
+
 }  // namespace pvb::slam

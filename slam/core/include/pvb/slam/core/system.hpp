@@ -53,6 +53,8 @@ class System {
   std::vector<geom::StampedPose> keyframe_trajectory();
   std::size_t num_keyframes();
   std::size_t num_map_points();
+  /// Positions of the map points (world frame), by point id.
+  std::vector<Eigen::Vector3d> map_point_positions();
   TrackingState state() const { return tracking_->state(); }
 
   // Dense point-cloud mapping (Settings::dense; off: the functions below

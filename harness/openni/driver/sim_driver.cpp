@@ -1,0 +1,340 @@
+// An OpenNI2 driver plug-in serving the simulator as an RGB-D camera.
+//
+// URI: sim://<scenario file>[?seed=S&frames=N&gl=egl|osmesa|auto&unplug_after=K]
+//
+// Frames are produced on demand (lockstep): OpenNI2 calls the device's
+// tryManualTrigger() whenever a reader waits on streams that hold no frame,
+// and the device then renders the next frame and raises it on every started
+// stream.  So each read gets the next frame, nothing is ever skipped, and a
+// run is as deterministic as the simulator.  After the last frame the device
+// reports DEVICE_STATE_EOF; with unplug_after=K it reports itself
+// disconnected after K frames instead (for testing the harness).
+//
+// Depth is served in 1 mm units (rounded), colour as RGB888.  The simulator
+// renders depth from the colour camera, so the streams are registered by
+// construction; both registration modes are accepted.  Ground truth is not
+// served: the harness re-derives it from the same scenario (docs/openni.md).
+//
+// Loaded by OpenNI2 from <folder of libOpenNI2.so.0>/OpenNI2/Drivers, which
+// the build stages under build/lib/openni2 (harness/openni/CMakeLists.txt).
+#include <cmath>
+#include <cstdarg>
+#include <cstring>
+#include <exception>
+#include <list>
+#include <memory>
+#include <string>
+
+#define XN_NEW(type, ...) new type(__VA_ARGS__)
+#define XN_DELETE(p) delete (p)
+#include <Driver/OniDriverAPI.h>
+
+#include "pvb/openni/sim_uri.hpp"
+#include "pvb/scenes/scenario.hpp"
+#include "pvb/sim/sim_frame_source.hpp"
+
+namespace {
+
+using oni::driver::DeviceBase;
+using oni::driver::DriverBase;
+using oni::driver::StreamBase;
+
+class SimDriver;
+
+/// One stream (depth or colour) of the simulated camera.
+class SimStream : public StreamBase {
+ public:
+  SimStream(OniSensorType type, OniVideoMode mode, double fx_px, double fy_px, int max_depth_mm)
+      : type_(type), mode_(mode), fx_px_(fx_px), fy_px_(fy_px), max_depth_mm_(max_depth_mm) {}
+
+  OniStatus start() override {
+    started_ = true;
+    return ONI_STATUS_OK;
+  }
+  void stop() override { started_ = false; }
+  bool started() const { return started_; }
+  OniSensorType type() const { return type_; }
+
+  int getRequiredFrameSize() override {
+    return mode_.resolutionX * mode_.resolutionY * (type_ == ONI_SENSOR_DEPTH ? 2 : 3);
+  }
+
+  OniBool isPropertySupported(int id) override {
+    switch (id) {
+      case ONI_STREAM_PROPERTY_VIDEO_MODE:
+      case ONI_STREAM_PROPERTY_MIRRORING:
+      case ONI_STREAM_PROPERTY_CROPPING:
+      case ONI_STREAM_PROPERTY_HORIZONTAL_FOV:
+      case ONI_STREAM_PROPERTY_VERTICAL_FOV:
+        return TRUE;
+      case ONI_STREAM_PROPERTY_MAX_VALUE:
+      case ONI_STREAM_PROPERTY_MIN_VALUE:
+        return type_ == ONI_SENSOR_DEPTH;
+      default:
+        return FALSE;
+    }
+  }
+
+  OniStatus getProperty(int id, void* data, int* size) override {
+    switch (id) {
+      case ONI_STREAM_PROPERTY_VIDEO_MODE:
+        return put(data, size, mode_);
+      case ONI_STREAM_PROPERTY_MIRRORING:
+        return put(data, size, OniBool(FALSE));
+      case ONI_STREAM_PROPERTY_CROPPING: {
+        // The player drops every frame of a stream without this property.
+        OniCropping c{};
+        c.enabled = FALSE;
+        c.originX = c.originY = 0;
+        c.width = mode_.resolutionX;
+        c.height = mode_.resolutionY;
+        return put(data, size, c);
+      }
+      case ONI_STREAM_PROPERTY_HORIZONTAL_FOV:
+        return put(data, size, static_cast<float>(2.0 * std::atan(0.5 * mode_.resolutionX / fx_px_)));
+      case ONI_STREAM_PROPERTY_VERTICAL_FOV:
+        return put(data, size, static_cast<float>(2.0 * std::atan(0.5 * mode_.resolutionY / fy_px_)));
+      case ONI_STREAM_PROPERTY_MAX_VALUE:
+        // The recorder's 16z codec only encodes values up to this one
+        // exactly: report the largest value a frame can hold, not the
+        // sensor's nominal range (noisy depth goes beyond it).
+        if (type_ != ONI_SENSOR_DEPTH) return ONI_STATUS_NOT_SUPPORTED;
+        return put(data, size, max_depth_mm_);
+      case ONI_STREAM_PROPERTY_MIN_VALUE:
+        if (type_ != ONI_SENSOR_DEPTH) return ONI_STATUS_NOT_SUPPORTED;
+        return put(data, size, 0);
+      default:
+        return ONI_STATUS_NOT_SUPPORTED;
+    }
+  }
+
+  OniStatus setProperty(int id, const void* data, int size) override {
+    switch (id) {
+      case ONI_STREAM_PROPERTY_VIDEO_MODE: {
+        if (size != static_cast<int>(sizeof(OniVideoMode))) return ONI_STATUS_BAD_PARAMETER;
+        OniVideoMode m;
+        std::memcpy(&m, data, sizeof m);
+        const bool same = m.pixelFormat == mode_.pixelFormat && m.resolutionX == mode_.resolutionX &&
+                          m.resolutionY == mode_.resolutionY && m.fps == mode_.fps;
+        return same ? ONI_STATUS_OK : ONI_STATUS_NOT_SUPPORTED;
+      }
+      case ONI_STREAM_PROPERTY_MIRRORING: {
+        if (size != static_cast<int>(sizeof(OniBool))) return ONI_STATUS_BAD_PARAMETER;
+        OniBool on;
+        std::memcpy(&on, data, sizeof on);
+        return on ? ONI_STATUS_NOT_SUPPORTED : ONI_STATUS_OK;
+      }
+      case ONI_STREAM_PROPERTY_CROPPING: {
+        if (size != static_cast<int>(sizeof(OniCropping))) return ONI_STATUS_BAD_PARAMETER;
+        OniCropping c;
+        std::memcpy(&c, data, sizeof c);
+        return c.enabled ? ONI_STATUS_NOT_SUPPORTED : ONI_STATUS_OK;
+      }
+      default:
+        return ONI_STATUS_NOT_SUPPORTED;
+    }
+  }
+
+  /// Raises one frame holding `image` (CV_16UC1 depth in mm or CV_8UC3 RGB).
+  void deliver(const cv::Mat& image, std::uint64_t t_us, int index) {
+    OniFrame* frame = getServices().acquireFrame();
+    if (!frame) return;
+    const int bpp = type_ == ONI_SENSOR_DEPTH ? 2 : 3;
+    const int row_bytes = mode_.resolutionX * bpp;
+    auto* dst = static_cast<unsigned char*>(frame->data);
+    for (int y = 0; y < mode_.resolutionY; ++y)
+      std::memcpy(dst + static_cast<std::size_t>(y) * row_bytes, image.ptr(y),
+                  static_cast<std::size_t>(row_bytes));
+    frame->dataSize = row_bytes * mode_.resolutionY;
+    frame->sensorType = type_;
+    frame->timestamp = t_us;
+    frame->frameIndex = index;
+    frame->videoMode = mode_;
+    frame->width = mode_.resolutionX;
+    frame->height = mode_.resolutionY;
+    frame->croppingEnabled = FALSE;
+    frame->cropOriginX = frame->cropOriginY = 0;
+    frame->stride = row_bytes;
+    raiseNewFrame(frame);
+    getServices().releaseFrame(frame);
+  }
+
+ private:
+  template <typename T>
+  static OniStatus put(void* data, int* size, const T& value) {
+    if (*size != static_cast<int>(sizeof(T))) return ONI_STATUS_BAD_PARAMETER;
+    std::memcpy(data, &value, sizeof(T));
+    return ONI_STATUS_OK;
+  }
+
+  OniSensorType type_;
+  OniVideoMode mode_;
+  double fx_px_, fy_px_;
+  int max_depth_mm_;
+  bool started_ = false;
+};
+
+/// The simulated camera: the simulator, its renderer and the two streams.
+class SimDevice : public DeviceBase {
+ public:
+  SimDevice(SimDriver& driver, const OniDeviceInfo& info, const pvb::openni::SimUri& uri);
+
+  OniStatus getSensorInfoList(OniSensorInfo** infos, int* count) override {
+    *infos = sensors_;
+    *count = 2;
+    return ONI_STATUS_OK;
+  }
+
+  StreamBase* createStream(OniSensorType type) override {
+    if (type == ONI_SENSOR_DEPTH) return &depth_;
+    if (type == ONI_SENSOR_COLOR) return &colour_;
+    return nullptr;
+  }
+  void destroyStream(StreamBase* stream) override { static_cast<SimStream*>(stream)->stop(); }
+
+  OniBool isImageRegistrationModeSupported(OniImageRegistrationMode mode) override {
+    return mode == ONI_IMAGE_REGISTRATION_OFF || mode == ONI_IMAGE_REGISTRATION_DEPTH_TO_COLOR;
+  }
+  OniBool isPropertySupported(int id) override { return id == ONI_DEVICE_PROPERTY_IMAGE_REGISTRATION; }
+  OniStatus getProperty(int id, void* data, int* size) override {
+    if (id != ONI_DEVICE_PROPERTY_IMAGE_REGISTRATION) return ONI_STATUS_NOT_SUPPORTED;
+    if (*size != static_cast<int>(sizeof(OniImageRegistrationMode))) return ONI_STATUS_BAD_PARAMETER;
+    std::memcpy(data, &registration_, sizeof registration_);
+    return ONI_STATUS_OK;
+  }
+  OniStatus setProperty(int id, const void* data, int size) override {
+    if (id != ONI_DEVICE_PROPERTY_IMAGE_REGISTRATION) return ONI_STATUS_NOT_SUPPORTED;
+    if (size != static_cast<int>(sizeof(OniImageRegistrationMode))) return ONI_STATUS_BAD_PARAMETER;
+    OniImageRegistrationMode m;
+    std::memcpy(&m, data, sizeof m);
+    if (!isImageRegistrationModeSupported(m)) return ONI_STATUS_NOT_SUPPORTED;
+    registration_ = m;
+    return ONI_STATUS_OK;
+  }
+
+  /// Lockstep: called by OpenNI2 when a reader waits and no frame is queued.
+  OniStatus tryManualTrigger() override;
+
+ private:
+  SimDriver& driver_;
+  OniDeviceInfo info_;
+  pvb::openni::SimUri uri_;
+  pvb::sim::SimFrameSource source_;
+  OniVideoMode depth_mode_, colour_mode_;
+  OniSensorInfo sensors_[2];
+  SimStream depth_, colour_;
+  OniImageRegistrationMode registration_ = ONI_IMAGE_REGISTRATION_DEPTH_TO_COLOR;
+  int served_ = 0;
+  bool finished_ = false;
+};
+
+class SimDriver : public DriverBase {
+ public:
+  explicit SimDriver(OniDriverServices* services) : DriverBase(services) {}
+
+  OniStatus tryDevice(const char* uri) override {
+    if (!uri || !pvb::openni::is_sim_uri(uri)) return ONI_STATUS_ERROR;
+    try {
+      const pvb::openni::SimUri parsed = pvb::openni::parse_sim_uri(uri);
+      pvb::scenes::load_scenario(parsed.scenario_path);  // a bad file fails here, with its line
+    } catch (const std::exception& e) {
+      report("sim device: %s", e.what());
+      return ONI_STATUS_ERROR;
+    }
+    for (const OniDeviceInfo& known : infos_)
+      if (std::strcmp(known.uri, uri) == 0) return ONI_STATUS_OK;
+    OniDeviceInfo info{};
+    std::snprintf(info.uri, sizeof info.uri, "%s", uri);
+    std::snprintf(info.vendor, sizeof info.vendor, "PE-SLAM Bench");
+    std::snprintf(info.name, sizeof info.name, "simulated RGB-D camera");
+    infos_.push_back(info);
+    deviceConnected(&infos_.back());
+    return ONI_STATUS_OK;
+  }
+
+  DeviceBase* deviceOpen(const char* uri, const char* /*mode*/) override {
+    for (const OniDeviceInfo& info : infos_) {
+      if (std::strcmp(info.uri, uri) != 0) continue;
+      try {
+        return new SimDevice(*this, info, pvb::openni::parse_sim_uri(uri));
+      } catch (const std::exception& e) {
+        report("sim device: %s", e.what());
+        return nullptr;
+      }
+    }
+    report("sim device: unknown URI %s", uri);
+    return nullptr;
+  }
+
+  void deviceClose(DeviceBase* device) override { delete static_cast<SimDevice*>(device); }
+  void shutdown() override {}
+
+  void report(const char* format, ...) {
+    va_list args;
+    va_start(args, format);
+    getServices().errorLoggerAppend(format, args);
+    va_end(args);
+  }
+  void state_changed(const OniDeviceInfo& info, OniDeviceState state) { deviceStateChanged(&info, state); }
+  void disconnected(const OniDeviceInfo& info) { deviceDisconnected(&info); }
+
+ private:
+  std::list<OniDeviceInfo> infos_;  // stable addresses: OpenNI2 keeps pointers
+};
+
+pvb::scenes::Scenario scenario_for(const pvb::openni::SimUri& uri) {
+  pvb::scenes::Scenario s = pvb::scenes::load_scenario(uri.scenario_path);
+  if (uri.seed) s.seed = *uri.seed;
+  return s;
+}
+
+SimDevice::SimDevice(SimDriver& driver, const OniDeviceInfo& info, const pvb::openni::SimUri& uri)
+    : driver_(driver),
+      info_(info),
+      uri_(uri),
+      source_(scenario_for(uri), pvb::sim::parse_gl_backend(uri.gl, "gl"), uri.frames),
+      depth_mode_{ONI_PIXEL_FORMAT_DEPTH_1_MM, source_.simulator().scenario().camera.width,
+                  source_.simulator().scenario().camera.height,
+                  static_cast<int>(std::lround(source_.simulator().scenario().camera.fps))},
+      colour_mode_{ONI_PIXEL_FORMAT_RGB888, depth_mode_.resolutionX, depth_mode_.resolutionY,
+                   depth_mode_.fps},
+      sensors_{{ONI_SENSOR_DEPTH, 1, &depth_mode_}, {ONI_SENSOR_COLOR, 1, &colour_mode_}},
+      depth_(ONI_SENSOR_DEPTH, depth_mode_, source_.simulator().scenario().camera.fx,
+             source_.simulator().scenario().camera.fy, 0xFFFF),
+      colour_(ONI_SENSOR_COLOR, colour_mode_, source_.simulator().scenario().camera.fx,
+              source_.simulator().scenario().camera.fy, 0) {}
+
+OniStatus SimDevice::tryManualTrigger() {
+  if (finished_ || (!depth_.started() && !colour_.started())) return ONI_STATUS_OK;
+  if (uri_.unplug_after > 0 && served_ >= uri_.unplug_after) {
+    finished_ = true;
+    driver_.disconnected(info_);
+    return ONI_STATUS_OK;
+  }
+  try {
+    std::optional<pvb::sensor::RgbdFrame> frame = source_.next();
+    if (!frame) {
+      finished_ = true;
+      driver_.state_changed(info_, ONI_DEVICE_STATE_EOF);
+      return ONI_STATUS_OK;
+    }
+    const std::uint64_t t_us = static_cast<std::uint64_t>((frame->t_ns + 500) / 1000);
+    if (depth_.started()) {
+      cv::Mat depth_mm;
+      frame->depth_m.convertTo(depth_mm, CV_16UC1, 1000.0);  // rounds to the nearest millimetre
+      depth_.deliver(depth_mm, t_us, served_);
+    }
+    if (colour_.started()) colour_.deliver(frame->rgb, t_us, served_);
+    ++served_;
+  } catch (const std::exception& e) {
+    finished_ = true;
+    driver_.report("sim device: %s", e.what());
+    driver_.state_changed(info_, ONI_DEVICE_STATE_ERROR);
+    return ONI_STATUS_ERROR;
+  }
+  return ONI_STATUS_OK;
+}
+
+}  // namespace
+
+ONI_EXPORT_DRIVER(SimDriver)
