@@ -17,6 +17,7 @@
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/evaluate.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
+#include "pvb/harness/matching/ground_truth.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
 
@@ -32,6 +33,84 @@ struct SlamArgs {
   std::uint32_t seed = 1;
   std::size_t max_frames = 0;
   double max_missing = 0.1;
+  bool dump_matches = false;
+};
+
+/// Ground-truth scoring of the motion model's coarse matches (--dump-matches):
+/// each match (last frame -> this frame) is labelled by harness/matching's
+/// label_by_rgbd from the last frame's depth and the ground-truth motion
+/// between the two frames; written per match to motion_matches.csv and
+/// summed for stats.json.
+class MotionMatchScorer {
+ public:
+  MotionMatchScorer(const std::string& out_dir, const std::string& gt_path, const slam::Settings& s)
+      : gt_path_(gt_path), csv_(out_dir + "/motion_matches.csv") {
+    if (!csv_) throw IoError(out_dir + "/motion_matches.csv", "cannot open for writing");
+    csv_ << "frame,octave1,octave2,u1,v1,u2,v2,label,pe_keep,pose_inlier\n";
+    gt_.K = s.K;
+    if (s.has_distortion()) gt_.dist_coeffs = (cv::Mat_<double>(1, 5) << s.k1, s.k2, s.p1, s.p2, s.k3);
+    gt_.threshold_px = kThresholdPx;
+  }
+
+  /// Scores the motion matches of `frame` (tracked as `r`) against the previous frame.
+  void add(const sensor::RgbdFrame& frame, const slam::FrameResult& r) {
+    const geom::SE3d T_w_c = harness::tum_pose_at(gt_path_, static_cast<double>(frame.t_ns) * 1e-9);
+    const auto& m = r.tracking.motion;
+    if (prev_depth_m_.empty() || m.undistorted.empty()) {
+      remember(frame, T_w_c);
+      return;
+    }
+    gt_.depth1_m = prev_depth_m_;
+    gt_.depth2_m = frame.depth_m;
+    gt_.T_c2_c1 = T_w_c.inverse() * prev_T_w_c_;
+    const std::vector<harness::MatchLabel> labels = harness::label_by_rgbd(m.raw, m.undistorted, gt_);
+    for (std::size_t k = 0; k < labels.size(); ++k) {
+      const int label = static_cast<int>(labels[k]);
+      const int keep = m.pe_keep[k];
+      const int inlier = k < m.pose_inlier.size() ? m.pose_inlier[k] : 0;
+      csv_ << frame.index << "," << m.octaves[k][0] << "," << m.octaves[k][1] << "," << m.undistorted[k].p1.x()
+           << "," << m.undistorted[k].p1.y() << "," << m.undistorted[k].p2.x() << "," << m.undistorted[k].p2.y()
+           << "," << label << "," << keep << "," << inlier << "\n";
+      if (labels[k] == harness::MatchLabel::kUnknown) continue;
+      const bool correct = labels[k] == harness::MatchLabel::kCorrect;
+      (correct ? correct_ : wrong_) += 1;
+      if (keep) (correct ? kept_correct_ : kept_wrong_) += 1;
+      if (inlier) (correct ? inlier_correct_ : inlier_wrong_) += 1;
+    }
+    csv_.flush();
+    remember(frame, T_w_c);
+  }
+
+  /// "motion_matches": {...} for stats.json.
+  std::string json() const {
+    const auto ratio = [](long a, long b) { return b > 0 ? static_cast<double>(a) / static_cast<double>(b) : 0.0; };
+    std::ostringstream js;
+    js << "\"motion_matches\": {\"threshold_px\": " << kThresholdPx << ", \"correct\": " << correct_
+       << ", \"wrong\": " << wrong_ << ", \"kept_correct\": " << kept_correct_ << ", \"kept_wrong\": " << kept_wrong_
+       << ", \"pe_precision\": " << fmt(ratio(kept_correct_, kept_correct_ + kept_wrong_))
+       << ", \"pe_recall\": " << fmt(ratio(kept_correct_, correct_))
+       << ", \"pose_inlier_correct\": " << inlier_correct_ << ", \"pose_inlier_wrong\": " << inlier_wrong_ << "}";
+    return js.str();
+  }
+
+ private:
+  static constexpr double kThresholdPx = 4.0;  ///< reprojection error of a correct match
+  static std::string fmt(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+  }
+  void remember(const sensor::RgbdFrame& frame, const geom::SE3d& T_w_c) {
+    prev_depth_m_ = frame.depth_m.clone();
+    prev_T_w_c_ = T_w_c;
+  }
+
+  std::string gt_path_;
+  std::ofstream csv_;
+  harness::RgbdGroundTruth gt_;
+  cv::Mat prev_depth_m_;
+  geom::SE3d prev_T_w_c_ = geom::SE3d::Identity();
+  long correct_ = 0, wrong_ = 0, kept_correct_ = 0, kept_wrong_ = 0, inlier_correct_ = 0, inlier_wrong_ = 0;
 };
 
 std::ofstream open_out(const std::string& path) {
@@ -81,6 +160,13 @@ int run_slam(const SlamArgs& a) {
   timing << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,inliers,keyframe,"
             "mapping_ms\n";
 
+  std::unique_ptr<MotionMatchScorer> scorer;
+  if (a.dump_matches) {
+    const std::string gt = a.sequence + "/groundtruth.txt";
+    if (!std::ifstream(gt)) throw IoError(gt, "--dump-matches needs the sequence's ground truth");
+    scorer = std::make_unique<MotionMatchScorer>(a.out, gt, settings);
+  }
+
   const std::size_t total = a.max_frames ? std::min(a.max_frames, reader.size_hint()) : reader.size_hint();
   ProgressBar bar(std::string("slam") + (settings.pe_match.enabled ? " (PE-match)" : " (baseline)"), total);
   std::vector<double> tracking_ms, pe_ms;
@@ -110,6 +196,7 @@ int run_slam(const SlamArgs& a) {
            << r.tracking.matches_kept << "," << r.tracking.inliers << "," << (r.tracking.new_keyframe ? 1 : 0)
            << "," << fmt(r.mapping_ms) << "\n"
            << std::flush;
+    if (scorer) scorer->add(*frame, r);
     bar.update(frames, slam::to_string(r.state));
   }
   bar.finish();
@@ -175,6 +262,7 @@ int run_slam(const SlamArgs& a) {
       std::fprintf(stderr, "pvbench slam: warning: no evaluation: %s\n", e.what());
     }
   }
+  if (scorer) js << ",\n  " << scorer->json();
   js << "\n}\n";
   write_file(a.out + "/stats.json", js.str());
   std::printf("wrote %s/{CameraTrajectory.txt,CameraTrajectoryRefined.txt,KeyFrameTrajectory.txt,timing.csv,stats.json}\n", a.out.c_str());
@@ -194,6 +282,9 @@ Command add_slam_command(CLI::App& app) {
   sub->add_flag("--sync", args->sync, "synchronous mode: no worker threads, bit-identical runs");
   sub->add_option("--seed", args->seed, "PE-match seed")->capture_default_str();
   sub->add_option("--max-frames", args->max_frames, "stop after this many frames (0: all)")->capture_default_str();
+  sub->add_flag("--dump-matches", args->dump_matches,
+                "score the motion model's coarse matches against groundtruth.txt: motion_matches.csv, "
+                "stats.json motion_matches");
   sub->add_option("--max-missing", args->max_missing, "stop when more than this share of frames is missing")
       ->capture_default_str();
   return {sub, [args] { return run_slam(*args); }};
