@@ -1,5 +1,5 @@
 // Pose-only optimisation and local bundle adjustment times on synthetic
-// problems (tests/slam/optim/synthetic.hpp).  Tracking runs optimize_pose
+// problems (pvb/slam/optim/synthetic.hpp).  Tracking runs optimize_pose
 // several times per frame, so it must stay at a few ms.
 #include <benchmark/benchmark.h>
 
@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "pvb/slam/optim/optimizer.hpp"
-#include "synthetic.hpp"
+#include "pvb/slam/optim/synthetic.hpp"
 
 namespace {
 

@@ -3,6 +3,7 @@
 // a groundtruth.txt in the folder it also evaluates ATE and RPE.  Unless
 // disabled, the dense map goes to PointCloud.ply.
 #include <algorithm>
+#include <ctime>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -18,6 +19,7 @@
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/evaluate.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
+#include "pvb/harness/matching/ground_truth.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"
@@ -35,7 +37,93 @@ struct SlamArgs {
   std::uint32_t seed = 1;
   std::size_t max_frames = 0;
   double max_missing = 0.1;
+  bool dump_matches = false;
 };
+
+/// Ground-truth scoring of the motion model's coarse matches (--dump-matches):
+/// each match (last frame -> this frame) is labelled by harness/matching's
+/// label_by_rgbd from the last frame's depth and the ground-truth motion
+/// between the two frames; written per match to motion_matches.csv and
+/// summed for stats.json.
+class MotionMatchScorer {
+ public:
+  MotionMatchScorer(const std::string& out_dir, const std::string& gt_path, const slam::Settings& s)
+      : gt_path_(gt_path), csv_(out_dir + "/motion_matches.csv") {
+    if (!csv_) throw IoError(out_dir + "/motion_matches.csv", "cannot open for writing");
+    csv_ << "frame,octave1,octave2,u1,v1,u2,v2,label,pe_keep,pose_inlier\n";
+    gt_.K = s.K;
+    if (s.has_distortion()) gt_.dist_coeffs = (cv::Mat_<double>(1, 5) << s.k1, s.k2, s.p1, s.p2, s.k3);
+    gt_.threshold_px = kThresholdPx;
+  }
+
+  /// Scores the motion matches of `frame` (tracked as `r`) against the previous frame.
+  void add(const sensor::RgbdFrame& frame, const slam::FrameResult& r) {
+    const geom::SE3d T_w_c = harness::tum_pose_at(gt_path_, static_cast<double>(frame.t_ns) * 1e-9);
+    const auto& m = r.tracking.motion;
+    if (prev_depth_m_.empty() || m.undistorted.empty()) {
+      remember(frame, T_w_c);
+      return;
+    }
+    gt_.depth1_m = prev_depth_m_;
+    gt_.depth2_m = frame.depth_m;
+    gt_.T_c2_c1 = T_w_c.inverse() * prev_T_w_c_;
+    const std::vector<harness::MatchLabel> labels = harness::label_by_rgbd(m.raw, m.undistorted, gt_);
+    for (std::size_t k = 0; k < labels.size(); ++k) {
+      const int label = static_cast<int>(labels[k]);
+      const int keep = m.pe_keep[k];
+      const int inlier = k < m.pose_inlier.size() ? m.pose_inlier[k] : 0;
+      csv_ << frame.index << "," << m.octaves[k][0] << "," << m.octaves[k][1] << "," << m.undistorted[k].p1.x()
+           << "," << m.undistorted[k].p1.y() << "," << m.undistorted[k].p2.x() << "," << m.undistorted[k].p2.y()
+           << "," << label << "," << keep << "," << inlier << "\n";
+      if (labels[k] == harness::MatchLabel::kUnknown) continue;
+      const bool correct = labels[k] == harness::MatchLabel::kCorrect;
+      (correct ? correct_ : wrong_) += 1;
+      if (keep) (correct ? kept_correct_ : kept_wrong_) += 1;
+      if (inlier) (correct ? inlier_correct_ : inlier_wrong_) += 1;
+    }
+    csv_.flush();
+    remember(frame, T_w_c);
+  }
+
+  /// "motion_matches": {...} for stats.json.
+  std::string json() const {
+    const auto ratio = [](long a, long b) { return b > 0 ? static_cast<double>(a) / static_cast<double>(b) : 0.0; };
+    std::ostringstream js;
+    js << "\"motion_matches\": {\"threshold_px\": " << kThresholdPx << ", \"correct\": " << correct_
+       << ", \"wrong\": " << wrong_ << ", \"kept_correct\": " << kept_correct_ << ", \"kept_wrong\": " << kept_wrong_
+       << ", \"pe_precision\": " << fmt(ratio(kept_correct_, kept_correct_ + kept_wrong_))
+       << ", \"pe_recall\": " << fmt(ratio(kept_correct_, correct_))
+       << ", \"pose_inlier_correct\": " << inlier_correct_ << ", \"pose_inlier_wrong\": " << inlier_wrong_ << "}";
+    return js.str();
+  }
+
+ private:
+  static constexpr double kThresholdPx = 4.0;  ///< reprojection error of a correct match
+  static std::string fmt(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+  }
+  void remember(const sensor::RgbdFrame& frame, const geom::SE3d& T_w_c) {
+    prev_depth_m_ = frame.depth_m.clone();
+    prev_T_w_c_ = T_w_c;
+  }
+
+  std::string gt_path_;
+  std::ofstream csv_;
+  harness::RgbdGroundTruth gt_;
+  cv::Mat prev_depth_m_;
+  geom::SE3d prev_T_w_c_ = geom::SE3d::Identity();
+  long correct_ = 0, wrong_ = 0, kept_correct_ = 0, kept_wrong_ = 0, inlier_correct_ = 0, inlier_wrong_ = 0;
+};
+
+/// CPU time of the calling thread in ms (unlike wall time, not inflated
+/// when other processes share the cores).
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
 
 std::ofstream open_out(const std::string& path) {
   std::ofstream f(path);
@@ -83,11 +171,19 @@ int run_slam(const SlamArgs& a) {
   cam_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
   kf_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
   timing << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,inliers,keyframe,"
-            "mapping_ms\n";
+            "mapping_ms,cpu_ms\n";
+
+  std::unique_ptr<MotionMatchScorer> scorer;
+  if (a.dump_matches) {
+    const std::string gt = a.sequence + "/groundtruth.txt";
+    if (!std::ifstream(gt)) throw IoError(gt, "--dump-matches needs the sequence's ground truth");
+    scorer = std::make_unique<MotionMatchScorer>(a.out, gt, settings);
+  }
 
   const std::size_t total = a.max_frames ? std::min(a.max_frames, reader.size_hint()) : reader.size_hint();
   ProgressBar bar(std::string("slam") + (settings.pe_match.enabled ? " (PE-match)" : " (baseline)"), total);
   std::vector<double> tracking_ms, pe_ms;
+  std::vector<double> cpu_ms_all;  ///< caller-thread CPU per frame: tracking, plus inline mapping in sync mode
   std::size_t frames = 0, lost = 0, not_init = 0;
   const std::size_t max_missing =
       std::max<std::size_t>(5, static_cast<std::size_t>(a.max_missing * static_cast<double>(reader.size_hint())));
@@ -100,7 +196,10 @@ int run_slam(const SlamArgs& a) {
       throw IoError(a.sequence, std::to_string(reader.skipped()) + " frames missing or corrupt (more than " +
                                     std::to_string(max_missing) + "); the trajectory so far is in " + a.out);
     }
+    const double cpu0_ms = thread_cpu_ms();
     const slam::FrameResult r = system.track(*frame);
+    const double cpu_ms = thread_cpu_ms() - cpu0_ms;
+    cpu_ms_all.push_back(cpu_ms);
     ++frames;
     if (r.state == slam::TrackingState::kLost) ++lost;
     if (r.state == slam::TrackingState::kNotInitialized) ++not_init;
@@ -115,8 +214,9 @@ int run_slam(const SlamArgs& a) {
            << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << "," << fmt(r.tracking_ms)
            << "," << fmt(r.orb_ms) << "," << fmt(r.tracking.pe_match_ms) << "," << r.tracking.coarse_matches << ","
            << r.tracking.matches_kept << "," << r.tracking.inliers << "," << (r.tracking.new_keyframe ? 1 : 0)
-           << "," << fmt(r.mapping_ms) << "\n"
+           << "," << fmt(r.mapping_ms) << "," << fmt(cpu_ms) << "\n"
            << std::flush;
+    if (scorer) scorer->add(*frame, r);
     bar.update(frames, slam::to_string(r.state));
   }
   bar.finish();
@@ -142,7 +242,12 @@ int run_slam(const SlamArgs& a) {
      << ",\n  \"keyframes\": " << system.num_keyframes() << ",\n  \"map_points\": " << system.num_map_points()
      << ",\n  \"tracking_ms\": {\"median\": " << fmt(percentile(tracking_ms, 0.5)) << ", \"mean\": " << fmt(mean)
      << ", \"p95\": " << fmt(percentile(tracking_ms, 0.95)) << "},\n  \"pe_match_ms\": {\"median\": "
-     << fmt(percentile(pe_ms, 0.5)) << ", \"p95\": " << fmt(percentile(pe_ms, 0.95)) << "}";
+     << fmt(percentile(pe_ms, 0.5)) << ", \"p95\": " << fmt(percentile(pe_ms, 0.95)) << "}"
+     << ",\n  \"cpu_ms\": {\"median\": " << fmt(percentile(cpu_ms_all, 0.5)) << ", \"mean\": "
+     << fmt(cpu_ms_all.empty() ? 0.0
+                               : std::accumulate(cpu_ms_all.begin(), cpu_ms_all.end(), 0.0) /
+                                     static_cast<double>(cpu_ms_all.size()))
+     << ", \"p95\": " << fmt(percentile(cpu_ms_all, 0.95)) << "}";
   if (system.dense_enabled()) {
     const double per_kf_ms =
         dense_stats.keyframes ? dense_stats.total_ms / static_cast<double>(dense_stats.keyframes) : 0.0;
@@ -194,6 +299,7 @@ int run_slam(const SlamArgs& a) {
       std::fprintf(stderr, "pvbench slam: warning: no evaluation: %s\n", e.what());
     }
   }
+  if (scorer) js << ",\n  " << scorer->json();
   js << "\n}\n";
   write_file(a.out + "/stats.json", js.str());
   std::printf("wrote %s/{CameraTrajectory.txt,CameraTrajectoryRefined.txt,KeyFrameTrajectory.txt,timing.csv,stats.json}\n", a.out.c_str());
@@ -214,6 +320,9 @@ Command add_slam_command(CLI::App& app) {
   sub->add_flag("--sync", args->sync, "synchronous mode: no worker threads, bit-identical runs");
   sub->add_option("--seed", args->seed, "PE-match seed")->capture_default_str();
   sub->add_option("--max-frames", args->max_frames, "stop after this many frames (0: all)")->capture_default_str();
+  sub->add_flag("--dump-matches", args->dump_matches,
+                "score the motion model's coarse matches against groundtruth.txt: motion_matches.csv, "
+                "stats.json motion_matches");
   sub->add_option("--max-missing", args->max_missing, "stop when more than this share of frames is missing")
       ->capture_default_str();
   return {sub, [args] { return run_slam(*args); }};

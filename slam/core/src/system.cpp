@@ -30,6 +30,7 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.pe_match.stall_iterations = settings.pe_match.stall_iterations;
   topt.pe_match.inlier_threshold_px = settings.pe_match.threshold_px;
   topt.pe_match.refine = settings.pe_match.refine;
+  topt.pe_match.distance = settings.pe_match.sampson ? EpipolarDistance::kSampson : EpipolarDistance::kPointLine;
   topt.pe_match.seed = options.seed;
   topt.max_frames = static_cast<int>(settings.fps);
   tracking_ = std::make_unique<Tracking>(map_, cam_, topt);

@@ -174,23 +174,31 @@ bool Tracking::track_with_motion_model(Frame& f) {
   stats_.matches_kept = stats_.coarse_matches;
   if (m.size() < 20) return false;
 
+  // Scoring record (stats_.motion); pixel pairs (last keypoint, current keypoint).
+  auto& rec = stats_.motion;
+  rec.undistorted.resize(m.size());
+  rec.raw.resize(m.size());
+  rec.octaves.resize(m.size());
+  rec.pe_keep.assign(m.size(), 1);
+  for (std::size_t k = 0; k < m.size(); ++k) {
+    const auto to_eigen = [](const cv::Point2f& p) { return Eigen::Vector2d(p.x, p.y); };
+    rec.undistorted[k] = {to_eigen(last_.keys_un[m[k].i1].pt), to_eigen(f.keys_un[m[k].i2].pt)};
+    rec.raw[k] = {to_eigen(last_.keys[m[k].i1].pt), to_eigen(f.keys[m[k].i2].pt)};
+    rec.octaves[k] = {last_.keys_un[m[k].i1].octave, f.keys_un[m[k].i2].octave};
+  }
+
   if (options_.use_pe_match) {
     // PE-match on the pixel pairs (last keypoint, current keypoint), paper sec. 3.
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<PointMatch> pairs(m.size());
-    for (std::size_t k = 0; k < m.size(); ++k) {
-      const cv::Point2f& a = last_.keys_un[m[k].i1].pt;
-      const cv::Point2f& b = f.keys_un[m[k].i2].pt;
-      pairs[k] = {Eigen::Vector2d(a.x, a.y), Eigen::Vector2d(b.x, b.y)};
-    }
     PeMatchResult r;
-    pe_matcher_.match(pairs.data(), pairs.size(), r);
+    pe_matcher_.match(rec.undistorted.data(), rec.undistorted.size(), r);
     if (r.F) {
       int kept = 0;
       for (std::size_t k = 0; k < m.size(); ++k) {
         if (r.inlier_mask[k]) ++kept;
         else f.map_points[m[k].i2] = nullptr;
       }
+      rec.pe_keep = r.inlier_mask;
       stats_.matches_kept = kept;
     }
     stats_.pe_match_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -198,6 +206,9 @@ bool Tracking::track_with_motion_model(Frame& f) {
   }
 
   optimize(f);
+  rec.pose_inlier.resize(m.size());
+  for (std::size_t k = 0; k < m.size(); ++k)
+    rec.pose_inlier[k] = (f.map_points[m[k].i2] && !f.outlier[m[k].i2]) ? 1 : 0;
   int map_matches = 0;
   discard_outliers(f, &map_matches);
   return map_matches >= 10;

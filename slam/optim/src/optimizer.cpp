@@ -17,23 +17,17 @@ namespace {
 
 using optim_detail::is_stereo;
 
-/// A camera pose as Ceres parameter blocks (see residuals.hpp): q_c_w in
-/// Eigen's (x, y, z, w) order and t_c_w.
-struct PoseBlocks {
-  double q_c_w[4] = {0, 0, 0, 1};
-  double t_c_w[3] = {0, 0, 0};
+/// A camera pose as one Ceres parameter block (see residuals.hpp):
+/// [q_c_w (x, y, z, w), t_c_w] on SE3LeftManifold.
+struct PoseBlock {
+  double pose[optim_detail::kPoseSize] = {0, 0, 0, 1, 0, 0, 0};
 
-  static PoseBlocks from_se3(const geom::SE3d& T_c_w) {
-    PoseBlocks b;
-    const Eigen::Quaterniond q(Eigen::Matrix3d(T_c_w.linear()));
-    Eigen::Map<Eigen::Quaterniond>(b.q_c_w) = q.normalized();
-    Eigen::Map<Eigen::Vector3d>(b.t_c_w) = T_c_w.translation();
+  static PoseBlock from_se3(const geom::SE3d& T_c_w) {
+    PoseBlock b;
+    optim_detail::pose_to_block(T_c_w, b.pose);
     return b;
   }
-  geom::SE3d to_se3() const {
-    return geom::make_se3(Eigen::Quaterniond(Eigen::Map<const Eigen::Quaterniond>(q_c_w)),
-                          Eigen::Vector3d(Eigen::Map<const Eigen::Vector3d>(t_c_w)));
-  }
+  geom::SE3d to_se3() const { return optim_detail::block_to_pose(pose); }
 };
 
 double chi2_threshold(const Observation& obs, double chi2_mono, double chi2_stereo) {
@@ -123,10 +117,10 @@ PoseOptimizerResult optimize_pose(const geom::SE3d& T_c_w_init, const std::vecto
   for (std::size_t i = 0; i < n; ++i) costs[i].reset(optim_detail::make_pose_only_cost(K, obs[i], points_w[i]));
   ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
   ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
-  ceres::EigenQuaternionManifold quaternion_manifold;
+  optim_detail::SE3LeftManifold se3_manifold;
 
   ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;  // one 6-DoF block
+  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // one 6-DoF block
   solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   solver_options.max_num_iterations = options.iterations_per_round;
   solver_options.num_threads = 1;  // deterministic
@@ -136,23 +130,22 @@ PoseOptimizerResult optimize_pose(const geom::SE3d& T_c_w_init, const std::vecto
   std::vector<std::uint8_t> use(n, 0);
   for (std::size_t i = 0; i < n; ++i) use[i] = (T_c_w_init * points_w[i]).z() > 0.0 ? 1 : 0;
 
-  PoseBlocks pose = PoseBlocks::from_se3(T_c_w_init);
-  const PoseBlocks pose_init = pose;
+  PoseBlock pose = PoseBlock::from_se3(T_c_w_init);
+  const PoseBlock pose_init = pose;
   for (int round = 0; round < options.rounds; ++round) {
     if (options.restart_from_initial) pose = pose_init;
     const geom::SE3d T_start = pose.to_se3();
     const bool robust = options.robust && round < options.robust_rounds;
 
     ceres::Problem problem(borrowed_problem_options());
-    problem.AddParameterBlock(pose.q_c_w, 4, &quaternion_manifold);
-    problem.AddParameterBlock(pose.t_c_w, 3);
+    problem.AddParameterBlock(pose.pose, optim_detail::kPoseSize, &se3_manifold);
     int num_used = 0;
     for (std::size_t i = 0; i < n; ++i) {
       // A residual must be defined at the starting pose (point in front).
       if (!use[i] || !((T_start * points_w[i]).z() > 0.0)) continue;
       ceres::LossFunction* loss = nullptr;
       if (robust) loss = is_stereo(obs[i]) ? &huber_stereo : &huber_mono;
-      problem.AddResidualBlock(costs[i].get(), loss, pose.q_c_w, pose.t_c_w);
+      problem.AddResidualBlock(costs[i].get(), loss, pose.pose);
       ++num_used;
     }
     if (num_used == 0) break;  // nothing left to optimise against; keep the pose
@@ -189,8 +182,8 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
     return result;
   }
 
-  std::vector<PoseBlocks> poses(ba.keyframes.size());
-  for (std::size_t k = 0; k < ba.keyframes.size(); ++k) poses[k] = PoseBlocks::from_se3(ba.keyframes[k].T_c_w);
+  std::vector<PoseBlock> poses(ba.keyframes.size());
+  for (std::size_t k = 0; k < ba.keyframes.size(); ++k) poses[k] = PoseBlock::from_se3(ba.keyframes[k].T_c_w);
   std::vector<Eigen::Vector3d> points(ba.points.size());
   for (std::size_t p = 0; p < ba.points.size(); ++p) points[p] = ba.points[p].p_w;
 
@@ -198,7 +191,7 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
   for (std::size_t e = 0; e < num_edges; ++e) costs[e].reset(optim_detail::make_ba_cost(K, ba.edges[e].obs));
   ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
   ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
-  ceres::EigenQuaternionManifold quaternion_manifold;
+  optim_detail::SE3LeftManifold se3_manifold;
 
   const auto edge_chi2 = [&](std::size_t e) {
     const BaEdge& edge = ba.edges[e];
@@ -223,23 +216,21 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
     for (std::size_t e = 0; e < num_edges; ++e) {
       if (!active[e]) continue;
       const BaEdge& edge = ba.edges[e];
-      PoseBlocks& pose = poses[edge.keyframe];
+      PoseBlock& pose = poses[edge.keyframe];
       if (!kf_in[edge.keyframe]) {
-        prob.AddParameterBlock(pose.q_c_w, 4, &quaternion_manifold);
-        prob.AddParameterBlock(pose.t_c_w, 3);
+        prob.AddParameterBlock(pose.pose, optim_detail::kPoseSize, &se3_manifold);
         // Fixed keyframes (ORB-SLAM2: covisible keyframes outside the local
         // window) anchor the gauge and the scale of the local map; they
         // constrain the local points but must not move.
         if (ba.keyframes[edge.keyframe].fixed) {
-          prob.SetParameterBlockConstant(pose.q_c_w);
-          prob.SetParameterBlockConstant(pose.t_c_w);
+          prob.SetParameterBlockConstant(pose.pose);
         }
         kf_in[edge.keyframe] = 1;
       }
       pt_in[edge.point] = 1;
       ceres::LossFunction* loss = nullptr;
       if (robust) loss = is_stereo(edge.obs) ? &huber_stereo : &huber_mono;
-      prob.AddResidualBlock(costs[e].get(), loss, pose.q_c_w, pose.t_c_w, points[edge.point].data());
+      prob.AddResidualBlock(costs[e].get(), loss, pose.pose, points[edge.point].data());
     }
     if (prob.NumResidualBlocks() == 0) return;
 
@@ -251,12 +242,11 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
     }
     for (std::size_t k = 0; k < poses.size(); ++k) {
       if (!kf_in[k]) continue;
-      ordering->AddElementToGroup(poses[k].q_c_w, 1);
-      ordering->AddElementToGroup(poses[k].t_c_w, 1);
+      ordering->AddElementToGroup(poses[k].pose, 1);
     }
 
     ceres::Solver::Options solver_options;
-    solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
+    solver_options.linear_solver_type = ceres::DENSE_SCHUR;
     solver_options.linear_solver_ordering = ordering;
     solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
     solver_options.max_num_iterations = iterations;

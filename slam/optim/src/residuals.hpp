@@ -1,13 +1,24 @@
 #pragma once
-// Ceres cost functors for the reprojection residuals of optimizer.hpp.
-// Private to pvb_slam_optim (and its tests): callers never see Ceres.
+// Ceres cost functions for the reprojection residuals of optimizer.hpp, with
+// analytic Jacobians on an SE(3) manifold.  Private to pvb_slam_optim (and
+// its tests): callers never see Ceres.
 //
-// Pose parameterisation: a camera pose T_c_w is two parameter blocks,
-//   q_c_w  4 doubles, Eigen's quaternion order (x, y, z, w), on
-//          ceres::EigenQuaternionManifold (increment q <- exp(dtheta) * q),
-//   t_c_w  3 doubles, Euclidean,
-// so p_c = q_c_w * p_w + t_c_w.  Derivatives are automatic (ceres::Jet).
-#include <ceres/autodiff_cost_function.h>
+// Pose parameterisation: a camera pose T_c_w is ONE parameter block of 7
+// doubles,
+//   [q_c_w (x, y, z, w, Eigen's order), t_c_w (3)],   p_c = q_c_w * p_w + t_c_w,
+// on SE3LeftManifold: tangent delta = [omega (3), rho (3)], the update of
+// g2o's SE3Quat that ORB-SLAM2 uses,
+//   T_c_w <- [Exp(omega) | rho] * T_c_w,  i.e.  R <- Exp(omega) R,  t <- Exp(omega) t + rho.
+//
+// Jacobians are "lifted" (as in VINS-Mono or OKVIS): the cost functions
+// return d r / d delta in the first 6 columns of their 7-column pose
+// Jacobian and 0 in the last, and the manifold's PlusJacobian is [I6; 0],
+// so Ceres' product J * PlusJacobian is exactly d r / d delta.  The 7
+// columns are therefore NOT derivatives with respect to the quaternion
+// components; tests compare the 6 tangent columns with numeric derivatives
+// of r(Plus(x, delta)) at delta = 0.
+#include <ceres/manifold.h>
+#include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -17,58 +28,171 @@
 
 namespace pvb::slam::optim_detail {
 
+constexpr int kPoseSize = 7;     ///< ambient size of a pose block: q (4) + t (3)
+constexpr int kPoseTangent = 6;  ///< tangent size: omega (3) + rho (3)
+
 /// True for a stereo observation (u_right >= 0, 3 residual rows); else monocular (2 rows).
 inline bool is_stereo(const Observation& obs) { return obs.u_right >= 0.0; }
 
-/// Weighted reprojection residual shared by all functors:
-///   p_c = q_c_w * p_w + t_c_w                    (camera optical frame)
-///   u   = fx x_c / z_c + cx,   v = fy y_c / z_c + cy
-///   u_r = u - bf / z_c                          (stereo rows only)
-///   r   = sqrt(inv_sigma2) * ([u_obs, v_obs(, u_r_obs)] - [u, v(, u_r)])
+/// Unit quaternion of the rotation vector omega (Exp(omega)), exact for any angle.
+inline Eigen::Quaterniond quaternion_exp(const Eigen::Vector3d& omega) {
+  const double theta = omega.norm();
+  if (theta < 1e-10) {
+    // Second order: q = (omega / 2, 1 - theta^2 / 8), then normalised.
+    Eigen::Quaterniond q(1.0 - theta * theta / 8.0, 0.5 * omega.x(), 0.5 * omega.y(), 0.5 * omega.z());
+    return q.normalized();
+  }
+  const double s = std::sin(0.5 * theta) / theta;
+  return Eigen::Quaterniond(std::cos(0.5 * theta), s * omega.x(), s * omega.y(), s * omega.z());
+}
+
+/// Rotation vector of a unit quaternion (Log), angle in [0, pi].
+inline Eigen::Vector3d quaternion_log(Eigen::Quaterniond q) {
+  if (q.w() < 0) q.coeffs() = -q.coeffs();  // same rotation, angle <= pi
+  const double vn = q.vec().norm();
+  if (vn < 1e-10) return 2.0 * q.vec() / q.w();
+  return (2.0 * std::atan2(vn, q.w()) / vn) * q.vec();
+}
+
+/// SE(3) with the left update T <- [Exp(omega) | rho] * T on the 7-double
+/// block described at the top of this file, with lifted Jacobians.
+class SE3LeftManifold final : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return kPoseSize; }
+  int TangentSize() const override { return kPoseTangent; }
+
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override {
+    const Eigen::Map<const Eigen::Quaterniond> q(x);
+    const Eigen::Map<const Eigen::Vector3d> t(x + 4);
+    const Eigen::Map<const Eigen::Vector3d> omega(delta), rho(delta + 3);
+    const Eigen::Quaterniond dq = quaternion_exp(omega);
+    const Eigen::Vector3d t_new = dq * t + rho;  // before writing: x may alias x_plus_delta
+    Eigen::Map<Eigen::Quaterniond> q_out(x_plus_delta);
+    Eigen::Map<Eigen::Vector3d> t_out(x_plus_delta + 4);
+    q_out = (dq * q).normalized();
+    t_out = t_new;
+    return true;
+  }
+
+  /// Lifted: [I6; 0] (see the top of this file).
+  bool PlusJacobian(const double* /*x*/, double* jacobian) const override {
+    Eigen::Map<Eigen::Matrix<double, kPoseSize, kPoseTangent, Eigen::RowMajor>> J(jacobian);
+    J.setZero();
+    J.topRows<kPoseTangent>().setIdentity();
+    return true;
+  }
+
+  /// delta with Plus(x, delta) = y: omega = Log(q_y q_x^-1), rho = t_y - Exp(omega) t_x.
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override {
+    const Eigen::Map<const Eigen::Quaterniond> q_x(x), q_y(y);
+    const Eigen::Map<const Eigen::Vector3d> t_x(x + 4), t_y(y + 4);
+    const Eigen::Quaterniond dq = (q_y * q_x.conjugate()).normalized();
+    Eigen::Map<Eigen::Vector3d> omega(y_minus_x), rho(y_minus_x + 3);
+    omega = quaternion_log(dq);
+    rho = t_y - dq * t_x;
+    return true;
+  }
+
+  /// Lifted: [I6 0], the counterpart of PlusJacobian.
+  bool MinusJacobian(const double* /*x*/, double* jacobian) const override {
+    Eigen::Map<Eigen::Matrix<double, kPoseTangent, kPoseSize, Eigen::RowMajor>> J(jacobian);
+    J.setZero();
+    J.leftCols<kPoseTangent>().setIdentity();
+    return true;
+  }
+};
+
+/// Writes a pose block from T_c_w (quaternion normalised).
+inline void pose_to_block(const geom::SE3d& T_c_w, double* pose) {
+  Eigen::Map<Eigen::Quaterniond> q_c_w(pose);
+  Eigen::Map<Eigen::Vector3d> t_c_w(pose + 4);
+  q_c_w = Eigen::Quaterniond(Eigen::Matrix3d(T_c_w.linear())).normalized();
+  t_c_w = T_c_w.translation();
+}
+
+/// T_c_w of a pose block.
+inline geom::SE3d block_to_pose(const double* pose) {
+  return geom::make_se3(Eigen::Quaterniond(Eigen::Map<const Eigen::Quaterniond>(pose)),
+                        Eigen::Vector3d(Eigen::Map<const Eigen::Vector3d>(pose + 4)));
+}
+
+/// Weighted reprojection residual of one observation and its Jacobians:
+///   p_c = R_c_w p_w + t_c_w                     (camera optical frame)
+///   u   = fx x / z + cx,   v = fy y / z + cy
+///   u_r = u - bf / z                            (stereo rows only)
+///   r   = w ([u_obs, v_obs(, u_r_obs)] - [u, v(, u_r)]),   w = sqrt(inv_sigma2)
 /// so |r|^2 is the chi2 of ORB-SLAM2's g2o edge with information inv_sigma2 * I
-/// (observation_chi2() computes the same number in plain doubles).
+/// (observation_chi2() computes the same number).
+///
+/// With P = d[u, v(, u_r)] / d p_c
+///   = [ fx/z   0     -fx x / z^2        ]
+///     [ 0      fy/z  -fy y / z^2        ]
+///     [ fx/z   0     (bf - fx x) / z^2  ]   (stereo row)
+/// and d p_c / d delta = [ -[p_c]x | I ] for the left update above,
+///   d r / d delta = -w P [ -[p_c]x | I ],    d r / d p_w = -w P R_c_w.
 /// Returns false (Ceres rejects the step) when the point is not in front of
 /// the camera, where the projection is undefined.
-template <typename T, int kRows>
-bool reprojection_residual(const StereoIntrinsics& K, const Observation& obs, const T* q_c_w_ptr,
-                           const T* t_c_w_ptr, const T* p_w_ptr, T* residual_ptr) {
-  const Eigen::Map<const Eigen::Quaternion<T>> q_c_w(q_c_w_ptr);
-  const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_c_w(t_c_w_ptr);
-  const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_w(p_w_ptr);
-  Eigen::Map<Eigen::Matrix<T, kRows, 1>> r(residual_ptr);
+template <int kRows>
+bool reprojection(const StereoIntrinsics& K, const Observation& obs, const double* pose, const Eigen::Vector3d& p_w,
+                  double* residual, double* J_pose /* kRows x 7 row-major, may be null */,
+                  double* J_point /* kRows x 3 row-major, may be null */) {
+  const Eigen::Map<const Eigen::Quaterniond> q_c_w(pose);
+  const Eigen::Map<const Eigen::Vector3d> t_c_w(pose + 4);
+  const Eigen::Matrix3d R_c_w = q_c_w.toRotationMatrix();
+  const Eigen::Vector3d p_c = R_c_w * p_w + t_c_w;
+  if (!(p_c.z() > 0.0)) return false;
+  const double inv_z = 1.0 / p_c.z();
+  const double u = K.fx * p_c.x() * inv_z + K.cx;
+  const double v = K.fy * p_c.y() * inv_z + K.cy;
+  const double w = std::sqrt(obs.inv_sigma2);
+  residual[0] = w * (obs.uv.x() - u);
+  residual[1] = w * (obs.uv.y() - v);
+  if constexpr (kRows == 3) residual[2] = w * (obs.u_right - (u - K.bf * inv_z));
+  if (J_pose == nullptr && J_point == nullptr) return true;
 
-  const Eigen::Matrix<T, 3, 1> p_c = q_c_w * p_w + t_c_w;
-  if (!(p_c.z() > T(0))) return false;
-  const T inv_z = T(1) / p_c.z();
-  const T u = T(K.fx) * p_c.x() * inv_z + T(K.cx);
-  const T v = T(K.fy) * p_c.y() * inv_z + T(K.cy);
-  const T w = T(std::sqrt(obs.inv_sigma2));
-  r(0) = w * (T(obs.uv.x()) - u);
-  r(1) = w * (T(obs.uv.y()) - v);
-  if constexpr (kRows == 3) r(2) = w * (T(obs.u_right) - (u - T(K.bf) * inv_z));
+  // D = -w P: the derivative of r with respect to p_c.
+  const double inv_z2 = inv_z * inv_z;
+  Eigen::Matrix<double, kRows, 3> D;
+  D(0, 0) = -w * K.fx * inv_z;
+  D(0, 1) = 0.0;
+  D(0, 2) = w * K.fx * p_c.x() * inv_z2;
+  D(1, 0) = 0.0;
+  D(1, 1) = -w * K.fy * inv_z;
+  D(1, 2) = w * K.fy * p_c.y() * inv_z2;
+  if constexpr (kRows == 3) {
+    D(2, 0) = D(0, 0);
+    D(2, 1) = 0.0;
+    D(2, 2) = -w * (K.bf - K.fx * p_c.x()) * inv_z2;
+  }
+  if (J_pose != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, kRows, kPoseSize, Eigen::RowMajor>> J(J_pose);
+    // D * (-[p_c]x) column by column: -[p_c]x = [[0, z, -y], [-z, 0, x], [y, -x, 0]].
+    J.col(0) = D.col(1) * (-p_c.z()) + D.col(2) * p_c.y();
+    J.col(1) = D.col(0) * p_c.z() - D.col(2) * p_c.x();
+    J.col(2) = -D.col(0) * p_c.y() + D.col(1) * p_c.x();
+    J.template block<kRows, 3>(0, 3) = D;
+    J.col(6).setZero();  // lifted: the 7th ambient column is unused
+  }
+  if (J_point != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, kRows, 3, Eigen::RowMajor>> J(J_point);
+    J = D * R_c_w;
+  }
   return true;
 }
 
 /// Pose-only edge (ORB-SLAM2's EdgeSE3ProjectXYZOnlyPose / EdgeStereoSE3ProjectXYZOnlyPose):
-/// the world point p_w is a constant of the functor, the pose is variable.
-/// Residual: reprojection_residual() above, kRows = 2 (mono) or 3 (stereo).
-/// Parameter blocks: q_c_w (4), t_c_w (3).
+/// the world point p_w is a constant, the pose is variable.
+/// Residual and Jacobian: reprojection() above, kRows = 2 (mono) or 3 (stereo).
+/// Parameter block: the pose (7, SE3LeftManifold).
 template <int kRows>
-class PoseOnlyReprojection {
+class PoseOnlyReprojection final : public ceres::SizedCostFunction<kRows, kPoseSize> {
  public:
   PoseOnlyReprojection(const StereoIntrinsics& K, const Observation& obs, const Eigen::Vector3d& p_w)
       : K_(K), obs_(obs), p_w_(p_w) {}
 
-  template <typename T>
-  bool operator()(const T* q_c_w, const T* t_c_w, T* residual) const {
-    const Eigen::Matrix<T, 3, 1> p_w = p_w_.cast<T>();
-    return reprojection_residual<T, kRows>(K_, obs_, q_c_w, t_c_w, p_w.data(), residual);
-  }
-
-  static ceres::CostFunction* Create(const StereoIntrinsics& K, const Observation& obs,
-                                     const Eigen::Vector3d& p_w) {
-    return new ceres::AutoDiffCostFunction<PoseOnlyReprojection, kRows, 4, 3>(
-        new PoseOnlyReprojection(K, obs, p_w));
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    return reprojection<kRows>(K_, obs_, parameters[0], p_w_, residuals,
+                               jacobians != nullptr ? jacobians[0] : nullptr, nullptr);
   }
 
  private:
@@ -79,20 +203,18 @@ class PoseOnlyReprojection {
 
 /// Bundle-adjustment edge (ORB-SLAM2's EdgeSE3ProjectXYZ / EdgeStereoSE3ProjectXYZ):
 /// pose and world point both variable.
-/// Residual: reprojection_residual() above, kRows = 2 (mono) or 3 (stereo).
-/// Parameter blocks: q_c_w (4), t_c_w (3), p_w (3).
+/// Residual and Jacobians: reprojection() above, kRows = 2 (mono) or 3 (stereo).
+/// Parameter blocks: the pose (7, SE3LeftManifold), p_w (3).
 template <int kRows>
-class BaReprojection {
+class BaReprojection final : public ceres::SizedCostFunction<kRows, kPoseSize, 3> {
  public:
   BaReprojection(const StereoIntrinsics& K, const Observation& obs) : K_(K), obs_(obs) {}
 
-  template <typename T>
-  bool operator()(const T* q_c_w, const T* t_c_w, const T* p_w, T* residual) const {
-    return reprojection_residual<T, kRows>(K_, obs_, q_c_w, t_c_w, p_w, residual);
-  }
-
-  static ceres::CostFunction* Create(const StereoIntrinsics& K, const Observation& obs) {
-    return new ceres::AutoDiffCostFunction<BaReprojection, kRows, 4, 3, 3>(new BaReprojection(K, obs));
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const Eigen::Map<const Eigen::Vector3d> p_w(parameters[1]);
+    return reprojection<kRows>(K_, obs_, parameters[0], p_w, residuals,
+                               jacobians != nullptr ? jacobians[0] : nullptr,
+                               jacobians != nullptr ? jacobians[1] : nullptr);
   }
 
  private:
@@ -103,13 +225,14 @@ class BaReprojection {
 /// Cost function of one pose-only observation, mono or stereo as the observation says.
 inline ceres::CostFunction* make_pose_only_cost(const StereoIntrinsics& K, const Observation& obs,
                                                 const Eigen::Vector3d& p_w) {
-  return is_stereo(obs) ? PoseOnlyReprojection<3>::Create(K, obs, p_w)
-                        : PoseOnlyReprojection<2>::Create(K, obs, p_w);
+  if (is_stereo(obs)) return new PoseOnlyReprojection<3>(K, obs, p_w);
+  return new PoseOnlyReprojection<2>(K, obs, p_w);
 }
 
 /// Cost function of one bundle-adjustment observation, mono or stereo as the observation says.
 inline ceres::CostFunction* make_ba_cost(const StereoIntrinsics& K, const Observation& obs) {
-  return is_stereo(obs) ? BaReprojection<3>::Create(K, obs) : BaReprojection<2>::Create(K, obs);
+  if (is_stereo(obs)) return new BaReprojection<3>(K, obs);
+  return new BaReprojection<2>(K, obs);
 }
 
 }  // namespace pvb::slam::optim_detail

@@ -65,6 +65,12 @@ void pe_repair_position(ParticlePos& pos, ParticlePos* vel, std::array<int, 8>& 
   for (int c = 0; c < kDim; ++c) pos[c] = idx[c];
 }
 
+bool PeMatcher::is_inlier(const Eigen::Matrix3d& F, const PointMatch& m) const {
+  const double thr = params_.inlier_threshold_px;
+  if (params_.distance == EpipolarDistance::kSampson) return sampson_distance_sq(F, m.p1, m.p2) <= thr * thr;
+  return within_epipolar_threshold(F, m.p1, m.p2, thr);
+}
+
 int PeMatcher::evaluate(const std::array<int, 8>& idx, Eigen::Matrix3d& F) {
   Eigen::Matrix<double, 8, 2> a, b;
   for (int c = 0; c < kDim; ++c) {
@@ -76,8 +82,7 @@ int PeMatcher::evaluate(const std::array<int, 8>& idx, Eigen::Matrix3d& F) {
   F.noalias() = norm2_.T.transpose() * Fn * norm1_.T;
   // Step 3(b)-(c): eq. 8 inliers among the j sampled coarse matches.
   int fit = 0;
-  const double thr = params_.inlier_threshold_px;
-  for (const PointMatch& m : sample_pts_) fit += within_epipolar_threshold(F, m.p1, m.p2, thr) ? 1 : 0;
+  for (const PointMatch& m : sample_pts_) fit += is_inlier(F, m) ? 1 : 0;
   return fit;
 }
 
@@ -280,19 +285,19 @@ void PeMatcher::match(const PointMatch* matches, std::size_t n, PeMatchResult& o
   const double thr = P.inlier_threshold_px;
   auto count_inliers = [&](const Eigen::Matrix3d& Fm) {
     int cnt = 0;
-    for (int i = 0; i < N; ++i) cnt += within_epipolar_threshold(Fm, matches[i].p1, matches[i].p2, thr) ? 1 : 0;
+    for (int i = 0; i < N; ++i) cnt += is_inlier(Fm, matches[i]) ? 1 : 0;
     return cnt;
   };
   if (P.refine) {
     // Beyond the paper: IRLS on the Sampson distance over all inliers; kept
-    // only if it does not lose inliers under eq. 8.
+    // only if it does not lose inliers under the chosen distance.
     Eigen::Matrix3d Fr = Fbest;
     if (refine_fundamental_irls(matches, n, thr, P.refine_iterations, Fr) && count_inliers(Fr) >= count_inliers(Fbest))
       Fbest = Fr;
   }
   // Step 8: filter all coarse matches with the output F.
   for (int i = 0; i < N; ++i) {
-    const bool in = within_epipolar_threshold(Fbest, matches[i].p1, matches[i].p2, thr);
+    const bool in = is_inlier(Fbest, matches[i]);
     out.inlier_mask[i] = in ? 1 : 0;
     out.num_inliers += in ? 1 : 0;
   }

@@ -113,6 +113,47 @@ TEST(SlamScenario, BaselineModeReportsNoPeMatch) {
   EXPECT_GT(motion, 50);
 }
 
+// --dump-matches labels the motion model's coarse matches against ground
+// truth; PE-match must drop wrong matches preferentially (the share of wrong
+// matches among those it drops far exceeds their share among all).
+TEST(SlamScenario, DumpMatchesScoresPeMatchAgainstGroundTruth) {
+  const std::string seq = station_sequence();
+  const std::string out = dir("dump");
+  const Result r = run("slam --sequence " + seq + " --settings " + seq +
+                       "/camera.yaml --sync --dump-matches --max-frames 60 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::istringstream in(pvb::read_file(out + "/motion_matches.csv"));
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "frame,octave1,octave2,u1,v1,u2,v2,label,pe_keep,pose_inlier");
+  long labelled = 0, wrong = 0, dropped = 0, dropped_wrong = 0;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
+    ASSERT_EQ(f.size(), 10u) << line;
+    const int label = std::stoi(f[7]), keep = std::stoi(f[8]);
+    ASSERT_TRUE(label >= 0 && label <= 2) << line;
+    if (label == 2) continue;  // no depth: unknown
+    ++labelled;
+    wrong += label == 0;
+    if (!keep) {
+      ++dropped;
+      dropped_wrong += label == 0;
+    }
+  }
+  ASSERT_GT(labelled, 5000);  // ~50 motion-model frames of a few hundred matches
+  ASSERT_GT(dropped, 50);
+  const double wrong_share = static_cast<double>(wrong) / labelled;
+  const double dropped_wrong_share = static_cast<double>(dropped_wrong) / dropped;
+  EXPECT_LT(wrong_share, 0.2);  // the coarse matcher is mostly right
+  EXPECT_GT(dropped_wrong_share, 3 * wrong_share) << wrong << " wrong of " << labelled << ", " << dropped_wrong
+                                                  << " wrong of " << dropped << " dropped";
+  const std::string stats = pvb::read_file(out + "/stats.json");
+  EXPECT_EQ(json_number(stats, "wrong"), wrong) << stats;
+  EXPECT_EQ(json_number(stats, "kept_wrong"), wrong - dropped_wrong) << stats;
+}
+
 TEST(SlamCli, MissingSettingsKeyIsOneClearError) {
   const std::string seq = station_sequence();
   const std::string bad = ::testing::TempDir() + "pvb_slam_bad_" + std::to_string(::getpid()) + ".yaml";

@@ -40,10 +40,14 @@ TEST(Settings, ReadsTum1Unchanged) {
   EXPECT_EQ(s.orb.num_levels, 8);
   EXPECT_EQ(s.orb.ini_fast_threshold, 20);
   EXPECT_EQ(s.orb.min_fast_threshold, 7);
-  // No PEMatch section: the paper's SLAM defaults.
+  // No PEMatch section: the paper's SLAM search values (sec. 5.2.2) with the
+  // filter chosen against ground truth (Sampson distance, 2 px, refinement).
   EXPECT_TRUE(s.pe_match.enabled);
   EXPECT_EQ(s.pe_match.num_fitness_samples, 50);
   EXPECT_EQ(s.pe_match.stall_iterations, 6);
+  EXPECT_DOUBLE_EQ(s.pe_match.threshold_px, 2.0);
+  EXPECT_TRUE(s.pe_match.sampson);
+  EXPECT_TRUE(s.pe_match.refine);
   // Viewer.* keys are ORB-SLAM2's own: no warnings.
   EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
 }
@@ -51,14 +55,16 @@ TEST(Settings, ReadsTum1Unchanged) {
 TEST(Settings, ReadsPeMatchSection) {
   const std::string path = temp_copy("pe", read_file(kTum1) +
                                                "\nPEMatch.enabled: 0\nPEMatch.population: 30\nPEMatch.j: 80\n"
-                                               "PEMatch.stallIterations: 9\nPEMatch.threshold: 2.5\nPEMatch.refine: 1\n");
+                                               "PEMatch.stallIterations: 9\nPEMatch.threshold: 2.5\nPEMatch.refine: 0\n"
+                                               "PEMatch.sampson: 0\n");
   const Settings s = read_settings(path);
   EXPECT_FALSE(s.pe_match.enabled);
   EXPECT_EQ(s.pe_match.population, 30);
   EXPECT_EQ(s.pe_match.num_fitness_samples, 80);
   EXPECT_EQ(s.pe_match.stall_iterations, 9);
   EXPECT_DOUBLE_EQ(s.pe_match.threshold_px, 2.5);
-  EXPECT_TRUE(s.pe_match.refine);
+  EXPECT_FALSE(s.pe_match.refine);   // the paper's filter: eq. 8, no refinement
+  EXPECT_FALSE(s.pe_match.sampson);
 }
 
 TEST(Settings, MissingKeyIsAnErrorNamingIt) {

@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "pvb/slam/optim/optimizer.hpp"
-#include "synthetic.hpp"
+#include "pvb/slam/optim/synthetic.hpp"
 
 namespace pvb::slam {
 namespace {

@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "pvb/slam/optim/optimizer.hpp"
-#include "synthetic.hpp"
+#include "pvb/slam/optim/synthetic.hpp"
 
 namespace pvb::slam {
 namespace {

@@ -17,8 +17,14 @@ struct PeMatchSettings {
   int population = 20;             ///< PEMatch.population: particles
   int num_fitness_samples = 50;    ///< PEMatch.j: matches scored per fitness evaluation
   int stall_iterations = 6;        ///< PEMatch.stallIterations: stop after this many without improvement
-  double threshold_px = 3.0;       ///< PEMatch.threshold: epipolar distance threshold, pixels
-  bool refine = false;             ///< PEMatch.refine (0/1): IRLS refinement of gbest's F
+  // Defaults below differ from the paper's (eq. 8 point-line distance, 3 px,
+  // no refinement): scored against ground truth on the motion model's coarse
+  // matches of the simulated sequences (docs/slam.md, bench/pematch_tracking_eval),
+  // Sampson 2 px + refinement discards half as many correct matches for the
+  // same share of wrong ones removed.
+  double threshold_px = 2.0;       ///< PEMatch.threshold: epipolar distance threshold, pixels
+  bool sampson = true;             ///< PEMatch.sampson (0/1): 1 = Sampson distance, 0 = eq. 8 point-line distance
+  bool refine = true;              ///< PEMatch.refine (0/1): IRLS refinement of gbest's F
 };
 
 /// PointCloudMapping.* section: the dense point-cloud mapping thread (paper

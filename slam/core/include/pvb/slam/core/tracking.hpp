@@ -2,6 +2,7 @@
 // Tracking (ORB-SLAM2 Tracking for RGB-D) with PE-match in the motion model
 // (paper sec. 3).  Runs on the caller's thread; takes Map::mutex() while it
 // reads or writes the map.  Loss of tracking is a state, never an error.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -29,6 +30,19 @@ struct TrackingStats {
   double pe_match_ms = 0;       ///< time in PE-match
   int inliers = 0;              ///< map-point inliers after the local-map optimisation
   bool new_keyframe = false;
+  /// The motion model's coarse matches (empty when it did not run), for
+  /// scoring PE-match against ground truth: pixel pairs (last frame,
+  /// this frame), undistorted and as detected, the octaves of both
+  /// keypoints, PE-match's keep mask (all 1 in baseline mode or with no
+  /// model) and whether the pose optimisation kept the match as an inlier.
+  struct MotionMatches {
+    std::vector<PointMatch> undistorted;
+    std::vector<PointMatch> raw;
+    std::vector<std::array<int, 2>> octaves;
+    std::vector<std::uint8_t> pe_keep;
+    std::vector<std::uint8_t> pose_inlier;
+  };
+  MotionMatches motion;
 };
 
 struct TrackingOptions {

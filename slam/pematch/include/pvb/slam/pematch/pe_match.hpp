@@ -17,6 +17,13 @@
 
 namespace pvb::slam {
 
+/// Distance of a coarse match to a fundamental matrix, used by the fitness
+/// (step 3c) and the final filter (step 8).
+enum class EpipolarDistance {
+  kPointLine,  ///< eq. 8: distance of p2 to the epipolar line F p1 in image 2 (the paper)
+  kSampson,    ///< Sampson distance, first-order geometric error over both images (beyond the paper)
+};
+
 /// PE-match parameters.  Defaults are the paper's image-pair values (sec. 5.1.2).
 struct PeMatchParams {
   int population = 20;            ///< particles
@@ -29,6 +36,7 @@ struct PeMatchParams {
   int stall_iterations = 8;       ///< stop when gbest's fitness has not improved this many iterations
   int max_iterations = 100;       ///< iteration cap
   double inlier_threshold_px = 3.0;  ///< eq. 8 distance threshold, pixels
+  EpipolarDistance distance = EpipolarDistance::kPointLine;  ///< distance compared with the threshold
   /// Beyond the paper: refine gbest's F on all its inliers (IRLS on the
   /// Sampson distance) before the final filtering.
   bool refine = false;
@@ -146,6 +154,8 @@ class PeMatcher {
   /// Fitness of the particle with indices idx (eq. 8 inliers among the j
   /// samples) and its F in pixels; -1 when the sample is degenerate.
   int evaluate(const std::array<int, 8>& idx, Eigen::Matrix3d& F);
+  /// True when m is within the threshold of F under params_.distance.
+  bool is_inlier(const Eigen::Matrix3d& F, const PointMatch& m) const;
 
   PeMatchParams params_;
   PeRng rng_;

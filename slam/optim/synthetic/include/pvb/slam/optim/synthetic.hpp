@@ -1,6 +1,7 @@
 #pragma once
 // Synthetic pose-optimisation and bundle-adjustment problems with known
-// ground truth, shared by the optimiser tests and bench/bench_optim.cpp.
+// ground truth, shared by the optimiser tests and bench/bench_optim.cpp
+// (target pvb::slam_optim_synthetic; never linked by the SLAM libraries).
 #include <Eigen/Geometry>
 #include <cmath>
 #include <random>
