@@ -11,6 +11,7 @@ Command add_record_command(CLI::App& app);
 Command add_eval_command(CLI::App& app);
 Command add_match_command(CLI::App& app);
 Command add_slam_command(CLI::App& app);
+Command add_run_command(CLI::App& app);
 
 // Sub-commands register here (one line each).
 std::vector<Command> add_all_commands(CLI::App& app) {
@@ -19,6 +20,7 @@ std::vector<Command> add_all_commands(CLI::App& app) {
   cmds.push_back(add_eval_command(app));
   cmds.push_back(add_match_command(app));
   cmds.push_back(add_slam_command(app));
+  cmds.push_back(add_run_command(app));
   return cmds;
 }
 }  // namespace pvb::cli
