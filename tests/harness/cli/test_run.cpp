@@ -60,6 +60,7 @@ void check_metrics_and_accuracy(const std::string& d) {
   EXPECT_GT(m["tracking_ms"]["median"].as<double>(), 0.0);
   EXPECT_GE(m["tracking_ms"]["p95"].as<double>(), m["tracking_ms"]["median"].as<double>());
   EXPECT_NEAR(m["sim_s"].as<double>(), 5.0, 1e-9);
+  EXPECT_GT(m["cpu_s"].as<double>(), 0.0);
   EXPECT_NEAR(m["realtime_factor"].as<double>(), m["sim_s"].as<double>() / m["wall_s"].as<double>(), 1e-6);
   for (const char* stage : {"physics", "render", "sensor_model", "tracking", "mapping", "eval", "report"})
     EXPECT_TRUE(m["profile"][stage]) << stage;
