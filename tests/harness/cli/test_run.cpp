@@ -64,6 +64,12 @@ void check_metrics_and_accuracy(const std::string& d) {
   EXPECT_NEAR(m["realtime_factor"].as<double>(), m["sim_s"].as<double>() / m["wall_s"].as<double>(), 1e-6);
   for (const char* stage : {"physics", "render", "sensor_model", "tracking", "mapping", "eval", "report"})
     EXPECT_TRUE(m["profile"][stage]) << stage;
+  // Sync mode: the CPU cost of both halves, which add up to about the whole.
+  const double sim_cpu_ms = m["profile"]["cpu_simulation"]["total_ms"].as<double>();
+  const double slam_cpu_ms = m["profile"]["cpu_slam"]["total_ms"].as<double>();
+  EXPECT_GT(sim_cpu_ms, 0.0);
+  EXPECT_GT(slam_cpu_ms, 0.0);
+  EXPECT_LE(sim_cpu_ms + slam_cpu_ms, 1000.0 * m["cpu_s"].as<double>() * 1.001 + 1.0);
   EXPECT_FALSE(m["closed_loop"]);
   EXPECT_FALSE(m["baseline"]);
 }
@@ -189,11 +195,11 @@ TEST(RunCli, ClosedLoopWaitsOnLossHoldingTheRobot) {
   text.replace(at, 14, "on_loss: wait");
   write_file(scenario, text);
   const test::RunResult r =
-      test::run_pvbench("run --scenario " + scenario + " --out " + d + " --sync --closed-loop --frames 125");
+      test::run_pvbench("run --scenario " + scenario + " --out " + d + " --sync --closed-loop --frames 105");
   EXPECT_EQ(r.code, 0) << r.output;
   const YAML::Node m = metrics(d);
   EXPECT_EQ(m["status"].as<std::string>(), "completed");
-  EXPECT_EQ(m["frames"].as<int>(), 125);
+  EXPECT_EQ(m["frames"].as<int>(), 105);
   ASSERT_GE(m["loss_events"].size(), 1u);
   EXPECT_GT(m["lost_frames"].as<int>(), 0);
   // Held while lost (and the robot stands: the last ground-truth poses agree).
