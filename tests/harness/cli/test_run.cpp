@@ -150,6 +150,26 @@ TEST(RunCli, CompareRendersOnceForBothSystems) {
   }
 }
 
+TEST(RunCli, BaselineAloneIsOrbSlam2WithoutPeMatch) {
+  const std::string d = fresh("baseline");
+  const test::RunResult r =
+      test::run_pvbench("run --scenario " + kStation + " --out " + d + " --sync --frames 10 --baseline");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const YAML::Node m = metrics(d);
+  EXPECT_EQ(m["mode"].as<std::string>(), "orb-slam2");
+  EXPECT_FALSE(m["baseline"]);
+  EXPECT_FALSE(m["comparison"]);
+  int motion_frames = 0;
+  for (const std::string& line : data_lines(d + "/timing.csv")) {
+    const std::vector<std::string> f = split_ws(line, ",");
+    if (f[0] == "frame") continue;
+    EXPECT_EQ(f[7], "0") << line;  // no PE-match time
+    EXPECT_EQ(f[8], f[9]) << line;  // coarse == kept
+    motion_frames += f[3] == "motion";
+  }
+  EXPECT_GT(motion_frames, 5);
+}
+
 TEST(RunCli, ClosedLoopFollowsTheRouteFromTheSlamPose) {
   const std::string d = fresh("closed");
   const test::RunResult r =
