@@ -52,14 +52,18 @@ class StopSignals {
   StopSignals& operator=(const StopSignals&) = delete;
 
  private:
-  struct sigaction old_int_ {}, old_term_ {};
+  struct sigaction old_int_ {
+  }, old_term_{};
 };
 
 int run_run(RunArgs& a) {
-  if (a.baseline && a.compare) throw ConfigError("pvbench run", "--baseline/--compare", "at most one of them");
+  if (a.baseline && a.compare)
+    throw ConfigError("pvbench run", "--baseline/--compare", "at most one of them");
   run::RunOptions& o = a.options;
   o.seed = a.seed;
-  o.mode = a.compare ? run::SlamMode::kCompare : a.baseline ? run::SlamMode::kBaseline : run::SlamMode::kPeSlam;
+  o.mode = a.compare    ? run::SlamMode::kCompare
+           : a.baseline ? run::SlamMode::kBaseline
+                        : run::SlamMode::kPeSlam;
   o.stop = &g_stop;
   o.on_log = [](const std::string& line) {
     std::printf("%s\n", line.c_str());
@@ -95,14 +99,16 @@ Command add_run_command(CLI::App& app) {
   sub->add_option("--scenario", args->options.scenario_file, "scenario YAML file")->required();
   sub->add_option("--out", args->options.out_dir, "report folder (created)")->required();
   sub->add_option("--seed", args->seed, "override the scenario's seed (also seeds PE-match)");
-  sub->add_option("--frames", args->options.max_frames, "stop after N frames (default: the scenario's duration)")
+  sub->add_option("--frames", args->options.max_frames,
+                  "stop after N frames (default: the scenario's duration)")
       ->check(CLI::PositiveNumber);
   sub->add_flag("--sync", args->options.sync, "synchronous: no threads, bit-identical runs");
   sub->add_flag("--baseline", args->baseline, "run the ORB-SLAM2 baseline (no PE-match) instead of PE-SLAM");
   sub->add_flag("--compare", args->compare, "run PE-SLAM and the baseline on the same rendered frames");
   sub->add_flag("--closed-loop", args->options.closed_loop,
                 "the route follower steers from the SLAM pose instead of ground truth");
-  sub->add_option("--gl", args->options.gl, "rendering backend")->check(CLI::IsMember({"auto", "egl", "osmesa"}));
+  sub->add_option("--gl", args->options.gl, "rendering backend")
+      ->check(CLI::IsMember({"auto", "egl", "osmesa"}));
   sub->add_flag("--check", args->check, "check metrics.json against the scenario's expect: bounds (exit 3)");
   return {sub, [args] { return run_run(*args); }};
 }

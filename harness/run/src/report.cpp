@@ -53,8 +53,8 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
     out += in + "\"ate\": null,\n" + in + "\"rpe\": null,\n" + in + "\"alignment\": null,\n";
   }
   if (!run.eval_note.empty()) out += in + "\"eval_note\": " + str(run.eval_note) + ",\n";
-  out += in + "\"tracking_ms\": {\"median\": " + num(percentile(ms, 0.5)) + ", \"mean\": " + num(mean_of(ms)) +
-         ", \"p95\": " + num(percentile(ms, 0.95)) + "},\n";
+  out += in + "\"tracking_ms\": {\"median\": " + num(percentile(ms, 0.5)) +
+         ", \"mean\": " + num(mean_of(ms)) + ", \"p95\": " + num(percentile(ms, 0.95)) + "},\n";
   out += in + "\"loss_events\": [";
   for (std::size_t k = 0; k < run.loss_events.size(); ++k) {
     const LossEvent& e = run.loss_events[k];
@@ -85,18 +85,25 @@ std::string run_fields(const RunReport& r, const std::string& in) {
 }
 
 std::string closed_loop_json(const ClosedLoopMetrics& c) {
-  return "{\"path_error_rmse_m\": " + num(c.path_error_rmse_m) + ", \"path_error_max_m\": " + num(c.path_error_max_m) +
-         ", \"hold_frames\": " + std::to_string(c.hold_frames) + ", \"frames\": " + std::to_string(c.t_s.size()) + "}";
+  return "{\"path_error_rmse_m\": " + num(c.path_error_rmse_m) +
+         ", \"path_error_max_m\": " + num(c.path_error_max_m) +
+         ", \"hold_frames\": " + std::to_string(c.hold_frames) +
+         ", \"frames\": " + std::to_string(c.t_s.size()) + "}";
 }
 
 std::string html_escape(const std::string& s) {
   std::string out;
   for (char c : s) {
-    if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '&') out += "&amp;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else if (c == '"')
+      out += "&quot;";
+    else
+      out += c;
   }
   return out;
 }
@@ -119,18 +126,24 @@ void write_figure(const eval::Figure& f, const std::string& dir, const std::stri
 
 const char* to_string(RunStatus s) {
   switch (s) {
-    case RunStatus::kCompleted: return "completed";
-    case RunStatus::kInterrupted: return "interrupted";
-    case RunStatus::kAborted: return "aborted";
+    case RunStatus::kCompleted:
+      return "completed";
+    case RunStatus::kInterrupted:
+      return "interrupted";
+    case RunStatus::kAborted:
+      return "aborted";
   }
   return "?";
 }
 
 int exit_code(RunStatus s) {
   switch (s) {
-    case RunStatus::kCompleted: return 0;
-    case RunStatus::kInterrupted: return 130;
-    case RunStatus::kAborted: return 4;
+    case RunStatus::kCompleted:
+      return 0;
+    case RunStatus::kInterrupted:
+      return 130;
+    case RunStatus::kAborted:
+      return 4;
   }
   return 1;
 }
@@ -168,13 +181,15 @@ std::string metrics_json(const RunReport& r) {
     out += ",\n  \"baseline\": {\n" + run_fields(r, "    ") + slam_fields(*r.baseline, "    ") + "\n  }";
     const bool both = r.primary.eval && r.baseline->eval;
     const std::vector<double> pe_ms = tracking_times(r.primary), base_ms = tracking_times(r.baseline.value());
-    out += ",\n  \"comparison\": {\"ate_rmse_reduction_pct\": " +
-           (both ? num(eval::reduction_percent(r.baseline->eval->ate.rmse, r.primary.eval->ate.rmse)) : "null") +
-           ", \"rpe_trans_rmse_reduction_pct\": " +
-           (both ? num(eval::reduction_percent(r.baseline->eval->rpe_trans_m.rmse, r.primary.eval->rpe_trans_m.rmse))
-                 : "null") +
-           ", \"tracking_ms_median\": {\"pe-slam\": " + num(percentile(pe_ms, 0.5)) +
-           ", \"orb-slam2\": " + num(percentile(base_ms, 0.5)) + "}}";
+    out +=
+        ",\n  \"comparison\": {\"ate_rmse_reduction_pct\": " +
+        (both ? num(eval::reduction_percent(r.baseline->eval->ate.rmse, r.primary.eval->ate.rmse)) : "null") +
+        ", \"rpe_trans_rmse_reduction_pct\": " +
+        (both ? num(eval::reduction_percent(r.baseline->eval->rpe_trans_m.rmse,
+                                            r.primary.eval->rpe_trans_m.rmse))
+              : "null") +
+        ", \"tracking_ms_median\": {\"pe-slam\": " + num(percentile(pe_ms, 0.5)) +
+        ", \"orb-slam2\": " + num(percentile(base_ms, 0.5)) + "}}";
   }
   out += ",\n  \"profile\": {";
   const double frames = std::max<double>(1.0, static_cast<double>(r.primary.frames));
@@ -204,13 +219,14 @@ std::string comparison_table(const RunReport& r) {
   }
   const std::vector<double> pe_ms = tracking_times(r.primary), base_ms = tracking_times(*r.baseline);
   char line[256];
-  std::snprintf(line, sizeof line, "%-22s%24s%24s\n", "tracking ms median", fixed(percentile(base_ms, 0.5), 2).c_str(),
-                fixed(percentile(pe_ms, 0.5), 2).c_str());
+  std::snprintf(line, sizeof line, "%-22s%24s%24s\n", "tracking ms median",
+                fixed(percentile(base_ms, 0.5), 2).c_str(), fixed(percentile(pe_ms, 0.5), 2).c_str());
   out += line;
   std::snprintf(line, sizeof line, "%-22s%24s%24s\n", "tracking ms mean", fixed(mean_of(base_ms), 2).c_str(),
                 fixed(mean_of(pe_ms), 2).c_str());
   out += line;
-  std::snprintf(line, sizeof line, "%-22s%24zu%24zu\n", "lost frames", r.baseline->lost_frames, r.primary.lost_frames);
+  std::snprintf(line, sizeof line, "%-22s%24zu%24zu\n", "lost frames", r.baseline->lost_frames,
+                r.primary.lost_frames);
   out += line;
   return out + footnote;
 }
@@ -237,14 +253,15 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
       series.push_back(std::move(s));
     }
     if (!series.empty())
-      write_figure(eval::make_line_chart("absolute trajectory error over time", "time [s]", "ATE [m]", series), dir,
-                   "ate_over_time", &written);
+      write_figure(
+          eval::make_line_chart("absolute trajectory error over time", "time [s]", "ATE [m]", series), dir,
+          "ate_over_time", &written);
   }
   // Tracking time histogram, one per run.
   for (const SlamRun* run : runs) {
     const std::vector<double> ms = tracking_times(*run);
-    write_figure(eval::make_histogram("tracking time per frame: " + run->mode, "tracking time [ms]", ms, 40), dir,
-                 run == &r.primary ? "tracking_time_hist" : "tracking_time_hist_" + run->mode, &written);
+    write_figure(eval::make_histogram("tracking time per frame: " + run->mode, "tracking time [ms]", ms, 40),
+                 dir, run == &r.primary ? "tracking_time_hist" : "tracking_time_hist_" + run->mode, &written);
   }
   // Coarse and kept motion-model matches per frame (gaps: other methods or lost).
   {
@@ -262,8 +279,8 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
       series.push_back(std::move(coarse));
       if (run->mode == "pe-slam") series.push_back(std::move(kept));  // the baseline keeps every coarse match
     }
-    write_figure(eval::make_line_chart("motion-model matches per frame (coarse, and kept by PE-match)", "frame",
-                                       "matches", series),
+    write_figure(eval::make_line_chart("motion-model matches per frame (coarse, and kept by PE-match)",
+                                       "frame", "matches", series),
                  dir, "matches", &written);
   }
   if (r.closed_loop) {
@@ -279,7 +296,8 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
   const SlamRun& p = r.primary;
   std::string h;
   h += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>pvbench run: " +
-       html_escape(r.scenario) + "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:1100px}"
+       html_escape(r.scenario) +
+       "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:1100px}"
        "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px;text-align:left}"
        "img{max-width:100%;border:1px solid #ddd}pre{background:#f6f6f6;padding:8px;overflow-x:auto}"
        ".bad{color:#b00}</style></head><body>\n";
@@ -294,16 +312,17 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
   row("scenario file", r.scenario_file);
   row("seed", std::to_string(r.seed));
   row("mode", p.mode + (r.baseline ? " (compared with " + r.baseline->mode + ")" : std::string()) +
-                  (r.closed_loop ? ", closed loop" : ", open loop") + (r.sync ? ", synchronous" : ", pipelined"));
+                  (r.closed_loop ? ", closed loop" : ", open loop") +
+                  (r.sync ? ", synchronous" : ", pipelined"));
   row("renderer", r.renderer);
   row("frames", std::to_string(p.frames) + " (" + fixed(r.sim_s, 2) + " s simulated)");
   row("lost frames", std::to_string(p.lost_frames));
   row("keyframes / map points", std::to_string(p.keyframes) + " / " + std::to_string(p.map_points));
   if (p.eval) {
-    row("ATE rmse / mean / max [m]",
-        fixed(p.eval->ate.rmse, 4) + " / " + fixed(p.eval->ate.mean, 4) + " / " + fixed(p.eval->ate.max, 4) + " (" +
-            eval::alignment_name(p.eval->alignment_kind) + " alignment, " + std::to_string(p.eval->ate.count) +
-            " poses)");
+    row("ATE rmse / mean / max [m]", fixed(p.eval->ate.rmse, 4) + " / " + fixed(p.eval->ate.mean, 4) + " / " +
+                                         fixed(p.eval->ate.max, 4) + " (" +
+                                         eval::alignment_name(p.eval->alignment_kind) + " alignment, " +
+                                         std::to_string(p.eval->ate.count) + " poses)");
     row("RPE trans rmse [m] / rot rmse [deg]",
         fixed(p.eval->rpe_trans_m.rmse, 4) + " / " + fixed(p.eval->rpe_rot_deg.rmse, 3));
   } else {
@@ -312,12 +331,12 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
   const std::vector<double> ms = tracking_times(p);
   row("tracking ms median / mean / p95",
       fixed(percentile(ms, 0.5), 2) + " / " + fixed(mean_of(ms), 2) + " / " + fixed(percentile(ms, 0.95), 2));
-  row("realtime factor", fixed(realtime_factor(r.sim_s, r.wall_s), 2) + " (" + fixed(r.sim_s, 2) + " s simulated in " +
-                             fixed(r.wall_s, 2) + " s)");
+  row("realtime factor", fixed(realtime_factor(r.sim_s, r.wall_s), 2) + " (" + fixed(r.sim_s, 2) +
+                             " s simulated in " + fixed(r.wall_s, 2) + " s)");
   if (r.closed_loop)
-    row("path error rmse / max [m]",
-        fixed(r.closed_loop->path_error_rmse_m, 4) + " / " + fixed(r.closed_loop->path_error_max_m, 4) + " (held " +
-            std::to_string(r.closed_loop->hold_frames) + " frames)");
+    row("path error rmse / max [m]", fixed(r.closed_loop->path_error_rmse_m, 4) + " / " +
+                                         fixed(r.closed_loop->path_error_max_m, 4) + " (held " +
+                                         std::to_string(r.closed_loop->hold_frames) + " frames)");
   h += "</table>\n";
 
   std::vector<const SlamRun*> runs{&p};
@@ -328,12 +347,13 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
       h += "<p>" + html_escape(run->mode) + ": tracking was never lost.</p>\n";
       continue;
     }
-    h += "<p>" + html_escape(run->mode) + ":</p>\n<table><tr><th>frame</th><th>t [s]</th><th>reason</th>"
+    h += "<p>" + html_escape(run->mode) +
+         ":</p>\n<table><tr><th>frame</th><th>t [s]</th><th>reason</th>"
          "<th>recovered at frame</th></tr>\n";
     for (const LossEvent& e : run->loss_events)
-      h += "<tr><td>" + std::to_string(e.frame) + "</td><td>" + fixed(e.t_s, 3) + "</td><td>" + html_escape(e.reason) +
-           "</td><td>" + (e.recovered_frame ? std::to_string(*e.recovered_frame) : std::string("never")) +
-           "</td></tr>\n";
+      h += "<tr><td>" + std::to_string(e.frame) + "</td><td>" + fixed(e.t_s, 3) + "</td><td>" +
+           html_escape(e.reason) + "</td><td>" +
+           (e.recovered_frame ? std::to_string(*e.recovered_frame) : std::string("never")) + "</td></tr>\n";
     h += "</table>\n";
   }
   const std::string table = comparison_table(r);
@@ -359,7 +379,8 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
                         "timing.csv", "camera.yaml", "run.log"})
     h += std::string("<li><a href=\"") + f + "\">" + f + "</a></li>\n";
   if (r.baseline)
-    for (const char* f : {"baseline/CameraTrajectory.txt", "baseline/KeyFrameTrajectory.txt", "baseline/timing.csv"})
+    for (const char* f :
+         {"baseline/CameraTrajectory.txt", "baseline/KeyFrameTrajectory.txt", "baseline/timing.csv"})
       h += std::string("<li><a href=\"") + f + "\">" + f + "</a></li>\n";
   h += "</ul>\n<h2>Log</h2>\n<pre>";
   for (const std::string& l : r.log_lines) h += html_escape(l) + "\n";

@@ -2,8 +2,8 @@
 
 #include <chrono>
 #include <cmath>
-#include <ctime>
 #include <cstdio>
+#include <ctime>
 #include <exception>
 #include <fstream>
 #include <future>
@@ -25,7 +25,9 @@ namespace pvb::run {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
 
 /// CPU time of the whole process (every thread, GL workers included), seconds.
 double process_cpu_s() {
@@ -70,16 +72,16 @@ class RunLog {
 /// before the next physics step.
 struct Steering {
   std::mutex mutex;
-  bool hold = true;                  ///< not initialised or lost: stand still
-  std::optional<sim::Pose2d> pose;   ///< the robot's pose as SLAM sees it (site frame)
+  bool hold = true;                 ///< not initialised or lost: stand still
+  std::optional<sim::Pose2d> pose;  ///< the robot's pose as SLAM sees it (site frame)
 };
 
 /// One frame from the producer: the sensor frame for SLAM and, beside it
 /// (never inside it), the ground truth for the harness.
 struct FrameItem {
   sensor::RgbdFrame frame;
-  geom::StampedPose gt;        ///< T_w_c of the frame, from the ground-truth sink
-  sim::Pose2d base_gt;         ///< robot axle centre, ground truth
+  geom::StampedPose gt;  ///< T_w_c of the frame, from the ground-truth sink
+  sim::Pose2d base_gt;   ///< robot axle centre, ground truth
   sim::SimFrameSource::StageTimes times;
 };
 
@@ -95,7 +97,8 @@ struct SimInfo {
 class FrameProducer {
  public:
   FrameProducer(const scenes::Scenario& scenario, sim::GlBackend backend, int frames, Steering* steering)
-      : source_(scenario, backend, frames, [this](const geom::StampedPose& p) { gt_ = p; }), steering_(steering) {
+      : source_(scenario, backend, frames, [this](const geom::StampedPose& p) { gt_ = p; }),
+        steering_(steering) {
     info_.renderer = source_.camera().description();
     info_.route = source_.simulator().follower().path();
   }
@@ -143,7 +146,8 @@ struct SystemSink {
     timing = open_out(dir + "/timing.csv");
     cam_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c; w = camera frame of the first tracked frame)\n";
     kf_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
-    timing << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,inliers,"
+    timing << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,"
+              "inliers,"
               "keyframe,mapping_ms\n";
     est.source = dir + "/CameraTrajectory.txt";
   }
@@ -159,8 +163,8 @@ struct SystemSink {
     tracking_ms += r.tracking_ms;
     orb_ms += r.orb_ms;
     inline_mapping_ms += r.mapping_ms;
-    run.per_frame.push_back({index, t_s, r.T_w_c.has_value(), r.tracking_ms, r.tracking.coarse_matches,
-                             r.tracking.matches_kept});
+    run.per_frame.push_back(
+        {index, t_s, r.T_w_c.has_value(), r.tracking_ms, r.tracking.coarse_matches, r.tracking.matches_kept});
     if (r.T_w_c) {
       cam_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
       est.poses.push_back({r.t_ns, *r.T_w_c});
@@ -168,10 +172,10 @@ struct SystemSink {
     }
     static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc"};
     timing << index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
-           << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << "," << fmt(r.tracking_ms)
-           << "," << fmt(r.orb_ms) << "," << fmt(r.tracking.pe_match_ms) << "," << r.tracking.coarse_matches << ","
-           << r.tracking.matches_kept << "," << r.tracking.inliers << "," << (r.tracking.new_keyframe ? 1 : 0) << ","
-           << fmt(r.mapping_ms) << "\n"
+           << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","
+           << fmt(r.tracking_ms) << "," << fmt(r.orb_ms) << "," << fmt(r.tracking.pe_match_ms) << ","
+           << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers << ","
+           << (r.tracking.new_keyframe ? 1 : 0) << "," << fmt(r.mapping_ms) << "\n"
            << std::flush;
 
     char head_buf[96];
@@ -197,7 +201,8 @@ struct SystemSink {
   void finish() {
     system->shutdown();
     kf_traj.close();
-    std::string text = "# timestamp tx ty tz qx qy qz qw (T_w_c, refined by local BA; culled keyframes left out)\n";
+    std::string text =
+        "# timestamp tx ty tz qx qy qz qw (T_w_c, refined by local BA; culled keyframes left out)\n";
     for (const auto& p : system->keyframe_trajectory()) text += geom::format_tum_line(p) + "\n";
     write_file(dir + "/KeyFrameTrajectory.txt", text);
     cam_traj.close();
@@ -302,7 +307,8 @@ RunReport run_scenario(const RunOptions& opt) {
   report.fps = scenario.camera.fps;
 
   std::ofstream gt_file = open_out(opt.out_dir + "/groundtruth.txt");
-  gt_file << "# timestamp tx ty tz qx qy qz qw (T_w_c: camera optical frame in the site frame, ground truth)\n";
+  gt_file
+      << "# timestamp tx ty tz qx qy qz qw (T_w_c: camera optical frame in the site frame, ground truth)\n";
   eval::Trajectory gt;
   gt.source = opt.out_dir + "/groundtruth.txt";
 
@@ -314,7 +320,8 @@ RunReport run_scenario(const RunOptions& opt) {
   geom::SE3d T_site_slam = geom::SE3d::Identity();  // SLAM world (first camera frame) in the site frame
   const std::vector<int> sheet_frames = plot::spread_indices(n, 12);
 
-  double physics_ms = 0, render_ms = 0, sensor_ms = 0, producer_wait_ms = 0, consumer_wait_ms = 0, output_ms = 0;
+  double physics_ms = 0, render_ms = 0, sensor_ms = 0, producer_wait_ms = 0, consumer_wait_ms = 0,
+         output_ms = 0;
   double setup_ms = 0;
   double sim_cpu_ms = 0, slam_cpu_ms = 0;  // sync mode: process CPU time of each half
   bool abort_run = false;
@@ -371,10 +378,10 @@ RunReport run_scenario(const RunOptions& opt) {
   log.line("pvbench run: scenario " + scenario.name + " (" + opt.scenario_file + "), seed " +
            std::to_string(scenario.seed) + ", " + std::to_string(n) + " frames, " +
            (compare ? "pe-slam and orb-slam2" : sinks.front()->run.mode) +
-           (opt.closed_loop ? ", closed loop (on loss: " +
-                                  std::string(scenario.route.on_loss == scenes::OnLoss::kAbort ? "abort" : "wait") +
-                                  ")"
-                            : ", open loop") +
+           (opt.closed_loop
+                ? ", closed loop (on loss: " +
+                      std::string(scenario.route.on_loss == scenes::OnLoss::kAbort ? "abort" : "wait") + ")"
+                : ", open loop") +
            (opt.sync ? ", synchronous" : ", pipelined"));
 
   Clock::time_point loop_start;
@@ -438,8 +445,10 @@ RunReport run_scenario(const RunOptions& opt) {
           if (!pushed) break;
         }
       } catch (...) {
-        if (started) producer_error = std::current_exception();
-        else ready.set_exception(std::current_exception());
+        if (started)
+          producer_error = std::current_exception();
+        else
+          ready.set_exception(std::current_exception());
       }
       queue.close();
     });
@@ -474,8 +483,10 @@ RunReport run_scenario(const RunOptions& opt) {
 
   const auto t_eval = Clock::now();
   for (auto& sink : sinks) {
-    if (!gt.empty()) sink->evaluate(gt);
-    else sink->run.eval_note = "no frames";
+    if (!gt.empty())
+      sink->evaluate(gt);
+    else
+      sink->run.eval_note = "no frames";
   }
   const double eval_ms = ms_since(t_eval);
 
@@ -501,10 +512,12 @@ RunReport run_scenario(const RunOptions& opt) {
                     {"sensor_model", sensor_ms, frames, opt.sync ? "main" : "producer"}};
   for (const auto& sink : sinks) {
     const std::string suffix = sink.get() == sinks.front().get() ? "" : "_baseline";
-    report.profile.push_back({"tracking" + suffix, sink->tracking_ms, frames, opt.sync ? "main" : "consumer"});
-    report.profile.push_back({"orb_extraction" + suffix, sink->orb_ms, frames, opt.sync ? "main" : "consumer"});
     report.profile.push_back(
-        {"mapping" + suffix, sink->system->mapping_busy_ms(), sink->run.keyframes, opt.sync ? "main" : "mapping"});
+        {"tracking" + suffix, sink->tracking_ms, frames, opt.sync ? "main" : "consumer"});
+    report.profile.push_back(
+        {"orb_extraction" + suffix, sink->orb_ms, frames, opt.sync ? "main" : "consumer"});
+    report.profile.push_back({"mapping" + suffix, sink->system->mapping_busy_ms(), sink->run.keyframes,
+                              opt.sync ? "main" : "mapping"});
   }
   report.profile.push_back({"output", output_ms, frames, opt.sync ? "main" : "consumer"});
   if (!opt.sync) {
@@ -519,16 +532,20 @@ RunReport run_scenario(const RunOptions& opt) {
 
   char summary[512];
   const SlamRun& p = report.primary;
-  std::snprintf(summary, sizeof summary,
-                "%s: %zu frames, %zu lost, %zu keyframes, ATE rmse %s m, tracking median %.2f ms, realtime factor "
-                "%.2f (%.2f s simulated in %.2f s wall, %.2f s CPU)",
-                to_string(report.status), p.frames, p.lost_frames, p.keyframes,
-                p.eval ? fmt(p.eval->ate.rmse).c_str() : "n/a", percentile([&] {
-                  std::vector<double> v;
-                  for (const auto& f : p.per_frame) v.push_back(f.tracking_ms);
-                  return v;
-                }(), 0.5),
-                realtime_factor(report.sim_s, report.wall_s), report.sim_s, report.wall_s, report.cpu_s);
+  std::snprintf(
+      summary, sizeof summary,
+      "%s: %zu frames, %zu lost, %zu keyframes, ATE rmse %s m, tracking median %.2f ms, realtime factor "
+      "%.2f (%.2f s simulated in %.2f s wall, %.2f s CPU)",
+      to_string(report.status), p.frames, p.lost_frames, p.keyframes,
+      p.eval ? fmt(p.eval->ate.rmse).c_str() : "n/a",
+      percentile(
+          [&] {
+            std::vector<double> v;
+            for (const auto& f : p.per_frame) v.push_back(f.tracking_ms);
+            return v;
+          }(),
+          0.5),
+      realtime_factor(report.sim_s, report.wall_s), report.sim_s, report.wall_s, report.cpu_s);
   log.line(summary);
   if (report.closed_loop)
     log.line("closed loop: path error rmse " + fmt(report.closed_loop->path_error_rmse_m) + " m, max " +

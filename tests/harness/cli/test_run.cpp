@@ -21,7 +21,8 @@ using namespace pvb;
 namespace {
 
 const std::string kStation = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
-const std::string kLossScenario = std::string(PVB_SOURCE_DIR) + "/tests/harness/run/data/turn_away_from_wall.yaml";
+const std::string kLossScenario =
+    std::string(PVB_SOURCE_DIR) + "/tests/harness/run/data/turn_away_from_wall.yaml";
 
 std::string fresh(const std::string& name) {
   const std::string d = ::testing::TempDir() + "pvb_run_" + name + "_" + std::to_string(::getpid());
@@ -78,10 +79,11 @@ void check_report_files(const std::string& d) {
   EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 150u);
   EXPECT_EQ(data_lines(d + "/CameraTrajectory.txt").size(), 150u);
   EXPECT_EQ(data_lines(d + "/timing.csv").size(), 151u);  // header + one line per frame
-  EXPECT_EQ(data_lines(d + "/KeyFrameTrajectory.txt").size(), static_cast<std::size_t>(metrics(d)["keyframes"].as<int>()));
+  EXPECT_EQ(data_lines(d + "/KeyFrameTrajectory.txt").size(),
+            static_cast<std::size_t>(metrics(d)["keyframes"].as<int>()));
   for (const char* f : {"run.log", "index.html", "contact_sheet.png", "camera.yaml", "trajectory_error.svg",
-                        "trajectory_error.png", "ate_over_time.svg", "ate_over_time.png", "tracking_time_hist.svg",
-                        "tracking_time_hist.png", "matches.svg", "matches.png"})
+                        "trajectory_error.png", "ate_over_time.svg", "ate_over_time.png",
+                        "tracking_time_hist.svg", "tracking_time_hist.png", "matches.svg", "matches.png"})
     EXPECT_TRUE(exists(d + "/" + f)) << f;
   const std::string html = read_file(d + "/index.html");
   EXPECT_NE(html.find("trajectory_error.png"), std::string::npos);
@@ -100,7 +102,8 @@ void check_report_files(const std::string& d) {
 void check_bit_identical_prefix(const std::string& d) {
   const std::string s = fresh("short");
   ASSERT_EQ(test::run_pvbench("run --scenario " + kStation + " --out " + s + " --sync --frames 40").code, 0);
-  const std::vector<std::string> a = data_lines(d + "/CameraTrajectory.txt"), b = data_lines(s + "/CameraTrajectory.txt");
+  const std::vector<std::string> a = data_lines(d + "/CameraTrajectory.txt"),
+                                 b = data_lines(s + "/CameraTrajectory.txt");
   ASSERT_EQ(b.size(), 40u);
   for (std::size_t i = 0; i < b.size(); ++i) EXPECT_EQ(a[i], b[i]) << "frame " << i;
 }
@@ -109,7 +112,8 @@ void check_bit_identical_prefix(const std::string& d) {
 // test in its own process, so the checks share this test).
 TEST(RunCli, DefaultStationSync) {
   const std::string d = fresh("station");
-  const test::RunResult r = test::run_pvbench("run --scenario " + kStation + " --out " + d + " --sync --frames 150");
+  const test::RunResult r =
+      test::run_pvbench("run --scenario " + kStation + " --out " + d + " --sync --frames 150");
   ASSERT_EQ(r.code, 0) << r.output;
   {
     SCOPED_TRACE("metrics and accuracy");
@@ -163,7 +167,7 @@ TEST(RunCli, BaselineAloneIsOrbSlam2WithoutPeMatch) {
   for (const std::string& line : data_lines(d + "/timing.csv")) {
     const std::vector<std::string> f = split_ws(line, ",");
     if (f[0] == "frame") continue;
-    EXPECT_EQ(f[7], "0") << line;  // no PE-match time
+    EXPECT_EQ(f[7], "0") << line;   // no PE-match time
     EXPECT_EQ(f[8], f[9]) << line;  // coarse == kept
     motion_frames += f[3] == "motion";
   }
@@ -179,7 +183,8 @@ TEST(RunCli, ClosedLoopFollowsTheRouteFromTheSlamPose) {
   ASSERT_TRUE(m["closed_loop"]);
   EXPECT_EQ(m["closed_loop"]["hold_frames"].as<int>(), 0);
   EXPECT_LT(m["closed_loop"]["path_error_max_m"].as<double>(), 0.10);
-  EXPECT_LE(m["closed_loop"]["path_error_rmse_m"].as<double>(), m["closed_loop"]["path_error_max_m"].as<double>());
+  EXPECT_LE(m["closed_loop"]["path_error_rmse_m"].as<double>(),
+            m["closed_loop"]["path_error_max_m"].as<double>());
   EXPECT_LT(m["ate"]["rmse"].as<double>(), 0.02);
   EXPECT_TRUE(exists(d + "/path_error.png"));
   // The robot moved: it was steered, not held.
@@ -192,7 +197,8 @@ TEST(RunCli, ClosedLoopFollowsTheRouteFromTheSlamPose) {
 // The fixture loses tracking for good when the robot turns away from the wall.
 TEST(RunCli, ClosedLoopAbortsOnLossWithAReport) {
   const std::string d = fresh("abort");
-  const test::RunResult r = test::run_pvbench("run --scenario " + kLossScenario + " --out " + d + " --sync --closed-loop");
+  const test::RunResult r =
+      test::run_pvbench("run --scenario " + kLossScenario + " --out " + d + " --sync --closed-loop");
   EXPECT_EQ(r.code, 4) << r.output;
   const YAML::Node m = metrics(d);
   EXPECT_EQ(m["status"].as<std::string>(), "aborted");
@@ -241,8 +247,8 @@ TEST(RunCli, SigintWritesThePartialReport) {
   if (pid == 0) {
     const std::string out = d;
     if (!freopen(log.c_str(), "w", stdout) || !freopen(log.c_str(), "a", stderr)) _exit(99);
-    execl(test::pvbench_path().c_str(), "pvbench", "run", "--scenario", kStation.c_str(), "--out", out.c_str(),
-          static_cast<char*>(nullptr));
+    execl(test::pvbench_path().c_str(), "pvbench", "run", "--scenario", kStation.c_str(), "--out",
+          out.c_str(), static_cast<char*>(nullptr));
     _exit(98);
   }
   using Clock = std::chrono::steady_clock;

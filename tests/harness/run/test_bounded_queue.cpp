@@ -16,7 +16,7 @@ TEST(BoundedQueue, DeliversInOrderThenEndsOnClose) {
   q.close();
   EXPECT_FALSE(q.push(3));  // refused after close
   EXPECT_EQ(q.pop(), 1);
-  EXPECT_EQ(q.pop(), 2);    // drained after close
+  EXPECT_EQ(q.pop(), 2);  // drained after close
   EXPECT_EQ(q.pop(), std::nullopt);
 }
 

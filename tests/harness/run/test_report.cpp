@@ -49,7 +49,8 @@ SlamRun slam_run(const std::string& mode, double lateral_error_m) {
   r.map_points = 900;
   for (int i = 0; i < 50; ++i)
     r.per_frame.push_back({i, i / 30.0, i != 20 && i != 21, 10.0 + i % 5, i > 0 ? 300 : 0, i > 0 ? 290 : 0});
-  r.loss_events.push_back({20, 20 / 30.0, "local map: only 21 inliers after pose optimisation (need 30)", 22});
+  r.loss_events.push_back(
+      {20, 20 / 30.0, "local map: only 21 inliers after pose optimisation (need 30)", 22});
   r.eval = synthetic_eval(lateral_error_m);
   return r;
 }
@@ -81,7 +82,8 @@ TEST(RunReport, MetricsJsonHasTheContractKeys) {
   EXPECT_EQ(m["keyframes"].as<int>(), 7);
   EXPECT_EQ(m["map_points"].as<int>(), 900);
   EXPECT_NEAR(m["ate"]["rmse"].as<double>(), r.primary.eval->ate.rmse, 1e-12);
-  for (const char* k : {"mean", "median", "std", "min", "max", "count"}) EXPECT_TRUE(m["ate"][k].IsScalar()) << k;
+  for (const char* k : {"mean", "median", "std", "min", "max", "count"})
+    EXPECT_TRUE(m["ate"][k].IsScalar()) << k;
   EXPECT_EQ(m["rpe"]["unit"].as<std::string>(), "f");
   EXPECT_NEAR(m["rpe"]["trans"]["rmse"].as<double>(), r.primary.eval->rpe_trans_m.rmse, 1e-12);
   EXPECT_NEAR(m["rpe"]["rot_deg"]["max"].as<double>(), r.primary.eval->rpe_rot_deg.max, 1e-12);
@@ -114,7 +116,8 @@ TEST(RunReport, CompareAddsBaselineAndReductions) {
   EXPECT_EQ(m["baseline"]["frames"].as<int>(), 50);
   EXPECT_EQ(m["baseline"]["status"].as<std::string>(), "completed");
   EXPECT_NEAR(m["baseline"]["ate"]["rmse"].as<double>(), r.baseline->eval->ate.rmse, 1e-12);
-  const double expected = 100.0 * (r.baseline->eval->ate.rmse - r.primary.eval->ate.rmse) / r.baseline->eval->ate.rmse;
+  const double expected =
+      100.0 * (r.baseline->eval->ate.rmse - r.primary.eval->ate.rmse) / r.baseline->eval->ate.rmse;
   EXPECT_GT(expected, 0.0);
   EXPECT_NEAR(m["comparison"]["ate_rmse_reduction_pct"].as<double>(), expected, 1e-6);
   EXPECT_TRUE(m["comparison"]["rpe_trans_rmse_reduction_pct"].IsScalar());
@@ -153,7 +156,7 @@ TEST(RunReport, DistanceToPolyline) {
   const std::vector<Eigen::Vector2d> line{{0, 0}, {2, 0}, {2, 2}};
   EXPECT_NEAR(distance_to_polyline({1, 0.5}, line), 0.5, 1e-12);
   EXPECT_NEAR(distance_to_polyline({3, 1}, line), 1.0, 1e-12);
-  EXPECT_NEAR(distance_to_polyline({-3, 4}, line), 5.0, 1e-12);  // beyond the first end point
+  EXPECT_NEAR(distance_to_polyline({-3, 4}, line), 5.0, 1e-12);     // beyond the first end point
   EXPECT_NEAR(distance_to_polyline({1.5, 1.0}, line), 0.5, 1e-12);  // nearer the second segment
   EXPECT_NEAR(distance_to_polyline({1, 1}, {{0, 0}}), std::sqrt(2.0), 1e-12);
   EXPECT_TRUE(std::isinf(distance_to_polyline({1, 1}, {})));
@@ -211,7 +214,7 @@ TEST(RunReport, IndexHtmlIsSelfContained) {
   EXPECT_NE(html.find("contact_sheet.png"), std::string::npos);
   EXPECT_NE(html.find("href=\"metrics.json\""), std::string::npos);
   EXPECT_NE(html.find("&lt;reason &amp; more&gt;"), std::string::npos);  // log text is escaped
-  EXPECT_NE(html.find("21 inliers"), std::string::npos);                  // the loss event and its reason
+  EXPECT_NE(html.find("21 inliers"), std::string::npos);                 // the loss event and its reason
   EXPECT_NE(html.find("PE-SLAM vs ORB-SLAM2"), std::string::npos);
   EXPECT_EQ(html.find("<script"), std::string::npos);
   EXPECT_EQ(html.find("http://"), std::string::npos);
@@ -226,8 +229,8 @@ TEST(RunReport, WriteReportWritesEveryFile) {
   r.baseline = slam_run("orb-slam2", 0.04);
   r.closed_loop = ClosedLoopMetrics{{0, 1}, {0.01, 0.03}, 0.0224, 0.03, 0};
   const std::vector<std::string> figures = write_report(r, dir);
-  for (const char* f : {"trajectory_error", "trajectory_error_orb-slam2", "ate_over_time", "tracking_time_hist",
-                        "matches", "path_error"}) {
+  for (const char* f : {"trajectory_error", "trajectory_error_orb-slam2", "ate_over_time",
+                        "tracking_time_hist", "matches", "path_error"}) {
     EXPECT_NE(std::find(figures.begin(), figures.end(), f), figures.end()) << f;
     for (const char* ext : {".svg", ".png"})
       EXPECT_TRUE(std::ifstream(dir + "/" + f + ext).good()) << f << ext;

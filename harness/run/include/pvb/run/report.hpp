@@ -46,9 +46,9 @@ struct FrameRecord {
 
 /// One SLAM system's run (PE-SLAM, or the ORB-SLAM2 baseline).
 struct SlamRun {
-  std::string mode;                    ///< "pe-slam" or "orb-slam2"
+  std::string mode;  ///< "pe-slam" or "orb-slam2"
   std::size_t frames = 0;
-  std::size_t lost_frames = 0;         ///< frames in state Lost
+  std::size_t lost_frames = 0;  ///< frames in state Lost
   std::size_t not_initialized_frames = 0;
   std::size_t keyframes = 0;
   std::size_t map_points = 0;
@@ -77,17 +77,17 @@ struct StageTime {
 };
 
 struct RunReport {
-  std::string scenario;       ///< scenario name
+  std::string scenario;  ///< scenario name
   std::string scenario_file;
   std::uint64_t seed = 0;
   RunStatus status = RunStatus::kCompleted;
   std::string status_detail;  ///< one line: why interrupted or aborted
   bool sync = false;
-  std::string renderer;       ///< GL backend description
+  std::string renderer;  ///< GL backend description
   double fps = 30;
-  double sim_s = 0;           ///< simulated time of the frames processed
-  double wall_s = 0;          ///< wall time of the loop (setup, evaluation and report excluded)
-  double cpu_s = 0;           ///< CPU time of the whole process over the same span (all threads)
+  double sim_s = 0;   ///< simulated time of the frames processed
+  double wall_s = 0;  ///< wall time of the loop (setup, evaluation and report excluded)
+  double cpu_s = 0;   ///< CPU time of the whole process over the same span (all threads)
   SlamRun primary;
   std::optional<SlamRun> baseline;  ///< --compare
   std::optional<ClosedLoopMetrics> closed_loop;

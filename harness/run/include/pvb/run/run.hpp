@@ -15,10 +15,10 @@
 #include <string>
 
 #include "pvb/dataset/tum_sequence.hpp"
+#include "pvb/geometry/se3.hpp"
 #include "pvb/run/report.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/robot.hpp"
-#include "pvb/geometry/se3.hpp"
 
 namespace pvb::run {
 
@@ -36,9 +36,9 @@ struct RunOptions {
   int max_frames = 0;                 ///< cap (0: the scenario's duration)
   bool sync = false;                  ///< no threads: bit-identical runs
   SlamMode mode = SlamMode::kPeSlam;
-  bool closed_loop = false;           ///< steer from the SLAM pose instead of ground truth
-  std::string gl = "auto";            ///< auto, egl or osmesa
-  std::size_t queue_capacity = 3;     ///< frames the producer may run ahead (open loop)
+  bool closed_loop = false;        ///< steer from the SLAM pose instead of ground truth
+  std::string gl = "auto";         ///< auto, egl or osmesa
+  std::size_t queue_capacity = 3;  ///< frames the producer may run ahead (open loop)
   /// Set asynchronously (by a signal handler) to stop the run; the partial
   /// report is then written with status "interrupted".  May be null.
   const std::atomic<bool>* stop = nullptr;
