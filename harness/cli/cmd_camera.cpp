@@ -23,11 +23,11 @@
 #include "pvb/openni/oni_file.hpp"
 #include "pvb/openni/openni_source.hpp"
 #include "pvb/openni/sim_uri.hpp"
+#include "pvb/run/run.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/simulator.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
-#include "scenario_settings.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -126,7 +126,7 @@ int run_camera(const CameraArgs& a) {
     const std::string text = read_file(a.settings);
     if (a.settings != settings_path) write_file(settings_path, text);
   } else if (scenario) {
-    dataset::OrbSlamSettings o = settings_for_scenario(*scenario);
+    dataset::OrbSlamSettings o = run::orbslam_settings_for(*scenario);
     o.depth_map_factor = 1000.0;  // OpenNI2 depth is in millimetres
     dataset::write_orbslam_settings(settings_path, o);
   } else {

@@ -8,13 +8,13 @@
 #include <optional>
 
 #include "command.hpp"
-#include "scenario_settings.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/plot/contact_sheet.hpp"
+#include "pvb/run/run.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/sim_frame_source.hpp"
 
@@ -46,7 +46,7 @@ int run_record(const RecordOptions& opt) {
   const sim::Simulator& sim = source.simulator();
 
   sim::write_scene(sim.assets(), opt.out);
-  dataset::write_orbslam_settings(opt.out + "/camera.yaml", settings_for_scenario(scenario));
+  dataset::write_orbslam_settings(opt.out + "/camera.yaml", run::orbslam_settings_for(scenario));
   dataset::TumSequenceWriter writer(opt.out, 5000.0, std::string("pvbench ") + pvb::version());
 
   double capture_ms = 0, write_ms = 0;

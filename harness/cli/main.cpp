@@ -14,6 +14,7 @@ Command add_slam_command(CLI::App& app);
 #ifdef PVB_HAVE_OPENNI2
 Command add_camera_command(CLI::App& app);
 #endif
+Command add_run_command(CLI::App& app);
 
 // Sub-commands register here (one line each).
 std::vector<Command> add_all_commands(CLI::App& app) {
@@ -25,6 +26,7 @@ std::vector<Command> add_all_commands(CLI::App& app) {
 #ifdef PVB_HAVE_OPENNI2
   cmds.push_back(add_camera_command(app));
 #endif
+  cmds.push_back(add_run_command(app));
   return cmds;
 }
 }  // namespace pvb::cli

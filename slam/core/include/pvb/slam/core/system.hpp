@@ -55,6 +55,8 @@ class System {
   std::size_t num_map_points();
   /// Positions of the map points (world frame), by point id.
   std::vector<Eigen::Vector3d> map_point_positions();
+  /// Time local mapping has spent on keyframes so far (inline or on its worker), ms.
+  double mapping_busy_ms() const { return mapping_->busy_ms(); }
   TrackingState state() const { return tracking_->state(); }
 
   // Dense point-cloud mapping (Settings::dense; off: the functions below

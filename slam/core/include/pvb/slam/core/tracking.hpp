@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "pvb/slam/core/map.hpp"
@@ -43,6 +44,10 @@ struct TrackingStats {
     std::vector<std::uint8_t> pose_inlier;
   };
   MotionMatches motion;
+  /// Why the frame was not tracked (empty when it was): each attempted
+  /// step's failure, "; "-separated, e.g. "motion model: only 7 map matches
+  /// after pose optimisation (need 10); reference keyframe: only 9 matches (need 15)".
+  std::string failure;
 };
 
 struct TrackingOptions {
@@ -86,6 +91,8 @@ class Tracking {
   int optimize(Frame& f);
   void discard_outliers(Frame& f, int* map_matches);
   void replace_in_last_frame();
+  /// Appends one step's failure to stats_.failure; returns false.
+  bool fail(const std::string& why);
 
   Map& map_;
   std::shared_ptr<const CameraModel> cam_;
