@@ -14,6 +14,7 @@
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/plot/contact_sheet.hpp"
+#include "pvb/run/run.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/sim_frame_source.hpp"
 
@@ -31,17 +32,6 @@ struct RecordOptions {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-dataset::OrbSlamSettings settings_for(const scenes::Scenario& s) {
-  dataset::OrbSlamSettings o;
-  o.K = {s.camera.fx, s.camera.fy, s.camera.cx(), s.camera.cy(), s.camera.width, s.camera.height};
-  o.fps = s.camera.fps;
-  o.bf = s.camera.depth_noise.baseline_m * s.camera.fx;
-  // ThDepth is in baselines: points beyond depth_range max are "far".
-  o.th_depth = s.camera.depth_range_m.y() / s.camera.depth_noise.baseline_m;
-  o.rgb_order = 1;
-  return o;
-}
-
 int run_record(const RecordOptions& opt) {
   const sim::GlBackend backend = sim::parse_gl_backend(opt.gl);
   scenes::Scenario scenario = scenes::load_scenario(opt.scenario);
@@ -56,7 +46,7 @@ int run_record(const RecordOptions& opt) {
   const sim::Simulator& sim = source.simulator();
 
   sim::write_scene(sim.assets(), opt.out);
-  dataset::write_orbslam_settings(opt.out + "/camera.yaml", settings_for(scenario));
+  dataset::write_orbslam_settings(opt.out + "/camera.yaml", run::orbslam_settings_for(scenario));
   dataset::TumSequenceWriter writer(opt.out, 5000.0, std::string("pvbench ") + pvb::version());
 
   double capture_ms = 0, write_ms = 0;

@@ -11,6 +11,7 @@ Command add_record_command(CLI::App& app);
 Command add_eval_command(CLI::App& app);
 Command add_match_command(CLI::App& app);
 Command add_slam_command(CLI::App& app);
+Command add_run_command(CLI::App& app);
 Command add_check_command(CLI::App& app);
 Command add_sweep_command(CLI::App& app);
 
@@ -21,6 +22,7 @@ std::vector<Command> add_all_commands(CLI::App& app) {
   cmds.push_back(add_eval_command(app));
   cmds.push_back(add_match_command(app));
   cmds.push_back(add_slam_command(app));
+  cmds.push_back(add_run_command(app));
   cmds.push_back(add_check_command(app));
   cmds.push_back(add_sweep_command(app));
   return cmds;

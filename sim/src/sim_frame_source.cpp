@@ -1,5 +1,7 @@
 #include "pvb/sim/sim_frame_source.hpp"
 
+#include <chrono>
+
 namespace pvb::sim {
 
 SimFrameSource::SimFrameSource(scenes::Scenario scenario, GlBackend backend, int max_frames, GroundTruthSink sink)
@@ -10,9 +12,13 @@ SimFrameSource::SimFrameSource(scenes::Scenario scenario, GlBackend backend, int
 
 std::optional<sensor::RgbdFrame> SimFrameSource::next() {
   if (next_index_ >= frames_) return std::nullopt;
+  const auto t0 = std::chrono::steady_clock::now();
   if (next_index_ > 0) sim_.advance();
+  last_times_.physics_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   ++next_index_;
   Capture cap = camera_.capture(sim_);
+  last_times_.render_ms = cap.render_ms;
+  last_times_.sensor_ms = cap.sensor_ms;
   if (sink_) sink_({cap.frame.t_ns, cap.T_w_c});
   last_depth_gt_m_ = cap.depth_gt_m;
   return std::move(cap.frame);

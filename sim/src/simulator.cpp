@@ -1,5 +1,6 @@
 #include "pvb/sim/simulator.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -144,9 +145,12 @@ RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
 }
 
 Capture RgbdCamera::capture(Simulator& sim) {
+  using Clock = std::chrono::steady_clock;
   Capture out;
   cv::Mat rgb;
+  const auto t0 = Clock::now();
   renderer_.render(sim.model(), sim.data(), sim.camera_id(), &rgb, &out.depth_gt_m);
+  const auto t1 = Clock::now();
   // Sky: beyond every scene distance (the skybox is drawn far away).
   const float sky = static_cast<float>(sim.assets().max_scene_depth_m);
   out.depth_gt_m.setTo(0.0f, out.depth_gt_m > sky);
@@ -158,6 +162,8 @@ Capture RgbdCamera::capture(Simulator& sim) {
   out.frame.t_ns = sim.t_ns();
   out.frame.index = frame;
   out.T_w_c = sim.T_w_c();
+  out.render_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  out.sensor_ms = std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
   return out;
 }
 

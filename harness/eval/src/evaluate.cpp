@@ -23,11 +23,21 @@ std::string num(double v) {
   return buf;
 }
 
+}  // namespace
+
 std::string stats_json(const Stats& s) {
   return "{\"rmse\": " + num(s.rmse) + ", \"mean\": " + num(s.mean) + ", \"median\": " + num(s.median) +
          ", \"std\": " + num(s.std) + ", \"min\": " + num(s.min) + ", \"max\": " + num(s.max) +
          ", \"count\": " + std::to_string(s.count) + "}";
 }
+
+std::string rpe_json(const EvalResult& r) {
+  return "{\"delta\": " + num(r.rpe_options.delta) + ", \"unit\": \"" + delta_unit_name(r.rpe_options.unit) +
+         "\", \"pairs\": \"" + (r.rpe_options.pairs == PairMode::kAll ? "all" : "consecutive") +
+         "\", \"trans\": " + stats_json(r.rpe_trans_m) + ", \"rot_deg\": " + stats_json(r.rpe_rot_deg) + "}";
+}
+
+namespace {
 
 std::string result_fields_json(const EvalResult& r, const std::string& indent) {
   std::string R = "[";

@@ -201,3 +201,109 @@ std::string format_svg(const Figure& f) {
 }
 
 }  // namespace pvb::eval
+
+namespace pvb::eval {
+
+Rgb series_color(std::size_t index) {
+  static const Rgb kColors[] = {{31, 90, 230}, {230, 120, 20}, {30, 150, 60}, {200, 30, 30}, {130, 60, 180}};
+  return kColors[index % (sizeof kColors / sizeof kColors[0])];
+}
+
+Figure make_line_chart(const std::string& title, const std::string& x_label, const std::string& y_label,
+                       const std::vector<Series>& series) {
+  Figure f;
+  f.width_px = 1000;
+  f.height_px = 480;
+  double x_lo = 1e300, x_hi = -1e300, y_lo = 1e300, y_hi = -1e300;
+  for (const Series& s : series)
+    for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      x_lo = std::min(x_lo, s.x[i]);
+      x_hi = std::max(x_hi, s.x[i]);
+      y_lo = std::min(y_lo, s.y[i]);
+      y_hi = std::max(y_hi, s.y[i]);
+    }
+  if (x_lo > x_hi) x_lo = 0, x_hi = 1, y_lo = 0, y_hi = 1;
+  if (y_lo >= 0) y_lo = 0;
+  if (x_hi - x_lo < 1e-9) x_hi = x_lo + 1;
+  if (y_hi - y_lo < 1e-12) y_hi = y_lo + 1;
+  y_hi += 0.08 * (y_hi - y_lo);
+  const Panel p{100, 60, 860, 330, x_lo, x_hi, y_lo, y_hi};
+  draw_axes(&f, p, x_label, y_label);
+  f.texts.push_back({f.width_px / 2.0, 34, title, 20.0, TextAnchor::kMiddle, false, kBlack});
+  for (const Series& s : series) {
+    FigPolyline line{{}, s.color, 1.6};
+    for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) {
+        if (line.points.size() > 1) f.polylines.push_back(line);
+        line.points.clear();
+        continue;
+      }
+      line.points.emplace_back(p.px(s.x[i]), p.py(s.y[i]));
+    }
+    if (line.points.size() == 1) line.points.push_back(line.points.front());
+    if (!line.points.empty()) f.polylines.push_back(line);
+  }
+  // Legend, right-aligned above the panel.
+  double lx = p.left + p.width;
+  for (std::size_t k = series.size(); k-- > 0;) {
+    const double text_w = 8.0 * static_cast<double>(series[k].name.size());
+    lx -= text_w + 50;
+    f.polylines.push_back({{{lx, p.top - 10}, {lx + 30, p.top - 10}}, series[k].color, 2.5});
+    f.texts.push_back({lx + 36, p.top - 5, series[k].name, kTickFont, TextAnchor::kStart, false, kBlack});
+  }
+  return f;
+}
+
+std::vector<std::size_t> histogram_counts(const std::vector<double>& values, double lo, double hi, int bins) {
+  std::vector<std::size_t> counts(static_cast<std::size_t>(std::max(bins, 1)), 0);
+  const double w = (hi - lo) / static_cast<double>(counts.size());
+  for (double v : values) {
+    if (!(v >= lo && v <= hi)) continue;
+    std::size_t b = w > 0 ? static_cast<std::size_t>((v - lo) / w) : 0;
+    if (b >= counts.size()) b = counts.size() - 1;
+    ++counts[b];
+  }
+  return counts;
+}
+
+Figure make_histogram(const std::string& title, const std::string& x_label, const std::vector<double>& values,
+                      int bins) {
+  Figure f;
+  f.width_px = 1000;
+  f.height_px = 480;
+  bins = std::max(bins, 1);
+  double lo = 0, hi = 1;
+  if (!values.empty()) {
+    lo = *std::min_element(values.begin(), values.end());
+    hi = *std::max_element(values.begin(), values.end());
+    if (hi - lo < 1e-9) hi = lo + 1;
+  }
+  const std::vector<std::size_t> counts = histogram_counts(values, lo, hi, bins);
+  const std::size_t peak = *std::max_element(counts.begin(), counts.end());
+  const Panel p{100, 60, 860, 330, lo, hi, 0.0, std::max<double>(1.0, 1.08 * static_cast<double>(peak))};
+  draw_axes(&f, p, x_label, "frames");
+  f.texts.push_back({f.width_px / 2.0, 34, title, 20.0, TextAnchor::kMiddle, false, kBlack});
+  const double w = (hi - lo) / bins;
+  for (int b = 0; b < bins; ++b) {
+    const double x0 = p.px(lo + b * w), x1 = p.px(lo + (b + 1) * w);
+    const double y0 = p.py(0), y1 = p.py(static_cast<double>(counts[static_cast<std::size_t>(b)]));
+    if (y1 >= y0) continue;
+    // A bar: filled with vertical strokes, then outlined.
+    for (double x = x0 + 1; x < x1 - 0.5; x += 2) f.lines.push_back({x, y0, x, y1, Rgb{140, 170, 235}, 2.0});
+    f.polylines.push_back({{{x0, y0}, {x0, y1}, {x1, y1}, {x1, y0}}, kBlue, 1.0});
+  }
+  if (!values.empty()) {
+    std::vector<double> sorted = values;
+    std::sort(sorted.begin(), sorted.end());
+    const std::size_t n = sorted.size();
+    const double median = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+    f.polylines.push_back({{{p.px(median), p.top}, {p.px(median), p.top + p.height}}, kRed, 1.5});
+    char buf[80];
+    std::snprintf(buf, sizeof buf, "median %.3g", median);
+    f.texts.push_back({p.px(median) + 6, p.top + 18, buf, kTickFont, TextAnchor::kStart, false, kRed});
+  }
+  return f;
+}
+
+}  // namespace pvb::eval

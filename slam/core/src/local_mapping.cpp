@@ -1,6 +1,7 @@
 #include "pvb/slam/core/local_mapping.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <set>
 
@@ -69,6 +70,14 @@ void LocalMapping::run() {
 }
 
 void LocalMapping::process(const std::shared_ptr<KeyFrame>& kf) {
+  const auto t0 = std::chrono::steady_clock::now();
+  struct BusyTimer {  // adds the time of this call to busy_us_, however it returns
+    std::atomic<std::int64_t>& total;
+    std::chrono::steady_clock::time_point t0;
+    ~BusyTimer() {
+      total += std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count();
+    }
+  } timer{busy_us_, t0};
   {
     std::lock_guard<std::mutex> lock(map_.mutex());
     process_new_keyframe(kf);

@@ -85,7 +85,9 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
 bool Tracking::initialize(Frame& f) {
   int with_depth = 0;
   for (float d : f.depth_m) with_depth += d > 0;
-  if (with_depth <= options_.min_init_points) return false;
+  if (with_depth <= options_.min_init_points)
+    return fail("initialisation: only " + std::to_string(with_depth) + " keypoints with depth (need more than " +
+                std::to_string(options_.min_init_points) + ")");
   f.T_c_w = geom::SE3d::Identity();
   f.has_pose = true;
   auto kf = map_.create_keyframe(f);
@@ -101,6 +103,12 @@ bool Tracking::initialize(Frame& f) {
   ref_kf_ = kf;
   local_kfs_ = {kf};
   return true;
+}
+
+bool Tracking::fail(const std::string& why) {
+  if (!stats_.failure.empty()) stats_.failure += "; ";
+  stats_.failure += why;
+  return false;
 }
 
 void Tracking::replace_in_last_frame() {
@@ -172,7 +180,8 @@ bool Tracking::track_with_motion_model(Frame& f) {
   }
   stats_.coarse_matches = static_cast<int>(m.size());
   stats_.matches_kept = stats_.coarse_matches;
-  if (m.size() < 20) return false;
+  if (m.size() < 20)
+    return fail("motion model: only " + std::to_string(m.size()) + " matches by projection (need 20)");
 
   if (options_.use_pe_match) {
     // PE-match on the pixel pairs (last keypoint, current keypoint), paper sec. 3.
@@ -194,25 +203,33 @@ bool Tracking::track_with_motion_model(Frame& f) {
       stats_.matches_kept = kept;
     }
     stats_.pe_match_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (stats_.matches_kept < 10) return false;
+    if (stats_.matches_kept < 10)
+      return fail("motion model: PE-match kept " + std::to_string(stats_.matches_kept) + " of " +
+                  std::to_string(stats_.coarse_matches) + " matches (need 10)");
   }
 
   optimize(f);
   int map_matches = 0;
   discard_outliers(f, &map_matches);
-  return map_matches >= 10;
+  if (map_matches < 10)
+    return fail("motion model: only " + std::to_string(map_matches) +
+                " map matches after pose optimisation (need 10)");
+  return true;
 }
 
 bool Tracking::track_reference_keyframe(Frame& f) {
-  if (!ref_kf_ || ref_kf_->bad()) return false;
+  if (!ref_kf_ || ref_kf_->bad()) return fail("reference keyframe: none (culled)");
   std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
   const int n = search_keyframe_bruteforce(*ref_kf_, f, kThLow, 0.7);
-  if (n < 15) return false;
+  if (n < 15) return fail("reference keyframe: only " + std::to_string(n) + " descriptor matches (need 15)");
   f.T_c_w = last_.has_pose ? last_.T_c_w : ref_kf_->T_c_w();
   optimize(f);
   int map_matches = 0;
   discard_outliers(f, &map_matches);
-  return map_matches >= 10;
+  if (map_matches < 10)
+    return fail("reference keyframe: only " + std::to_string(map_matches) +
+                " map matches after pose optimisation (need 10)");
+  return true;
 }
 
 bool Tracking::relocalize(Frame& f) {
@@ -230,10 +247,12 @@ bool Tracking::relocalize(Frame& f) {
     for (const auto& c : ref_kf_->best_covisibles(10))
       if (seen.insert(c->id()).second) cands.push_back(c);
 
+  int best_matches = 0, best_inliers = 0;  // over the candidates, for the failure reason
   for (const auto& kf : cands) {
     if (kf->bad()) continue;
     std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
     const int n = search_keyframe_bruteforce(*kf, f, kThLow, 0.75);
+    best_matches = std::max(best_matches, n);
     if (n < 15) continue;
     std::vector<cv::Point3d> obj;
     std::vector<cv::Point2d> img;
@@ -279,13 +298,16 @@ bool Tracking::relocalize(Frame& f) {
       good = optimize(f);
       discard_outliers(f, &map_matches);
     }
+    best_inliers = std::max(best_inliers, good);
     if (good >= 50) {
       last_reloc_frame_id_ = f.id;
       return true;
     }
   }
   std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
-  return false;
+  return fail("relocalisation: no candidate keyframe matched (" + std::to_string(cands.size()) +
+              " candidates, best " + std::to_string(best_matches) + " descriptor matches (need 15), best " +
+              std::to_string(best_inliers) + " pose inliers (need 50))");
 }
 
 void Tracking::update_local_map(const Frame& f) {
@@ -369,8 +391,11 @@ bool Tracking::track_local_map(Frame& f) {
   stats_.inliers = matches_inliers_;
   if (f.id < last_reloc_frame_id_ + static_cast<std::uint64_t>(options_.max_frames) && last_reloc_frame_id_ > 0 &&
       matches_inliers_ < 50)
-    return false;
-  return matches_inliers_ >= 30;
+    return fail("local map: only " + std::to_string(matches_inliers_) +
+                " inliers after pose optimisation (need 50 just after relocalisation)");
+  if (matches_inliers_ < 30)
+    return fail("local map: only " + std::to_string(matches_inliers_) + " inliers after pose optimisation (need 30)");
+  return true;
 }
 
 bool Tracking::need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue) const {

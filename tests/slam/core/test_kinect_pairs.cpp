@@ -95,8 +95,18 @@ TEST(KinectPairs, LostOnABlankFrameThenRelocalised) {
   const FrameResult rb = system.track(blank);
   EXPECT_EQ(rb.state, TrackingState::kLost);
   EXPECT_FALSE(rb.T_w_c.has_value());
+  // The reason names the step that failed and its numbers (no velocity yet:
+  // the reference keyframe was tried).
+  EXPECT_NE(rb.tracking.failure.find("reference keyframe: only 0 descriptor matches (need 15)"), std::string::npos)
+      << rb.tracking.failure;
+  sensor::RgbdFrame blank2 = blank;
+  blank2.t_ns = (blank.t_ns + f2.t_ns) / 2;
+  const FrameResult rb2 = system.track(blank2);
+  EXPECT_EQ(rb2.state, TrackingState::kLost);
+  EXPECT_EQ(rb2.tracking.failure.rfind("relocalisation: ", 0), 0u) << rb2.tracking.failure;
   const FrameResult r2 = system.track(f2);
   ASSERT_EQ(r2.state, TrackingState::kOk);
+  EXPECT_TRUE(r2.tracking.failure.empty()) << r2.tracking.failure;
   EXPECT_EQ(r2.tracking.method, TrackingMethod::kRelocalization);
   const eval::Trajectory gt = eval::read_tum(kData + name + "/groundtruth.txt");
   const auto off = static_cast<std::int64_t>(-0.02 * 1e9);

@@ -32,6 +32,14 @@ class SimFrameSource : public sensor::FrameSource {
   /// Rendered (noise-free) depth of the last frame, for diagnostics.
   const cv::Mat& last_depth_gt_m() const { return last_depth_gt_m_; }
 
+  /// Where the time of the last next() went, milliseconds.
+  struct StageTimes {
+    double physics_ms = 0;  ///< Simulator::advance (steering + physics steps)
+    double render_ms = 0;   ///< GL rendering and read-back
+    double sensor_ms = 0;   ///< depth and RGB sensor model
+  };
+  const StageTimes& last_stage_times() const { return last_times_; }
+
  private:
   Simulator sim_;
   RgbdCamera camera_;
@@ -39,6 +47,7 @@ class SimFrameSource : public sensor::FrameSource {
   int next_index_ = 0;
   GroundTruthSink sink_;
   cv::Mat last_depth_gt_m_;
+  StageTimes last_times_;
 };
 
 }  // namespace pvb::sim

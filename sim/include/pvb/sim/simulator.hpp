@@ -80,6 +80,8 @@ struct Capture {
   sensor::RgbdFrame frame;   ///< what the sensor delivers (noisy)
   cv::Mat depth_gt_m;        ///< rendered depth, exact, sky = 0
   geom::SE3d T_w_c;          ///< ground-truth camera pose
+  double render_ms = 0;      ///< time spent rendering (GL + read-back)
+  double sensor_ms = 0;      ///< time spent in the sensor model (depth and RGB noise)
 };
 
 /// Renders the simulator's camera and applies the sensor model.

@@ -52,6 +52,14 @@ std::string format_comparison(const std::vector<EvalResult>& results);
 /// 100 * (reference - value) / reference; 0 when reference is 0.
 double reduction_percent(double reference, double value);
 
+/// JSON object of one Stats: {"rmse", "mean", "median", "std", "min", "max", "count"}
+/// on one line (non-finite values as null).
+std::string stats_json(const Stats& s);
+
+/// JSON object of a result's RPE on one line: {"delta", "unit", "pairs",
+/// "trans": stats_json, "rot_deg": stats_json} (the "rpe" value of format_json).
+std::string rpe_json(const EvalResult& result);
+
 /// JSON of one result: pairs, ate.{rmse,mean,median,std,min,max,count},
 /// rpe.{delta,unit,trans.{...},rot_deg.{...}}, alignment.{kind,R,t,s}.
 std::string format_json(const EvalResult& result);

@@ -47,6 +47,33 @@ struct Figure {
 /// ground truth; below it the ATE over time (seconds since the first pair).
 Figure make_error_figure(const EvalResult& result, const std::string& title);
 
+/// One named line of a chart; x and y have the same length.  Points whose
+/// y is not finite break the line (a gap, e.g. frames that were not tracked).
+struct Series {
+  std::string name;
+  std::vector<double> x, y;
+  Rgb color;
+};
+
+/// Colours for the first, second, ... series of a chart.
+Rgb series_color(std::size_t index);
+
+/// A line chart of several series on shared axes, with a legend.  The y
+/// range starts at 0 when every value is non-negative.  Empty series are
+/// allowed (the axes then span [0, 1]).
+Figure make_line_chart(const std::string& title, const std::string& x_label, const std::string& y_label,
+                       const std::vector<Series>& series);
+
+/// A histogram of `values` with `bins` equal bins over [min, max] (or
+/// [0, 1] for no values); the bar heights are counts.  A thin vertical line
+/// marks the median.
+Figure make_histogram(const std::string& title, const std::string& x_label, const std::vector<double>& values,
+                      int bins);
+
+/// Bin counts of make_histogram(): `bins` equal bins over [lo, hi], the last
+/// bin closed; values outside [lo, hi] are not counted.
+std::vector<std::size_t> histogram_counts(const std::vector<double>& values, double lo, double hi, int bins);
+
 /// Serialises a figure as a standalone SVG document.
 std::string format_svg(const Figure& figure);
 

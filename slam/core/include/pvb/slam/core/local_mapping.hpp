@@ -6,6 +6,7 @@
 // thread; otherwise a worker thread started with start() takes keyframes
 // from a closable blocking queue until stop().
 #include <atomic>
+#include <cstdint>
 #include <condition_variable>
 #include <deque>
 #include <list>
@@ -101,6 +102,8 @@ class LocalMapping {
 
   /// Processes one keyframe (takes the map lock as needed).
   void process(const std::shared_ptr<KeyFrame>& kf);
+  /// Total time spent in process() so far, milliseconds (for profiles).
+  double busy_ms() const { return static_cast<double>(busy_us_.load()) / 1000.0; }
 
  private:
   void run();
@@ -117,6 +120,7 @@ class LocalMapping {
   std::list<std::shared_ptr<MapPoint>> recent_points_;  ///< points on trial
   ClosableQueue<std::shared_ptr<KeyFrame>> queue_;
   std::atomic<int> pending_{0};  ///< keyframes inserted and not yet processed
+  std::atomic<std::int64_t> busy_us_{0};  ///< time in process(), microseconds
   std::thread worker_;
 };
 

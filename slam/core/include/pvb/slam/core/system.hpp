@@ -49,6 +49,8 @@ class System {
   std::vector<geom::StampedPose> keyframe_trajectory();
   std::size_t num_keyframes();
   std::size_t num_map_points();
+  /// Time local mapping has spent on keyframes so far (inline or on its worker), ms.
+  double mapping_busy_ms() const { return mapping_->busy_ms(); }
   TrackingState state() const { return tracking_->state(); }
 
  private:

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "pvb/slam/core/map.hpp"
@@ -29,6 +30,10 @@ struct TrackingStats {
   double pe_match_ms = 0;       ///< time in PE-match
   int inliers = 0;              ///< map-point inliers after the local-map optimisation
   bool new_keyframe = false;
+  /// Why the frame was not tracked (empty when it was): each attempted
+  /// step's failure, "; "-separated, e.g. "motion model: only 7 map matches
+  /// after pose optimisation (need 10); reference keyframe: only 9 matches (need 15)".
+  std::string failure;
 };
 
 struct TrackingOptions {
@@ -72,6 +77,8 @@ class Tracking {
   int optimize(Frame& f);
   void discard_outliers(Frame& f, int* map_matches);
   void replace_in_last_frame();
+  /// Appends one step's failure to stats_.failure; returns false.
+  bool fail(const std::string& why);
 
   Map& map_;
   std::shared_ptr<const CameraModel> cam_;

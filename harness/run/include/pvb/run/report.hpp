@@ -1,0 +1,128 @@
+#pragma once
+// What a scenario run measured, and the report folder written from it:
+// metrics.json (the contract in docs/run.md), plots (SVG and PNG), the
+// contact sheet and index.html.  Everything here is a pure function of a
+// RunReport, so tests build reports by hand and check the pieces.
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pvb/eval/evaluate.hpp"
+#include "pvb/plot/contact_sheet.hpp"
+
+namespace pvb::run {
+
+/// How a run ended.
+enum class RunStatus {
+  kCompleted,    ///< every frame of the scenario (or of --frames) was processed
+  kInterrupted,  ///< stopped by SIGINT/SIGTERM; the report is partial
+  kAborted,      ///< closed loop, tracking lost and the scenario says on_loss: abort
+};
+const char* to_string(RunStatus s);
+
+/// Process exit code for a status: 0 completed, 130 interrupted (as a shell
+/// reports SIGINT), 4 aborted.
+int exit_code(RunStatus s);
+
+/// Tracking was lost at `frame` (it was Ok, or not yet initialised, before).
+struct LossEvent {
+  int frame = 0;
+  double t_s = 0;
+  std::string reason;                  ///< from slam::TrackingStats::failure
+  std::optional<int> recovered_frame;  ///< first frame tracked again (relocalised)
+};
+
+/// Per-frame record of one SLAM system.
+struct FrameRecord {
+  int frame = 0;
+  double t_s = 0;
+  bool tracked = false;
+  double tracking_ms = 0;
+  int coarse_matches = 0;
+  int matches_kept = 0;
+};
+
+/// One SLAM system's run (PE-SLAM, or the ORB-SLAM2 baseline).
+struct SlamRun {
+  std::string mode;                    ///< "pe-slam" or "orb-slam2"
+  std::size_t frames = 0;
+  std::size_t lost_frames = 0;         ///< frames in state Lost
+  std::size_t not_initialized_frames = 0;
+  std::size_t keyframes = 0;
+  std::size_t map_points = 0;
+  std::vector<FrameRecord> per_frame;
+  std::vector<LossEvent> loss_events;
+  std::optional<eval::EvalResult> eval;  ///< nullopt when it could not be evaluated
+  std::string eval_note;                 ///< why not, or which alignment fallback was used
+};
+
+/// Closed loop: distance of the ground-truth robot (axle centre) from the
+/// route polyline, per frame.
+struct ClosedLoopMetrics {
+  std::vector<double> t_s;
+  std::vector<double> path_error_m;
+  double path_error_rmse_m = 0;
+  double path_error_max_m = 0;
+  int hold_frames = 0;  ///< frames the robot was held (not initialised or lost)
+};
+
+/// Where the time went: total milliseconds per stage over the run.
+struct StageTime {
+  std::string name;
+  double total_ms = 0;
+  std::size_t count = 0;  ///< how many times the stage ran (frames, keyframes, 1)
+  std::string thread;     ///< "producer", "consumer", "mapping", "main"
+};
+
+struct RunReport {
+  std::string scenario;       ///< scenario name
+  std::string scenario_file;
+  std::uint64_t seed = 0;
+  RunStatus status = RunStatus::kCompleted;
+  std::string status_detail;  ///< one line: why interrupted or aborted
+  bool sync = false;
+  std::string renderer;       ///< GL backend description
+  double fps = 30;
+  double sim_s = 0;           ///< simulated time of the frames processed
+  double wall_s = 0;          ///< wall time of the loop (setup, evaluation and report excluded)
+  SlamRun primary;
+  std::optional<SlamRun> baseline;  ///< --compare
+  std::optional<ClosedLoopMetrics> closed_loop;
+  std::vector<StageTime> profile;
+  std::vector<plot::Thumbnail> thumbnails;  ///< for the contact sheet
+  std::vector<std::string> log_lines;       ///< shown in index.html (run.log holds them too)
+};
+
+/// Distance from point p to the polyline (minimum over its segments); the
+/// distance to the single point for a one-point line; +inf for an empty one.
+double distance_to_polyline(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& polyline);
+
+/// p-quantile (0..1) with linear interpolation; 0 for no values.
+double percentile(std::vector<double> values, double p);
+
+/// The realtime factor: simulated seconds per wall second (0 when wall_s is 0).
+double realtime_factor(double sim_s, double wall_s);
+
+/// The metrics.json document (plain JSON that yaml-cpp parses).
+std::string metrics_json(const RunReport& report);
+
+/// The paper-style comparison table (PE-SLAM vs baseline): ATE and RPE
+/// statistics with reductions, plus tracking time and lost frames.  Empty
+/// when there is no baseline or either run has no evaluation.
+std::string comparison_table(const RunReport& report);
+
+/// Writes the figures (SVG and PNG) of one run into dir with file names
+/// prefixed by `prefix`; returns the file names (without dir) written.
+std::vector<std::string> write_figures(const RunReport& report, const std::string& dir);
+
+/// index.html: summary, loss events, comparison, figures, files; relative
+/// links only, no scripts.  `figures` are file names in the folder.
+std::string index_html(const RunReport& report, const std::vector<std::string>& figures);
+
+/// Writes metrics.json, the figures, contact_sheet.png and index.html into
+/// dir; returns the figure names (as write_figures()).
+std::vector<std::string> write_report(const RunReport& report, const std::string& dir);
+
+}  // namespace pvb::run

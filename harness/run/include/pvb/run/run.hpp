@@ -1,0 +1,76 @@
+#pragma once
+// A scenario run: the simulator feeds PE-SLAM in memory, frame by frame,
+// while ground truth goes to the harness through its own sink; at the end
+// the trajectories are evaluated and the report folder is written.
+//
+// Threads (default): a producer thread steps the physics, renders and
+// applies the sensor model into a bounded queue; the calling thread pops
+// frames and runs tracking (of one or two SLAM systems); local mapping runs
+// on each System's worker.  With `sync` everything runs inline on the
+// calling thread and the run is bit-reproducible.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "pvb/dataset/tum_sequence.hpp"
+#include "pvb/run/report.hpp"
+#include "pvb/scenes/scenario.hpp"
+#include "pvb/sim/robot.hpp"
+#include "pvb/geometry/se3.hpp"
+
+namespace pvb::run {
+
+/// Which SLAM systems see the frames.
+enum class SlamMode {
+  kPeSlam,    ///< PE-SLAM only
+  kBaseline,  ///< the ORB-SLAM2 baseline only (--no-pe-match motion model)
+  kCompare,   ///< both on the same rendered frames; PE-SLAM is the primary run
+};
+
+struct RunOptions {
+  std::string scenario_file;
+  std::string out_dir;
+  std::optional<std::uint64_t> seed;  ///< overrides the scenario's seed (also seeds PE-match)
+  int max_frames = 0;                 ///< cap (0: the scenario's duration)
+  bool sync = false;                  ///< no threads: bit-identical runs
+  SlamMode mode = SlamMode::kPeSlam;
+  bool closed_loop = false;           ///< steer from the SLAM pose instead of ground truth
+  std::string gl = "auto";            ///< auto, egl or osmesa
+  std::size_t queue_capacity = 3;     ///< frames the producer may run ahead (open loop)
+  /// Set asynchronously (by a signal handler) to stop the run; the partial
+  /// report is then written with status "interrupted".  May be null.
+  const std::atomic<bool>* stop = nullptr;
+  /// Receives each log line (also written to run.log); may be empty.
+  std::function<void(const std::string&)> on_log;
+  /// Called after each processed frame with (frames done, frames total).
+  std::function<void(std::size_t, std::size_t)> on_progress;
+};
+
+/// ORB-SLAM2 RGB-D settings for the scenario's camera (camera.yaml of
+/// `pvbench record` and of a run's report).
+dataset::OrbSlamSettings orbslam_settings_for(const scenes::Scenario& scenario);
+
+/// Runs the scenario and writes the report folder (also when interrupted or
+/// aborted).  Throws pvb::Error for bad configuration or I/O.
+RunReport run_scenario(const RunOptions& options);
+
+/// Closed loop: the robot's planar pose from a camera pose, given the
+/// camera's fixed mounting measured at the start: `offset_b` is the camera
+/// position relative to the axle centre in the robot frame (x forward,
+/// y left) and `yaw_offset` the camera heading minus the robot heading.
+/// The camera heading is the direction of its optical axis projected on
+/// the ground plane.
+struct CameraMount {
+  Eigen::Vector2d offset_b = Eigen::Vector2d::Zero();
+  double yaw_offset = 0;
+};
+/// Heading (rad, CCW from x) of a camera's optical axis (z) on the ground plane.
+double camera_heading(const geom::SE3d& T_w_c);
+/// Measures the mount from a ground-truth robot pose and camera pose taken together.
+CameraMount measure_mount(const sim::Pose2d& base, const geom::SE3d& T_w_c);
+/// The robot pose implied by a camera pose and the mount.
+sim::Pose2d base_from_camera(const geom::SE3d& T_w_c, const CameraMount& mount);
+
+}  // namespace pvb::run

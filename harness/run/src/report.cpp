@@ -1,0 +1,372 @@
+#include "pvb/run/report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numeric>
+
+#include "pvb/common/text.hpp"
+#include "pvb/eval/plot.hpp"
+#include "pvb/geometry/time.hpp"
+#include "pvb/plot/png.hpp"
+
+namespace pvb::run {
+namespace {
+
+/// JSON number: finite values with enough digits, null otherwise.
+std::string num(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+std::string str(const std::string& s) { return "\"" + json_escape(s) + "\""; }
+
+std::vector<double> tracking_times(const SlamRun& run) {
+  std::vector<double> v;
+  v.reserve(run.per_frame.size());
+  for (const FrameRecord& r : run.per_frame) v.push_back(r.tracking_ms);
+  return v;
+}
+
+double mean_of(const std::vector<double>& v) {
+  return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+
+/// The keys one SLAM system contributes (shared by the top level and "baseline").
+std::string slam_fields(const SlamRun& run, const std::string& in) {
+  const std::vector<double> ms = tracking_times(run);
+  std::string out;
+  out += in + "\"mode\": " + str(run.mode) + ",\n";
+  out += in + "\"frames\": " + std::to_string(run.frames) + ",\n";
+  out += in + "\"lost_frames\": " + std::to_string(run.lost_frames) + ",\n";
+  out += in + "\"not_initialized_frames\": " + std::to_string(run.not_initialized_frames) + ",\n";
+  out += in + "\"keyframes\": " + std::to_string(run.keyframes) + ",\n";
+  out += in + "\"map_points\": " + std::to_string(run.map_points) + ",\n";
+  if (run.eval) {
+    out += in + "\"ate\": " + eval::stats_json(run.eval->ate) + ",\n";
+    out += in + "\"rpe\": " + eval::rpe_json(*run.eval) + ",\n";
+    out += in + "\"alignment\": " + str(eval::alignment_name(run.eval->alignment_kind)) + ",\n";
+  } else {
+    out += in + "\"ate\": null,\n" + in + "\"rpe\": null,\n" + in + "\"alignment\": null,\n";
+  }
+  if (!run.eval_note.empty()) out += in + "\"eval_note\": " + str(run.eval_note) + ",\n";
+  out += in + "\"tracking_ms\": {\"median\": " + num(percentile(ms, 0.5)) + ", \"mean\": " + num(mean_of(ms)) +
+         ", \"p95\": " + num(percentile(ms, 0.95)) + "},\n";
+  out += in + "\"loss_events\": [";
+  for (std::size_t k = 0; k < run.loss_events.size(); ++k) {
+    const LossEvent& e = run.loss_events[k];
+    out += (k ? ",\n" : "\n") + in + "  {\"frame\": " + std::to_string(e.frame) + ", \"t_s\": " + num(e.t_s) +
+           ", \"reason\": " + str(e.reason) + ", \"recovered_frame\": " +
+           (e.recovered_frame ? std::to_string(*e.recovered_frame) : std::string("null")) + "}";
+  }
+  out += run.loss_events.empty() ? "]" : "\n" + in + "]";
+  return out;
+}
+
+/// Run-level keys (shared by the top level and "baseline").
+std::string run_fields(const RunReport& r, const std::string& in) {
+  std::string out;
+  out += in + "\"scenario\": " + str(r.scenario) + ",\n";
+  out += in + "\"scenario_file\": " + str(r.scenario_file) + ",\n";
+  out += in + "\"seed\": " + std::to_string(r.seed) + ",\n";
+  out += in + "\"status\": " + str(to_string(r.status)) + ",\n";
+  if (!r.status_detail.empty()) out += in + "\"status_detail\": " + str(r.status_detail) + ",\n";
+  out += in + "\"sync\": " + (r.sync ? "true" : "false") + ",\n";
+  out += in + "\"renderer\": " + str(r.renderer) + ",\n";
+  out += in + "\"fps\": " + num(r.fps) + ",\n";
+  out += in + "\"realtime_factor\": " + num(realtime_factor(r.sim_s, r.wall_s)) + ",\n";
+  out += in + "\"sim_s\": " + num(r.sim_s) + ",\n";
+  out += in + "\"wall_s\": " + num(r.wall_s) + ",\n";
+  return out;
+}
+
+std::string closed_loop_json(const ClosedLoopMetrics& c) {
+  return "{\"path_error_rmse_m\": " + num(c.path_error_rmse_m) + ", \"path_error_max_m\": " + num(c.path_error_max_m) +
+         ", \"hold_frames\": " + std::to_string(c.hold_frames) + ", \"frames\": " + std::to_string(c.t_s.size()) + "}";
+}
+
+std::string html_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else if (c == '&') out += "&amp;";
+    else if (c == '"') out += "&quot;";
+    else out += c;
+  }
+  return out;
+}
+
+std::string fixed(double v, int decimals) {
+  if (!std::isfinite(v)) return "-";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+void write_figure(const eval::Figure& f, const std::string& dir, const std::string& name,
+                  std::vector<std::string>* written) {
+  write_file(dir + "/" + name + ".svg", eval::format_svg(f));
+  plot::write_png(f, dir + "/" + name + ".png");
+  written->push_back(name);
+}
+
+}  // namespace
+
+const char* to_string(RunStatus s) {
+  switch (s) {
+    case RunStatus::kCompleted: return "completed";
+    case RunStatus::kInterrupted: return "interrupted";
+    case RunStatus::kAborted: return "aborted";
+  }
+  return "?";
+}
+
+int exit_code(RunStatus s) {
+  switch (s) {
+    case RunStatus::kCompleted: return 0;
+    case RunStatus::kInterrupted: return 130;
+    case RunStatus::kAborted: return 4;
+  }
+  return 1;
+}
+
+double distance_to_polyline(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& line) {
+  if (line.empty()) return std::numeric_limits<double>::infinity();
+  if (line.size() == 1) return (p - line.front()).norm();
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+    const Eigen::Vector2d a = line[i], ab = line[i + 1] - line[i];
+    const double len2 = ab.squaredNorm();
+    const double s = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    best = std::min(best, (p - (a + s * ab)).norm());
+  }
+  return best;
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const double pos = std::clamp(p, 0.0, 1.0) * static_cast<double>(v.size() - 1);
+  const std::size_t lo = static_cast<std::size_t>(pos);
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+double realtime_factor(double sim_s, double wall_s) { return wall_s > 0 ? sim_s / wall_s : 0.0; }
+
+std::string metrics_json(const RunReport& r) {
+  std::string out = "{\n";
+  out += run_fields(r, "  ");
+  out += slam_fields(r.primary, "  ");
+  if (r.closed_loop) out += ",\n  \"closed_loop\": " + closed_loop_json(*r.closed_loop);
+  if (r.baseline) {
+    out += ",\n  \"baseline\": {\n" + run_fields(r, "    ") + slam_fields(*r.baseline, "    ") + "\n  }";
+    const bool both = r.primary.eval && r.baseline->eval;
+    const std::vector<double> pe_ms = tracking_times(r.primary), base_ms = tracking_times(r.baseline.value());
+    out += ",\n  \"comparison\": {\"ate_rmse_reduction_pct\": " +
+           (both ? num(eval::reduction_percent(r.baseline->eval->ate.rmse, r.primary.eval->ate.rmse)) : "null") +
+           ", \"rpe_trans_rmse_reduction_pct\": " +
+           (both ? num(eval::reduction_percent(r.baseline->eval->rpe_trans_m.rmse, r.primary.eval->rpe_trans_m.rmse))
+                 : "null") +
+           ", \"tracking_ms_median\": {\"pe-slam\": " + num(percentile(pe_ms, 0.5)) +
+           ", \"orb-slam2\": " + num(percentile(base_ms, 0.5)) + "}}";
+  }
+  out += ",\n  \"profile\": {";
+  const double frames = std::max<double>(1.0, static_cast<double>(r.primary.frames));
+  for (std::size_t k = 0; k < r.profile.size(); ++k) {
+    const StageTime& s = r.profile[k];
+    out += (k ? ",\n    " : "\n    ") + str(s.name) + ": {\"total_ms\": " + num(s.total_ms) +
+           ", \"per_frame_ms\": " + num(s.total_ms / frames) + ", \"count\": " + std::to_string(s.count) +
+           ", \"thread\": " + str(s.thread) + "}";
+  }
+  out += r.profile.empty() ? "}" : "\n  }";
+  out += "\n}\n";
+  return out;
+}
+
+std::string comparison_table(const RunReport& r) {
+  if (!r.baseline || !r.baseline->eval || !r.primary.eval) return {};
+  eval::EvalResult base = *r.baseline->eval, pe = *r.primary.eval;
+  base.est_source = "ORB-SLAM2";
+  pe.est_source = "PE-SLAM";
+  std::string out = eval::format_comparison({base, pe});
+  const std::vector<double> pe_ms = tracking_times(r.primary), base_ms = tracking_times(*r.baseline);
+  char line[256];
+  std::snprintf(line, sizeof line, "%-22s%24s%24s\n", "tracking ms median", fixed(percentile(base_ms, 0.5), 2).c_str(),
+                fixed(percentile(pe_ms, 0.5), 2).c_str());
+  out += line;
+  std::snprintf(line, sizeof line, "%-22s%24s%24s\n", "tracking ms mean", fixed(mean_of(base_ms), 2).c_str(),
+                fixed(mean_of(pe_ms), 2).c_str());
+  out += line;
+  std::snprintf(line, sizeof line, "%-22s%24zu%24zu\n", "lost frames", r.baseline->lost_frames, r.primary.lost_frames);
+  out += line;
+  return out;
+}
+
+std::vector<std::string> write_figures(const RunReport& r, const std::string& dir) {
+  std::vector<std::string> written;
+  std::vector<const SlamRun*> runs{&r.primary};
+  if (r.baseline) runs.push_back(&*r.baseline);
+  // Trajectory with error (top view + ATE over time), one per run.
+  for (const SlamRun* run : runs)
+    if (run->eval)
+      write_figure(eval::make_error_figure(*run->eval, r.scenario + ": " + run->mode), dir,
+                   run == &r.primary ? "trajectory_error" : "trajectory_error_" + run->mode, &written);
+  // ATE over time, every run on one chart.
+  {
+    std::vector<eval::Series> series;
+    for (const SlamRun* run : runs) {
+      if (!run->eval) continue;
+      eval::Series s{run->mode, {}, {}, eval::series_color(series.size())};
+      for (std::size_t i = 0; i < run->eval->t_ns.size(); ++i) {
+        s.x.push_back(geom::ns_to_seconds(run->eval->t_ns[i]));
+        s.y.push_back(run->eval->ate_m[i]);
+      }
+      series.push_back(std::move(s));
+    }
+    if (!series.empty())
+      write_figure(eval::make_line_chart("absolute trajectory error over time", "time [s]", "ATE [m]", series), dir,
+                   "ate_over_time", &written);
+  }
+  // Tracking time histogram, one per run.
+  for (const SlamRun* run : runs) {
+    const std::vector<double> ms = tracking_times(*run);
+    write_figure(eval::make_histogram("tracking time per frame: " + run->mode, "tracking time [ms]", ms, 40), dir,
+                 run == &r.primary ? "tracking_time_hist" : "tracking_time_hist_" + run->mode, &written);
+  }
+  // Coarse and kept motion-model matches per frame (gaps: other methods or lost).
+  {
+    std::vector<eval::Series> series;
+    for (const SlamRun* run : runs) {
+      eval::Series coarse{run->mode + " coarse", {}, {}, eval::series_color(series.size())};
+      eval::Series kept{run->mode + " kept", {}, {}, eval::series_color(series.size() + 1)};
+      for (const FrameRecord& f : run->per_frame) {
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        coarse.x.push_back(f.frame);
+        kept.x.push_back(f.frame);
+        coarse.y.push_back(f.coarse_matches > 0 ? f.coarse_matches : nan);
+        kept.y.push_back(f.coarse_matches > 0 ? f.matches_kept : nan);
+      }
+      series.push_back(std::move(coarse));
+      if (run->mode == "pe-slam") series.push_back(std::move(kept));  // the baseline keeps every coarse match
+    }
+    write_figure(eval::make_line_chart("motion-model matches per frame (coarse, and kept by PE-match)", "frame",
+                                       "matches", series),
+                 dir, "matches", &written);
+  }
+  if (r.closed_loop) {
+    eval::Series s{"path error", r.closed_loop->t_s, r.closed_loop->path_error_m, eval::series_color(0)};
+    write_figure(eval::make_line_chart("closed loop: ground-truth robot distance from the route", "time [s]",
+                                       "path error [m]", {s}),
+                 dir, "path_error", &written);
+  }
+  return written;
+}
+
+std::string index_html(const RunReport& r, const std::vector<std::string>& figures) {
+  const SlamRun& p = r.primary;
+  std::string h;
+  h += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>pvbench run: " +
+       html_escape(r.scenario) + "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:1100px}"
+       "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px;text-align:left}"
+       "img{max-width:100%;border:1px solid #ddd}pre{background:#f6f6f6;padding:8px;overflow-x:auto}"
+       ".bad{color:#b00}</style></head><body>\n";
+  h += "<h1>pvbench run: " + html_escape(r.scenario) + "</h1>\n";
+  const std::string status_class = r.status == RunStatus::kCompleted ? "" : " class=\"bad\"";
+  h += "<p>Status: <b" + status_class + ">" + to_string(r.status) + "</b>";
+  if (!r.status_detail.empty()) h += " (" + html_escape(r.status_detail) + ")";
+  h += "</p>\n<table>\n";
+  auto row = [&h](const std::string& k, const std::string& v) {
+    h += "<tr><th>" + html_escape(k) + "</th><td>" + html_escape(v) + "</td></tr>\n";
+  };
+  row("scenario file", r.scenario_file);
+  row("seed", std::to_string(r.seed));
+  row("mode", p.mode + (r.baseline ? " (compared with " + r.baseline->mode + ")" : std::string()) +
+                  (r.closed_loop ? ", closed loop" : ", open loop") + (r.sync ? ", synchronous" : ", pipelined"));
+  row("renderer", r.renderer);
+  row("frames", std::to_string(p.frames) + " (" + fixed(r.sim_s, 2) + " s simulated)");
+  row("lost frames", std::to_string(p.lost_frames));
+  row("keyframes / map points", std::to_string(p.keyframes) + " / " + std::to_string(p.map_points));
+  if (p.eval) {
+    row("ATE rmse / mean / max [m]",
+        fixed(p.eval->ate.rmse, 4) + " / " + fixed(p.eval->ate.mean, 4) + " / " + fixed(p.eval->ate.max, 4) + " (" +
+            eval::alignment_name(p.eval->alignment_kind) + " alignment, " + std::to_string(p.eval->ate.count) +
+            " poses)");
+    row("RPE trans rmse [m] / rot rmse [deg]",
+        fixed(p.eval->rpe_trans_m.rmse, 4) + " / " + fixed(p.eval->rpe_rot_deg.rmse, 3));
+  } else {
+    row("ATE", "not evaluated: " + p.eval_note);
+  }
+  const std::vector<double> ms = tracking_times(p);
+  row("tracking ms median / mean / p95",
+      fixed(percentile(ms, 0.5), 2) + " / " + fixed(mean_of(ms), 2) + " / " + fixed(percentile(ms, 0.95), 2));
+  row("realtime factor", fixed(realtime_factor(r.sim_s, r.wall_s), 2) + " (" + fixed(r.sim_s, 2) + " s simulated in " +
+                             fixed(r.wall_s, 2) + " s)");
+  if (r.closed_loop)
+    row("path error rmse / max [m]",
+        fixed(r.closed_loop->path_error_rmse_m, 4) + " / " + fixed(r.closed_loop->path_error_max_m, 4) + " (held " +
+            std::to_string(r.closed_loop->hold_frames) + " frames)");
+  h += "</table>\n";
+
+  std::vector<const SlamRun*> runs{&p};
+  if (r.baseline) runs.push_back(&*r.baseline);
+  h += "<h2>Tracking loss</h2>\n";
+  for (const SlamRun* run : runs) {
+    if (run->loss_events.empty()) {
+      h += "<p>" + html_escape(run->mode) + ": tracking was never lost.</p>\n";
+      continue;
+    }
+    h += "<p>" + html_escape(run->mode) + ":</p>\n<table><tr><th>frame</th><th>t [s]</th><th>reason</th>"
+         "<th>recovered at frame</th></tr>\n";
+    for (const LossEvent& e : run->loss_events)
+      h += "<tr><td>" + std::to_string(e.frame) + "</td><td>" + fixed(e.t_s, 3) + "</td><td>" + html_escape(e.reason) +
+           "</td><td>" + (e.recovered_frame ? std::to_string(*e.recovered_frame) : std::string("never")) +
+           "</td></tr>\n";
+    h += "</table>\n";
+  }
+  const std::string table = comparison_table(r);
+  if (!table.empty()) h += "<h2>PE-SLAM vs ORB-SLAM2</h2>\n<pre>" + html_escape(table) + "</pre>\n";
+
+  h += "<h2>Figures</h2>\n";
+  for (const std::string& f : figures)
+    h += "<p><a href=\"" + f + ".svg\"><img src=\"" + f + ".png\" alt=\"" + f + "\"></a><br>" + f +
+         " (<a href=\"" + f + ".svg\">SVG</a>, <a href=\"" + f + ".png\">PNG</a>)</p>\n";
+  h += "<h2>Frames</h2>\n<p><img src=\"contact_sheet.png\" alt=\"contact sheet\"></p>\n";
+
+  if (!r.profile.empty()) {
+    h += "<h2>Where the time went</h2>\n<table><tr><th>stage</th><th>thread</th><th>total [ms]</th>"
+         "<th>per frame [ms]</th></tr>\n";
+    const double frames = std::max<double>(1.0, static_cast<double>(p.frames));
+    for (const StageTime& s : r.profile)
+      h += "<tr><td>" + html_escape(s.name) + "</td><td>" + html_escape(s.thread) + "</td><td>" +
+           fixed(s.total_ms, 1) + "</td><td>" + fixed(s.total_ms / frames, 2) + "</td></tr>\n";
+    h += "</table>\n";
+  }
+  h += "<h2>Files</h2>\n<ul>\n";
+  for (const char* f : {"metrics.json", "groundtruth.txt", "CameraTrajectory.txt", "KeyFrameTrajectory.txt",
+                        "timing.csv", "camera.yaml", "run.log"})
+    h += std::string("<li><a href=\"") + f + "\">" + f + "</a></li>\n";
+  if (r.baseline)
+    for (const char* f : {"baseline/CameraTrajectory.txt", "baseline/KeyFrameTrajectory.txt", "baseline/timing.csv"})
+      h += std::string("<li><a href=\"") + f + "\">" + f + "</a></li>\n";
+  h += "</ul>\n<h2>Log</h2>\n<pre>";
+  for (const std::string& l : r.log_lines) h += html_escape(l) + "\n";
+  h += "</pre>\n</body></html>\n";
+  return h;
+}
+
+std::vector<std::string> write_report(const RunReport& r, const std::string& dir) {
+  write_file(dir + "/metrics.json", metrics_json(r));
+  const std::vector<std::string> figures = write_figures(r, dir);
+  std::vector<plot::Thumbnail> thumbs = r.thumbnails;
+  if (thumbs.empty()) thumbs.push_back({cv::Mat(240, 320, CV_8UC3, cv::Scalar(255, 255, 255)), "no frames"});
+  plot::write_rgb_png(plot::make_contact_sheet(thumbs, 4, 320), dir + "/contact_sheet.png");
+  write_file(dir + "/index.html", index_html(r, figures));
+  return figures;
+}
+
+}  // namespace pvb::run

@@ -1,0 +1,533 @@
+#include "pvb/run/run.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <fstream>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+#include "pvb/dataset/tum_sequence.hpp"
+#include "pvb/geometry/stamped_pose.hpp"
+#include "pvb/geometry/time.hpp"
+#include "pvb/run/bounded_queue.hpp"
+#include "pvb/sim/sim_frame_source.hpp"
+#include "pvb/slam/core/settings.hpp"
+#include "pvb/slam/core/system.hpp"
+
+namespace pvb::run {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+double wrap_angle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+
+std::string fmt(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::ofstream open_out(const std::string& path) {
+  std::ofstream f(path);
+  if (!f) throw IoError(path, "cannot open for writing");
+  return f;
+}
+
+/// run.log, flushed line by line; also kept for index.html and echoed.
+class RunLog {
+ public:
+  RunLog(const std::string& path, std::function<void(const std::string&)> echo)
+      : file_(open_out(path)), echo_(std::move(echo)) {}
+  void line(const std::string& text) {
+    file_ << text << "\n" << std::flush;
+    lines_.push_back(text);
+    if (echo_) echo_(text);
+  }
+  const std::vector<std::string>& lines() const { return lines_; }
+
+ private:
+  std::ofstream file_;
+  std::function<void(const std::string&)> echo_;
+  std::vector<std::string> lines_;
+};
+
+/// Closed loop: what the consumer (SLAM) tells the producer (simulator)
+/// before the next physics step.
+struct Steering {
+  std::mutex mutex;
+  bool hold = true;                  ///< not initialised or lost: stand still
+  std::optional<sim::Pose2d> pose;   ///< the robot's pose as SLAM sees it (site frame)
+};
+
+/// One frame from the producer: the sensor frame for SLAM and, beside it
+/// (never inside it), the ground truth for the harness.
+struct FrameItem {
+  sensor::RgbdFrame frame;
+  geom::StampedPose gt;        ///< T_w_c of the frame, from the ground-truth sink
+  sim::Pose2d base_gt;         ///< robot axle centre, ground truth
+  sim::SimFrameSource::StageTimes times;
+};
+
+/// What the consumer needs to know about the simulator once it is built.
+struct SimInfo {
+  std::string renderer;
+  std::vector<Eigen::Vector2d> route;
+};
+
+/// The simulator side: builds the scene and renderer on the thread that
+/// will render (a GL context belongs to its thread), applies the closed-loop
+/// steering before each physics step and hands frames out.
+class FrameProducer {
+ public:
+  FrameProducer(const scenes::Scenario& scenario, sim::GlBackend backend, int frames, Steering* steering)
+      : source_(scenario, backend, frames, [this](const geom::StampedPose& p) { gt_ = p; }), steering_(steering) {
+    info_.renderer = source_.camera().description();
+    info_.route = source_.simulator().follower().path();
+  }
+  const SimInfo& info() const { return info_; }
+
+  std::optional<FrameItem> next() {
+    sim::Simulator& sim = source_.simulator();
+    if (steering_) {
+      std::lock_guard<std::mutex> lock(steering_->mutex);
+      sim.set_hold(steering_->hold);
+      sim.set_steering_pose(steering_->pose);
+    }
+    std::optional<sensor::RgbdFrame> f = source_.next();
+    if (!f) return std::nullopt;
+    return FrameItem{std::move(*f), gt_, sim.base_pose(), source_.last_stage_times()};
+  }
+
+ private:
+  sim::SimFrameSource source_;
+  Steering* steering_;
+  geom::StampedPose gt_;
+  SimInfo info_;
+};
+
+/// One SLAM system with its output files and bookkeeping.
+struct SystemSink {
+  SlamRun run;
+  std::unique_ptr<slam::System> system;
+  std::string dir;
+  std::ofstream cam_traj, kf_traj, timing;
+  eval::Trajectory est;
+  slam::TrackingState prev_state = slam::TrackingState::kNotInitialized;
+  double tracking_ms = 0, orb_ms = 0, inline_mapping_ms = 0;
+
+  SystemSink(const std::string& mode, const slam::Settings& settings, bool sync, std::uint32_t seed,
+             const std::string& out_dir)
+      : dir(out_dir) {
+    run.mode = mode;
+    slam::SystemOptions options;
+    options.synchronous = sync;
+    options.seed = seed;
+    system = std::make_unique<slam::System>(settings, options);
+    cam_traj = open_out(dir + "/CameraTrajectory.txt");
+    kf_traj = open_out(dir + "/KeyFrameTrajectory.txt");
+    timing = open_out(dir + "/timing.csv");
+    cam_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c; w = camera frame of the first tracked frame)\n";
+    kf_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
+    timing << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,inliers,"
+              "keyframe,mapping_ms\n";
+    est.source = dir + "/CameraTrajectory.txt";
+  }
+
+  /// Tracks one frame, writes its lines and records loss and recovery.
+  slam::FrameResult track(const sensor::RgbdFrame& frame, RunLog& log) {
+    const slam::FrameResult r = system->track(frame);
+    const int index = static_cast<int>(frame.index);
+    const double t_s = geom::ns_to_seconds(frame.t_ns);
+    ++run.frames;
+    if (r.state == slam::TrackingState::kLost) ++run.lost_frames;
+    if (r.state == slam::TrackingState::kNotInitialized) ++run.not_initialized_frames;
+    tracking_ms += r.tracking_ms;
+    orb_ms += r.orb_ms;
+    inline_mapping_ms += r.mapping_ms;
+    run.per_frame.push_back({index, t_s, r.T_w_c.has_value(), r.tracking_ms, r.tracking.coarse_matches,
+                             r.tracking.matches_kept});
+    if (r.T_w_c) {
+      cam_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+      est.poses.push_back({r.t_ns, *r.T_w_c});
+      if (r.tracking.new_keyframe) kf_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+    }
+    static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc"};
+    timing << index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
+           << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << "," << fmt(r.tracking_ms)
+           << "," << fmt(r.orb_ms) << "," << fmt(r.tracking.pe_match_ms) << "," << r.tracking.coarse_matches << ","
+           << r.tracking.matches_kept << "," << r.tracking.inliers << "," << (r.tracking.new_keyframe ? 1 : 0) << ","
+           << fmt(r.mapping_ms) << "\n"
+           << std::flush;
+
+    char head_buf[96];
+    std::snprintf(head_buf, sizeof head_buf, "frame %d (t = %.3f s): %s ", index, t_s, run.mode.c_str());
+    const std::string head = head_buf;
+    const std::string reason = r.tracking.failure.empty() ? "no reason given" : r.tracking.failure;
+    if (r.state == slam::TrackingState::kLost && prev_state != slam::TrackingState::kLost) {
+      run.loss_events.push_back({index, t_s, reason, std::nullopt});
+      log.line(head + std::string("lost tracking: ") + reason);
+    } else if (r.state == slam::TrackingState::kOk && prev_state == slam::TrackingState::kLost) {
+      if (!run.loss_events.empty()) run.loss_events.back().recovered_frame = index;
+      log.line(head + std::string("relocalised"));
+    } else if (r.state == slam::TrackingState::kNotInitialized && run.frames == 1) {
+      log.line(head + "not initialised: " + reason);
+    } else if (r.state == slam::TrackingState::kOk && prev_state == slam::TrackingState::kNotInitialized) {
+      log.line(head + "initialised");
+    }
+    prev_state = r.state;
+    return r;
+  }
+
+  /// Stops mapping, rewrites the keyframe trajectory with refined poses.
+  void finish() {
+    system->shutdown();
+    kf_traj.close();
+    std::string text = "# timestamp tx ty tz qx qy qz qw (T_w_c, refined by local BA; culled keyframes left out)\n";
+    for (const auto& p : system->keyframe_trajectory()) text += geom::format_tum_line(p) + "\n";
+    write_file(dir + "/KeyFrameTrajectory.txt", text);
+    cam_traj.close();
+    timing.close();
+    run.keyframes = system->num_keyframes();
+    run.map_points = system->num_map_points();
+  }
+
+  void evaluate(const eval::Trajectory& gt) {
+    if (est.poses.size() < 3) {
+      run.eval_note = "only " + std::to_string(est.poses.size()) + " tracked frames (need 3)";
+      return;
+    }
+    eval::EvalOptions eo;
+    try {
+      run.eval = eval::evaluate(gt, est, eo);
+    } catch (const eval::EvalError& e) {
+      // A numerically degenerate set (a robot that did not move): the SLAM
+      // world is its first camera frame, so align that instead.
+      eo.alignment = eval::Alignment::kOrigin;
+      try {
+        run.eval = eval::evaluate(gt, est, eo);
+        run.eval_note = std::string("se3 alignment impossible (") + e.what() + "); origin alignment";
+      } catch (const eval::EvalError& e2) {
+        run.eval_note = e2.what();
+      }
+    }
+  }
+};
+
+}  // namespace
+
+dataset::OrbSlamSettings orbslam_settings_for(const scenes::Scenario& s) {
+  dataset::OrbSlamSettings o;
+  o.K = {s.camera.fx, s.camera.fy, s.camera.cx(), s.camera.cy(), s.camera.width, s.camera.height};
+  o.fps = s.camera.fps;
+  o.bf = s.camera.depth_noise.baseline_m * s.camera.fx;
+  // ThDepth is in baselines: points beyond depth_range max are "far".
+  o.th_depth = s.camera.depth_range_m.y() / s.camera.depth_noise.baseline_m;
+  o.rgb_order = 1;
+  return o;
+}
+
+double camera_heading(const geom::SE3d& T_w_c) {
+  const Eigen::Vector3d z = T_w_c.linear().col(2);
+  return std::atan2(z.y(), z.x());
+}
+
+CameraMount measure_mount(const sim::Pose2d& base, const geom::SE3d& T_w_c) {
+  CameraMount m;
+  m.yaw_offset = wrap_angle(camera_heading(T_w_c) - base.yaw);
+  const Eigen::Vector2d d(T_w_c.translation().x() - base.x, T_w_c.translation().y() - base.y);
+  const double c = std::cos(base.yaw), s = std::sin(base.yaw);
+  m.offset_b = Eigen::Vector2d(c * d.x() + s * d.y(), -s * d.x() + c * d.y());
+  return m;
+}
+
+sim::Pose2d base_from_camera(const geom::SE3d& T_w_c, const CameraMount& mount) {
+  sim::Pose2d p;
+  p.yaw = wrap_angle(camera_heading(T_w_c) - mount.yaw_offset);
+  const double c = std::cos(p.yaw), s = std::sin(p.yaw);
+  p.x = T_w_c.translation().x() - (c * mount.offset_b.x() - s * mount.offset_b.y());
+  p.y = T_w_c.translation().y() - (s * mount.offset_b.x() + c * mount.offset_b.y());
+  return p;
+}
+
+RunReport run_scenario(const RunOptions& opt) {
+  const sim::GlBackend backend = sim::parse_gl_backend(opt.gl);
+  scenes::Scenario scenario = scenes::load_scenario(opt.scenario_file);
+  if (opt.seed) scenario.seed = *opt.seed;
+  const int n = scenes::frame_count(scenario, opt.max_frames);
+  dataset::make_dirs(opt.out_dir);
+  const bool compare = opt.mode == SlamMode::kCompare;
+  if (compare) dataset::make_dirs(opt.out_dir + "/baseline");
+
+  RunLog log(opt.out_dir + "/run.log", opt.on_log);
+  auto stopping = [&opt] { return opt.stop && opt.stop->load(); };
+
+  // SLAM settings from the scenario's camera, kept in the report as camera.yaml.
+  dataset::write_orbslam_settings(opt.out_dir + "/camera.yaml", orbslam_settings_for(scenario));
+  slam::Settings settings = slam::read_settings(opt.out_dir + "/camera.yaml");
+  for (const std::string& w : settings.warnings) log.line("warning: " + w);
+  const auto slam_seed = static_cast<std::uint32_t>(scenario.seed);
+  std::vector<std::unique_ptr<SystemSink>> sinks;
+  {
+    slam::Settings s = settings;
+    s.pe_match.enabled = opt.mode != SlamMode::kBaseline;
+    sinks.push_back(std::make_unique<SystemSink>(s.pe_match.enabled ? "pe-slam" : "orb-slam2", s, opt.sync,
+                                                 slam_seed, opt.out_dir));
+    if (compare) {
+      s.pe_match.enabled = false;
+      sinks.push_back(
+          std::make_unique<SystemSink>("orb-slam2", s, opt.sync, slam_seed, opt.out_dir + "/baseline"));
+    }
+  }
+
+  RunReport report;
+  report.scenario = scenario.name;
+  report.scenario_file = opt.scenario_file;
+  report.seed = scenario.seed;
+  report.sync = opt.sync;
+  report.fps = scenario.camera.fps;
+
+  std::ofstream gt_file = open_out(opt.out_dir + "/groundtruth.txt");
+  gt_file << "# timestamp tx ty tz qx qy qz qw (T_w_c: camera optical frame in the site frame, ground truth)\n";
+  eval::Trajectory gt;
+  gt.source = opt.out_dir + "/groundtruth.txt";
+
+  Steering steering;
+  Steering* steering_ptr = opt.closed_loop ? &steering : nullptr;
+  ClosedLoopMetrics closed;
+  std::vector<Eigen::Vector2d> route;
+  CameraMount mount;
+  geom::SE3d T_site_slam = geom::SE3d::Identity();  // SLAM world (first camera frame) in the site frame
+  const std::vector<int> sheet_frames = plot::spread_indices(n, 12);
+
+  double physics_ms = 0, render_ms = 0, sensor_ms = 0, producer_wait_ms = 0, consumer_wait_ms = 0, output_ms = 0;
+  double setup_ms = 0;
+  bool abort_run = false;
+
+  // The consumer side for one frame; returns false to stop the run.
+  auto consume = [&](FrameItem& item) -> bool {
+    physics_ms += item.times.physics_ms;
+    render_ms += item.times.render_ms;
+    sensor_ms += item.times.sensor_ms;
+    const int index = static_cast<int>(item.frame.index);
+    std::vector<slam::FrameResult> results;
+    for (auto& sink : sinks) results.push_back(sink->track(item.frame, log));
+    const auto t0 = Clock::now();
+    gt_file << geom::format_tum_line(item.gt) << "\n" << std::flush;
+    gt.poses.push_back(item.gt);
+    if (std::find(sheet_frames.begin(), sheet_frames.end(), index) != sheet_frames.end()) {
+      char label[64];
+      std::snprintf(label, sizeof label, "frame %d  t=%.2f s", index, geom::ns_to_seconds(item.frame.t_ns));
+      report.thumbnails.push_back({item.frame.rgb.clone(), label});
+    }
+    if (opt.closed_loop) {
+      if (index == 0) {
+        // The robot knows where it starts: its start pose in the site frame
+        // (here the ground truth of frame 0) and the camera's mounting.  It
+        // stands still until SLAM initialises, so the SLAM world (the first
+        // tracked camera frame) is the start camera pose.
+        mount = measure_mount(item.base_gt, item.gt.T_w_c);
+        T_site_slam = item.gt.T_w_c;
+      }
+      const slam::FrameResult& r = results.front();
+      const double err = distance_to_polyline(Eigen::Vector2d(item.base_gt.x, item.base_gt.y), route);
+      closed.t_s.push_back(geom::ns_to_seconds(item.frame.t_ns));
+      closed.path_error_m.push_back(err);
+      const bool ok = r.state == slam::TrackingState::kOk && r.T_w_c;
+      if (!ok) ++closed.hold_frames;
+      {
+        std::lock_guard<std::mutex> lock(steering.mutex);
+        steering.hold = !ok;
+        if (ok) steering.pose = base_from_camera(T_site_slam * *r.T_w_c, mount);
+      }
+      if (r.state == slam::TrackingState::kLost && scenario.route.on_loss == scenes::OnLoss::kAbort) {
+        report.status = RunStatus::kAborted;
+        report.status_detail = "tracking lost at frame " + std::to_string(index) +
+                               " and the scenario's route.on_loss is abort: " + r.tracking.failure;
+        log.line("aborting: " + report.status_detail);
+        abort_run = true;
+      }
+    }
+    output_ms += ms_since(t0);
+    if (opt.on_progress) opt.on_progress(sinks.front()->run.frames, static_cast<std::size_t>(n));
+    return !abort_run;
+  };
+
+  log.line("pvbench run: scenario " + scenario.name + " (" + opt.scenario_file + "), seed " +
+           std::to_string(scenario.seed) + ", " + std::to_string(n) + " frames, " +
+           (compare ? "pe-slam and orb-slam2" : sinks.front()->run.mode) +
+           (opt.closed_loop ? ", closed loop (on loss: " +
+                                  std::string(scenario.route.on_loss == scenes::OnLoss::kAbort ? "abort" : "wait") +
+                                  ")"
+                            : ", open loop") +
+           (opt.sync ? ", synchronous" : ", pipelined"));
+
+  Clock::time_point loop_start;
+  if (opt.sync) {
+    const auto t_setup = Clock::now();
+    FrameProducer producer(scenario, backend, n, steering_ptr);
+    setup_ms = ms_since(t_setup);
+    report.renderer = producer.info().renderer;
+    route = producer.info().route;
+    log.line("renderer: " + report.renderer);
+    loop_start = Clock::now();
+    while (!stopping()) {
+      std::optional<FrameItem> item = producer.next();
+      if (!item || !consume(*item)) break;
+    }
+  } else {
+    // Producer thread: simulate, render, sensor model -> queue.  In the
+    // closed loop the queue holds one frame, so the steering pose is at
+    // most two frames old.
+    BoundedQueue<FrameItem> queue(opt.closed_loop ? 1 : opt.queue_capacity);
+    std::promise<SimInfo> ready;
+    std::future<SimInfo> ready_future = ready.get_future();
+    std::exception_ptr producer_error;
+    double producer_setup_ms = 0;
+    std::thread producer_thread;
+    // However the consumer leaves (end, stop, abort, exception), the
+    // producer is released and joined.
+    struct JoinGuard {
+      BoundedQueue<FrameItem>& queue;
+      std::thread& thread;
+      ~JoinGuard() {
+        queue.close_and_clear();
+        if (thread.joinable()) thread.join();
+      }
+    } guard{queue, producer_thread};
+    producer_thread = std::thread([&] {
+      bool started = false;
+      try {
+        const auto t_setup = Clock::now();
+        FrameProducer producer(scenario, backend, n, steering_ptr);
+        producer_setup_ms = ms_since(t_setup);
+        ready.set_value(producer.info());
+        started = true;
+        while (!stopping()) {
+          std::optional<FrameItem> item = producer.next();
+          if (!item) break;
+          const auto t_wait = Clock::now();
+          const bool pushed = queue.push(std::move(*item));
+          producer_wait_ms += ms_since(t_wait);
+          if (!pushed) break;
+        }
+      } catch (...) {
+        if (started) producer_error = std::current_exception();
+        else ready.set_exception(std::current_exception());
+      }
+      queue.close();
+    });
+    const SimInfo info = ready_future.get();  // rethrows a setup error (the guard joins)
+    setup_ms = producer_setup_ms;
+    report.renderer = info.renderer;
+    route = info.route;
+    log.line("renderer: " + report.renderer);
+    loop_start = Clock::now();
+    while (!stopping()) {
+      const auto t_wait = Clock::now();
+      std::optional<FrameItem> item = queue.pop();
+      consumer_wait_ms += ms_since(t_wait);
+      if (!item || !consume(*item)) break;
+    }
+    queue.close_and_clear();
+    producer_thread.join();
+    if (producer_error) std::rethrow_exception(producer_error);
+  }
+  for (auto& sink : sinks) sink->finish();  // waits for local mapping
+  report.wall_s = ms_since(loop_start) / 1000.0;
+  report.sim_s = static_cast<double>(sinks.front()->run.frames) / scenario.camera.fps;
+  if (stopping() && !abort_run && report.status == RunStatus::kCompleted) {
+    report.status = RunStatus::kInterrupted;
+    report.status_detail = "interrupted after " + std::to_string(sinks.front()->run.frames) + " of " +
+                           std::to_string(n) + " frames";
+    log.line("interrupted: " + report.status_detail + "; writing the partial report");
+  }
+  gt_file.close();
+
+  const auto t_eval = Clock::now();
+  for (auto& sink : sinks) {
+    if (!gt.empty()) sink->evaluate(gt);
+    else sink->run.eval_note = "no frames";
+  }
+  const double eval_ms = ms_since(t_eval);
+
+  if (opt.closed_loop && !closed.path_error_m.empty()) {
+    double sum2 = 0;
+    for (double e : closed.path_error_m) {
+      sum2 += e * e;
+      closed.path_error_max_m = std::max(closed.path_error_max_m, e);
+    }
+    closed.path_error_rmse_m = std::sqrt(sum2 / static_cast<double>(closed.path_error_m.size()));
+    report.closed_loop = closed;
+  } else if (opt.closed_loop) {
+    report.closed_loop = closed;
+  }
+
+  report.primary = sinks.front()->run;
+  if (compare) report.baseline = sinks[1]->run;
+
+  const std::size_t frames = report.primary.frames;
+  report.profile = {{"setup (scene, physics calibration, GL)", setup_ms, 1, opt.sync ? "main" : "producer"},
+                    {"physics", physics_ms, frames, opt.sync ? "main" : "producer"},
+                    {"render", render_ms, frames, opt.sync ? "main" : "producer"},
+                    {"sensor_model", sensor_ms, frames, opt.sync ? "main" : "producer"}};
+  for (const auto& sink : sinks) {
+    const std::string suffix = sinks.size() > 1 ? " (" + sink->run.mode + ")" : "";
+    report.profile.push_back({"tracking" + suffix, sink->tracking_ms, frames, opt.sync ? "main" : "consumer"});
+    report.profile.push_back({"of which orb_extraction" + suffix, sink->orb_ms, frames, opt.sync ? "main" : "consumer"});
+    report.profile.push_back(
+        {"mapping" + suffix, sink->system->mapping_busy_ms(), sink->run.keyframes, opt.sync ? "main" : "mapping"});
+  }
+  report.profile.push_back({"output (trajectory files, bookkeeping)", output_ms, frames, opt.sync ? "main" : "consumer"});
+  if (!opt.sync) {
+    report.profile.push_back({"producer waiting for queue room", producer_wait_ms, frames, "producer"});
+    report.profile.push_back({"consumer waiting for frames", consumer_wait_ms, frames, "consumer"});
+  }
+  report.profile.push_back({"eval", eval_ms, 1, "main"});
+
+  char summary[512];
+  const SlamRun& p = report.primary;
+  std::snprintf(summary, sizeof summary,
+                "%s: %zu frames, %zu lost, %zu keyframes, ATE rmse %s m, tracking median %.2f ms, realtime factor "
+                "%.2f (%.2f s simulated in %.2f s)",
+                to_string(report.status), p.frames, p.lost_frames, p.keyframes,
+                p.eval ? fmt(p.eval->ate.rmse).c_str() : "n/a", percentile([&] {
+                  std::vector<double> v;
+                  for (const auto& f : p.per_frame) v.push_back(f.tracking_ms);
+                  return v;
+                }(), 0.5),
+                realtime_factor(report.sim_s, report.wall_s), report.sim_s, report.wall_s);
+  log.line(summary);
+  if (report.closed_loop)
+    log.line("closed loop: path error rmse " + fmt(report.closed_loop->path_error_rmse_m) + " m, max " +
+             fmt(report.closed_loop->path_error_max_m) + " m, held " +
+             std::to_string(report.closed_loop->hold_frames) + " frames");
+  const std::string table = comparison_table(report);
+  if (!table.empty()) {
+    log.line("PE-SLAM against the ORB-SLAM2 baseline on the same frames:");
+    for (std::size_t a = 0, b; a < table.size(); a = b + 1) {
+      b = table.find('\n', a);
+      if (b == std::string::npos) b = table.size();
+      log.line(table.substr(a, b - a));
+    }
+  }
+
+  const auto t_report = Clock::now();
+  report.log_lines = log.lines();
+  const std::vector<std::string> figures = write_report(report, opt.out_dir);
+  report.profile.push_back({"report", ms_since(t_report), 1, "main"});
+  // Again, so the report's own time is in it.
+  log.line("report written to " + opt.out_dir + "/index.html");
+  report.log_lines = log.lines();
+  write_file(opt.out_dir + "/metrics.json", metrics_json(report));
+  write_file(opt.out_dir + "/index.html", index_html(report, figures));
+  return report;
+}
+
+}  // namespace pvb::run
