@@ -56,7 +56,7 @@ struct SweepArgs {
 };
 
 volatile std::sig_atomic_t g_stop_signal = 0;
-extern "C" void on_stop_signal(int sig) { g_stop_signal = sig; }
+extern "C" void sweep_on_stop_signal(int sig) { g_stop_signal = sig; }
 
 std::string seed_dir(const std::string& out, std::uint64_t seed) {
   return (fs::path(out) / ("seed_" + std::to_string(seed))).string();
@@ -160,7 +160,7 @@ std::string seed_summary(const suite::SeedRun& r) {
 /// (-1 for a seed never started because the sweep was stopped).
 std::map<std::uint64_t, int> run_seeds(const SweepArgs& a, const std::vector<std::uint64_t>& seeds) {
   struct sigaction sa {};
-  sa.sa_handler = on_stop_signal;
+  sa.sa_handler = sweep_on_stop_signal;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = 0;  // no SA_RESTART: waitpid returns EINTR so the loop sees the flag
   struct sigaction old_int {}, old_term {};
