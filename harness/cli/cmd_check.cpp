@@ -38,7 +38,8 @@ int run_check(const CheckArgs& a) {
 Command add_check_command(CLI::App& app) {
   auto args = std::make_shared<CheckArgs>();
   CLI::App* sub = app.add_subcommand(
-      "check", "Compare a run's metrics.json with its scenario's expect: bounds (exit 3 when one is violated)");
+      "check",
+      "Compare a run's metrics.json with its scenario's expect: bounds (exit 3 when one is violated)");
   sub->add_option("--scenario", args->scenario, "scenario YAML file with an expect: section")->required();
   sub->add_option("--metrics", args->metrics, "metrics.json written by pvbench run")->required();
   return {sub, [args] { return run_check(*args); }};

@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -64,7 +65,7 @@ std::string seed_dir(const std::string& out, std::uint64_t seed) {
 
 /// The arguments after the program name for one seed's `pvbench run`.
 std::vector<std::string> run_args(const SweepArgs& a, std::uint64_t seed) {
-  std::vector<std::string> v = {"run", "--scenario", a.scenario, "--seed", std::to_string(seed),
+  std::vector<std::string> v = {"run",   "--scenario",         a.scenario, "--seed", std::to_string(seed),
                                 "--out", seed_dir(a.out, seed)};
   if (a.frames > 0) {
     v.push_back("--frames");
@@ -81,8 +82,9 @@ std::vector<std::string> run_args(const SweepArgs& a, std::uint64_t seed) {
 }
 
 std::string shell_quote(const std::string& s) {
-  if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-./=:,+@") ==
-                        std::string::npos)
+  if (!s.empty() &&
+      s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-./=:,+@") ==
+          std::string::npos)
     return s;
   std::string out = "'";
   for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
@@ -146,13 +148,15 @@ std::string describe_exit(int status) {
 std::string seed_summary(const suite::SeedRun& r) {
   if (!r.metrics) return "no metrics: " + r.error;
   const suite::RunMetrics& m = r.metrics->primary;
-  char buf[200];
-  std::string ate = m.ate_rmse_m ? (std::snprintf(buf, sizeof buf, "%.2f mm", *m.ate_rmse_m * 1000.0), buf) : "n/a";
-  std::string s = m.status + ", ATE RMSE " + ate + ", " + std::to_string(m.lost_frames) + " lost";
-  if (r.metrics->baseline && r.metrics->baseline->ate_rmse_m) {
-    std::snprintf(buf, sizeof buf, "%.2f mm", *r.metrics->baseline->ate_rmse_m * 1000.0);
-    s += ", baseline " + std::string(buf);
-  }
+  auto mm = [](const std::optional<double>& v) {
+    if (!v) return std::string("n/a");
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2f mm", *v * 1000.0);
+    return std::string(buf);
+  };
+  std::string s =
+      m.status + ", ATE RMSE " + mm(m.ate_rmse_m) + ", " + std::to_string(m.lost_frames) + " lost";
+  if (r.metrics->baseline) s += ", baseline " + mm(r.metrics->baseline->ate_rmse_m);
   return s;
 }
 
@@ -163,7 +167,8 @@ std::map<std::uint64_t, int> run_seeds(const SweepArgs& a, const std::vector<std
   sa.sa_handler = sweep_on_stop_signal;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = 0;  // no SA_RESTART: waitpid returns EINTR so the loop sees the flag
-  struct sigaction old_int {}, old_term {};
+  struct sigaction old_int {
+  }, old_term{};
   ::sigaction(SIGINT, &sa, &old_int);
   ::sigaction(SIGTERM, &sa, &old_term);
 
@@ -201,7 +206,8 @@ std::map<std::uint64_t, int> run_seeds(const SweepArgs& a, const std::vector<std
     const std::uint64_t seed = it->second;
     running.erase(it);
     ++done;
-    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    const int code =
+        WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
     exit_codes[seed] = code;
     const suite::SeedRun r = suite::read_seed_run(seed, seed_dir(a.out, seed) + "/metrics.json", code);
     std::printf("[%zu/%zu] seed %llu: %s; %s\n", done, seeds.size(), static_cast<unsigned long long>(seed),
@@ -234,8 +240,8 @@ std::vector<std::uint64_t> discover_seeds(const std::string& out) {
   return seeds;
 }
 
-int write_aggregate(const SweepArgs& a, const std::string& scenario_name, const std::vector<std::uint64_t>& seeds,
-                    const std::map<std::uint64_t, int>& exit_codes) {
+int write_aggregate(const SweepArgs& a, const std::string& scenario_name,
+                    const std::vector<std::uint64_t>& seeds, const std::map<std::uint64_t, int>& exit_codes) {
   std::vector<suite::SeedRun> runs;
   for (std::uint64_t s : seeds) {
     const auto it = exit_codes.find(s);
@@ -259,20 +265,25 @@ int write_aggregate(const SweepArgs& a, const std::string& scenario_name, const 
   const eval::Figure fig = suite::make_sweep_figure(agg);
   write_file((out / "aggregate.svg").string(), eval::format_svg(fig));
   plot::write_png(fig, (out / "aggregate.png").string());
-  std::printf("\n%s\nwrote %s/aggregate.{md,csv,json,svg,png}\n", suite::format_markdown(agg).c_str(), a.out.c_str());
+  std::printf("\n%s\nwrote %s/aggregate.{md,csv,json,svg,png}\n", suite::format_markdown(agg).c_str(),
+              a.out.c_str());
   std::fflush(stdout);
   return agg.failed;
 }
 
 int run_sweep(SweepArgs a) {
   if (a.jobs < 1) throw ConfigError("command line", "--jobs", "a value >= 1", std::to_string(a.jobs));
-  if (a.compare && a.baseline) throw ConfigError("command line", "--baseline", "either --compare or --baseline, not both");
+  if (a.compare && a.baseline)
+    throw ConfigError("command line", "--baseline", "either --compare or --baseline, not both");
   std::string scenario_name;
-  if (!a.scenario.empty()) scenario_name = scenes::load_scenario(a.scenario).name;  // validates the file early
-  else if (!a.aggregate_only) throw ConfigError("command line", "--scenario", "a scenario file");
+  if (!a.scenario.empty())
+    scenario_name = scenes::load_scenario(a.scenario).name;  // validates the file early
+  else if (!a.aggregate_only)
+    throw ConfigError("command line", "--scenario", "a scenario file");
 
   if (a.aggregate_only) {
-    const std::vector<std::uint64_t> seeds = a.seeds.empty() ? discover_seeds(a.out) : suite::parse_seed_list(a.seeds);
+    const std::vector<std::uint64_t> seeds =
+        a.seeds.empty() ? discover_seeds(a.out) : suite::parse_seed_list(a.seeds);
     if (seeds.empty()) throw ConfigError(a.out, "seed_*/metrics.json", "at least one seed folder", "none");
     const int failed = write_aggregate(a, scenario_name, seeds, {});
     return failed > 0 ? kSeedFailedExit : 0;
@@ -291,7 +302,11 @@ int run_sweep(SweepArgs a) {
               a.out.c_str());
   const std::map<std::uint64_t, int> exit_codes = run_seeds(a, seeds);
   const int failed = write_aggregate(a, scenario_name, seeds, exit_codes);
-  if (g_stop_signal != 0) return kInterruptedExit;
+  if (g_stop_signal != 0) {
+    std::printf("sweep: stopped by signal %d; the aggregate covers the seeds that wrote metrics\n",
+                static_cast<int>(g_stop_signal));
+    return kInterruptedExit;
+  }
   if (failed > 0) std::printf("sweep: %d seed(s) failed\n", failed);
   return failed > 0 ? kSeedFailedExit : 0;
 }
@@ -306,7 +321,8 @@ Command add_sweep_command(CLI::App& app) {
   sub->add_option("--seeds", args->seeds, "seed list: 1-20, 1,3,5 or 1-5,9");
   sub->add_option("--jobs,-j", args->jobs, "seeds run at once")->capture_default_str();
   sub->add_option("--out", args->out, "sweep folder (DIR/seed_S per seed, DIR/aggregate.*)")->required();
-  sub->add_option("--frames", args->frames, "passed to pvbench run: at most N frames")->check(CLI::PositiveNumber);
+  sub->add_option("--frames", args->frames, "passed to pvbench run: at most N frames")
+      ->check(CLI::PositiveNumber);
   sub->add_flag("--compare", args->compare, "passed to pvbench run: PE-SLAM and the ORB-SLAM2 baseline");
   sub->add_flag("--baseline", args->baseline, "passed to pvbench run: the ORB-SLAM2 baseline alone");
   sub->add_flag("--sync", args->sync, "passed to pvbench run: synchronous, bit-reproducible SLAM");

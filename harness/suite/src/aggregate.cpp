@@ -42,12 +42,14 @@ std::string pm(const Summary& s, const char* f, double scale = 1.0) {
 
 std::string summary_json(const Summary& s) {
   if (s.count == 0) return "{\"count\": 0}";
-  return "{\"count\": " + std::to_string(s.count) + ", \"mean\": " + json_num(s.mean) + ", \"sd\": " +
-         json_num(s.sd) + ", \"min\": " + json_num(s.min) + ", \"max\": " + json_num(s.max) + "}";
+  return "{\"count\": " + std::to_string(s.count) + ", \"mean\": " + json_num(s.mean) +
+         ", \"sd\": " + json_num(s.sd) + ", \"min\": " + json_num(s.min) + ", \"max\": " + json_num(s.max) +
+         "}";
 }
 
 std::string run_summary_json(const RunSummary& r) {
-  return "{\"ate_rmse_m\": " + summary_json(r.ate_rmse_m) + ", \"lost_frames\": " + summary_json(r.lost_frames) +
+  return "{\"ate_rmse_m\": " + summary_json(r.ate_rmse_m) +
+         ", \"lost_frames\": " + summary_json(r.lost_frames) +
          ", \"tracking_ms_median\": " + summary_json(r.tracking_ms_median) +
          ", \"realtime_factor\": " + summary_json(r.realtime_factor) + "}";
 }
@@ -120,10 +122,19 @@ std::string format_markdown(const SweepAggregate& a) {
            pm(s.ate_rmse_m, "%.2f", 1000.0) + " | " + pm(s.lost_frames, "%.1f") + " | " +
            pm(s.tracking_ms_median, "%.2f") + " | " + pm(s.realtime_factor, "%.3f") + " |\n";
   };
-  row(a.has_baseline ? "PE-SLAM" : "primary", a.primary);
+  // The primary run's name: PE-SLAM unless the seeds ran --baseline alone.
+  std::string primary_name = "PE-SLAM";
+  for (const SeedRun& r : a.runs)
+    if (r.metrics && !r.metrics->primary.mode.empty()) {
+      if (r.metrics->primary.mode == "orb-slam2") primary_name = "ORB-SLAM2 baseline";
+      break;
+    }
+  row(primary_name.c_str(), a.primary);
   if (a.has_baseline) row("ORB-SLAM2 baseline", a.baseline);
 
-  out += "\n## Per seed\n\n| seed | exit | status | frames | lost | ATE RMSE (mm) | tracking ms | realtime factor |";
+  out +=
+      "\n## Per seed\n\n| seed | exit | status | frames | lost | ATE RMSE (mm) | tracking ms | realtime "
+      "factor |";
   if (a.has_baseline) out += " baseline lost | baseline ATE RMSE (mm) |";
   out += " note |\n|---|---|---|---|---|---|---|---|";
   if (a.has_baseline) out += "---|---|";
@@ -143,8 +154,9 @@ std::string format_markdown(const SweepAggregate& a) {
           out += " | |";
       }
       std::string note;
-      if (!m.loss_events.empty()) note = "first loss at frame " + std::to_string(m.loss_events.front().frame) + ": " +
-                                         m.loss_events.front().reason;
+      if (!m.loss_events.empty())
+        note = "first loss at frame " + std::to_string(m.loss_events.front().frame) + ": " +
+               m.loss_events.front().reason;
       for (char& c : note) c = c == '|' ? '/' : c;
       out += " " + note + " |\n";
     } else {
@@ -158,7 +170,8 @@ std::string format_markdown(const SweepAggregate& a) {
 
 std::string format_csv(const SweepAggregate& a) {
   std::string out =
-      "seed,exit_code,status,frames,lost_frames,ate_rmse_m,rpe_trans_rmse_m,tracking_ms_median,realtime_factor,"
+      "seed,exit_code,status,frames,lost_frames,ate_rmse_m,rpe_trans_rmse_m,tracking_ms_median,realtime_"
+      "factor,"
       "baseline_lost_frames,baseline_ate_rmse_m,baseline_tracking_ms_median,error\n";
   for (const SeedRun& r : a.runs) {
     out += std::to_string(r.seed) + "," + std::to_string(r.exit_code) + ",";
@@ -183,8 +196,9 @@ std::string format_csv(const SweepAggregate& a) {
 }
 
 std::string format_json(const SweepAggregate& a) {
-  std::string out = "{\n  \"scenario\": \"" + json_escape(a.scenario) + "\",\n  \"seeds\": " +
-                    std::to_string(a.runs.size()) + ",\n  \"failed\": " + std::to_string(a.failed) + ",\n";
+  std::string out = "{\n  \"scenario\": \"" + json_escape(a.scenario) +
+                    "\",\n  \"seeds\": " + std::to_string(a.runs.size()) +
+                    ",\n  \"failed\": " + std::to_string(a.failed) + ",\n";
   out += "  \"primary\": " + run_summary_json(a.primary) + ",\n";
   out += "  \"baseline\": " + (a.has_baseline ? run_summary_json(a.baseline) : std::string("null")) + ",\n";
   out += "  \"runs\": [\n";
@@ -194,7 +208,8 @@ std::string format_json(const SweepAggregate& a) {
     if (r.metrics) {
       const RunMetrics& m = r.metrics->primary;
       out += ", \"status\": \"" + json_escape(m.status) + "\", \"frames\": " + std::to_string(m.frames) +
-             ", \"lost_frames\": " + std::to_string(m.lost_frames) + ", \"ate_rmse_m\": " + json_opt(m.ate_rmse_m) +
+             ", \"lost_frames\": " + std::to_string(m.lost_frames) +
+             ", \"ate_rmse_m\": " + json_opt(m.ate_rmse_m) +
              ", \"rpe_trans_rmse_m\": " + json_opt(m.rpe_trans_rmse_m) +
              ", \"tracking_ms_median\": " + json_opt(m.tracking_ms_median) +
              ", \"realtime_factor\": " + json_opt(m.realtime_factor);
@@ -242,32 +257,39 @@ eval::Figure make_sweep_figure(const SweepAggregate& a) {
   const std::size_t n = a.runs.size();
   auto X = [&](std::size_t i) { return left + (right - left) * (i + 0.5) / std::max<std::size_t>(n, 1); };
 
-  f.texts.push_back({f.width_px / 2.0, 22, "ATE RMSE per seed: " + a.scenario, 15, eval::TextAnchor::kMiddle, false, black});
+  f.texts.push_back({f.width_px / 2.0, 22, "ATE RMSE per seed: " + a.scenario, 15, eval::TextAnchor::kMiddle,
+                     false, black});
   for (double t : ticks) {
     if (t > ytop + 1e-12) continue;
     f.lines.push_back({left, Y(t), right, Y(t), grey, 1});
-    f.texts.push_back({left - 6, Y(t) + 4, eval::tick_label(t, step), 11, eval::TextAnchor::kEnd, false, black});
+    f.texts.push_back(
+        {left - 6, Y(t) + 4, eval::tick_label(t, step), 11, eval::TextAnchor::kEnd, false, black});
   }
   f.lines.push_back({left, top, left, bottom, black, 1});
   f.lines.push_back({left, bottom, right, bottom, black, 1});
   f.texts.push_back({18, (top + bottom) / 2, "ATE RMSE (mm)", 12, eval::TextAnchor::kMiddle, true, black});
-  f.texts.push_back({(left + right) / 2, f.height_px - 10.0, "seed", 12, eval::TextAnchor::kMiddle, false, black});
+  f.texts.push_back(
+      {(left + right) / 2, f.height_px - 10.0, "seed", 12, eval::TextAnchor::kMiddle, false, black});
   const std::size_t label_every = std::max<std::size_t>(1, n / 20);
   for (std::size_t i = 0; i < n; ++i) {
     if (i % label_every == 0)
-      f.texts.push_back({X(i), bottom + 16, std::to_string(a.runs[i].seed), 11, eval::TextAnchor::kMiddle, false, black});
+      f.texts.push_back(
+          {X(i), bottom + 16, std::to_string(a.runs[i].seed), 11, eval::TextAnchor::kMiddle, false, black});
     if (seed_failed(a.runs[i]))
-      f.texts.push_back({X(i), bottom - 6, "x", 13, eval::TextAnchor::kMiddle, false, eval::Rgb{200, 30, 30}});
+      f.texts.push_back(
+          {X(i), bottom - 6, "x", 13, eval::TextAnchor::kMiddle, false, eval::Rgb{200, 30, 30}});
   }
   auto dashed = [&](double v, const eval::Rgb& c) {
-    for (double x = left; x < right; x += 12) f.lines.push_back({x, Y(v), std::min(x + 7, right), Y(v), c, 1.5});
+    for (double x = left; x < right; x += 12)
+      f.lines.push_back({x, Y(v), std::min(x + 7, right), Y(v), c, 1.5});
   };
   if (a.primary.ate_rmse_m.count > 0) dashed(a.primary.ate_rmse_m.mean * 1000.0, blue);
   if (a.has_baseline && a.baseline.ate_rmse_m.count > 0) dashed(a.baseline.ate_rmse_m.mean * 1000.0, orange);
   for (std::size_t i = 0; i < n; ++i) {
     if (std::isfinite(base[i])) {  // hollow square
       const double x = X(i), y = Y(base[i]), h = 5;
-      f.polylines.push_back({{{x - h, y - h}, {x + h, y - h}, {x + h, y + h}, {x - h, y + h}, {x - h, y - h}}, orange, 1.5});
+      f.polylines.push_back(
+          {{{x - h, y - h}, {x + h, y - h}, {x + h, y + h}, {x - h, y + h}, {x - h, y - h}}, orange, 1.5});
     }
     if (std::isfinite(pe[i])) {  // filled dot: a short thick stroke
       const double x = X(i), y = Y(pe[i]);
@@ -277,10 +299,14 @@ eval::Figure make_sweep_figure(const SweepAggregate& a) {
   // Legend.
   double lx = right - 250;
   f.lines.push_back({lx, top - 8, lx + 1, top - 8, blue, 8});
-  f.texts.push_back({lx + 10, top - 4, a.has_baseline ? "PE-SLAM" : "run", 11, eval::TextAnchor::kStart, false, black});
+  f.texts.push_back(
+      {lx + 10, top - 4, a.has_baseline ? "PE-SLAM" : "run", 11, eval::TextAnchor::kStart, false, black});
   if (a.has_baseline) {
     lx += 90;
-    f.polylines.push_back({{{lx - 5, top - 13}, {lx + 5, top - 13}, {lx + 5, top - 3}, {lx - 5, top - 3}, {lx - 5, top - 13}}, orange, 1.5});
+    f.polylines.push_back(
+        {{{lx - 5, top - 13}, {lx + 5, top - 13}, {lx + 5, top - 3}, {lx - 5, top - 3}, {lx - 5, top - 13}},
+         orange,
+         1.5});
     f.texts.push_back({lx + 10, top - 4, "ORB-SLAM2", 11, eval::TextAnchor::kStart, false, black});
   }
   f.texts.push_back({right, top - 4 + 14, "dashed: mean", 10, eval::TextAnchor::kEnd, false, black});

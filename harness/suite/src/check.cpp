@@ -21,7 +21,8 @@ std::vector<Violation> check_expectations(const scenes::Expectations& expect, co
     if (run.status == "interrupted")
       out.push_back({"tracking_loss_expected", "the run was interrupted before it ended"});
     if (run.loss_events.empty()) {
-      out.push_back({"tracking_loss_expected", "no tracking loss was reported (" + std::to_string(run.lost_frames) +
+      out.push_back({"tracking_loss_expected", "no tracking loss was reported (" +
+                                                   std::to_string(run.lost_frames) +
                                                    " lost frames, no loss_events)"});
     }
     for (std::size_t i = 0; i < run.loss_events.size(); ++i) {
@@ -40,7 +41,8 @@ std::vector<Violation> check_expectations(const scenes::Expectations& expect, co
     if (!run.ate_rmse_m)
       out.push_back({"ate_rmse_m_max", "no ATE in the metrics (ate is null)"});
     else if (!(*run.ate_rmse_m <= expect.ate_rmse_m_max))
-      out.push_back({"ate_rmse_m_max", "ATE RMSE " + metres(*run.ate_rmse_m) + " > " + metres(expect.ate_rmse_m_max)});
+      out.push_back(
+          {"ate_rmse_m_max", "ATE RMSE " + metres(*run.ate_rmse_m) + " > " + metres(expect.ate_rmse_m_max)});
   }
   if (expect.has_rpe_trans_rmse_m_max) {
     if (!run.rpe_trans_rmse_m)
@@ -62,12 +64,14 @@ std::vector<Violation> check_expectations(const scenes::Expectations& expect, co
       out.push_back({"pe_not_worse_than_baseline", "PE-SLAM has no ATE (ate is null)"});
     else if (!(*run.ate_rmse_m <= *metrics.baseline->ate_rmse_m))
       out.push_back({"pe_not_worse_than_baseline", "PE-SLAM ATE RMSE " + metres(*run.ate_rmse_m) +
-                                                       " > baseline " + metres(*metrics.baseline->ate_rmse_m)});
+                                                       " > baseline " +
+                                                       metres(*metrics.baseline->ate_rmse_m)});
   }
   return out;
 }
 
-std::vector<Violation> check_expectations(const scenes::Expectations& expect, const std::string& metrics_json_path) {
+std::vector<Violation> check_expectations(const scenes::Expectations& expect,
+                                          const std::string& metrics_json_path) {
   return check_expectations(expect, read_metrics_file(metrics_json_path));
 }
 

@@ -29,7 +29,8 @@ class Reader {
   double number(const YAML::Node& obj, const std::string& key) const {
     const YAML::Node n = required(obj, key);
     double v = 0;
-    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v)) fail(n, key, "expected a number");
+    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
+      fail(n, key, "expected a number");
     return v;
   }
 
@@ -47,7 +48,8 @@ class Reader {
   }
 
   /// An optional number under obj[key][sub] (absent or null object -> nullopt).
-  std::optional<double> optional_number(const YAML::Node& obj, const std::string& key, const std::string& sub) const {
+  std::optional<double> optional_number(const YAML::Node& obj, const std::string& key,
+                                        const std::string& sub) const {
     const YAML::Node n = obj[key];
     if (!n.IsDefined() || n.IsNull()) return std::nullopt;
     if (!n.IsMap()) fail(n, key, "expected an object or null");

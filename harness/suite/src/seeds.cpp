@@ -34,15 +34,18 @@ std::string trim(const std::string& s) {
 
 }  // namespace
 
-std::vector<std::uint64_t> parse_seed_list(const std::string& text, const std::string& what, std::size_t max_seeds) {
+std::vector<std::uint64_t> parse_seed_list(const std::string& text, const std::string& what,
+                                           std::size_t max_seeds) {
   if (trim(text).empty()) throw ConfigError("command line", what, kSyntax, "an empty list");
   std::vector<std::uint64_t> seeds;
   std::set<std::uint64_t> seen;
   std::size_t pos = 0;
   while (pos <= text.size()) {
     const std::size_t comma = text.find(',', pos);
-    const std::string item = trim(text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos));
-    if (item.empty()) throw ConfigError("command line", what, kSyntax + std::string(" (an empty item)"), text);
+    const std::string item =
+        trim(text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos));
+    if (item.empty())
+      throw ConfigError("command line", what, kSyntax + std::string(" (an empty item)"), text);
     std::uint64_t lo = 0, hi = 0;
     const std::size_t dash = item.find('-');
     if (dash == std::string::npos) {

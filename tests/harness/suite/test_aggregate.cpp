@@ -65,7 +65,8 @@ TEST(SweepAggregate, NoBaselineWithoutCompare) {
   const suite::SweepAggregate a = suite::aggregate("tracking_failure", runs);
   EXPECT_FALSE(a.has_baseline);
   EXPECT_EQ(a.failed, 0);
-  EXPECT_NE(suite::format_markdown(a).find("| primary | 1 | n/a |"), std::string::npos) << suite::format_markdown(a);
+  EXPECT_NE(suite::format_markdown(a).find("| PE-SLAM | 1 | n/a |"), std::string::npos)
+      << suite::format_markdown(a);
 }
 
 TEST(SweepAggregate, MarkdownHasSummaryAndPerSeedRows) {

@@ -110,7 +110,8 @@ TEST(SuiteCheck, ExpectedTrackingLossFailsWithoutLossOrReason) {
   e.tracking_loss_expected = true;
   const auto none = suite::check_expectations(e, fixture("good_compare.json"));
   ASSERT_EQ(none.size(), 1u);
-  EXPECT_EQ(none[0].line(), "tracking_loss_expected: no tracking loss was reported (0 lost frames, no loss_events)");
+  EXPECT_EQ(none[0].line(),
+            "tracking_loss_expected: no tracking loss was reported (0 lost frames, no loss_events)");
 
   const auto bad = suite::check_expectations(e, fixture("lost_no_reason.json"));
   ASSERT_EQ(bad.size(), 2u);
@@ -129,7 +130,8 @@ TEST(SuiteCheck, MalformedMetricsAreIoErrorsNamingFileAndKey) {
   };
   EXPECT_NE(message("missing_status.json").find("missing_status.json:1: status: missing"), std::string::npos)
       << message("missing_status.json");
-  EXPECT_NE(message("bad_type.json").find("bad_type.json:2: lost_frames: expected an integer"), std::string::npos)
+  EXPECT_NE(message("bad_type.json").find("bad_type.json:2: lost_frames: expected an integer"),
+            std::string::npos)
       << message("bad_type.json");
   EXPECT_NE(message("not_json.json").find("not_json.json"), std::string::npos);
   EXPECT_NE(message("not_json.json").find("not valid JSON"), std::string::npos) << message("not_json.json");

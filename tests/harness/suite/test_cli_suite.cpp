@@ -45,22 +45,26 @@ int count_lines(const std::string& s) {
 }  // namespace
 
 TEST(CliCheck, PassingRunExitsZero) {
-  const auto r = run_pvbench("check --scenario " + scenario_file() + " --metrics " + fixture("good_compare.json"));
+  const auto r =
+      run_pvbench("check --scenario " + scenario_file() + " --metrics " + fixture("good_compare.json"));
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("good_compare.json: ok (s)"), std::string::npos) << r.output;
 }
 
 TEST(CliCheck, ViolationsExitThreeWithOneLineEach) {
-  const auto r = run_pvbench("check --scenario " + scenario_file() + " --metrics " + fixture("worse_than_baseline.json"));
+  const auto r = run_pvbench("check --scenario " + scenario_file() + " --metrics " +
+                             fixture("worse_than_baseline.json"));
   EXPECT_EQ(r.code, 3) << r.output;
   EXPECT_EQ(count_lines(r.output), 4) << r.output;
-  EXPECT_NE(r.output.find("worse_than_baseline.json: ate_rmse_m_max: ATE RMSE 0.0235 m > 0.01 m"), std::string::npos)
+  EXPECT_NE(r.output.find("worse_than_baseline.json: ate_rmse_m_max: ATE RMSE 0.0235 m > 0.01 m"),
+            std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("lost_frames_max: 4 lost frames > 0"), std::string::npos) << r.output;
 }
 
 TEST(CliCheck, MalformedMetricsIsOneErrorLine) {
-  const auto r = run_pvbench("check --scenario " + scenario_file() + " --metrics " + fixture("missing_status.json"));
+  const auto r =
+      run_pvbench("check --scenario " + scenario_file() + " --metrics " + fixture("missing_status.json"));
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_EQ(count_lines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("pvbench: error: "), std::string::npos) << r.output;
@@ -69,10 +73,15 @@ TEST(CliCheck, MalformedMetricsIsOneErrorLine) {
 
 TEST(CliCheck, ShippedFailureScenarioAcceptsAReportedLoss) {
   const std::string scenes = std::string(PVB_SOURCE_DIR) + "/scenes/";
-  EXPECT_EQ(run_pvbench("check --scenario " + scenes + "tracking_failure.yaml --metrics " + fixture("lost_aborted.json")).code, 0);
-  const auto r = run_pvbench("check --scenario " + scenes + "tracking_failure.yaml --metrics " + fixture("good_compare.json"));
+  EXPECT_EQ(run_pvbench("check --scenario " + scenes + "tracking_failure.yaml --metrics " +
+                        fixture("lost_aborted.json"))
+                .code,
+            0);
+  const auto r = run_pvbench("check --scenario " + scenes + "tracking_failure.yaml --metrics " +
+                             fixture("good_compare.json"));
   EXPECT_EQ(r.code, 3) << r.output;
-  EXPECT_NE(r.output.find("tracking_loss_expected: no tracking loss was reported"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("tracking_loss_expected: no tracking loss was reported"), std::string::npos)
+      << r.output;
 }
 
 TEST(CliSweep, BadSeedListIsOneErrorLine) {
@@ -91,8 +100,9 @@ TEST(CliSweep, PrintCommandsGivesOneSelfContainedLinePerSeed) {
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(count_lines(r.output), 3) << r.output;
   const std::string exe = fs::canonical(pvb::test::pvbench_path()).string();
-  const std::string seed9 = "mkdir -p " + out + "/seed_9 && " + exe + " run --scenario " + scenario + " --seed 9 --out " +
-                            out + "/seed_9 --frames 30 --compare --sync > " + out + "/seed_9/stdout.log 2>&1\n";
+  const std::string seed9 = "mkdir -p " + out + "/seed_9 && " + exe + " run --scenario " + scenario +
+                            " --seed 9 --out " + out + "/seed_9 --frames 30 --compare --sync > " + out +
+                            "/seed_9/stdout.log 2>&1\n";
   EXPECT_NE(r.output.find(seed9), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out + "/seed_1"));  // printing runs nothing
 }
@@ -121,13 +131,15 @@ TEST(CliSweep, AggregateOnlyCollectsSeedFolders) {
   // An explicit list aggregates only those seeds.
   const auto two = run_pvbench("sweep --out " + out + " --aggregate-only --seeds 1-2");
   EXPECT_EQ(two.code, 0) << two.output;
-  EXPECT_NE(pvb::read_file(out + "/aggregate.md").find("2 seeds, 2 with metrics, 0 failed"), std::string::npos);
+  EXPECT_NE(pvb::read_file(out + "/aggregate.md").find("2 seeds, 2 with metrics, 0 failed"),
+            std::string::npos);
 }
 
 TEST(CliSweep, AggregateOnlyWithoutSeedFoldersIsAnError) {
   const std::string out = scratch("empty");
   const auto r = run_pvbench("sweep --out " + out + " --aggregate-only");
   EXPECT_EQ(r.code, 1) << r.output;
-  EXPECT_NE(r.output.find("seed_*/metrics.json: expected at least one seed folder, got none"), std::string::npos)
+  EXPECT_NE(r.output.find("seed_*/metrics.json: expected at least one seed folder, got none"),
+            std::string::npos)
       << r.output;
 }

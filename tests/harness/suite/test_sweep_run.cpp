@@ -24,15 +24,18 @@ TEST(SweepRun, TwoSeedsThenASlurmTaskThenAggregateOnly) {
   const std::string scenario = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
   const std::string common = " --frames " + std::to_string(kFrames) + " --compare --sync";
 
-  const auto r = run_pvbench("sweep --scenario " + scenario + " --seeds 1,2 --jobs 2 --out " + out.string() + common);
+  const auto r =
+      run_pvbench("sweep --scenario " + scenario + " --seeds 1,2 --jobs 2 --out " + out.string() + common);
   ASSERT_EQ(r.code, 0) << r.output;
   for (int seed : {1, 2}) {
     const fs::path dir = out / ("seed_" + std::to_string(seed));
     ASSERT_TRUE(fs::exists(dir / "metrics.json")) << dir;
     const std::string metrics = pvb::read_file((dir / "metrics.json").string());
     EXPECT_NE(metrics.find("\"seed\": " + std::to_string(seed)), std::string::npos) << metrics.substr(0, 300);
-    EXPECT_NE(pvb::read_file((dir / "stdout.log").string()).find("pvbench run: scenario pv_station"), std::string::npos);
-    EXPECT_NE(r.output.find("seed " + std::to_string(seed) + ": exit 0; completed"), std::string::npos) << r.output;
+    EXPECT_NE(pvb::read_file((dir / "stdout.log").string()).find("pvbench run: scenario pv_station"),
+              std::string::npos);
+    EXPECT_NE(r.output.find("seed " + std::to_string(seed) + ": exit 0; completed"), std::string::npos)
+        << r.output;
   }
   const std::string md = pvb::read_file((out / "aggregate.md").string());
   EXPECT_NE(md.find("2 seeds, 2 with metrics, 0 failed"), std::string::npos) << md;
@@ -43,9 +46,9 @@ TEST(SweepRun, TwoSeedsThenASlurmTaskThenAggregateOnly) {
   // The Slurm script runs the same self-contained command for its task's
   // seed.  Seed 2 again, into another folder: sync mode is bit-identical.
   const fs::path slurm_out = out / "slurm";
-  const std::string slurm = "cd " + std::string(PVB_SOURCE_DIR) + " && SLURM_ARRAY_TASK_ID=2 PVBENCH=" +
-                            pvb::test::pvbench_path() + " bash scripts/slurm_sweep.sh " + scenario + " " +
-                            slurm_out.string() + common;
+  const std::string slurm = "cd " + std::string(PVB_SOURCE_DIR) +
+                            " && SLURM_ARRAY_TASK_ID=2 PVBENCH=" + pvb::test::pvbench_path() +
+                            " bash scripts/slurm_sweep.sh " + scenario + " " + slurm_out.string() + common;
   ASSERT_EQ(std::system(slurm.c_str()), 0) << slurm;
   EXPECT_EQ(pvb::read_file((slurm_out / "seed_2" / "CameraTrajectory.txt").string()),
             pvb::read_file((out / "seed_2" / "CameraTrajectory.txt").string()));

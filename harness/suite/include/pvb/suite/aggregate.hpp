@@ -14,8 +14,8 @@ namespace pvb::suite {
 /// One seed of a sweep.
 struct SeedRun {
   std::uint64_t seed = 0;
-  int exit_code = 0;                  ///< of the child process; 0 when only aggregated
-  std::string error;                  ///< why there are no metrics ("" when there are)
+  int exit_code = 0;  ///< of the child process; 0 when only aggregated
+  std::string error;  ///< why there are no metrics ("" when there are)
   std::optional<MetricsFile> metrics;
 };
 
@@ -42,7 +42,7 @@ struct SweepAggregate {
   RunSummary primary;
   bool has_baseline = false;  ///< any seed ran with --compare
   RunSummary baseline;
-  int failed = 0;             ///< seeds without metrics or with a non-zero exit
+  int failed = 0;  ///< seeds without metrics or with a non-zero exit
 };
 
 /// Reads DIR/seed_S/metrics.json for one seed into a SeedRun; a missing or

@@ -31,6 +31,7 @@ struct Violation {
 std::vector<Violation> check_expectations(const scenes::Expectations& expect, const MetricsFile& metrics);
 
 /// Same, reading the metrics from a file (throws IoError as read_metrics_file).
-std::vector<Violation> check_expectations(const scenes::Expectations& expect, const std::string& metrics_json_path);
+std::vector<Violation> check_expectations(const scenes::Expectations& expect,
+                                          const std::string& metrics_json_path);
 
 }  // namespace pvb::suite

@@ -20,8 +20,8 @@ struct RunMetrics {
   std::string status;  ///< "completed", "interrupted" or "aborted"
   int frames = 0;
   int lost_frames = 0;
-  std::optional<double> ate_rmse_m;         ///< absent when "ate" is null
-  std::optional<double> rpe_trans_rmse_m;   ///< absent when "rpe" is null
+  std::optional<double> ate_rmse_m;        ///< absent when "ate" is null
+  std::optional<double> rpe_trans_rmse_m;  ///< absent when "rpe" is null
   std::optional<double> tracking_ms_median;
   std::optional<double> realtime_factor;
   std::vector<LossEvent> loss_events;
