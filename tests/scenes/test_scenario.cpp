@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 
 #include "pvb/common/error.hpp"
@@ -141,4 +142,21 @@ TEST(Scenario, WallFinish) {
   EXPECT_EQ(s.walls[1].finish, WallFinish::kPlaster);
   EXPECT_NE(error_of(std::string(kMinimal) + "walls:\n  - {finish: glass}\n").find("walls[0].finish: expected one of brick, plaster, got glass"),
             std::string::npos);
+}
+
+// The suite: every shipped scenario states its bounds, and the fast CI
+// subset (expect.ci_frames > 0) stays at two scenarios at most.
+TEST(Scenario, EveryShippedScenarioHasBoundsAndTheCiSubsetIsSmall) {
+  int in_ci = 0, files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(PVB_SOURCE_DIR) + "/scenes")) {
+    if (e.path().extension() != ".yaml") continue;
+    ++files;
+    const Scenario s = load_scenario(e.path().string());
+    EXPECT_TRUE(s.expect.any()) << e.path();
+    EXPECT_EQ(s.name, e.path().stem().string()) << "the CTest names follow the file names";
+    if (s.expect.ci_frames > 0) ++in_ci;
+  }
+  EXPECT_GE(files, 10);
+  EXPECT_GE(in_ci, 1);
+  EXPECT_LE(in_ci, 2);
 }
