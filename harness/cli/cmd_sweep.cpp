@@ -167,8 +167,8 @@ std::map<std::uint64_t, int> run_seeds(const SweepArgs& a, const std::vector<std
   sa.sa_handler = sweep_on_stop_signal;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = 0;  // no SA_RESTART: waitpid returns EINTR so the loop sees the flag
-  struct sigaction old_int {
-  }, old_term{};
+  struct sigaction old_int = {};
+  struct sigaction old_term = {};
   ::sigaction(SIGINT, &sa, &old_int);
   ::sigaction(SIGTERM, &sa, &old_term);
 
