@@ -251,8 +251,11 @@ eval::Figure make_sweep_figure(const SweepAggregate& a) {
   }
   if (!(ymax > 0)) ymax = 1.0;
   double step = 1;
-  const std::vector<double> ticks = eval::nice_ticks(0.0, ymax * 1.05, 5, &step);
-  const double ytop = std::max(ymax * 1.05, ticks.empty() ? ymax : ticks.back());
+  std::vector<double> ticks = eval::nice_ticks(0.0, ymax * 1.05, 5, &step);
+  // The axis ends on a tick at or above the largest value.
+  if (ticks.empty()) ticks.push_back(0.0);
+  while (ticks.back() < ymax * 1.05 - 1e-12) ticks.push_back(ticks.back() + step);
+  const double ytop = ticks.back() > 0 ? ticks.back() : ymax * 1.05;
   auto Y = [&](double v) { return bottom - (bottom - top) * v / ytop; };
   const std::size_t n = a.runs.size();
   auto X = [&](std::size_t i) { return left + (right - left) * (i + 0.5) / std::max<std::size_t>(n, 1); };
