@@ -80,6 +80,7 @@ std::string run_fields(const RunReport& r, const std::string& in) {
   out += in + "\"realtime_factor\": " + num(realtime_factor(r.sim_s, r.wall_s)) + ",\n";
   out += in + "\"sim_s\": " + num(r.sim_s) + ",\n";
   out += in + "\"wall_s\": " + num(r.wall_s) + ",\n";
+  out += in + "\"cpu_s\": " + num(r.cpu_s) + ",\n";
   return out;
 }
 

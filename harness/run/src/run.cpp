@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <exception>
 #include <fstream>
@@ -25,6 +26,13 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+/// CPU time of the whole process (every thread, GL workers included), seconds.
+double process_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 double wrap_angle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
@@ -369,6 +377,7 @@ RunReport run_scenario(const RunOptions& opt) {
            (opt.sync ? ", synchronous" : ", pipelined"));
 
   Clock::time_point loop_start;
+  double loop_start_cpu_s = 0;
   if (opt.sync) {
     const auto t_setup = Clock::now();
     FrameProducer producer(scenario, backend, n, steering_ptr);
@@ -377,6 +386,7 @@ RunReport run_scenario(const RunOptions& opt) {
     route = producer.info().route;
     log.line("renderer: " + report.renderer);
     loop_start = Clock::now();
+    loop_start_cpu_s = process_cpu_s();
     while (!stopping()) {
       std::optional<FrameItem> item = producer.next();
       if (!item || !consume(*item)) break;
@@ -429,6 +439,7 @@ RunReport run_scenario(const RunOptions& opt) {
     route = info.route;
     log.line("renderer: " + report.renderer);
     loop_start = Clock::now();
+    loop_start_cpu_s = process_cpu_s();
     while (!stopping()) {
       const auto t_wait = Clock::now();
       std::optional<FrameItem> item = queue.pop();
@@ -441,6 +452,7 @@ RunReport run_scenario(const RunOptions& opt) {
   }
   for (auto& sink : sinks) sink->finish();  // waits for local mapping
   report.wall_s = ms_since(loop_start) / 1000.0;
+  report.cpu_s = process_cpu_s() - loop_start_cpu_s;
   report.sim_s = static_cast<double>(sinks.front()->run.frames) / scenario.camera.fps;
   if (stopping() && !abort_run && report.status == RunStatus::kCompleted) {
     report.status = RunStatus::kInterrupted;
@@ -473,21 +485,21 @@ RunReport run_scenario(const RunOptions& opt) {
   if (compare) report.baseline = sinks[1]->run;
 
   const std::size_t frames = report.primary.frames;
-  report.profile = {{"setup (scene, physics calibration, GL)", setup_ms, 1, opt.sync ? "main" : "producer"},
+  report.profile = {{"setup", setup_ms, 1, opt.sync ? "main" : "producer"},
                     {"physics", physics_ms, frames, opt.sync ? "main" : "producer"},
                     {"render", render_ms, frames, opt.sync ? "main" : "producer"},
                     {"sensor_model", sensor_ms, frames, opt.sync ? "main" : "producer"}};
   for (const auto& sink : sinks) {
-    const std::string suffix = sinks.size() > 1 ? " (" + sink->run.mode + ")" : "";
+    const std::string suffix = sink.get() == sinks.front().get() ? "" : "_baseline";
     report.profile.push_back({"tracking" + suffix, sink->tracking_ms, frames, opt.sync ? "main" : "consumer"});
-    report.profile.push_back({"of which orb_extraction" + suffix, sink->orb_ms, frames, opt.sync ? "main" : "consumer"});
+    report.profile.push_back({"orb_extraction" + suffix, sink->orb_ms, frames, opt.sync ? "main" : "consumer"});
     report.profile.push_back(
         {"mapping" + suffix, sink->system->mapping_busy_ms(), sink->run.keyframes, opt.sync ? "main" : "mapping"});
   }
-  report.profile.push_back({"output (trajectory files, bookkeeping)", output_ms, frames, opt.sync ? "main" : "consumer"});
+  report.profile.push_back({"output", output_ms, frames, opt.sync ? "main" : "consumer"});
   if (!opt.sync) {
-    report.profile.push_back({"producer waiting for queue room", producer_wait_ms, frames, "producer"});
-    report.profile.push_back({"consumer waiting for frames", consumer_wait_ms, frames, "consumer"});
+    report.profile.push_back({"producer_wait", producer_wait_ms, frames, "producer"});
+    report.profile.push_back({"consumer_wait", consumer_wait_ms, frames, "consumer"});
   }
   report.profile.push_back({"eval", eval_ms, 1, "main"});
 
@@ -495,14 +507,14 @@ RunReport run_scenario(const RunOptions& opt) {
   const SlamRun& p = report.primary;
   std::snprintf(summary, sizeof summary,
                 "%s: %zu frames, %zu lost, %zu keyframes, ATE rmse %s m, tracking median %.2f ms, realtime factor "
-                "%.2f (%.2f s simulated in %.2f s)",
+                "%.2f (%.2f s simulated in %.2f s wall, %.2f s CPU)",
                 to_string(report.status), p.frames, p.lost_frames, p.keyframes,
                 p.eval ? fmt(p.eval->ate.rmse).c_str() : "n/a", percentile([&] {
                   std::vector<double> v;
                   for (const auto& f : p.per_frame) v.push_back(f.tracking_ms);
                   return v;
                 }(), 0.5),
-                realtime_factor(report.sim_s, report.wall_s), report.sim_s, report.wall_s);
+                realtime_factor(report.sim_s, report.wall_s), report.sim_s, report.wall_s, report.cpu_s);
   log.line(summary);
   if (report.closed_loop)
     log.line("closed loop: path error rmse " + fmt(report.closed_loop->path_error_rmse_m) + " m, max " +

@@ -87,6 +87,7 @@ struct RunReport {
   double fps = 30;
   double sim_s = 0;           ///< simulated time of the frames processed
   double wall_s = 0;          ///< wall time of the loop (setup, evaluation and report excluded)
+  double cpu_s = 0;           ///< CPU time of the whole process over the same span (all threads)
   SlamRun primary;
   std::optional<SlamRun> baseline;  ///< --compare
   std::optional<ClosedLoopMetrics> closed_loop;

@@ -1,0 +1,265 @@
+// pvbench run, end to end: the default station in synchronous mode (metrics
+// contract, report files, accuracy), bit-identical prefixes, --compare, the
+// closed loop, tracking loss with on_loss abort and wait, Ctrl-C, bad input.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <thread>
+
+#include "pvb/common/text.hpp"
+#include "run_pvbench.hpp"
+
+using namespace pvb;
+
+namespace {
+
+const std::string kStation = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
+const std::string kLossScenario = std::string(PVB_SOURCE_DIR) + "/tests/harness/run/data/turn_away_from_wall.yaml";
+
+std::string fresh(const std::string& name) {
+  const std::string d = ::testing::TempDir() + "pvb_run_" + name + "_" + std::to_string(::getpid());
+  std::system(("rm -rf " + d).c_str());
+  return d;
+}
+
+bool exists(const std::string& path) { return std::ifstream(path).good(); }
+
+/// Data lines (not '#' comments) of a text file.
+std::vector<std::string> data_lines(const std::string& path) {
+  std::vector<std::string> out;
+  std::ifstream in(path);
+  for (std::string l; std::getline(in, l);)
+    if (!l.empty() && l[0] != '#') out.push_back(l);
+  return out;
+}
+
+YAML::Node metrics(const std::string& dir) { return YAML::Load(read_file(dir + "/metrics.json")); }
+
+void check_metrics_and_accuracy(const std::string& d) {
+  const YAML::Node m = metrics(d);
+  EXPECT_EQ(m["scenario"].as<std::string>(), "pv_station");
+  EXPECT_EQ(m["seed"].as<int>(), 7);
+  EXPECT_EQ(m["mode"].as<std::string>(), "pe-slam");
+  EXPECT_EQ(m["status"].as<std::string>(), "completed");
+  EXPECT_EQ(m["frames"].as<int>(), 150);
+  EXPECT_EQ(m["lost_frames"].as<int>(), 0);
+  EXPECT_EQ(m["loss_events"].size(), 0u);
+  EXPECT_GT(m["keyframes"].as<int>(), 1);
+  EXPECT_GT(m["map_points"].as<int>(), 500);
+  EXPECT_EQ(m["ate"]["count"].as<int>(), 150);
+  EXPECT_LT(m["ate"]["rmse"].as<double>(), 0.02);
+  EXPECT_GT(m["ate"]["rmse"].as<double>(), 0.0);  // noisy sensor: never exactly zero
+  EXPECT_LT(m["rpe"]["trans"]["rmse"].as<double>(), 0.01);
+  EXPECT_GT(m["tracking_ms"]["median"].as<double>(), 0.0);
+  EXPECT_GE(m["tracking_ms"]["p95"].as<double>(), m["tracking_ms"]["median"].as<double>());
+  EXPECT_NEAR(m["sim_s"].as<double>(), 5.0, 1e-9);
+  EXPECT_GT(m["cpu_s"].as<double>(), 0.0);
+  EXPECT_NEAR(m["realtime_factor"].as<double>(), m["sim_s"].as<double>() / m["wall_s"].as<double>(), 1e-6);
+  for (const char* stage : {"physics", "render", "sensor_model", "tracking", "mapping", "eval", "report"})
+    EXPECT_TRUE(m["profile"][stage]) << stage;
+  EXPECT_FALSE(m["closed_loop"]);
+  EXPECT_FALSE(m["baseline"]);
+}
+
+void check_report_files(const std::string& d) {
+  EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 150u);
+  EXPECT_EQ(data_lines(d + "/CameraTrajectory.txt").size(), 150u);
+  EXPECT_EQ(data_lines(d + "/timing.csv").size(), 151u);  // header + one line per frame
+  EXPECT_EQ(data_lines(d + "/KeyFrameTrajectory.txt").size(), static_cast<std::size_t>(metrics(d)["keyframes"].as<int>()));
+  for (const char* f : {"run.log", "index.html", "contact_sheet.png", "camera.yaml", "trajectory_error.svg",
+                        "trajectory_error.png", "ate_over_time.svg", "ate_over_time.png", "tracking_time_hist.svg",
+                        "tracking_time_hist.png", "matches.svg", "matches.png"})
+    EXPECT_TRUE(exists(d + "/" + f)) << f;
+  const std::string html = read_file(d + "/index.html");
+  EXPECT_NE(html.find("trajectory_error.png"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  // The ground truth is the simulator's: the same poses `pvbench record` writes.
+  const std::string rec = fresh("record");
+  ASSERT_EQ(test::run_pvbench("record --scenario " + kStation + " --out " + rec + " --frames 3").code, 0);
+  const std::vector<std::string> rec_gt = data_lines(rec + "/groundtruth.txt");
+  const std::vector<std::string> run_gt = data_lines(d + "/groundtruth.txt");
+  ASSERT_EQ(rec_gt.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(rec_gt[i], run_gt[i]);
+}
+
+// Sync mode is bit-identical, and a shorter run is a prefix of a longer one
+// (nothing depends on frames not yet seen).
+void check_bit_identical_prefix(const std::string& d) {
+  const std::string s = fresh("short");
+  ASSERT_EQ(test::run_pvbench("run --scenario " + kStation + " --out " + s + " --sync --frames 40").code, 0);
+  const std::vector<std::string> a = data_lines(d + "/CameraTrajectory.txt"), b = data_lines(s + "/CameraTrajectory.txt");
+  ASSERT_EQ(b.size(), 40u);
+  for (std::size_t i = 0; i < b.size(); ++i) EXPECT_EQ(a[i], b[i]) << "frame " << i;
+}
+
+// One 150-frame synchronous run of the default station (ctest runs every
+// test in its own process, so the checks share this test).
+TEST(RunCli, DefaultStationSync) {
+  const std::string d = fresh("station");
+  const test::RunResult r = test::run_pvbench("run --scenario " + kStation + " --out " + d + " --sync --frames 150");
+  ASSERT_EQ(r.code, 0) << r.output;
+  {
+    SCOPED_TRACE("metrics and accuracy");
+    check_metrics_and_accuracy(d);
+  }
+  {
+    SCOPED_TRACE("report files");
+    check_report_files(d);
+  }
+  {
+    SCOPED_TRACE("bit-identical prefix");
+    check_bit_identical_prefix(d);
+  }
+}
+
+TEST(RunCli, CompareRendersOnceForBothSystems) {
+  const std::string d = fresh("compare");
+  const test::RunResult r =
+      test::run_pvbench("run --scenario " + kStation + " --out " + d + " --sync --frames 40 --compare");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("PE-SLAM"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("ORB-SLAM2"), std::string::npos);
+  const YAML::Node m = metrics(d);
+  EXPECT_EQ(m["mode"].as<std::string>(), "pe-slam");
+  ASSERT_TRUE(m["baseline"]);
+  EXPECT_EQ(m["baseline"]["mode"].as<std::string>(), "orb-slam2");
+  EXPECT_EQ(m["baseline"]["frames"].as<int>(), 40);
+  EXPECT_LT(m["baseline"]["ate"]["rmse"].as<double>(), 0.02);
+  EXPECT_TRUE(m["comparison"]["ate_rmse_reduction_pct"].IsScalar());
+  EXPECT_EQ(data_lines(d + "/baseline/CameraTrajectory.txt").size(), 40u);
+  // Both saw the same frames: one ground truth for both.
+  EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 40u);
+  // The baseline never runs PE-match.
+  for (const std::string& line : data_lines(d + "/baseline/timing.csv")) {
+    const std::vector<std::string> f = split_ws(line, ",");
+    if (f[0] == "frame") continue;
+    EXPECT_EQ(f[8], f[9]) << line;  // coarse == kept
+  }
+}
+
+TEST(RunCli, ClosedLoopFollowsTheRouteFromTheSlamPose) {
+  const std::string d = fresh("closed");
+  const test::RunResult r =
+      test::run_pvbench("run --scenario " + kStation + " --out " + d + " --sync --frames 90 --closed-loop");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const YAML::Node m = metrics(d);
+  ASSERT_TRUE(m["closed_loop"]);
+  EXPECT_EQ(m["closed_loop"]["hold_frames"].as<int>(), 0);
+  EXPECT_LT(m["closed_loop"]["path_error_max_m"].as<double>(), 0.10);
+  EXPECT_LE(m["closed_loop"]["path_error_rmse_m"].as<double>(), m["closed_loop"]["path_error_max_m"].as<double>());
+  EXPECT_LT(m["ate"]["rmse"].as<double>(), 0.02);
+  EXPECT_TRUE(exists(d + "/path_error.png"));
+  // The robot moved: it was steered, not held.
+  const std::vector<std::string> gt = data_lines(d + "/groundtruth.txt");
+  ASSERT_EQ(gt.size(), 90u);
+  const std::vector<std::string> a = split_ws(gt.front()), b = split_ws(gt.back());
+  EXPECT_GT(std::hypot(std::stod(b[1]) - std::stod(a[1]), std::stod(b[2]) - std::stod(a[2])), 0.9);
+}
+
+// The fixture loses tracking for good when the robot turns away from the wall.
+TEST(RunCli, ClosedLoopAbortsOnLossWithAReport) {
+  const std::string d = fresh("abort");
+  const test::RunResult r = test::run_pvbench("run --scenario " + kLossScenario + " --out " + d + " --sync --closed-loop");
+  EXPECT_EQ(r.code, 4) << r.output;
+  const YAML::Node m = metrics(d);
+  EXPECT_EQ(m["status"].as<std::string>(), "aborted");
+  ASSERT_EQ(m["loss_events"].size(), 1u);
+  const int frame = m["loss_events"][0]["frame"].as<int>();
+  EXPECT_GT(frame, 30);
+  EXPECT_EQ(m["frames"].as<int>(), frame + 1);  // stopped at the loss
+  const std::string reason = m["loss_events"][0]["reason"].as<std::string>();
+  EXPECT_NE(reason.find("need"), std::string::npos) << reason;
+  EXPECT_NE(r.output.find("lost tracking: " + reason), std::string::npos) << r.output;
+  EXPECT_NE(read_file(d + "/index.html").find(reason), std::string::npos);
+}
+
+TEST(RunCli, ClosedLoopWaitsOnLossHoldingTheRobot) {
+  const std::string d = fresh("wait");
+  const std::string scenario = ::testing::TempDir() + "pvb_run_wait_" + std::to_string(::getpid()) + ".yaml";
+  std::string text = read_file(kLossScenario);
+  const std::size_t at = text.find("on_loss: abort");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 14, "on_loss: wait");
+  write_file(scenario, text);
+  const test::RunResult r =
+      test::run_pvbench("run --scenario " + scenario + " --out " + d + " --sync --closed-loop --frames 125");
+  EXPECT_EQ(r.code, 0) << r.output;
+  const YAML::Node m = metrics(d);
+  EXPECT_EQ(m["status"].as<std::string>(), "completed");
+  EXPECT_EQ(m["frames"].as<int>(), 125);
+  ASSERT_GE(m["loss_events"].size(), 1u);
+  EXPECT_GT(m["lost_frames"].as<int>(), 0);
+  // Held while lost (and the robot stands: the last ground-truth poses agree).
+  EXPECT_GE(m["closed_loop"]["hold_frames"].as<int>(), m["lost_frames"].as<int>());
+  const std::vector<std::string> gt = data_lines(d + "/groundtruth.txt");
+  const std::vector<std::string> a = split_ws(gt[gt.size() - 5]), b = split_ws(gt.back());
+  if (m["loss_events"][m["loss_events"].size() - 1]["recovered_frame"].IsNull()) {
+    EXPECT_LT(std::hypot(std::stod(b[1]) - std::stod(a[1]), std::stod(b[2]) - std::stod(a[2])), 0.01);
+  }
+}
+
+// Ctrl-C: a child `pvbench run` (pipelined) gets SIGINT once it has
+// tracked some frames; it must exit 130 with a partial report.
+TEST(RunCli, SigintWritesThePartialReport) {
+  const std::string d = fresh("sigint");
+  const std::string log = ::testing::TempDir() + "pvb_run_sigint_" + std::to_string(::getpid()) + ".txt";
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string out = d;
+    if (!freopen(log.c_str(), "w", stdout) || !freopen(log.c_str(), "a", stderr)) _exit(99);
+    execl(test::pvbench_path().c_str(), "pvbench", "run", "--scenario", kStation.c_str(), "--out", out.c_str(),
+          static_cast<char*>(nullptr));
+    _exit(98);
+  }
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  auto seconds = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  // Wait for 20 tracked frames (the trajectory is flushed as it grows).
+  while (data_lines(d + "/CameraTrajectory.txt").size() < 20 && seconds() < 300) {
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) FAIL() << "pvbench ended early: " << read_file(log);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  int status = 0;
+  pid_t done = 0;
+  const double t_signal = seconds();
+  while ((done = waitpid(pid, &status, WNOHANG)) == 0 && seconds() - t_signal < 120)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  if (done == 0) {
+    kill(pid, SIGKILL);
+    waitpid(pid, &status, 0);
+    FAIL() << "pvbench did not stop within 120 s of SIGINT";
+  }
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by a signal: " << read_file(log);
+  EXPECT_EQ(WEXITSTATUS(status), 130) << read_file(log);
+  const YAML::Node m = metrics(d);
+  EXPECT_EQ(m["status"].as<std::string>(), "interrupted");
+  const int frames = m["frames"].as<int>();
+  EXPECT_GE(frames, 20);
+  EXPECT_LT(frames, 751);
+  EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), static_cast<std::size_t>(frames));
+  EXPECT_TRUE(m["ate"].IsMap());  // the partial trajectory is evaluated
+  EXPECT_TRUE(exists(d + "/index.html"));
+  EXPECT_NE(read_file(d + "/run.log").find("interrupted"), std::string::npos);
+}
+
+TEST(RunCli, BadInputIsOneClearError) {
+  const std::string d = fresh("bad");
+  test::RunResult r = test::run_pvbench("run --scenario /nonexistent/scene.yaml --out " + d);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("pvbench: error: /nonexistent/scene.yaml"), std::string::npos) << r.output;
+  r = test::run_pvbench("run --scenario " + kStation + " --out " + d + " --compare --baseline");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("pvbench: error:"), std::string::npos) << r.output;
+}
+
+}  // namespace

@@ -1,0 +1,264 @@
+// The report pieces of a scenario run, on hand-built reports: metrics.json
+// (parsed back with yaml-cpp, as the checker reads it), geometry helpers,
+// the closed-loop camera mount, the comparison table and index.html.
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+
+#include "pvb/common/text.hpp"
+#include "pvb/eval/plot.hpp"
+#include "pvb/run/run.hpp"
+
+namespace pvb::run {
+namespace {
+
+geom::SE3d pose_xy(double x, double y, double yaw) {
+  geom::SE3d T = geom::SE3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(x, y, 0.5);
+  return T;
+}
+
+/// An evaluation of a synthetic drive: ground truth along x, the estimate
+/// off by a known lateral error that grows with time.
+eval::EvalResult synthetic_eval(double lateral_error_m) {
+  eval::Trajectory gt, est;
+  for (int i = 0; i < 50; ++i) {
+    const std::int64_t t_ns = i * 33'333'333LL;
+    const double x = 0.02 * i;
+    gt.poses.push_back({t_ns, pose_xy(x, 0.1 * std::sin(0.2 * i), 0.05 * i)});
+    est.poses.push_back({t_ns, pose_xy(x, 0.1 * std::sin(0.2 * i) + lateral_error_m * i / 49.0, 0.05 * i)});
+  }
+  eval::EvalOptions eo;
+  eo.alignment = eval::Alignment::kNone;
+  return eval::evaluate(gt, est, eo);
+}
+
+SlamRun slam_run(const std::string& mode, double lateral_error_m) {
+  SlamRun r;
+  r.mode = mode;
+  r.frames = 50;
+  r.lost_frames = 2;
+  r.keyframes = 7;
+  r.map_points = 900;
+  for (int i = 0; i < 50; ++i)
+    r.per_frame.push_back({i, i / 30.0, i != 20 && i != 21, 10.0 + i % 5, i > 0 ? 300 : 0, i > 0 ? 290 : 0});
+  r.loss_events.push_back({20, 20 / 30.0, "local map: only 21 inliers after pose optimisation (need 30)", 22});
+  r.eval = synthetic_eval(lateral_error_m);
+  return r;
+}
+
+RunReport hand_report() {
+  RunReport r;
+  r.scenario = "pv_station";
+  r.scenario_file = "scenes/pv_station.yaml";
+  r.seed = 7;
+  r.sync = true;
+  r.renderer = "test";
+  r.sim_s = 50 / 30.0;
+  r.wall_s = 0.5;
+  r.primary = slam_run("pe-slam", 0.01);
+  r.profile = {{"render", 500, 50, "producer"}, {"tracking", 250, 50, "consumer"}};
+  return r;
+}
+
+TEST(RunReport, MetricsJsonHasTheContractKeys) {
+  const RunReport r = hand_report();
+  const YAML::Node m = YAML::Load(metrics_json(r));
+  EXPECT_EQ(m["scenario"].as<std::string>(), "pv_station");
+  EXPECT_EQ(m["scenario_file"].as<std::string>(), "scenes/pv_station.yaml");
+  EXPECT_EQ(m["seed"].as<int>(), 7);
+  EXPECT_EQ(m["mode"].as<std::string>(), "pe-slam");
+  EXPECT_EQ(m["status"].as<std::string>(), "completed");
+  EXPECT_EQ(m["frames"].as<int>(), 50);
+  EXPECT_EQ(m["lost_frames"].as<int>(), 2);
+  EXPECT_EQ(m["keyframes"].as<int>(), 7);
+  EXPECT_EQ(m["map_points"].as<int>(), 900);
+  EXPECT_NEAR(m["ate"]["rmse"].as<double>(), r.primary.eval->ate.rmse, 1e-12);
+  for (const char* k : {"mean", "median", "std", "min", "max", "count"}) EXPECT_TRUE(m["ate"][k].IsScalar()) << k;
+  EXPECT_EQ(m["rpe"]["unit"].as<std::string>(), "f");
+  EXPECT_NEAR(m["rpe"]["trans"]["rmse"].as<double>(), r.primary.eval->rpe_trans_m.rmse, 1e-12);
+  EXPECT_NEAR(m["rpe"]["rot_deg"]["max"].as<double>(), r.primary.eval->rpe_rot_deg.max, 1e-12);
+  // tracking times 10..14 ms, evenly: median 12, mean 12.
+  EXPECT_NEAR(m["tracking_ms"]["median"].as<double>(), 12.0, 1e-9);
+  EXPECT_NEAR(m["tracking_ms"]["mean"].as<double>(), 12.0, 1e-9);
+  EXPECT_NEAR(m["tracking_ms"]["p95"].as<double>(), 14.0, 1e-9);
+  EXPECT_NEAR(m["realtime_factor"].as<double>(), (50 / 30.0) / 0.5, 1e-6);
+  EXPECT_NEAR(m["sim_s"].as<double>(), 50 / 30.0, 1e-6);
+  EXPECT_NEAR(m["wall_s"].as<double>(), 0.5, 1e-9);
+  ASSERT_EQ(m["loss_events"].size(), 1u);
+  EXPECT_EQ(m["loss_events"][0]["frame"].as<int>(), 20);
+  EXPECT_NEAR(m["loss_events"][0]["t_s"].as<double>(), 20 / 30.0, 1e-6);
+  EXPECT_NE(m["loss_events"][0]["reason"].as<std::string>().find("21 inliers"), std::string::npos);
+  EXPECT_EQ(m["loss_events"][0]["recovered_frame"].as<int>(), 22);
+  EXPECT_NEAR(m["profile"]["render"]["per_frame_ms"].as<double>(), 10.0, 1e-9);
+  EXPECT_EQ(m["profile"]["render"]["thread"].as<std::string>(), "producer");
+  // Only with --closed-loop / --compare:
+  EXPECT_FALSE(m["closed_loop"]);
+  EXPECT_FALSE(m["baseline"]);
+  EXPECT_FALSE(m["comparison"]);
+}
+
+TEST(RunReport, CompareAddsBaselineAndReductions) {
+  RunReport r = hand_report();
+  r.baseline = slam_run("orb-slam2", 0.04);
+  const YAML::Node m = YAML::Load(metrics_json(r));
+  ASSERT_TRUE(m["baseline"]);
+  EXPECT_EQ(m["baseline"]["mode"].as<std::string>(), "orb-slam2");
+  EXPECT_EQ(m["baseline"]["frames"].as<int>(), 50);
+  EXPECT_EQ(m["baseline"]["status"].as<std::string>(), "completed");
+  EXPECT_NEAR(m["baseline"]["ate"]["rmse"].as<double>(), r.baseline->eval->ate.rmse, 1e-12);
+  const double expected = 100.0 * (r.baseline->eval->ate.rmse - r.primary.eval->ate.rmse) / r.baseline->eval->ate.rmse;
+  EXPECT_GT(expected, 0.0);
+  EXPECT_NEAR(m["comparison"]["ate_rmse_reduction_pct"].as<double>(), expected, 1e-6);
+  EXPECT_TRUE(m["comparison"]["rpe_trans_rmse_reduction_pct"].IsScalar());
+
+  const std::string table = comparison_table(r);
+  EXPECT_NE(table.find("ORB-SLAM2"), std::string::npos);
+  EXPECT_NE(table.find("PE-SLAM"), std::string::npos);
+  EXPECT_NE(table.find("tracking ms median"), std::string::npos);
+  EXPECT_NE(table.find("ATE rmse"), std::string::npos);
+  EXPECT_TRUE(comparison_table(hand_report()).empty());
+}
+
+TEST(RunReport, UnevaluatedRunsAndStatuses) {
+  RunReport r = hand_report();
+  r.primary.eval.reset();
+  r.primary.eval_note = "only 2 tracked frames (need 3)";
+  r.status = RunStatus::kInterrupted;
+  r.status_detail = "interrupted after 50 of 751 frames";
+  r.closed_loop = ClosedLoopMetrics{{0, 1}, {0.01, 0.03}, 0.0224, 0.03, 4};
+  const YAML::Node m = YAML::Load(metrics_json(r));
+  EXPECT_TRUE(m["ate"].IsNull());
+  EXPECT_TRUE(m["rpe"].IsNull());
+  EXPECT_EQ(m["status"].as<std::string>(), "interrupted");
+  EXPECT_EQ(m["eval_note"].as<std::string>(), "only 2 tracked frames (need 3)");
+  EXPECT_NEAR(m["closed_loop"]["path_error_rmse_m"].as<double>(), 0.0224, 1e-12);
+  EXPECT_NEAR(m["closed_loop"]["path_error_max_m"].as<double>(), 0.03, 1e-12);
+  EXPECT_EQ(m["closed_loop"]["hold_frames"].as<int>(), 4);
+  EXPECT_EQ(exit_code(RunStatus::kCompleted), 0);
+  EXPECT_EQ(exit_code(RunStatus::kInterrupted), 130);
+  EXPECT_EQ(exit_code(RunStatus::kAborted), 4);
+  EXPECT_STREQ(to_string(RunStatus::kAborted), "aborted");
+}
+
+TEST(RunReport, DistanceToPolyline) {
+  const std::vector<Eigen::Vector2d> line{{0, 0}, {2, 0}, {2, 2}};
+  EXPECT_NEAR(distance_to_polyline({1, 0.5}, line), 0.5, 1e-12);
+  EXPECT_NEAR(distance_to_polyline({3, 1}, line), 1.0, 1e-12);
+  EXPECT_NEAR(distance_to_polyline({-3, 4}, line), 5.0, 1e-12);  // beyond the first end point
+  EXPECT_NEAR(distance_to_polyline({1.5, 1.0}, line), 0.5, 1e-12);  // nearer the second segment
+  EXPECT_NEAR(distance_to_polyline({1, 1}, {{0, 0}}), std::sqrt(2.0), 1e-12);
+  EXPECT_TRUE(std::isinf(distance_to_polyline({1, 1}, {})));
+}
+
+TEST(RunReport, PercentileAndRealtimeFactor) {
+  EXPECT_EQ(percentile({}, 0.5), 0.0);
+  EXPECT_NEAR(percentile({4, 1, 3, 2}, 0.5), 2.5, 1e-12);
+  EXPECT_NEAR(percentile({0, 10}, 0.95), 9.5, 1e-12);
+  EXPECT_NEAR(realtime_factor(25, 20), 1.25, 1e-12);
+  EXPECT_EQ(realtime_factor(25, 0), 0.0);
+}
+
+// The closed loop turns a SLAM camera pose into the robot pose it steers
+// from; the mount measured at the start must give back the robot pose for
+// any later pose of the same rigid robot.
+TEST(ClosedLoop, RobotPoseFromCameraPoseRoundTrip) {
+  // Camera 0.15 m ahead, 0.05 m left, 1.1 m up, yawed 12 deg left and pitched 12 deg down.
+  const double yaw_c = 12 * M_PI / 180, pitch = -12 * M_PI / 180;
+  Eigen::Matrix3d R_b_c;  // optical: x right, y down, z forward
+  const Eigen::Matrix3d R_b_fwd = (Eigen::AngleAxisd(yaw_c, Eigen::Vector3d::UnitZ()) *
+                                   Eigen::AngleAxisd(-pitch, Eigen::Vector3d::UnitY()))
+                                      .toRotationMatrix();
+  R_b_c = R_b_fwd * (Eigen::Matrix3d() << 0, 0, 1, -1, 0, 0, 0, -1, 0).finished();
+  const Eigen::Vector3d t_b_c(0.15, 0.05, 1.1);
+  auto camera_of = [&](const sim::Pose2d& b) {
+    geom::SE3d T_w_b = geom::SE3d::Identity();
+    T_w_b.linear() = Eigen::AngleAxisd(b.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    T_w_b.translation() = Eigen::Vector3d(b.x, b.y, 0.1);
+    geom::SE3d T_b_c = geom::SE3d::Identity();
+    T_b_c.linear() = R_b_c;
+    T_b_c.translation() = t_b_c;
+    return T_w_b * T_b_c;
+  };
+  const sim::Pose2d start{-0.5, -3.1, 0.3};
+  const CameraMount mount = measure_mount(start, camera_of(start));
+  EXPECT_NEAR(mount.yaw_offset, yaw_c, 1e-9);
+  EXPECT_NEAR(mount.offset_b.x(), 0.15, 1e-9);
+  EXPECT_NEAR(mount.offset_b.y(), 0.05, 1e-9);
+  for (const sim::Pose2d& b : {sim::Pose2d{4.0, -2.0, -2.5}, sim::Pose2d{10, 3, 3.1}, start}) {
+    const sim::Pose2d got = base_from_camera(camera_of(b), mount);
+    EXPECT_NEAR(got.x, b.x, 1e-9);
+    EXPECT_NEAR(got.y, b.y, 1e-9);
+    EXPECT_NEAR(std::remainder(got.yaw - b.yaw, 2 * M_PI), 0.0, 1e-9);
+  }
+}
+
+TEST(RunReport, IndexHtmlIsSelfContained) {
+  RunReport r = hand_report();
+  r.baseline = slam_run("orb-slam2", 0.04);
+  r.log_lines = {"frame 20 (t = 0.667 s): pe-slam lost tracking: <reason & more>"};
+  const std::string html = index_html(r, {"trajectory_error", "matches"});
+  EXPECT_NE(html.find("<img src=\"trajectory_error.png\""), std::string::npos);
+  EXPECT_NE(html.find("href=\"matches.svg\""), std::string::npos);
+  EXPECT_NE(html.find("contact_sheet.png"), std::string::npos);
+  EXPECT_NE(html.find("href=\"metrics.json\""), std::string::npos);
+  EXPECT_NE(html.find("&lt;reason &amp; more&gt;"), std::string::npos);  // log text is escaped
+  EXPECT_NE(html.find("21 inliers"), std::string::npos);                  // the loss event and its reason
+  EXPECT_NE(html.find("PE-SLAM vs ORB-SLAM2"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("http://"), std::string::npos);
+  EXPECT_EQ(html.find("https://"), std::string::npos);
+  EXPECT_EQ(html.find("src=\"/"), std::string::npos);  // relative links only
+}
+
+TEST(RunReport, WriteReportWritesEveryFile) {
+  const std::string dir = ::testing::TempDir() + "pvb_run_report_" + std::to_string(::getpid());
+  std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());
+  RunReport r = hand_report();
+  r.baseline = slam_run("orb-slam2", 0.04);
+  r.closed_loop = ClosedLoopMetrics{{0, 1}, {0.01, 0.03}, 0.0224, 0.03, 0};
+  const std::vector<std::string> figures = write_report(r, dir);
+  for (const char* f : {"trajectory_error", "trajectory_error_orb-slam2", "ate_over_time", "tracking_time_hist",
+                        "matches", "path_error"}) {
+    EXPECT_NE(std::find(figures.begin(), figures.end(), f), figures.end()) << f;
+    for (const char* ext : {".svg", ".png"})
+      EXPECT_TRUE(std::ifstream(dir + "/" + f + ext).good()) << f << ext;
+  }
+  for (const char* f : {"metrics.json", "index.html", "contact_sheet.png"})
+    EXPECT_TRUE(std::ifstream(dir + "/" + f).good()) << f;
+  EXPECT_NO_THROW(YAML::Load(read_file(dir + "/metrics.json")));
+}
+
+TEST(Charts, HistogramCountsEqualBinsLastClosed) {
+  const std::vector<std::size_t> c = eval::histogram_counts({0, 0.5, 1, 1.5, 2, 2, 5, -1}, 0, 2, 4);
+  ASSERT_EQ(c.size(), 4u);
+  EXPECT_EQ(c[0], 1u);  // 0              bins of width 0.5, closed on the left
+  EXPECT_EQ(c[1], 1u);  // 0.5
+  EXPECT_EQ(c[2], 1u);  // 1
+  EXPECT_EQ(c[3], 3u);  // 1.5, 2, 2 (the last bin is closed); 5 and -1 are outside
+}
+
+TEST(Charts, LineChartBreaksAtNonFiniteValues) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  eval::Series s{"a", {0, 1, 2, 3, 4}, {1, 2, nan, 3, 4}, eval::series_color(0)};
+  const eval::Figure f = eval::make_line_chart("t", "x", "y", {s});
+  // Two pieces of the data line; the legend stroke (horizontal) aside.
+  int pieces = 0;
+  for (const auto& p : f.polylines) {
+    const bool same_colour = p.color.r == s.color.r && p.color.g == s.color.g && p.color.b == s.color.b;
+    const bool legend = p.points.size() == 2 && p.points[0].second == p.points[1].second;
+    if (same_colour && !legend) ++pieces;
+  }
+  EXPECT_EQ(pieces, 2);
+  EXPECT_NE(eval::format_svg(f).find("<polyline"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace pvb::run
