@@ -15,6 +15,8 @@ Command add_slam_command(CLI::App& app);
 Command add_camera_command(CLI::App& app);
 #endif
 Command add_run_command(CLI::App& app);
+Command add_check_command(CLI::App& app);
+Command add_sweep_command(CLI::App& app);
 
 // Sub-commands register here (one line each).
 std::vector<Command> add_all_commands(CLI::App& app) {
@@ -27,6 +29,8 @@ std::vector<Command> add_all_commands(CLI::App& app) {
   cmds.push_back(add_camera_command(app));
 #endif
   cmds.push_back(add_run_command(app));
+  cmds.push_back(add_check_command(app));
+  cmds.push_back(add_sweep_command(app));
   return cmds;
 }
 }  // namespace pvb::cli

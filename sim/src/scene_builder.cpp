@@ -212,6 +212,8 @@ SceneAssets build_scene(const scenes::Scenario& s) {
       x.line("<material name=\"" + n + "\" texture=\"" + n + "\" specular=\"" + f(0.9 - 0.4 * s.pv_arrays[i].dirt) +
              "\" shininess=\"0.85\"/>");
     }
+  // Plaster: one flat colour, matte (walls with finish: plaster).
+  x.line("<material name=\"plaster\" rgba=\"0.78 0.76 0.72 1\" specular=\"0.02\" shininess=\"0.05\"/>");
   x.line("<material name=\"backsheet\" rgba=\"0.80 0.81 0.82 1\" specular=\"0.1\"/>");
   x.line("<material name=\"steel\" rgba=\"0.58 0.60 0.62 1\" specular=\"0.4\" shininess=\"0.4\"/>");
   x.line("<material name=\"robot\" rgba=\"0.95 0.55 0.10 1\" specular=\"0.3\"/>");
@@ -228,9 +230,10 @@ SceneAssets build_scene(const scenes::Scenario& s) {
     const Eigen::Vector2d mid = 0.5 * (w.start_m + w.end_m);
     const double len = (w.end_m - w.start_m).norm();
     // local x along the wall, local y up: the brick texture maps onto the face
+    const char* material = w.finish == scenes::WallFinish::kPlaster ? "plaster" : "brick";
     x.line("<geom name=\"wall" + std::to_string(i) + "\" class=\"scenery\" type=\"box\" size=\"" +
            v3(len / 2, w.height_m / 2, w.thickness_m / 2) + "\" pos=\"" + v3(mid.x(), mid.y(), w.height_m / 2) +
-           "\" xyaxes=\"" + v3(d.x(), d.y(), 0) + " 0 0 1\" material=\"brick\"/>");
+           "\" xyaxes=\"" + v3(d.x(), d.y(), 0) + " 0 0 1\" material=\"" + material + "\"/>");
   }
   // Vegetation: rejection sampling away from the route, walls and arrays.
   {

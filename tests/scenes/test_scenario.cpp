@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 
 #include "pvb/common/error.hpp"
@@ -21,7 +22,8 @@ const char* kMinimal = "route: {waypoints_m: [[0, 0], [5, 0]]}\n";
 }  // namespace
 
 TEST(Scenario, ShippedScenariosLoad) {
-  for (const char* name : {"pv_station", "along_row", "lawnmower", "loop"}) {
+  for (const char* name : {"pv_station", "along_row", "lawnmower", "loop", "wall_pass", "dusty_panels",
+                           "low_sun_glare", "high_noise", "fast_turns", "tracking_failure"}) {
     const Scenario s = load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + name + ".yaml");
     EXPECT_EQ(s.name, name);
     EXPECT_GE(s.duration_s, 20.0) << name;
@@ -85,3 +87,76 @@ TEST(Scenario, SyntaxErrorNamesLine) {
 }
 
 TEST(Scenario, MissingFileIsAnIoError) { EXPECT_THROW(load_scenario("/nonexistent/x.yaml"), pvb::IoError); }
+
+TEST(Scenario, ExpectSectionIsReadAndOptional) {
+  const Scenario none = parse_scenario(kMinimal, "min.yaml");
+  EXPECT_FALSE(none.expect.any());
+  EXPECT_EQ(none.expect.ci_frames, 0);
+
+  const Scenario s = parse_scenario(std::string(kMinimal) +
+                                        "expect:\n"
+                                        "  ate_rmse_m_max: 0.01\n"
+                                        "  rpe_trans_rmse_m_max: 0.005\n"
+                                        "  lost_frames_max: 0\n"
+                                        "  pe_not_worse_than_baseline: true\n"
+                                        "  ci_frames: 240\n",
+                                    "e.yaml");
+  EXPECT_TRUE(s.expect.any());
+  EXPECT_TRUE(s.expect.has_ate_rmse_m_max);
+  EXPECT_DOUBLE_EQ(s.expect.ate_rmse_m_max, 0.01);
+  EXPECT_TRUE(s.expect.has_rpe_trans_rmse_m_max);
+  EXPECT_DOUBLE_EQ(s.expect.rpe_trans_rmse_m_max, 0.005);
+  EXPECT_TRUE(s.expect.has_lost_frames_max);
+  EXPECT_EQ(s.expect.lost_frames_max, 0);
+  EXPECT_TRUE(s.expect.pe_not_worse_than_baseline);
+  EXPECT_FALSE(s.expect.tracking_loss_expected);
+  EXPECT_EQ(s.expect.ci_frames, 240);
+}
+
+TEST(Scenario, ExpectSectionIsStrict) {
+  const std::string base = std::string(kMinimal) + "expect:\n";
+  EXPECT_NE(error_of(base + "  ate_rmse_max: 0.01\n").find("bad.yaml:3: expect.ate_rmse_max: expected a known key"),
+            std::string::npos)
+      << error_of(base + "  ate_rmse_max: 0.01\n");
+  EXPECT_NE(error_of(base + "  ate_rmse_m_max: 1cm\n").find("expect.ate_rmse_m_max: expected a number, got 1cm"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "  ate_rmse_m_max: -0.01\n").find("expect.ate_rmse_m_max: expected a value in"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "  lost_frames_max: 2.5\n").find("expect.lost_frames_max: expected an integer, got 2.5"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "  pe_not_worse_than_baseline: maybe\n")
+                .find("expect.pe_not_worse_than_baseline: expected true or false, got maybe"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "  ci_frames: 1\n").find("expect.ci_frames"), std::string::npos);
+  EXPECT_NE(error_of(base + "  tracking_loss_expected: true\n  lost_frames_max: 0\n").find("expect.lost_frames_max"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kMinimal) + "expect: [1, 2]\n").find("expect: expected a mapping of keys"),
+            std::string::npos);
+}
+
+TEST(Scenario, WallFinish) {
+  const std::string wall = "walls:\n  - {start_m: [0, 0], end_m: [4, 0]}\n  - {start_m: [0, 2], end_m: [4, 2], finish: plaster}\n";
+  const Scenario s = parse_scenario(std::string(kMinimal) + wall, "w.yaml");
+  ASSERT_EQ(s.walls.size(), 2u);
+  EXPECT_EQ(s.walls[0].finish, WallFinish::kBrick);
+  EXPECT_EQ(s.walls[1].finish, WallFinish::kPlaster);
+  EXPECT_NE(error_of(std::string(kMinimal) + "walls:\n  - {finish: glass}\n").find("walls[0].finish: expected one of brick, plaster, got glass"),
+            std::string::npos);
+}
+
+// The suite: every shipped scenario states its bounds, and the fast CI
+// subset (expect.ci_frames > 0) stays at two scenarios at most.
+TEST(Scenario, EveryShippedScenarioHasBoundsAndTheCiSubsetIsSmall) {
+  int in_ci = 0, files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(PVB_SOURCE_DIR) + "/scenes")) {
+    if (e.path().extension() != ".yaml") continue;
+    ++files;
+    const Scenario s = load_scenario(e.path().string());
+    EXPECT_TRUE(s.expect.any()) << e.path();
+    EXPECT_EQ(s.name, e.path().stem().string()) << "the CTest names follow the file names";
+    if (s.expect.ci_frames > 0) ++in_ci;
+  }
+  EXPECT_GE(files, 10);
+  EXPECT_GE(in_ci, 1);
+  EXPECT_LE(in_ci, 2);
+}

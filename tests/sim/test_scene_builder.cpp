@@ -37,3 +37,20 @@ TEST(SceneBuilder, SameScenarioGivesTheSameBytes) {
   other.seed = 8;
   EXPECT_NE(sim::build_scene(other).files[0].second, a.files[0].second);  // textures follow the seed
 }
+
+TEST(SceneBuilder, WallFinishPicksTheMaterial) {
+  scenes::Scenario s = station();
+  ASSERT_EQ(s.walls.size(), 1u);
+  scenes::Wall plain = s.walls[0];
+  plain.finish = scenes::WallFinish::kPlaster;
+  s.walls.push_back(plain);
+  const sim::SceneAssets a = sim::build_scene(s);
+  const sim::ModelPtr m = sim::compile_scene(a);
+  const int brick = mj_name2id(m.get(), mjOBJ_MATERIAL, "brick");
+  const int plaster = mj_name2id(m.get(), mjOBJ_MATERIAL, "plaster");
+  ASSERT_GE(brick, 0);
+  ASSERT_GE(plaster, 0);
+  EXPECT_EQ(m->geom_matid[mj_name2id(m.get(), mjOBJ_GEOM, "wall0")], brick);
+  EXPECT_EQ(m->geom_matid[mj_name2id(m.get(), mjOBJ_GEOM, "wall1")], plaster);
+  EXPECT_EQ(m->mat_texid[plaster], -1);  // untextured: one flat colour
+}

@@ -15,6 +15,7 @@ enum class PanelOrientation { kPortrait, kLandscape };
 enum class RoutePattern { kWaypoints, kAlongRow, kLawnmower, kLoop };
 enum class DepthNoiseModel { kNone, kKinect };
 enum class OnLoss { kWait, kAbort };
+enum class WallFinish { kBrick, kPlaster };
 
 struct Ground {
   GroundType type = GroundType::kSoil;
@@ -53,6 +54,9 @@ struct Wall {
   Eigen::Vector2d end_m{10.0, 0.0};
   double height_m = 2.0;
   double thickness_m = 0.24;
+  /// Brick (grey bricks of highly similar look) or plaster (one flat,
+  /// untextured colour, e.g. the side of an inverter station).
+  WallFinish finish = WallFinish::kBrick;
 };
 
 struct Vegetation {
@@ -128,6 +132,26 @@ struct Robot {
   double max_wheel_speed_radps = 12.0;
 };
 
+/// What a run of this scenario must achieve (the `expect:` section).  The
+/// checker in harness/suite compares a run's metrics.json against it.  A
+/// bound that is not set (has_*) is not checked.
+struct Expectations {
+  bool has_ate_rmse_m_max = false;
+  double ate_rmse_m_max = 0.0;        ///< ATE RMSE of the primary run, metres
+  bool has_rpe_trans_rmse_m_max = false;
+  double rpe_trans_rmse_m_max = 0.0;  ///< RPE translation RMSE of the primary run, metres
+  bool has_lost_frames_max = false;
+  int lost_frames_max = 0;            ///< frames in the Lost state
+  bool pe_not_worse_than_baseline = false;  ///< PE-SLAM ATE RMSE <= the baseline's (needs --compare)
+  bool tracking_loss_expected = false;      ///< the run must report a loss with a reason
+  int ci_frames = 0;                  ///< frames of the fast CI run; 0 = not in the fast subset
+  /// True when any bound or flag is set.
+  bool any() const {
+    return has_ate_rmse_m_max || has_rpe_trans_rmse_m_max || has_lost_frames_max || pe_not_worse_than_baseline ||
+           tracking_loss_expected;
+  }
+};
+
 struct Scenario {
   std::string source_file;  ///< where it was loaded from ("" if built in code)
   std::string name = "unnamed";
@@ -142,6 +166,7 @@ struct Scenario {
   Route route;
   Robot robot;
   Camera camera;
+  Expectations expect;
 };
 
 /// Loads and validates a scenario file.  Throws ConfigError or IoError.

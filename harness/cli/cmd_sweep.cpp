@@ -1,0 +1,338 @@
+// pvbench sweep: runs one scenario over a list of seeds, each seed as an
+// independent child process `pvbench run ... --seed S --out DIR/seed_S`
+// (this same binary, through /proc/self/exe), at most --jobs at once, then
+// aggregates DIR/seed_*/metrics.json into DIR/aggregate.{md,csv,json,svg,png}.
+//
+// Every seed's command is self-contained (--print-commands prints them), so
+// a cluster scheduler can run them anywhere and `--aggregate-only` collects
+// the results afterwards (docs/sweeps.md).
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "command.hpp"
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+#include "pvb/eval/plot.hpp"
+#include "pvb/plot/png.hpp"
+#include "pvb/scenes/scenario.hpp"
+#include "pvb/suite/aggregate.hpp"
+#include "pvb/suite/seeds.hpp"
+
+namespace pvb::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Exit status when at least one seed failed (the aggregate is still written).
+constexpr int kSeedFailedExit = 3;
+/// Exit status after Ctrl-C / SIGTERM (the aggregate of what finished is written).
+constexpr int kInterruptedExit = 130;
+
+struct SweepArgs {
+  std::string scenario;
+  std::string seeds;
+  int jobs = 1;
+  std::string out;
+  int frames = 0;
+  bool compare = false;
+  bool baseline = false;
+  bool sync = false;
+  std::string gl;
+  bool print_commands = false;
+  bool aggregate_only = false;
+};
+
+volatile std::sig_atomic_t g_stop_signal = 0;
+extern "C" void sweep_on_stop_signal(int sig) { g_stop_signal = sig; }
+
+std::string seed_dir(const std::string& out, std::uint64_t seed) {
+  return (fs::path(out) / ("seed_" + std::to_string(seed))).string();
+}
+
+/// The arguments after the program name for one seed's `pvbench run`.
+std::vector<std::string> run_args(const SweepArgs& a, std::uint64_t seed) {
+  std::vector<std::string> v = {"run",   "--scenario",         a.scenario, "--seed", std::to_string(seed),
+                                "--out", seed_dir(a.out, seed)};
+  if (a.frames > 0) {
+    v.push_back("--frames");
+    v.push_back(std::to_string(a.frames));
+  }
+  if (a.compare) v.push_back("--compare");
+  if (a.baseline) v.push_back("--baseline");
+  if (a.sync) v.push_back("--sync");
+  if (!a.gl.empty()) {
+    v.push_back("--gl");
+    v.push_back(a.gl);
+  }
+  return v;
+}
+
+std::string shell_quote(const std::string& s) {
+  if (!s.empty() &&
+      s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-./=:,+@") ==
+          std::string::npos)
+    return s;
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string self_path() {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string("pvbench") : p.string();
+}
+
+/// One line of shell per seed: make the folder, run, log to stdout.log.
+std::string seed_command(const SweepArgs& a, const std::string& exe, std::uint64_t seed) {
+  const std::string dir = seed_dir(a.out, seed);
+  std::string cmd = "mkdir -p " + shell_quote(dir) + " && " + shell_quote(exe);
+  for (const auto& arg : run_args(a, seed)) cmd += " " + shell_quote(arg);
+  return cmd + " > " + shell_quote(dir + "/stdout.log") + " 2>&1";
+}
+
+/// Starts `exe run ...` for one seed with stdout and stderr in DIR/seed_S/stdout.log.
+pid_t start_seed(const SweepArgs& a, std::uint64_t seed) {
+  const std::string dir = seed_dir(a.out, seed);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw IoError(dir, "cannot create the seed folder: " + ec.message());
+  const std::string log = dir + "/stdout.log";
+  const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw IoError(log, std::string("cannot open: ") + std::strerror(errno));
+  std::vector<std::string> args = run_args(a, seed);
+  args.insert(args.begin(), "pvbench");
+  std::vector<char*> argv;
+  for (auto& s : args) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fd);
+    throw IoError(log, std::string("cannot start a child process: ") + std::strerror(errno));
+  }
+  if (pid == 0) {
+    // Child: only async-signal-safe calls until exec.
+    ::dup2(fd, STDOUT_FILENO);
+    ::dup2(fd, STDERR_FILENO);
+    ::execv("/proc/self/exe", argv.data());
+    const char msg[] = "pvbench sweep: cannot exec /proc/self/exe\n";
+    ssize_t ignored = ::write(STDERR_FILENO, msg, sizeof msg - 1);
+    (void)ignored;
+    ::_exit(127);
+  }
+  ::close(fd);
+  return pid;
+}
+
+std::string describe_exit(int status) {
+  if (WIFEXITED(status)) return "exit " + std::to_string(WEXITSTATUS(status));
+  if (WIFSIGNALED(status)) return std::string("killed by signal ") + std::to_string(WTERMSIG(status));
+  return "ended";
+}
+
+std::string seed_summary(const suite::SeedRun& r) {
+  if (!r.metrics) return "no metrics: " + r.error;
+  const suite::RunMetrics& m = r.metrics->primary;
+  auto mm = [](const std::optional<double>& v) {
+    if (!v) return std::string("n/a");
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2f mm", *v * 1000.0);
+    return std::string(buf);
+  };
+  std::string s =
+      m.status + ", ATE RMSE " + mm(m.ate_rmse_m) + ", " + std::to_string(m.lost_frames) + " lost";
+  if (r.metrics->baseline) s += ", baseline " + mm(r.metrics->baseline->ate_rmse_m);
+  return s;
+}
+
+/// Runs every seed, at most a.jobs at once.  Returns each seed's exit code
+/// (-1 for a seed never started because the sweep was stopped).
+std::map<std::uint64_t, int> run_seeds(const SweepArgs& a, const std::vector<std::uint64_t>& seeds) {
+  struct sigaction sa {};
+  sa.sa_handler = sweep_on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;  // no SA_RESTART: waitpid returns EINTR so the loop sees the flag
+  struct sigaction old_int = {};
+  struct sigaction old_term = {};
+  ::sigaction(SIGINT, &sa, &old_int);
+  ::sigaction(SIGTERM, &sa, &old_term);
+
+  std::map<std::uint64_t, int> exit_codes;
+  std::map<pid_t, std::uint64_t> running;
+  std::size_t next = 0, done = 0;
+  bool forwarded = false;
+  while (next < seeds.size() || !running.empty()) {
+    while (g_stop_signal == 0 && next < seeds.size() && static_cast<int>(running.size()) < a.jobs) {
+      const std::uint64_t seed = seeds[next++];
+      running[start_seed(a, seed)] = seed;
+      std::printf("seed %llu: started (%s/stdout.log)\n", static_cast<unsigned long long>(seed),
+                  seed_dir(a.out, seed).c_str());
+      std::fflush(stdout);
+    }
+    if (g_stop_signal != 0 && !forwarded) {
+      // Ctrl-C reaches the children through the terminal's process group;
+      // a SIGTERM sent to the sweep alone is passed on so they write their
+      // partial reports too.
+      if (g_stop_signal == SIGTERM)
+        for (const auto& [pid, seed] : running) ::kill(pid, SIGTERM);
+      std::printf("sweep: stopping, waiting for %zu running seed(s)\n", running.size());
+      std::fflush(stdout);
+      forwarded = true;
+    }
+    if (running.empty()) break;
+    int status = 0;
+    const pid_t pid = ::waitpid(-1, &status, 0);
+    if (pid < 0) {
+      if (errno == EINTR) continue;
+      throw IoError("sweep", std::string("waitpid failed: ") + std::strerror(errno));
+    }
+    const auto it = running.find(pid);
+    if (it == running.end()) continue;
+    const std::uint64_t seed = it->second;
+    running.erase(it);
+    ++done;
+    const int code =
+        WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    exit_codes[seed] = code;
+    const suite::SeedRun r = suite::read_seed_run(seed, seed_dir(a.out, seed) + "/metrics.json", code);
+    std::printf("[%zu/%zu] seed %llu: %s; %s\n", done, seeds.size(), static_cast<unsigned long long>(seed),
+                describe_exit(status).c_str(), seed_summary(r).c_str());
+    if (code != 0) std::printf("  see %s/stdout.log\n", seed_dir(a.out, seed).c_str());
+    std::fflush(stdout);
+  }
+  for (std::uint64_t s : seeds)
+    if (!exit_codes.count(s)) exit_codes[s] = -1;
+  ::sigaction(SIGINT, &old_int, nullptr);
+  ::sigaction(SIGTERM, &old_term, nullptr);
+  return exit_codes;
+}
+
+/// Seeds with a DIR/seed_S folder, in numeric order.
+std::vector<std::uint64_t> discover_seeds(const std::string& out) {
+  std::vector<std::uint64_t> seeds;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(out, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!e.is_directory() || name.rfind("seed_", 0) != 0) continue;
+    try {
+      const auto s = suite::parse_seed_list(name.substr(5), "seed folder");
+      if (s.size() == 1 && std::to_string(s[0]) == name.substr(5)) seeds.push_back(s[0]);
+    } catch (const ConfigError&) {
+    }
+  }
+  if (ec) throw IoError(out, "cannot list the sweep folder: " + ec.message());
+  std::sort(seeds.begin(), seeds.end());
+  return seeds;
+}
+
+int write_aggregate(const SweepArgs& a, const std::string& scenario_name,
+                    const std::vector<std::uint64_t>& seeds, const std::map<std::uint64_t, int>& exit_codes) {
+  std::vector<suite::SeedRun> runs;
+  for (std::uint64_t s : seeds) {
+    const auto it = exit_codes.find(s);
+    const int code = it == exit_codes.end() ? 0 : it->second;
+    suite::SeedRun r = suite::read_seed_run(s, seed_dir(a.out, s) + "/metrics.json", code);
+    if (code == -1 && !r.metrics) r.error = "not run (the sweep was stopped)";
+    runs.push_back(std::move(r));
+  }
+  std::string name = scenario_name;
+  if (name.empty())
+    for (const auto& r : runs)
+      if (r.metrics && !r.metrics->scenario.empty()) {
+        name = r.metrics->scenario;
+        break;
+      }
+  const suite::SweepAggregate agg = suite::aggregate(name, std::move(runs));
+  const fs::path out(a.out);
+  write_file((out / "aggregate.md").string(), suite::format_markdown(agg));
+  write_file((out / "aggregate.csv").string(), suite::format_csv(agg));
+  write_file((out / "aggregate.json").string(), suite::format_json(agg));
+  const eval::Figure fig = suite::make_sweep_figure(agg);
+  write_file((out / "aggregate.svg").string(), eval::format_svg(fig));
+  plot::write_png(fig, (out / "aggregate.png").string());
+  std::printf("\n%s\nwrote %s/aggregate.{md,csv,json,svg,png}\n", suite::format_markdown(agg).c_str(),
+              a.out.c_str());
+  std::fflush(stdout);
+  return agg.failed;
+}
+
+int run_sweep(SweepArgs a) {
+  if (a.jobs < 1) throw ConfigError("command line", "--jobs", "a value >= 1", std::to_string(a.jobs));
+  if (a.compare && a.baseline)
+    throw ConfigError("command line", "--baseline", "either --compare or --baseline, not both");
+  std::string scenario_name;
+  if (!a.scenario.empty())
+    scenario_name = scenes::load_scenario(a.scenario).name;  // validates the file early
+  else if (!a.aggregate_only)
+    throw ConfigError("command line", "--scenario", "a scenario file");
+
+  if (a.aggregate_only) {
+    const std::vector<std::uint64_t> seeds =
+        a.seeds.empty() ? discover_seeds(a.out) : suite::parse_seed_list(a.seeds);
+    if (seeds.empty()) throw ConfigError(a.out, "seed_*/metrics.json", "at least one seed folder", "none");
+    const int failed = write_aggregate(a, scenario_name, seeds, {});
+    return failed > 0 ? kSeedFailedExit : 0;
+  }
+  if (a.seeds.empty()) throw ConfigError("command line", "--seeds", "a seed list like 1-20, 1,3,5 or 1-5,9");
+  const std::vector<std::uint64_t> seeds = suite::parse_seed_list(a.seeds);
+  if (a.print_commands) {
+    const std::string exe = self_path();
+    for (std::uint64_t s : seeds) std::printf("%s\n", seed_command(a, exe, s).c_str());
+    return 0;
+  }
+  std::error_code ec;
+  fs::create_directories(a.out, ec);
+  if (ec) throw IoError(a.out, "cannot create the sweep folder: " + ec.message());
+  std::printf("sweep: %s, %zu seed(s), %d at once, into %s\n", scenario_name.c_str(), seeds.size(), a.jobs,
+              a.out.c_str());
+  const std::map<std::uint64_t, int> exit_codes = run_seeds(a, seeds);
+  const int failed = write_aggregate(a, scenario_name, seeds, exit_codes);
+  if (g_stop_signal != 0) {
+    std::printf("sweep: stopped by signal %d; the aggregate covers the seeds that wrote metrics\n",
+                static_cast<int>(g_stop_signal));
+    return kInterruptedExit;
+  }
+  if (failed > 0) std::printf("sweep: %d seed(s) failed\n", failed);
+  return failed > 0 ? kSeedFailedExit : 0;
+}
+
+}  // namespace
+
+Command add_sweep_command(CLI::App& app) {
+  auto args = std::make_shared<SweepArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "sweep", "Run a scenario over many seeds in parallel processes and aggregate the results");
+  sub->add_option("--scenario", args->scenario, "scenario YAML file");
+  sub->add_option("--seeds", args->seeds, "seed list: 1-20, 1,3,5 or 1-5,9");
+  sub->add_option("--jobs,-j", args->jobs, "seeds run at once")->capture_default_str();
+  sub->add_option("--out", args->out, "sweep folder (DIR/seed_S per seed, DIR/aggregate.*)")->required();
+  sub->add_option("--frames", args->frames, "passed to pvbench run: at most N frames")
+      ->check(CLI::PositiveNumber);
+  sub->add_flag("--compare", args->compare, "passed to pvbench run: PE-SLAM and the ORB-SLAM2 baseline");
+  sub->add_flag("--baseline", args->baseline, "passed to pvbench run: the ORB-SLAM2 baseline alone");
+  sub->add_flag("--sync", args->sync, "passed to pvbench run: synchronous, bit-reproducible SLAM");
+  sub->add_option("--gl", args->gl, "passed to pvbench run: rendering backend")
+      ->check(CLI::IsMember({"auto", "egl", "osmesa"}));
+  sub->add_flag("--print-commands", args->print_commands,
+                "print one self-contained shell command per seed (for Slurm, GNU parallel) and exit");
+  sub->add_flag("--aggregate-only", args->aggregate_only,
+                "only aggregate existing DIR/seed_*/metrics.json (after a cluster run)");
+  return {sub, [args] { return run_sweep(*args); }};
+}
+
+}  // namespace pvb::cli

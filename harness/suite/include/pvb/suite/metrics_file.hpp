@@ -1,0 +1,43 @@
+#pragma once
+// The parts of a run's metrics.json (written by `pvbench run`, see
+// docs/sweeps.md for the keys) that the checker and the sweep aggregation
+// read.  JSON is read with yaml-cpp, which parses JSON.
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pvb::suite {
+
+struct LossEvent {
+  int frame = -1;
+  double t_s = 0.0;
+  std::string reason;
+};
+
+/// One SLAM run's figures (the top level, or the "baseline" object).
+struct RunMetrics {
+  std::string mode;    ///< "pe-slam" or "orb-slam2"
+  std::string status;  ///< "completed", "interrupted" or "aborted"
+  int frames = 0;
+  int lost_frames = 0;
+  std::optional<double> ate_rmse_m;        ///< absent when "ate" is null
+  std::optional<double> rpe_trans_rmse_m;  ///< absent when "rpe" is null
+  std::optional<double> tracking_ms_median;
+  std::optional<double> realtime_factor;
+  std::vector<LossEvent> loss_events;
+};
+
+struct MetricsFile {
+  std::string path;
+  std::string scenario;
+  std::optional<unsigned long long> seed;
+  RunMetrics primary;                  ///< the top-level run (PE-SLAM with --compare)
+  std::optional<RunMetrics> baseline;  ///< only with --compare
+};
+
+/// Reads and checks the shape of a metrics.json.  Throws IoError naming the
+/// file and the key when the file is missing, is not JSON, or a required key
+/// (status, frames, lost_frames, ate, rpe) is missing or of the wrong type.
+MetricsFile read_metrics_file(const std::string& path);
+
+}  // namespace pvb::suite

@@ -1,0 +1,319 @@
+#include "pvb/suite/aggregate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+
+namespace pvb::suite {
+namespace {
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+std::string opt(const std::optional<double>& v, const char* f, double scale = 1.0) {
+  return v ? fmt(f, *v * scale) : "";
+}
+std::string json_num(double v) {
+  if (!std::isfinite(v)) return "null";
+  return fmt("%.9g", v);
+}
+std::string json_opt(const std::optional<double>& v) { return v ? json_num(*v) : "null"; }
+
+RunSummary summarize_runs(const std::vector<const RunMetrics*>& runs) {
+  std::vector<double> ate, lost, ms, rtf;
+  for (const RunMetrics* r : runs) {
+    if (r->ate_rmse_m) ate.push_back(*r->ate_rmse_m);
+    lost.push_back(r->lost_frames);
+    if (r->tracking_ms_median) ms.push_back(*r->tracking_ms_median);
+    if (r->realtime_factor) rtf.push_back(*r->realtime_factor);
+  }
+  return {summarize(ate), summarize(lost), summarize(ms), summarize(rtf)};
+}
+
+std::string pm(const Summary& s, const char* f, double scale = 1.0) {
+  if (s.count == 0) return "n/a";
+  return fmt(f, s.mean * scale) + " ± " + fmt(f, s.sd * scale);
+}
+
+std::string summary_json(const Summary& s) {
+  if (s.count == 0) return "{\"count\": 0}";
+  return "{\"count\": " + std::to_string(s.count) + ", \"mean\": " + json_num(s.mean) +
+         ", \"sd\": " + json_num(s.sd) + ", \"min\": " + json_num(s.min) + ", \"max\": " + json_num(s.max) +
+         "}";
+}
+
+std::string run_summary_json(const RunSummary& r) {
+  return "{\"ate_rmse_m\": " + summary_json(r.ate_rmse_m) +
+         ", \"lost_frames\": " + summary_json(r.lost_frames) +
+         ", \"tracking_ms_median\": " + summary_json(r.tracking_ms_median) +
+         ", \"realtime_factor\": " + summary_json(r.realtime_factor) + "}";
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
+  return out + "\"";
+}
+
+bool seed_failed(const SeedRun& r) { return !r.metrics || r.exit_code != 0; }
+
+}  // namespace
+
+Summary summarize(const std::vector<double>& values) {
+  Summary s;
+  s.count = static_cast<int>(values.size());
+  if (values.empty()) return s;
+  double sum = 0;
+  for (double v : values) sum += v;
+  s.mean = sum / s.count;
+  double ss = 0;
+  for (double v : values) ss += (v - s.mean) * (v - s.mean);
+  s.sd = s.count > 1 ? std::sqrt(ss / (s.count - 1)) : 0.0;
+  s.min = *std::min_element(values.begin(), values.end());
+  s.max = *std::max_element(values.begin(), values.end());
+  return s;
+}
+
+SeedRun read_seed_run(std::uint64_t seed, const std::string& metrics_path, int exit_code) {
+  SeedRun r;
+  r.seed = seed;
+  r.exit_code = exit_code;
+  try {
+    r.metrics = read_metrics_file(metrics_path);
+  } catch (const Error& e) {
+    r.error = e.what();
+  }
+  return r;
+}
+
+SweepAggregate aggregate(const std::string& scenario, std::vector<SeedRun> runs) {
+  SweepAggregate a;
+  a.scenario = scenario;
+  a.runs = std::move(runs);
+  std::vector<const RunMetrics*> primary, baseline;
+  for (const SeedRun& r : a.runs) {
+    if (seed_failed(r)) ++a.failed;
+    if (!r.metrics) continue;
+    primary.push_back(&r.metrics->primary);
+    if (r.metrics->baseline) baseline.push_back(&*r.metrics->baseline);
+  }
+  a.primary = summarize_runs(primary);
+  a.has_baseline = !baseline.empty();
+  if (a.has_baseline) a.baseline = summarize_runs(baseline);
+  return a;
+}
+
+std::string format_markdown(const SweepAggregate& a) {
+  int with_metrics = 0;
+  for (const SeedRun& r : a.runs) with_metrics += r.metrics ? 1 : 0;
+  std::string out = "# Sweep: " + a.scenario + "\n\n" + std::to_string(a.runs.size()) + " seeds, " +
+                    std::to_string(with_metrics) + " with metrics, " + std::to_string(a.failed) +
+                    " failed. Mean ± sample SD over the seeds with metrics.\n\n";
+  out += "| run | seeds | ATE RMSE (mm) | lost frames | tracking ms (median) | realtime factor |\n";
+  out += "|---|---|---|---|---|---|\n";
+  auto row = [&](const char* name, const RunSummary& s) {
+    out += std::string("| ") + name + " | " + std::to_string(s.lost_frames.count) + " | " +
+           pm(s.ate_rmse_m, "%.2f", 1000.0) + " | " + pm(s.lost_frames, "%.1f") + " | " +
+           pm(s.tracking_ms_median, "%.2f") + " | " + pm(s.realtime_factor, "%.3f") + " |\n";
+  };
+  // The primary run's name: PE-SLAM unless the seeds ran --baseline alone.
+  std::string primary_name = "PE-SLAM";
+  for (const SeedRun& r : a.runs)
+    if (r.metrics && !r.metrics->primary.mode.empty()) {
+      if (r.metrics->primary.mode == "orb-slam2") primary_name = "ORB-SLAM2 baseline";
+      break;
+    }
+  row(primary_name.c_str(), a.primary);
+  if (a.has_baseline) row("ORB-SLAM2 baseline", a.baseline);
+
+  out +=
+      "\n## Per seed\n\n| seed | exit | status | frames | lost | ATE RMSE (mm) | tracking ms | realtime "
+      "factor |";
+  if (a.has_baseline) out += " baseline lost | baseline ATE RMSE (mm) |";
+  out += " note |\n|---|---|---|---|---|---|---|---|";
+  if (a.has_baseline) out += "---|---|";
+  out += "---|\n";
+  for (const SeedRun& r : a.runs) {
+    out += "| " + std::to_string(r.seed) + " | " + std::to_string(r.exit_code) + " | ";
+    if (r.metrics) {
+      const RunMetrics& m = r.metrics->primary;
+      out += m.status + " | " + std::to_string(m.frames) + " | " + std::to_string(m.lost_frames) + " | " +
+             opt(m.ate_rmse_m, "%.2f", 1000.0) + " | " + opt(m.tracking_ms_median, "%.2f") + " | " +
+             opt(m.realtime_factor, "%.3f") + " |";
+      if (a.has_baseline) {
+        if (r.metrics->baseline)
+          out += " " + std::to_string(r.metrics->baseline->lost_frames) + " | " +
+                 opt(r.metrics->baseline->ate_rmse_m, "%.2f", 1000.0) + " |";
+        else
+          out += " | |";
+      }
+      std::string note;
+      if (!m.loss_events.empty())
+        note = "first loss at frame " + std::to_string(m.loss_events.front().frame) + ": " +
+               m.loss_events.front().reason;
+      for (char& c : note) c = c == '|' ? '/' : c;
+      out += " " + note + " |\n";
+    } else {
+      std::string note = "no metrics: " + r.error;
+      for (char& c : note) c = c == '|' ? '/' : c;
+      out += " | | | | | |" + std::string(a.has_baseline ? " | |" : "") + " " + note + " |\n";
+    }
+  }
+  return out;
+}
+
+std::string format_csv(const SweepAggregate& a) {
+  std::string out =
+      "seed,exit_code,status,frames,lost_frames,ate_rmse_m,rpe_trans_rmse_m,tracking_ms_median,realtime_"
+      "factor,"
+      "baseline_lost_frames,baseline_ate_rmse_m,baseline_tracking_ms_median,error\n";
+  for (const SeedRun& r : a.runs) {
+    out += std::to_string(r.seed) + "," + std::to_string(r.exit_code) + ",";
+    if (r.metrics) {
+      const RunMetrics& m = r.metrics->primary;
+      out += m.status + "," + std::to_string(m.frames) + "," + std::to_string(m.lost_frames) + "," +
+             opt(m.ate_rmse_m, "%.9g") + "," + opt(m.rpe_trans_rmse_m, "%.9g") + "," +
+             opt(m.tracking_ms_median, "%.9g") + "," + opt(m.realtime_factor, "%.9g") + ",";
+      if (r.metrics->baseline) {
+        const RunMetrics& b = *r.metrics->baseline;
+        out += std::to_string(b.lost_frames) + "," + opt(b.ate_rmse_m, "%.9g") + "," +
+               opt(b.tracking_ms_median, "%.9g") + ",";
+      } else {
+        out += ",,,";
+      }
+      out += "\n";
+    } else {
+      out += ",,,,,,,,,," + csv_field(r.error) + "\n";
+    }
+  }
+  return out;
+}
+
+std::string format_json(const SweepAggregate& a) {
+  std::string out = "{\n  \"scenario\": \"" + json_escape(a.scenario) +
+                    "\",\n  \"seeds\": " + std::to_string(a.runs.size()) +
+                    ",\n  \"failed\": " + std::to_string(a.failed) + ",\n";
+  out += "  \"primary\": " + run_summary_json(a.primary) + ",\n";
+  out += "  \"baseline\": " + (a.has_baseline ? run_summary_json(a.baseline) : std::string("null")) + ",\n";
+  out += "  \"runs\": [\n";
+  for (std::size_t i = 0; i < a.runs.size(); ++i) {
+    const SeedRun& r = a.runs[i];
+    out += "    {\"seed\": " + std::to_string(r.seed) + ", \"exit_code\": " + std::to_string(r.exit_code);
+    if (r.metrics) {
+      const RunMetrics& m = r.metrics->primary;
+      out += ", \"status\": \"" + json_escape(m.status) + "\", \"frames\": " + std::to_string(m.frames) +
+             ", \"lost_frames\": " + std::to_string(m.lost_frames) +
+             ", \"ate_rmse_m\": " + json_opt(m.ate_rmse_m) +
+             ", \"rpe_trans_rmse_m\": " + json_opt(m.rpe_trans_rmse_m) +
+             ", \"tracking_ms_median\": " + json_opt(m.tracking_ms_median) +
+             ", \"realtime_factor\": " + json_opt(m.realtime_factor);
+      if (r.metrics->baseline) {
+        const RunMetrics& b = *r.metrics->baseline;
+        out += ", \"baseline\": {\"lost_frames\": " + std::to_string(b.lost_frames) +
+               ", \"ate_rmse_m\": " + json_opt(b.ate_rmse_m) +
+               ", \"tracking_ms_median\": " + json_opt(b.tracking_ms_median) + "}";
+      }
+    } else {
+      out += ", \"error\": \"" + json_escape(r.error) + "\"";
+    }
+    out += i + 1 < a.runs.size() ? "},\n" : "}\n";
+  }
+  out += "  ]\n}\n";
+  return out;
+}
+
+eval::Figure make_sweep_figure(const SweepAggregate& a) {
+  eval::Figure f;
+  f.width_px = 760;
+  f.height_px = 380;
+  const double left = 70, right = f.width_px - 20.0, top = 40, bottom = f.height_px - 50.0;
+  const eval::Rgb black{0, 0, 0}, grey{200, 200, 200}, blue{31, 119, 180}, orange{230, 120, 20};
+
+  // Values in millimetres per seed (NaN where missing).
+  std::vector<double> pe, base;
+  double ymax = 0;
+  for (const SeedRun& r : a.runs) {
+    const double nan = std::nan("");
+    double p = nan, b = nan;
+    if (r.metrics && r.metrics->primary.ate_rmse_m) p = *r.metrics->primary.ate_rmse_m * 1000.0;
+    if (r.metrics && r.metrics->baseline && r.metrics->baseline->ate_rmse_m)
+      b = *r.metrics->baseline->ate_rmse_m * 1000.0;
+    pe.push_back(p);
+    base.push_back(b);
+    if (std::isfinite(p)) ymax = std::max(ymax, p);
+    if (std::isfinite(b)) ymax = std::max(ymax, b);
+  }
+  if (!(ymax > 0)) ymax = 1.0;
+  double step = 1;
+  std::vector<double> ticks = eval::nice_ticks(0.0, ymax * 1.05, 5, &step);
+  // The axis ends on a tick at or above the largest value.
+  if (ticks.empty()) ticks.push_back(0.0);
+  while (ticks.back() < ymax * 1.05 - 1e-12) ticks.push_back(ticks.back() + step);
+  const double ytop = ticks.back() > 0 ? ticks.back() : ymax * 1.05;
+  auto Y = [&](double v) { return bottom - (bottom - top) * v / ytop; };
+  const std::size_t n = a.runs.size();
+  auto X = [&](std::size_t i) { return left + (right - left) * (i + 0.5) / std::max<std::size_t>(n, 1); };
+
+  f.texts.push_back({f.width_px / 2.0, 22, "ATE RMSE per seed: " + a.scenario, 15, eval::TextAnchor::kMiddle,
+                     false, black});
+  for (double t : ticks) {
+    if (t > ytop + 1e-12) continue;
+    f.lines.push_back({left, Y(t), right, Y(t), grey, 1});
+    f.texts.push_back(
+        {left - 6, Y(t) + 4, eval::tick_label(t, step), 11, eval::TextAnchor::kEnd, false, black});
+  }
+  f.lines.push_back({left, top, left, bottom, black, 1});
+  f.lines.push_back({left, bottom, right, bottom, black, 1});
+  f.texts.push_back({18, (top + bottom) / 2, "ATE RMSE (mm)", 12, eval::TextAnchor::kMiddle, true, black});
+  f.texts.push_back(
+      {(left + right) / 2, f.height_px - 10.0, "seed", 12, eval::TextAnchor::kMiddle, false, black});
+  const std::size_t label_every = std::max<std::size_t>(1, n / 20);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i % label_every == 0)
+      f.texts.push_back(
+          {X(i), bottom + 16, std::to_string(a.runs[i].seed), 11, eval::TextAnchor::kMiddle, false, black});
+    if (seed_failed(a.runs[i]))
+      f.texts.push_back(
+          {X(i), bottom - 6, "x", 13, eval::TextAnchor::kMiddle, false, eval::Rgb{200, 30, 30}});
+  }
+  auto dashed = [&](double v, const eval::Rgb& c) {
+    for (double x = left; x < right; x += 12)
+      f.lines.push_back({x, Y(v), std::min(x + 7, right), Y(v), c, 1.5});
+  };
+  if (a.primary.ate_rmse_m.count > 0) dashed(a.primary.ate_rmse_m.mean * 1000.0, blue);
+  if (a.has_baseline && a.baseline.ate_rmse_m.count > 0) dashed(a.baseline.ate_rmse_m.mean * 1000.0, orange);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (std::isfinite(base[i])) {  // hollow square
+      const double x = X(i), y = Y(base[i]), h = 5;
+      f.polylines.push_back(
+          {{{x - h, y - h}, {x + h, y - h}, {x + h, y + h}, {x - h, y + h}, {x - h, y - h}}, orange, 1.5});
+    }
+    if (std::isfinite(pe[i])) {  // filled dot: a short thick stroke
+      const double x = X(i), y = Y(pe[i]);
+      f.lines.push_back({x - 0.5, y, x + 0.5, y, blue, 8});
+    }
+  }
+  // Legend.
+  double lx = right - 250;
+  f.lines.push_back({lx, top - 8, lx + 1, top - 8, blue, 8});
+  f.texts.push_back(
+      {lx + 10, top - 4, a.has_baseline ? "PE-SLAM" : "run", 11, eval::TextAnchor::kStart, false, black});
+  if (a.has_baseline) {
+    lx += 90;
+    f.polylines.push_back(
+        {{{lx - 5, top - 13}, {lx + 5, top - 13}, {lx + 5, top - 3}, {lx - 5, top - 3}, {lx - 5, top - 13}},
+         orange,
+         1.5});
+    f.texts.push_back({lx + 10, top - 4, "ORB-SLAM2", 11, eval::TextAnchor::kStart, false, black});
+  }
+  f.texts.push_back({right, top - 4 + 14, "dashed: mean", 10, eval::TextAnchor::kEnd, false, black});
+  return f;
+}
+
+}  // namespace pvb::suite

@@ -1,0 +1,145 @@
+#include "pvb/suite/metrics_file.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+
+namespace pvb::suite {
+namespace {
+
+// Reads one metrics object; `prefix` names nested keys in errors ("baseline.").
+class Reader {
+ public:
+  Reader(std::string path, std::string prefix) : path_(std::move(path)), prefix_(std::move(prefix)) {}
+
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& key, const std::string& what) const {
+    const YAML::Mark m = at.Mark();
+    throw IoError(path_, prefix_ + key + ": " + what, m.line >= 0 ? m.line + 1 : 0);
+  }
+
+  YAML::Node required(const YAML::Node& obj, const std::string& key) const {
+    const YAML::Node n = obj[key];
+    if (!n.IsDefined()) fail(obj, key, "missing");
+    return n;
+  }
+
+  double number(const YAML::Node& obj, const std::string& key) const {
+    const YAML::Node n = required(obj, key);
+    double v = 0;
+    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
+      fail(n, key, "expected a number");
+    return v;
+  }
+
+  int integer(const YAML::Node& obj, const std::string& key) const {
+    const YAML::Node n = required(obj, key);
+    long long v = 0;
+    if (!n.IsScalar() || !YAML::convert<long long>::decode(n, v)) fail(n, key, "expected an integer");
+    return static_cast<int>(v);
+  }
+
+  std::string text(const YAML::Node& obj, const std::string& key) const {
+    const YAML::Node n = required(obj, key);
+    if (!n.IsScalar()) fail(n, key, "expected a string");
+    return n.Scalar();
+  }
+
+  /// An optional number under obj[key][sub] (absent or null object -> nullopt).
+  std::optional<double> optional_number(const YAML::Node& obj, const std::string& key,
+                                        const std::string& sub) const {
+    const YAML::Node n = obj[key];
+    if (!n.IsDefined() || n.IsNull()) return std::nullopt;
+    if (!n.IsMap()) fail(n, key, "expected an object or null");
+    const Reader inner(path_, prefix_ + key + ".");
+    return inner.number(n, sub);
+  }
+
+  /// "ate"/"rpe" must be present, and an object or null.
+  std::optional<double> stats_rmse(const YAML::Node& obj, const std::string& key,
+                                   const std::vector<std::string>& path) const {
+    YAML::Node n = required(obj, key);
+    if (n.IsNull()) return std::nullopt;
+    std::string name = key;
+    for (const auto& p : path) {
+      if (!n.IsMap()) fail(n, name, "expected an object or null");
+      const YAML::Node child = n[p];
+      if (!child.IsDefined()) fail(n, name + "." + p, "missing");
+      n = child;
+      name += "." + p;
+    }
+    if (!n.IsMap()) fail(n, name, "expected an object");
+    const Reader inner(path_, prefix_ + name + ".");
+    return inner.number(n, "rmse");
+  }
+
+  RunMetrics run(const YAML::Node& obj) const {
+    if (!obj.IsMap()) fail(obj, "(top level)", "expected a JSON object");
+    RunMetrics r;
+    if (obj["mode"].IsDefined()) r.mode = text(obj, "mode");
+    r.status = text(obj, "status");
+    if (r.status != "completed" && r.status != "interrupted" && r.status != "aborted")
+      fail(obj["status"], "status", "expected completed, interrupted or aborted, got " + r.status);
+    r.frames = integer(obj, "frames");
+    r.lost_frames = integer(obj, "lost_frames");
+    r.ate_rmse_m = stats_rmse(obj, "ate", {});
+    r.rpe_trans_rmse_m = stats_rmse(obj, "rpe", {"trans"});
+    r.tracking_ms_median = optional_number(obj, "tracking_ms", "median");
+    const YAML::Node rtf = obj["realtime_factor"];
+    if (rtf.IsDefined() && !rtf.IsNull()) r.realtime_factor = number(obj, "realtime_factor");
+    const YAML::Node events = obj["loss_events"];
+    if (events.IsDefined() && !events.IsNull()) {
+      if (!events.IsSequence()) fail(events, "loss_events", "expected a list");
+      for (std::size_t i = 0; i < events.size(); ++i) {
+        const Reader inner(path_, prefix_ + "loss_events[" + std::to_string(i) + "].");
+        if (!events[i].IsMap()) inner.fail(events[i], "", "expected an object");
+        LossEvent e;
+        e.frame = inner.integer(events[i], "frame");
+        if (events[i]["t_s"].IsDefined()) e.t_s = inner.number(events[i], "t_s");
+        const YAML::Node reason = events[i]["reason"];
+        if (reason.IsDefined() && !reason.IsNull()) e.reason = inner.text(events[i], "reason");
+        r.loss_events.push_back(e);
+      }
+    }
+    return r;
+  }
+
+ private:
+  std::string path_;
+  std::string prefix_;
+};
+
+}  // namespace
+
+MetricsFile read_metrics_file(const std::string& path) {
+  const std::string text = read_file(path);
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw IoError(path, "not valid JSON: " + e.msg, e.mark.line + 1);
+  }
+  if (!root.IsMap()) throw IoError(path, "expected a JSON object at the top level");
+  MetricsFile m;
+  m.path = path;
+  const Reader top(path, "");
+  if (root["scenario"].IsDefined()) m.scenario = top.text(root, "scenario");
+  const YAML::Node seed = root["seed"];
+  if (seed.IsDefined() && !seed.IsNull()) {
+    unsigned long long v = 0;
+    if (!seed.IsScalar() || !YAML::convert<unsigned long long>::decode(seed, v))
+      top.fail(seed, "seed", "expected a non-negative integer");
+    m.seed = v;
+  }
+  m.primary = top.run(root);
+  const YAML::Node base = root["baseline"];
+  if (base.IsDefined() && !base.IsNull()) {
+    if (!base.IsMap()) top.fail(base, "baseline", "expected an object");
+    m.baseline = Reader(path, "baseline.").run(base);
+  }
+  return m;
+}
+
+}  // namespace pvb::suite

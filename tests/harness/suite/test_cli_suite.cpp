@@ -1,0 +1,145 @@
+// pvbench check and the parts of pvbench sweep that need no `pvbench run`:
+// exit codes, one line per violation, seed-list errors, --print-commands
+// and --aggregate-only over hand-written metrics.json fixtures.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "pvb/common/text.hpp"
+#include "run_pvbench.hpp"
+
+namespace fs = std::filesystem;
+using pvb::test::run_pvbench;
+
+namespace {
+
+std::string fixture(const std::string& name) {
+  return std::string(PVB_SOURCE_DIR) + "/tests/harness/suite/fixtures/" + name;
+}
+
+std::string scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("pvb_cli_suite_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir.string();
+}
+
+// A scenario with the nominal bounds.
+std::string scenario_file() {
+  const std::string path = scratch("scenario") + "/s.yaml";
+  pvb::write_file(path,
+                  "name: s\nroute: {waypoints_m: [[0, 0], [5, 0]]}\n"
+                  "expect:\n  ate_rmse_m_max: 0.01\n  rpe_trans_rmse_m_max: 0.005\n  lost_frames_max: 0\n"
+                  "  pe_not_worse_than_baseline: true\n");
+  return path;
+}
+
+int count_lines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+}  // namespace
+
+TEST(CliCheck, PassingRunExitsZero) {
+  const auto r =
+      run_pvbench("check --scenario " + scenario_file() + " --metrics " + fixture("good_compare.json"));
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("good_compare.json: ok (s)"), std::string::npos) << r.output;
+}
+
+TEST(CliCheck, ViolationsExitThreeWithOneLineEach) {
+  const auto r = run_pvbench("check --scenario " + scenario_file() + " --metrics " +
+                             fixture("worse_than_baseline.json"));
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_EQ(count_lines(r.output), 4) << r.output;
+  EXPECT_NE(r.output.find("worse_than_baseline.json: ate_rmse_m_max: ATE RMSE 0.0235 m > 0.01 m"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("lost_frames_max: 4 lost frames > 0"), std::string::npos) << r.output;
+}
+
+TEST(CliCheck, MalformedMetricsIsOneErrorLine) {
+  const auto r =
+      run_pvbench("check --scenario " + scenario_file() + " --metrics " + fixture("missing_status.json"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(count_lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("pvbench: error: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("missing_status.json:1: status: missing"), std::string::npos) << r.output;
+}
+
+TEST(CliCheck, ShippedFailureScenarioAcceptsAReportedLoss) {
+  const std::string scenes = std::string(PVB_SOURCE_DIR) + "/scenes/";
+  EXPECT_EQ(run_pvbench("check --scenario " + scenes + "tracking_failure.yaml --metrics " +
+                        fixture("lost_aborted.json"))
+                .code,
+            0);
+  const auto r = run_pvbench("check --scenario " + scenes + "tracking_failure.yaml --metrics " +
+                             fixture("good_compare.json"));
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("tracking_loss_expected: no tracking loss was reported"), std::string::npos)
+      << r.output;
+}
+
+TEST(CliSweep, BadSeedListIsOneErrorLine) {
+  const std::string out = scratch("bad_seeds");
+  const auto r = run_pvbench("sweep --scenario " + scenario_file() + " --seeds 5-1 --out " + out);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(r.output, "pvbench: error: command line: --seeds: expected a range a-b with a <= b, got '5-1'\n");
+  EXPECT_FALSE(fs::exists(out + "/seed_5"));
+}
+
+TEST(CliSweep, PrintCommandsGivesOneSelfContainedLinePerSeed) {
+  const std::string out = scratch("print");
+  const std::string scenario = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
+  const auto r = run_pvbench("sweep --scenario " + scenario + " --seeds 1-2,9 --out " + out +
+                             " --frames 30 --compare --sync --print-commands");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(count_lines(r.output), 3) << r.output;
+  const std::string exe = fs::canonical(pvb::test::pvbench_path()).string();
+  const std::string seed9 = "mkdir -p " + out + "/seed_9 && " + exe + " run --scenario " + scenario +
+                            " --seed 9 --out " + out + "/seed_9 --frames 30 --compare --sync > " + out +
+                            "/seed_9/stdout.log 2>&1\n";
+  EXPECT_NE(r.output.find(seed9), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out + "/seed_1"));  // printing runs nothing
+}
+
+TEST(CliSweep, AggregateOnlyCollectsSeedFolders) {
+  const std::string out = scratch("aggregate");
+  fs::create_directories(out + "/seed_1");
+  fs::create_directories(out + "/seed_2");
+  fs::create_directories(out + "/seed_10");  // a seed that left no metrics
+  fs::create_directories(out + "/not_a_seed");
+  fs::copy_file(fixture("good_compare.json"), out + "/seed_1/metrics.json");
+  fs::copy_file(fixture("worse_than_baseline.json"), out + "/seed_2/metrics.json");
+  const auto r = run_pvbench("sweep --out " + out + " --aggregate-only");
+  EXPECT_EQ(r.code, 3) << r.output;  // one seed failed
+  for (const char* f : {"aggregate.md", "aggregate.csv", "aggregate.json", "aggregate.svg", "aggregate.png"})
+    EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
+  const std::string md = pvb::read_file(out + "/aggregate.md");
+  EXPECT_NE(md.find("# Sweep: pv_station"), std::string::npos) << md;  // name from the metrics
+  EXPECT_NE(md.find("3 seeds, 2 with metrics, 1 failed"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 10 | 0 |"), std::string::npos) << md;
+  const std::string csv = pvb::read_file(out + "/aggregate.csv");
+  EXPECT_EQ(count_lines(csv), 4) << csv;  // header + seeds 1, 2, 10 in numeric order
+  EXPECT_LT(csv.find("\n1,"), csv.find("\n2,"));
+  EXPECT_LT(csv.find("\n2,"), csv.find("\n10,"));
+
+  // An explicit list aggregates only those seeds.
+  const auto two = run_pvbench("sweep --out " + out + " --aggregate-only --seeds 1-2");
+  EXPECT_EQ(two.code, 0) << two.output;
+  EXPECT_NE(pvb::read_file(out + "/aggregate.md").find("2 seeds, 2 with metrics, 0 failed"),
+            std::string::npos);
+}
+
+TEST(CliSweep, AggregateOnlyWithoutSeedFoldersIsAnError) {
+  const std::string out = scratch("empty");
+  const auto r = run_pvbench("sweep --out " + out + " --aggregate-only");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("seed_*/metrics.json: expected at least one seed folder, got none"),
+            std::string::npos)
+      << r.output;
+}

@@ -1,0 +1,62 @@
+// A real two-seed sweep of the default scenario (a few frames each), then
+// the Slurm array script for a third seed and --aggregate-only over all
+// three.  Label `scenario`: it runs `pvbench run` three times.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "pvb/common/text.hpp"
+#include "run_pvbench.hpp"
+
+namespace fs = std::filesystem;
+using pvb::test::run_pvbench;
+
+namespace {
+constexpr int kFrames = 12;
+}  // namespace
+
+TEST(SweepRun, TwoSeedsThenASlurmTaskThenAggregateOnly) {
+  const fs::path out = fs::temp_directory_path() / ("pvb_sweep_run_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const std::string scenario = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
+  const std::string common = " --frames " + std::to_string(kFrames) + " --compare --sync";
+
+  const auto r =
+      run_pvbench("sweep --scenario " + scenario + " --seeds 1,2 --jobs 2 --out " + out.string() + common);
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (int seed : {1, 2}) {
+    const fs::path dir = out / ("seed_" + std::to_string(seed));
+    ASSERT_TRUE(fs::exists(dir / "metrics.json")) << dir;
+    const std::string metrics = pvb::read_file((dir / "metrics.json").string());
+    EXPECT_NE(metrics.find("\"seed\": " + std::to_string(seed)), std::string::npos) << metrics.substr(0, 300);
+    EXPECT_NE(pvb::read_file((dir / "stdout.log").string()).find("pvbench run: scenario pv_station"),
+              std::string::npos);
+    EXPECT_NE(r.output.find("seed " + std::to_string(seed) + ": exit 0; completed"), std::string::npos)
+        << r.output;
+  }
+  const std::string md = pvb::read_file((out / "aggregate.md").string());
+  EXPECT_NE(md.find("2 seeds, 2 with metrics, 0 failed"), std::string::npos) << md;
+  EXPECT_NE(md.find("| ORB-SLAM2 baseline | 2 |"), std::string::npos) << md;
+  for (const char* f : {"aggregate.csv", "aggregate.json", "aggregate.svg", "aggregate.png"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+
+  // The Slurm script runs the same self-contained command for its task's
+  // seed.  Seed 2 again, into another folder: sync mode is bit-identical.
+  const fs::path slurm_out = out / "slurm";
+  const std::string slurm = "cd " + std::string(PVB_SOURCE_DIR) +
+                            " && SLURM_ARRAY_TASK_ID=2 PVBENCH=" + pvb::test::pvbench_path() +
+                            " bash scripts/slurm_sweep.sh " + scenario + " " + slurm_out.string() + common;
+  ASSERT_EQ(std::system(slurm.c_str()), 0) << slurm;
+  EXPECT_EQ(pvb::read_file((slurm_out / "seed_2" / "CameraTrajectory.txt").string()),
+            pvb::read_file((out / "seed_2" / "CameraTrajectory.txt").string()));
+  fs::copy(slurm_out / "seed_2", out / "seed_3", fs::copy_options::recursive);  // stands in for a third task
+
+  const auto agg = run_pvbench("sweep --out " + out.string() + " --aggregate-only");
+  EXPECT_EQ(agg.code, 0) << agg.output;
+  EXPECT_NE(pvb::read_file((out / "aggregate.md").string()).find("3 seeds, 3 with metrics, 0 failed"),
+            std::string::npos);
+  fs::remove_all(out);
+}
