@@ -12,9 +12,14 @@
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/run/run.hpp"
+#include "pvb/scenes/scenario.hpp"
+#include "pvb/suite/check.hpp"
 
 namespace pvb::cli {
 namespace {
+
+/// Exit status when --check finds a violated bound (as pvbench check).
+constexpr int kViolationExit = 3;
 
 struct RunArgs {
   run::RunOptions options;
@@ -80,14 +85,20 @@ int run_run(RunArgs& a) {
   if (bar) bar->finish();
   std::printf("report: %s/index.html (metrics.json, trajectories, figures, run.log)\n", o.out_dir.c_str());
   const int code = run::exit_code(report.status);
-  if (code != 0) return code;
-  if (a.check) {
-    // Hook for the scenario checker (pvbench check, scenes' `expect:` bounds):
-    // compare o.out_dir + "/metrics.json" with the scenario's bounds, print
-    // one line per violated bound and return 3.  Wired at merge.
-    throw UnavailableError("--check: the scenario checker is not part of this build");
+  if (!a.check || report.status == run::RunStatus::kInterrupted) return code;
+  // --check: the scenario's expect: bounds judge the run.  An aborted run
+  // (on_loss: abort) passes when the scenario expects tracking to be lost.
+  const scenes::Scenario scenario = scenes::load_scenario(o.scenario_file);
+  if (!scenario.expect.any()) {
+    std::printf("%s: no expect: section, nothing to check\n", o.scenario_file.c_str());
+    return code;
   }
-  return 0;
+  const std::string metrics = o.out_dir + "/metrics.json";
+  const std::vector<suite::Violation> violations = suite::check_expectations(scenario.expect, metrics);
+  for (const auto& v : violations) std::printf("%s: %s\n", metrics.c_str(), v.line().c_str());
+  if (violations.empty()) std::printf("%s: ok (%s)\n", metrics.c_str(), scenario.name.c_str());
+  std::fflush(stdout);
+  return violations.empty() ? 0 : kViolationExit;
 }
 
 }  // namespace

@@ -1,10 +1,11 @@
 # Runs one scenario of the suite end to end and checks its bounds:
-#   pvbench run --scenario SCENARIO --out OUT --compare --sync [--frames FRAMES]
+#   pvbench run --scenario SCENARIO --out OUT --compare --sync --check [--frames FRAMES]
 #   pvbench check --scenario SCENARIO --metrics OUT/metrics.json
-# Fails when the run crashes or exits non-zero (4, "aborted" by the
-# scenario's route.on_loss, is left to the checker: only a scenario that
-# expects a tracking loss accepts it), or when a bound in the scenario's
-# expect: section is violated.  pvbench's output goes to
+# Fails when the run crashes or exits with anything but 0 (bounds hold) or 3
+# (a bound is violated; "aborted" by route.on_loss is judged by the checker:
+# only a scenario that expects a tracking loss accepts it), when a bound in
+# the scenario's expect: section is violated, or when `run --check` and
+# `pvbench check` disagree.  pvbench's output goes to
 # OUT.stdout.log; the tail is printed on failure.
 foreach(v PVBENCH SCENARIO OUT)
   if(NOT DEFINED ${v})
@@ -16,14 +17,15 @@ file(REMOVE_RECURSE "${OUT}")
 get_filename_component(parent "${OUT}" DIRECTORY)
 file(MAKE_DIRECTORY "${parent}")
 set(log "${OUT}.stdout.log")
-set(args run --scenario "${SCENARIO}" --out "${OUT}" --compare --sync)
+set(args run --scenario "${SCENARIO}" --out "${OUT}" --compare --sync --check)
 if(FRAMES)
   list(APPEND args --frames ${FRAMES})
 endif()
 string(REPLACE ";" " " shown "${args}")
 message(STATUS "pvbench ${shown}")
 execute_process(COMMAND "${PVBENCH}" ${args} RESULT_VARIABLE rc OUTPUT_FILE "${log}" ERROR_FILE "${log}")
-if(NOT rc EQUAL 0 AND NOT rc EQUAL 4)
+set(run_rc ${rc})
+if(NOT rc EQUAL 0 AND NOT rc EQUAL 3)
   file(STRINGS "${log}" lines)
   list(LENGTH lines n)
   if(n GREATER 40)
@@ -37,6 +39,9 @@ endif()
 execute_process(COMMAND "${PVBENCH}" check --scenario "${SCENARIO}" --metrics "${OUT}/metrics.json"
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
 message("${out}")
+if((rc EQUAL 0) AND NOT (run_rc EQUAL 0) OR (run_rc EQUAL 0) AND NOT (rc EQUAL 0))
+  message(FATAL_ERROR "pvbench run --check exited ${run_rc} but pvbench check exited ${rc}")
+endif()
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "pvbench check: the run violates the scenario's expect: bounds (exit ${rc})")
 endif()
