@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
 # The README's first command: install, build, and run the main job on the
 # default photovoltaic scenario, end to end:
-#   render the station (751 frames) -> PE-SLAM and the ORB-SLAM2 baseline
-#   (synchronous, deterministic) -> ATE/RPE table, plots and JSON.
+#   1. render the station (751 frames) into a TUM RGB-D sequence that
+#      ORB-SLAM2 and other systems read unchanged;
+#   2. simulation in the loop: render again and feed PE-SLAM and the
+#      ORB-SLAM2 baseline in memory, evaluate against ground truth, print the
+#      ATE/RPE comparison and write the report (index.html, metrics.json,
+#      figures, trajectories, contact sheet, run.log).
 # Output goes to ./out/pv_station (override the root with PVB_OUT).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,16 +15,10 @@ bash ci/build.sh
 B=./build/bin/pvbench
 OUT="${PVB_OUT:-out}/pv_station"
 rm -rf "$OUT"
-mkdir -p "$OUT/report"
-echo "== 1/4 rendering scenes/pv_station.yaml"
+mkdir -p "$OUT"
+echo "== 1/2 rendering scenes/pv_station.yaml into a TUM RGB-D sequence"
 $B record --scenario scenes/pv_station.yaml --out "$OUT/sequence"
-echo "== 2/4 PE-SLAM"
-$B slam --sequence "$OUT/sequence" --settings "$OUT/sequence/camera.yaml" --out "$OUT/pe_slam" --sync
-echo "== 3/4 ORB-SLAM2 baseline (same binary, --no-pe-match)"
-$B slam --sequence "$OUT/sequence" --settings "$OUT/sequence/camera.yaml" --out "$OUT/baseline" --sync --no-pe-match
-echo "== 4/4 evaluation"
-$B eval --gt "$OUT/sequence/groundtruth.txt" \
-  --est "$OUT/pe_slam/CameraTrajectory.txt" --est "$OUT/baseline/CameraTrajectory.txt" \
-  --json "$OUT/report/metrics.json" --plot "$OUT/report/trajectory.svg" | tee "$OUT/report/summary.txt"
-cp "$OUT/sequence/contact_sheet.png" "$OUT/report/"
-echo "report: $OUT/report (summary.txt, metrics.json, trajectory.svg/png, contact_sheet.png)"
+echo "== 2/2 PE-SLAM against the ORB-SLAM2 baseline, simulator in the loop"
+$B run --scenario scenes/pv_station.yaml --compare --out "$OUT/report" | tee "$OUT/summary.txt"
+echo "sequence: $OUT/sequence (TUM RGB-D, camera.yaml for ORB-SLAM2)"
+echo "report:   $OUT/report/index.html (metrics.json, figures, trajectories, run.log)"
