@@ -5,33 +5,18 @@
 #include <memory>
 #include <string>
 
+#include "check_report.hpp"
 #include "command.hpp"
-#include "pvb/scenes/scenario.hpp"
-#include "pvb/suite/check.hpp"
 
 namespace pvb::cli {
 namespace {
-
-/// Exit status when a bound is violated (1 and 2 are errors, see main.cpp).
-constexpr int kViolationExit = 3;
 
 struct CheckArgs {
   std::string scenario;
   std::string metrics;
 };
 
-int run_check(const CheckArgs& a) {
-  const scenes::Scenario s = scenes::load_scenario(a.scenario);
-  if (!s.expect.any()) {
-    std::printf("%s: no expect: section, nothing to check\n", a.scenario.c_str());
-    return 0;
-  }
-  const std::vector<suite::Violation> violations = suite::check_expectations(s.expect, a.metrics);
-  for (const auto& v : violations) std::printf("%s: %s\n", a.metrics.c_str(), v.line().c_str());
-  if (violations.empty()) std::printf("%s: ok (%s)\n", a.metrics.c_str(), s.name.c_str());
-  std::fflush(stdout);
-  return violations.empty() ? 0 : kViolationExit;
-}
+int run_check(const CheckArgs& a) { return check_and_print(a.scenario, a.metrics, 0); }
 
 }  // namespace
 

@@ -8,18 +8,14 @@
 #include <memory>
 #include <optional>
 
+#include "check_report.hpp"
 #include "command.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/run/run.hpp"
-#include "pvb/scenes/scenario.hpp"
-#include "pvb/suite/check.hpp"
 
 namespace pvb::cli {
 namespace {
-
-/// Exit status when --check finds a violated bound (as pvbench check).
-constexpr int kViolationExit = 3;
 
 struct RunArgs {
   run::RunOptions options;
@@ -88,17 +84,7 @@ int run_run(RunArgs& a) {
   if (!a.check || report.status == run::RunStatus::kInterrupted) return code;
   // --check: the scenario's expect: bounds judge the run.  An aborted run
   // (on_loss: abort) passes when the scenario expects tracking to be lost.
-  const scenes::Scenario scenario = scenes::load_scenario(o.scenario_file);
-  if (!scenario.expect.any()) {
-    std::printf("%s: no expect: section, nothing to check\n", o.scenario_file.c_str());
-    return code;
-  }
-  const std::string metrics = o.out_dir + "/metrics.json";
-  const std::vector<suite::Violation> violations = suite::check_expectations(scenario.expect, metrics);
-  for (const auto& v : violations) std::printf("%s: %s\n", metrics.c_str(), v.line().c_str());
-  if (violations.empty()) std::printf("%s: ok (%s)\n", metrics.c_str(), scenario.name.c_str());
-  std::fflush(stdout);
-  return violations.empty() ? 0 : kViolationExit;
+  return check_and_print(o.scenario_file, o.out_dir + "/metrics.json", code);
 }
 
 }  // namespace

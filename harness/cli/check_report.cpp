@@ -1,0 +1,24 @@
+#include "check_report.hpp"
+
+#include <cstdio>
+#include <vector>
+
+#include "pvb/scenes/scenario.hpp"
+#include "pvb/suite/check.hpp"
+
+namespace pvb::cli {
+
+int check_and_print(const std::string& scenario_file, const std::string& metrics_path, int no_expect_code) {
+  const scenes::Scenario s = scenes::load_scenario(scenario_file);
+  if (!s.expect.any()) {
+    std::printf("%s: no expect: section, nothing to check\n", scenario_file.c_str());
+    return no_expect_code;
+  }
+  const std::vector<suite::Violation> violations = suite::check_expectations(s.expect, metrics_path);
+  for (const auto& v : violations) std::printf("%s: %s\n", metrics_path.c_str(), v.line().c_str());
+  if (violations.empty()) std::printf("%s: ok (%s)\n", metrics_path.c_str(), s.name.c_str());
+  std::fflush(stdout);
+  return violations.empty() ? 0 : kViolationExit;
+}
+
+}  // namespace pvb::cli
