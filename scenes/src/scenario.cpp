@@ -351,17 +351,14 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
   });
   with_map(top, "expect", [&](MapReader& r) {
     Expectations& e = s.expect;
-    e.has_ate_rmse_m_max = r.has("ate_rmse_m_max");
-    e.ate_rmse_m_max = r.number("ate_rmse_m_max", e.ate_rmse_m_max, 1e-6, 100);
-    e.has_rpe_trans_rmse_m_max = r.has("rpe_trans_rmse_m_max");
-    e.rpe_trans_rmse_m_max = r.number("rpe_trans_rmse_m_max", e.rpe_trans_rmse_m_max, 1e-6, 100);
-    e.has_lost_frames_max = r.has("lost_frames_max");
-    e.lost_frames_max = r.integer("lost_frames_max", e.lost_frames_max, 0, 1000000);
+    if (r.has("ate_rmse_m_max")) e.ate_rmse_m_max = r.number("ate_rmse_m_max", 0.0, 1e-6, 100);
+    if (r.has("rpe_trans_rmse_m_max")) e.rpe_trans_rmse_m_max = r.number("rpe_trans_rmse_m_max", 0.0, 1e-6, 100);
+    if (r.has("lost_frames_max")) e.lost_frames_max = r.integer("lost_frames_max", 0, 0, 1000000);
     e.pe_not_worse_than_baseline = r.boolean("pe_not_worse_than_baseline", e.pe_not_worse_than_baseline);
     e.tracking_loss_expected = r.boolean("tracking_loss_expected", e.tracking_loss_expected);
     e.ci_frames = r.integer("ci_frames", e.ci_frames, 0, 1000000);
     if (e.ci_frames == 1) r.fail(r.full("ci_frames"), YAML::Node(), "0 (not in the fast subset) or at least 2 frames", "1");
-    if (e.tracking_loss_expected && e.has_lost_frames_max && e.lost_frames_max == 0)
+    if (e.tracking_loss_expected && e.lost_frames_max == 0)
       r.fail(r.full("lost_frames_max"), YAML::Node(), "a value >= 1 when tracking_loss_expected is true", "0");
   });
   top.finish();

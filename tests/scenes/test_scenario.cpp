@@ -102,12 +102,12 @@ TEST(Scenario, ExpectSectionIsReadAndOptional) {
                                         "  ci_frames: 240\n",
                                     "e.yaml");
   EXPECT_TRUE(s.expect.any());
-  EXPECT_TRUE(s.expect.has_ate_rmse_m_max);
-  EXPECT_DOUBLE_EQ(s.expect.ate_rmse_m_max, 0.01);
-  EXPECT_TRUE(s.expect.has_rpe_trans_rmse_m_max);
-  EXPECT_DOUBLE_EQ(s.expect.rpe_trans_rmse_m_max, 0.005);
-  EXPECT_TRUE(s.expect.has_lost_frames_max);
-  EXPECT_EQ(s.expect.lost_frames_max, 0);
+  ASSERT_TRUE(s.expect.ate_rmse_m_max);
+  EXPECT_DOUBLE_EQ(*s.expect.ate_rmse_m_max, 0.01);
+  ASSERT_TRUE(s.expect.rpe_trans_rmse_m_max);
+  EXPECT_DOUBLE_EQ(*s.expect.rpe_trans_rmse_m_max, 0.005);
+  ASSERT_TRUE(s.expect.lost_frames_max);
+  EXPECT_EQ(*s.expect.lost_frames_max, 0);
   EXPECT_TRUE(s.expect.pe_not_worse_than_baseline);
   EXPECT_FALSE(s.expect.tracking_loss_expected);
   EXPECT_EQ(s.expect.ci_frames, 240);

@@ -37,23 +37,23 @@ std::vector<Violation> check_expectations(const scenes::Expectations& expect, co
     out.push_back({"status", "the run ended " + run.status + ", expected completed"});
   }
 
-  if (expect.has_ate_rmse_m_max) {
+  if (expect.ate_rmse_m_max) {
     if (!run.ate_rmse_m)
       out.push_back({"ate_rmse_m_max", "no ATE in the metrics (ate is null)"});
-    else if (!(*run.ate_rmse_m <= expect.ate_rmse_m_max))
+    else if (!(*run.ate_rmse_m <= *expect.ate_rmse_m_max))
       out.push_back(
-          {"ate_rmse_m_max", "ATE RMSE " + metres(*run.ate_rmse_m) + " > " + metres(expect.ate_rmse_m_max)});
+          {"ate_rmse_m_max", "ATE RMSE " + metres(*run.ate_rmse_m) + " > " + metres(*expect.ate_rmse_m_max)});
   }
-  if (expect.has_rpe_trans_rmse_m_max) {
+  if (expect.rpe_trans_rmse_m_max) {
     if (!run.rpe_trans_rmse_m)
       out.push_back({"rpe_trans_rmse_m_max", "no RPE in the metrics (rpe is null)"});
-    else if (!(*run.rpe_trans_rmse_m <= expect.rpe_trans_rmse_m_max))
+    else if (!(*run.rpe_trans_rmse_m <= *expect.rpe_trans_rmse_m_max))
       out.push_back({"rpe_trans_rmse_m_max", "RPE translation RMSE " + metres(*run.rpe_trans_rmse_m) + " > " +
-                                                 metres(expect.rpe_trans_rmse_m_max)});
+                                                 metres(*expect.rpe_trans_rmse_m_max)});
   }
-  if (expect.has_lost_frames_max && run.lost_frames > expect.lost_frames_max)
+  if (expect.lost_frames_max && run.lost_frames > *expect.lost_frames_max)
     out.push_back({"lost_frames_max", std::to_string(run.lost_frames) + " lost frames > " +
-                                          std::to_string(expect.lost_frames_max)});
+                                          std::to_string(*expect.lost_frames_max)});
 
   if (expect.pe_not_worse_than_baseline) {
     if (!metrics.baseline)

@@ -18,11 +18,8 @@ std::string fixture(const std::string& name) {
 // The expectations of a nominal PV scene.
 scenes::Expectations nominal() {
   scenes::Expectations e;
-  e.has_ate_rmse_m_max = true;
   e.ate_rmse_m_max = 0.01;
-  e.has_rpe_trans_rmse_m_max = true;
   e.rpe_trans_rmse_m_max = 0.005;
-  e.has_lost_frames_max = true;
   e.lost_frames_max = 0;
   e.pe_not_worse_than_baseline = true;
   return e;
@@ -74,9 +71,7 @@ TEST(SuiteCheck, EachViolatedBoundIsOneLine) {
 
 TEST(SuiteCheck, BoundsAreInclusiveAndUnsetBoundsAreNotChecked) {
   scenes::Expectations e;
-  e.has_ate_rmse_m_max = true;
   e.ate_rmse_m_max = 0.0235;  // exactly the measured value
-  e.has_lost_frames_max = true;
   e.lost_frames_max = 4;
   EXPECT_TRUE(suite::check_expectations(e, fixture("worse_than_baseline.json")).empty());
   e.ate_rmse_m_max = 0.0234;

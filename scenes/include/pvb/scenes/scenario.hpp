@@ -5,6 +5,7 @@
 // ConfigErrors naming the file, the line, the key and what was expected.
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -136,18 +137,16 @@ struct Robot {
 /// checker in harness/suite compares a run's metrics.json against it.  A
 /// bound that is not set (has_*) is not checked.
 struct Expectations {
-  bool has_ate_rmse_m_max = false;
-  double ate_rmse_m_max = 0.0;        ///< ATE RMSE of the primary run, metres
-  bool has_rpe_trans_rmse_m_max = false;
-  double rpe_trans_rmse_m_max = 0.0;  ///< RPE translation RMSE of the primary run, metres
-  bool has_lost_frames_max = false;
-  int lost_frames_max = 0;            ///< frames in the Lost state
+  // Unset bounds are not checked.
+  std::optional<double> ate_rmse_m_max;        ///< ATE RMSE of the primary run, metres
+  std::optional<double> rpe_trans_rmse_m_max;  ///< RPE translation RMSE of the primary run, metres
+  std::optional<int> lost_frames_max;          ///< frames in the Lost state
   bool pe_not_worse_than_baseline = false;  ///< PE-SLAM ATE RMSE <= the baseline's (needs --compare)
   bool tracking_loss_expected = false;      ///< the run must report a loss with a reason
   int ci_frames = 0;                  ///< frames of the fast CI run; 0 = not in the fast subset
   /// True when any bound or flag is set.
   bool any() const {
-    return has_ate_rmse_m_max || has_rpe_trans_rmse_m_max || has_lost_frames_max || pe_not_worse_than_baseline ||
+    return ate_rmse_m_max || rpe_trans_rmse_m_max || lost_frames_max || pe_not_worse_than_baseline ||
            tracking_loss_expected;
   }
 };
