@@ -16,12 +16,7 @@ std::string fmt(const char* f, double v) {
 }
 
 /// JSON number: finite values with full precision, null otherwise.
-std::string num(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
+std::string num(double v) { return json_number(v, 17); }
 
 }  // namespace
 

@@ -15,12 +15,7 @@ namespace pvb::run {
 namespace {
 
 /// JSON number: finite values with enough digits, null otherwise.
-std::string num(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
+std::string num(double v) { return json_number(v, 10); }
 
 std::string str(const std::string& s) { return "\"" + json_escape(s) + "\""; }
 

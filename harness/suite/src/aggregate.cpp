@@ -18,10 +18,7 @@ std::string fmt(const char* f, double v) {
 std::string opt(const std::optional<double>& v, const char* f, double scale = 1.0) {
   return v ? fmt(f, *v * scale) : "";
 }
-std::string json_num(double v) {
-  if (!std::isfinite(v)) return "null";
-  return fmt("%.9g", v);
-}
+std::string json_num(double v) { return json_number(v, 9); }
 std::string json_opt(const std::optional<double>& v) { return v ? json_num(*v) : "null"; }
 
 RunSummary summarize_runs(const std::vector<const RunMetrics*>& runs) {

@@ -14,5 +14,7 @@ void write_file(const std::string& path, const std::string& content);
 std::vector<std::string> split_ws(const std::string& line, const char* seps = " \t\r,");
 /// Escapes a string for a JSON string literal (without the quotes).
 std::string json_escape(const std::string& s);
+/// A JSON number with `significant_digits` digits (%.Ng); null when not finite.
+std::string json_number(double v, int significant_digits = 17);
 
 }  // namespace pvb
