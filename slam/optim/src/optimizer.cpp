@@ -1,9 +1,13 @@
 // Pose-only optimisation and local bundle adjustment (ORB-SLAM2's
-// Optimizer::PoseOptimization and Optimizer::LocalBundleAdjustment) on Ceres.
+// Optimizer::PoseOptimization and Optimizer::LocalBundleAdjustment): the
+// pose-only problem by a dense 6x6 Levenberg-Marquardt written here, local
+// BA on Ceres.
 #include "pvb/slam/optim/optimizer.hpp"
 
 #include <ceres/ceres.h>
 
+#include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -61,6 +65,151 @@ class AbortCallback : public ceres::IterationCallback {
 
 bool aborted(const bool* flag) { return flag != nullptr && *flag; }
 
+/// Normal equations of the pose-only problem at one pose: H = sum J^T w J,
+/// g = sum J^T w r over the active observations (J = d r / d delta, 6
+/// columns of reprojection()'s lifted Jacobian), and the robust cost
+/// 0.5 sum rho(|r|^2).  w = rho'(|r|^2) is the Huber IRLS weight (1 inside
+/// the threshold, delta / |r| outside; g2o's robustified information, as
+/// ORB-SLAM2 uses it).  Returns false if a point is not in front of the camera.
+struct PoseNormalEquations {
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+  double cost = 0.0;
+};
+
+/// Huber rho(s) and rho'(s) of a squared residual s with threshold delta^2 = chi2.
+inline void huber(double s, double chi2, bool robust, double* rho, double* drho) {
+  if (!robust || s <= chi2) {
+    *rho = s;
+    *drho = 1.0;
+    return;
+  }
+  const double delta = std::sqrt(chi2), r = std::sqrt(s);
+  *rho = 2.0 * delta * r - chi2;
+  *drho = delta / r;
+}
+
+/// H += w J J^T (upper triangle only) and g += w r J for one residual row.
+inline void accumulate_upper(const Eigen::Matrix<double, 6, 1>& J, double w, double r, Eigen::Matrix<double, 6, 6>* H,
+                             Eigen::Matrix<double, 6, 1>* g) {
+  for (int c = 0; c < 6; ++c) {
+    const double wj = w * J[c];
+    for (int k = 0; k <= c; ++k) (*H)(k, c) += wj * J[k];
+    (*g)[c] += wj * r;
+  }
+}
+
+template <bool kWithJacobian>
+bool pose_normal_equations(const StereoIntrinsics& K, const std::vector<Eigen::Vector3d>& points_w,
+                           const std::vector<Observation>& obs, const std::vector<std::size_t>& active, bool robust,
+                           const PoseOptimizerOptions& options, const double* pose, PoseNormalEquations* out) {
+  // The residual and Jacobian of optim_detail::reprojection() (residuals.hpp,
+  // where the formulas are written out), with the rotation computed once per
+  // evaluation instead of once per observation; test_residuals checks both.
+  *out = PoseNormalEquations();
+  const Eigen::Map<const Eigen::Quaterniond> q_c_w(pose);
+  const Eigen::Map<const Eigen::Vector3d> t_c_w(pose + 4);
+  const Eigen::Matrix3d R_c_w = q_c_w.toRotationMatrix();
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+  double cost = 0.0;
+  for (std::size_t i : active) {
+    const Observation& o = obs[i];
+    const bool stereo = is_stereo(o);
+    const Eigen::Vector3d p_c = R_c_w * points_w[i] + t_c_w;
+    if (!(p_c.z() > 0.0)) return false;
+    const double inv_z = 1.0 / p_c.z();
+    const double u = K.fx * p_c.x() * inv_z + K.cx;
+    const double v = K.fy * p_c.y() * inv_z + K.cy;
+    const double w = std::sqrt(o.inv_sigma2);
+    const double r0 = w * (o.uv.x() - u), r1 = w * (o.uv.y() - v);
+    const double r2 = stereo ? w * (o.u_right - (u - K.bf * inv_z)) : 0.0;
+    const double s = r0 * r0 + r1 * r1 + r2 * r2;
+    double rho, drho;
+    huber(s, stereo ? options.chi2_stereo : options.chi2_mono, robust, &rho, &drho);
+    cost += 0.5 * rho;
+    if constexpr (kWithJacobian) {
+      // Rows of d r / d delta = D [ -[p_c]x | I ] with D = d r / d p_c.
+      const double x = p_c.x(), y = p_c.y(), z = p_c.z();
+      const double inv_z2 = inv_z * inv_z;
+      const double d00 = -w * K.fx * inv_z, d02 = w * K.fx * x * inv_z2;
+      const double d11 = -w * K.fy * inv_z, d12 = w * K.fy * y * inv_z2;
+      Eigen::Matrix<double, 6, 1> J0, J1;
+      J0 << d02 * y, d00 * z - d02 * x, -d00 * y, d00, 0.0, d02;
+      J1 << -d11 * z + d12 * y, -d12 * x, d11 * x, 0.0, d11, d12;
+      accumulate_upper(J0, drho, r0, &H, &g);
+      accumulate_upper(J1, drho, r1, &H, &g);
+      if (stereo) {
+        const double d22 = -w * (K.bf - K.fx * x) * inv_z2;
+        Eigen::Matrix<double, 6, 1> J2;
+        J2 << d22 * y, d00 * z - d22 * x, -d00 * y, d00, 0.0, d22;
+        accumulate_upper(J2, drho, r2, &H, &g);
+      }
+    }
+  }
+  if constexpr (kWithJacobian) {
+    out->H = H.selfadjointView<Eigen::Upper>();
+    out->g = g;
+  }
+  out->cost = cost;
+  return true;
+}
+
+/// Levenberg-Marquardt on one pose against fixed points, the way g2o's
+/// OptimizationAlgorithmLevenberg runs it for ORB-SLAM2's PoseOptimization:
+/// lambda starts at 1e-5 max(diag H), a rejected step multiplies it by
+/// nu (2, 4, 8, ...; at most 10 tries per iteration), an accepted one scales
+/// it by max(1/3, 1 - (2 rho - 1)^3).  The step solves (H + lambda I) dx = -g
+/// in the tangent space and is applied with SE3LeftManifold::Plus.  Stops
+/// after options.iterations_per_round iterations, when no step lowers the
+/// cost, or when a step changes the cost by less than 1e-10 relative (as
+/// Ceres' function tolerance, tighter) or the pose by less than 1e-12.
+/// Updates pose in place; returns the final robust cost 0.5 sum rho.
+/// This replaced a Ceres solve per round: with a single 6-DoF block, Ceres'
+/// problem construction, preprocessing and virtual residual calls cost
+/// several times the arithmetic itself (docs/slam.md, "Speed").
+double pose_only_levenberg_marquardt(const StereoIntrinsics& K, const std::vector<Eigen::Vector3d>& points_w,
+                                     const std::vector<Observation>& obs, const std::vector<std::size_t>& active,
+                                     bool robust, const PoseOptimizerOptions& options, double* pose) {
+  PoseNormalEquations ne;
+  if (!pose_normal_equations<true>(K, points_w, obs, active, robust, options, pose, &ne)) return 0.0;
+  double lambda = 1e-5 * ne.H.diagonal().maxCoeff();
+  double nu = 2.0;
+  double trial[optim_detail::kPoseSize];
+  optim_detail::SE3LeftManifold manifold;
+  PoseNormalEquations trial_ne;
+  for (int it = 0; it < options.iterations_per_round; ++it) {
+    bool accepted = false;
+    bool converged = false;
+    for (int attempt = 0; attempt < 10 && !accepted; ++attempt) {
+      Eigen::Matrix<double, 6, 6> A = ne.H;
+      A.diagonal().array() += lambda;
+      const Eigen::Matrix<double, 6, 1> dx = A.ldlt().solve(-ne.g);
+      if (!dx.allFinite()) return ne.cost;
+      manifold.Plus(pose, dx.data(), trial);
+      const bool valid = pose_normal_equations<false>(K, points_w, obs, active, robust, options, trial, &trial_ne);
+      // Predicted decrease of the quadratic model: -dx^T g - 0.5 dx^T H dx = 0.5 dx^T (lambda dx - g).
+      const double predicted = 0.5 * dx.dot(lambda * dx - ne.g);
+      const double gain = valid ? (ne.cost - trial_ne.cost) / std::max(predicted, 1e-300) : -1.0;
+      if (valid && gain > 0.0 && std::isfinite(trial_ne.cost)) {
+        converged = (ne.cost - trial_ne.cost) <= 1e-10 * ne.cost || dx.norm() <= 1e-12;
+        std::copy(trial, trial + optim_detail::kPoseSize, pose);
+        lambda *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * gain - 1.0, 3));
+        nu = 2.0;
+        accepted = true;
+      } else {
+        lambda *= nu;
+        nu *= 2.0;
+      }
+    }
+    if (!accepted) break;  // no step lowers the cost: at a minimum (numerically)
+    if (!pose_normal_equations<true>(K, points_w, obs, active, robust, options, pose, &ne)) break;
+    if (converged) break;
+  }
+  return ne.cost;
+}
+
+
 }  // namespace
 
 Eigen::Vector2d project(const StereoIntrinsics& K, const Eigen::Vector3d& p_c) {
@@ -113,46 +262,26 @@ PoseOptimizerResult optimize_pose(const geom::SE3d& T_c_w_init, const std::vecto
     return result;
   }
 
-  std::vector<std::unique_ptr<ceres::CostFunction>> costs(n);
-  for (std::size_t i = 0; i < n; ++i) costs[i].reset(optim_detail::make_pose_only_cost(K, obs[i], points_w[i]));
-  ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
-  ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
-  optim_detail::SE3LeftManifold se3_manifold;
-
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // one 6-DoF block
-  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  solver_options.max_num_iterations = options.iterations_per_round;
-  solver_options.num_threads = 1;  // deterministic
-  solver_options.logging_type = ceres::SILENT;
-
   // Round 0 uses every observation in front of the initial camera.
   std::vector<std::uint8_t> use(n, 0);
   for (std::size_t i = 0; i < n; ++i) use[i] = (T_c_w_init * points_w[i]).z() > 0.0 ? 1 : 0;
 
   PoseBlock pose = PoseBlock::from_se3(T_c_w_init);
   const PoseBlock pose_init = pose;
+  std::vector<std::size_t> active;
+  active.reserve(n);
   for (int round = 0; round < options.rounds; ++round) {
     if (options.restart_from_initial) pose = pose_init;
     const geom::SE3d T_start = pose.to_se3();
     const bool robust = options.robust && round < options.robust_rounds;
-
-    ceres::Problem problem(borrowed_problem_options());
-    problem.AddParameterBlock(pose.pose, optim_detail::kPoseSize, &se3_manifold);
-    int num_used = 0;
+    active.clear();
     for (std::size_t i = 0; i < n; ++i) {
       // A residual must be defined at the starting pose (point in front).
-      if (!use[i] || !((T_start * points_w[i]).z() > 0.0)) continue;
-      ceres::LossFunction* loss = nullptr;
-      if (robust) loss = is_stereo(obs[i]) ? &huber_stereo : &huber_mono;
-      problem.AddResidualBlock(costs[i].get(), loss, pose.pose);
-      ++num_used;
+      if (use[i] && (T_start * points_w[i]).z() > 0.0) active.push_back(i);
     }
-    if (num_used == 0) break;  // nothing left to optimise against; keep the pose
+    if (active.empty()) break;  // nothing left to optimise against; keep the pose
 
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver_options, &problem, &summary);
-    result.final_cost = summary.final_cost;
+    result.final_cost = pose_only_levenberg_marquardt(K, points_w, obs, active, robust, options, pose.pose);
 
     // Classify every observation (outliers too: they may come back).
     classify(pose.to_se3());
