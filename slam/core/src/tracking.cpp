@@ -16,6 +16,28 @@ const char* to_string(TrackingState s) {
   return "?";
 }
 
+void IdMarks::new_pass() {
+  ++pass_;
+  if (pass_ == 0) {  // wrapped: clear the stamps once every 2^32 passes
+    std::fill(stamp_.begin(), stamp_.end(), 0);
+    pass_ = 1;
+  }
+  sparse_.clear();
+}
+
+bool IdMarks::mark(std::uint64_t id) {
+  if (id >= kDenseLimit) return sparse_.insert(id).second;
+  if (id >= stamp_.size()) stamp_.resize(std::max<std::size_t>(id + 1, 2 * stamp_.size()), 0);
+  if (stamp_[id] == pass_) return false;
+  stamp_[id] = pass_;
+  return true;
+}
+
+bool IdMarks::marked(std::uint64_t id) const {
+  if (id >= kDenseLimit) return sparse_.count(id) > 0;
+  return id < stamp_.size() && stamp_[id] == pass_;
+}
+
 Tracking::Tracking(Map& map, std::shared_ptr<const CameraModel> cam, const TrackingOptions& options)
     : map_(map), cam_(std::move(cam)), options_(options), pe_matcher_(options.pe_match) {}
 
@@ -366,23 +388,24 @@ void Tracking::update_local_map(const Frame& f) {
   if (best) ref_kf_ = best;
 
   local_points_.clear();
-  std::set<std::uint64_t> seen;
+  local_marks_.new_pass();
   for (const auto& kf : local_kfs_)
     for (const auto& mp : kf->map_points())
-      if (mp && !mp->bad() && seen.insert(mp->id()).second) local_points_.push_back(mp);
+      if (mp && !mp->bad() && local_marks_.mark(mp->id())) local_points_.push_back(mp);
 }
 
 bool Tracking::track_local_map(Frame& f) {
   update_local_map(f);
-  std::set<std::uint64_t> in_frame;
+  frame_marks_.new_pass();
   for (const auto& mp : f.map_points)
     if (mp && !mp->bad()) {
       mp->increase_visible();
-      in_frame.insert(mp->id());
+      frame_marks_.mark(mp->id());
     }
   std::vector<ProjectedPoint> proj;
+  proj.reserve(local_points_.size());
   for (const auto& mp : local_points_) {
-    if (in_frame.count(mp->id())) continue;
+    if (frame_marks_.marked(mp->id())) continue;
     ProjectedPoint p;
     if (project_in_frustum(f, mp, &p)) {
       mp->increase_visible();

@@ -60,6 +60,26 @@ struct TrackingOptions {
   int min_frames = 0;
 };
 
+/// "Already seen in this pass" marks for map-point ids: a pass stamp per
+/// id, so a new pass is O(1) and a look-up an array access (map-point ids
+/// are dense from 0).  Ids from kDenseLimit up (visual-odometry points)
+/// go to a small ordered set.  Scratch state of an algorithm, never stored
+/// on the points (ORB-SLAM2's mnTrackReferenceForFrame).
+class IdMarks {
+ public:
+  /// Starts a pass: nothing is marked.
+  void new_pass();
+  /// Marks id; true when it was not marked yet in this pass.
+  bool mark(std::uint64_t id);
+  bool marked(std::uint64_t id) const;
+
+ private:
+  static constexpr std::uint64_t kDenseLimit = std::uint64_t(1) << 32;
+  std::vector<std::uint32_t> stamp_;  ///< pass in which each dense id was last marked
+  std::uint32_t pass_ = 0;
+  std::set<std::uint64_t> sparse_;    ///< ids >= kDenseLimit marked in this pass
+};
+
 class Tracking {
  public:
   Tracking(Map& map, std::shared_ptr<const CameraModel> cam, const TrackingOptions& options);
@@ -114,6 +134,8 @@ class Tracking {
   // Local map (scratch state of this algorithm, rebuilt per frame)
   std::vector<std::shared_ptr<KeyFrame>> local_kfs_;
   std::vector<std::shared_ptr<MapPoint>> local_points_;
+  IdMarks local_marks_;  ///< points already in local_points_ (update_local_map)
+  IdMarks frame_marks_;  ///< points already matched in the frame (track_local_map)
 };
 
 }  // namespace pvb::slam
