@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
@@ -219,6 +221,11 @@ bool Tracking::track_with_motion_model(Frame& f) {
   }
 
   if (options_.use_pe_match) {
+    stats_.translation_parallax_px = translation_parallax_px(m, *velocity_);
+    stats_.pe_skipped =
+        options_.pe_skip_low_parallax && stats_.translation_parallax_px < options_.pe_match.inlier_threshold_px;
+  }
+  if (options_.use_pe_match && !stats_.pe_skipped) {
     // PE-match on the pixel pairs (last keypoint, current keypoint), paper sec. 3.
     const auto t0 = std::chrono::steady_clock::now();
     PeMatchResult r;
@@ -248,6 +255,31 @@ bool Tracking::track_with_motion_model(Frame& f) {
     return fail("motion model: only " + std::to_string(map_matches) +
                 " map matches after pose optimisation (need 10)");
   return true;
+}
+
+double Tracking::translation_parallax_px(const std::vector<IndexMatch>& m, const geom::SE3d& T_cur_last) const {
+  // For each match with depth in the last frame: its point p in the last
+  // camera, and the distance between its projections under the predicted
+  // motion with and without the translation, |pi(R p + t) - pi(R p)|.
+  const StereoIntrinsics& K = cam_->K;
+  const Eigen::Matrix3d R = T_cur_last.linear();
+  const Eigen::Vector3d t = T_cur_last.translation();
+  std::vector<double> d;
+  d.reserve(m.size());
+  for (const IndexMatch& mm : m) {
+    const double z = last_.depth_m[mm.i1];
+    if (!(z > 0)) continue;
+    const cv::Point2f& uv = last_.keys_un[mm.i1].pt;
+    const Eigen::Vector3d p((uv.x - K.cx) * z / K.fx, (uv.y - K.cy) * z / K.fy, z);
+    const Eigen::Vector3d a = R * p, b = a + t;
+    if (!(a.z() > 0) || !(b.z() > 0)) continue;
+    const double du = K.fx * (b.x() / b.z() - a.x() / a.z()), dv = K.fy * (b.y() / b.z() - a.y() / a.z());
+    d.push_back(std::hypot(du, dv));
+  }
+  if (d.size() < 8) return std::numeric_limits<double>::infinity();
+  const auto mid = d.begin() + static_cast<long>(d.size() / 2);
+  std::nth_element(d.begin(), mid, d.end());
+  return *mid;
 }
 
 bool Tracking::track_reference_keyframe(Frame& f) {
