@@ -91,11 +91,19 @@ Frame::Frame(std::uint64_t frame_id, std::int64_t time_ns, OrbFeatures features,
 
 std::vector<std::size_t> Frame::features_in_area(double u, double v, double r, int min_level, int max_level) const {
   std::vector<std::size_t> out;
+  features_in_area(u, v, r, min_level, max_level, &out);
+  return out;
+}
+
+void Frame::features_in_area(double u, double v, double r, int min_level, int max_level,
+                             std::vector<std::size_t>* result) const {
+  std::vector<std::size_t>& out = *result;
+  out.clear();
   const int c0 = std::max(0, static_cast<int>(std::floor((u - cam->min_x - r) * cam->grid_inv_w)));
   const int c1 = std::min(CameraModel::kGridCols - 1, static_cast<int>(std::ceil((u - cam->min_x + r) * cam->grid_inv_w)));
   const int r0 = std::max(0, static_cast<int>(std::floor((v - cam->min_y - r) * cam->grid_inv_h)));
   const int r1 = std::min(CameraModel::kGridRows - 1, static_cast<int>(std::ceil((v - cam->min_y + r) * cam->grid_inv_h)));
-  if (c0 > c1 || r0 > r1 || grid_.empty()) return out;
+  if (c0 > c1 || r0 > r1 || grid_.empty()) return;
   for (int gy = r0; gy <= r1; ++gy)
     for (int gx = c0; gx <= c1; ++gx)
       for (std::uint32_t i : grid_[gy * CameraModel::kGridCols + gx]) {
@@ -106,7 +114,6 @@ std::vector<std::size_t> Frame::features_in_area(double u, double v, double r, i
         if (std::abs(dx) < r && std::abs(dy) < r) out.push_back(i);
       }
   std::sort(out.begin(), out.end());
-  return out;
 }
 
 std::vector<std::pair<float, std::size_t>> Frame::keypoints_by_depth() const {

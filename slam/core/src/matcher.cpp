@@ -67,6 +67,7 @@ std::vector<IndexMatch> search_by_projection(Frame& cur, const Frame& last, doub
 
   std::vector<IndexMatch> matches;
   std::vector<float> diffs;
+  std::vector<std::size_t> cands;
   for (std::size_t i = 0; i < last.size(); ++i) {
     const auto& mp = last.map_points[i];
     if (!mp || last.outlier[i] || mp->bad()) continue;
@@ -76,10 +77,9 @@ std::vector<IndexMatch> search_by_projection(Frame& cur, const Frame& last, doub
     if (!cam.in_bounds(uv.x(), uv.y())) continue;
     const int last_octave = last.keys_un[i].octave;
     const double radius = th * cam.scale[last_octave];
-    std::vector<std::size_t> cands;
-    if (forward) cands = cur.features_in_area(uv.x(), uv.y(), radius, last_octave, -1);
-    else if (backward) cands = cur.features_in_area(uv.x(), uv.y(), radius, 0, last_octave);
-    else cands = cur.features_in_area(uv.x(), uv.y(), radius, std::max(0, last_octave - 1), last_octave + 1);
+    if (forward) cur.features_in_area(uv.x(), uv.y(), radius, last_octave, -1, &cands);
+    else if (backward) cur.features_in_area(uv.x(), uv.y(), radius, 0, last_octave, &cands);
+    else cur.features_in_area(uv.x(), uv.y(), radius, std::max(0, last_octave - 1), last_octave + 1, &cands);
     if (cands.empty()) continue;
     const double ur = uv.x() - cam.K.bf / p_c.z();
     const unsigned char* d_mp = mp->descriptor().empty() ? desc_row(last.descriptors, i) : mp->descriptor().ptr<unsigned char>(0);
@@ -131,10 +131,11 @@ int search_local_points(Frame& cur, const std::vector<ProjectedPoint>& points, d
   const CameraModel& cam = *cur.cam;
   constexpr double kRatio = 0.8;
   int n = 0;
+  std::vector<std::size_t> cands;
   for (const ProjectedPoint& p : points) {
     if (p.mp->bad()) continue;
     const double r = th * (p.view_cos > 0.998 ? 2.5 : 4.0) * cam.scale[p.level];
-    const std::vector<std::size_t> cands = cur.features_in_area(p.u, p.v, r, p.level - 1, p.level);
+    cur.features_in_area(p.u, p.v, r, p.level - 1, p.level, &cands);
     if (cands.empty()) continue;
     const unsigned char* d_mp = p.mp->descriptor().ptr<unsigned char>(0);
     BestTwo b;

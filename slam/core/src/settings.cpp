@@ -105,6 +105,7 @@ Settings read_settings(const std::string& path) {
   pe.threshold_px = r.real("PEMatch.threshold", false, pe.threshold_px);
   pe.refine = r.flag("PEMatch.refine", pe.refine);
   pe.sampson = r.flag("PEMatch.sampson", pe.sampson);
+  pe.skip_low_parallax = r.flag("PEMatch.skipLowParallax", pe.skip_low_parallax);
   if (pe.population < 2) throw ConfigError(path, "PEMatch.population", "an integer >= 2");
   r.positive("PEMatch.j", pe.num_fitness_samples);
   r.positive("PEMatch.stallIterations", pe.stall_iterations);

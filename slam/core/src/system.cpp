@@ -32,6 +32,7 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.pe_match.refine = settings.pe_match.refine;
   topt.pe_match.distance = settings.pe_match.sampson ? EpipolarDistance::kSampson : EpipolarDistance::kPointLine;
   topt.pe_match.seed = options.seed;
+  topt.pe_skip_low_parallax = settings.pe_match.skip_low_parallax;
   topt.max_frames = static_cast<int>(settings.fps);
   tracking_ = std::make_unique<Tracking>(map_, cam_, topt);
   mapping_ = std::make_unique<LocalMapping>(map_, cam_);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
@@ -14,6 +16,28 @@ const char* to_string(TrackingState s) {
     case TrackingState::kLost: return "lost";
   }
   return "?";
+}
+
+void IdMarks::new_pass() {
+  ++pass_;
+  if (pass_ == 0) {  // wrapped: clear the stamps once every 2^32 passes
+    std::fill(stamp_.begin(), stamp_.end(), 0);
+    pass_ = 1;
+  }
+  sparse_.clear();
+}
+
+bool IdMarks::mark(std::uint64_t id) {
+  if (id >= kDenseLimit) return sparse_.insert(id).second;
+  if (id >= stamp_.size()) stamp_.resize(std::max<std::size_t>(id + 1, 2 * stamp_.size()), 0);
+  if (stamp_[id] == pass_) return false;
+  stamp_[id] = pass_;
+  return true;
+}
+
+bool IdMarks::marked(std::uint64_t id) const {
+  if (id >= kDenseLimit) return sparse_.count(id) > 0;
+  return id < stamp_.size() && stamp_[id] == pass_;
 }
 
 Tracking::Tracking(Map& map, std::shared_ptr<const CameraModel> cam, const TrackingOptions& options)
@@ -197,6 +221,11 @@ bool Tracking::track_with_motion_model(Frame& f) {
   }
 
   if (options_.use_pe_match) {
+    stats_.translation_parallax_px = translation_parallax_px(m, *velocity_);
+    stats_.pe_skipped =
+        options_.pe_skip_low_parallax && stats_.translation_parallax_px < options_.pe_match.inlier_threshold_px;
+  }
+  if (options_.use_pe_match && !stats_.pe_skipped) {
     // PE-match on the pixel pairs (last keypoint, current keypoint), paper sec. 3.
     const auto t0 = std::chrono::steady_clock::now();
     PeMatchResult r;
@@ -226,6 +255,31 @@ bool Tracking::track_with_motion_model(Frame& f) {
     return fail("motion model: only " + std::to_string(map_matches) +
                 " map matches after pose optimisation (need 10)");
   return true;
+}
+
+double Tracking::translation_parallax_px(const std::vector<IndexMatch>& m, const geom::SE3d& T_cur_last) const {
+  // For each match with depth in the last frame: its point p in the last
+  // camera, and the distance between its projections under the predicted
+  // motion with and without the translation, |pi(R p + t) - pi(R p)|.
+  const StereoIntrinsics& K = cam_->K;
+  const Eigen::Matrix3d R = T_cur_last.linear();
+  const Eigen::Vector3d t = T_cur_last.translation();
+  std::vector<double> d;
+  d.reserve(m.size());
+  for (const IndexMatch& mm : m) {
+    const double z = last_.depth_m[mm.i1];
+    if (!(z > 0)) continue;
+    const cv::Point2f& uv = last_.keys_un[mm.i1].pt;
+    const Eigen::Vector3d p((uv.x - K.cx) * z / K.fx, (uv.y - K.cy) * z / K.fy, z);
+    const Eigen::Vector3d a = R * p, b = a + t;
+    if (!(a.z() > 0) || !(b.z() > 0)) continue;
+    const double du = K.fx * (b.x() / b.z() - a.x() / a.z()), dv = K.fy * (b.y() / b.z() - a.y() / a.z());
+    d.push_back(std::hypot(du, dv));
+  }
+  if (d.size() < 8) return std::numeric_limits<double>::infinity();
+  const auto mid = d.begin() + static_cast<long>(d.size() / 2);
+  std::nth_element(d.begin(), mid, d.end());
+  return *mid;
 }
 
 bool Tracking::track_reference_keyframe(Frame& f) {
@@ -366,23 +420,24 @@ void Tracking::update_local_map(const Frame& f) {
   if (best) ref_kf_ = best;
 
   local_points_.clear();
-  std::set<std::uint64_t> seen;
+  local_marks_.new_pass();
   for (const auto& kf : local_kfs_)
     for (const auto& mp : kf->map_points())
-      if (mp && !mp->bad() && seen.insert(mp->id()).second) local_points_.push_back(mp);
+      if (mp && !mp->bad() && local_marks_.mark(mp->id())) local_points_.push_back(mp);
 }
 
 bool Tracking::track_local_map(Frame& f) {
   update_local_map(f);
-  std::set<std::uint64_t> in_frame;
+  frame_marks_.new_pass();
   for (const auto& mp : f.map_points)
     if (mp && !mp->bad()) {
       mp->increase_visible();
-      in_frame.insert(mp->id());
+      frame_marks_.mark(mp->id());
     }
   std::vector<ProjectedPoint> proj;
+  proj.reserve(local_points_.size());
   for (const auto& mp : local_points_) {
-    if (in_frame.count(mp->id())) continue;
+    if (frame_marks_.marked(mp->id())) continue;
     ProjectedPoint p;
     if (project_in_frustum(f, mp, &p)) {
       mp->increase_visible();

@@ -78,9 +78,9 @@ std::vector<cv::KeyPoint> distribute_quadtree(const std::vector<cv::KeyPoint>& k
     const size_t prev_size = nodes.size();
     next.clear();
     int to_expand = 0;
-    for (const QuadNode& n : nodes) {
+    for (QuadNode& n : nodes) {
       if (!splittable(n)) {
-        next.push_back(n);
+        next.push_back(std::move(n));
         continue;
       }
       const size_t before = next.size();
@@ -237,8 +237,28 @@ std::vector<cv::KeyPoint> OrbExtractor::detect_level(int level, int num_wanted) 
   const int w_cell = (width + num_cols - 1) / num_cols;
   const int h_cell = (height + num_rows - 1) / num_rows;
 
+  // FAST once over the whole detection area at the initial threshold, then
+  // per cell: its corners, or, where it has none, FAST on the cell alone at
+  // the minimum threshold (ORB-SLAM2's per-cell fallback).  ORB-SLAM2 runs
+  // FAST on every 30 px cell (plus a 3 px margin) separately; one call per
+  // level gives the same corners and scores in the cell interiors, and
+  // non-maximum suppression that also sees across cell borders (see
+  // docs/slam.md, "Deviations").
+  const cv::Mat area = img(cv::Range(min_y, max_y), cv::Range(min_x, max_x));
+  std::vector<cv::KeyPoint> strong;
+  strong.reserve(static_cast<size_t>(num_wanted) * 10);
+  cv::FAST(area, strong, params_.ini_fast_threshold, true);
+  // Cell (i, j) detects in [min + kFastBorderPx + i * h_cell, ... + h_cell):
+  // bucket the corners (area coordinates) by that rule.
+  std::vector<std::vector<cv::KeyPoint>> per_cell(static_cast<size_t>(num_rows) * num_cols);
+  for (const cv::KeyPoint& kp : strong) {
+    const int j = std::min(num_cols - 1, (static_cast<int>(kp.pt.x) - kFastBorderPx) / w_cell);
+    const int i = std::min(num_rows - 1, (static_cast<int>(kp.pt.y) - kFastBorderPx) / h_cell);
+    per_cell[static_cast<size_t>(i) * num_cols + j].push_back(kp);
+  }
+
   std::vector<cv::KeyPoint> all, cell;
-  all.reserve(static_cast<size_t>(num_wanted) * 10);
+  all.reserve(strong.size() + 64);
   for (int i = 0; i < num_rows; ++i) {
     const int y0 = min_y + i * h_cell;
     int y1 = y0 + h_cell + 2 * kFastBorderPx;
@@ -249,10 +269,18 @@ std::vector<cv::KeyPoint> OrbExtractor::detect_level(int level, int num_wanted) 
       int x1 = x0 + w_cell + 2 * kFastBorderPx;
       if (x0 >= max_x - kFastBorderPx) continue;
       x1 = std::min(x1, max_x);
+      const std::vector<cv::KeyPoint>& found = per_cell[static_cast<size_t>(i) * num_cols + j];
+      if (!found.empty()) {
+        for (cv::KeyPoint kp : found) {
+          kp.pt.x += static_cast<float>(min_x);
+          kp.pt.y += static_cast<float>(min_y);
+          all.push_back(kp);
+        }
+        continue;
+      }
       const cv::Mat roi = img(cv::Range(y0, y1), cv::Range(x0, x1));
       cell.clear();
-      cv::FAST(roi, cell, params_.ini_fast_threshold, true);
-      if (cell.empty()) cv::FAST(roi, cell, params_.min_fast_threshold, true);
+      cv::FAST(roi, cell, params_.min_fast_threshold, true);
       for (auto& kp : cell) {
         kp.pt.x += static_cast<float>(x0);
         kp.pt.y += static_cast<float>(y0);

@@ -1,9 +1,13 @@
 // Pose-only optimisation and local bundle adjustment (ORB-SLAM2's
-// Optimizer::PoseOptimization and Optimizer::LocalBundleAdjustment) on Ceres.
+// Optimizer::PoseOptimization and Optimizer::LocalBundleAdjustment): the
+// pose-only problem by a dense 6x6 Levenberg-Marquardt written here, local
+// BA on Ceres.
 #include "pvb/slam/optim/optimizer.hpp"
 
 #include <ceres/ceres.h>
 
+#include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -16,6 +20,8 @@ namespace pvb::slam {
 namespace {
 
 using optim_detail::is_stereo;
+using optim_detail::PoseNormalEquations;
+using optim_detail::pose_normal_equations;
 
 /// A camera pose as one Ceres parameter block (see residuals.hpp):
 /// [q_c_w (x, y, z, w), t_c_w] on SE3LeftManifold.
@@ -60,6 +66,60 @@ class AbortCallback : public ceres::IterationCallback {
 };
 
 bool aborted(const bool* flag) { return flag != nullptr && *flag; }
+
+/// Levenberg-Marquardt on one pose against fixed points, the way g2o's
+/// OptimizationAlgorithmLevenberg runs it for ORB-SLAM2's PoseOptimization:
+/// lambda starts at 1e-5 max(diag H), a rejected step multiplies it by
+/// nu (2, 4, 8, ...; at most 10 tries per iteration), an accepted one scales
+/// it by max(1/3, 1 - (2 rho - 1)^3).  The step solves (H + lambda I) dx = -g
+/// in the tangent space and is applied with SE3LeftManifold::Plus.  Stops
+/// after options.iterations_per_round iterations, when no step lowers the
+/// cost, or when a step changes the cost by less than 1e-10 relative (as
+/// Ceres' function tolerance, tighter) or the pose by less than 1e-12.
+/// Updates pose in place; returns the final robust cost 0.5 sum rho.
+/// This replaced a Ceres solve per round: with a single 6-DoF block, Ceres'
+/// problem construction, preprocessing and virtual residual calls cost
+/// several times the arithmetic itself (docs/slam.md, "Speed").
+double pose_only_levenberg_marquardt(const StereoIntrinsics& K, const std::vector<Eigen::Vector3d>& points_w,
+                                     const std::vector<Observation>& obs, const std::vector<std::size_t>& active,
+                                     bool robust, const PoseOptimizerOptions& options, double* pose) {
+  PoseNormalEquations ne;
+  if (!pose_normal_equations<true>(K, points_w, obs, active, robust, options, pose, &ne)) return 0.0;
+  double lambda = 1e-5 * ne.H.diagonal().maxCoeff();
+  double nu = 2.0;
+  double trial[optim_detail::kPoseSize];
+  optim_detail::SE3LeftManifold manifold;
+  PoseNormalEquations trial_ne;
+  for (int it = 0; it < options.iterations_per_round; ++it) {
+    bool accepted = false;
+    bool converged = false;
+    for (int attempt = 0; attempt < 10 && !accepted; ++attempt) {
+      Eigen::Matrix<double, 6, 6> A = ne.H;
+      A.diagonal().array() += lambda;
+      const Eigen::Matrix<double, 6, 1> dx = A.ldlt().solve(-ne.g);
+      if (!dx.allFinite()) return ne.cost;
+      manifold.Plus(pose, dx.data(), trial);
+      const bool valid = pose_normal_equations<false>(K, points_w, obs, active, robust, options, trial, &trial_ne);
+      // Predicted decrease of the quadratic model: -dx^T g - 0.5 dx^T H dx = 0.5 dx^T (lambda dx - g).
+      const double predicted = 0.5 * dx.dot(lambda * dx - ne.g);
+      const double gain = valid ? (ne.cost - trial_ne.cost) / std::max(predicted, 1e-300) : -1.0;
+      if (valid && gain > 0.0 && std::isfinite(trial_ne.cost)) {
+        converged = (ne.cost - trial_ne.cost) <= 1e-10 * ne.cost || dx.norm() <= 1e-12;
+        std::copy(trial, trial + optim_detail::kPoseSize, pose);
+        lambda *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * gain - 1.0, 3));
+        nu = 2.0;
+        accepted = true;
+      } else {
+        lambda *= nu;
+        nu *= 2.0;
+      }
+    }
+    if (!accepted) break;  // no step lowers the cost: at a minimum (numerically)
+    if (!pose_normal_equations<true>(K, points_w, obs, active, robust, options, pose, &ne)) break;
+    if (converged) break;
+  }
+  return ne.cost;
+}
 
 }  // namespace
 
@@ -113,46 +173,26 @@ PoseOptimizerResult optimize_pose(const geom::SE3d& T_c_w_init, const std::vecto
     return result;
   }
 
-  std::vector<std::unique_ptr<ceres::CostFunction>> costs(n);
-  for (std::size_t i = 0; i < n; ++i) costs[i].reset(optim_detail::make_pose_only_cost(K, obs[i], points_w[i]));
-  ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
-  ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
-  optim_detail::SE3LeftManifold se3_manifold;
-
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // one 6-DoF block
-  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  solver_options.max_num_iterations = options.iterations_per_round;
-  solver_options.num_threads = 1;  // deterministic
-  solver_options.logging_type = ceres::SILENT;
-
   // Round 0 uses every observation in front of the initial camera.
   std::vector<std::uint8_t> use(n, 0);
   for (std::size_t i = 0; i < n; ++i) use[i] = (T_c_w_init * points_w[i]).z() > 0.0 ? 1 : 0;
 
   PoseBlock pose = PoseBlock::from_se3(T_c_w_init);
   const PoseBlock pose_init = pose;
+  std::vector<std::size_t> active;
+  active.reserve(n);
   for (int round = 0; round < options.rounds; ++round) {
     if (options.restart_from_initial) pose = pose_init;
     const geom::SE3d T_start = pose.to_se3();
     const bool robust = options.robust && round < options.robust_rounds;
-
-    ceres::Problem problem(borrowed_problem_options());
-    problem.AddParameterBlock(pose.pose, optim_detail::kPoseSize, &se3_manifold);
-    int num_used = 0;
+    active.clear();
     for (std::size_t i = 0; i < n; ++i) {
       // A residual must be defined at the starting pose (point in front).
-      if (!use[i] || !((T_start * points_w[i]).z() > 0.0)) continue;
-      ceres::LossFunction* loss = nullptr;
-      if (robust) loss = is_stereo(obs[i]) ? &huber_stereo : &huber_mono;
-      problem.AddResidualBlock(costs[i].get(), loss, pose.pose);
-      ++num_used;
+      if (use[i] && (T_start * points_w[i]).z() > 0.0) active.push_back(i);
     }
-    if (num_used == 0) break;  // nothing left to optimise against; keep the pose
+    if (active.empty()) break;  // nothing left to optimise against; keep the pose
 
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver_options, &problem, &summary);
-    result.final_cost = summary.final_cost;
+    result.final_cost = pose_only_levenberg_marquardt(K, points_w, obs, active, robust, options, pose.pose);
 
     // Classify every observation (outliers too: they may come back).
     classify(pose.to_se3());

@@ -48,6 +48,7 @@ TEST(Settings, ReadsTum1Unchanged) {
   EXPECT_DOUBLE_EQ(s.pe_match.threshold_px, 2.0);
   EXPECT_TRUE(s.pe_match.sampson);
   EXPECT_TRUE(s.pe_match.refine);
+  EXPECT_FALSE(s.pe_match.skip_low_parallax);
   // Viewer.* keys are ORB-SLAM2's own: no warnings.
   EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
 }
@@ -56,8 +57,10 @@ TEST(Settings, ReadsPeMatchSection) {
   const std::string path = temp_copy("pe", read_file(kTum1) +
                                                "\nPEMatch.enabled: 0\nPEMatch.population: 30\nPEMatch.j: 80\n"
                                                "PEMatch.stallIterations: 9\nPEMatch.threshold: 2.5\nPEMatch.refine: 0\n"
-                                               "PEMatch.sampson: 0\n");
+                                               "PEMatch.sampson: 0\nPEMatch.skipLowParallax: 1\n");
   const Settings s = read_settings(path);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+  EXPECT_TRUE(s.pe_match.skip_low_parallax);
   EXPECT_FALSE(s.pe_match.enabled);
   EXPECT_EQ(s.pe_match.population, 30);
   EXPECT_EQ(s.pe_match.num_fitness_samples, 80);

@@ -1,6 +1,7 @@
-// project(), observation_chi2() on hand-computed cases, and the Ceres cost
+// project(), observation_chi2() on hand-computed cases, the Ceres cost
 // functions (analytic Jacobians on the SE(3) manifold) against the
-// plain-double helper and against numeric differentiation.
+// plain-double helper and against numeric differentiation, and the
+// pose-only normal equations of optimize_pose.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -199,6 +200,81 @@ TEST(OptimCostFunctions, PointBehindCameraIsRejected) {
   const double* params[] = {s.pose, behind.data()};
   double r[2];
   EXPECT_FALSE(ba->Evaluate(params, r, nullptr));
+}
+
+
+// The pose-only normal equations that optimize_pose's Levenberg-Marquardt
+// builds: H and g against sums over reprojection()'s residuals and
+// Jacobians, and g against the numeric gradient of the robust cost on the
+// manifold (Huber active on some observations).
+TEST(OptimPoseNormalEquations, MatchReprojectionAndNumericGradient) {
+  const StereoIntrinsics K = hand_intrinsics();
+  double pose[optim_detail::kPoseSize];
+  optim_detail::pose_to_block(
+      geom::make_se3(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 1.0, -0.4).normalized())),
+                     Eigen::Vector3d(0.1, -0.2, 0.3)),
+      pose);
+  const geom::SE3d T_c_w = optim_detail::block_to_pose(pose);
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Observation> obs;
+  std::vector<std::size_t> active;
+  for (int i = 0; i < 40; ++i) {
+    const Eigen::Vector3d p_c(-0.8 + 0.04 * i, 0.5 * std::sin(i), 1.5 + 0.05 * i);
+    points.push_back(T_c_w.inverse() * p_c);
+    Observation o;
+    o.uv = project(K, p_c) + Eigen::Vector2d(0.7 * std::cos(3.0 * i), (i % 7 == 0) ? 9.0 : 0.4 * std::sin(i));
+    o.u_right = (i % 3 == 0) ? -1.0 : o.uv.x() - K.bf / p_c.z() + 0.3;
+    o.inv_sigma2 = 1.0 / std::pow(1.2, 2 * (i % 4));
+    obs.push_back(o);
+    active.push_back(static_cast<std::size_t>(i));
+  }
+  const PoseOptimizerOptions options;
+  optim_detail::PoseNormalEquations ne;
+  ASSERT_TRUE(optim_detail::pose_normal_equations<true>(K, points, obs, active, true, options, pose, &ne));
+
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+  double cost = 0.0;
+  int robust_active = 0;
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    const bool stereo = optim_detail::is_stereo(obs[i]);
+    double r[3] = {0, 0, 0};
+    double J[3 * optim_detail::kPoseSize];
+    ASSERT_TRUE(stereo ? optim_detail::reprojection<3>(K, obs[i], pose, points[i], r, J, nullptr)
+                       : optim_detail::reprojection<2>(K, obs[i], pose, points[i], r, J, nullptr));
+    const int rows = stereo ? 3 : 2;
+    const double chi2 = stereo ? options.chi2_stereo : options.chi2_mono;
+    double s = 0;
+    for (int k = 0; k < rows; ++k) s += r[k] * r[k];
+    const double w = s <= chi2 ? 1.0 : std::sqrt(chi2 / s);
+    robust_active += s > chi2;
+    cost += 0.5 * (s <= chi2 ? s : 2.0 * std::sqrt(chi2 * s) - chi2);
+    for (int k = 0; k < rows; ++k) {
+      const Eigen::Map<const Eigen::Matrix<double, 6, 1>> Jk(J + k * optim_detail::kPoseSize);
+      H += w * Jk * Jk.transpose();
+      g += w * r[k] * Jk;
+    }
+  }
+  ASSERT_GT(robust_active, 3);  // the Huber branch is exercised
+  EXPECT_NEAR(ne.cost, cost, 1e-9 * cost);
+  EXPECT_LT((ne.H - H).norm(), 1e-9 * H.norm());
+  EXPECT_LT((ne.g - g).norm(), 1e-9 * g.norm());
+
+  // Numeric gradient of the cost through the manifold's Plus.
+  optim_detail::SE3LeftManifold manifold;
+  for (int c = 0; c < 6; ++c) {
+    const double h = 1e-6;
+    double delta[6] = {0, 0, 0, 0, 0, 0};
+    double plus[optim_detail::kPoseSize], minus[optim_detail::kPoseSize];
+    delta[c] = h;
+    manifold.Plus(pose, delta, plus);
+    delta[c] = -h;
+    manifold.Plus(pose, delta, minus);
+    optim_detail::PoseNormalEquations a, b;
+    ASSERT_TRUE(optim_detail::pose_normal_equations<false>(K, points, obs, active, true, options, plus, &a));
+    ASSERT_TRUE(optim_detail::pose_normal_equations<false>(K, points, obs, active, true, options, minus, &b));
+    EXPECT_NEAR((a.cost - b.cost) / (2 * h), ne.g[c], 1e-4 * (1.0 + g.norm())) << "component " << c;
+  }
 }
 
 }  // namespace

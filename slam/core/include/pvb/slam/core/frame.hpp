@@ -60,6 +60,10 @@ class Frame {
   /// [min_level, max_level] (max_level < 0: any).
   std::vector<std::size_t> features_in_area(double u, double v, double radius_px, int min_level = -1,
                                             int max_level = -1) const;
+  /// The same into `out` (cleared first; ascending), so that a search over
+  /// many points reuses one buffer.
+  void features_in_area(double u, double v, double radius_px, int min_level, int max_level,
+                        std::vector<std::size_t>* out) const;
   /// World point of keypoint i from its depth; precondition depth_m[i] > 0.
   Eigen::Vector3d unproject_world(std::size_t i) const;
   /// (depth, keypoint index) of the keypoints with depth, nearest first.

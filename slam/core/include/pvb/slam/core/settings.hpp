@@ -25,6 +25,10 @@ struct PeMatchSettings {
   double threshold_px = 2.0;       ///< PEMatch.threshold: epipolar distance threshold, pixels
   bool sampson = true;             ///< PEMatch.sampson (0/1): 1 = Sampson distance, 0 = eq. 8 point-line distance
   bool refine = true;              ///< PEMatch.refine (0/1): IRLS refinement of gbest's F
+  /// PEMatch.skipLowParallax (0/1): skip PE-match on frames whose predicted
+  /// translation moves the matches by less than the threshold (an
+  /// experiment; it did not help on fast_turns, docs/slam.md).
+  bool skip_low_parallax = false;
 };
 
 /// PointCloudMapping.* section: the dense point-cloud mapping thread (paper

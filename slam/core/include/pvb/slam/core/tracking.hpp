@@ -29,6 +29,12 @@ struct TrackingStats {
   int coarse_matches = 0;       ///< motion-model matches after the orientation check
   int matches_kept = 0;         ///< after PE-match (== coarse without it)
   double pe_match_ms = 0;       ///< time in PE-match
+  /// Median pixel displacement that the predicted translation alone causes
+  /// at the motion model's matches with depth (+inf when unknown), and
+  /// whether PE-match was skipped because it is below the epipolar
+  /// threshold (TrackingOptions::pe_skip_low_parallax).
+  double translation_parallax_px = 0;
+  bool pe_skipped = false;
   int inliers = 0;              ///< map-point inliers after the local-map optimisation
   bool new_keyframe = false;
   /// The motion model's coarse matches (empty when it did not run), for
@@ -53,11 +59,39 @@ struct TrackingStats {
 struct TrackingOptions {
   bool use_pe_match = true;    ///< false: ORB-SLAM2 baseline motion model
   PeMatchParams pe_match = PeMatchParams::for_slam();
+  /// Beyond the paper: skip PE-match when the predicted translation moves
+  /// the matched points by less than its own inlier threshold (median over
+  /// the matches with depth).  There the epipole is not determined by the
+  /// matches (the motion is a homography within the noise), so an F from
+  /// eight of them says little about the others.  Off by default: on
+  /// fast_turns it changed neither the turn-frame errors nor the ATE
+  /// (docs/slam.md, "PE-match on fast_turns").
+  bool pe_skip_low_parallax = false;
   double motion_th = 7.0;      ///< ORB-SLAM2 window for stereo / RGB-D, x scale of the octave
   double motion_ratio = 0.9;   ///< paper sec. 3 step 1
   int min_init_points = 500;   ///< keypoints with depth needed to initialise
   int max_frames = 30;         ///< keyframe spacing limit (= fps)
   int min_frames = 0;
+};
+
+/// "Already seen in this pass" marks for map-point ids: a pass stamp per
+/// id, so a new pass is O(1) and a look-up an array access (map-point ids
+/// are dense from 0).  Ids from kDenseLimit up (visual-odometry points)
+/// go to a small ordered set.  Scratch state of an algorithm, never stored
+/// on the points (ORB-SLAM2's mnTrackReferenceForFrame).
+class IdMarks {
+ public:
+  /// Starts a pass: nothing is marked.
+  void new_pass();
+  /// Marks id; true when it was not marked yet in this pass.
+  bool mark(std::uint64_t id);
+  bool marked(std::uint64_t id) const;
+
+ private:
+  static constexpr std::uint64_t kDenseLimit = std::uint64_t(1) << 32;
+  std::vector<std::uint32_t> stamp_;  ///< pass in which each dense id was last marked
+  std::uint32_t pass_ = 0;
+  std::set<std::uint64_t> sparse_;    ///< ids >= kDenseLimit marked in this pass
 };
 
 class Tracking {
@@ -79,6 +113,10 @@ class Tracking {
  private:
   bool initialize(Frame& f);
   bool track_with_motion_model(Frame& f);
+  /// Median translational parallax of the motion-model matches m (last
+  /// keypoint with depth) under the predicted motion T_cur_last; +inf with
+  /// fewer than 8 such matches.
+  double translation_parallax_px(const std::vector<IndexMatch>& m, const geom::SE3d& T_cur_last) const;
   bool track_reference_keyframe(Frame& f);
   bool relocalize(Frame& f);
   bool track_local_map(Frame& f);
@@ -114,6 +152,8 @@ class Tracking {
   // Local map (scratch state of this algorithm, rebuilt per frame)
   std::vector<std::shared_ptr<KeyFrame>> local_kfs_;
   std::vector<std::shared_ptr<MapPoint>> local_points_;
+  IdMarks local_marks_;  ///< points already in local_points_ (update_local_map)
+  IdMarks frame_marks_;  ///< points already matched in the frame (track_local_map)
 };
 
 }  // namespace pvb::slam

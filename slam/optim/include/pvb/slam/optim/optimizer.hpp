@@ -1,7 +1,8 @@
 #pragma once
 // Pose-only optimisation and local bundle adjustment for RGB-D SLAM (the
 // parts of ORB-SLAM2's g2o Optimizer that tracking and local mapping use),
-// written on Ceres.  Inputs in, result out: no map types here, so the
+// pose-only by a small Levenberg-Marquardt of its own, local BA on Ceres.
+// Inputs in, result out: no map types here, so the
 // optimiser is tested on synthetic problems and the SLAM core converts its
 // map into these structs.
 //
@@ -43,13 +44,15 @@ struct PoseOptimizerResult {
   geom::SE3d T_c_w;                 ///< optimised pose
   std::vector<std::uint8_t> inlier; ///< per observation, after the last round
   int num_inliers = 0;
-  double final_cost = 0;            ///< Ceres cost (0.5 sum of rho(chi2)) at the end of the last round
+  double final_cost = 0;            ///< robust cost 0.5 sum of rho(chi2) at the end of the last round
 };
 
 /// Optimises one camera pose against fixed 3-D points (ORB-SLAM2's
 /// Optimizer::PoseOptimization).  points_w[i] is observed by obs[i].
 /// Outliers (chi2 above the threshold) are excluded from the next round and
-/// reported in `inlier`.  Deterministic (single-threaded Ceres).
+/// reported in `inlier`.  Each round is Levenberg-Marquardt on the 6-DoF
+/// tangent of the pose (g2o's schedule, as ORB-SLAM2), Huber as IRLS
+/// weights; deterministic.
 PoseOptimizerResult optimize_pose(const geom::SE3d& T_c_w_init, const std::vector<Eigen::Vector3d>& points_w,
                                   const std::vector<Observation>& obs, const StereoIntrinsics& K,
                                   const PoseOptimizerOptions& options = {});
