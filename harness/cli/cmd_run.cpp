@@ -106,6 +106,9 @@ Command add_run_command(CLI::App& app) {
                 "the route follower steers from the SLAM pose instead of ground truth");
   sub->add_option("--gl", args->options.gl, "rendering backend")
       ->check(CLI::IsMember({"auto", "egl", "osmesa"}));
+  sub->add_option("--mapping-nice", args->options.mapping_nice,
+                  "pipelined: nice value of the local/dense mapping workers (default 10; 0: same as the rest)")
+      ->check(CLI::Range(-20, 19));
   sub->add_flag("--check", args->check, "check metrics.json against the scenario's expect: bounds (exit 3)");
   return {sub, [args] { return run_run(*args); }};
 }

@@ -7,12 +7,14 @@
 #include <exception>
 #include <fstream>
 #include <future>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <thread>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/common/threads.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
@@ -85,15 +87,33 @@ struct FrameItem {
   sim::SimFrameSource::StageTimes times;
 };
 
+/// A frame between the render stage and the sensor-model stage.
+struct RenderedItem {
+  sim::RenderedFrame rendered;
+  geom::StampedPose gt;
+  sim::Pose2d base_gt;
+  sim::SimFrameSource::StageTimes times;
+};
+
+/// The sensor-model stage: a pure function of the rendered frame (noise
+/// seeded by scenario seed and frame index), so it gives the same frame on
+/// whichever thread it runs.
+FrameItem apply_sensor(const sim::SensorModel& sensor, RenderedItem&& item) {
+  sim::Capture cap = sensor.apply(std::move(item.rendered));
+  item.times.sensor_ms = cap.sensor_ms;
+  return FrameItem{std::move(cap.frame), item.gt, item.base_gt, item.times};
+}
+
 /// What the consumer needs to know about the simulator once it is built.
 struct SimInfo {
   std::string renderer;
   std::vector<Eigen::Vector2d> route;
+  std::optional<sim::SensorModel> sensor;  ///< a copy, for the sensor-model thread
 };
 
 /// The simulator side: builds the scene and renderer on the thread that
 /// will render (a GL context belongs to its thread), applies the closed-loop
-/// steering before each physics step and hands frames out.
+/// steering before each physics step and hands rendered frames out.
 class FrameProducer {
  public:
   FrameProducer(const scenes::Scenario& scenario, sim::GlBackend backend, int frames, Steering* steering)
@@ -101,19 +121,28 @@ class FrameProducer {
         steering_(steering) {
     info_.renderer = source_.camera().description();
     info_.route = source_.simulator().follower().path();
+    info_.sensor = source_.sensor_model();
   }
   const SimInfo& info() const { return info_; }
 
-  std::optional<FrameItem> next() {
+  /// Steering, physics and rendering (the GL thread's part).
+  std::optional<RenderedItem> next_rendered() {
     sim::Simulator& sim = source_.simulator();
     if (steering_) {
       std::lock_guard<std::mutex> lock(steering_->mutex);
       sim.set_hold(steering_->hold);
       sim.set_steering_pose(steering_->pose);
     }
-    std::optional<sensor::RgbdFrame> f = source_.next();
-    if (!f) return std::nullopt;
-    return FrameItem{std::move(*f), gt_, sim.base_pose(), source_.last_stage_times()};
+    std::optional<sim::RenderedFrame> r = source_.next_rendered();
+    if (!r) return std::nullopt;
+    return RenderedItem{std::move(*r), gt_, sim.base_pose(), source_.last_stage_times()};
+  }
+
+  /// Both stages on the calling thread.
+  std::optional<FrameItem> next() {
+    std::optional<RenderedItem> r = next_rendered();
+    if (!r) return std::nullopt;
+    return apply_sensor(source_.sensor_model(), std::move(*r));
   }
 
  private:
@@ -320,8 +349,10 @@ RunReport run_scenario(const RunOptions& opt) {
   geom::SE3d T_site_slam = geom::SE3d::Identity();  // SLAM world (first camera frame) in the site frame
   const std::vector<int> sheet_frames = plot::spread_indices(n, 12);
 
-  double physics_ms = 0, render_ms = 0, sensor_ms = 0, producer_wait_ms = 0, consumer_wait_ms = 0,
-         output_ms = 0;
+  double physics_ms = 0, render_ms = 0, sensor_ms = 0, producer_wait_ms = 0, sensor_wait_ms = 0,
+         consumer_wait_ms = 0, output_ms = 0;
+  // Pipelined: CPU time per thread (by name) over the loop, from /proc.
+  std::map<std::string, double> thread_cpu_start, thread_cpu_end;
   double setup_ms = 0;
   double sim_cpu_ms = 0, slam_cpu_ms = 0;  // sync mode: process CPU time of each half
   bool abort_run = false;
@@ -409,26 +440,46 @@ RunReport run_scenario(const RunOptions& opt) {
       if (!go_on) break;
     }
   } else {
-    // Producer thread: simulate, render, sensor model -> queue.  In the
-    // closed loop the queue holds one frame, so the steering pose is at
-    // most two frames old.
+    // Render thread: steering, physics, rendering -> rendered queue; sensor
+    // thread: sensor model -> frame queue; this thread: tracking.  No stage
+    // has to fit the whole simulation into one frame period.  In the closed
+    // loop the sensor model stays on the render thread and the frame queue
+    // holds one frame, so the steering pose is at most two frames old.
+    const bool sensor_thread_on = !opt.closed_loop;
+    BoundedQueue<RenderedItem> rendered_queue(2);
     BoundedQueue<FrameItem> queue(opt.closed_loop ? 1 : opt.queue_capacity);
     std::promise<SimInfo> ready;
     std::future<SimInfo> ready_future = ready.get_future();
-    std::exception_ptr producer_error;
+    std::exception_ptr producer_error, sensor_error;
     double producer_setup_ms = 0;
-    std::thread producer_thread;
-    // However the consumer leaves (end, stop, abort, exception), the
-    // producer is released and joined.
+    std::thread producer_thread, sensor_thread;
+    // The render thread keeps its GL context (and llvmpipe's threads) until
+    // released, so that the per-thread CPU times can be read at the end.
+    std::promise<void> release;
+    std::shared_future<void> released = release.get_future().share();
+    bool release_set = false;
+    auto release_producer = [&] {
+      if (!release_set) release.set_value();
+      release_set = true;
+    };
+    // However the consumer leaves (end, stop, abort, exception), both
+    // stages are released and joined.
     struct JoinGuard {
+      BoundedQueue<RenderedItem>& rendered_queue;
       BoundedQueue<FrameItem>& queue;
-      std::thread& thread;
+      std::function<void()> release;
+      std::thread& producer;
+      std::thread& sensor;
       ~JoinGuard() {
         queue.close_and_clear();
-        if (thread.joinable()) thread.join();
+        rendered_queue.close_and_clear();
+        release();
+        if (sensor.joinable()) sensor.join();
+        if (producer.joinable()) producer.join();
       }
-    } guard{queue, producer_thread};
+    } guard{rendered_queue, queue, release_producer, producer_thread, sensor_thread};
     producer_thread = std::thread([&] {
+      set_thread_name("pvb-render");
       bool started = false;
       try {
         const auto t_setup = Clock::now();
@@ -437,28 +488,72 @@ RunReport run_scenario(const RunOptions& opt) {
         ready.set_value(producer.info());
         started = true;
         while (!stopping()) {
-          std::optional<FrameItem> item = producer.next();
-          if (!item) break;
-          const auto t_wait = Clock::now();
-          const bool pushed = queue.push(std::move(*item));
-          producer_wait_ms += ms_since(t_wait);
+          bool pushed = false;
+          if (sensor_thread_on) {
+            std::optional<RenderedItem> item = producer.next_rendered();
+            if (!item) break;
+            const auto t_wait = Clock::now();
+            pushed = rendered_queue.push(std::move(*item));
+            producer_wait_ms += ms_since(t_wait);
+          } else {
+            std::optional<FrameItem> item = producer.next();
+            if (!item) break;
+            const auto t_wait = Clock::now();
+            pushed = queue.push(std::move(*item));
+            producer_wait_ms += ms_since(t_wait);
+          }
           if (!pushed) break;
         }
+        rendered_queue.close();
+        if (!sensor_thread_on) queue.close();
+        released.wait();
       } catch (...) {
         if (started)
           producer_error = std::current_exception();
         else
           ready.set_exception(std::current_exception());
+        rendered_queue.close();
+        queue.close();
       }
-      queue.close();
     });
     const SimInfo info = ready_future.get();  // rethrows a setup error (the guard joins)
     setup_ms = producer_setup_ms;
     report.renderer = info.renderer;
     route = info.route;
     log.line("renderer: " + report.renderer);
+    if (opt.mapping_nice != 0) {
+      // The workers started with the systems and have named themselves by
+      // now (the renderer's start-up took far longer); found by name.
+      const int changed =
+          set_thread_nice("pvb-mapping", opt.mapping_nice) + set_thread_nice("pvb-dense", opt.mapping_nice);
+      log.line("mapping workers: " + std::to_string(changed) + " at nice " + std::to_string(opt.mapping_nice));
+    }
+    if (sensor_thread_on) {
+      sensor_thread = std::thread([&] {
+        set_thread_name("pvb-sensor");
+        try {
+          while (true) {
+            auto t_wait = Clock::now();
+            std::optional<RenderedItem> item = rendered_queue.pop();
+            sensor_wait_ms += ms_since(t_wait);
+            if (!item) break;
+            FrameItem frame = apply_sensor(*info.sensor, std::move(*item));
+            t_wait = Clock::now();
+            const bool pushed = queue.push(std::move(frame));
+            sensor_wait_ms += ms_since(t_wait);
+            if (!pushed) break;
+          }
+        } catch (...) {
+          sensor_error = std::current_exception();
+        }
+        rendered_queue.close_and_clear();  // the render thread stops too
+        queue.close();
+        released.wait();  // alive for the CPU table
+      });
+    }
     loop_start = Clock::now();
     loop_start_cpu_s = process_cpu_s();
+    thread_cpu_start = thread_cpu_ms();
     while (!stopping()) {
       const auto t_wait = Clock::now();
       std::optional<FrameItem> item = queue.pop();
@@ -466,8 +561,13 @@ RunReport run_scenario(const RunOptions& opt) {
       if (!item || !consume(*item)) break;
     }
     queue.close_and_clear();
+    rendered_queue.close_and_clear();
+    thread_cpu_end = thread_cpu_ms();  // every stage still lives, waiting for release
+    release_producer();
+    if (sensor_thread.joinable()) sensor_thread.join();
     producer_thread.join();
     if (producer_error) std::rethrow_exception(producer_error);
+    if (sensor_error) std::rethrow_exception(sensor_error);
   }
   for (auto& sink : sinks) sink->finish();  // waits for local mapping
   report.wall_s = ms_since(loop_start) / 1000.0;
@@ -522,7 +622,17 @@ RunReport run_scenario(const RunOptions& opt) {
   report.profile.push_back({"output", output_ms, frames, opt.sync ? "main" : "consumer"});
   if (!opt.sync) {
     report.profile.push_back({"producer_wait", producer_wait_ms, frames, "producer"});
+    if (!opt.closed_loop) report.profile.push_back({"sensor_wait", sensor_wait_ms, frames, "sensor"});
     report.profile.push_back({"consumer_wait", consumer_wait_ms, frames, "consumer"});
+    // CPU time of each thread (group) over the loop: pvb-render (physics,
+    // GL calls), llvmpipe (its rasteriser workers), pvb-sensor, pvbench
+    // (this thread: tracking), pvb-mapping, pvb-dense, and OpenCV's pool
+    // under the name of the thread that started it.
+    for (const auto& [name, end_ms] : thread_cpu_end) {
+      const auto it = thread_cpu_start.find(name);
+      const double ms = end_ms - (it == thread_cpu_start.end() ? 0.0 : it->second);
+      report.profile.push_back({"cpu_thread_" + name, ms, frames, name});
+    }
   }
   if (opt.sync) {
     report.profile.push_back({"cpu_simulation", sim_cpu_ms, frames, "main"});

@@ -39,6 +39,12 @@ struct RunOptions {
   bool closed_loop = false;        ///< steer from the SLAM pose instead of ground truth
   std::string gl = "auto";         ///< auto, egl or osmesa
   std::size_t queue_capacity = 3;  ///< frames the producer may run ahead (open loop)
+  /// Pipelined: nice value of SLAM's background workers (local and dense
+  /// mapping).  Tracking makes a keyframe only when local mapping is idle,
+  /// so mapping takes whatever CPU is left; at a lower priority it takes
+  /// only that, and the stages that set the frame rate (rendering, sensor
+  /// model, tracking) are not slowed by it.  0: the same as the rest.
+  int mapping_nice = 10;
   /// Set asynchronously (by a signal handler) to stop the run; the partial
   /// report is then written with status "interrupted".  May be null.
   const std::atomic<bool>* stop = nullptr;
