@@ -606,10 +606,12 @@ RunReport run_scenario(const RunOptions& opt) {
   if (compare) report.baseline = sinks[1]->run;
 
   const std::size_t frames = report.primary.frames;
-  report.profile = {{"setup", setup_ms, 1, opt.sync ? "main" : "producer"},
-                    {"physics", physics_ms, frames, opt.sync ? "main" : "producer"},
-                    {"render", render_ms, frames, opt.sync ? "main" : "producer"},
-                    {"sensor_model", sensor_ms, frames, opt.sync ? "main" : "producer"}};
+  const char* render_thread = opt.sync ? "main" : "render";
+  const char* sensor_thread_name = opt.sync ? "main" : opt.closed_loop ? "render" : "sensor";
+  report.profile = {{"setup", setup_ms, 1, render_thread},
+                    {"physics", physics_ms, frames, render_thread},
+                    {"render", render_ms, frames, render_thread},
+                    {"sensor_model", sensor_ms, frames, sensor_thread_name}};
   for (const auto& sink : sinks) {
     const std::string suffix = sink.get() == sinks.front().get() ? "" : "_baseline";
     report.profile.push_back(
@@ -621,7 +623,7 @@ RunReport run_scenario(const RunOptions& opt) {
   }
   report.profile.push_back({"output", output_ms, frames, opt.sync ? "main" : "consumer"});
   if (!opt.sync) {
-    report.profile.push_back({"producer_wait", producer_wait_ms, frames, "producer"});
+    report.profile.push_back({"producer_wait", producer_wait_ms, frames, "render"});
     if (!opt.closed_loop) report.profile.push_back({"sensor_wait", sensor_wait_ms, frames, "sensor"});
     report.profile.push_back({"consumer_wait", consumer_wait_ms, frames, "consumer"});
     // CPU time of each thread (group) over the loop: pvb-render (physics,

@@ -3,11 +3,13 @@
 // while ground truth goes to the harness through its own sink; at the end
 // the trajectories are evaluated and the report folder is written.
 //
-// Threads (default): a producer thread steps the physics, renders and
-// applies the sensor model into a bounded queue; the calling thread pops
-// frames and runs tracking (of one or two SLAM systems); local mapping runs
-// on each System's worker.  With `sync` everything runs inline on the
-// calling thread and the run is bit-reproducible.
+// Threads (default): a render thread steps the physics and renders into a
+// bounded queue; a sensor thread applies the sensor model into a second
+// one (in the closed loop the render thread does both, for a short
+// steering latency); the calling thread pops frames and runs tracking (of
+// one or two SLAM systems); local mapping runs on each System's worker, at
+// a lower priority (mapping_nice).  With `sync` everything runs inline on
+// the calling thread and the run is bit-reproducible.
 #include <atomic>
 #include <cstdint>
 #include <functional>
