@@ -351,6 +351,7 @@ RunReport run_scenario(const RunOptions& opt) {
 
   double physics_ms = 0, render_ms = 0, sensor_ms = 0, producer_wait_ms = 0, sensor_wait_ms = 0,
          consumer_wait_ms = 0, output_ms = 0;
+  double frame_latency_ms = 0, frame_latency_max_ms = 0;  // pipelined: due time to tracked
   // Pipelined: CPU time per thread (by name) over the loop, from /proc.
   std::map<std::string, double> thread_cpu_start, thread_cpu_end;
   double setup_ms = 0;
@@ -450,6 +451,12 @@ RunReport run_scenario(const RunOptions& opt) {
     BoundedQueue<FrameItem> queue(opt.closed_loop ? 1 : opt.queue_capacity);
     std::promise<SimInfo> ready;
     std::future<SimInfo> ready_future = ready.get_future();
+    // Pacing: frame i is due at pace_start + i / fps (set before `ready`).
+    Clock::time_point pace_start;
+    const auto frame_due = [&](int i) {
+      return pace_start + std::chrono::duration_cast<Clock::duration>(
+                              std::chrono::duration<double>(static_cast<double>(i) / scenario.camera.fps));
+    };
     std::exception_ptr producer_error, sensor_error;
     double producer_setup_ms = 0;
     std::thread producer_thread, sensor_thread;
@@ -485,9 +492,13 @@ RunReport run_scenario(const RunOptions& opt) {
         const auto t_setup = Clock::now();
         FrameProducer producer(scenario, backend, n, steering_ptr);
         producer_setup_ms = ms_since(t_setup);
+        pace_start = Clock::now();
         ready.set_value(producer.info());
         started = true;
-        while (!stopping()) {
+        for (int i = 0; !stopping(); ++i) {
+          // A camera delivers frame i at i / fps: wait for it (a blocking
+          // sleep of at most one period, so Ctrl-C is seen in time).
+          if (opt.pace) std::this_thread::sleep_until(frame_due(i));
           bool pushed = false;
           if (sensor_thread_on) {
             std::optional<RenderedItem> item = producer.next_rendered();
@@ -521,13 +532,17 @@ RunReport run_scenario(const RunOptions& opt) {
     report.renderer = info.renderer;
     route = info.route;
     log.line("renderer: " + report.renderer);
-    if (opt.mapping_nice != 0) {
+    const int mapping_nice = opt.mapping_nice.value_or(opt.pace ? 10 : 0);
+    if (mapping_nice != 0) {
       // The workers started with the systems and have named themselves by
       // now (the renderer's start-up took far longer); found by name.
       const int changed =
-          set_thread_nice("pvb-mapping", opt.mapping_nice) + set_thread_nice("pvb-dense", opt.mapping_nice);
-      log.line("mapping workers: " + std::to_string(changed) + " at nice " + std::to_string(opt.mapping_nice));
+          set_thread_nice("pvb-mapping", mapping_nice) + set_thread_nice("pvb-dense", mapping_nice);
+      log.line("mapping workers: " + std::to_string(changed) + " at nice " + std::to_string(mapping_nice));
     }
+    bool mapping_yields = mapping_nice != 0;  // the workers are at mapping_nice
+    int mapping_priority_changes = 0;
+    log.line(opt.pace ? "frames paced at " + fmt(scenario.camera.fps) + " Hz" : "frames not paced (as fast as the stages go)");
     if (sensor_thread_on) {
       sensor_thread = std::thread([&] {
         set_thread_name("pvb-sensor");
@@ -551,15 +566,46 @@ RunReport run_scenario(const RunOptions& opt) {
         released.wait();  // alive for the CPU table
       });
     }
-    loop_start = Clock::now();
+    loop_start = pace_start;  // when frame 0 began (set before `ready`, so visible here)
     loop_start_cpu_s = process_cpu_s();
     thread_cpu_start = thread_cpu_ms();
     while (!stopping()) {
       const auto t_wait = Clock::now();
       std::optional<FrameItem> item = queue.pop();
       consumer_wait_ms += ms_since(t_wait);
-      if (!item || !consume(*item)) break;
+      if (!item) break;
+      const int index = static_cast<int>(item->frame.index);
+      const bool go_on = consume(*item);
+      // From when the frame was due (paced) or rendering began on the
+      // simulated clock (not paced) to when it is tracked.
+      const double latency_ms =
+          std::chrono::duration<double, std::milli>(Clock::now() - frame_due(index)).count();
+      frame_latency_ms += latency_ms;
+      frame_latency_max_ms = std::max(frame_latency_max_ms, latency_ms);
+      // A loop that cannot keep up with the camera gains nothing from
+      // starving local mapping: mapping goes back to the common priority
+      // while tracking is more than kBehindFrames periods late, and yields
+      // again once it is within kCaughtUpFrames.
+      // (Not in the first second: start-up makes frame 0 late anyway.)
+      if (opt.pace && mapping_nice != 0 && index >= static_cast<int>(scenario.camera.fps)) {
+        constexpr double kBehindFrames = 6, kCaughtUpFrames = 2;
+        const double late_frames = latency_ms * scenario.camera.fps / 1000.0;
+        const bool yield = mapping_yields ? late_frames < kBehindFrames : late_frames < kCaughtUpFrames;
+        if (yield != mapping_yields) {
+          mapping_yields = yield;
+          const int nice = yield ? mapping_nice : 0;
+          set_thread_nice("pvb-mapping", nice);
+          set_thread_nice("pvb-dense", nice);
+          ++mapping_priority_changes;
+          if (mapping_priority_changes <= 10)
+            log.line("frame " + std::to_string(index) + ": tracked " + fmt(latency_ms) + " ms after it was due; " +
+                     "mapping workers at nice " + std::to_string(nice));
+        }
+      }
+      if (!go_on) break;
     }
+    if (mapping_priority_changes > 10)
+      log.line("mapping priority changed " + std::to_string(mapping_priority_changes) + " times in all");
     queue.close_and_clear();
     rendered_queue.close_and_clear();
     thread_cpu_end = thread_cpu_ms();  // every stage still lives, waiting for release
@@ -626,6 +672,13 @@ RunReport run_scenario(const RunOptions& opt) {
     report.profile.push_back({"producer_wait", producer_wait_ms, frames, "render"});
     if (!opt.closed_loop) report.profile.push_back({"sensor_wait", sensor_wait_ms, frames, "sensor"});
     report.profile.push_back({"consumer_wait", consumer_wait_ms, frames, "consumer"});
+    // Paced: how long after the camera delivered it each frame was tracked
+    // (a loop that keeps up stays within a few periods); mean per frame,
+    // and the worst frame as its own entry.
+    if (opt.pace) {
+      report.profile.push_back({"frame_latency", frame_latency_ms, frames, "consumer"});
+      report.profile.push_back({"frame_latency_max", frame_latency_max_ms, 1, "consumer"});
+    }
     // CPU time of each thread (group) over the loop: pvb-render (physics,
     // GL calls), llvmpipe (its rasteriser workers), pvb-sensor, pvbench
     // (this thread: tracking), pvb-mapping, pvb-dense, and OpenCV's pool

@@ -238,8 +238,9 @@ TEST(RunCli, ClosedLoopWaitsOnLossHoldingTheRobot) {
 }
 
 // The pipelined run (the default): render thread, sensor-model thread and
-// tracking, each with its CPU time in the profile; mapping at a lower
-// priority; the same ground truth as the simulator gives `pvbench record`.
+// tracking, each with its CPU time in the profile; frames paced at the
+// camera rate; mapping at a lower priority; the same ground truth as the
+// simulator gives `pvbench record`.
 TEST(RunCli, PipelinedRunProfilesEachThread) {
   const std::string d = fresh("pipelined");
   const test::RunResult r = test::run_pvbench("run --scenario " + kStation + " --out " + d + " --frames 45");
@@ -265,7 +266,15 @@ TEST(RunCli, PipelinedRunProfilesEachThread) {
   // The threads' times are parts of the process's over the loop.
   EXPECT_LE(thread_sum_ms, 1000.0 * m["cpu_s"].as<double>() * 1.02 + 20.0);
   EXPECT_GT(thread_sum_ms, 0.5 * 1000.0 * m["cpu_s"].as<double>());
-  EXPECT_NE(read_file(d + "/run.log").find("at nice 10"), std::string::npos);
+  const std::string log = read_file(d + "/run.log");
+  EXPECT_NE(log.find("mapping workers: 2 at nice 10"), std::string::npos) << log;  // local and dense
+  EXPECT_NE(log.find("frames paced at 30 Hz"), std::string::npos) << log;
+  // Paced: a frame is tracked after it is due, never before.
+  ASSERT_TRUE(p["frame_latency"]);
+  EXPECT_GT(p["frame_latency"]["per_frame_ms"].as<double>(), 0.0);
+  EXPECT_GE(p["frame_latency_max"]["total_ms"].as<double>(), p["frame_latency"]["per_frame_ms"].as<double>());
+  // Frame 44 is due 44 / 30 s after frame 0: a paced loop cannot be faster.
+  EXPECT_GE(m["wall_s"].as<double>(), 44.0 / 30.0);
   const std::string rec = fresh("record_pipelined");
   ASSERT_EQ(test::run_pvbench("record --scenario " + kStation + " --out " + rec + " --frames 5").code, 0);
   const std::vector<std::string> rec_gt = data_lines(rec + "/groundtruth.txt");
