@@ -13,7 +13,7 @@
 // generated scene's).  Depth is compared with the sky masked (0), as
 // RgbdCamera delivers it.  With --out, a few frames are written as
 // reference | variant | |difference| x 4.  Example (docs/run.md):
-//   render_variants --gl=egl 1024:28:16:4 1024 512 512:16:8:1
+//   render_variants --gl=egl 1024 1024:28:16:1 512:28:16:1 512:16:8:1
 #include <mujoco/mujoco.h>
 #include <sys/resource.h>
 
@@ -42,7 +42,8 @@ struct Variant {
   std::string label() const {
     std::string l = std::to_string(shadow_map_px) + " px shadow map";
     if (slices > 0)
-      l += ", tessellation " + std::to_string(slices) + "/" + std::to_string(stacks) + "/" + std::to_string(quads);
+      l += ", tessellation " + std::to_string(slices) + "/" + std::to_string(stacks) + "/" +
+           std::to_string(quads);
     return l;
   }
 };
@@ -50,9 +51,9 @@ struct Variant {
 struct Result {
   double cpu_ms = 0;
   int renders = 0;
-  double mean_abs_sum = 0;      ///< mean |colour difference| (0..255), summed over frames
-  double changed_sum = 0;       ///< share of pixels with a channel off by more than 16
-  double depth_changed_sum = 0; ///< share of pixels whose depth is off by more than 1 mm
+  double mean_abs_sum = 0;       ///< mean |colour difference| (0..255), summed over frames
+  double changed_sum = 0;        ///< share of pixels with a channel off by more than 16
+  double depth_changed_sum = 0;  ///< share of pixels whose depth is off by more than 1 mm
 };
 
 }  // namespace
@@ -72,13 +73,14 @@ int main(int argc, char** argv) {
       Variant v;
       const int got = std::sscanf(argv[i], "%d:%d:%d:%d", &v.shadow_map_px, &v.slices, &v.stacks, &v.quads);
       if ((got != 1 && got != 4) || v.shadow_map_px < 1) {
-        std::fprintf(stderr, "render_variants: error: %s: expected SHADOW_MAP_PX[:SLICES:STACKS:QUADS]\n", argv[i]);
+        std::fprintf(stderr, "render_variants: error: %s: expected SHADOW_MAP_PX[:SLICES:STACKS:QUADS]\n",
+                     argv[i]);
         return 1;
       }
       variants.push_back(v);
     }
   }
-  if (variants.empty()) variants = {{1024, 28, 16, 4}, {1024}, {512}};
+  if (variants.empty()) variants = {{1024}, {1024, 28, 16, 1}, {512}};
   const pvb::sim::GlBackend gl = pvb::sim::parse_gl_backend(backend);
   const pvb::scenes::Scenario base = pvb::scenes::load_scenario(PVB_SOURCE_DIR "/scenes/pv_station.yaml");
   const int frames = pvb::scenes::frame_count(base);
@@ -143,8 +145,8 @@ int main(int argc, char** argv) {
     }
     results.push_back(res);
   }
-  std::printf("%-44s %12s %14s %14s %12s\n", "variant (first: reference)", "CPU ms", "mean |diff|", "px off >16",
-              "depth >1mm");
+  std::printf("%-44s %12s %14s %14s %12s\n", "variant (first: reference)", "CPU ms", "mean |diff|",
+              "px off >16", "depth >1mm");
   for (std::size_t i = 0; i < variants.size(); ++i) {
     const Result& r = results[i];
     std::printf("%-44s %12.2f %14.3f %13.2f%% %11.3f%%\n", variants[i].label().c_str(), r.cpu_ms / r.renders,

@@ -134,7 +134,8 @@ void apply_rgb_model(cv::Mat* rgb, const scenes::RgbNoise& params, const std::op
     if (plain) {
       for (int c = 0; c < rgb->cols; ++c) {
         const std::uint64_t bits = rng.next();
-        for (int k = 0; k < 3; ++k) px[c][k] = cv::saturate_cast<uchar>(px[c][k] + noise[(bits >> (12 * k)) & 4095]);
+        for (int k = 0; k < 3; ++k)
+          px[c][k] = cv::saturate_cast<uchar>(px[c][k] + noise[(bits >> (12 * k)) & 4095]);
       }
       continue;
     }
@@ -145,8 +146,10 @@ void apply_rgb_model(cv::Mat* rgb, const scenes::RgbNoise& params, const std::op
         add = 255.0 * params.glare * std::exp(-(dx * dx + dy * dy) / (2 * sigma_px * sigma_px));
       }
       const std::uint64_t bits = rng.next();
-      for (int k = 0; k < 3; ++k)
-        px[c][k] = cv::saturate_cast<uchar>(px[c][k] * params.exposure + add + noise[(bits >> (12 * k)) & 4095]);
+      for (int k = 0; k < 3; ++k) {
+        const double n = noise[(bits >> (12 * k)) & 4095];
+        px[c][k] = cv::saturate_cast<uchar>(px[c][k] * params.exposure + add + n);
+      }
     }
   }
   });

@@ -542,7 +542,8 @@ RunReport run_scenario(const RunOptions& opt) {
     }
     bool mapping_yields = mapping_nice != 0;  // the workers are at mapping_nice
     int mapping_priority_changes = 0;
-    log.line(opt.pace ? "frames paced at " + fmt(scenario.camera.fps) + " Hz" : "frames not paced (as fast as the stages go)");
+    log.line(opt.pace ? "frames paced at " + fmt(scenario.camera.fps) + " Hz"
+                      : "frames not paced (as fast as the stages go)");
     if (sensor_thread_on) {
       sensor_thread = std::thread([&] {
         set_thread_name("pvb-sensor");
@@ -598,8 +599,8 @@ RunReport run_scenario(const RunOptions& opt) {
           set_thread_nice("pvb-dense", nice);
           ++mapping_priority_changes;
           if (mapping_priority_changes <= 10)
-            log.line("frame " + std::to_string(index) + ": tracked " + fmt(latency_ms) + " ms after it was due; " +
-                     "mapping workers at nice " + std::to_string(nice));
+            log.line("frame " + std::to_string(index) + ": tracked " + fmt(latency_ms) +
+                     " ms after it was due; mapping workers at nice " + std::to_string(nice));
         }
       }
       if (!go_on) break;

@@ -251,7 +251,8 @@ TEST(RunCli, PipelinedRunProfilesEachThread) {
   EXPECT_EQ(m["frames"].as<int>(), 45);
   EXPECT_EQ(m["lost_frames"].as<int>(), 0);
   const YAML::Node p = m["profile"];
-  for (const char* stage : {"render", "sensor_model", "tracking", "producer_wait", "sensor_wait", "consumer_wait"})
+  for (const char* stage :
+       {"render", "sensor_model", "tracking", "producer_wait", "sensor_wait", "consumer_wait"})
     EXPECT_TRUE(p[stage]) << stage;
   double thread_sum_ms = 0;
   for (const auto& kv : p) {
