@@ -71,6 +71,22 @@ void BM_Capture(benchmark::State& state) {
 }
 BENCHMARK(BM_Capture)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// The sensor-model stage alone (Kinect depth model and RGB noise) on one
+// rendered frame: what the run's sensor thread does per frame.
+void BM_SensorModel(benchmark::State& state) {
+  World& w = world();
+  const pvb::sim::RenderedFrame rendered = w.camera->render(*w.sim);
+  const double cpu0 = process_cpu_ms();
+  for (auto _ : state) {
+    pvb::sim::RenderedFrame copy = rendered;
+    copy.rgb = rendered.rgb.clone();
+    pvb::sim::Capture c = w.camera->sensor_model().apply(std::move(copy));
+    benchmark::DoNotOptimize(c.frame.depth_m.data);
+  }
+  state.counters["process_cpu_ms/frame"] = (process_cpu_ms() - cpu0) / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_SensorModel)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_PhysicsFrame(benchmark::State& state) {
   World& w = world();
   for (auto _ : state) w.sim->advance();

@@ -23,6 +23,7 @@ struct RunArgs {
   bool baseline = false;
   bool compare = false;
   bool check = false;
+  bool no_pace = false;
 };
 
 std::atomic<bool> g_stop{false};
@@ -62,6 +63,7 @@ int run_run(RunArgs& a) {
     throw ConfigError("pvbench run", "--baseline/--compare", "at most one of them");
   run::RunOptions& o = a.options;
   o.seed = a.seed;
+  o.pace = !a.no_pace;
   o.mode = a.compare    ? run::SlamMode::kCompare
            : a.baseline ? run::SlamMode::kBaseline
                         : run::SlamMode::kPeSlam;
@@ -106,6 +108,11 @@ Command add_run_command(CLI::App& app) {
                 "the route follower steers from the SLAM pose instead of ground truth");
   sub->add_option("--gl", args->options.gl, "rendering backend")
       ->check(CLI::IsMember({"auto", "egl", "osmesa"}));
+  sub->add_flag("--no-pace", args->no_pace,
+                "pipelined: run the stages as fast as they go instead of at the camera's frame rate");
+  sub->add_option("--mapping-nice", args->options.mapping_nice,
+                  "pipelined: nice value of the local/dense mapping workers (default 10 when paced, else 0)")
+      ->check(CLI::Range(-20, 19));
   sub->add_flag("--check", args->check, "check metrics.json against the scenario's expect: bounds (exit 3)");
   return {sub, [args] { return run_run(*args); }};
 }

@@ -67,7 +67,11 @@ cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, c
   std::vector<float> xn(static_cast<std::size_t>(W)), yn(static_cast<std::size_t>(H));
   for (int c = 0; c < W; ++c) xn[static_cast<std::size_t>(c)] = static_cast<float>((c - K.cx) / K.fx);
   for (int r = 0; r < H; ++r) yn[static_cast<std::size_t>(r)] = static_cast<float>((r - K.cy) / K.fy);
-  auto gt_at = [&](int r, int c) { return gt.ptr<float>(std::clamp(r, 0, H - 1))[std::clamp(c, 0, W - 1)]; };
+  // Lateral jitter in whole pixels for each of the 4096 quantiles: the same
+  // values as rounding per pixel, 4096 roundings instead of two per pixel.
+  std::array<int, 4096> jitter_px{};
+  for (std::size_t i = 0; i < jitter_px.size(); ++i)
+    jitter_px[i] = static_cast<int>(std::lround(nt[i] * p.lateral_sigma_px));
   // Rows run in parallel; each row has its own generator seeded by (seed,
   // frame, row), so the result does not depend on the number of threads.
   cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
@@ -77,13 +81,15 @@ cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, c
     for (int c = 0; c < W; ++c) {
       const std::uint64_t bits = rng.next();
       // lateral jitter: sample a neighbouring pixel (nearest, so no mixing at edges)
-      const int dc = static_cast<int>(std::lround(nt[bits & 4095] * p.lateral_sigma_px));
-      const int dr = static_cast<int>(std::lround(nt[(bits >> 12) & 4095] * p.lateral_sigma_px));
+      const int dc = jitter_px[bits & 4095];
+      const int dr = jitter_px[(bits >> 12) & 4095];
+      // rr and cc stay one pixel inside the image, so their neighbours are in it
       const int rr = std::clamp(r + dr, 1, H - 2), cc = std::clamp(c + dc, 1, W - 2);
-      const float z = gt_at(rr, cc);
+      const float* g = gt.ptr<float>(rr);
+      const float z = g[cc];
       if (z <= 0.0f) continue;
       // incidence angle from the local surface normal
-      const float zl = gt_at(rr, cc - 1), zr = gt_at(rr, cc + 1), zu = gt_at(rr - 1, cc), zd = gt_at(rr + 1, cc);
+      const float zl = g[cc - 1], zr = g[cc + 1], zu = gt.ptr<float>(rr - 1)[cc], zd = gt.ptr<float>(rr + 1)[cc];
       if (zl <= 0 || zr <= 0 || zu <= 0 || zd <= 0) continue;  // silhouette edge: no return
       // P(u, v) = z (xn(u), yn(v), 1); n = dP/du x dP/dv by central
       // differences; compare squared cosines to avoid square roots.
@@ -115,11 +121,24 @@ void apply_rgb_model(cv::Mat* rgb, const scenes::RgbNoise& params, const std::op
   const bool glare = params.glare > 0 && sun_px.has_value();
   if (params.sigma <= 0 && params.exposure == 1.0 && !glare) return;
   const auto& nt = normal_table();
+  // The noise for each of the 4096 quantiles, the same products as per pixel.
+  std::array<double, 4096> noise{};
+  for (std::size_t i = 0; i < noise.size(); ++i) noise[i] = params.sigma > 0 ? nt[i] * params.sigma : 0.0;
   const double sigma_px = 0.35 * rgb->cols;
+  // Without exposure and glare, v * 1.0 + 0.0 + n is exactly v + n.
+  const bool plain = params.exposure == 1.0 && !glare;
   cv::parallel_for_(cv::Range(0, rgb->rows), [&](const cv::Range& rows) {
   for (int r = rows.start; r < rows.end; ++r) {
     SplitMix rng(seed, (frame << 21) + 2 * static_cast<std::uint64_t>(r));
     auto* px = rgb->ptr<cv::Vec3b>(r);
+    if (plain) {
+      for (int c = 0; c < rgb->cols; ++c) {
+        const std::uint64_t bits = rng.next();
+        for (int k = 0; k < 3; ++k)
+          px[c][k] = cv::saturate_cast<uchar>(px[c][k] + noise[(bits >> (12 * k)) & 4095]);
+      }
+      continue;
+    }
     for (int c = 0; c < rgb->cols; ++c) {
       double add = 0;
       if (glare) {
@@ -128,7 +147,7 @@ void apply_rgb_model(cv::Mat* rgb, const scenes::RgbNoise& params, const std::op
       }
       const std::uint64_t bits = rng.next();
       for (int k = 0; k < 3; ++k) {
-        const double n = params.sigma > 0 ? nt[(bits >> (12 * k)) & 4095] * params.sigma : 0.0;
+        const double n = noise[(bits >> (12 * k)) & 4095];
         px[c][k] = cv::saturate_cast<uchar>(px[c][k] * params.exposure + add + n);
       }
     }

@@ -10,16 +10,24 @@ SimFrameSource::SimFrameSource(scenes::Scenario scenario, GlBackend backend, int
       frames_(scenes::frame_count(sim_.scenario(), max_frames)),
       sink_(std::move(sink)) {}
 
-std::optional<sensor::RgbdFrame> SimFrameSource::next() {
+std::optional<RenderedFrame> SimFrameSource::next_rendered() {
   if (next_index_ >= frames_) return std::nullopt;
   const auto t0 = std::chrono::steady_clock::now();
   if (next_index_ > 0) sim_.advance();
   last_times_.physics_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   ++next_index_;
-  Capture cap = camera_.capture(sim_);
-  last_times_.render_ms = cap.render_ms;
+  RenderedFrame rendered = camera_.render(sim_);
+  last_times_.render_ms = rendered.render_ms;
+  last_times_.sensor_ms = 0;
+  if (sink_) sink_({rendered.t_ns, rendered.T_w_c});
+  return rendered;
+}
+
+std::optional<sensor::RgbdFrame> SimFrameSource::next() {
+  std::optional<RenderedFrame> rendered = next_rendered();
+  if (!rendered) return std::nullopt;
+  Capture cap = camera_.sensor_model().apply(std::move(*rendered));
   last_times_.sensor_ms = cap.sensor_ms;
-  if (sink_) sink_({cap.frame.t_ns, cap.T_w_c});
   last_depth_gt_m_ = cap.depth_gt_m;
   return std::move(cap.frame);
 }

@@ -140,30 +140,44 @@ std::optional<cv::Point2d> Simulator::sun_pixel() const {
 }
 
 RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
-    : renderer_(sim.model(), backend, sim.scenario().camera.width, sim.scenario().camera.height) {
+    : renderer_(sim.model(), backend, sim.scenario().camera.width, sim.scenario().camera.height), sensor_(sim) {
   renderer_.set_shadows(sim.scenario().light.shadows);
 }
 
-Capture RgbdCamera::capture(Simulator& sim) {
+RenderedFrame RgbdCamera::render(Simulator& sim) {
   using Clock = std::chrono::steady_clock;
-  Capture out;
-  cv::Mat rgb;
+  RenderedFrame out;
   const auto t0 = Clock::now();
-  renderer_.render(sim.model(), sim.data(), sim.camera_id(), &rgb, &out.depth_gt_m);
-  const auto t1 = Clock::now();
+  renderer_.render(sim.model(), sim.data(), sim.camera_id(), &out.rgb, &out.depth_gt_m);
   // Sky: beyond every scene distance (the skybox is drawn far away).
   const float sky = static_cast<float>(sim.assets().max_scene_depth_m);
   out.depth_gt_m.setTo(0.0f, out.depth_gt_m > sky);
-  const scenes::Scenario& s = sim.scenario();
-  const auto frame = static_cast<std::uint64_t>(sim.frame_index());
-  out.frame.depth_m = apply_depth_model(out.depth_gt_m, sim.intrinsics(), s.camera, s.seed, frame);
-  apply_rgb_model(&rgb, s.camera.rgb, sim.sun_pixel(), s.seed, frame);
-  out.frame.rgb = rgb;
-  out.frame.t_ns = sim.t_ns();
-  out.frame.index = frame;
+  out.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  out.sun_px = sim.sun_pixel();
+  out.index = static_cast<std::uint64_t>(sim.frame_index());
+  out.t_ns = sim.t_ns();
   out.T_w_c = sim.T_w_c();
-  out.render_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
-  out.sensor_ms = std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
+  return out;
+}
+
+Capture RgbdCamera::capture(Simulator& sim) { return sensor_.apply(render(sim)); }
+
+SensorModel::SensorModel(const Simulator& sim)
+    : camera_(sim.scenario().camera), K_(sim.intrinsics()), seed_(sim.scenario().seed) {}
+
+Capture SensorModel::apply(RenderedFrame rendered) const {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  Capture out;
+  out.depth_gt_m = std::move(rendered.depth_gt_m);
+  out.frame.depth_m = apply_depth_model(out.depth_gt_m, K_, camera_, seed_, rendered.index);
+  apply_rgb_model(&rendered.rgb, camera_.rgb, rendered.sun_px, seed_, rendered.index);
+  out.frame.rgb = std::move(rendered.rgb);
+  out.frame.t_ns = rendered.t_ns;
+  out.frame.index = rendered.index;
+  out.T_w_c = rendered.T_w_c;
+  out.render_ms = rendered.render_ms;
+  out.sensor_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   return out;
 }
 

@@ -54,6 +54,8 @@ TEST(Scenario, UnknownKeyIsNamedWithFileAndLine) {
 TEST(Scenario, WrongTypeIsNamed) {
   const std::string msg = error_of(std::string(kMinimal) + "light:\n  shadows: maybe\n");
   EXPECT_NE(msg.find("light.shadows: expected true or false, got maybe"), std::string::npos) << msg;
+  const std::string msg3 = error_of(std::string(kMinimal) + "light:\n  box_quads: 0\n");
+  EXPECT_NE(msg3.find("light.box_quads"), std::string::npos) << msg3;
   const std::string msg2 = error_of(std::string(kMinimal) + "duration_s: long\n");
   EXPECT_NE(msg2.find("duration_s: expected a number, got long"), std::string::npos) << msg2;
 }

@@ -54,3 +54,11 @@ TEST(SceneBuilder, WallFinishPicksTheMaterial) {
   EXPECT_EQ(m->geom_matid[mj_name2id(m.get(), mjOBJ_GEOM, "wall1")], plaster);
   EXPECT_EQ(m->mat_texid[plaster], -1);  // untextured: one flat colour
 }
+
+TEST(SceneBuilder, BoxQuadsSetMujocoTessellation) {
+  scenes::Scenario s = station();
+  EXPECT_EQ(s.light.box_quads, 4);  // MuJoCo's own default: the station renders as it always did
+  EXPECT_EQ(sim::compile_scene(sim::build_scene(s))->vis.quality.numquads, 4);
+  s.light.box_quads = 1;
+  EXPECT_EQ(sim::compile_scene(sim::build_scene(s))->vis.quality.numquads, 1);
+}

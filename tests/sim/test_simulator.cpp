@@ -2,6 +2,9 @@
 // following and determinism, on scenes built by the generator.
 #include <gtest/gtest.h>
 
+#include <optional>
+#include <thread>
+
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/sim/sim_frame_source.hpp"
@@ -186,4 +189,46 @@ TEST(SimFrameSource, StreamsFramesWithGroundTruthThroughItsOwnSink) {
   }
   EXPECT_FALSE(src.next().has_value());
   EXPECT_NE(src.describe().find("sim:wall_test"), std::string::npos);
+}
+
+// The run's pipeline renders on one thread and applies the sensor model on
+// another: that must give exactly the frames next() gives, noise included.
+TEST(SimFrameSource, SensorModelOnAnotherThreadGivesTheFramesOfNext) {
+  scenes::Scenario s = wall_scenario();
+  s.camera.depth_noise.model = scenes::DepthNoiseModel::kKinect;
+  s.camera.rgb.sigma = 2.0;
+  constexpr int kFrames = 4;
+  std::vector<sensor::RgbdFrame> direct;
+  {
+    // One source at a time: a renderer draws in the context made current last.
+    sim::SimFrameSource src(s, sim::GlBackend::kAuto, kFrames);
+    while (auto f = src.next()) direct.push_back(*f);
+  }
+  std::vector<geom::StampedPose> gt;
+  std::vector<sim::RenderedFrame> rendered;
+  std::optional<sim::SensorModel> model;
+  {
+    sim::SimFrameSource src(s, sim::GlBackend::kAuto, kFrames,
+                            [&gt](const geom::StampedPose& p) { gt.push_back(p); });
+    while (auto r = src.next_rendered()) rendered.push_back(std::move(*r));
+    model = src.sensor_model();  // a copy outlives the source and its simulator
+  }
+  ASSERT_EQ(rendered.size(), static_cast<std::size_t>(kFrames));
+  ASSERT_EQ(gt.size(), rendered.size());  // ground truth leaves at render time
+  std::vector<sensor::RgbdFrame> split;
+  std::thread worker([&] {
+    for (auto& r : rendered) split.push_back(model->apply(std::move(r)).frame);
+  });
+  worker.join();
+  ASSERT_EQ(split.size(), direct.size());
+  for (std::size_t i = 0; i < split.size(); ++i) {
+    EXPECT_EQ(split[i].index, direct[i].index);
+    EXPECT_EQ(split[i].t_ns, direct[i].t_ns);
+    EXPECT_EQ(split[i].t_ns, gt[i].t_ns);
+    EXPECT_EQ(cv::norm(split[i].rgb, direct[i].rgb, cv::NORM_INF), 0.0) << "frame " << i;
+    EXPECT_EQ(cv::norm(split[i].depth_m, direct[i].depth_m, cv::NORM_INF), 0.0) << "frame " << i;
+    EXPECT_GT(cv::countNonZero(split[i].depth_m), 1000) << "frame " << i;
+  }
+  // The noise differs from frame to frame (seeded by the frame index).
+  EXPECT_GT(cv::norm(split[1].depth_m, split[2].depth_m, cv::NORM_INF), 0.0);
 }

@@ -7,12 +7,14 @@
 #include <exception>
 #include <fstream>
 #include <future>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <thread>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/common/threads.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
@@ -85,15 +87,33 @@ struct FrameItem {
   sim::SimFrameSource::StageTimes times;
 };
 
+/// A frame between the render stage and the sensor-model stage.
+struct RenderedItem {
+  sim::RenderedFrame rendered;
+  geom::StampedPose gt;
+  sim::Pose2d base_gt;
+  sim::SimFrameSource::StageTimes times;
+};
+
+/// The sensor-model stage: a pure function of the rendered frame (noise
+/// seeded by scenario seed and frame index), so it gives the same frame on
+/// whichever thread it runs.
+FrameItem apply_sensor(const sim::SensorModel& sensor, RenderedItem&& item) {
+  sim::Capture cap = sensor.apply(std::move(item.rendered));
+  item.times.sensor_ms = cap.sensor_ms;
+  return FrameItem{std::move(cap.frame), item.gt, item.base_gt, item.times};
+}
+
 /// What the consumer needs to know about the simulator once it is built.
 struct SimInfo {
   std::string renderer;
   std::vector<Eigen::Vector2d> route;
+  std::optional<sim::SensorModel> sensor;  ///< a copy, for the sensor-model thread
 };
 
 /// The simulator side: builds the scene and renderer on the thread that
 /// will render (a GL context belongs to its thread), applies the closed-loop
-/// steering before each physics step and hands frames out.
+/// steering before each physics step and hands rendered frames out.
 class FrameProducer {
  public:
   FrameProducer(const scenes::Scenario& scenario, sim::GlBackend backend, int frames, Steering* steering)
@@ -101,19 +121,28 @@ class FrameProducer {
         steering_(steering) {
     info_.renderer = source_.camera().description();
     info_.route = source_.simulator().follower().path();
+    info_.sensor = source_.sensor_model();
   }
   const SimInfo& info() const { return info_; }
 
-  std::optional<FrameItem> next() {
+  /// Steering, physics and rendering (the GL thread's part).
+  std::optional<RenderedItem> next_rendered() {
     sim::Simulator& sim = source_.simulator();
     if (steering_) {
       std::lock_guard<std::mutex> lock(steering_->mutex);
       sim.set_hold(steering_->hold);
       sim.set_steering_pose(steering_->pose);
     }
-    std::optional<sensor::RgbdFrame> f = source_.next();
-    if (!f) return std::nullopt;
-    return FrameItem{std::move(*f), gt_, sim.base_pose(), source_.last_stage_times()};
+    std::optional<sim::RenderedFrame> r = source_.next_rendered();
+    if (!r) return std::nullopt;
+    return RenderedItem{std::move(*r), gt_, sim.base_pose(), source_.last_stage_times()};
+  }
+
+  /// Both stages on the calling thread.
+  std::optional<FrameItem> next() {
+    std::optional<RenderedItem> r = next_rendered();
+    if (!r) return std::nullopt;
+    return apply_sensor(source_.sensor_model(), std::move(*r));
   }
 
  private:
@@ -320,8 +349,11 @@ RunReport run_scenario(const RunOptions& opt) {
   geom::SE3d T_site_slam = geom::SE3d::Identity();  // SLAM world (first camera frame) in the site frame
   const std::vector<int> sheet_frames = plot::spread_indices(n, 12);
 
-  double physics_ms = 0, render_ms = 0, sensor_ms = 0, producer_wait_ms = 0, consumer_wait_ms = 0,
-         output_ms = 0;
+  double physics_ms = 0, render_ms = 0, sensor_ms = 0, producer_wait_ms = 0, sensor_wait_ms = 0,
+         consumer_wait_ms = 0, output_ms = 0;
+  double frame_latency_ms = 0, frame_latency_max_ms = 0;  // pipelined: due time to tracked
+  // Pipelined: CPU time per thread (by name) over the loop, from /proc.
+  std::map<std::string, double> thread_cpu_start, thread_cpu_end;
   double setup_ms = 0;
   double sim_cpu_ms = 0, slam_cpu_ms = 0;  // sync mode: process CPU time of each half
   bool abort_run = false;
@@ -409,65 +441,180 @@ RunReport run_scenario(const RunOptions& opt) {
       if (!go_on) break;
     }
   } else {
-    // Producer thread: simulate, render, sensor model -> queue.  In the
-    // closed loop the queue holds one frame, so the steering pose is at
-    // most two frames old.
+    // Render thread: steering, physics, rendering -> rendered queue; sensor
+    // thread: sensor model -> frame queue; this thread: tracking.  No stage
+    // has to fit the whole simulation into one frame period.  In the closed
+    // loop the sensor model stays on the render thread and the frame queue
+    // holds one frame, so the steering pose is at most two frames old.
+    const bool sensor_thread_on = !opt.closed_loop;
+    BoundedQueue<RenderedItem> rendered_queue(2);
     BoundedQueue<FrameItem> queue(opt.closed_loop ? 1 : opt.queue_capacity);
     std::promise<SimInfo> ready;
     std::future<SimInfo> ready_future = ready.get_future();
-    std::exception_ptr producer_error;
+    // Pacing: frame i is due at pace_start + i / fps (set before `ready`).
+    Clock::time_point pace_start;
+    const auto frame_due = [&](int i) {
+      return pace_start + std::chrono::duration_cast<Clock::duration>(
+                              std::chrono::duration<double>(static_cast<double>(i) / scenario.camera.fps));
+    };
+    std::exception_ptr producer_error, sensor_error;
     double producer_setup_ms = 0;
-    std::thread producer_thread;
-    // However the consumer leaves (end, stop, abort, exception), the
-    // producer is released and joined.
+    std::thread producer_thread, sensor_thread;
+    // The render thread keeps its GL context (and llvmpipe's threads) until
+    // released, so that the per-thread CPU times can be read at the end.
+    std::promise<void> release;
+    std::shared_future<void> released = release.get_future().share();
+    bool release_set = false;
+    auto release_producer = [&] {
+      if (!release_set) release.set_value();
+      release_set = true;
+    };
+    // However the consumer leaves (end, stop, abort, exception), both
+    // stages are released and joined.
     struct JoinGuard {
+      BoundedQueue<RenderedItem>& rendered_queue;
       BoundedQueue<FrameItem>& queue;
-      std::thread& thread;
+      std::function<void()> release;
+      std::thread& producer;
+      std::thread& sensor;
       ~JoinGuard() {
         queue.close_and_clear();
-        if (thread.joinable()) thread.join();
+        rendered_queue.close_and_clear();
+        release();
+        if (sensor.joinable()) sensor.join();
+        if (producer.joinable()) producer.join();
       }
-    } guard{queue, producer_thread};
+    } guard{rendered_queue, queue, release_producer, producer_thread, sensor_thread};
     producer_thread = std::thread([&] {
+      set_thread_name("pvb-render");
       bool started = false;
       try {
         const auto t_setup = Clock::now();
         FrameProducer producer(scenario, backend, n, steering_ptr);
         producer_setup_ms = ms_since(t_setup);
+        pace_start = Clock::now();
         ready.set_value(producer.info());
         started = true;
-        while (!stopping()) {
-          std::optional<FrameItem> item = producer.next();
-          if (!item) break;
-          const auto t_wait = Clock::now();
-          const bool pushed = queue.push(std::move(*item));
-          producer_wait_ms += ms_since(t_wait);
+        for (int i = 0; !stopping(); ++i) {
+          // A camera delivers frame i at i / fps: wait for it (a blocking
+          // sleep of at most one period, so Ctrl-C is seen in time).
+          if (opt.pace) std::this_thread::sleep_until(frame_due(i));
+          bool pushed = false;
+          if (sensor_thread_on) {
+            std::optional<RenderedItem> item = producer.next_rendered();
+            if (!item) break;
+            const auto t_wait = Clock::now();
+            pushed = rendered_queue.push(std::move(*item));
+            producer_wait_ms += ms_since(t_wait);
+          } else {
+            std::optional<FrameItem> item = producer.next();
+            if (!item) break;
+            const auto t_wait = Clock::now();
+            pushed = queue.push(std::move(*item));
+            producer_wait_ms += ms_since(t_wait);
+          }
           if (!pushed) break;
         }
+        rendered_queue.close();
+        if (!sensor_thread_on) queue.close();
+        released.wait();
       } catch (...) {
         if (started)
           producer_error = std::current_exception();
         else
           ready.set_exception(std::current_exception());
+        rendered_queue.close();
+        queue.close();
       }
-      queue.close();
     });
     const SimInfo info = ready_future.get();  // rethrows a setup error (the guard joins)
     setup_ms = producer_setup_ms;
     report.renderer = info.renderer;
     route = info.route;
     log.line("renderer: " + report.renderer);
-    loop_start = Clock::now();
+    const int mapping_nice = opt.mapping_nice.value_or(opt.pace ? 10 : 0);
+    if (mapping_nice != 0) {
+      // The workers started with the systems and have named themselves by
+      // now (the renderer's start-up took far longer); found by name.
+      const int changed =
+          set_thread_nice("pvb-mapping", mapping_nice) + set_thread_nice("pvb-dense", mapping_nice);
+      log.line("mapping workers: " + std::to_string(changed) + " at nice " + std::to_string(mapping_nice));
+    }
+    bool mapping_yields = mapping_nice != 0;  // the workers are at mapping_nice
+    int mapping_priority_changes = 0;
+    log.line(opt.pace ? "frames paced at " + fmt(scenario.camera.fps) + " Hz"
+                      : "frames not paced (as fast as the stages go)");
+    if (sensor_thread_on) {
+      sensor_thread = std::thread([&] {
+        set_thread_name("pvb-sensor");
+        try {
+          while (true) {
+            auto t_wait = Clock::now();
+            std::optional<RenderedItem> item = rendered_queue.pop();
+            sensor_wait_ms += ms_since(t_wait);
+            if (!item) break;
+            FrameItem frame = apply_sensor(*info.sensor, std::move(*item));
+            t_wait = Clock::now();
+            const bool pushed = queue.push(std::move(frame));
+            sensor_wait_ms += ms_since(t_wait);
+            if (!pushed) break;
+          }
+        } catch (...) {
+          sensor_error = std::current_exception();
+        }
+        rendered_queue.close_and_clear();  // the render thread stops too
+        queue.close();
+        released.wait();  // alive for the CPU table
+      });
+    }
+    loop_start = pace_start;  // when frame 0 began (set before `ready`, so visible here)
     loop_start_cpu_s = process_cpu_s();
+    thread_cpu_start = thread_cpu_ms();
     while (!stopping()) {
       const auto t_wait = Clock::now();
       std::optional<FrameItem> item = queue.pop();
       consumer_wait_ms += ms_since(t_wait);
-      if (!item || !consume(*item)) break;
+      if (!item) break;
+      const int index = static_cast<int>(item->frame.index);
+      const bool go_on = consume(*item);
+      // From when the frame was due (paced) or rendering began on the
+      // simulated clock (not paced) to when it is tracked.
+      const double latency_ms =
+          std::chrono::duration<double, std::milli>(Clock::now() - frame_due(index)).count();
+      frame_latency_ms += latency_ms;
+      frame_latency_max_ms = std::max(frame_latency_max_ms, latency_ms);
+      // A loop that cannot keep up with the camera gains nothing from
+      // starving local mapping: mapping goes back to the common priority
+      // while tracking is more than kBehindFrames periods late, and yields
+      // again once it is within kCaughtUpFrames.
+      // (Not in the first second: start-up makes frame 0 late anyway.)
+      if (opt.pace && mapping_nice != 0 && index >= static_cast<int>(scenario.camera.fps)) {
+        constexpr double kBehindFrames = 6, kCaughtUpFrames = 2;
+        const double late_frames = latency_ms * scenario.camera.fps / 1000.0;
+        const bool yield = mapping_yields ? late_frames < kBehindFrames : late_frames < kCaughtUpFrames;
+        if (yield != mapping_yields) {
+          mapping_yields = yield;
+          const int nice = yield ? mapping_nice : 0;
+          set_thread_nice("pvb-mapping", nice);
+          set_thread_nice("pvb-dense", nice);
+          ++mapping_priority_changes;
+          if (mapping_priority_changes <= 10)
+            log.line("frame " + std::to_string(index) + ": tracked " + fmt(latency_ms) +
+                     " ms after it was due; mapping workers at nice " + std::to_string(nice));
+        }
+      }
+      if (!go_on) break;
     }
+    if (mapping_priority_changes > 10)
+      log.line("mapping priority changed " + std::to_string(mapping_priority_changes) + " times in all");
     queue.close_and_clear();
+    rendered_queue.close_and_clear();
+    thread_cpu_end = thread_cpu_ms();  // every stage still lives, waiting for release
+    release_producer();
+    if (sensor_thread.joinable()) sensor_thread.join();
     producer_thread.join();
     if (producer_error) std::rethrow_exception(producer_error);
+    if (sensor_error) std::rethrow_exception(sensor_error);
   }
   for (auto& sink : sinks) sink->finish();  // waits for local mapping
   report.wall_s = ms_since(loop_start) / 1000.0;
@@ -506,10 +653,12 @@ RunReport run_scenario(const RunOptions& opt) {
   if (compare) report.baseline = sinks[1]->run;
 
   const std::size_t frames = report.primary.frames;
-  report.profile = {{"setup", setup_ms, 1, opt.sync ? "main" : "producer"},
-                    {"physics", physics_ms, frames, opt.sync ? "main" : "producer"},
-                    {"render", render_ms, frames, opt.sync ? "main" : "producer"},
-                    {"sensor_model", sensor_ms, frames, opt.sync ? "main" : "producer"}};
+  const char* render_thread = opt.sync ? "main" : "render";
+  const char* sensor_thread_name = opt.sync ? "main" : opt.closed_loop ? "render" : "sensor";
+  report.profile = {{"setup", setup_ms, 1, render_thread},
+                    {"physics", physics_ms, frames, render_thread},
+                    {"render", render_ms, frames, render_thread},
+                    {"sensor_model", sensor_ms, frames, sensor_thread_name}};
   for (const auto& sink : sinks) {
     const std::string suffix = sink.get() == sinks.front().get() ? "" : "_baseline";
     report.profile.push_back(
@@ -521,8 +670,25 @@ RunReport run_scenario(const RunOptions& opt) {
   }
   report.profile.push_back({"output", output_ms, frames, opt.sync ? "main" : "consumer"});
   if (!opt.sync) {
-    report.profile.push_back({"producer_wait", producer_wait_ms, frames, "producer"});
+    report.profile.push_back({"producer_wait", producer_wait_ms, frames, "render"});
+    if (!opt.closed_loop) report.profile.push_back({"sensor_wait", sensor_wait_ms, frames, "sensor"});
     report.profile.push_back({"consumer_wait", consumer_wait_ms, frames, "consumer"});
+    // Paced: how long after the camera delivered it each frame was tracked
+    // (a loop that keeps up stays within a few periods); mean per frame,
+    // and the worst frame as its own entry.
+    if (opt.pace) {
+      report.profile.push_back({"frame_latency", frame_latency_ms, frames, "consumer"});
+      report.profile.push_back({"frame_latency_max", frame_latency_max_ms, 1, "consumer"});
+    }
+    // CPU time of each thread (group) over the loop: pvb-render (physics,
+    // GL calls), llvmpipe (its rasteriser workers), pvb-sensor, pvbench
+    // (this thread: tracking), pvb-mapping, pvb-dense, and OpenCV's pool
+    // under the name of the thread that started it.
+    for (const auto& [name, end_ms] : thread_cpu_end) {
+      const auto it = thread_cpu_start.find(name);
+      const double ms = end_ms - (it == thread_cpu_start.end() ? 0.0 : it->second);
+      report.profile.push_back({"cpu_thread_" + name, ms, frames, name});
+    }
   }
   if (opt.sync) {
     report.profile.push_back({"cpu_simulation", sim_cpu_ms, frames, "main"});

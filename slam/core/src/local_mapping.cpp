@@ -7,6 +7,7 @@
 
 #include "pvb/slam/core/matcher.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
+#include "pvb/common/threads.hpp"
 
 namespace pvb::slam {
 
@@ -48,7 +49,10 @@ LocalMapping::~LocalMapping() { stop(); }
 
 void LocalMapping::start() {
   if (worker_.joinable()) return;
-  worker_ = std::thread([this] { run(); });
+  worker_ = std::thread([this] {
+    set_thread_name("pvb-mapping");
+    run();
+  });
 }
 
 void LocalMapping::stop() {

@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "pvb/common/threads.hpp"
+
 namespace pvb::slam::dense {
 
 DenseMapper::DenseMapper(const DenseMapperOptions& options) : options_(options) {}
@@ -10,7 +12,10 @@ DenseMapper::~DenseMapper() { stop(); }
 
 void DenseMapper::start() {
   if (worker_.joinable() || stopped_) return;
-  worker_ = std::thread([this] { run(); });
+  worker_ = std::thread([this] {
+    set_thread_name("pvb-dense");
+    run();
+  });
 }
 
 void DenseMapper::stop() {

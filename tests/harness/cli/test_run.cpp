@@ -237,6 +237,54 @@ TEST(RunCli, ClosedLoopWaitsOnLossHoldingTheRobot) {
   }
 }
 
+// The pipelined run (the default): render thread, sensor-model thread and
+// tracking, each with its CPU time in the profile; frames paced at the
+// camera rate; mapping at a lower priority; the same ground truth as the
+// simulator gives `pvbench record`.
+TEST(RunCli, PipelinedRunProfilesEachThread) {
+  const std::string d = fresh("pipelined");
+  const test::RunResult r = test::run_pvbench("run --scenario " + kStation + " --out " + d + " --frames 45");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const YAML::Node m = metrics(d);
+  EXPECT_EQ(m["status"].as<std::string>(), "completed");
+  EXPECT_FALSE(m["sync"].as<bool>());
+  EXPECT_EQ(m["frames"].as<int>(), 45);
+  EXPECT_EQ(m["lost_frames"].as<int>(), 0);
+  const YAML::Node p = m["profile"];
+  for (const char* stage :
+       {"render", "sensor_model", "tracking", "producer_wait", "sensor_wait", "consumer_wait"})
+    EXPECT_TRUE(p[stage]) << stage;
+  double thread_sum_ms = 0;
+  for (const auto& kv : p) {
+    const std::string name = kv.first.as<std::string>();
+    if (name.rfind("cpu_thread_", 0) == 0) thread_sum_ms += kv.second["total_ms"].as<double>();
+  }
+  for (const char* thread : {"cpu_thread_pvb-render", "cpu_thread_pvb-sensor", "cpu_thread_pvbench"}) {
+    ASSERT_TRUE(p[thread]) << thread;
+    EXPECT_GT(p[thread]["total_ms"].as<double>(), 0.0) << thread;
+  }
+  EXPECT_TRUE(p["cpu_thread_pvb-mapping"]);
+  // The threads' times are parts of the process's over the loop.
+  EXPECT_LE(thread_sum_ms, 1000.0 * m["cpu_s"].as<double>() * 1.02 + 20.0);
+  EXPECT_GT(thread_sum_ms, 0.5 * 1000.0 * m["cpu_s"].as<double>());
+  const std::string log = read_file(d + "/run.log");
+  EXPECT_NE(log.find("mapping workers: 2 at nice 10"), std::string::npos) << log;  // local and dense
+  EXPECT_NE(log.find("frames paced at 30 Hz"), std::string::npos) << log;
+  // Paced: a frame is tracked after it is due, never before.
+  ASSERT_TRUE(p["frame_latency"]);
+  EXPECT_GT(p["frame_latency"]["per_frame_ms"].as<double>(), 0.0);
+  EXPECT_GE(p["frame_latency_max"]["total_ms"].as<double>(), p["frame_latency"]["per_frame_ms"].as<double>());
+  // Frame 44 is due 44 / 30 s after frame 0: a paced loop cannot be faster.
+  EXPECT_GE(m["wall_s"].as<double>(), 44.0 / 30.0);
+  const std::string rec = fresh("record_pipelined");
+  ASSERT_EQ(test::run_pvbench("record --scenario " + kStation + " --out " + rec + " --frames 5").code, 0);
+  const std::vector<std::string> rec_gt = data_lines(rec + "/groundtruth.txt");
+  const std::vector<std::string> run_gt = data_lines(d + "/groundtruth.txt");
+  ASSERT_EQ(run_gt.size(), 45u);
+  ASSERT_EQ(rec_gt.size(), 5u);
+  for (std::size_t i = 0; i < rec_gt.size(); ++i) EXPECT_EQ(rec_gt[i], run_gt[i]);
+}
+
 // Ctrl-C: a child `pvbench run` (pipelined) gets SIGINT once it has
 // tracked some frames; it must exit 130 with a partial report.
 TEST(RunCli, SigintWritesThePartialReport) {

@@ -76,6 +76,9 @@ struct Light {
   double ambient = 0.35;            ///< ambient light, 0..1
   bool shadows = true;
   int shadow_map_px = 1024;  ///< shadow map resolution; the map covers 18 m around the robot
+  /// Quads along each edge of a box face (MuJoCo vis.quality.numquads);
+  /// only per-vertex lighting uses them.  1 renders faster (docs/run.md).
+  int box_quads = 4;
 };
 
 struct Route {

@@ -23,6 +23,11 @@ class SimFrameSource : public sensor::FrameSource {
   /// Advances the physics by one camera period (not before frame 0),
   /// renders and applies the sensor model.  nullopt after the last frame.
   std::optional<sensor::RgbdFrame> next() override;
+  /// The simulator's half of next(): advances, renders and sends the ground
+  /// truth to the sink, without the sensor model.  For pipelines that run
+  /// sensor_model().apply() on another thread; next() is both halves.
+  std::optional<RenderedFrame> next_rendered();
+  const SensorModel& sensor_model() const { return camera_.sensor_model(); }
   std::size_t size_hint() const override { return static_cast<std::size_t>(frames_); }
   std::string describe() const override;
 

@@ -84,16 +84,50 @@ struct Capture {
   double sensor_ms = 0;      ///< time spent in the sensor model (depth and RGB noise)
 };
 
+/// One rendered frame before the sensor model: the noise-free images and
+/// what the sensor model needs from the simulator state at render time.
+/// It carries no reference to the simulator, so the sensor model can run on
+/// another thread while the next frame renders.
+struct RenderedFrame {
+  cv::Mat rgb;                        ///< noise-free colour, R, G, B order
+  cv::Mat depth_gt_m;                 ///< rendered depth, exact, sky = 0
+  std::optional<cv::Point2d> sun_px;  ///< the sun's projection (Simulator::sun_pixel)
+  std::uint64_t index = 0;            ///< frame index
+  std::int64_t t_ns = 0;
+  geom::SE3d T_w_c;                   ///< ground-truth camera pose
+  double render_ms = 0;               ///< GL rendering and read-back
+};
+
+/// The Kinect depth and RGB noise models with the scenario's parameters.
+/// apply() is const and touches no shared state: safe on any thread.
+class SensorModel {
+ public:
+  explicit SensorModel(const Simulator& sim);
+  /// Applies the sensor model; the result does not depend on the thread
+  /// or on which frames were processed before.
+  Capture apply(RenderedFrame rendered) const;
+
+ private:
+  scenes::Camera camera_;
+  geom::PinholeIntrinsics K_;
+  std::uint64_t seed_;
+};
+
 /// Renders the simulator's camera and applies the sensor model.
 class RgbdCamera {
  public:
   RgbdCamera(const Simulator& sim, GlBackend backend);
+  /// render() then the sensor model, on the calling thread.
   Capture capture(Simulator& sim);
+  /// Renders the current state (the GL thread's part of capture()).
+  RenderedFrame render(Simulator& sim);
+  const SensorModel& sensor_model() const { return sensor_; }
   const std::string& description() const { return renderer_.description(); }
   GlBackend backend() const { return renderer_.backend(); }
 
  private:
   Renderer renderer_;
+  SensorModel sensor_;
 };
 
 /// Installs MuJoCo error/warning handlers that throw pvb::Error instead of

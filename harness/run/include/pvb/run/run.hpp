@@ -3,11 +3,13 @@
 // while ground truth goes to the harness through its own sink; at the end
 // the trajectories are evaluated and the report folder is written.
 //
-// Threads (default): a producer thread steps the physics, renders and
-// applies the sensor model into a bounded queue; the calling thread pops
-// frames and runs tracking (of one or two SLAM systems); local mapping runs
-// on each System's worker.  With `sync` everything runs inline on the
-// calling thread and the run is bit-reproducible.
+// Threads (default): a render thread steps the physics and renders into a
+// bounded queue; a sensor thread applies the sensor model into a second
+// one (in the closed loop the render thread does both, for a short
+// steering latency), paced at the camera's frame rate; the calling thread
+// pops frames and runs tracking (of one or two SLAM systems); local mapping
+// runs on each System's worker, at a lower priority (mapping_nice).  With `sync` everything runs inline on
+// the calling thread and the run is bit-reproducible.
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -39,6 +41,16 @@ struct RunOptions {
   bool closed_loop = false;        ///< steer from the SLAM pose instead of ground truth
   std::string gl = "auto";         ///< auto, egl or osmesa
   std::size_t queue_capacity = 3;  ///< frames the producer may run ahead (open loop)
+  /// Pipelined: release frame i no earlier than i / fps after the first,
+  /// as a camera delivers them, instead of as fast as the stages go.
+  bool pace = true;
+  /// Pipelined: nice value of SLAM's background workers (local and dense
+  /// mapping); nullopt: 10 when paced, 0 otherwise.  Tracking makes a
+  /// keyframe only when local mapping is idle, so mapping takes whatever
+  /// CPU is left; at a lower priority it takes only that, and the stages
+  /// that must keep up with the camera are not slowed by it.  Free-running
+  /// stages leave it nothing, hence 0 without pacing.
+  std::optional<int> mapping_nice;
   /// Set asynchronously (by a signal handler) to stop the run; the partial
   /// report is then written with status "interrupted".  May be null.
   const std::atomic<bool>* stop = nullptr;
