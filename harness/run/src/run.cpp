@@ -309,6 +309,7 @@ RunReport run_scenario(const RunOptions& opt) {
   std::vector<std::unique_ptr<SystemSink>> sinks;
   {
     slam::Settings s = settings;
+    s.loop.enabled = s.loop.enabled && opt.loop_closing;
     s.pe_match.enabled = opt.mode != SlamMode::kBaseline;
     sinks.push_back(std::make_unique<SystemSink>(s.pe_match.enabled ? "pe-slam" : "orb-slam2", s, opt.sync,
                                                  slam_seed, opt.out_dir));

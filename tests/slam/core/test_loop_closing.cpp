@@ -209,6 +209,29 @@ TEST(LoopClosing, ClosesOnlyAfterConsistentDetectionsAndRemovesTheDrift) {
   EXPECT_FALSE(kfs[2]->set_bad());  // a keyframe with a loop edge is kept
 }
 
+TEST(LoopClosing, CorrectionIsBitIdenticalRunToRun) {
+  const auto run_once = [] {
+    Map map;
+    const cv::Mat tex = make_texture(1);
+    add_keyframe(map, tex, pose(0, 0, 0), pose(0, 0, 0));
+    LoopClosingOptions o = test_options();
+    o.consistency = 1;
+    LoopClosing lc(map, o);
+    for (const auto& T : {pose(2, 0.06, 0.02), pose(1, 0.03, 0.01)}) lc.process(add_keyframe(map, tex, T, drifted(T)));
+    std::vector<double> state;
+    for (const auto& [id, kf] : map.keyframes())
+      for (int k = 0; k < 16; ++k) state.push_back(kf->T_c_w().matrix()(k / 4, k % 4));
+    for (const auto& [id, mp] : map.points())
+      for (int k = 0; k < 3; ++k) state.push_back(mp->p_w()(k));
+    return std::make_pair(lc.stats().loops.size(), state);
+  };
+  const auto a = run_once(), b = run_once();
+  EXPECT_EQ(a.first, 1u);
+  EXPECT_EQ(a.first, b.first);
+  ASSERT_EQ(a.second.size(), b.second.size());
+  EXPECT_TRUE(a.second == b.second);  // exact, not approximate
+}
+
 TEST(LoopClosingSettings, DefaultsAndDisabled) {
   const LoopClosingOptions d;
   EXPECT_TRUE(d.enabled);
