@@ -148,7 +148,8 @@ std::string to_json(const LoopClosingStats& stats) {
            ", \"fused_points\": " + std::to_string(e.fused_points) +
            ", \"graph_keyframes\": " + std::to_string(e.graph_keyframes) +
            ", \"graph_edges\": " + std::to_string(e.graph_edges) + ", \"detect_ms\": " + num(e.detect_ms) +
-           ", \"correct_ms\": " + num(e.correct_ms) + "}";
+           ", \"correct_ms\": " + num(e.correct_ms) + ", \"global_ba_ms\": " + num(e.global_ba_ms) +
+           ", \"global_ba_outliers\": " + std::to_string(e.global_ba_outliers) + "}";
   }
   out += "], \"keyframes\": " + std::to_string(stats.keyframes) + ", \"candidates\": " +
          std::to_string(stats.candidates) + ", \"consistent\": " + std::to_string(stats.consistent) +
@@ -262,6 +263,11 @@ bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
   const auto t1 = std::chrono::steady_clock::now();
   correct(kf, loop_kf, best, &event);
   event.correct_ms = ms_since(t1);
+  if (options_.global_ba) {
+    const auto t2 = std::chrono::steady_clock::now();
+    global_bundle_adjustment(&event);
+    event.global_ba_ms = ms_since(t2);
+  }
   groups_.clear();
   any_loop_ = true;
   last_loop_kf_id_ = kf->id();
@@ -443,6 +449,57 @@ void LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared
 
   kf->add_loop_edge(loop_kf);
   loop_kf->add_loop_edge(kf);
+}
+
+void LoopClosing::global_bundle_adjustment(LoopEvent* event) {
+  BaProblem problem;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  std::vector<std::shared_ptr<MapPoint>> pts;
+  std::map<std::uint64_t, std::size_t> kf_index;
+  for (const auto& [id, k] : map_.keyframes()) {
+    if (k->bad()) continue;
+    kf_index[id] = kfs.size();
+    problem.keyframes.push_back({id, k->T_c_w(), id == 0});  // keyframe 0 fixes the gauge (the world frame)
+    kfs.push_back(k);
+  }
+  if (kfs.size() < 2) return;
+  for (const auto& [id, mp] : map_.points()) {
+    if (mp->bad()) continue;
+    const std::size_t p = pts.size();
+    bool any = false;
+    for (const auto& [kid, o] : mp->observations()) {
+      auto it = kf_index.find(kid);
+      if (it == kf_index.end()) continue;
+      if (!any) {
+        problem.points.push_back({id, mp->p_w()});
+        pts.push_back(mp);
+        any = true;
+      }
+      problem.edges.push_back({it->second, p, kfs[it->second]->frame().observation(o.idx)});
+    }
+  }
+  if (problem.edges.empty()) return;
+  BaOptions options;
+  options.sparse_schur = true;
+  const BaResult result = slam::local_bundle_adjustment(&problem, kfs[0]->frame().cam->K, options);
+  for (std::size_t e : result.outlier_edges) {
+    const BaEdge& edge = problem.edges[e];
+    const auto& k = kfs[edge.keyframe];
+    const auto& mp = pts[edge.point];
+    const long idx = mp->index_in(k->id());
+    if (idx < 0) continue;
+    if (k->map_points()[static_cast<std::size_t>(idx)] == mp) k->set_map_point(static_cast<std::size_t>(idx), nullptr);
+    mp->erase_observation(k->id());
+  }
+  event->global_ba_outliers = static_cast<int>(result.outlier_edges.size());
+  for (std::size_t k = 0; k < kfs.size(); ++k)
+    if (!problem.keyframes[k].fixed) kfs[k]->set_T_c_w(problem.keyframes[k].T_c_w);
+  for (std::size_t p = 0; p < pts.size(); ++p)
+    if (!pts[p]->bad()) {
+      pts[p]->set_p_w(problem.points[p].p_w);
+      pts[p]->update_normal_and_depth();
+    }
+  map_.remove_bad_points();
 }
 
 }  // namespace pvb::slam

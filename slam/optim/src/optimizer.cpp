@@ -246,7 +246,7 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
     }
 
     ceres::Solver::Options solver_options;
-    solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+    solver_options.linear_solver_type = options.sparse_schur ? ceres::SPARSE_SCHUR : ceres::DENSE_SCHUR;
     solver_options.linear_solver_ordering = ordering;
     solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
     solver_options.max_num_iterations = iterations;

@@ -77,7 +77,7 @@ TEST(Settings, ReadsLoopClosingSection) {
                                                  "LoopClosing.maxCandidates: 3\nLoopClosing.minMatches: 25\n"
                                                  "LoopClosing.consistency: 3\nLoopClosing.minInliers: 60\n"
                                                  "LoopClosing.maxCorrection: 0.2\nLoopClosing.maxCorrectionAngle: 5\n"
-                                                 "LoopClosing.essentialWeight: 80\n");
+                                                 "LoopClosing.essentialWeight: 80\nLoopClosing.globalBA: 0\n");
   const Settings s = read_settings(path);
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_FALSE(s.loop.enabled);
@@ -91,6 +91,8 @@ TEST(Settings, ReadsLoopClosingSection) {
   EXPECT_DOUBLE_EQ(s.loop.max_correction_m, 0.2);
   EXPECT_DOUBLE_EQ(s.loop.max_correction_deg, 5);
   EXPECT_EQ(s.loop.essential_weight, 80);
+  EXPECT_TRUE(d.loop.global_ba);
+  EXPECT_FALSE(s.loop.global_ba);
   for (const std::string bad : {"LoopClosing.enabled: 2", "LoopClosing.searchRadius: -1", "LoopClosing.minInliers: 3",
                                 "LoopClosing.maxAngle: 200", "LoopClosing.consistency: 1.5"}) {
     const std::string key = bad.substr(0, bad.find(':'));

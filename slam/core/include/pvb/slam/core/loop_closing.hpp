@@ -22,7 +22,9 @@
 //      side), loop edges added, the essential graph (spanning tree, loop
 //      edges, covisibility edges of weight >= `essential_weight`) optimised
 //      as an SE(3) pose graph, and every map point moved with its reference
-//      keyframe.
+//      keyframe;
+//   5. optionally (`global_ba`, on by default) a bundle adjustment of the
+//      whole map, inline, with the map locked (tracking waits).
 //
 // Pose proximity only works while the drift is small compared with the
 // search radius (centimetres here): it cannot close a loop after the
@@ -41,9 +43,9 @@ namespace pvb::slam {
 /// LoopClosing.* settings (docs/slam.md, "Loop closing").
 struct LoopClosingOptions {
   bool enabled = true;             ///< LoopClosing.enabled (0/1)
-  double search_radius_m = 1.0;    ///< LoopClosing.searchRadius: camera centre distance, metres
+  double search_radius_m = 3.0;    ///< LoopClosing.searchRadius: camera centre distance, metres
   double max_angle_deg = 30.0;     ///< LoopClosing.maxAngle: angle between the optical axes
-  int min_keyframe_gap = 50;       ///< LoopClosing.minKeyFrameGap: candidate this many keyframe ids older
+  int min_keyframe_gap = 30;       ///< LoopClosing.minKeyFrameGap: candidate this many keyframe ids older
   int max_candidates = 5;          ///< LoopClosing.maxCandidates: closest first
   int min_matches = 20;            ///< LoopClosing.minMatches: appearance check, descriptor matches
   int consistency = 2;             ///< LoopClosing.consistency: consecutive consistent detections needed
@@ -52,6 +54,7 @@ struct LoopClosingOptions {
   double max_correction_deg = 10;  ///< LoopClosing.maxCorrectionAngle, degrees
   int essential_weight = 100;      ///< LoopClosing.essentialWeight: covisibility edges in the essential graph
   int keyframes_between_loops = 10;  ///< no detection for this many keyframes after a loop (ORB-SLAM2: 10)
+  bool global_ba = true;           ///< LoopClosing.globalBA (0/1): bundle adjustment of the whole map after a loop
 };
 
 /// One closed loop.
@@ -66,6 +69,8 @@ struct LoopEvent {
   int graph_edges = 0;
   double detect_ms = 0;       ///< detection and verification for this keyframe
   double correct_ms = 0;      ///< correction (fusion, pose graph, points)
+  double global_ba_ms = 0;    ///< global bundle adjustment afterwards (0 when off)
+  int global_ba_outliers = 0; ///< observations it removed
 };
 
 /// Running totals (all keyframes).
@@ -126,6 +131,9 @@ class LoopClosing {
   };
   /// Steps 1-2; returns the candidates consistent enough for verification.
   std::vector<std::shared_ptr<KeyFrame>> detect(const std::shared_ptr<KeyFrame>& kf);
+  /// Step 5 (optional): bundle adjustment of every keyframe and point,
+  /// keyframe 0 fixed, map locked throughout.
+  void global_bundle_adjustment(LoopEvent* event);
   /// Step 4.
   void correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf, const LoopMatch& m,
                LoopEvent* event);

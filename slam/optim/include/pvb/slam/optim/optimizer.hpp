@@ -81,6 +81,9 @@ struct BaOptions {
   double chi2_mono = 5.991;
   double chi2_stereo = 7.815;
   const bool* abort_flag = nullptr;  ///< optional: stop early when it becomes true
+  /// Sparse Schur complement (global BA over the whole map: many keyframes,
+  /// each seeing a few others); false: dense (local BA, a few dozen keyframes).
+  bool sparse_schur = false;
 };
 
 struct BaResult {
