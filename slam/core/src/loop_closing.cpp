@@ -377,7 +377,7 @@ void LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared
   const auto add_edge = [&](std::size_t i, std::size_t j, const geom::SE3d& T_iw, const geom::SE3d& T_jw) {
     const auto key = std::minmax(i, j);
     if (!inserted.insert(key).second) return;
-    graph.edges.push_back({i, j, T_iw * T_jw.inverse(), 1.0});
+    graph.edges.push_back({i, j, T_iw * T_jw.inverse(), 1.0, options_.rotation_weight});
   };
   for (const auto& [id, links] : loop_links) {
     auto it = node.find(id);

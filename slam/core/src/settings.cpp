@@ -137,6 +137,8 @@ Settings read_settings(const std::string& path) {
   lc.max_correction_deg = r.real("LoopClosing.maxCorrectionAngle", false, lc.max_correction_deg);
   lc.essential_weight = r.integer("LoopClosing.essentialWeight", false, lc.essential_weight);
   lc.global_ba = r.flag("LoopClosing.globalBA", lc.global_ba);
+  lc.rotation_weight = r.real("LoopClosing.rotationWeight", false, lc.rotation_weight);
+  r.positive("LoopClosing.rotationWeight", lc.rotation_weight);
   r.positive("LoopClosing.searchRadius", lc.search_radius_m);
   if (!(lc.max_angle_deg > 0 && lc.max_angle_deg <= 180))
     throw ConfigError(path, "LoopClosing.maxAngle", "a value in (0, 180]", std::to_string(lc.max_angle_deg));

@@ -311,7 +311,7 @@ PoseGraphResult optimize_pose_graph(PoseGraphProblem* problem, const PoseGraphOp
   ceres::Problem cp(po);
   for (std::size_t k = 0; k < g.nodes.size(); ++k) cp.AddParameterBlock(poses[k].pose, optim_detail::kPoseSize, &se3_manifold);
   for (const PoseGraphEdge& e : g.edges)
-    cp.AddResidualBlock(new optim_detail::RelativePoseError(e.T_i_j, e.weight), nullptr, poses[e.i].pose,
+    cp.AddResidualBlock(new optim_detail::RelativePoseError(e.T_i_j, e.weight, e.rotation_weight), nullptr, poses[e.i].pose,
                         poses[e.j].pose);
   for (std::size_t k = 0; k < g.nodes.size(); ++k)
     if (g.nodes[k].fixed) cp.SetParameterBlockConstant(poses[k].pose);  // the gauge (and what the caller pins)

@@ -226,7 +226,7 @@ class BaReprojection final : public ceres::SizedCostFunction<kRows, kPoseSize, 3
 
 /// Relative-pose edge of the SE(3) pose graph (optimize_pose_graph):
 ///   E = M T_i T_j^-1,  M = T_i_j(measured)^-1,  T_i = T_iw, T_j = T_jw,
-///   r = w [Log(R_E); t_E]                        (6 rows)
+///   r = w [w_r Log(R_E); t_E]                   (6 rows)
 /// Jacobians with respect to the left updates T <- [Exp(omega) | rho] T of
 /// both poses, lifted as above (columns 0-5, column 6 zero), computed by
 /// forward-mode automatic differentiation of r(Plus(x_i, d_i), Plus(x_j, d_j))
@@ -234,10 +234,11 @@ class BaReprojection final : public ceres::SizedCostFunction<kRows, kPoseSize, 3
 /// Parameter blocks: pose i (7), pose j (7), both on SE3LeftManifold.
 class RelativePoseError final : public ceres::SizedCostFunction<6, kPoseSize, kPoseSize> {
  public:
-  RelativePoseError(const geom::SE3d& T_i_j, double weight)
+  RelativePoseError(const geom::SE3d& T_i_j, double weight, double rotation_weight = 1.0)
       : q_m_(Eigen::Quaterniond(Eigen::Matrix3d(T_i_j.inverse().linear())).normalized()),
         t_m_(T_i_j.inverse().translation()),
-        weight_(weight) {}
+        weight_(weight),
+        rotation_weight_(rotation_weight) {}
 
   /// The residual at the perturbed poses (d = [omega, rho] for each).
   template <typename T>
@@ -269,7 +270,7 @@ class RelativePoseError final : public ceres::SizedCostFunction<6, kPoseSize, kP
     const T q_e_ceres[4] = {q_e.w(), q_e.x(), q_e.y(), q_e.z()};
     ceres::QuaternionToAngleAxis(q_e_ceres, r);
     for (int k = 0; k < 3; ++k) {
-      r[k] *= T(weight_);
+      r[k] *= T(weight_ * rotation_weight_);
       r[3 + k] = T(weight_) * t_e[k];
     }
   }
@@ -304,6 +305,7 @@ class RelativePoseError final : public ceres::SizedCostFunction<6, kPoseSize, kP
   Eigen::Quaterniond q_m_;  ///< rotation of M = T_i_j^-1
   Eigen::Vector3d t_m_;     ///< translation of M
   double weight_;
+  double rotation_weight_;
 };
 
 /// Cost function of one pose-only observation, mono or stereo as the observation says.

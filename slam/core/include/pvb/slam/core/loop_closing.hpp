@@ -23,7 +23,7 @@
 //      edges, covisibility edges of weight >= `essential_weight`) optimised
 //      as an SE(3) pose graph, and every map point moved with its reference
 //      keyframe;
-//   5. optionally (`global_ba`, on by default) a bundle adjustment of the
+//   5. optionally (`global_ba`, off by default) a bundle adjustment of the
 //      whole map, inline, with the map locked (tracking waits).
 //
 // Pose proximity only works while the drift is small compared with the
@@ -54,7 +54,8 @@ struct LoopClosingOptions {
   double max_correction_deg = 10;  ///< LoopClosing.maxCorrectionAngle, degrees
   int essential_weight = 100;      ///< LoopClosing.essentialWeight: covisibility edges in the essential graph
   int keyframes_between_loops = 10;  ///< no detection for this many keyframes after a loop (ORB-SLAM2: 10)
-  bool global_ba = true;           ///< LoopClosing.globalBA (0/1): bundle adjustment of the whole map after a loop
+  double rotation_weight = 1.0;    ///< LoopClosing.rotationWeight: pose-graph rotation rows (rad) against translation (m)
+  bool global_ba = false;          ///< LoopClosing.globalBA (0/1): bundle adjustment of the whole map after a loop
 };
 
 /// One closed loop.

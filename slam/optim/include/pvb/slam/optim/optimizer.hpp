@@ -106,7 +106,8 @@ struct PoseGraphNode {
 struct PoseGraphEdge {
   std::size_t i = 0, j = 0;  ///< indices into PoseGraphProblem::nodes
   geom::SE3d T_i_j;          ///< measured pose of camera j in camera i
-  double weight = 1.0;       ///< information = weight^2 * I6
+  double weight = 1.0;       ///< information = weight^2 * diag(r^2 I3, I3)
+  double rotation_weight = 1.0;  ///< r: rotation rows (radians) against translation rows (metres)
 };
 struct PoseGraphProblem {
   std::vector<PoseGraphNode> nodes;
@@ -121,7 +122,7 @@ struct PoseGraphResult {
 };
 
 /// Optimises the non-fixed nodes in place.  Residual per edge:
-/// r = weight [Log(R_E); t_E] with E = T_i_j^-1 T_iw T_jw^-1 (zero when the
+/// r = weight [rotation_weight Log(R_E); t_E] with E = T_i_j^-1 T_iw T_jw^-1 (zero when the
 /// poses agree with the measurement).  Deterministic (single thread).
 /// Throws std::invalid_argument for an edge naming a missing node.
 PoseGraphResult optimize_pose_graph(PoseGraphProblem* problem, const PoseGraphOptions& options = {});
