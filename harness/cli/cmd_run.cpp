@@ -21,6 +21,7 @@ struct RunArgs {
   run::RunOptions options;
   std::optional<std::uint64_t> seed;
   bool baseline = false;
+  bool no_loop_closing = false;
   bool compare = false;
   bool check = false;
   bool no_pace = false;
@@ -64,6 +65,7 @@ int run_run(RunArgs& a) {
   run::RunOptions& o = a.options;
   o.seed = a.seed;
   o.pace = !a.no_pace;
+  o.loop_closing = !a.no_loop_closing;
   o.mode = a.compare    ? run::SlamMode::kCompare
            : a.baseline ? run::SlamMode::kBaseline
                         : run::SlamMode::kPeSlam;
@@ -102,6 +104,7 @@ Command add_run_command(CLI::App& app) {
                   "stop after N frames (default: the scenario's duration)")
       ->check(CLI::PositiveNumber);
   sub->add_flag("--sync", args->options.sync, "synchronous: no threads, bit-identical runs");
+  sub->add_flag("--no-loop-closing", args->no_loop_closing, "switch loop closing off (LoopClosing.enabled: 0)");
   sub->add_flag("--baseline", args->baseline, "run the ORB-SLAM2 baseline (no PE-match) instead of PE-SLAM");
   sub->add_flag("--compare", args->compare, "run PE-SLAM and the baseline on the same rendered frames");
   sub->add_flag("--closed-loop", args->options.closed_loop,

@@ -259,6 +259,18 @@ int run_slam(const SlamArgs& a) {
   }
   std::printf("frames %zu, lost %zu, keyframes %zu, map points %zu\n", frames, lost, system.num_keyframes(),
               system.num_map_points());
+  if (system.loop_closing_enabled()) {
+    const slam::LoopClosingStats loops = system.loop_stats();
+    js << ",\n  \"loop_closing\": " << slam::to_json(loops);
+    std::printf("loop closing: %zu loops closed (%d consistent detections, %d refused by geometry)\n",
+                loops.loops.size(), loops.consistent, loops.rejected);
+    for (const slam::LoopEvent& e : loops.loops)
+      std::printf("  frame %llu (keyframe %llu) -> frame %llu (keyframe %llu): %d inliers, moved %.3f m / %.2f deg, "
+                  "%.0f ms\n",
+                  static_cast<unsigned long long>(e.frame_id), static_cast<unsigned long long>(e.keyframe_id),
+                  static_cast<unsigned long long>(e.loop_frame_id), static_cast<unsigned long long>(e.loop_keyframe_id),
+                  e.inliers, e.correction_m, e.correction_deg, e.detect_ms + e.correct_ms);
+  }
   std::printf("tracking ms: median %.2f, mean %.2f, p95 %.2f; PE-match ms: median %.2f\n",
               percentile(tracking_ms, 0.5), mean, percentile(tracking_ms, 0.95), percentile(pe_ms, 0.5));
 

@@ -48,6 +48,10 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
     out += in + "\"ate\": null,\n" + in + "\"rpe\": null,\n" + in + "\"alignment\": null,\n";
   }
   if (!run.eval_note.empty()) out += in + "\"eval_note\": " + str(run.eval_note) + ",\n";
+  if (run.refined_eval)
+    out += in + "\"refined\": {\"ate_rmse\": " + num(run.refined_eval->ate.rmse) +
+           ", \"rpe_trans_rmse\": " + num(run.refined_eval->rpe_trans_m.rmse) + "},\n";
+  if (!run.loop_closing_json.empty()) out += in + "\"loop_closing\": " + run.loop_closing_json + ",\n";
   out += in + "\"tracking_ms\": {\"median\": " + num(percentile(ms, 0.5)) +
          ", \"mean\": " + num(mean_of(ms)) + ", \"p95\": " + num(percentile(ms, 0.95)) + "},\n";
   out += in + "\"loss_events\": [";

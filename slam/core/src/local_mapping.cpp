@@ -94,6 +94,7 @@ void LocalMapping::process(const std::shared_ptr<KeyFrame>& kf) {
     std::lock_guard<std::mutex> lock(map_.mutex());
     cull_keyframes(kf);
   }
+  if (after_keyframe_) after_keyframe_(kf);
   --pending_;
 }
 

@@ -224,6 +224,13 @@ std::vector<std::shared_ptr<KeyFrame>> KeyFrame::children() const {
   return out;
 }
 
+std::vector<std::shared_ptr<KeyFrame>> KeyFrame::loop_edges() const {
+  std::vector<std::shared_ptr<KeyFrame>> out;
+  for (const auto& [id, w] : loop_edges_)
+    if (auto k = w.lock()) out.push_back(k);
+  return out;
+}
+
 void KeyFrame::add_child(const std::shared_ptr<KeyFrame>& kf) { children_[kf->id()] = kf; }
 void KeyFrame::erase_child(std::uint64_t kf_id) { children_.erase(kf_id); }
 void KeyFrame::change_parent(const std::shared_ptr<KeyFrame>& kf) {
@@ -232,7 +239,7 @@ void KeyFrame::change_parent(const std::shared_ptr<KeyFrame>& kf) {
 }
 
 bool KeyFrame::set_bad() {
-  if (id_ == 0 || bad_) return false;
+  if (id_ == 0 || bad_ || !loop_edges_.empty()) return false;
   for (const auto& [kid, c] : connections_)
     if (auto k = c.first.lock()) k->erase_connection(id_);
   for (std::size_t i = 0; i < frame_.map_points.size(); ++i)

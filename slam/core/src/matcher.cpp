@@ -188,7 +188,8 @@ int search_keyframe_bruteforce(const KeyFrame& kf, Frame& cur, int max_distance,
   return n;
 }
 
-int fuse(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::vector<std::shared_ptr<MapPoint>>& points, double th) {
+int fuse(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::vector<std::shared_ptr<MapPoint>>& points, double th,
+         FusePolicy policy) {
   const Frame& f = kf->frame();
   const CameraModel& cam = *f.cam;
   const Eigen::Vector3d center = f.camera_center_w();
@@ -230,7 +231,9 @@ int fuse(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::vector<std::s
     if (best > kThLow) continue;
     const auto existing = f.map_points[best_idx];
     if (existing && !existing->bad()) {
-      if (existing->num_observations() > mp->num_observations()) mp->replace(existing, mp);
+      if (existing == mp) continue;
+      if (policy == FusePolicy::kIncomingWins) existing->replace(mp, existing);
+      else if (existing->num_observations() > mp->num_observations()) mp->replace(existing, mp);
       else existing->replace(mp, existing);
     } else {
       mp->add_observation(kf, best_idx);

@@ -125,6 +125,33 @@ Settings read_settings(const std::string& path) {
     throw ConfigError(path, "PointCloudMapping.MaxDepth", "a value > PointCloudMapping.MinDepth",
                       std::to_string(pc.max_depth_m));
 
+  LoopClosingOptions& lc = s.loop;
+  lc.enabled = r.flag("LoopClosing.enabled", lc.enabled);
+  lc.search_radius_m = r.real("LoopClosing.searchRadius", false, lc.search_radius_m);
+  lc.max_angle_deg = r.real("LoopClosing.maxAngle", false, lc.max_angle_deg);
+  lc.min_keyframe_gap = r.integer("LoopClosing.minKeyFrameGap", false, lc.min_keyframe_gap);
+  lc.max_candidates = r.integer("LoopClosing.maxCandidates", false, lc.max_candidates);
+  lc.min_matches = r.integer("LoopClosing.minMatches", false, lc.min_matches);
+  lc.consistency = r.integer("LoopClosing.consistency", false, lc.consistency);
+  lc.min_inliers = r.integer("LoopClosing.minInliers", false, lc.min_inliers);
+  lc.max_correction_m = r.real("LoopClosing.maxCorrection", false, lc.max_correction_m);
+  lc.max_correction_deg = r.real("LoopClosing.maxCorrectionAngle", false, lc.max_correction_deg);
+  lc.essential_weight = r.integer("LoopClosing.essentialWeight", false, lc.essential_weight);
+  lc.global_ba = r.flag("LoopClosing.globalBA", lc.global_ba);
+  lc.rotation_weight = r.real("LoopClosing.rotationWeight", false, lc.rotation_weight);
+  r.positive("LoopClosing.rotationWeight", lc.rotation_weight);
+  r.positive("LoopClosing.searchRadius", lc.search_radius_m);
+  if (!(lc.max_angle_deg > 0 && lc.max_angle_deg <= 180))
+    throw ConfigError(path, "LoopClosing.maxAngle", "a value in (0, 180]", std::to_string(lc.max_angle_deg));
+  r.positive("LoopClosing.minKeyFrameGap", lc.min_keyframe_gap);
+  r.positive("LoopClosing.maxCandidates", lc.max_candidates);
+  if (lc.min_matches < 6) throw ConfigError(path, "LoopClosing.minMatches", "an integer >= 6", std::to_string(lc.min_matches));
+  if (lc.consistency < 0) throw ConfigError(path, "LoopClosing.consistency", "an integer >= 0", std::to_string(lc.consistency));
+  if (lc.min_inliers < 6) throw ConfigError(path, "LoopClosing.minInliers", "an integer >= 6", std::to_string(lc.min_inliers));
+  r.positive("LoopClosing.maxCorrection", lc.max_correction_m);
+  r.positive("LoopClosing.maxCorrectionAngle", lc.max_correction_deg);
+  r.positive("LoopClosing.essentialWeight", lc.essential_weight);
+
   const cv::FileNode root = fs.root();
   for (auto it = root.begin(); it != root.end(); ++it) {
     const std::string key = (*it).name();

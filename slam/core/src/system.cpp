@@ -36,6 +36,10 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.max_frames = static_cast<int>(settings.fps);
   tracking_ = std::make_unique<Tracking>(map_, cam_, topt);
   mapping_ = std::make_unique<LocalMapping>(map_, cam_);
+  if (settings.loop.enabled) {
+    loop_ = std::make_unique<LoopClosing>(map_, settings.loop);
+    mapping_->set_after_keyframe([this](const std::shared_ptr<KeyFrame>& kf) { loop_->process(kf); });
+  }
   if (!options.synchronous) mapping_->start();
   if (settings.dense.enabled) {
     dense::DenseMapperOptions dopt;

@@ -286,7 +286,7 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
     }
 
     ceres::Solver::Options solver_options;
-    solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+    solver_options.linear_solver_type = options.sparse_schur ? ceres::SPARSE_SCHUR : ceres::DENSE_SCHUR;
     solver_options.linear_solver_ordering = ordering;
     solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
     solver_options.max_num_iterations = iterations;
@@ -328,6 +328,47 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
   for (std::size_t p = 0; p < ba.points.size(); ++p) {
     if (point_used[p]) ba.points[p].p_w = points[p];
   }
+  return result;
+}
+
+// ---------------------------------------------------------------------------
+// SE(3) pose graph
+// ---------------------------------------------------------------------------
+PoseGraphResult optimize_pose_graph(PoseGraphProblem* problem, const PoseGraphOptions& options) {
+  if (problem == nullptr) throw std::invalid_argument("optimize_pose_graph: null problem");
+  PoseGraphProblem& g = *problem;
+  for (std::size_t e = 0; e < g.edges.size(); ++e)
+    if (g.edges[e].i >= g.nodes.size() || g.edges[e].j >= g.nodes.size() || g.edges[e].i == g.edges[e].j)
+      throw std::invalid_argument("optimize_pose_graph: edge " + std::to_string(e) + " refers to a missing node");
+  PoseGraphResult result;
+  if (g.edges.empty()) return result;
+
+  std::vector<PoseBlock> poses(g.nodes.size());
+  for (std::size_t k = 0; k < g.nodes.size(); ++k) poses[k] = PoseBlock::from_se3(g.nodes[k].T_c_w);
+  optim_detail::SE3LeftManifold se3_manifold;
+  ceres::Problem::Options po;
+  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem cp(po);
+  for (std::size_t k = 0; k < g.nodes.size(); ++k) cp.AddParameterBlock(poses[k].pose, optim_detail::kPoseSize, &se3_manifold);
+  for (const PoseGraphEdge& e : g.edges)
+    cp.AddResidualBlock(new optim_detail::RelativePoseError(e.T_i_j, e.weight, e.rotation_weight), nullptr, poses[e.i].pose,
+                        poses[e.j].pose);
+  for (std::size_t k = 0; k < g.nodes.size(); ++k)
+    if (g.nodes[k].fixed) cp.SetParameterBlockConstant(poses[k].pose);  // the gauge (and what the caller pins)
+
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;  // a sparse graph of 6-DoF blocks
+  so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  so.max_num_iterations = options.iterations;
+  so.num_threads = 1;  // deterministic
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &cp, &summary);
+  result.initial_cost = summary.initial_cost;
+  result.final_cost = summary.final_cost;
+  result.iterations = static_cast<int>(summary.iterations.size());
+  for (std::size_t k = 0; k < g.nodes.size(); ++k)
+    if (!g.nodes[k].fixed) g.nodes[k].T_c_w = poses[k].to_se3();
   return result;
 }
 

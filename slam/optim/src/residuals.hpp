@@ -17,7 +17,9 @@
 // columns are therefore NOT derivatives with respect to the quaternion
 // components; tests compare the 6 tangent columns with numeric derivatives
 // of r(Plus(x, delta)) at delta = 0.
+#include <ceres/jet.h>
 #include <ceres/manifold.h>
+#include <ceres/rotation.h>
 #include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
@@ -311,6 +313,89 @@ inline bool pose_normal_equations(const StereoIntrinsics& K, const std::vector<E
   out->cost = cost;
   return true;
 }
+/// Relative-pose edge of the SE(3) pose graph (optimize_pose_graph):
+///   E = M T_i T_j^-1,  M = T_i_j(measured)^-1,  T_i = T_iw, T_j = T_jw,
+///   r = w [w_r Log(R_E); t_E]                   (6 rows)
+/// Jacobians with respect to the left updates T <- [Exp(omega) | rho] T of
+/// both poses, lifted as above (columns 0-5, column 6 zero), computed by
+/// forward-mode automatic differentiation of r(Plus(x_i, d_i), Plus(x_j, d_j))
+/// at d = 0 with 12-dimensional jets.
+/// Parameter blocks: pose i (7), pose j (7), both on SE3LeftManifold.
+class RelativePoseError final : public ceres::SizedCostFunction<6, kPoseSize, kPoseSize> {
+ public:
+  RelativePoseError(const geom::SE3d& T_i_j, double weight, double rotation_weight = 1.0)
+      : q_m_(Eigen::Quaterniond(Eigen::Matrix3d(T_i_j.inverse().linear())).normalized()),
+        t_m_(T_i_j.inverse().translation()),
+        weight_(weight),
+        rotation_weight_(rotation_weight) {}
+
+  /// The residual at the perturbed poses (d = [omega, rho] for each).
+  template <typename T>
+  void residual(const double* x_i, const double* x_j, const T* d_i, const T* d_j, T* r) const {
+    using Quat = Eigen::Quaternion<T>;
+    using Vec3 = Eigen::Matrix<T, 3, 1>;
+    const auto perturbed = [](const double* x, const T* d, Quat* q, Vec3* t) {
+      T q_ceres[4];  // Ceres' order: w, x, y, z
+      ceres::AngleAxisToQuaternion(d, q_ceres);
+      const Quat dq(q_ceres[0], q_ceres[1], q_ceres[2], q_ceres[3]);
+      const Quat q0{T{x[3]}, T{x[0]}, T{x[1]}, T{x[2]}};
+      const Vec3 t0{T{x[4]}, T{x[5]}, T{x[6]}};
+      *q = dq * q0;
+      *t = dq * t0 + Vec3(d[3], d[4], d[5]);
+    };
+    Quat q_i, q_j;
+    Vec3 t_i, t_j;
+    perturbed(x_i, d_i, &q_i, &t_i);
+    perturbed(x_j, d_j, &q_j, &t_j);
+    const Quat q_j_inv = q_j.conjugate();
+    const Vec3 t_j_inv = -(q_j_inv * t_j);
+    const Quat q_m = q_m_.cast<T>();
+    const Vec3 t_m = t_m_.cast<T>();
+    // E = M * T_i * T_j^-1
+    const Quat q_ij = q_i * q_j_inv;
+    const Vec3 t_ij = q_i * t_j_inv + t_i;
+    const Quat q_e = q_m * q_ij;
+    const Vec3 t_e = q_m * t_ij + t_m;
+    const T q_e_ceres[4] = {q_e.w(), q_e.x(), q_e.y(), q_e.z()};
+    ceres::QuaternionToAngleAxis(q_e_ceres, r);
+    for (int k = 0; k < 3; ++k) {
+      r[k] *= T(weight_ * rotation_weight_);
+      r[3 + k] = T(weight_) * t_e[k];
+    }
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const bool want_jacobians = jacobians != nullptr && (jacobians[0] != nullptr || jacobians[1] != nullptr);
+    if (!want_jacobians) {
+      const double zero[6] = {0, 0, 0, 0, 0, 0};
+      residual<double>(parameters[0], parameters[1], zero, zero, residuals);
+      return true;
+    }
+    using Jet = ceres::Jet<double, 12>;
+    Jet d_i[6], d_j[6], r[6];
+    for (int k = 0; k < 6; ++k) {
+      d_i[k] = Jet(0.0, k);
+      d_j[k] = Jet(0.0, 6 + k);
+    }
+    residual<Jet>(parameters[0], parameters[1], d_i, d_j, r);
+    for (int row = 0; row < 6; ++row) {
+      residuals[row] = r[row].a;
+      for (int b = 0; b < 2; ++b) {
+        if (jacobians[b] == nullptr) continue;
+        double* J = jacobians[b] + row * kPoseSize;
+        for (int c = 0; c < kPoseTangent; ++c) J[c] = r[row].v[6 * b + c];
+        J[6] = 0.0;  // lifted
+      }
+    }
+    return true;
+  }
+
+ private:
+  Eigen::Quaterniond q_m_;  ///< rotation of M = T_i_j^-1
+  Eigen::Vector3d t_m_;     ///< translation of M
+  double weight_;
+  double rotation_weight_;
+};
 
 /// Cost function of one pose-only observation, mono or stereo as the observation says.
 inline ceres::CostFunction* make_pose_only_cost(const StereoIntrinsics& K, const Observation& obs,

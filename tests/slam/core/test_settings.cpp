@@ -70,6 +70,46 @@ TEST(Settings, ReadsPeMatchSection) {
   EXPECT_FALSE(s.pe_match.sampson);
 }
 
+TEST(Settings, ReadsLoopClosingSection) {
+  const Settings d = read_settings(kTum1);  // absent: on, with the documented defaults
+  EXPECT_TRUE(d.loop.enabled);
+  EXPECT_EQ(d.loop.min_inliers, 40);
+  const std::string path = temp_copy("loop", read_file(kTum1) +
+                                                 "\nLoopClosing.enabled: 0\nLoopClosing.searchRadius: 2.5\n"
+                                                 "LoopClosing.maxAngle: 45\nLoopClosing.minKeyFrameGap: 20\n"
+                                                 "LoopClosing.maxCandidates: 3\nLoopClosing.minMatches: 25\n"
+                                                 "LoopClosing.consistency: 3\nLoopClosing.minInliers: 60\n"
+                                                 "LoopClosing.maxCorrection: 0.2\nLoopClosing.maxCorrectionAngle: 5\n"
+                                                 "LoopClosing.essentialWeight: 80\nLoopClosing.globalBA: 1\n"
+                                                 "LoopClosing.rotationWeight: 3\n");
+  const Settings s = read_settings(path);
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_FALSE(s.loop.enabled);
+  EXPECT_DOUBLE_EQ(s.loop.search_radius_m, 2.5);
+  EXPECT_DOUBLE_EQ(s.loop.max_angle_deg, 45);
+  EXPECT_EQ(s.loop.min_keyframe_gap, 20);
+  EXPECT_EQ(s.loop.max_candidates, 3);
+  EXPECT_EQ(s.loop.min_matches, 25);
+  EXPECT_EQ(s.loop.consistency, 3);
+  EXPECT_EQ(s.loop.min_inliers, 60);
+  EXPECT_DOUBLE_EQ(s.loop.max_correction_m, 0.2);
+  EXPECT_DOUBLE_EQ(s.loop.max_correction_deg, 5);
+  EXPECT_EQ(s.loop.essential_weight, 80);
+  EXPECT_FALSE(d.loop.global_ba);  // off by default: it made the loop scenario worse (docs/slam.md)
+  EXPECT_TRUE(s.loop.global_ba);
+  EXPECT_DOUBLE_EQ(s.loop.rotation_weight, 3);
+  for (const std::string bad : {"LoopClosing.enabled: 2", "LoopClosing.searchRadius: -1", "LoopClosing.minInliers: 3",
+                                "LoopClosing.maxAngle: 200", "LoopClosing.consistency: 1.5", "LoopClosing.rotationWeight: 0"}) {
+    const std::string key = bad.substr(0, bad.find(':'));
+    try {
+      read_settings(temp_copy("loopbad", read_file(kTum1) + "\n" + bad + "\n"));
+      FAIL() << "expected ConfigError for " << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), key);
+    }
+  }
+}
+
 TEST(Settings, MissingKeyIsAnErrorNamingIt) {
   const std::string text = std::regex_replace(read_file(kTum1), std::regex("Camera\\.bf: 40\\.0"), "");
   const std::string path = temp_copy("missing", text);

@@ -56,6 +56,11 @@ struct SlamRun {
   std::vector<LossEvent> loss_events;
   std::optional<eval::EvalResult> eval;  ///< nullopt when it could not be evaluated
   std::string eval_note;                 ///< why not, or which alignment fallback was used
+  /// The trajectory re-anchored at the end on the final keyframe poses
+  /// (local BA and loop closing), CameraTrajectoryRefined.txt; same alignment.
+  std::optional<eval::EvalResult> refined_eval;
+  std::string loop_closing_json;  ///< slam::to_json(LoopClosingStats); empty when loop closing is off
+  std::size_t loops_closed = 0;
 };
 
 /// Closed loop: distance of the ground-truth robot (axle centre) from the

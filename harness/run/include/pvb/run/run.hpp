@@ -39,6 +39,7 @@ struct RunOptions {
   bool sync = false;                  ///< no threads: bit-identical runs
   SlamMode mode = SlamMode::kPeSlam;
   bool closed_loop = false;        ///< steer from the SLAM pose instead of ground truth
+  bool loop_closing = true;        ///< false: LoopClosing.enabled = 0 for every system (--no-loop-closing)
   std::string gl = "auto";         ///< auto, egl or osmesa
   std::size_t queue_capacity = 3;  ///< frames the producer may run ahead (open loop)
   /// Pipelined: release frame i no earlier than i / fps after the first,

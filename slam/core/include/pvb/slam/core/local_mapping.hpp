@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <list>
 #include <memory>
 #include <mutex>
@@ -52,6 +53,10 @@ class LocalMapping {
   LocalMapping(const LocalMapping&) = delete;
   LocalMapping& operator=(const LocalMapping&) = delete;
 
+  /// Work to run on the same thread after each processed keyframe (loop
+  /// closing); set before start().
+  void set_after_keyframe(std::function<void(const std::shared_ptr<KeyFrame>&)> hook) { after_keyframe_ = std::move(hook); }
+
   /// Starts the worker thread (asynchronous mode).
   void start();
   /// Processes the keyframes still queued, then joins the worker.
@@ -85,6 +90,7 @@ class LocalMapping {
   ClosableQueue<std::shared_ptr<KeyFrame>> queue_;
   std::atomic<int> pending_{0};  ///< keyframes inserted and not yet processed
   std::atomic<std::int64_t> busy_us_{0};  ///< time in process(), microseconds
+  std::function<void(const std::shared_ptr<KeyFrame>&)> after_keyframe_;
   std::thread worker_;
 };
 

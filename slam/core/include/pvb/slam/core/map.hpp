@@ -122,6 +122,13 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   std::vector<std::shared_ptr<KeyFrame>> best_covisibles(int n) const;
   int weight(std::uint64_t kf_id) const;
 
+  // Loop edges (loop closing) ---------------------------------------------------
+  /// Records a closed loop between this keyframe and kf; a keyframe with a
+  /// loop edge is never removed (it anchors the essential graph).
+  void add_loop_edge(const std::shared_ptr<KeyFrame>& kf) { loop_edges_[kf->id()] = kf; }
+  std::vector<std::shared_ptr<KeyFrame>> loop_edges() const;
+  bool has_loop_edges() const { return !loop_edges_.empty(); }
+
   // Spanning tree -----------------------------------------------------------
   std::shared_ptr<KeyFrame> parent() const { return parent_.lock(); }
   std::vector<std::shared_ptr<KeyFrame>> children() const;
@@ -131,7 +138,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
 
   /// Removes the keyframe from the graph: its map points forget it, its
   /// children are re-attached in the spanning tree (ORB-SLAM2 SetBadFlag).
-  /// The first keyframe (id 0) is never removed; returns false then.
+  /// The first keyframe (id 0) and keyframes with loop edges are never
+  /// removed; returns false then.
   bool set_bad();
   /// World-to-camera pose, for a removed keyframe composed through the
   /// spanning tree from its pose relative to its parent at removal time.
@@ -147,6 +155,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   bool first_connection_ = true;
   std::weak_ptr<KeyFrame> parent_;
   std::map<std::uint64_t, std::weak_ptr<KeyFrame>> children_;
+  std::map<std::uint64_t, std::weak_ptr<KeyFrame>> loop_edges_;
   bool bad_ = false;
   std::shared_ptr<KeyFrame> removed_parent_;          ///< parent at removal (kept alive for trajectories)
   geom::SE3d T_c_parent_ = geom::SE3d::Identity();  ///< pose relative to it at removal

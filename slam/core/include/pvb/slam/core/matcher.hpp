@@ -54,11 +54,16 @@ int search_local_points(Frame& cur, const std::vector<ProjectedPoint>& points, d
 /// < ratio x second best, orientation check.  Sets cur.map_points.
 int search_keyframe_bruteforce(const KeyFrame& kf, Frame& cur, int max_distance, double ratio);
 
+/// Which point survives when fuse() finds a keypoint already matched.
+enum class FusePolicy {
+  kMoreObservations,  ///< local mapping: the point with more observations
+  kIncomingWins,      ///< loop closing: the projected (loop-side) point replaces the keyframe's
+};
 /// Projects `points` into keyframe kf and fuses: an empty keypoint gets the
-/// observation, an occupied one keeps the point with more observations.
+/// observation, an occupied one is resolved by `policy`.
 /// Returns the number of fused points.
 int fuse(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::vector<std::shared_ptr<MapPoint>>& points,
-         double th = 3.0);
+         double th = 3.0, FusePolicy policy = FusePolicy::kMoreObservations);
 
 /// Epipolar search between the unmatched keypoints of kf1 and kf2 for
 /// triangulation: descriptor distance <= TH_LOW, distance to the epipolar

@@ -1,12 +1,13 @@
 #pragma once
 // SLAM settings: ORB-SLAM2 RGB-D YAML files read unchanged (Camera.*,
-// ThDepth, DepthMapFactor, ORBextractor.*) plus optional PEMatch.* and
-// PointCloudMapping.* sections.  A missing required key is a pvb::ConfigError naming it; an
+// ThDepth, DepthMapFactor, ORBextractor.*) plus optional PEMatch.*,
+// PointCloudMapping.* and LoopClosing.* sections.  A missing required key is a pvb::ConfigError naming it; an
 // unknown key is a warning (returned, not printed: the app prints it).
 #include <string>
 #include <vector>
 
 #include "pvb/geometry/pinhole.hpp"
+#include "pvb/slam/core/loop_closing.hpp"
 #include "pvb/slam/features/orb_extractor.hpp"
 
 namespace pvb::slam {
@@ -56,6 +57,7 @@ struct Settings {
   OrbParams orb;                    ///< ORBextractor.*
   PeMatchSettings pe_match;         ///< PEMatch.* (optional section)
   PointCloudMappingSettings dense;  ///< PointCloudMapping.* (optional section)
+  LoopClosingOptions loop;          ///< LoopClosing.* (optional section)
   std::vector<std::string> warnings;  ///< unknown keys and similar, one line each
 
   /// Close/far depth threshold in metres (ORB-SLAM2: bf * ThDepth / fx).

@@ -12,6 +12,7 @@
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/sensor/rgbd_frame.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
+#include "pvb/slam/core/loop_closing.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/tracking.hpp"
 #include "pvb/slam/dense/dense_mapper.hpp"
@@ -58,6 +59,9 @@ class System {
   /// Time local mapping has spent on keyframes so far (inline or on its worker), ms.
   double mapping_busy_ms() const { return mapping_->busy_ms(); }
   TrackingState state() const { return tracking_->state(); }
+  /// Loops closed so far and detection totals (empty when LoopClosing.enabled is 0).
+  LoopClosingStats loop_stats() const { return loop_ ? loop_->stats() : LoopClosingStats{}; }
+  bool loop_closing_enabled() const { return loop_ != nullptr; }
 
   // Dense point-cloud mapping (Settings::dense; off: the functions below
   // return empty results) ----------------------------------------------------
@@ -80,6 +84,7 @@ class System {
   OrbExtractor extractor_;
   Map map_;
   std::unique_ptr<Tracking> tracking_;
+  std::unique_ptr<LoopClosing> loop_;  ///< null when loop closing is disabled; runs on the mapping thread
   std::unique_ptr<LocalMapping> mapping_;
   std::unique_ptr<dense::DenseMapper> dense_;  ///< null when dense mapping is disabled
   /// Keyframes handed to the dense mapper, by id (for their current poses).

@@ -84,6 +84,9 @@ struct BaOptions {
   double chi2_mono = 5.991;
   double chi2_stereo = 7.815;
   const bool* abort_flag = nullptr;  ///< optional: stop early when it becomes true
+  /// Sparse Schur complement (global BA over the whole map: many keyframes,
+  /// each seeing a few others); false: dense (local BA, a few dozen keyframes).
+  bool sparse_schur = false;
 };
 
 struct BaResult {
@@ -94,6 +97,38 @@ struct BaResult {
 
 /// Optimises the non-fixed keyframe poses and all points in place.
 BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, const BaOptions& options = {});
+
+/// An SE(3) pose graph (ORB-SLAM2's Optimizer::OptimizeEssentialGraph with
+/// scale fixed, as for RGB-D): nodes are keyframe poses T_c_w, edges are
+/// measured relative poses T_i_j = T_iw * T_jw^-1 (camera j in camera i).
+struct PoseGraphNode {
+  std::uint64_t id = 0;
+  geom::SE3d T_c_w;    ///< initial value in, optimised value out
+  bool fixed = false;  ///< held constant (at least one node fixes the gauge)
+};
+struct PoseGraphEdge {
+  std::size_t i = 0, j = 0;  ///< indices into PoseGraphProblem::nodes
+  geom::SE3d T_i_j;          ///< measured pose of camera j in camera i
+  double weight = 1.0;       ///< information = weight^2 * diag(r^2 I3, I3)
+  double rotation_weight = 1.0;  ///< r: rotation rows (radians) against translation rows (metres)
+};
+struct PoseGraphProblem {
+  std::vector<PoseGraphNode> nodes;
+  std::vector<PoseGraphEdge> edges;
+};
+struct PoseGraphOptions {
+  int iterations = 20;  ///< Levenberg-Marquardt iterations (ORB-SLAM2: 20)
+};
+struct PoseGraphResult {
+  double initial_cost = 0, final_cost = 0;  ///< 0.5 sum |r|^2
+  int iterations = 0;
+};
+
+/// Optimises the non-fixed nodes in place.  Residual per edge:
+/// r = weight [rotation_weight Log(R_E); t_E] with E = T_i_j^-1 T_iw T_jw^-1 (zero when the
+/// poses agree with the measurement).  Deterministic (single thread).
+/// Throws std::invalid_argument for an edge naming a missing node.
+PoseGraphResult optimize_pose_graph(PoseGraphProblem* problem, const PoseGraphOptions& options = {});
 
 /// Reprojection residual helpers (also used by tests and by map-point culling).
 Eigen::Vector2d project(const StereoIntrinsics& K, const Eigen::Vector3d& p_c);

@@ -1,0 +1,151 @@
+#pragma once
+// Loop closing for RGB-D (ORB-SLAM2 LoopClosing with the scale known: SE(3)
+// instead of Sim(3), and no bag of words).  Runs after local mapping has
+// processed a keyframe, on the same thread (the local-mapping worker, or
+// inline in synchronous mode), holding the map mutex:
+//
+//   1. candidates by pose proximity: keyframes at least `min_keyframe_gap`
+//      ids older, outside the new keyframe's covisibility neighbourhood,
+//      whose camera centre lies within `search_radius_m` and whose optical
+//      axis within `max_angle_deg` of the new keyframe's estimate; each
+//      verified by appearance (brute-force ORB matching of its map points,
+//      ratio 0.75, orientation check, >= `min_matches`);
+//   2. consistency: a candidate's group (it and its covisibles) must meet a
+//      group of the previous keyframe's candidates `consistency` times in a
+//      row (ORB-SLAM2 DetectLoop);
+//   3. geometric verification: EPnP RANSAC on the brute-force matches, pose
+//      optimisation, guided search by projection of the candidate's
+//      neighbourhood, pose optimisation again; >= `min_inliers` inliers and
+//      a correction within `max_correction_m` / `max_correction_deg`;
+//   4. correction: the new keyframe's covisibility neighbourhood is moved
+//      with it, duplicated points fused (the loop side replaces the current
+//      side), loop edges added, the essential graph (spanning tree, loop
+//      edges, covisibility edges of weight >= `essential_weight`) optimised
+//      as an SE(3) pose graph, and every map point moved with its reference
+//      keyframe;
+//   5. optionally (`global_ba`, off by default) a bundle adjustment of the
+//      whole map, inline, with the map locked (tracking waits).
+//
+// Pose proximity only works while the drift is small compared with the
+// search radius (centimetres here): it cannot close a loop after the
+// estimate has drifted by metres; that would need place recognition.
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "pvb/slam/core/map.hpp"
+
+namespace pvb::slam {
+
+/// LoopClosing.* settings (docs/slam.md, "Loop closing").
+struct LoopClosingOptions {
+  bool enabled = true;             ///< LoopClosing.enabled (0/1)
+  double search_radius_m = 3.0;    ///< LoopClosing.searchRadius: camera centre distance, metres
+  double max_angle_deg = 30.0;     ///< LoopClosing.maxAngle: angle between the optical axes
+  int min_keyframe_gap = 30;       ///< LoopClosing.minKeyFrameGap: candidate this many keyframe ids older
+  int max_candidates = 5;          ///< LoopClosing.maxCandidates: closest first
+  int min_matches = 20;            ///< LoopClosing.minMatches: appearance check, descriptor matches
+  int consistency = 2;             ///< LoopClosing.consistency: consecutive consistent detections needed
+  int min_inliers = 40;            ///< LoopClosing.minInliers: after the guided search
+  double max_correction_m = 0.5;   ///< LoopClosing.maxCorrection: larger corrections are refused, metres
+  double max_correction_deg = 10;  ///< LoopClosing.maxCorrectionAngle, degrees
+  int essential_weight = 100;      ///< LoopClosing.essentialWeight: covisibility edges in the essential graph
+  int keyframes_between_loops = 10;  ///< no detection for this many keyframes after a loop (ORB-SLAM2: 10)
+  double rotation_weight = 1.0;    ///< LoopClosing.rotationWeight: pose-graph rotation rows (rad) against translation (m)
+  bool global_ba = false;          ///< LoopClosing.globalBA (0/1): bundle adjustment of the whole map after a loop
+};
+
+/// One closed loop.
+struct LoopEvent {
+  std::uint64_t keyframe_id = 0, frame_id = 0;            ///< the new keyframe
+  std::uint64_t loop_keyframe_id = 0, loop_frame_id = 0;  ///< the old keyframe it matched
+  int inliers = 0;            ///< after the guided search
+  double correction_m = 0;    ///< how far the new keyframe moved
+  double correction_deg = 0;
+  int fused_points = 0;       ///< current-side points replaced or joined by loop-side ones
+  int graph_keyframes = 0;    ///< nodes of the essential graph
+  int graph_edges = 0;
+  double detect_ms = 0;       ///< detection and verification for this keyframe
+  double correct_ms = 0;      ///< correction (fusion, pose graph, points)
+  double global_ba_ms = 0;    ///< global bundle adjustment afterwards (0 when off)
+  int global_ba_outliers = 0; ///< observations it removed
+};
+
+/// Running totals (all keyframes).
+struct LoopClosingStats {
+  std::vector<LoopEvent> loops;
+  int keyframes = 0;              ///< keyframes examined
+  int candidates = 0;             ///< pose candidates that passed the appearance check
+  int consistent = 0;             ///< keyframes with a consistent candidate
+  int rejected = 0;               ///< consistent detections refused by geometry or the correction bound
+  double detect_ms_total = 0;     ///< all detection work
+};
+
+/// The stats as one JSON object for stats.json / metrics.json:
+/// {"loops": n, "events": [{keyframe, frame, loop_keyframe, loop_frame,
+/// inliers, correction_m, correction_deg, fused_points, graph_keyframes,
+/// graph_edges, detect_ms, correct_ms}], "keyframes", "candidates",
+/// "consistent", "rejected", "detect_ms_total"}.
+std::string to_json(const LoopClosingStats& stats);
+
+/// Result of the geometric verification of one candidate.
+struct LoopMatch {
+  bool accepted = false;
+  geom::SE3d T_c_w;  ///< the new keyframe's pose in the candidate's map frame
+  /// Per keypoint of the new keyframe: the matched loop-side point (inliers only), or null.
+  std::vector<std::shared_ptr<MapPoint>> points;
+  int initial_matches = 0;  ///< brute-force matches
+  int ransac_inliers = 0;
+  int inliers = 0;          ///< after the guided search and pose optimisation
+};
+
+/// Pose-proximity candidates for `kf` (step 1 without the appearance
+/// check), closest first, at most options.max_candidates.  Call with the
+/// map mutex held.
+std::vector<std::shared_ptr<KeyFrame>> pose_candidates(const Map& map, const KeyFrame& kf,
+                                                       const LoopClosingOptions& options);
+
+/// Geometric verification of `cand` for `kf` (step 3).  Call with the map
+/// mutex held.  Deterministic (fixed RANSAC seed).
+LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, const LoopClosingOptions& options);
+
+class LoopClosing {
+ public:
+  LoopClosing(Map& map, const LoopClosingOptions& options);
+
+  /// Detects and, when verified, closes a loop for a keyframe local mapping
+  /// has just processed.  Takes the map mutex.  Returns true when a loop
+  /// was closed.
+  bool process(const std::shared_ptr<KeyFrame>& kf);
+
+  LoopClosingStats stats() const;
+  const LoopClosingOptions& options() const { return options_; }
+
+ private:
+  /// A candidate and its covisibles, with how many times in a row it was consistent.
+  struct Group {
+    std::set<std::uint64_t> ids;
+    int consistency = 0;
+  };
+  /// Steps 1-2; returns the candidates consistent enough for verification.
+  std::vector<std::shared_ptr<KeyFrame>> detect(const std::shared_ptr<KeyFrame>& kf);
+  /// Step 5 (optional): bundle adjustment of every keyframe and point,
+  /// keyframe 0 fixed, map locked throughout.
+  void global_bundle_adjustment(LoopEvent* event);
+  /// Step 4.
+  void correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf, const LoopMatch& m,
+               LoopEvent* event);
+
+  Map& map_;
+  LoopClosingOptions options_;
+  std::vector<Group> groups_;  ///< consistency groups of the previous keyframe
+  std::uint64_t last_loop_kf_id_ = 0;
+  bool any_loop_ = false;
+  mutable std::mutex stats_mutex_;
+  LoopClosingStats stats_;
+};
+
+}  // namespace pvb::slam

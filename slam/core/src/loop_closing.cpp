@@ -1,0 +1,505 @@
+#include "pvb/slam/core/loop_closing.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "pvb/common/text.hpp"
+#include "pvb/slam/core/matcher.hpp"
+#include "pvb/slam/optim/optimizer.hpp"
+
+namespace pvb::slam {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Optical axis (z) of a keyframe in the world frame.
+Eigen::Vector3d optical_axis_w(const KeyFrame& kf) { return kf.T_c_w().linear().row(2).transpose(); }
+
+/// Pose-only optimisation of `f` against its map points (all keypoints with
+/// a point); drops the outliers.  Returns the inlier count.
+int optimize_and_prune(Frame& f) {
+  std::vector<Eigen::Vector3d> pts;
+  std::vector<Observation> obs;
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (!f.map_points[i]) continue;
+    pts.push_back(f.map_points[i]->p_w());
+    obs.push_back(f.observation(i));
+    idx.push_back(i);
+  }
+  if (pts.size() < 3) return 0;
+  const PoseOptimizerResult r = optimize_pose(f.T_c_w, pts, obs, f.cam->K);
+  f.T_c_w = r.T_c_w;
+  for (std::size_t k = 0; k < idx.size(); ++k)
+    if (!r.inlier[k]) f.map_points[idx[k]] = nullptr;
+  return r.num_inliers;
+}
+
+/// Rotation angle (degrees) and camera-centre distance (metres) between two poses T_c_w.
+void pose_difference(const geom::SE3d& a, const geom::SE3d& b, double* dist_m, double* angle_deg) {
+  *dist_m = (a.inverse().translation() - b.inverse().translation()).norm();
+  *angle_deg = geom::rotation_angle_rad(a.linear() * b.linear().transpose()) * kRadToDeg;
+}
+
+}  // namespace
+
+std::vector<std::shared_ptr<KeyFrame>> pose_candidates(const Map& map, const KeyFrame& kf,
+                                                       const LoopClosingOptions& options) {
+  std::set<std::uint64_t> connected = {kf.id()};
+  for (const auto& n : kf.best_covisibles(-1)) connected.insert(n->id());
+  const Eigen::Vector3d c = kf.camera_center_w();
+  const Eigen::Vector3d axis = optical_axis_w(kf);
+  const double min_cos = std::cos(options.max_angle_deg / kRadToDeg);
+  std::vector<std::pair<double, std::shared_ptr<KeyFrame>>> found;
+  for (const auto& [id, k] : map.keyframes()) {
+    if (id + static_cast<std::uint64_t>(options.min_keyframe_gap) > kf.id()) break;  // ordered by id
+    if (k->bad() || connected.count(id)) continue;
+    const double d = (k->camera_center_w() - c).norm();
+    if (d > options.search_radius_m) continue;
+    if (optical_axis_w(*k).dot(axis) < min_cos) continue;
+    found.emplace_back(d, k);
+  }
+  std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<std::shared_ptr<KeyFrame>> out;
+  for (const auto& [d, k] : found) {
+    if (static_cast<int>(out.size()) >= options.max_candidates) break;
+    out.push_back(k);
+  }
+  return out;
+}
+
+LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, const LoopClosingOptions& options) {
+  LoopMatch out;
+  Frame probe = kf.frame();  // a copy: its map_points become the loop-side matches
+  std::fill(probe.map_points.begin(), probe.map_points.end(), nullptr);
+  out.initial_matches = search_keyframe_bruteforce(*cand, probe, kThLow, 0.75);
+  if (out.initial_matches < options.min_matches) return out;
+
+  // EPnP RANSAC on the loop-side points against the new keyframe's keypoints.
+  std::vector<cv::Point3d> obj;
+  std::vector<cv::Point2d> img;
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < probe.size(); ++i) {
+    if (!probe.map_points[i]) continue;
+    const Eigen::Vector3d& p = probe.map_points[i]->p_w();
+    obj.emplace_back(p.x(), p.y(), p.z());
+    img.emplace_back(probe.keys_un[i].pt.x, probe.keys_un[i].pt.y);
+    idx.push_back(i);
+  }
+  cv::Mat rvec, tvec;
+  std::vector<int> inliers;
+  cv::setRNGSeed(0);  // deterministic RANSAC
+  const bool solved = cv::solvePnPRansac(obj, img, probe.cam->K_cv, cv::noArray(), rvec, tvec, false, 300, 4.0f,
+                                         0.99, inliers, cv::SOLVEPNP_EPNP);
+  out.ransac_inliers = static_cast<int>(inliers.size());
+  if (!solved || out.ransac_inliers < options.min_matches / 2) return out;
+  cv::Mat R_cv;
+  cv::Rodrigues(rvec, R_cv);
+  Eigen::Matrix3d R;
+  Eigen::Vector3d t;
+  cv::cv2eigen(R_cv, R);
+  cv::cv2eigen(tvec, t);
+  probe.T_c_w = geom::make_se3(R, t);
+  std::vector<std::uint8_t> keep(idx.size(), 0);
+  for (int i : inliers) keep[static_cast<std::size_t>(i)] = 1;
+  for (std::size_t q = 0; q < idx.size(); ++q)
+    if (!keep[q]) probe.map_points[idx[q]] = nullptr;
+  if (optimize_and_prune(probe) < options.min_matches / 2) return out;
+
+  // Guided search: the points of the candidate and its covisibles, projected
+  // with the verified pose (ORB-SLAM2 SearchByProjection of mvpLoopMapPoints).
+  std::set<std::uint64_t> have;
+  for (const auto& mp : probe.map_points)
+    if (mp) have.insert(mp->id());
+  std::vector<std::shared_ptr<KeyFrame>> group = {cand};
+  for (const auto& n : cand->best_covisibles(-1)) group.push_back(n);
+  std::vector<ProjectedPoint> proj;
+  for (const auto& g : group)
+    for (const auto& mp : g->map_points()) {
+      if (!mp || mp->bad() || !have.insert(mp->id()).second) continue;
+      ProjectedPoint p;
+      if (project_in_frustum(probe, mp, &p)) proj.push_back(p);
+    }
+  search_local_points(probe, proj, 10.0 / 4.0);
+  out.inliers = optimize_and_prune(probe);
+  out.T_c_w = probe.T_c_w;
+  out.points = probe.map_points;
+  out.accepted = out.inliers >= options.min_inliers;
+  return out;
+}
+
+std::string to_json(const LoopClosingStats& stats) {
+  const auto num = [](double v) { return json_number(v, 6); };
+  std::string out = "{\"loops\": " + std::to_string(stats.loops.size()) + ", \"events\": [";
+  for (std::size_t k = 0; k < stats.loops.size(); ++k) {
+    const LoopEvent& e = stats.loops[k];
+    out += std::string(k ? ", " : "") + "{\"keyframe\": " + std::to_string(e.keyframe_id) +
+           ", \"frame\": " + std::to_string(e.frame_id) + ", \"loop_keyframe\": " + std::to_string(e.loop_keyframe_id) +
+           ", \"loop_frame\": " + std::to_string(e.loop_frame_id) + ", \"inliers\": " + std::to_string(e.inliers) +
+           ", \"correction_m\": " + num(e.correction_m) + ", \"correction_deg\": " + num(e.correction_deg) +
+           ", \"fused_points\": " + std::to_string(e.fused_points) +
+           ", \"graph_keyframes\": " + std::to_string(e.graph_keyframes) +
+           ", \"graph_edges\": " + std::to_string(e.graph_edges) + ", \"detect_ms\": " + num(e.detect_ms) +
+           ", \"correct_ms\": " + num(e.correct_ms) + ", \"global_ba_ms\": " + num(e.global_ba_ms) +
+           ", \"global_ba_outliers\": " + std::to_string(e.global_ba_outliers) + "}";
+  }
+  out += "], \"keyframes\": " + std::to_string(stats.keyframes) + ", \"candidates\": " +
+         std::to_string(stats.candidates) + ", \"consistent\": " + std::to_string(stats.consistent) +
+         ", \"rejected\": " + std::to_string(stats.rejected) + ", \"detect_ms_total\": " +
+         num(stats.detect_ms_total) + "}";
+  return out;
+}
+
+LoopClosing::LoopClosing(Map& map, const LoopClosingOptions& options) : map_(map), options_(options) {}
+
+LoopClosingStats LoopClosing::stats() const {
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  return stats_;
+}
+
+std::vector<std::shared_ptr<KeyFrame>> LoopClosing::detect(const std::shared_ptr<KeyFrame>& kf) {
+  std::vector<std::shared_ptr<KeyFrame>> candidates;
+  for (const auto& cand : pose_candidates(map_, *kf, options_)) {
+    Frame probe = kf->frame();
+    std::fill(probe.map_points.begin(), probe.map_points.end(), nullptr);
+    if (search_keyframe_bruteforce(*cand, probe, kThLow, 0.75) >= options_.min_matches) candidates.push_back(cand);
+  }
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    stats_.candidates += static_cast<int>(candidates.size());
+  }
+  if (candidates.empty()) {
+    groups_.clear();
+    return {};
+  }
+  // ORB-SLAM2 DetectLoop: a candidate group is consistent with a previous
+  // group when they share a keyframe; its count grows by one per keyframe.
+  std::vector<Group> next;
+  std::vector<bool> extended(groups_.size(), false);
+  std::vector<std::shared_ptr<KeyFrame>> enough;
+  for (const auto& cand : candidates) {
+    Group g;
+    g.ids.insert(cand->id());
+    for (const auto& n : cand->best_covisibles(-1)) g.ids.insert(n->id());
+    bool consistent_any = false, added = false;
+    for (std::size_t i = 0; i < groups_.size(); ++i) {
+      const bool shares = std::any_of(g.ids.begin(), g.ids.end(), [&](std::uint64_t id) { return groups_[i].ids.count(id) > 0; });
+      if (!shares) continue;
+      consistent_any = true;
+      const int consistency = groups_[i].consistency + 1;
+      if (!extended[i]) {
+        next.push_back({g.ids, consistency});
+        extended[i] = true;
+      }
+      if (consistency >= options_.consistency && !added) {
+        enough.push_back(cand);
+        added = true;
+      }
+    }
+    if (!consistent_any) next.push_back({g.ids, 0});
+  }
+  groups_ = std::move(next);
+  return enough;
+}
+
+bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
+  if (!options_.enabled) return false;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  {
+    std::lock_guard<std::mutex> s(stats_mutex_);
+    ++stats_.keyframes;
+  }
+  if (kf->bad()) return false;
+  if (any_loop_ && kf->id() < last_loop_kf_id_ + static_cast<std::uint64_t>(options_.keyframes_between_loops)) {
+    groups_.clear();
+    return false;
+  }
+  const std::vector<std::shared_ptr<KeyFrame>> consistent = detect(kf);
+  LoopMatch best;
+  std::shared_ptr<KeyFrame> loop_kf;
+  bool rejected = false;
+  for (const auto& cand : consistent) {
+    LoopMatch m = verify_loop(*kf, cand, options_);
+    if (!m.accepted) {
+      rejected = true;
+      continue;
+    }
+    double dist_m = 0, angle_deg = 0;
+    pose_difference(m.T_c_w, kf->T_c_w(), &dist_m, &angle_deg);
+    if (dist_m > options_.max_correction_m || angle_deg > options_.max_correction_deg) {
+      rejected = true;
+      continue;
+    }
+    best = std::move(m);
+    loop_kf = cand;
+    break;
+  }
+  const double detect_ms = ms_since(t0);
+  {
+    std::lock_guard<std::mutex> s(stats_mutex_);
+    stats_.detect_ms_total += detect_ms;
+    if (!consistent.empty()) ++stats_.consistent;
+    if (rejected && !loop_kf) ++stats_.rejected;
+  }
+  if (!loop_kf) return false;
+
+  LoopEvent event;
+  event.keyframe_id = kf->id();
+  event.frame_id = kf->frame_id();
+  event.loop_keyframe_id = loop_kf->id();
+  event.loop_frame_id = loop_kf->frame_id();
+  event.inliers = best.inliers;
+  pose_difference(best.T_c_w, kf->T_c_w(), &event.correction_m, &event.correction_deg);
+  event.detect_ms = detect_ms;
+  const auto t1 = std::chrono::steady_clock::now();
+  correct(kf, loop_kf, best, &event);
+  event.correct_ms = ms_since(t1);
+  if (options_.global_ba) {
+    const auto t2 = std::chrono::steady_clock::now();
+    global_bundle_adjustment(&event);
+    event.global_ba_ms = ms_since(t2);
+  }
+  groups_.clear();
+  any_loop_ = true;
+  last_loop_kf_id_ = kf->id();
+  std::lock_guard<std::mutex> s(stats_mutex_);
+  stats_.loops.push_back(event);
+  return true;
+}
+
+void LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf,
+                          const LoopMatch& m, LoopEvent* event) {
+  kf->update_connections();
+
+  // 1. Move the new keyframe's neighbourhood with it (ORB-SLAM2 CorrectLoop,
+  //    scale 1): T_iw' = T_i_cur * T_cur_w', points with the keyframe that
+  //    corrected them first.
+  std::vector<std::shared_ptr<KeyFrame>> connected = {kf};
+  for (const auto& n : kf->best_covisibles(-1)) connected.push_back(n);
+  const geom::SE3d T_w_cur = kf->T_c_w().inverse();
+  std::map<std::uint64_t, geom::SE3d> corrected, uncorrected;  // T_c_w by keyframe id
+  for (const auto& k : connected) {
+    uncorrected[k->id()] = k->T_c_w();
+    corrected[k->id()] = k->T_c_w() * T_w_cur * m.T_c_w;
+  }
+  std::map<std::uint64_t, std::uint64_t> corrected_by;  // point id -> keyframe id it moved with
+  for (const auto& k : connected) {
+    const geom::SE3d move = corrected.at(k->id()).inverse() * uncorrected.at(k->id());
+    for (const auto& mp : k->map_points()) {
+      if (!mp || mp->bad() || corrected_by.count(mp->id())) continue;
+      mp->set_p_w(move * mp->p_w());
+      corrected_by[mp->id()] = k->id();
+    }
+  }
+  for (const auto& k : connected) k->set_T_c_w(corrected.at(k->id()));
+  for (const auto& k : connected)
+    for (const auto& mp : k->map_points())
+      if (mp && !mp->bad()) mp->update_normal_and_depth();
+
+  // 2. Fuse: the verified matches first (the loop-side point replaces the
+  //    current one), then the loop neighbourhood's points projected into
+  //    the corrected neighbourhood.
+  std::map<std::uint64_t, std::set<std::uint64_t>> neighbours_before;
+  for (const auto& k : connected)
+    for (const auto& n : k->best_covisibles(-1)) neighbours_before[k->id()].insert(n->id());
+  int fused = 0;
+  for (std::size_t i = 0; i < m.points.size(); ++i) {
+    const auto& lp = m.points[i];
+    if (!lp || lp->bad()) continue;
+    const auto existing = kf->map_points()[i];
+    if (existing == lp) continue;
+    if (existing && !existing->bad()) {
+      existing->replace(lp, existing);
+      ++fused;
+    } else if (lp->index_in(kf->id()) < 0) {
+      kf->set_map_point(i, lp);
+      lp->add_observation(kf, i);
+      lp->compute_distinctive_descriptor();
+      ++fused;
+    }
+  }
+  std::vector<std::shared_ptr<MapPoint>> loop_points;
+  {
+    std::set<std::uint64_t> seen;
+    std::vector<std::shared_ptr<KeyFrame>> loop_group = {loop_kf};
+    for (const auto& n : loop_kf->best_covisibles(-1)) loop_group.push_back(n);
+    for (const auto& g : loop_group)
+      for (const auto& mp : g->map_points())
+        if (mp && !mp->bad() && seen.insert(mp->id()).second) loop_points.push_back(mp);
+  }
+  for (const auto& k : connected)
+    if (!k->bad()) fused += fuse(map_, k, loop_points, 4.0, FusePolicy::kIncomingWins);
+  map_.remove_bad_points();
+  event->fused_points = fused;
+
+  // 3. New links: neighbours each keyframe of the group has gained, outside the group.
+  std::set<std::uint64_t> connected_ids;
+  for (const auto& k : connected) connected_ids.insert(k->id());
+  std::map<std::uint64_t, std::vector<std::shared_ptr<KeyFrame>>> loop_links;
+  for (const auto& k : connected) {
+    if (k->bad()) continue;
+    k->update_connections();
+    for (const auto& n : k->best_covisibles(-1))
+      if (!neighbours_before[k->id()].count(n->id()) && !connected_ids.count(n->id())) loop_links[k->id()].push_back(n);
+  }
+
+  // 4. The essential graph as an SE(3) pose graph.  Nodes: keyframes in the
+  //    spanning tree (and the loop keyframe, held fixed: the gauge).
+  //    Measurements come from the poses before the correction (the odometry
+  //    as it was); the new loop links from the corrected poses.
+  PoseGraphProblem graph;
+  std::map<std::uint64_t, std::size_t> node;
+  std::vector<std::shared_ptr<KeyFrame>> node_kf;
+  std::map<std::uint64_t, geom::SE3d> initial;  // T_c_w at the start of the optimisation
+  for (const auto& [id, k] : map_.keyframes()) {
+    if (k->bad()) continue;
+    const bool in_tree = id == 0 || k->parent() != nullptr || k == loop_kf;
+    initial[id] = k->T_c_w();
+    if (!in_tree) continue;  // queued, not yet processed by local mapping: moved below
+    node[id] = graph.nodes.size();
+    graph.nodes.push_back({id, k->T_c_w(), k == loop_kf});
+    node_kf.push_back(k);
+  }
+  const auto measured = [&](const std::shared_ptr<KeyFrame>& k) {
+    auto it = uncorrected.find(k->id());
+    return it != uncorrected.end() ? it->second : k->T_c_w();
+  };
+  std::set<std::pair<std::size_t, std::size_t>> inserted;
+  const auto add_edge = [&](std::size_t i, std::size_t j, const geom::SE3d& T_iw, const geom::SE3d& T_jw) {
+    const auto key = std::minmax(i, j);
+    if (!inserted.insert(key).second) return;
+    graph.edges.push_back({i, j, T_iw * T_jw.inverse(), 1.0, options_.rotation_weight});
+  };
+  for (const auto& [id, links] : loop_links) {
+    auto it = node.find(id);
+    if (it == node.end()) continue;
+    const auto& k = node_kf[it->second];
+    for (const auto& n : links) {
+      auto jt = node.find(n->id());
+      if (jt == node.end()) continue;
+      const bool the_loop = k == kf && n == loop_kf;
+      if (!the_loop && k->weight(n->id()) < options_.essential_weight) continue;
+      add_edge(it->second, jt->second, k->T_c_w(), n->T_c_w());  // corrected poses
+    }
+  }
+  if (node.count(kf->id()) && node.count(loop_kf->id()))
+    add_edge(node.at(kf->id()), node.at(loop_kf->id()), kf->T_c_w(), loop_kf->T_c_w());
+  for (std::size_t i = 0; i < node_kf.size(); ++i) {
+    const auto& k = node_kf[i];
+    const geom::SE3d T_iw = measured(k);
+    if (auto p = k->parent()) {
+      auto jt = node.find(p->id());
+      if (jt != node.end()) add_edge(i, jt->second, T_iw, measured(p));
+    }
+    for (const auto& l : k->loop_edges()) {
+      auto jt = node.find(l->id());
+      if (jt != node.end() && l->id() < k->id()) add_edge(i, jt->second, T_iw, measured(l));
+    }
+    for (const auto& n : k->best_covisibles(-1)) {
+      if (k->weight(n->id()) < options_.essential_weight) break;  // sorted by weight
+      if (n->id() >= k->id()) continue;
+      auto jt = node.find(n->id());
+      if (jt != node.end()) add_edge(i, jt->second, T_iw, measured(n));
+    }
+  }
+  event->graph_keyframes = static_cast<int>(graph.nodes.size());
+  event->graph_edges = static_cast<int>(graph.edges.size());
+  optimize_pose_graph(&graph);
+
+  // 5. Write the poses back; every point moves with its reference keyframe
+  //    (or the keyframe that corrected it in step 1).  Keyframes not in the
+  //    graph (queued for local mapping) move as the new keyframe did.
+  std::map<std::uint64_t, geom::SE3d> final_pose;
+  for (std::size_t i = 0; i < node_kf.size(); ++i) final_pose[node_kf[i]->id()] = graph.nodes[i].T_c_w;
+  const geom::SE3d kf_move = final_pose.count(kf->id()) ? geom::SE3d(final_pose.at(kf->id()).inverse() * uncorrected.at(kf->id()))
+                                                        : geom::SE3d::Identity();
+  for (const auto& [id, k] : map_.keyframes()) {
+    if (k->bad() || final_pose.count(id) || !initial.count(id)) continue;
+    final_pose[id] = (kf_move * initial.at(id).inverse()).inverse();  // T_c_w' = T_c_w * kf_move^-1
+  }
+  for (const auto& [id, mp] : map_.points()) {
+    if (mp->bad()) continue;
+    std::uint64_t ref_id;
+    auto cb = corrected_by.find(id);
+    if (cb != corrected_by.end()) {
+      ref_id = cb->second;
+    } else {
+      auto ref = mp->reference_keyframe();
+      if (!ref) continue;
+      ref_id = ref->id();
+    }
+    auto it0 = initial.find(ref_id);
+    auto it1 = final_pose.find(ref_id);
+    if (it0 == initial.end() || it1 == final_pose.end()) continue;
+    mp->set_p_w(it1->second.inverse() * (it0->second * mp->p_w()));
+  }
+  for (const auto& [id, k] : map_.keyframes())
+    if (!k->bad() && final_pose.count(id)) k->set_T_c_w(final_pose.at(id));
+  for (const auto& [id, mp] : map_.points())
+    if (!mp->bad()) mp->update_normal_and_depth();
+
+  kf->add_loop_edge(loop_kf);
+  loop_kf->add_loop_edge(kf);
+}
+
+void LoopClosing::global_bundle_adjustment(LoopEvent* event) {
+  BaProblem problem;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  std::vector<std::shared_ptr<MapPoint>> pts;
+  std::map<std::uint64_t, std::size_t> kf_index;
+  for (const auto& [id, k] : map_.keyframes()) {
+    if (k->bad()) continue;
+    kf_index[id] = kfs.size();
+    problem.keyframes.push_back({id, k->T_c_w(), id == 0});  // keyframe 0 fixes the gauge (the world frame)
+    kfs.push_back(k);
+  }
+  if (kfs.size() < 2) return;
+  for (const auto& [id, mp] : map_.points()) {
+    if (mp->bad()) continue;
+    const std::size_t p = pts.size();
+    bool any = false;
+    for (const auto& [kid, o] : mp->observations()) {
+      auto it = kf_index.find(kid);
+      if (it == kf_index.end()) continue;
+      if (!any) {
+        problem.points.push_back({id, mp->p_w()});
+        pts.push_back(mp);
+        any = true;
+      }
+      problem.edges.push_back({it->second, p, kfs[it->second]->frame().observation(o.idx)});
+    }
+  }
+  if (problem.edges.empty()) return;
+  BaOptions options;
+  options.sparse_schur = true;
+  const BaResult result = slam::local_bundle_adjustment(&problem, kfs[0]->frame().cam->K, options);
+  for (std::size_t e : result.outlier_edges) {
+    const BaEdge& edge = problem.edges[e];
+    const auto& k = kfs[edge.keyframe];
+    const auto& mp = pts[edge.point];
+    const long idx = mp->index_in(k->id());
+    if (idx < 0) continue;
+    if (k->map_points()[static_cast<std::size_t>(idx)] == mp) k->set_map_point(static_cast<std::size_t>(idx), nullptr);
+    mp->erase_observation(k->id());
+  }
+  event->global_ba_outliers = static_cast<int>(result.outlier_edges.size());
+  for (std::size_t k = 0; k < kfs.size(); ++k)
+    if (!problem.keyframes[k].fixed) kfs[k]->set_T_c_w(problem.keyframes[k].T_c_w);
+  for (std::size_t p = 0; p < pts.size(); ++p)
+    if (!pts[p]->bad()) {
+      pts[p]->set_p_w(problem.points[p].p_w);
+      pts[p]->update_normal_and_depth();
+    }
+  map_.remove_bad_points();
+}
+
+}  // namespace pvb::slam
