@@ -78,7 +78,7 @@ struct Light {
   int shadow_map_px = 1024;  ///< shadow map resolution; the map covers 18 m around the robot
   /// Quads along each edge of a box face (MuJoCo vis.quality.numquads);
   /// only per-vertex lighting uses them.  1 renders faster (docs/run.md).
-  int box_quads = 4;
+  int box_quads = 1;
 };
 
 struct Route {
