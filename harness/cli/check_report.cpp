@@ -14,7 +14,10 @@ int check_and_print(const std::string& scenario_file, const std::string& metrics
     std::printf("%s: no expect: section, nothing to check\n", scenario_file.c_str());
     return no_expect_code;
   }
-  const std::vector<suite::Violation> violations = suite::check_expectations(s.expect, metrics_path);
+  std::vector<std::string> notes;
+  const std::vector<suite::Violation> violations =
+      suite::check_expectations(s.expect, metrics_path, scenes::frame_count(s), &notes);
+  for (const auto& n : notes) std::printf("%s: note: %s\n", metrics_path.c_str(), n.c_str());
   for (const auto& v : violations) std::printf("%s: %s\n", metrics_path.c_str(), v.line().c_str());
   if (violations.empty()) std::printf("%s: ok (%s)\n", metrics_path.c_str(), s.name.c_str());
   std::fflush(stdout);

@@ -132,3 +132,19 @@ TEST(SuiteCheck, MalformedMetricsAreIoErrorsNamingFileAndKey) {
   EXPECT_NE(message("not_json.json").find("not valid JSON"), std::string::npos) << message("not_json.json");
   EXPECT_THROW(suite::read_metrics_file(fixture("does_not_exist.json")), IoError);
 }
+
+TEST(SuiteCheck, PeAgainstBaselineIsJudgedOnTheWholeScenarioOnly) {
+  const suite::MetricsFile m = suite::read_metrics_file(fixture("worse_than_baseline.json"));
+  std::vector<std::string> notes;
+  // Run as long as the scenario: judged.
+  auto v = suite::check_expectations(nominal(), m, m.primary.frames, &notes);
+  EXPECT_TRUE(has_key(v, "pe_not_worse_than_baseline"));
+  EXPECT_TRUE(notes.empty());
+  // Cut short (the scenario has more frames): not judged, a note with both values instead.
+  v = suite::check_expectations(nominal(), m, m.primary.frames + 1, &notes);
+  EXPECT_FALSE(has_key(v, "pe_not_worse_than_baseline"));
+  EXPECT_TRUE(has_key(v, "ate_rmse_m_max"));  // the other bounds still hold for a cut run
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("not judged"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("baseline 0.015 m"), std::string::npos) << notes[0];
+}
