@@ -20,6 +20,20 @@ CullDecision recent_point_rule(double found_ratio, int num_observations, std::ui
   return CullDecision::kKeep;
 }
 
+void erase_outlier_observations(const BaProblem& problem, const std::vector<std::size_t>& outlier_edges,
+                                const std::vector<std::shared_ptr<KeyFrame>>& kfs,
+                                const std::vector<std::shared_ptr<MapPoint>>& pts) {
+  for (std::size_t e : outlier_edges) {
+    const BaEdge& edge = problem.edges[e];
+    const auto& k = kfs[edge.keyframe];
+    const auto& mp = pts[edge.point];
+    const long idx = mp->index_in(k->id());
+    if (idx < 0) continue;
+    if (k->map_points()[static_cast<std::size_t>(idx)] == mp) k->set_map_point(static_cast<std::size_t>(idx), nullptr);
+    mp->erase_observation(k->id());
+  }
+}
+
 bool is_redundant_keyframe(const KeyFrame& kf, double th_depth_m, double ratio, int observers) {
   const Frame& f = kf.frame();
   int num_points = 0, redundant = 0;
@@ -280,15 +294,7 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
   const BaResult result = slam::local_bundle_adjustment(&problem, cam_->K);
 
   std::lock_guard<std::mutex> lock(map_.mutex());
-  for (std::size_t e : result.outlier_edges) {
-    const BaEdge& edge = problem.edges[e];
-    const auto& k = kfs[edge.keyframe];
-    const auto& mp = pts[edge.point];
-    const long idx = mp->index_in(k->id());
-    if (idx < 0) continue;
-    if (k->map_points()[static_cast<std::size_t>(idx)] == mp) k->set_map_point(static_cast<std::size_t>(idx), nullptr);
-    mp->erase_observation(k->id());
-  }
+  erase_outlier_observations(problem, result.outlier_edges, kfs, pts);
   for (std::size_t k = 0; k < kfs.size(); ++k)
     if (!problem.keyframes[k].fixed && !kfs[k]->bad()) kfs[k]->set_T_c_w(problem.keyframes[k].T_c_w);
   for (std::size_t p = 0; p < pts.size(); ++p)

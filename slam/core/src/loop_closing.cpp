@@ -8,6 +8,7 @@
 #include <opencv2/core/eigen.hpp>
 
 #include "pvb/common/text.hpp"
+#include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/matcher.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
 
@@ -84,34 +85,8 @@ LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand,
   if (out.initial_matches < options.min_matches) return out;
 
   // EPnP RANSAC on the loop-side points against the new keyframe's keypoints.
-  std::vector<cv::Point3d> obj;
-  std::vector<cv::Point2d> img;
-  std::vector<std::size_t> idx;
-  for (std::size_t i = 0; i < probe.size(); ++i) {
-    if (!probe.map_points[i]) continue;
-    const Eigen::Vector3d& p = probe.map_points[i]->p_w();
-    obj.emplace_back(p.x(), p.y(), p.z());
-    img.emplace_back(probe.keys_un[i].pt.x, probe.keys_un[i].pt.y);
-    idx.push_back(i);
-  }
-  cv::Mat rvec, tvec;
-  std::vector<int> inliers;
-  cv::setRNGSeed(0);  // deterministic RANSAC
-  const bool solved = cv::solvePnPRansac(obj, img, probe.cam->K_cv, cv::noArray(), rvec, tvec, false, 300, 4.0f,
-                                         0.99, inliers, cv::SOLVEPNP_EPNP);
-  out.ransac_inliers = static_cast<int>(inliers.size());
-  if (!solved || out.ransac_inliers < options.min_matches / 2) return out;
-  cv::Mat R_cv;
-  cv::Rodrigues(rvec, R_cv);
-  Eigen::Matrix3d R;
-  Eigen::Vector3d t;
-  cv::cv2eigen(R_cv, R);
-  cv::cv2eigen(tvec, t);
-  probe.T_c_w = geom::make_se3(R, t);
-  std::vector<std::uint8_t> keep(idx.size(), 0);
-  for (int i : inliers) keep[static_cast<std::size_t>(i)] = 1;
-  for (std::size_t q = 0; q < idx.size(); ++q)
-    if (!keep[q]) probe.map_points[idx[q]] = nullptr;
+  out.ransac_inliers = pnp_ransac_on_matches(probe, options.min_matches / 2);
+  if (out.ransac_inliers < options.min_matches / 2) return out;
   if (optimize_and_prune(probe) < options.min_matches / 2) return out;
 
   // Guided search: the points of the candidate and its covisibles, projected
@@ -482,15 +457,7 @@ void LoopClosing::global_bundle_adjustment(LoopEvent* event) {
   BaOptions options;
   options.sparse_schur = true;
   const BaResult result = slam::local_bundle_adjustment(&problem, kfs[0]->frame().cam->K, options);
-  for (std::size_t e : result.outlier_edges) {
-    const BaEdge& edge = problem.edges[e];
-    const auto& k = kfs[edge.keyframe];
-    const auto& mp = pts[edge.point];
-    const long idx = mp->index_in(k->id());
-    if (idx < 0) continue;
-    if (k->map_points()[static_cast<std::size_t>(idx)] == mp) k->set_map_point(static_cast<std::size_t>(idx), nullptr);
-    mp->erase_observation(k->id());
-  }
+  erase_outlier_observations(problem, result.outlier_edges, kfs, pts);
   event->global_ba_outliers = static_cast<int>(result.outlier_edges.size());
   for (std::size_t k = 0; k < kfs.size(); ++k)
     if (!problem.keyframes[k].fixed) kfs[k]->set_T_c_w(problem.keyframes[k].T_c_w);

@@ -4,6 +4,8 @@
 #include <array>
 #include <climits>
 #include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 
 namespace pvb::slam {
 namespace {
@@ -297,6 +299,39 @@ std::vector<IndexMatch> search_for_triangulation(const KeyFrame& kf1, const KeyF
   for (std::size_t k = 0; k < matches.size(); ++k)
     if (ok[k] && matches[k].i1 != SIZE_MAX) kept.push_back(matches[k]);
   return kept;
+}
+
+int pnp_ransac_on_matches(Frame& cur, int min_inliers) {
+  std::vector<cv::Point3d> obj;
+  std::vector<cv::Point2d> img;
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < cur.size(); ++i) {
+    if (!cur.map_points[i]) continue;
+    const Eigen::Vector3d& p = cur.map_points[i]->p_w();
+    obj.emplace_back(p.x(), p.y(), p.z());
+    img.emplace_back(cur.keys_un[i].pt.x, cur.keys_un[i].pt.y);
+    idx.push_back(i);
+  }
+  if (obj.size() < 4) return 0;
+  cv::Mat rvec, tvec;
+  std::vector<int> inliers;
+  cv::setRNGSeed(0);  // deterministic RANSAC
+  const bool solved = cv::solvePnPRansac(obj, img, cur.cam->K_cv, cv::noArray(), rvec, tvec, false, 300, 4.0f, 0.99,
+                                         inliers, cv::SOLVEPNP_EPNP);
+  const int n = solved ? static_cast<int>(inliers.size()) : 0;
+  if (n == 0 || n < min_inliers) return n;
+  cv::Mat R_cv;
+  cv::Rodrigues(rvec, R_cv);
+  Eigen::Matrix3d R;
+  Eigen::Vector3d t;
+  cv::cv2eigen(R_cv, R);
+  cv::cv2eigen(tvec, t);
+  cur.T_c_w = geom::make_se3(R, t);
+  std::vector<std::uint8_t> keep(idx.size(), 0);
+  for (int i : inliers) keep[static_cast<std::size_t>(i)] = 1;
+  for (std::size_t q = 0; q < idx.size(); ++q)
+    if (!keep[q]) cur.map_points[idx[q]] = nullptr;
+  return n;
 }
 
 }  // namespace pvb::slam

@@ -319,33 +319,7 @@ bool Tracking::relocalize(Frame& f) {
     const int n = search_keyframe_bruteforce(*kf, f, kThLow, 0.75);
     best_matches = std::max(best_matches, n);
     if (n < 15) continue;
-    std::vector<cv::Point3d> obj;
-    std::vector<cv::Point2d> img;
-    std::vector<std::size_t> idx;
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      if (!f.map_points[i]) continue;
-      const Eigen::Vector3d& p = f.map_points[i]->p_w();
-      obj.emplace_back(p.x(), p.y(), p.z());
-      img.emplace_back(f.keys_un[i].pt.x, f.keys_un[i].pt.y);
-      idx.push_back(i);
-    }
-    cv::Mat rvec, tvec;
-    std::vector<int> inliers;
-    cv::setRNGSeed(0);
-    const bool solved = cv::solvePnPRansac(obj, img, cam_->K_cv, cv::noArray(), rvec, tvec, false, 300, 4.0f, 0.99,
-                                           inliers, cv::SOLVEPNP_EPNP);
-    if (!solved || inliers.size() < 10) continue;
-    cv::Mat R_cv;
-    cv::Rodrigues(rvec, R_cv);
-    Eigen::Matrix3d R;
-    Eigen::Vector3d t;
-    cv::cv2eigen(R_cv, R);
-    cv::cv2eigen(tvec, t);
-    f.T_c_w = geom::make_se3(R, t);
-    std::vector<std::uint8_t> is_inlier(idx.size(), 0);
-    for (int i : inliers) is_inlier[static_cast<std::size_t>(i)] = 1;
-    for (std::size_t q = 0; q < idx.size(); ++q)
-      if (!is_inlier[q]) f.map_points[idx[q]] = nullptr;
+    if (pnp_ransac_on_matches(f, 10) < 10) continue;
     int good = optimize(f);
     if (good < 10) continue;
     int map_matches = 0;

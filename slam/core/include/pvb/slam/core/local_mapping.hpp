@@ -18,6 +18,7 @@
 
 #include "pvb/common/closable_queue.hpp"
 #include "pvb/slam/core/map.hpp"
+#include "pvb/slam/optim/optimizer.hpp"
 
 namespace pvb::slam {
 
@@ -45,6 +46,14 @@ CullDecision recent_point_rule(double found_ratio, int num_observations, std::ui
 /// are seen by at least `observers` other keyframes at the same or a finer
 /// scale.  Exposed for tests.
 bool is_redundant_keyframe(const KeyFrame& kf, double th_depth_m, double ratio = 0.9, int observers = 3);
+
+/// After a bundle adjustment: unlinks each outlier edge's point from its
+/// keyframe (both directions), as local and global BA do.  `kfs` and `pts`
+/// are the keyframes and points behind problem.keyframes / problem.points,
+/// index for index.  The caller holds the map mutex.
+void erase_outlier_observations(const BaProblem& problem, const std::vector<std::size_t>& outlier_edges,
+                                const std::vector<std::shared_ptr<KeyFrame>>& kfs,
+                                const std::vector<std::shared_ptr<MapPoint>>& pts);
 
 class LocalMapping {
  public:

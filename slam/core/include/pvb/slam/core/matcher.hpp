@@ -54,6 +54,13 @@ int search_local_points(Frame& cur, const std::vector<ProjectedPoint>& points, d
 /// < ratio x second best, orientation check.  Sets cur.map_points.
 int search_keyframe_bruteforce(const KeyFrame& kf, Frame& cur, int max_distance, double ratio);
 
+/// EPnP RANSAC (OpenCV, 300 iterations, 4 px, fixed seed) of cur's matched
+/// map points against their undistorted keypoints, as relocalisation and
+/// loop verification use it after search_keyframe_bruteforce.  Returns the
+/// number of RANSAC inliers (0 when no pose was found).  Only when that is
+/// >= min_inliers does it set cur.T_c_w and drop the outliers' matches.
+int pnp_ransac_on_matches(Frame& cur, int min_inliers);
+
 /// Which point survives when fuse() finds a keypoint already matched.
 enum class FusePolicy {
   kMoreObservations,  ///< local mapping: the point with more observations
