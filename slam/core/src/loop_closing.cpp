@@ -27,21 +27,13 @@ Eigen::Vector3d optical_axis_w(const KeyFrame& kf) { return kf.T_c_w().linear().
 /// Pose-only optimisation of `f` against its map points (all keypoints with
 /// a point); drops the outliers.  Returns the inlier count.
 int optimize_and_prune(Frame& f) {
-  std::vector<Eigen::Vector3d> pts;
-  std::vector<Observation> obs;
-  std::vector<std::size_t> idx;
-  for (std::size_t i = 0; i < f.size(); ++i) {
-    if (!f.map_points[i]) continue;
-    pts.push_back(f.map_points[i]->p_w());
-    obs.push_back(f.observation(i));
-    idx.push_back(i);
-  }
-  if (pts.size() < 3) return 0;
-  const PoseOptimizerResult r = optimize_pose(f.T_c_w, pts, obs, f.cam->K);
-  f.T_c_w = r.T_c_w;
-  for (std::size_t k = 0; k < idx.size(); ++k)
-    if (!r.inlier[k]) f.map_points[idx[k]] = nullptr;
-  return r.num_inliers;
+  const int inliers = optimize_frame_pose(f);
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (f.outlier[i]) {
+      f.map_points[i] = nullptr;
+      f.outlier[i] = 0;
+    }
+  return inliers;
 }
 
 /// Rotation angle (degrees) and camera-centre distance (metres) between two poses T_c_w.

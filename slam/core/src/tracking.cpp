@@ -160,25 +160,6 @@ void Tracking::update_last_frame() {
   }
 }
 
-int Tracking::optimize(Frame& f) {
-  std::vector<Eigen::Vector3d> pts;
-  std::vector<Observation> obs;
-  std::vector<std::size_t> idx;
-  for (std::size_t i = 0; i < f.size(); ++i) {
-    if (!f.map_points[i]) continue;
-    pts.push_back(f.map_points[i]->p_w());
-    obs.push_back(f.observation(i));
-    idx.push_back(i);
-  }
-  std::fill(f.outlier.begin(), f.outlier.end(), 0);
-  if (pts.size() < 3) return 0;
-  const PoseOptimizerResult r = optimize_pose(f.T_c_w, pts, obs, cam_->K);
-  f.T_c_w = r.T_c_w;
-  f.has_pose = true;
-  for (std::size_t k = 0; k < idx.size(); ++k) f.outlier[idx[k]] = r.inlier[k] ? 0 : 1;
-  return r.num_inliers;
-}
-
 void Tracking::discard_outliers(Frame& f, int* map_matches) {
   int n = 0;
   for (std::size_t i = 0; i < f.size(); ++i) {
@@ -245,7 +226,7 @@ bool Tracking::track_with_motion_model(Frame& f) {
                   std::to_string(stats_.coarse_matches) + " matches (need 10)");
   }
 
-  optimize(f);
+  optimize_frame_pose(f);
   rec.pose_inlier.resize(m.size());
   for (std::size_t k = 0; k < m.size(); ++k)
     rec.pose_inlier[k] = (f.map_points[m[k].i2] && !f.outlier[m[k].i2]) ? 1 : 0;
@@ -288,7 +269,7 @@ bool Tracking::track_reference_keyframe(Frame& f) {
   const int n = search_keyframe_bruteforce(*ref_kf_, f, kThLow, 0.7);
   if (n < 15) return fail("reference keyframe: only " + std::to_string(n) + " descriptor matches (need 15)");
   f.T_c_w = last_.has_pose ? last_.T_c_w : ref_kf_->T_c_w();
-  optimize(f);
+  optimize_frame_pose(f);
   int map_matches = 0;
   discard_outliers(f, &map_matches);
   if (map_matches < 10)
@@ -320,7 +301,7 @@ bool Tracking::relocalize(Frame& f) {
     best_matches = std::max(best_matches, n);
     if (n < 15) continue;
     if (pnp_ransac_on_matches(f, 10) < 10) continue;
-    int good = optimize(f);
+    int good = optimize_frame_pose(f);
     if (good < 10) continue;
     int map_matches = 0;
     discard_outliers(f, &map_matches);
@@ -334,7 +315,7 @@ bool Tracking::relocalize(Frame& f) {
         if (project_in_frustum(f, mp, &p)) proj.push_back(p);
       }
       search_local_points(f, proj, 10.0 / 4.0);
-      good = optimize(f);
+      good = optimize_frame_pose(f);
       discard_outliers(f, &map_matches);
     }
     best_inliers = std::max(best_inliers, good);
@@ -420,7 +401,7 @@ bool Tracking::track_local_map(Frame& f) {
   }
   const double th = f.id < last_reloc_frame_id_ + 2 ? 5.0 : 3.0;
   search_local_points(f, proj, th);
-  optimize(f);
+  optimize_frame_pose(f);
   matches_inliers_ = 0;
   for (std::size_t i = 0; i < f.size(); ++i) {
     const auto& mp = f.map_points[i];

@@ -124,9 +124,6 @@ class Tracking {
   void update_local_map(const Frame& f);
   bool need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue) const;
   std::shared_ptr<KeyFrame> create_keyframe(Frame& f);
-  /// Pose-only optimisation of f against its map points; marks outliers and
-  /// returns the inlier count.
-  int optimize(Frame& f);
   void discard_outliers(Frame& f, int* map_matches);
   void replace_in_last_frame();
   /// Appends one step's failure to stats_.failure; returns false.
