@@ -327,10 +327,17 @@ OrbFeatures OrbExtractor::extract(const cv::Mat& image) {
     if (per_level[l].empty()) continue;
     cv::GaussianBlur(padded_[l], blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
     const cv::Mat view = blurred(cv::Rect(kEdgeThreshold, kEdgeThreshold, pyramid_[l].cols, pyramid_[l].rows));
-    const float s = static_cast<float>(scales_[l]);
+    // Level pixel centres back to level-0 pixels. cv::resize (INTER_LINEAR)
+    // maps a destination pixel x to source (x + 0.5) * ratio - 0.5, and the
+    // ratios compose, so level l's pixel x sits at (x + 0.5) * W0 / Wl - 0.5.
+    // ORB-SLAM2 multiplies by the nominal scale instead, which puts level-l
+    // keypoints 0.5 * (scale - 1) px too far up and left (1.3 px at level 7).
+    const float sx = static_cast<float>(pyramid_[0].cols) / static_cast<float>(pyramid_[l].cols);
+    const float sy = static_cast<float>(pyramid_[0].rows) / static_cast<float>(pyramid_[l].rows);
     for (cv::KeyPoint kp : per_level[l]) {
       compute_rbrief(view, kp, out.descriptors.ptr<uchar>(row++));
-      kp.pt *= s;
+      kp.pt.x = (kp.pt.x + 0.5f) * sx - 0.5f;
+      kp.pt.y = (kp.pt.y + 0.5f) * sy - 0.5f;
       out.keypoints.push_back(kp);
     }
   }
