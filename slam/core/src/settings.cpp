@@ -111,6 +111,12 @@ Settings read_settings(const std::string& path) {
   r.positive("PEMatch.stallIterations", pe.stall_iterations);
   r.positive("PEMatch.threshold", pe.threshold_px);
 
+  KeyFrameSettings& kfs = s.keyframe;
+  kfs.min_tracked_close = r.integer("KeyFrame.minTrackedClose", false, kfs.min_tracked_close);
+  kfs.min_untracked_close = r.integer("KeyFrame.minUntrackedClose", false, kfs.min_untracked_close);
+  r.positive("KeyFrame.minTrackedClose", kfs.min_tracked_close);
+  r.positive("KeyFrame.minUntrackedClose", kfs.min_untracked_close);
+
   PointCloudMappingSettings& pc = s.dense;
   pc.enabled = r.flag("PointCloudMapping.Enabled", pc.enabled);
   pc.resolution_m = r.real("PointCloudMapping.Resolution", false, pc.resolution_m);

@@ -34,6 +34,8 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.pe_match.seed = options.seed;
   topt.pe_skip_low_parallax = settings.pe_match.skip_low_parallax;
   topt.max_frames = static_cast<int>(settings.fps);
+  topt.kf_min_tracked_close = settings.keyframe.min_tracked_close;
+  topt.kf_min_untracked_close = settings.keyframe.min_untracked_close;
   tracking_ = std::make_unique<Tracking>(map_, cam_, topt);
   mapping_ = std::make_unique<LocalMapping>(map_, cam_);
   if (settings.loop.enabled) {

@@ -432,7 +432,8 @@ bool Tracking::need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t 
       else ++non_tracked_close;
     }
   }
-  const bool need_close = tracked_close < 100 && non_tracked_close > 70;
+  const bool need_close =
+      tracked_close < options_.kf_min_tracked_close && non_tracked_close > options_.kf_min_untracked_close;
   const double ref_ratio = num_kfs < 2 ? 0.4 : 0.75;
   const bool c1a = f.id >= last_kf_frame_id_ + max_frames;
   const bool c1b = f.id >= last_kf_frame_id_ + static_cast<std::uint64_t>(options_.min_frames) && mapping_idle;

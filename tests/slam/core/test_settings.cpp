@@ -70,6 +70,26 @@ TEST(Settings, ReadsPeMatchSection) {
   EXPECT_FALSE(s.pe_match.sampson);
 }
 
+TEST(Settings, ReadsKeyFrameSection) {
+  const Settings d = read_settings(kTum1);  // absent: the documented defaults
+  EXPECT_EQ(d.keyframe.min_tracked_close, 200);
+  EXPECT_EQ(d.keyframe.min_untracked_close, 70);
+  const Settings s = read_settings(temp_copy("kf", read_file(kTum1) + "\nKeyFrame.minTrackedClose: 100\n"
+                                                                      "KeyFrame.minUntrackedClose: 50\n"));
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_EQ(s.keyframe.min_tracked_close, 100);  // ORB-SLAM2's value
+  EXPECT_EQ(s.keyframe.min_untracked_close, 50);
+  for (const std::string bad : {"KeyFrame.minTrackedClose: 0", "KeyFrame.minUntrackedClose: -3",
+                                "KeyFrame.minTrackedClose: 1.5"}) {
+    try {
+      read_settings(temp_copy("kfbad", read_file(kTum1) + "\n" + bad + "\n"));
+      FAIL() << "expected ConfigError for " << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), bad.substr(0, bad.find(':')));
+    }
+  }
+}
+
 TEST(Settings, ReadsLoopClosingSection) {
   const Settings d = read_settings(kTum1);  // absent: on, with the documented defaults
   EXPECT_TRUE(d.loop.enabled);

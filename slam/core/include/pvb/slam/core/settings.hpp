@@ -12,6 +12,19 @@
 
 namespace pvb::slam {
 
+/// KeyFrame.* section (optional): the close-point rule of the keyframe
+/// decision, which ORB-SLAM2 hard-codes at 100 / 70.
+struct KeyFrameSettings {
+  /// KeyFrame.minTrackedClose: a keyframe is needed when fewer close points
+  /// than this are tracked (and more than minUntrackedClose are not).
+  /// ORB-SLAM2: 100. Default 200: with a Kinect-range sensor every depth
+  /// point is close, and at 100 a forward drive waits until tracking is down
+  /// to about 100 inliers before each keyframe (docs/slam.md, "Keyframe
+  /// spacing and drift").
+  int min_tracked_close = 200;
+  int min_untracked_close = 70;  ///< KeyFrame.minUntrackedClose (ORB-SLAM2: 70)
+};
+
 /// PEMatch.* section; defaults are the paper's SLAM values (sec. 5.2.2).
 struct PeMatchSettings {
   bool enabled = true;             ///< PEMatch.enabled (0/1): off = ORB-SLAM2 baseline motion model
@@ -56,6 +69,7 @@ struct Settings {
   double depth_map_factor = 5000.0; ///< DepthMapFactor: raw depth units per metre
   OrbParams orb;                    ///< ORBextractor.*
   PeMatchSettings pe_match;         ///< PEMatch.* (optional section)
+  KeyFrameSettings keyframe;        ///< KeyFrame.* (optional section)
   PointCloudMappingSettings dense;  ///< PointCloudMapping.* (optional section)
   LoopClosingOptions loop;          ///< LoopClosing.* (optional section)
   std::vector<std::string> warnings;  ///< unknown keys and similar, one line each

@@ -72,6 +72,8 @@ struct TrackingOptions {
   int min_init_points = 500;   ///< keypoints with depth needed to initialise
   int max_frames = 30;         ///< keyframe spacing limit (= fps)
   int min_frames = 0;
+  int kf_min_tracked_close = 200;    ///< KeyFrame.minTrackedClose (ORB-SLAM2: 100)
+  int kf_min_untracked_close = 70;   ///< KeyFrame.minUntrackedClose
 };
 
 /// "Already seen in this pass" marks for map-point ids: a pass stamp per
