@@ -1,7 +1,8 @@
 // pvbench sweep: runs one scenario over a list of seeds, each seed as an
 // independent child process `pvbench run ... --seed S --out DIR/seed_S`
 // (this same binary, through /proc/self/exe), at most --jobs at once, then
-// aggregates DIR/seed_*/metrics.json into DIR/aggregate.{md,csv,json,svg,png}.
+// aggregates DIR/seed_*/metrics.json into DIR/aggregate.{md,csv,json,svg,png}
+// and, with --compare, prints the paired PE-SLAM − baseline ATE line last.
 //
 // Every seed's command is self-contained (--print-commands prints them), so
 // a cluster scheduler can run them anywhere and `--aggregate-only` collects
@@ -267,6 +268,8 @@ int write_aggregate(const SweepArgs& a, const std::string& scenario_name,
   plot::write_png(fig, (out / "aggregate.png").string());
   std::printf("\n%s\nwrote %s/aggregate.{md,csv,json,svg,png}\n", suite::format_markdown(agg).c_str(),
               a.out.c_str());
+  // With --compare, the paired PE-SLAM − baseline figure is the sweep's answer: last.
+  if (agg.has_baseline) std::printf("%s\n", suite::format_paired_line(agg.paired).c_str());
   std::fflush(stdout);
   return agg.failed;
 }

@@ -51,6 +51,15 @@ std::string run_summary_json(const RunSummary& r) {
          ", \"realtime_factor\": " + summary_json(r.realtime_factor) + "}";
 }
 
+std::string paired_json(const PairedComparison& p) {
+  const auto ci = [&](double v) { return p.has_ci ? json_num(v) : std::string("null"); };
+  return "{\"count\": " + std::to_string(p.count) + ", \"mean_m\": " + json_num(p.mean_m) +
+         ", \"sd_m\": " + json_num(p.sd_m) + ", \"se_m\": " + json_num(p.se_m) +
+         ", \"t_quantile\": " + ci(p.t_quantile) + ", \"ci95_low_m\": " + ci(p.ci_low_m) +
+         ", \"ci95_high_m\": " + ci(p.ci_high_m) + ", \"pe_not_worse\": " + std::to_string(p.pe_not_worse) +
+         ", \"verdict\": \"" + json_escape(verdict_text(p.verdict)) + "\"}";
+}
+
 std::string csv_field(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string out = "\"";
@@ -60,7 +69,113 @@ std::string csv_field(const std::string& s) {
 
 bool seed_failed(const SeedRun& r) { return !r.metrics || r.exit_code != 0; }
 
+constexpr double kPi = 3.14159265358979323846;
+
+/// P(|T| < t) for t >= 0 and Student's t with `dof` >= 1 degrees of freedom,
+/// the closed forms for integer dof (Abramowitz & Stegun 26.7.3 and 26.7.4)
+/// with theta = atan(t / sqrt(dof)):
+///   dof = 1:     2 theta / pi
+///   dof odd:     2/pi (theta + sin theta (cos theta + 2/3 cos^3 theta + ...
+///                      + (2·4···(dof−3)) / (1·3···(dof−2)) cos^(dof−2) theta))
+///   dof even:    sin theta (1 + 1/2 cos^2 theta + 1·3/(2·4) cos^4 theta + ...
+///                      + (1·3···(dof−3)) / (2·4···(dof−2)) cos^(dof−2) theta)
+double t_central_mass(double t, int dof) {
+  const double theta = std::atan(t / std::sqrt(static_cast<double>(dof)));
+  const double s = std::sin(theta), c = std::cos(theta), c2 = c * c;
+  if (dof % 2 == 0) {
+    double term = 1.0, sum = 1.0;
+    for (int j = 1; j <= (dof - 2) / 2; ++j) {
+      term *= c2 * (2.0 * j - 1.0) / (2.0 * j);
+      sum += term;
+    }
+    return s * sum;
+  }
+  if (dof == 1) return 2.0 * theta / kPi;
+  double term = c, sum = c;
+  for (int j = 1; j <= (dof - 3) / 2; ++j) {
+    term *= c2 * (2.0 * j) / (2.0 * j + 1.0);
+    sum += term;
+  }
+  return 2.0 / kPi * (theta + s * sum);
+}
+
+std::string mm2(double v_m) { return fmt("%.2f", v_m * 1000.0); }
+
 }  // namespace
+
+double student_t_quantile(double p, int dof) {
+  if (!(p > 0.0 && p < 1.0) || dof < 1) return std::nan("");
+  if (p == 0.5) return 0.0;
+  // Solve P(|T| < t) = |2p − 1| for t >= 0; the mass rises monotonically in t.
+  const double target = std::abs(2.0 * p - 1.0);
+  double lo = 0.0, hi = 1.0;
+  for (int i = 0; i < 1100 && t_central_mass(hi, dof) < target; ++i) {
+    lo = hi;
+    hi *= 2.0;
+  }
+  for (int i = 0; i < 200 && hi - lo > 1e-15 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (t_central_mass(mid, dof) < target ? lo : hi) = mid;
+  }
+  const double t = 0.5 * (lo + hi);
+  return p > 0.5 ? t : -t;
+}
+
+const char* verdict_text(PairedVerdict v) {
+  switch (v) {
+    case PairedVerdict::kPeBetter:
+      return "PE-SLAM better";
+    case PairedVerdict::kBaselineBetter:
+      return "baseline better";
+    case PairedVerdict::kNoSignificantDifference:
+      return "no significant difference at 95 %";
+    case PairedVerdict::kTooFewSeeds:
+      break;
+  }
+  return "too few seeds";
+}
+
+std::optional<double> paired_ate_difference_m(const SeedRun& r) {
+  if (!r.metrics || !r.metrics->baseline || !r.metrics->primary.ate_rmse_m ||
+      !r.metrics->baseline->ate_rmse_m)
+    return std::nullopt;
+  return *r.metrics->primary.ate_rmse_m - *r.metrics->baseline->ate_rmse_m;
+}
+
+PairedComparison compare_paired(const std::vector<SeedRun>& runs) {
+  PairedComparison p;
+  std::vector<double> d;
+  for (const SeedRun& r : runs) {
+    const std::optional<double> diff = paired_ate_difference_m(r);
+    if (!diff) continue;
+    d.push_back(*diff);
+    if (*r.metrics->primary.ate_rmse_m <= *r.metrics->baseline->ate_rmse_m) ++p.pe_not_worse;
+  }
+  const Summary s = summarize(d);
+  p.count = s.count;
+  p.mean_m = s.mean;
+  p.sd_m = s.sd;
+  if (p.count > 0) p.se_m = s.sd / std::sqrt(static_cast<double>(p.count));
+  if (p.count < 2) return p;  // verdict stays kTooFewSeeds
+  p.has_ci = true;
+  p.t_quantile = student_t_quantile(0.975, p.count - 1);
+  p.ci_low_m = p.mean_m - p.t_quantile * p.se_m;
+  p.ci_high_m = p.mean_m + p.t_quantile * p.se_m;
+  p.verdict = p.ci_high_m < 0.0  ? PairedVerdict::kPeBetter
+              : p.ci_low_m > 0.0 ? PairedVerdict::kBaselineBetter
+                                 : PairedVerdict::kNoSignificantDifference;
+  return p;
+}
+
+std::string format_paired_line(const PairedComparison& p) {
+  std::string out = "PE-SLAM − baseline ATE: ";
+  if (p.count == 0) return out + "no seed with both ATEs; " + verdict_text(p.verdict);
+  out += "mean " + mm2(p.mean_m) + " mm";
+  if (p.has_ci) out += ", 95 % CI [" + mm2(p.ci_low_m) + ", " + mm2(p.ci_high_m) + "] mm";
+  out += " over " + std::to_string(p.count) + (p.count == 1 ? " seed" : " seeds") + " (PE ≤ baseline on " +
+         std::to_string(p.pe_not_worse) + "); " + verdict_text(p.verdict);
+  return out;
+}
 
 Summary summarize(const std::vector<double>& values) {
   Summary s;
@@ -103,6 +218,7 @@ SweepAggregate aggregate(const std::string& scenario, std::vector<SeedRun> runs)
   a.primary = summarize_runs(primary);
   a.has_baseline = !baseline.empty();
   if (a.has_baseline) a.baseline = summarize_runs(baseline);
+  a.paired = compare_paired(a.runs);
   return a;
 }
 
@@ -127,14 +243,22 @@ std::string format_markdown(const SweepAggregate& a) {
       break;
     }
   row(primary_name.c_str(), a.primary);
-  if (a.has_baseline) row("ORB-SLAM2 baseline", a.baseline);
+  if (a.has_baseline) {
+    row("ORB-SLAM2 baseline", a.baseline);
+    // The paired figure (docs/sweeps.md): per seed d = PE − baseline on the same frames.
+    out += "\n" + format_paired_line(a.paired) + "\n";
+    if (a.paired.count > 0)
+      out += "\nPaired per seed (both runs track the same frames): d = PE-SLAM − baseline ATE RMSE, SD " +
+             mm2(a.paired.sd_m) + " mm, standard error " + mm2(a.paired.se_m) +
+             " mm; the interval is mean ± t(0.975, n − 1) · SE.\n";
+  }
 
   out +=
       "\n## Per seed\n\n| seed | exit | status | frames | lost | ATE RMSE (mm) | tracking ms | realtime "
       "factor |";
-  if (a.has_baseline) out += " baseline lost | baseline ATE RMSE (mm) |";
+  if (a.has_baseline) out += " baseline lost | baseline ATE RMSE (mm) | PE − baseline (mm) |";
   out += " note |\n|---|---|---|---|---|---|---|---|";
-  if (a.has_baseline) out += "---|---|";
+  if (a.has_baseline) out += "---|---|---|";
   out += "---|\n";
   for (const SeedRun& r : a.runs) {
     out += "| " + std::to_string(r.seed) + " | " + std::to_string(r.exit_code) + " | ";
@@ -146,9 +270,10 @@ std::string format_markdown(const SweepAggregate& a) {
       if (a.has_baseline) {
         if (r.metrics->baseline)
           out += " " + std::to_string(r.metrics->baseline->lost_frames) + " | " +
-                 opt(r.metrics->baseline->ate_rmse_m, "%.2f", 1000.0) + " |";
+                 opt(r.metrics->baseline->ate_rmse_m, "%.2f", 1000.0) + " | " +
+                 opt(paired_ate_difference_m(r), "%.2f", 1000.0) + " |";
         else
-          out += " | |";
+          out += " | | |";
       }
       std::string note;
       if (!m.loss_events.empty())
@@ -159,7 +284,7 @@ std::string format_markdown(const SweepAggregate& a) {
     } else {
       std::string note = "no metrics: " + r.error;
       for (char& c : note) c = c == '|' ? '/' : c;
-      out += " | | | | | |" + std::string(a.has_baseline ? " | |" : "") + " " + note + " |\n";
+      out += " | | | | | |" + std::string(a.has_baseline ? " | | |" : "") + " " + note + " |\n";
     }
   }
   return out;
@@ -169,7 +294,7 @@ std::string format_csv(const SweepAggregate& a) {
   std::string out =
       "seed,exit_code,status,frames,lost_frames,ate_rmse_m,rpe_trans_rmse_m,tracking_ms_median,realtime_"
       "factor,"
-      "baseline_lost_frames,baseline_ate_rmse_m,baseline_tracking_ms_median,error\n";
+      "baseline_lost_frames,baseline_ate_rmse_m,baseline_tracking_ms_median,pe_minus_baseline_ate_m,error\n";
   for (const SeedRun& r : a.runs) {
     out += std::to_string(r.seed) + "," + std::to_string(r.exit_code) + ",";
     if (r.metrics) {
@@ -180,13 +305,13 @@ std::string format_csv(const SweepAggregate& a) {
       if (r.metrics->baseline) {
         const RunMetrics& b = *r.metrics->baseline;
         out += std::to_string(b.lost_frames) + "," + opt(b.ate_rmse_m, "%.9g") + "," +
-               opt(b.tracking_ms_median, "%.9g") + ",";
+               opt(b.tracking_ms_median, "%.9g") + "," + opt(paired_ate_difference_m(r), "%.9g") + ",";
       } else {
-        out += ",,,";
+        out += ",,,,";
       }
       out += "\n";
     } else {
-      out += ",,,,,,,,,," + csv_field(r.error) + "\n";
+      out += ",,,,,,,,,,," + csv_field(r.error) + "\n";
     }
   }
   return out;
@@ -198,6 +323,7 @@ std::string format_json(const SweepAggregate& a) {
                     ",\n  \"failed\": " + std::to_string(a.failed) + ",\n";
   out += "  \"primary\": " + run_summary_json(a.primary) + ",\n";
   out += "  \"baseline\": " + (a.has_baseline ? run_summary_json(a.baseline) : std::string("null")) + ",\n";
+  out += "  \"paired\": " + (a.has_baseline ? paired_json(a.paired) : std::string("null")) + ",\n";
   out += "  \"runs\": [\n";
   for (std::size_t i = 0; i < a.runs.size(); ++i) {
     const SeedRun& r = a.runs[i];
@@ -214,7 +340,8 @@ std::string format_json(const SweepAggregate& a) {
         const RunMetrics& b = *r.metrics->baseline;
         out += ", \"baseline\": {\"lost_frames\": " + std::to_string(b.lost_frames) +
                ", \"ate_rmse_m\": " + json_opt(b.ate_rmse_m) +
-               ", \"tracking_ms_median\": " + json_opt(b.tracking_ms_median) + "}";
+               ", \"tracking_ms_median\": " + json_opt(b.tracking_ms_median) +
+               "}, \"pe_minus_baseline_ate_m\": " + json_opt(paired_ate_difference_m(r));
       }
     } else {
       out += ", \"error\": \"" + json_escape(r.error) + "\"";

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "pvb/suite/aggregate.hpp"
@@ -26,7 +27,164 @@ suite::SweepAggregate sample() {
   return suite::aggregate("pv_station", runs);
 }
 
+// A --compare seed built by hand: ATEs in millimetres, nullopt for "ate": null.
+suite::SeedRun compare_run(std::uint64_t seed, std::optional<double> pe_mm, std::optional<double> base_mm) {
+  suite::SeedRun r;
+  r.seed = seed;
+  suite::MetricsFile m;
+  m.primary.mode = "pe-slam";
+  m.primary.status = "completed";
+  m.primary.frames = 100;
+  if (pe_mm) m.primary.ate_rmse_m = *pe_mm / 1000.0;
+  suite::RunMetrics b;
+  b.mode = "orb-slam2";
+  b.status = "completed";
+  b.frames = 100;
+  if (base_mm) b.ate_rmse_m = *base_mm / 1000.0;
+  m.baseline = b;
+  r.metrics = m;
+  return r;
+}
+
 }  // namespace
+
+TEST(StudentT, QuantilesMatchPublishedTables) {
+  // Two-sided 95 % critical values from the usual t table (3 decimals).
+  EXPECT_NEAR(suite::student_t_quantile(0.975, 1), 12.706, 5e-4);
+  EXPECT_NEAR(suite::student_t_quantile(0.975, 2), 4.303, 5e-4);
+  EXPECT_NEAR(suite::student_t_quantile(0.975, 3), 3.182, 5e-4);
+  EXPECT_NEAR(suite::student_t_quantile(0.975, 4), 2.776, 5e-4);
+  EXPECT_NEAR(suite::student_t_quantile(0.975, 7), 2.365, 5e-4);
+  EXPECT_NEAR(suite::student_t_quantile(0.975, 10), 2.228, 5e-4);
+  EXPECT_NEAR(suite::student_t_quantile(0.975, 30), 2.042, 5e-4);
+  EXPECT_NEAR(suite::student_t_quantile(0.975, 120), 1.980, 5e-4);
+  EXPECT_NEAR(suite::student_t_quantile(0.975, 100000), 1.960, 5e-4);  // the normal's 1.95996
+  EXPECT_NEAR(suite::student_t_quantile(0.95, 10), 1.812, 5e-4);
+  EXPECT_NEAR(suite::student_t_quantile(0.995, 5), 4.032, 5e-4);
+}
+
+TEST(StudentT, ClosedFormsSymmetryAndBadInput) {
+  // dof 1 is the Cauchy distribution: t = tan(pi (p - 1/2)); dof 2:
+  // t = (2p - 1) sqrt(2 / (4 p (1 - p))).
+  const double pi = 3.14159265358979323846;
+  EXPECT_NEAR(suite::student_t_quantile(0.975, 1), std::tan(pi * 0.475), 1e-9);
+  EXPECT_NEAR(suite::student_t_quantile(0.9, 2), 0.8 * std::sqrt(2.0 / (4 * 0.9 * 0.1)), 1e-12);
+  EXPECT_DOUBLE_EQ(suite::student_t_quantile(0.025, 6), -suite::student_t_quantile(0.975, 6));
+  EXPECT_EQ(suite::student_t_quantile(0.5, 3), 0.0);
+  EXPECT_TRUE(std::isnan(suite::student_t_quantile(1.0, 3)));
+  EXPECT_TRUE(std::isnan(suite::student_t_quantile(0.975, 0)));
+}
+
+TEST(PairedComparison, ClearPeWin) {
+  // d = -1, -2, -3, -2 mm: mean -2, sd sqrt(2/3) = 0.8165, se 0.40825,
+  // t(0.975, 3) = 3.1824 -> half width 1.2992 mm.
+  const suite::PairedComparison p = suite::compare_paired(
+      {compare_run(1, 5, 6), compare_run(2, 4, 6), compare_run(3, 3, 6), compare_run(4, 5, 7)});
+  EXPECT_EQ(p.count, 4);
+  EXPECT_NEAR(p.mean_m, -0.002, 1e-12);
+  EXPECT_NEAR(p.sd_m, 0.001 * std::sqrt(2.0 / 3.0), 1e-12);
+  EXPECT_NEAR(p.se_m, 0.001 * std::sqrt(2.0 / 3.0) / 2.0, 1e-12);
+  ASSERT_TRUE(p.has_ci);
+  EXPECT_NEAR(p.t_quantile, 3.1824, 1e-4);
+  EXPECT_NEAR(p.ci_low_m, -0.0032992, 1e-6);
+  EXPECT_NEAR(p.ci_high_m, -0.0007008, 1e-6);
+  EXPECT_EQ(p.pe_not_worse, 4);
+  EXPECT_EQ(p.verdict, suite::PairedVerdict::kPeBetter);
+  EXPECT_EQ(suite::format_paired_line(p),
+            "PE-SLAM − baseline ATE: mean -2.00 mm, 95 % CI [-3.30, -0.70] mm over 4 seeds "
+            "(PE ≤ baseline on 4); PE-SLAM better");
+}
+
+TEST(PairedComparison, ClearLoss) {
+  // d = +3, +5, +4 mm: mean 4, sd 1, se 0.57735, t(0.975, 2) = 4.3027 ->
+  // half width 2.4841 mm.
+  const suite::PairedComparison p =
+      suite::compare_paired({compare_run(1, 9, 6), compare_run(2, 10, 5), compare_run(3, 12, 8)});
+  EXPECT_EQ(p.count, 3);
+  EXPECT_NEAR(p.mean_m, 0.004, 1e-12);
+  EXPECT_NEAR(p.sd_m, 0.001, 1e-12);
+  EXPECT_NEAR(p.ci_low_m, 0.0015159, 1e-6);
+  EXPECT_NEAR(p.ci_high_m, 0.0064841, 1e-6);
+  EXPECT_EQ(p.pe_not_worse, 0);
+  EXPECT_EQ(p.verdict, suite::PairedVerdict::kBaselineBetter);
+  EXPECT_EQ(suite::format_paired_line(p),
+            "PE-SLAM − baseline ATE: mean 4.00 mm, 95 % CI [1.52, 6.48] mm over 3 seeds "
+            "(PE ≤ baseline on 0); baseline better");
+}
+
+TEST(PairedComparison, TieStraddlesZeroAndEqualCountsAsNotWorse) {
+  // d = -1, +1.5, -0.5, +0.5, 0 mm: mean 0.1, sd sqrt(3.7 / 4) = 0.96177,
+  // se 0.43012, t(0.975, 4) = 2.7764 -> CI [-1.0942, 1.2942] mm.  PE ≤
+  // baseline on the seeds with d = -1, -0.5 and the exact tie.
+  const suite::PairedComparison p =
+      suite::compare_paired({compare_run(1, 4, 5), compare_run(2, 6.5, 5), compare_run(3, 4.5, 5),
+                             compare_run(4, 5.5, 5), compare_run(5, 5, 5)});
+  EXPECT_EQ(p.count, 5);
+  EXPECT_NEAR(p.mean_m, 0.0001, 1e-12);
+  EXPECT_NEAR(p.sd_m, 0.001 * std::sqrt(0.925), 1e-12);
+  EXPECT_NEAR(p.ci_low_m, -0.0010942, 1e-6);
+  EXPECT_NEAR(p.ci_high_m, 0.0012942, 1e-6);
+  EXPECT_EQ(p.pe_not_worse, 3);
+  EXPECT_EQ(p.verdict, suite::PairedVerdict::kNoSignificantDifference);
+  EXPECT_EQ(suite::format_paired_line(p),
+            "PE-SLAM − baseline ATE: mean 0.10 mm, 95 % CI [-1.09, 1.29] mm over 5 seeds "
+            "(PE ≤ baseline on 3); no significant difference at 95 %");
+}
+
+TEST(PairedComparison, SeedsWithoutBothAtesAreLeftOut) {
+  std::vector<suite::SeedRun> runs = {compare_run(1, 4, 6),             // d = -2
+                                      compare_run(2, std::nullopt, 5),  // PE lost its ATE
+                                      compare_run(3, 7, std::nullopt),  // baseline lost its ATE
+                                      compare_run(4, 3, 4),             // d = -1
+                                      compare_run(5, 100, 1)};          // no baseline object (below)
+  runs[4].metrics->baseline.reset();
+  suite::SeedRun no_metrics;
+  no_metrics.seed = 6;
+  no_metrics.error = "missing";
+  runs.push_back(no_metrics);
+  EXPECT_FALSE(suite::paired_ate_difference_m(runs[1]));
+  EXPECT_FALSE(suite::paired_ate_difference_m(runs[2]));
+  EXPECT_FALSE(suite::paired_ate_difference_m(runs[4]));
+  EXPECT_FALSE(suite::paired_ate_difference_m(runs[5]));
+  EXPECT_NEAR(*suite::paired_ate_difference_m(runs[0]), -0.002, 1e-12);
+
+  // Pairs: d = -2, -1 mm; mean -1.5, sd 0.7071, se 0.5, t(0.975, 1) = 12.706.
+  const suite::SweepAggregate a = suite::aggregate("s", runs);
+  EXPECT_EQ(a.paired.count, 2);
+  EXPECT_NEAR(a.paired.mean_m, -0.0015, 1e-12);
+  EXPECT_NEAR(a.paired.se_m, 0.0005, 1e-12);
+  EXPECT_NEAR(a.paired.ci_low_m, -0.0015 - 12.7062 * 0.0005, 1e-6);
+  EXPECT_EQ(a.paired.pe_not_worse, 2);
+  EXPECT_EQ(a.paired.verdict, suite::PairedVerdict::kNoSignificantDifference);
+  // The per-system means still use every ATE they have.
+  EXPECT_EQ(a.primary.ate_rmse_m.count, 4);
+  EXPECT_EQ(a.baseline.ate_rmse_m.count, 3);
+}
+
+TEST(PairedComparison, OneSeedHasNoInterval) {
+  const suite::PairedComparison p =
+      suite::compare_paired({compare_run(1, 4, 5), compare_run(2, std::nullopt, 5)});
+  EXPECT_EQ(p.count, 1);
+  EXPECT_FALSE(p.has_ci);
+  EXPECT_NEAR(p.mean_m, -0.001, 1e-12);
+  EXPECT_EQ(p.sd_m, 0.0);
+  EXPECT_EQ(p.verdict, suite::PairedVerdict::kTooFewSeeds);
+  EXPECT_EQ(suite::format_paired_line(p),
+            "PE-SLAM − baseline ATE: mean -1.00 mm over 1 seed (PE ≤ baseline on 1); too few seeds");
+
+  const suite::PairedComparison none = suite::compare_paired({compare_run(1, std::nullopt, 5)});
+  EXPECT_EQ(none.count, 0);
+  EXPECT_EQ(none.verdict, suite::PairedVerdict::kTooFewSeeds);
+  EXPECT_EQ(suite::format_paired_line(none), "PE-SLAM − baseline ATE: no seed with both ATEs; too few seeds");
+  const std::string md = suite::format_markdown(suite::aggregate("s", {compare_run(1, std::nullopt, 5)}));
+  EXPECT_NE(md.find("\nPE-SLAM − baseline ATE: no seed with both ATEs; too few seeds\n"), std::string::npos)
+      << md;
+  EXPECT_EQ(md.find("standard error"), std::string::npos) << md;
+  const YAML::Node j = YAML::Load(suite::format_json(suite::aggregate("s", {compare_run(1, 4, 5)})));
+  EXPECT_EQ(j["paired"]["count"].as<int>(), 1);
+  EXPECT_TRUE(j["paired"]["ci95_low_m"].IsNull());
+  EXPECT_EQ(j["paired"]["verdict"].as<std::string>(), "too few seeds");
+}
 
 TEST(SweepAggregate, SummaryIsMeanAndSampleSd) {
   const suite::Summary s = suite::summarize({1.0, 2.0, 3.0, 4.0});
@@ -67,6 +225,8 @@ TEST(SweepAggregate, NoBaselineWithoutCompare) {
   EXPECT_EQ(a.failed, 0);
   EXPECT_NE(suite::format_markdown(a).find("| PE-SLAM | 1 | n/a |"), std::string::npos)
       << suite::format_markdown(a);
+  EXPECT_EQ(suite::format_markdown(a).find("PE-SLAM − baseline"), std::string::npos);
+  EXPECT_TRUE(YAML::Load(suite::format_json(a))["paired"].IsNull());
 }
 
 TEST(SweepAggregate, MarkdownHasSummaryAndPerSeedRows) {
@@ -78,6 +238,16 @@ TEST(SweepAggregate, MarkdownHasSummaryAndPerSeedRows) {
   EXPECT_NE(md.find("| 2 | 0 | completed | 600 | 4 | 23.50 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| 3 | 1 |"), std::string::npos) << md;
   EXPECT_NE(md.find("first loss at frame 141"), std::string::npos) << md;
+  // Paired: d = -0.9 and +8.5 mm; mean 3.8, sd 6.6468, se 4.7, t(0.975, 1)
+  // = 12.7062 -> half width 59.72 mm.  Right after the summary table.
+  const std::size_t line = md.find(
+      "\nPE-SLAM − baseline ATE: mean 3.80 mm, 95 % CI [-55.92, 63.52] mm over 2 seeds (PE ≤ baseline on 1); "
+      "no significant difference at 95 %\n");
+  EXPECT_NE(line, std::string::npos) << md;
+  EXPECT_LT(md.find("| ORB-SLAM2 baseline | 2 |"), line);
+  EXPECT_LT(line, md.find("## Per seed"));
+  EXPECT_NE(md.find("SD 6.65 mm, standard error 4.70 mm"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 15.00 | 8.50 |"), std::string::npos) << md;  // seed 2's baseline ATE and d
 }
 
 TEST(SweepAggregate, CsvHasOneRowPerSeed) {
@@ -91,9 +261,12 @@ TEST(SweepAggregate, CsvHasOneRowPerSeed) {
   }
   ASSERT_EQ(lines.size(), 5u);
   EXPECT_EQ(lines[0].substr(0, 10), "seed,exit_");
-  EXPECT_EQ(lines[1], "1,0,completed,300,0,0.0042,0.0011,17.5,1.12,0,0.0051,16.9,");
-  EXPECT_EQ(lines[4], "4,0,aborted,142,1,,,15,1.3,,,,");
-  EXPECT_EQ(lines[3].substr(0, 14), "3,1,,,,,,,,,,,");
+  EXPECT_NE(lines[0].find(",baseline_tracking_ms_median,pe_minus_baseline_ate_m,error"), std::string::npos);
+  EXPECT_EQ(lines[1], "1,0,completed,300,0,0.0042,0.0011,17.5,1.12,0,0.0051,16.9,-0.0009,");
+  EXPECT_EQ(lines[2].substr(lines[2].size() - 8), ",0.0085,");
+  EXPECT_EQ(lines[4], "4,0,aborted,142,1,,,15,1.3,,,,,");
+  EXPECT_EQ(lines[3].substr(0, 15), "3,1,,,,,,,,,,,,");  // 14 columns, the last one the error
+  EXPECT_NE(lines[3][15], ',');
 }
 
 TEST(SweepAggregate, JsonParsesAndCarriesTheSummaries) {
@@ -108,6 +281,14 @@ TEST(SweepAggregate, JsonParsesAndCarriesTheSummaries) {
   EXPECT_TRUE(j["runs"][3]["ate_rmse_m"].IsNull());
   EXPECT_NE(j["runs"][2]["error"].as<std::string>().find("seed_3_never_written"), std::string::npos);
   EXPECT_NEAR(j["runs"][1]["baseline"]["ate_rmse_m"].as<double>(), 0.015, 1e-12);
+  EXPECT_NEAR(j["runs"][1]["pe_minus_baseline_ate_m"].as<double>(), 0.0085, 1e-12);
+  EXPECT_EQ(j["paired"]["count"].as<int>(), 2);
+  EXPECT_NEAR(j["paired"]["mean_m"].as<double>(), 0.0038, 1e-9);
+  EXPECT_NEAR(j["paired"]["se_m"].as<double>(), 0.0047, 1e-9);
+  EXPECT_NEAR(j["paired"]["ci95_low_m"].as<double>(), 0.0038 - 12.7062 * 0.0047, 1e-6);
+  EXPECT_NEAR(j["paired"]["ci95_high_m"].as<double>(), 0.0038 + 12.7062 * 0.0047, 1e-6);
+  EXPECT_EQ(j["paired"]["pe_not_worse"].as<int>(), 1);
+  EXPECT_EQ(j["paired"]["verdict"].as<std::string>(), "no significant difference at 95 %");
 }
 
 TEST(SweepAggregate, FigureShowsEverySeedAndBothModes) {

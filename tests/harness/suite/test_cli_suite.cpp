@@ -127,6 +127,13 @@ TEST(CliSweep, AggregateOnlyCollectsSeedFolders) {
   EXPECT_EQ(count_lines(csv), 4) << csv;  // header + seeds 1, 2, 10 in numeric order
   EXPECT_LT(csv.find("\n1,"), csv.find("\n2,"));
   EXPECT_LT(csv.find("\n2,"), csv.find("\n10,"));
+  // Both seeds ran --compare: the paired line is the last thing printed
+  // (d = -0.9 and +8.5 mm, CI from t(0.975, 1) = 12.706).
+  const std::string paired =
+      "PE-SLAM − baseline ATE: mean 3.80 mm, 95 % CI [-55.92, 63.52] mm over 2 seeds (PE ≤ baseline on 1); "
+      "no significant difference at 95 %\n";
+  ASSERT_GE(r.output.size(), paired.size());
+  EXPECT_EQ(r.output.substr(r.output.size() - paired.size()), paired) << r.output;
 
   // An explicit list aggregates only those seeds.
   const auto two = run_pvbench("sweep --out " + out + " --aggregate-only --seeds 1-2");

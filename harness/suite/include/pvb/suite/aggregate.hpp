@@ -1,6 +1,7 @@
 #pragma once
-// Aggregation of a seed sweep: per-seed rows read from DIR/seed_S/metrics.json
-// and mean ± sd over the seeds that produced metrics.
+// Aggregation of a seed sweep: per-seed rows read from DIR/seed_S/metrics.json,
+// mean ± sd over the seeds that produced metrics and, with --compare, the
+// paired PE-SLAM − baseline ATE difference with its 95 % confidence interval.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -29,6 +30,49 @@ struct Summary {
 };
 Summary summarize(const std::vector<double>& values);
 
+/// Quantile of Student's t distribution with `dof` degrees of freedom: the
+/// t with P(T <= t) = p, for 0 < p < 1 and dof >= 1.  Exact up to the
+/// bisection's double precision: P(|T| < t) is the closed-form finite sum for
+/// integer degrees of freedom (Abramowitz & Stegun 26.7.3 and 26.7.4),
+/// inverted by bisection.  E.g. student_t_quantile(0.975, 4) = 2.776.
+double student_t_quantile(double p, int dof);
+
+/// What the paired comparison says about PE-SLAM against the baseline.
+enum class PairedVerdict {
+  kTooFewSeeds,              ///< fewer than 2 pairs: no interval
+  kPeBetter,                 ///< the whole 95 % CI of PE − baseline is below 0
+  kBaselineBetter,           ///< the whole 95 % CI is above 0
+  kNoSignificantDifference,  ///< the CI contains 0
+};
+/// "PE-SLAM better", "baseline better", "no significant difference at 95 %", "too few seeds".
+const char* verdict_text(PairedVerdict v);
+
+/// PE-SLAM − baseline ATE RMSE per seed (d_i, metres) over the seeds where
+/// both runs of a --compare run have an ATE.  Both runs of one seed track
+/// the same rendered frames, so the scene, the noise and the route cancel
+/// in d_i and what is left is the effect of PE-match plus run-to-run noise.
+struct PairedComparison {
+  int count = 0;            ///< n: seeds with both ATEs
+  double mean_m = 0.0;      ///< mean of d_i
+  double sd_m = 0.0;        ///< sample SD of d_i (n − 1; 0 for n = 1)
+  double se_m = 0.0;        ///< standard error sd / sqrt(n)
+  bool has_ci = false;      ///< n >= 2
+  double t_quantile = 0.0;  ///< t(0.975, n − 1) when has_ci
+  double ci_low_m = 0.0;    ///< mean − t · se
+  double ci_high_m = 0.0;   ///< mean + t · se
+  int pe_not_worse = 0;     ///< seeds with PE ATE <= baseline ATE (d_i <= 0)
+  PairedVerdict verdict = PairedVerdict::kTooFewSeeds;
+};
+
+/// PE-SLAM − baseline ATE of one seed, when both are present.
+std::optional<double> paired_ate_difference_m(const SeedRun& r);
+/// The paired comparison over the runs (seeds without both ATEs left out).
+PairedComparison compare_paired(const std::vector<SeedRun>& runs);
+/// One line in millimetres, e.g. "PE-SLAM − baseline ATE: mean -0.42 mm,
+/// 95 % CI [-1.10, 0.26] mm over 8 seeds (PE ≤ baseline on 5); no
+/// significant difference at 95 %".
+std::string format_paired_line(const PairedComparison& p);
+
 struct RunSummary {
   Summary ate_rmse_m;
   Summary lost_frames;
@@ -42,7 +86,8 @@ struct SweepAggregate {
   RunSummary primary;
   bool has_baseline = false;  ///< any seed ran with --compare
   RunSummary baseline;
-  int failed = 0;  ///< seeds without metrics or with a non-zero exit
+  PairedComparison paired;  ///< meaningful when has_baseline
+  int failed = 0;           ///< seeds without metrics or with a non-zero exit
 };
 
 /// Reads DIR/seed_S/metrics.json for one seed into a SeedRun; a missing or
@@ -52,7 +97,8 @@ SeedRun read_seed_run(std::uint64_t seed, const std::string& metrics_path, int e
 /// Summaries over the runs that have metrics (ATE over runs with an ATE).
 SweepAggregate aggregate(const std::string& scenario, std::vector<SeedRun> runs);
 
-/// aggregate.md: a summary table (mean ± sd) and the per-seed rows.
+/// aggregate.md: a summary table (mean ± sd), the paired line when there is a
+/// baseline, and the per-seed rows.
 std::string format_markdown(const SweepAggregate& a);
 /// aggregate.csv: one row per seed.
 std::string format_csv(const SweepAggregate& a);
