@@ -79,8 +79,8 @@ TEST(Settings, ReadsKeyFrameSection) {
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_EQ(s.keyframe.min_tracked_close, 100);  // ORB-SLAM2's value
   EXPECT_EQ(s.keyframe.min_untracked_close, 50);
-  for (const std::string bad : {"KeyFrame.minTrackedClose: 0", "KeyFrame.minUntrackedClose: -3",
-                                "KeyFrame.minTrackedClose: 1.5"}) {
+  for (const std::string bad :
+       {"KeyFrame.minTrackedClose: 0", "KeyFrame.minUntrackedClose: -3", "KeyFrame.minTrackedClose: 1.5"}) {
     try {
       read_settings(temp_copy("kfbad", read_file(kTum1) + "\n" + bad + "\n"));
       FAIL() << "expected ConfigError for " << bad;

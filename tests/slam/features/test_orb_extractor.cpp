@@ -112,7 +112,8 @@ TEST(OrbExtractor, KeypointsOfEveryLevelLandWhereAKnownZoomPutsThem) {
   cv::Mat master(H * kM, W * kM, CV_8U, cv::Scalar(128));
   cv::RNG rng(7);
   for (int i = 0; i < 2500; ++i) {
-    const cv::Point2f c(rng.uniform(0.f, static_cast<float>(master.cols)), rng.uniform(0.f, static_cast<float>(master.rows)));
+    const cv::Point2f c(rng.uniform(0.f, static_cast<float>(master.cols)),
+                        rng.uniform(0.f, static_cast<float>(master.rows)));
     const cv::Size2f sz(rng.uniform(12.f, 160.f), rng.uniform(12.f, 160.f));
     cv::Point2f corners[4];
     cv::RotatedRect(c, sz, rng.uniform(0.f, 180.f)).points(corners);
@@ -144,7 +145,8 @@ TEST(OrbExtractor, KeypointsOfEveryLevelLandWhereAKnownZoomPutsThem) {
       const cv::KeyPoint& ka = fa.keypoints[i];
       if (ka.octave != kb.octave - 3) continue;
       if (cv::norm(ka.pt - pa) > 2.0 * ex.level_scale(ka.octave)) continue;
-      const int d = static_cast<int>(cv::norm(fa.descriptors.row(static_cast<int>(i)), fb.descriptors.row(static_cast<int>(j)), cv::NORM_HAMMING));
+      const int d = static_cast<int>(cv::norm(fa.descriptors.row(static_cast<int>(i)),
+                                              fb.descriptors.row(static_cast<int>(j)), cv::NORM_HAMMING));
       if (d < best_d) best_d = d, best = static_cast<int>(i);
     }
     if (best < 0) continue;
@@ -156,8 +158,10 @@ TEST(OrbExtractor, KeypointsOfEveryLevelLandWhereAKnownZoomPutsThem) {
   for (int l = 3; l < 8; ++l) {
     ASSERT_GE(count[l], 10) << "level " << l;
     const cv::Point2d m = sum[l] / count[l];
-    const cv::Point2d sd(std::sqrt(sum2[l].x / count[l] - m.x * m.x), std::sqrt(sum2[l].y / count[l] - m.y * m.y));
-    std::printf("level %d: %d matches, mean residual (%.3f, %.3f) px, sd (%.3f, %.3f)\n", l, count[l], m.x, m.y, sd.x, sd.y);
+    const cv::Point2d sd(std::sqrt(sum2[l].x / count[l] - m.x * m.x),
+                         std::sqrt(sum2[l].y / count[l] - m.y * m.y));
+    std::printf("level %d: %d matches, mean residual (%.3f, %.3f) px, sd (%.3f, %.3f)\n", l, count[l], m.x,
+                m.y, sd.x, sd.y);
     // Unbiased placement gives |mean| <= 0.18 px here (standard error up to
     // 0.11 px at level 7); ORB-SLAM2's pt * 1.2^l gives 0.36 px at level 3
     // and 0.54 px at level 4.
