@@ -554,11 +554,14 @@ RunReport run_scenario(const RunOptions& opt) {
     route = info.route;
     log.line("renderer: " + report.renderer);
     const int mapping_nice = opt.mapping_nice.value_or(opt.pace ? 10 : 0);
+    // Local and dense mapping workers, found by name; returns how many.
+    const auto set_mapping_nice = [](int nice) {
+      return set_thread_nice("pvb-mapping", nice) + set_thread_nice("pvb-dense", nice);
+    };
     if (mapping_nice != 0) {
       // The workers started with the systems and have named themselves by
-      // now (the renderer's start-up took far longer); found by name.
-      const int changed =
-          set_thread_nice("pvb-mapping", mapping_nice) + set_thread_nice("pvb-dense", mapping_nice);
+      // now (the renderer's start-up took far longer).
+      const int changed = set_mapping_nice(mapping_nice);
       log.line("mapping workers: " + std::to_string(changed) + " at nice " + std::to_string(mapping_nice));
     }
     bool mapping_yields = mapping_nice != 0;  // the workers are at mapping_nice
@@ -616,8 +619,7 @@ RunReport run_scenario(const RunOptions& opt) {
         if (yield != mapping_yields) {
           mapping_yields = yield;
           const int nice = yield ? mapping_nice : 0;
-          set_thread_nice("pvb-mapping", nice);
-          set_thread_nice("pvb-dense", nice);
+          set_mapping_nice(nice);
           ++mapping_priority_changes;
           if (mapping_priority_changes <= 10)
             log.line("frame " + std::to_string(index) + ": tracked " + fmt(latency_ms) +

@@ -4,8 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
 
 namespace pvb::slam {
 
@@ -201,10 +199,9 @@ bool Tracking::track_with_motion_model(Frame& f) {
     rec.octaves[k] = {last_.keys_un[m[k].i1].octave, f.keys_un[m[k].i2].octave};
   }
 
-  if (options_.use_pe_match) {
+  if (options_.use_pe_match && options_.pe_skip_low_parallax) {
     stats_.translation_parallax_px = translation_parallax_px(m, *velocity_);
-    stats_.pe_skipped =
-        options_.pe_skip_low_parallax && stats_.translation_parallax_px < options_.pe_match.inlier_threshold_px;
+    stats_.pe_skipped = stats_.translation_parallax_px < options_.pe_match.inlier_threshold_px;
   }
   if (options_.use_pe_match && !stats_.pe_skipped) {
     // PE-match on the pixel pairs (last keypoint, current keypoint), paper sec. 3.

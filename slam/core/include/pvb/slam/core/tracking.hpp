@@ -29,10 +29,10 @@ struct TrackingStats {
   int coarse_matches = 0;       ///< motion-model matches after the orientation check
   int matches_kept = 0;         ///< after PE-match (== coarse without it)
   double pe_match_ms = 0;       ///< time in PE-match
-  /// Median pixel displacement that the predicted translation alone causes
+  /// With TrackingOptions::pe_skip_low_parallax on (else 0 / false): the
+  /// median pixel displacement that the predicted translation alone causes
   /// at the motion model's matches with depth (+inf when unknown), and
-  /// whether PE-match was skipped because it is below the epipolar
-  /// threshold (TrackingOptions::pe_skip_low_parallax).
+  /// whether PE-match was skipped because it is below the epipolar threshold.
   double translation_parallax_px = 0;
   bool pe_skipped = false;
   int inliers = 0;              ///< map-point inliers after the local-map optimisation
