@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -188,6 +190,46 @@ void compute_rbrief(const cv::Mat& image, const cv::KeyPoint& kp, unsigned char*
   }
 }
 
+int fast9_score(const cv::Mat& grey, int x, int y) {
+  assert(grey.type() == CV_8UC1);
+  // Bresenham circle of radius 3, clockwise from the top.
+  static constexpr int kDx[16] = {0, 1, 2, 3, 3, 3, 2, 1, 0, -1, -2, -3, -3, -3, -2, -1};
+  static constexpr int kDy[16] = {-3, -3, -2, -1, 0, 1, 2, 3, 3, 3, 2, 1, 0, -1, -2, -3};
+  const int centre = grey.at<uchar>(y, x);
+  // The circle's differences to the centre, wrapped so that every arc of 9
+  // is contiguous: arc s is diff[s .. s + 8].
+  std::int16_t diff[25];
+  for (int i = 0; i < 16; ++i) diff[i] = static_cast<std::int16_t>(grey.at<uchar>(y + kDy[i], x + kDx[i]) - centre);
+  for (int i = 16; i < 25; ++i) diff[i] = diff[i - 16];
+  // Arc s passes t when all of it is brighter than centre + t (t < lo[s])
+  // or all darker than centre - t (t < -hi[s]); eight arcs per vector.
+  int best = 0;
+  for (int half = 0; half < 16; half += 8) {
+    cv::v_int16x8 lo = cv::v_load(diff + half), hi = lo;
+    for (int k = 1; k < 9; ++k) {
+      const cv::v_int16x8 d = cv::v_load(diff + half + k);
+      lo = cv::v_min(lo, d);
+      hi = cv::v_max(hi, d);
+    }
+    best = std::max(best, std::max<int>(cv::v_reduce_max(lo), -cv::v_reduce_min(hi)));
+  }
+  return std::max(best - 1, 0);
+}
+
+cv::Point2f quadratic_peak_offset(const float s[3][3]) {
+  const double gx = 0.5 * (s[1][2] - s[1][0]);
+  const double gy = 0.5 * (s[2][1] - s[0][1]);
+  const double hxx = s[1][2] - 2.0 * s[1][1] + s[1][0];
+  const double hyy = s[2][1] - 2.0 * s[1][1] + s[0][1];
+  const double hxy = 0.25 * (s[2][2] - s[2][0] - s[0][2] + s[0][0]);
+  const double det = hxx * hyy - hxy * hxy;
+  // A maximum needs a negative-definite Hessian.
+  if (!(hxx < 0 && det > 0)) return {0.f, 0.f};
+  const double dx = -(hyy * gx - hxy * gy) / det;
+  const double dy = -(hxx * gy - hxy * gx) / det;
+  return {static_cast<float>(std::clamp(dx, -0.5, 0.5)), static_cast<float>(std::clamp(dy, -0.5, 0.5))};
+}
+
 OrbExtractor::OrbExtractor(const OrbParams& params) : params_(params) {
   const int n = params_.num_levels;
   scales_.resize(n);
@@ -334,8 +376,21 @@ OrbFeatures OrbExtractor::extract(const cv::Mat& image) {
     // keypoints 0.5 * (scale - 1) px too far up and left (1.3 px at level 7).
     const float sx = static_cast<float>(pyramid_[0].cols) / static_cast<float>(pyramid_[l].cols);
     const float sy = static_cast<float>(pyramid_[0].rows) / static_cast<float>(pyramid_[l].rows);
+    const cv::Mat& level = pyramid_[l];
     for (cv::KeyPoint kp : per_level[l]) {
       compute_rbrief(view, kp, out.descriptors.ptr<uchar>(row++));
+      if (params_.sub_pixel) {
+        // Orientation and descriptor stay at the whole pixel; only the
+        // position moves.  FAST keeps 3 px off its 16 px-inset detection
+        // area, so the 3x3 neighbourhood's circles stay inside the level.
+        const int x = cvRound(kp.pt.x), y = cvRound(kp.pt.y);
+        float score[3][3];
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) score[dy + 1][dx + 1] = static_cast<float>(fast9_score(level, x + dx, y + dy));
+        const cv::Point2f off = quadratic_peak_offset(score);
+        kp.pt.x += off.x;
+        kp.pt.y += off.y;
+      }
       kp.pt.x = (kp.pt.x + 0.5f) * sx - 0.5f;
       kp.pt.y = (kp.pt.y + 0.5f) * sy - 0.5f;
       out.keypoints.push_back(kp);

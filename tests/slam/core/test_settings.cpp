@@ -90,6 +90,19 @@ TEST(Settings, ReadsKeyFrameSection) {
   }
 }
 
+TEST(Settings, ReadsOrbSubPixelFlag) {
+  EXPECT_TRUE(read_settings(kTum1).orb.sub_pixel);  // absent: on
+  const Settings s = read_settings(temp_copy("subpx", read_file(kTum1) + "\nORBextractor.subPixel: 0\n"));
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_FALSE(s.orb.sub_pixel);  // ORB-SLAM2's whole level pixels
+  try {
+    read_settings(temp_copy("subpxbad", read_file(kTum1) + "\nORBextractor.subPixel: 2\n"));
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "ORBextractor.subPixel");
+  }
+}
+
 TEST(Settings, ReadsLoopClosingSection) {
   const Settings d = read_settings(kTum1);  // absent: on, with the documented defaults
   EXPECT_TRUE(d.loop.enabled);

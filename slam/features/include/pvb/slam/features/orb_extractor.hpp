@@ -16,6 +16,10 @@ struct OrbParams {
   int num_levels = 8;          ///< pyramid levels
   int ini_fast_threshold = 20; ///< FAST threshold tried first in each cell
   int min_fast_threshold = 7;  ///< FAST threshold used where a cell has no corner
+  /// Sub-pixel keypoints: fit a quadratic to the FAST score of the 3x3
+  /// neighbourhood at the keypoint's level and move the keypoint to its
+  /// peak (at most half a level pixel).  ORB-SLAM2 keeps whole level pixels.
+  bool sub_pixel = true;
 };
 
 /// Keypoints and their descriptors, one row of `descriptors` per keypoint.
@@ -26,6 +30,17 @@ struct OrbFeatures {
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;  ///< CV_8U, N x 32 (256 bits per row)
 };
+
+/// FAST-9 (16-pixel circle) corner score at (x, y): the largest t for which
+/// 9 contiguous circle pixels are all brighter than centre + t or all darker
+/// than centre - t, minus one, as cv::FAST's score (0 where no arc passes
+/// t = 1).  (x, y) must lie at least 3 px inside the image.
+int fast9_score(const cv::Mat& grey, int x, int y);
+
+/// Offset (dx, dy), each in [-0.5, 0.5], of the peak of the quadratic fitted
+/// to a 3x3 grid of scores s[row][col] centred on s[1][1]; (0, 0) where the
+/// fit has no maximum.
+cv::Point2f quadratic_peak_offset(const float s[3][3]);
 
 /// ORB extractor.  Holds the pyramid and scratch buffers so that repeated
 /// calls reuse memory; not thread-safe (one per thread).
