@@ -9,6 +9,8 @@
 
 #include <cstdio>
 #include <cstring>
+#include <map>
+#include <mutex>
 #include <string>
 
 #include "gl_module_api.h"
@@ -40,6 +42,29 @@ bool has_ext(const char* list, const char* name) {
     if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == '\0')) return true;
   }
   return false;
+}
+
+// Contexts alive per display.  eglGetPlatformDisplay returns the same
+// display for every context of a process, and eglTerminate ends all of its
+// contexts, so the display is terminated only when its last context goes.
+std::mutex g_displays_mutex;
+std::map<EGLDisplay, int> g_display_contexts;
+
+void retain_display(EGLDisplay dpy) {
+  const std::lock_guard<std::mutex> lock(g_displays_mutex);
+  ++g_display_contexts[dpy];
+}
+
+// Drops one context's hold (retained == false: a failed create that held
+// none) and terminates the display when nothing holds it.
+void release_display(EGLDisplay dpy, bool retained) {
+  const std::lock_guard<std::mutex> lock(g_displays_mutex);
+  auto it = g_display_contexts.find(dpy);
+  if (retained && it != g_display_contexts.end() && --it->second == 0) {
+    g_display_contexts.erase(it);
+    it = g_display_contexts.end();
+  }
+  if (it == g_display_contexts.end()) eglTerminate(dpy);
 }
 
 // Tries to initialise a display; returns EGL_NO_DISPLAY on failure.
@@ -108,13 +133,13 @@ extern "C" void* pvb_gl_create(int width, int height, char* err, int err_len) {
     const EGLint any_attribs[] = {EGL_SURFACE_TYPE, 0, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
     if (eglChooseConfig(dpy, any_attribs, &config, 1, &n_configs) != EGL_TRUE || n_configs < 1) {
       set_err(err, err_len, "EGL (" + platform + "): no OpenGL config (error " + hex(eglGetError()) + ")");
-      eglTerminate(dpy);
+      release_display(dpy, false);
       return nullptr;
     }
   }
   if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE) {
     set_err(err, err_len, "EGL (" + platform + "): desktop OpenGL API unavailable");
-    eglTerminate(dpy);
+    release_display(dpy, false);
     return nullptr;
   }
   // MuJoCo 2.2.2 uses fixed-function GL: ask for a compatibility profile.
@@ -124,16 +149,17 @@ extern "C" void* pvb_gl_create(int width, int height, char* err, int err_len) {
   if (ctx == EGL_NO_CONTEXT) ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, nullptr);
   if (ctx == EGL_NO_CONTEXT) {
     set_err(err, err_len, "EGL (" + platform + "): cannot create a context (error " + hex(eglGetError()) + ")");
-    eglTerminate(dpy);
+    release_display(dpy, false);
     return nullptr;
   }
   if (eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx) != EGL_TRUE) {
     set_err(err, err_len,
             "EGL (" + platform + "): cannot make a surfaceless context current (error " + hex(eglGetError()) + ")");
     eglDestroyContext(dpy, ctx);
-    eglTerminate(dpy);
+    release_display(dpy, false);
     return nullptr;
   }
+  retain_display(dpy);
   auto* c = new EglContext{dpy, ctx, {}};
   auto get_string = reinterpret_cast<const GLubyte* (*)(GLenum)>(eglGetProcAddress("glGetString"));
   const char* vendor = get_string ? reinterpret_cast<const char*>(get_string(GL_VENDOR)) : nullptr;
@@ -150,9 +176,9 @@ extern "C" int pvb_gl_make_current(void* h) {
 extern "C" void pvb_gl_destroy(void* h) {
   auto* c = static_cast<EglContext*>(h);
   if (c == nullptr) return;
-  eglMakeCurrent(c->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  if (eglGetCurrentContext() == c->context) eglMakeCurrent(c->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   eglDestroyContext(c->display, c->context);
-  eglTerminate(c->display);
+  release_display(c->display, true);
   delete c;
 }
 

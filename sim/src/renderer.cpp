@@ -29,6 +29,12 @@ Renderer::Renderer(const mjModel* model, GlBackend backend, int width, int heigh
 }
 
 Renderer::~Renderer() {
+  // MuJoCo frees its GL objects in the current context: make it ours.
+  try {
+    gl_->make_current();
+  } catch (const UnavailableError&) {
+    // nothing to free into; the context goes with gl_
+  }
   mjr_freeContext(&con_);
   mjv_freeScene(&scene_);
 }
@@ -36,6 +42,9 @@ Renderer::~Renderer() {
 void Renderer::set_shadows(bool on) { scene_.flags[mjRND_SHADOW] = on ? 1 : 0; }
 
 void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat* rgb, cv::Mat* depth_m) {
+  // Another renderer of this process (or none, once it was destroyed) may
+  // hold the thread's current context.
+  gl_->make_current();
   camera_.type = mjCAMERA_FIXED;
   camera_.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);

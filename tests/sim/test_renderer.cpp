@@ -122,6 +122,35 @@ void check_projection(sim::GlBackend backend) {
   EXPECT_EQ(depth.at<float>(10, 10), 0.0f);
 }
 
+// Depth at the image centre with the wall's front face at d metres.
+float centre_depth(Fixture* f, double d) {
+  const int wall = mj_name2id(f->model.get(), mjOBJ_BODY, "wall");
+  f->data->mocap_pos[3 * f->model->body_mocapid[wall]] = d + 0.5;
+  mj_forward(f->model.get(), f->data);
+  cv::Mat rgb, depth;
+  f->renderer->render(f->model.get(), f->data, 0, &rgb, &depth);
+  return depth.at<float>(kH / 2, kW / 2 + 40);  // beside the markers
+}
+
+// Two renderers in one process (one per scene, say): each render must go to
+// its own context, also after the other renderer was destroyed (EGL: the
+// shared display must outlive it).
+void check_two_renderers(sim::GlBackend backend) {
+  Fixture a;
+  if (!make_fixture(&a, backend)) GTEST_SKIP() << "another GL backend is loaded in this process";
+  auto b = std::make_unique<Fixture>();
+  ASSERT_TRUE(make_fixture(b.get(), backend));
+  EXPECT_NEAR(centre_depth(&a, 1.0), 1.0, 1e-4);
+  EXPECT_NEAR(centre_depth(b.get(), 2.5), 2.5, 1e-4);
+  EXPECT_NEAR(centre_depth(&a, 1.5), 1.5, 1e-4);
+  b.reset();
+  EXPECT_NEAR(centre_depth(&a, 3.0), 3.0, 1e-4);
+  Fixture c;  // and a new one after that
+  ASSERT_TRUE(make_fixture(&c, backend));
+  EXPECT_NEAR(centre_depth(&c, 2.0), 2.0, 1e-4);
+  EXPECT_NEAR(centre_depth(&a, 0.8), 0.8, 1e-4);
+}
+
 }  // namespace
 
 TEST(Renderer, DepthFromBufferFormula) {
@@ -137,6 +166,10 @@ TEST(RendererEgl, PlaneDepthIsExact) { check_plane_depth(sim::GlBackend::kEgl); 
 TEST(RendererEgl, KnownPointsProjectWithinTwoTenthsOfAPixel) { check_projection(sim::GlBackend::kEgl); }
 TEST(RendererOsmesa, PlaneDepthIsExact) { check_plane_depth(sim::GlBackend::kOsmesa); }
 TEST(RendererOsmesa, KnownPointsProjectWithinTwoTenthsOfAPixel) { check_projection(sim::GlBackend::kOsmesa); }
+TEST(RendererEgl, TwoRenderersInOneProcessEachUseTheirOwnContext) { check_two_renderers(sim::GlBackend::kEgl); }
+TEST(RendererOsmesa, TwoRenderersInOneProcessEachUseTheirOwnContext) {
+  check_two_renderers(sim::GlBackend::kOsmesa);
+}
 
 TEST(GlContext, OneProcessNeverLoadsBothBackends) {
   auto first = sim::GlContext::create(sim::GlBackend::kAuto, 64, 64);

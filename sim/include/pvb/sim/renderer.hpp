@@ -27,7 +27,10 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  /// Renders camera `camera_id` for the state in `data`.  rgb becomes CV_8UC3
+  /// Renders camera `camera_id` for the state in `data`, first making this
+  /// renderer's GL context current on the calling thread (several renderers
+  /// may live in one process, on one thread at a time each; throws
+  /// UnavailableError when the context cannot be made current).  rgb becomes CV_8UC3
   /// (R, G, B order), depth_m CV_32FC1 metres (0 = nothing within zfar).
   void render(const mjModel* model, mjData* data, int camera_id, cv::Mat* rgb, cv::Mat* depth_m);
 
