@@ -1,5 +1,6 @@
 #include "pvb/run/run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,13 +13,13 @@
 #include <mutex>
 #include <thread>
 
+#include "pvb/common/closable_queue.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/common/threads.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
-#include "pvb/run/bounded_queue.hpp"
 #include "pvb/sim/sim_frame_source.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
@@ -468,8 +469,8 @@ RunReport run_scenario(const RunOptions& opt) {
     // loop the sensor model stays on the render thread and the frame queue
     // holds one frame, so the steering pose is at most two frames old.
     const bool sensor_thread_on = !opt.closed_loop;
-    BoundedQueue<RenderedItem> rendered_queue(2);
-    BoundedQueue<FrameItem> queue(opt.closed_loop ? 1 : opt.queue_capacity);
+    ClosableQueue<RenderedItem> rendered_queue(2);
+    ClosableQueue<FrameItem> queue(opt.closed_loop ? 1 : std::max<std::size_t>(opt.queue_capacity, 1));
     std::promise<SimInfo> ready;
     std::future<SimInfo> ready_future = ready.get_future();
     // Pacing: frame i is due at pace_start + i / fps (set before `ready`).
@@ -493,8 +494,8 @@ RunReport run_scenario(const RunOptions& opt) {
     // However the consumer leaves (end, stop, abort, exception), both
     // stages are released and joined.
     struct JoinGuard {
-      BoundedQueue<RenderedItem>& rendered_queue;
-      BoundedQueue<FrameItem>& queue;
+      ClosableQueue<RenderedItem>& rendered_queue;
+      ClosableQueue<FrameItem>& queue;
       std::function<void()> release;
       std::thread& producer;
       std::thread& sensor;

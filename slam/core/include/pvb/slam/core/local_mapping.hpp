@@ -22,11 +22,6 @@
 
 namespace pvb::slam {
 
-/// The closable blocking queue (moved to pvb::common so that the dense
-/// mapper shares it).
-template <typename T>
-using ClosableQueue = pvb::ClosableQueue<T>;
-
 struct LocalMappingOptions {
   int covisible_for_triangulation = 10;  ///< neighbours searched for new points (RGB-D: 10)
   double redundant_ratio = 0.9;          ///< keyframe culling: share of points seen by >= 3 others
