@@ -51,12 +51,18 @@ Options parse(int argc, char** argv) {
       if (v <= 0) throw pvb::ConfigError("command line", name, "a positive integer", argv[i]);
       return v;
     };
-    if (a == "--gap") o.gap = value("--gap");
-    else if (a == "--step") o.step = value("--step");
-    else if (a == "--frames") o.frames = value("--frames");
-    else if (a == "--whole-pixels") o.whole_pixels = true;
-    else if (o.dir.empty() && a.rfind("--", 0) != 0) o.dir = a;
-    else throw pvb::ConfigError("command line", a, "DIR [--gap N] [--step N] [--frames N] [--whole-pixels]");
+    if (a == "--gap")
+      o.gap = value("--gap");
+    else if (a == "--step")
+      o.step = value("--step");
+    else if (a == "--frames")
+      o.frames = value("--frames");
+    else if (a == "--whole-pixels")
+      o.whole_pixels = true;
+    else if (o.dir.empty() && a.rfind("--", 0) != 0)
+      o.dir = a;
+    else
+      throw pvb::ConfigError("command line", a, "DIR [--gap N] [--step N] [--frames N] [--whole-pixels]");
   }
   if (o.dir.empty()) throw pvb::ConfigError("command line", "DIR", "a recorded sequence folder");
   return o;
@@ -79,7 +85,8 @@ void run(const Options& o) {
   const auto T_w_c_of = [&](std::int64_t t_ns) {
     auto it = T_w_c_at.lower_bound(t_ns - 1'000'000);
     if (it == T_w_c_at.end() || std::llabs(it->first - t_ns) > 1'000'000)
-      throw pvb::Error(o.dir + "/groundtruth.txt: no pose within 1 ms of frame time " + std::to_string(t_ns) + " ns");
+      throw pvb::Error(o.dir + "/groundtruth.txt: no pose within 1 ms of frame time " + std::to_string(t_ns) +
+                       " ns");
     return it->second;
   };
 
@@ -154,11 +161,13 @@ void run(const Options& o) {
   for (int l = 0; l < 8; ++l) all2 += acc.sum2[l], all += acc.count[l];
   std::printf("%s, %s, gap %d: %d pairs, %d matches\n", o.dir.c_str(),
               o.whole_pixels ? "whole level pixels" : "sub-pixel", o.gap, acc.pairs, all);
-  std::printf("residual RMS %.3f level px; pose from exact points: rotation RMS %.4f deg, position RMS %.2f mm\n",
-              std::sqrt(all2 / all), std::sqrt(acc.rot2_deg / acc.pairs), 1e3 * std::sqrt(acc.pos2_m / acc.pairs));
+  std::printf(
+      "residual RMS %.3f level px; pose from exact points: rotation RMS %.4f deg, position RMS %.2f mm\n",
+      std::sqrt(all2 / all), std::sqrt(acc.rot2_deg / acc.pairs), 1e3 * std::sqrt(acc.pos2_m / acc.pairs));
   std::printf("per level:");
   for (int l = 0; l < 8; ++l)
-    if (acc.count[l] > 0) std::printf(" %d: %.3f (%d)", l, std::sqrt(acc.sum2[l] / acc.count[l]), acc.count[l]);
+    if (acc.count[l] > 0)
+      std::printf(" %d: %.3f (%d)", l, std::sqrt(acc.sum2[l] / acc.count[l]), acc.count[l]);
   std::printf("\n");
 }
 

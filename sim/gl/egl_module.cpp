@@ -176,7 +176,8 @@ extern "C" int pvb_gl_make_current(void* h) {
 extern "C" void pvb_gl_destroy(void* h) {
   auto* c = static_cast<EglContext*>(h);
   if (c == nullptr) return;
-  if (eglGetCurrentContext() == c->context) eglMakeCurrent(c->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  if (eglGetCurrentContext() == c->context)
+    eglMakeCurrent(c->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   eglDestroyContext(c->display, c->context);
   release_display(c->display, true);
   delete c;

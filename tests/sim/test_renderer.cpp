@@ -166,7 +166,9 @@ TEST(RendererEgl, PlaneDepthIsExact) { check_plane_depth(sim::GlBackend::kEgl); 
 TEST(RendererEgl, KnownPointsProjectWithinTwoTenthsOfAPixel) { check_projection(sim::GlBackend::kEgl); }
 TEST(RendererOsmesa, PlaneDepthIsExact) { check_plane_depth(sim::GlBackend::kOsmesa); }
 TEST(RendererOsmesa, KnownPointsProjectWithinTwoTenthsOfAPixel) { check_projection(sim::GlBackend::kOsmesa); }
-TEST(RendererEgl, TwoRenderersInOneProcessEachUseTheirOwnContext) { check_two_renderers(sim::GlBackend::kEgl); }
+TEST(RendererEgl, TwoRenderersInOneProcessEachUseTheirOwnContext) {
+  check_two_renderers(sim::GlBackend::kEgl);
+}
 TEST(RendererOsmesa, TwoRenderersInOneProcessEachUseTheirOwnContext) {
   check_two_renderers(sim::GlBackend::kOsmesa);
 }

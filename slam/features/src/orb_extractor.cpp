@@ -199,7 +199,8 @@ int fast9_score(const cv::Mat& grey, int x, int y) {
   // The circle's differences to the centre, wrapped so that every arc of 9
   // is contiguous: arc s is diff[s .. s + 8].
   std::int16_t diff[25];
-  for (int i = 0; i < 16; ++i) diff[i] = static_cast<std::int16_t>(grey.at<uchar>(y + kDy[i], x + kDx[i]) - centre);
+  for (int i = 0; i < 16; ++i)
+    diff[i] = static_cast<std::int16_t>(grey.at<uchar>(y + kDy[i], x + kDx[i]) - centre);
   for (int i = 16; i < 25; ++i) diff[i] = diff[i - 16];
   // Arc s passes t when all of it is brighter than centre + t (t < lo[s])
   // or all darker than centre - t (t < -hi[s]); eight arcs per vector.
@@ -227,7 +228,8 @@ cv::Point2f quadratic_peak_offset(const float s[3][3]) {
   if (!(hxx < 0 && det > 0)) return {0.f, 0.f};
   const double dx = -(hyy * gx - hxy * gy) / det;
   const double dy = -(hxx * gy - hxy * gx) / det;
-  return {static_cast<float>(std::clamp(dx, -0.5, 0.5)), static_cast<float>(std::clamp(dy, -0.5, 0.5))};
+  return {static_cast<float>(std::clamp(dx, -0.5, 0.5)),
+          static_cast<float>(std::clamp(dy, -0.5, 0.5))};
 }
 
 OrbExtractor::OrbExtractor(const OrbParams& params) : params_(params) {
@@ -386,7 +388,8 @@ OrbFeatures OrbExtractor::extract(const cv::Mat& image) {
         const int x = cvRound(kp.pt.x), y = cvRound(kp.pt.y);
         float score[3][3];
         for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) score[dy + 1][dx + 1] = static_cast<float>(fast9_score(level, x + dx, y + dy));
+          for (int dx = -1; dx <= 1; ++dx)
+            score[dy + 1][dx + 1] = static_cast<float>(fast9_score(level, x + dx, y + dy));
         const cv::Point2f off = quadratic_peak_offset(score);
         kp.pt.x += off.x;
         kp.pt.y += off.y;
