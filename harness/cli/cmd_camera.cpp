@@ -147,6 +147,7 @@ int run_camera(const CameraArgs& a) {
   so.fps = static_cast<int>(std::lround(settings.fps));
   so.record_path = a.record;
   so.timeout_ms = a.timeout_ms;
+  so.stop_requested = [] { return g_stop_requested != 0; };  // Ctrl-C also ends a wait for frames
   openni::OpenniSource source(so);
 
   slam::SystemOptions options;

@@ -1,6 +1,6 @@
 // An OpenNI2 driver plug-in serving the simulator as an RGB-D camera.
 //
-// URI: sim://<scenario file>[?seed=S&frames=N&gl=egl|osmesa|auto&unplug_after=K]
+// URI: sim://<scenario file>[?seed=S&frames=N&gl=egl|osmesa|auto&unplug_after=K&stall_after=K]
 //
 // Frames are produced on demand (lockstep): OpenNI2 calls the device's
 // tryManualTrigger() whenever a reader waits on streams that hold no frame,
@@ -8,7 +8,8 @@
 // stream.  So each read gets the next frame, nothing is ever skipped, and a
 // run is as deterministic as the simulator.  After the last frame the device
 // reports DEVICE_STATE_EOF; with unplug_after=K it reports itself
-// disconnected after K frames instead (for testing the harness).
+// disconnected after K frames instead, with stall_after=K it serves nothing
+// more after K frames but stays connected (both for testing the harness).
 //
 // Depth is served in 1 mm units (rounded), colour as RGB888.  The simulator
 // renders depth from the colour camera, so the streams are registered by
@@ -311,6 +312,7 @@ OniStatus SimDevice::tryManualTrigger() {
     driver_.disconnected(info_);
     return ONI_STATUS_OK;
   }
+  if (uri_.stall_after > 0 && served_ >= uri_.stall_after) return ONI_STATUS_OK;  // hung, not gone
   try {
     std::optional<pvb::sensor::RgbdFrame> frame = source_.next();
     if (!frame) {

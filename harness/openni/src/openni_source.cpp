@@ -247,6 +247,7 @@ std::optional<sensor::RgbdFrame> OpenniSource::Impl::next() {
       throw IoError(source_name,
                     "the camera was disconnected after " + std::to_string(next_index) + " frames");
 
+    if (options.stop_requested && options.stop_requested()) return std::nullopt;  // e.g. Ctrl-C while waiting
     std::vector<::openni::VideoStream*> wait;
     if (!is_file || depth_read < depth_total) wait.push_back(&depth);
     if (!is_file || colour_read < colour_total) wait.push_back(&colour);

@@ -44,12 +44,14 @@ SimUri parse_sim_uri(const std::string& uri) {
       out.frames = static_cast<int>(parse_int(uri, key, value, 1));
     } else if (key == "unplug_after") {
       out.unplug_after = static_cast<int>(parse_int(uri, key, value, 1));
+    } else if (key == "stall_after") {
+      out.stall_after = static_cast<int>(parse_int(uri, key, value, 1));
     } else if (key == "gl") {
       if (value != "auto" && value != "egl" && value != "osmesa")
         throw ConfigError(uri, key, "auto, egl or osmesa", "'" + value + "'");
       out.gl = value;
     } else {
-      throw ConfigError(uri, key, "one of seed, frames, gl, unplug_after", "'" + key + "'");
+      throw ConfigError(uri, key, "one of seed, frames, gl, unplug_after, stall_after", "'" + key + "'");
     }
   }
   return out;

@@ -181,6 +181,39 @@ TEST(PVB_CAMERA_SUITE, DeviceEndOfStreamEndsTheRun) {
   EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 8u);
 }
 
+// A camera that stops sending but stays connected: after --timeout-ms
+// without a frame the run ends with one error line and keeps what it
+// tracked.
+TEST(PVB_CAMERA_SUITE, HungCameraTimesOutAndKeepsTheTrajectory) {
+  const std::string d = fresh("stall");
+  const Result r =
+      run("camera --uri 'sim://scenes/pv_station.yaml?stall_after=8' --sync --timeout-ms 1500 --out " + d);
+  expect_one_error_line(r, "no frame for 1500 ms");
+  EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 8u);
+  EXPECT_GT(data_lines(d + "/CameraTrajectory.txt").size(), 4u) << r.output;
+  EXPECT_TRUE(std::ifstream(d + "/stats.json").good());
+}
+
+// Ctrl-C while the camera is hung ends the run at once (not after
+// --timeout-ms, here 10 minutes), as a normal stop: exit 0, outputs written.
+// A watchdog kills pvbench after 120 s, which fails the test.
+TEST(PVB_CAMERA_SUITE, CtrlCWhileWaitingForFramesStopsAtOnce) {
+  const std::string d = fresh("sigint");
+  const std::string log = d + "/out.txt";
+  const std::string script =
+      "cd " + std::string(PVB_SOURCE_DIR) + " && (timeout -s KILL 120 " + kBin +
+      " camera --uri 'sim://scenes/pv_station.yaml?stall_after=8' --sync --timeout-ms 600000 --out " + d +
+      " > " + log + " 2>&1 & pid=$!; "
+      "for i in $(seq 1 600); do [ \"$(grep -vc '^#' " + d + "/groundtruth.txt 2>/dev/null)\" = 8 ] && break; sleep 0.2; done; "
+      "sleep 1; kill -INT $pid; wait $pid; echo \"exit $?\" >> " + log + ")";
+  std::system(script.c_str());
+  const std::string out = pvb::read_file(log);
+  EXPECT_NE(out.find("exit 0"), std::string::npos) << out;
+  EXPECT_NE(out.find("stopped by a signal"), std::string::npos) << out;
+  EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 8u);
+  EXPECT_EQ(json_number(pvb::read_file(d + "/stats.json"), "frames"), 8) << out;
+}
+
 TEST(PVB_CAMERA_SUITE, BadUriIsOneErrorLine) {
   const std::string d = fresh("baduri");
   expect_one_error_line(run("camera --uri sim://scenes/no_such_scenario.yaml --out " + d),

@@ -15,6 +15,7 @@
 // IoError.  Recordings (.oni playback, the simulator) are read in lockstep:
 // the next frame is produced only when the previous one was read.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -36,6 +37,10 @@ struct OpenniOptions {
   std::string record_path;
   /// No frame for this long is an error (camera unplugged, file cut short).
   int timeout_ms = 10000;
+  /// Polled while next() waits for frames (every 50 ms at most); when it
+  /// returns true, next() returns nullopt at once, as at the end of a
+  /// stream (Ctrl-C on a camera that has stopped sending).  May be empty.
+  std::function<bool()> stop_requested;
 };
 
 /// What a finished recording holds.

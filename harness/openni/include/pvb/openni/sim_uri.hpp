@@ -6,7 +6,9 @@
 // keys: seed (overrides the scenario seed), frames (stream length; default
 // the scenario's duration), gl (auto|egl|osmesa), unplug_after (the device
 // reports itself unplugged after serving this many frames: a test hook for
-// the harness's disconnect path).  Shared by the driver plug-in and the
+// the harness's disconnect path), stall_after (the device stops serving
+// after this many frames but stays connected: a hung camera, for the
+// harness's timeout and Ctrl-C paths).  Shared by the driver plug-in and the
 // harness, so both read a URI the same way.
 #include <cstdint>
 #include <optional>
@@ -20,6 +22,7 @@ struct SimUri {
   int frames = 0;  ///< 0: the scenario's duration
   std::string gl = "auto";
   int unplug_after = 0;  ///< 0: never
+  int stall_after = 0;   ///< 0: never
 };
 
 inline constexpr const char* kSimScheme = "sim://";
