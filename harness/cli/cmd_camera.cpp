@@ -5,7 +5,6 @@
 // (flushed frame by frame), KeyFrameTrajectory.txt, map.ply (the sparse map
 // points), stats.json, and for sim:// sources groundtruth.txt and the ATE.
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -14,6 +13,7 @@
 #include <string>
 
 #include "command.hpp"
+#include "stop_signals.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
@@ -46,31 +46,6 @@ struct CameraArgs {
 };
 
 using Clock = std::chrono::steady_clock;
-
-// Ctrl-C (or SIGTERM) ends a live run cleanly: the loop stops, the recorder
-// is closed and every output is written.
-volatile std::sig_atomic_t g_stop_requested = 0;
-void request_stop(int) { g_stop_requested = 1; }
-
-/// Installs the handlers for the life of a run, restores the old ones after.
-class StopOnSignal {
- public:
-  StopOnSignal() {
-    g_stop_requested = 0;
-    old_int_ = std::signal(SIGINT, request_stop);
-    old_term_ = std::signal(SIGTERM, request_stop);
-  }
-  ~StopOnSignal() {
-    std::signal(SIGINT, old_int_);
-    std::signal(SIGTERM, old_term_);
-  }
-  StopOnSignal(const StopOnSignal&) = delete;
-  StopOnSignal& operator=(const StopOnSignal&) = delete;
-
- private:
-  void (*old_int_)(int) = SIG_DFL;
-  void (*old_term_)(int) = SIG_DFL;
-};
 
 std::ofstream open_out(const std::string& path) {
   std::ofstream f(path);
@@ -147,7 +122,7 @@ int run_camera(const CameraArgs& a) {
   so.fps = static_cast<int>(std::lround(settings.fps));
   so.record_path = a.record;
   so.timeout_ms = a.timeout_ms;
-  so.stop_requested = [] { return g_stop_requested != 0; };  // Ctrl-C also ends a wait for frames
+  so.stop_requested = [] { return StopSignals::requested(); };  // Ctrl-C also ends a wait for frames
   openni::OpenniSource source(so);
 
   slam::SystemOptions options;
@@ -174,10 +149,12 @@ int run_camera(const CameraArgs& a) {
   std::optional<IoError> stream_error;
   const auto t0 = Clock::now();
   {
-    const StopOnSignal stop_on_signal;
+    // Ctrl-C (or SIGTERM) ends a live run cleanly: the loop stops, the
+    // recorder is closed and every output is written (exit 0).
+    const StopSignals stop_signals;
     ProgressBar bar("camera " + source.describe(), total);
     try {
-      while ((a.frames == 0 || frames < a.frames) && !g_stop_requested) {
+      while ((a.frames == 0 || frames < a.frames) && !StopSignals::requested()) {
         std::optional<sensor::RgbdFrame> frame = source.next();
         if (!frame) break;
         if (frame->rgb.cols != settings.K.width || frame->rgb.rows != settings.K.height)
@@ -233,7 +210,7 @@ int run_camera(const CameraArgs& a) {
      << ",\n  \"fps\": " << fmt(fps);
   std::printf("camera: %zu frames (%.1f fps), lost %zu, keyframes %zu, map points %zu%s\n", frames, fps, lost,
               system.num_keyframes(), system.num_map_points(),
-              g_stop_requested ? " (stopped by a signal)" : "");
+              StopSignals::requested() ? " (stopped by a signal)" : "");
   if (rec) {
     std::printf("recorded %u depth and %u colour frames to %s\n", rec->depth_frames, rec->colour_frames,
                 rec->path.c_str());

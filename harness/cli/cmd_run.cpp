@@ -2,14 +2,13 @@
 // and feeds PE-SLAM in memory; the report folder gets metrics.json,
 // trajectories, figures, a contact sheet, run.log and index.html.
 // Ctrl-C (SIGINT/SIGTERM) stops the loop and writes the partial report.
-#include <atomic>
-#include <csignal>
 #include <cstdio>
 #include <memory>
 #include <optional>
 
 #include "check_report.hpp"
 #include "command.hpp"
+#include "stop_signals.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/run/run.hpp"
@@ -27,38 +26,6 @@ struct RunArgs {
   bool no_pace = false;
 };
 
-std::atomic<bool> g_stop{false};
-
-extern "C" void on_stop_signal(int sig) {
-  g_stop.store(true);
-  // A second Ctrl-C ends the process at once.
-  std::signal(sig, SIG_DFL);
-}
-
-/// Installs the stop handlers for the lifetime of a run and restores the
-/// previous ones afterwards.
-class StopSignals {
- public:
-  StopSignals() {
-    struct sigaction sa {};
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESTART;
-    sigaction(SIGINT, &sa, &old_int_);
-    sigaction(SIGTERM, &sa, &old_term_);
-  }
-  ~StopSignals() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-  StopSignals(const StopSignals&) = delete;
-  StopSignals& operator=(const StopSignals&) = delete;
-
- private:
-  struct sigaction old_int_ {
-  }, old_term_{};
-};
-
 int run_run(RunArgs& a) {
   if (a.baseline && a.compare)
     throw ConfigError("pvbench run", "--baseline/--compare", "at most one of them");
@@ -69,7 +36,7 @@ int run_run(RunArgs& a) {
   o.mode = a.compare    ? run::SlamMode::kCompare
            : a.baseline ? run::SlamMode::kBaseline
                         : run::SlamMode::kPeSlam;
-  o.stop = &g_stop;
+  o.stop = &StopSignals::flag();
   o.on_log = [](const std::string& line) {
     std::printf("%s\n", line.c_str());
     std::fflush(stdout);
@@ -79,8 +46,7 @@ int run_run(RunArgs& a) {
     if (!bar) bar = std::make_unique<ProgressBar>("run", total);
     bar->update(done);
   };
-  g_stop.store(false);
-  StopSignals signals;
+  const StopSignals signals;
   const run::RunReport report = run::run_scenario(o);
   if (bar) bar->finish();
   std::printf("report: %s/index.html (metrics.json, trajectories, figures, run.log)\n", o.out_dir.c_str());

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "command.hpp"
+#include "stop_signals.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
@@ -187,7 +188,10 @@ int run_slam(const SlamArgs& a) {
   std::size_t frames = 0, lost = 0, not_init = 0;
   const std::size_t max_missing =
       std::max<std::size_t>(5, static_cast<std::size_t>(a.max_missing * static_cast<double>(reader.size_hint())));
-  while (frames < total || total == 0) {
+  // Ctrl-C (or SIGTERM) stops taking frames; everything tracked so far is
+  // still written and evaluated, and the exit code is 130.
+  const StopSignals stop_signals;
+  while ((frames < total || total == 0) && !StopSignals::requested()) {
     std::optional<sensor::RgbdFrame> frame = reader.next();
     if (!frame) break;
     if (reader.skipped() > max_missing) {
@@ -220,6 +224,8 @@ int run_slam(const SlamArgs& a) {
     bar.update(frames, slam::to_string(r.state));
   }
   bar.finish();
+  const bool interrupted = StopSignals::requested();
+  if (interrupted) std::printf("slam: stopped by a signal after %zu frames; writing what was tracked\n", frames);
   system.shutdown();
   kf_traj.close();
   // Rewrite the keyframe trajectory with the poses refined by local BA
@@ -237,7 +243,8 @@ int run_slam(const SlamArgs& a) {
   std::ostringstream js;
   js << "{\n  \"sequence\": \"" << json_escape(a.sequence) << "\",\n  \"pe_match\": "
      << (settings.pe_match.enabled ? "true" : "false") << ",\n  \"sync\": " << (a.sync ? "true" : "false")
-     << ",\n  \"seed\": " << a.seed << ",\n  \"frames\": " << frames << ",\n  \"lost_frames\": " << lost
+     << ",\n  \"seed\": " << a.seed << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
+     << ",\n  \"frames\": " << frames << ",\n  \"lost_frames\": " << lost
      << ",\n  \"not_initialized_frames\": " << not_init << ",\n  \"skipped_frames\": " << reader.skipped()
      << ",\n  \"keyframes\": " << system.num_keyframes() << ",\n  \"map_points\": " << system.num_map_points()
      << ",\n  \"tracking_ms\": {\"median\": " << fmt(percentile(tracking_ms, 0.5)) << ", \"mean\": " << fmt(mean)
@@ -315,7 +322,7 @@ int run_slam(const SlamArgs& a) {
   js << "\n}\n";
   write_file(a.out + "/stats.json", js.str());
   std::printf("wrote %s/{CameraTrajectory.txt,CameraTrajectoryRefined.txt,KeyFrameTrajectory.txt,timing.csv,stats.json}\n", a.out.c_str());
-  return 0;
+  return interrupted ? 130 : 0;
 }
 
 }  // namespace
