@@ -2,16 +2,13 @@
 // contract, report files, accuracy), bit-identical prefixes, --compare, the
 // closed loop, tracking loss with on_loss abort and wait, Ctrl-C, bad input.
 #include <gtest/gtest.h>
-#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
-#include <thread>
 
 #include "pvb/common/text.hpp"
 #include "run_pvbench.hpp"
@@ -290,35 +287,14 @@ TEST(RunCli, PipelinedRunProfilesEachThread) {
 TEST(RunCli, SigintWritesThePartialReport) {
   const std::string d = fresh("sigint");
   const std::string log = ::testing::TempDir() + "pvb_run_sigint_" + std::to_string(::getpid()) + ".txt";
-  const pid_t pid = fork();
+  const pid_t pid = test::spawn_pvbench({"run", "--scenario", kStation, "--out", d}, log);
   ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const std::string out = d;
-    if (!freopen(log.c_str(), "w", stdout) || !freopen(log.c_str(), "a", stderr)) _exit(99);
-    execl(test::pvbench_path().c_str(), "pvbench", "run", "--scenario", kStation.c_str(), "--out",
-          out.c_str(), static_cast<char*>(nullptr));
-    _exit(98);
-  }
-  using Clock = std::chrono::steady_clock;
-  const auto t0 = Clock::now();
-  auto seconds = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   // Wait for 20 tracked frames (the trajectory is flushed as it grows).
-  while (data_lines(d + "/CameraTrajectory.txt").size() < 20 && seconds() < 300) {
-    int status = 0;
-    if (waitpid(pid, &status, WNOHANG) == pid) FAIL() << "pvbench ended early: " << read_file(log);
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  ASSERT_EQ(kill(pid, SIGINT), 0);
-  int status = 0;
-  pid_t done = 0;
-  const double t_signal = seconds();
-  while ((done = waitpid(pid, &status, WNOHANG)) == 0 && seconds() - t_signal < 120)
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  if (done == 0) {
-    kill(pid, SIGKILL);
-    waitpid(pid, &status, 0);
-    FAIL() << "pvbench did not stop within 120 s of SIGINT";
-  }
+  ASSERT_TRUE(test::wait_until(pid, [&] { return data_lines(d + "/CameraTrajectory.txt").size() >= 20; }, 300))
+      << "pvbench ended early or tracked nothing: " << read_file(log);
+  const std::optional<int> ended = test::interrupt_and_wait(pid, 120);
+  ASSERT_TRUE(ended.has_value()) << "pvbench did not stop within 120 s of SIGINT";
+  const int status = *ended;
   ASSERT_TRUE(WIFEXITED(status)) << "killed by a signal: " << read_file(log);
   EXPECT_EQ(WEXITSTATUS(status), 130) << read_file(log);
   const YAML::Node m = metrics(d);

@@ -11,13 +11,11 @@
 #include <regex>
 #include <sstream>
 #include <vector>
-#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <chrono>
 #include <fstream>
-#include <thread>
+#include <optional>
 
 #include "pvb/common/text.hpp"
 #include "run_pvbench.hpp"
@@ -166,15 +164,9 @@ TEST(SlamCli, SigintWritesWhatWasTracked) {
   const std::string seq = station_sequence();
   const std::string out = dir("sigint");
   const std::string log = out + ".log";
-  const pid_t pid = fork();
+  const pid_t pid = pvb::test::spawn_pvbench(
+      {"slam", "--sequence", seq, "--settings", seq + "/camera.yaml", "--out", out}, log);
   ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    if (!freopen(log.c_str(), "w", stdout) || !freopen(log.c_str(), "a", stderr)) _exit(99);
-    const std::string settings = seq + "/camera.yaml";
-    execl(pvb::test::pvbench_path().c_str(), "pvbench", "slam", "--sequence", seq.c_str(), "--settings",
-          settings.c_str(), "--out", out.c_str(), static_cast<char*>(nullptr));
-    _exit(98);
-  }
   const auto lines = [&](const std::string& path) {
     std::ifstream in(path);
     std::size_t n = 0;
@@ -182,24 +174,11 @@ TEST(SlamCli, SigintWritesWhatWasTracked) {
       if (!l.empty() && l[0] != '#') ++n;
     return n;
   };
-  using Clock = std::chrono::steady_clock;
-  const auto t0 = Clock::now();
-  const auto seconds = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
-  int status = 0;
-  while (lines(out + "/CameraTrajectory.txt") < 30 && seconds() < 300) {
-    if (waitpid(pid, &status, WNOHANG) == pid) FAIL() << "pvbench ended early: " << pvb::read_file(log);
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  ASSERT_EQ(kill(pid, SIGINT), 0);
-  pid_t done = 0;
-  const double t_signal = seconds();
-  while ((done = waitpid(pid, &status, WNOHANG)) == 0 && seconds() - t_signal < 120)
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  if (done == 0) {
-    kill(pid, SIGKILL);
-    waitpid(pid, &status, 0);
-    FAIL() << "pvbench slam did not stop within 120 s of SIGINT";
-  }
+  ASSERT_TRUE(pvb::test::wait_until(pid, [&] { return lines(out + "/CameraTrajectory.txt") >= 30; }, 300))
+      << "pvbench ended early or tracked nothing: " << pvb::read_file(log);
+  const std::optional<int> ended = pvb::test::interrupt_and_wait(pid, 120);
+  ASSERT_TRUE(ended.has_value()) << "pvbench slam did not stop within 120 s of SIGINT";
+  const int status = *ended;
   const std::string output = pvb::read_file(log);
   ASSERT_TRUE(WIFEXITED(status)) << "killed by a signal: " << output;
   EXPECT_EQ(WEXITSTATUS(status), 130) << output;
