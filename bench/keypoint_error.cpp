@@ -105,9 +105,10 @@ std::vector<cv::Mat> grey_pyramid(const cv::Mat& grey, const pvb::slam::OrbExtra
   levels[0] = grey;
   for (std::size_t l = 1; l < levels.size(); ++l) {
     const double s = 1.0 / ex.level_scale(static_cast<int>(l));
-    cv::resize(levels[l - 1], levels[l],
-               cv::Size(static_cast<int>(std::lround(grey.cols * s)), static_cast<int>(std::lround(grey.rows * s))), 0,
-               0, cv::INTER_LINEAR);
+    cv::resize(
+        levels[l - 1], levels[l],
+        cv::Size(static_cast<int>(std::lround(grey.cols * s)), static_cast<int>(std::lround(grey.rows * s))),
+        0, 0, cv::INTER_LINEAR);
   }
   return levels;
 }
@@ -122,14 +123,16 @@ double from_level(double xl, double scale) { return (xl + 0.5) * scale - 0.5; }
 /// Returns false (kb unchanged) when the patch leaves an image, the
 /// alignment does not converge or it moves more than 1.5 level px.
 bool align_patch(const std::vector<cv::Mat>& pyr_a, const std::vector<cv::Mat>& pyr_b,
-                 const pvb::slam::OrbExtractor& ex, cv::Point2f pa, const Eigen::Matrix2d& A, cv::KeyPoint* kb) {
+                 const pvb::slam::OrbExtractor& ex, cv::Point2f pa, const Eigen::Matrix2d& A,
+                 cv::KeyPoint* kb) {
   constexpr int kR = 4;  // 9x9 patch
   const int lb = kb->octave;
   const double sb = ex.level_scale(lb);
   // The first image's level whose scale matches the patch's size there.
   const double zoom = std::sqrt(std::abs(A.determinant()));
-  const int la = std::clamp(static_cast<int>(std::lround(lb + std::log(zoom) / std::log(ex.params().scale_factor))),
-                            0, ex.params().num_levels - 1);
+  const int la =
+      std::clamp(static_cast<int>(std::lround(lb + std::log(zoom) / std::log(ex.params().scale_factor))), 0,
+                 ex.params().num_levels - 1);
   const double sa = ex.level_scale(la);
   const Eigen::Matrix2d A_inv = A.inverse();
   std::vector<double> tmpl;
@@ -162,8 +165,8 @@ bool align_patch(const std::vector<cv::Mat>& pyr_a, const std::vector<cv::Mat>& 
     for (std::size_t i = 0; i < tmpl.size(); ++i) {
       const double x = c.x() + offsets[i].x(), y = c.y() + offsets[i].y();
       double xp = 0, xm = 0, yp = 0, ym = 0;
-      if (!bilinear(img, x + 0.5, y, &xp) || !bilinear(img, x - 0.5, y, &xm) || !bilinear(img, x, y + 0.5, &yp) ||
-          !bilinear(img, x, y - 0.5, &ym))
+      if (!bilinear(img, x + 0.5, y, &xp) || !bilinear(img, x - 0.5, y, &xm) ||
+          !bilinear(img, x, y + 0.5, &yp) || !bilinear(img, x, y - 0.5, &ym))
         return false;
       const Eigen::Vector2d grad(xp - xm, yp - ym);
       const double e = (cur[i] - c_mean) - (tmpl[i] - t_mean);
@@ -296,8 +299,9 @@ void run(const Options& o) {
       "residual RMS %.3f level px; pose from exact points: rotation RMS %.4f deg, position RMS %.2f mm\n",
       std::sqrt(all2 / all), std::sqrt(acc.rot2_deg / acc.pairs), 1e3 * std::sqrt(acc.pos2_m / acc.pairs));
   const Eigen::Vector3d rot_mean = acc.rot_sum_deg / acc.pairs, pos_mean = 1e3 * acc.pos_sum_m / acc.pairs;
-  std::printf("mean pose error (camera frame): rotation (%.4f, %.4f, %.4f) deg, position (%.2f, %.2f, %.2f) mm\n",
-              rot_mean.x(), rot_mean.y(), rot_mean.z(), pos_mean.x(), pos_mean.y(), pos_mean.z());
+  std::printf(
+      "mean pose error (camera frame): rotation (%.4f, %.4f, %.4f) deg, position (%.2f, %.2f, %.2f) mm\n",
+      rot_mean.x(), rot_mean.y(), rot_mean.z(), pos_mean.x(), pos_mean.y(), pos_mean.z());
   std::printf("per level:");
   for (int l = 0; l < 8; ++l)
     if (acc.count[l] > 0)

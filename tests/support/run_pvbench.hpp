@@ -59,7 +59,8 @@ inline bool wait_until(pid_t pid, const std::function<bool()>& ready, double tim
   while (!ready()) {
     int status = 0;
     if (waitpid(pid, &status, WNOHANG) == pid) return false;
-    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > timeout_s) return false;
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > timeout_s)
+      return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   return true;
