@@ -99,23 +99,24 @@ bool bilinear(const cv::Mat& img, double x, double y, double* value) {
   return true;
 }
 
-/// The grey pyramid the extractor builds (cv::resize, rounded level sizes).
-std::vector<cv::Mat> grey_pyramid(const cv::Mat& grey, const pvb::slam::OrbExtractor& ex) {
-  std::vector<cv::Mat> levels(static_cast<std::size_t>(ex.params().num_levels));
-  levels[0] = grey;
-  for (std::size_t l = 1; l < levels.size(); ++l) {
-    const double s = 1.0 / ex.level_scale(static_cast<int>(l));
-    cv::resize(
-        levels[l - 1], levels[l],
-        cv::Size(static_cast<int>(std::lround(grey.cols * s)), static_cast<int>(std::lround(grey.rows * s))),
-        0, 0, cv::INTER_LINEAR);
-  }
+/// Deep copies of the extractor's level images after an extract().
+std::vector<cv::Mat> copy_pyramid(const pvb::slam::OrbExtractor& ex) {
+  std::vector<cv::Mat> levels;
+  for (const cv::Mat& level : ex.pyramid()) levels.push_back(level.clone());
   return levels;
 }
 
-/// Level-l pixel of a level-0 position and back (the extractor's placement).
-double to_level(double x0, double scale) { return (x0 + 0.5) / scale - 0.5; }
-double from_level(double xl, double scale) { return (xl + 0.5) * scale - 0.5; }
+/// Level-l pixel of a level-0 position and back: the extractor's placement,
+/// level pixel x at level-0 (x + 0.5) * W0 / Wl - 0.5 (per axis).
+Eigen::Vector2d level_ratio(const std::vector<cv::Mat>& pyr, int l) {
+  return {static_cast<double>(pyr[0].cols) / pyr[l].cols, static_cast<double>(pyr[0].rows) / pyr[l].rows};
+}
+Eigen::Vector2d to_level(const Eigen::Vector2d& p0, const Eigen::Vector2d& ratio) {
+  return (p0.array() + 0.5) / ratio.array() - 0.5;
+}
+Eigen::Vector2d from_level(const Eigen::Vector2d& pl, const Eigen::Vector2d& ratio) {
+  return (pl.array() + 0.5) * ratio.array() - 0.5;
+}
 
 /// Moves `kb` (a keypoint of the second image, level-0 px) to where the
 /// patch of the first image around `pa` (level-0 px) lies.  A maps first-
@@ -127,22 +128,23 @@ bool align_patch(const std::vector<cv::Mat>& pyr_a, const std::vector<cv::Mat>& 
                  cv::KeyPoint* kb) {
   constexpr int kR = 4;  // 9x9 patch
   const int lb = kb->octave;
-  const double sb = ex.level_scale(lb);
+  const Eigen::Vector2d rb = level_ratio(pyr_b, lb);
   // The first image's level whose scale matches the patch's size there.
   const double zoom = std::sqrt(std::abs(A.determinant()));
   const int la =
       std::clamp(static_cast<int>(std::lround(lb + std::log(zoom) / std::log(ex.params().scale_factor))), 0,
                  ex.params().num_levels - 1);
-  const double sa = ex.level_scale(la);
+  const Eigen::Vector2d ra = level_ratio(pyr_a, la);
   const Eigen::Matrix2d A_inv = A.inverse();
   std::vector<double> tmpl;
   std::vector<Eigen::Vector2d> offsets;
   for (int dy = -kR; dy <= kR; ++dy)
     for (int dx = -kR; dx <= kR; ++dx) {
       const Eigen::Vector2d off_b(dx, dy);
-      const Eigen::Vector2d p0 = Eigen::Vector2d(pa.x, pa.y) + A_inv * (off_b * sb);
+      const Eigen::Vector2d p0 = Eigen::Vector2d(pa.x, pa.y) + A_inv * off_b.cwiseProduct(rb);
+      const Eigen::Vector2d q = to_level(p0, ra);
       double v = 0;
-      if (!bilinear(pyr_a[la], to_level(p0.x(), sa), to_level(p0.y(), sa), &v)) return false;
+      if (!bilinear(pyr_a[la], q.x(), q.y(), &v)) return false;
       tmpl.push_back(v);
       offsets.push_back(off_b);
     }
@@ -150,7 +152,7 @@ bool align_patch(const std::vector<cv::Mat>& pyr_a, const std::vector<cv::Mat>& 
   for (double v : tmpl) t_mean += v;
   t_mean /= static_cast<double>(tmpl.size());
   const cv::Mat& img = pyr_b[lb];
-  const Eigen::Vector2d start(to_level(kb->pt.x, sb), to_level(kb->pt.y, sb));
+  const Eigen::Vector2d start = to_level(Eigen::Vector2d(kb->pt.x, kb->pt.y), rb);
   Eigen::Vector2d c = start;
   std::vector<double> cur(tmpl.size());
   for (int it = 0; it < 10; ++it) {
@@ -179,8 +181,9 @@ bool align_patch(const std::vector<cv::Mat>& pyr_a, const std::vector<cv::Mat>& 
     if (step.norm() < 1e-3) break;
   }
   if ((c - start).norm() > 1.5) return false;
-  kb->pt.x = static_cast<float>(from_level(c.x(), sb));
-  kb->pt.y = static_cast<float>(from_level(c.y(), sb));
+  const Eigen::Vector2d p = from_level(c, rb);
+  kb->pt.x = static_cast<float>(p.x());
+  kb->pt.y = static_cast<float>(p.y());
   return true;
 }
 
@@ -219,15 +222,11 @@ void run(const Options& o) {
   const int n = std::min<int>(o.frames, static_cast<int>(reader.size_hint()));
   for (int k = 0; k + o.gap < n; k += o.step) {
     const pvb::sensor::RgbdFrame f0 = reader.load(k), f1 = reader.load(k + o.gap);
-    const pvb::slam::OrbFeatures a = extract(f0.rgb), b = extract(f1.rgb);
     std::vector<cv::Mat> pyr_a, pyr_b;
-    if (o.align_patches) {
-      cv::Mat grey_a, grey_b;
-      cv::cvtColor(f0.rgb, grey_a, cv::COLOR_RGB2GRAY);
-      cv::cvtColor(f1.rgb, grey_b, cv::COLOR_RGB2GRAY);
-      pyr_a = grey_pyramid(grey_a, extractor);
-      pyr_b = grey_pyramid(grey_b, extractor);
-    }
+    const pvb::slam::OrbFeatures a = extract(f0.rgb);
+    if (o.align_patches) pyr_a = copy_pyramid(extractor);
+    const pvb::slam::OrbFeatures b = extract(f1.rgb);
+    if (o.align_patches) pyr_b = copy_pyramid(extractor);
     const pvb::geom::SE3d T_w_c0 = T_w_c_of(f0.t_ns), T_c1_w = T_w_c_of(f1.t_ns).inverse();
     std::vector<Eigen::Vector3d> points_w;
     std::vector<pvb::slam::Observation> obs;

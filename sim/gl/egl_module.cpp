@@ -50,21 +50,16 @@ bool has_ext(const char* list, const char* name) {
 std::mutex g_displays_mutex;
 std::map<EGLDisplay, int> g_display_contexts;
 
-void retain_display(EGLDisplay dpy) {
+// Adds `delta` to the display's count of live contexts (+1 on create, -1 on
+// destroy, 0 after a failed create) and terminates it when none is left.
+void count_display_contexts(EGLDisplay dpy, int delta) {
   const std::lock_guard<std::mutex> lock(g_displays_mutex);
-  ++g_display_contexts[dpy];
-}
-
-// Drops one context's hold (retained == false: a failed create that held
-// none) and terminates the display when nothing holds it.
-void release_display(EGLDisplay dpy, bool retained) {
-  const std::lock_guard<std::mutex> lock(g_displays_mutex);
-  auto it = g_display_contexts.find(dpy);
-  if (retained && it != g_display_contexts.end() && --it->second == 0) {
-    g_display_contexts.erase(it);
-    it = g_display_contexts.end();
+  int& live = g_display_contexts[dpy];
+  live += delta;
+  if (live <= 0) {
+    g_display_contexts.erase(dpy);
+    eglTerminate(dpy);
   }
-  if (it == g_display_contexts.end()) eglTerminate(dpy);
 }
 
 // Tries to initialise a display; returns EGL_NO_DISPLAY on failure.
@@ -133,13 +128,13 @@ extern "C" void* pvb_gl_create(int width, int height, char* err, int err_len) {
     const EGLint any_attribs[] = {EGL_SURFACE_TYPE, 0, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
     if (eglChooseConfig(dpy, any_attribs, &config, 1, &n_configs) != EGL_TRUE || n_configs < 1) {
       set_err(err, err_len, "EGL (" + platform + "): no OpenGL config (error " + hex(eglGetError()) + ")");
-      release_display(dpy, false);
+      count_display_contexts(dpy, 0);
       return nullptr;
     }
   }
   if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE) {
     set_err(err, err_len, "EGL (" + platform + "): desktop OpenGL API unavailable");
-    release_display(dpy, false);
+    count_display_contexts(dpy, 0);
     return nullptr;
   }
   // MuJoCo 2.2.2 uses fixed-function GL: ask for a compatibility profile.
@@ -149,17 +144,17 @@ extern "C" void* pvb_gl_create(int width, int height, char* err, int err_len) {
   if (ctx == EGL_NO_CONTEXT) ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, nullptr);
   if (ctx == EGL_NO_CONTEXT) {
     set_err(err, err_len, "EGL (" + platform + "): cannot create a context (error " + hex(eglGetError()) + ")");
-    release_display(dpy, false);
+    count_display_contexts(dpy, 0);
     return nullptr;
   }
   if (eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx) != EGL_TRUE) {
     set_err(err, err_len,
             "EGL (" + platform + "): cannot make a surfaceless context current (error " + hex(eglGetError()) + ")");
     eglDestroyContext(dpy, ctx);
-    release_display(dpy, false);
+    count_display_contexts(dpy, 0);
     return nullptr;
   }
-  retain_display(dpy);
+  count_display_contexts(dpy, +1);
   auto* c = new EglContext{dpy, ctx, {}};
   auto get_string = reinterpret_cast<const GLubyte* (*)(GLenum)>(eglGetProcAddress("glGetString"));
   const char* vendor = get_string ? reinterpret_cast<const char*>(get_string(GL_VENDOR)) : nullptr;
@@ -179,7 +174,7 @@ extern "C" void pvb_gl_destroy(void* h) {
   if (eglGetCurrentContext() == c->context)
     eglMakeCurrent(c->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   eglDestroyContext(c->display, c->context);
-  release_display(c->display, true);
+  count_display_contexts(c->display, -1);
   delete c;
 }
 

@@ -385,11 +385,13 @@ OrbFeatures OrbExtractor::extract(const cv::Mat& image) {
         // Orientation and descriptor stay at the whole pixel; only the
         // position moves.  FAST keeps 3 px off its 16 px-inset detection
         // area, so the 3x3 neighbourhood's circles stay inside the level.
+        // The centre's score is the corner's own FAST response.
         const int x = cvRound(kp.pt.x), y = cvRound(kp.pt.y);
         float score[3][3];
         for (int dy = -1; dy <= 1; ++dy)
           for (int dx = -1; dx <= 1; ++dx)
-            score[dy + 1][dx + 1] = static_cast<float>(fast9_score(level, x + dx, y + dy));
+            score[dy + 1][dx + 1] =
+                dx == 0 && dy == 0 ? kp.response : static_cast<float>(fast9_score(level, x + dx, y + dy));
         const cv::Point2f off = quadratic_peak_offset(score);
         kp.pt.x += off.x;
         kp.pt.y += off.y;

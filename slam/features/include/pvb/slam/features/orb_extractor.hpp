@@ -57,6 +57,10 @@ class OrbExtractor {
 
   const OrbParams& params() const { return params_; }
 
+  /// The level images of the last extract() (level 0 is the grey input);
+  /// views into buffers that the next extract() overwrites.
+  const std::vector<cv::Mat>& pyramid() const { return pyramid_; }
+
  private:
   void build_pyramid(const cv::Mat& grey);
   std::vector<cv::KeyPoint> detect_level(int level, int num_wanted) const;
