@@ -84,7 +84,8 @@ void BM_TrackFrame(benchmark::State& state, const std::string& dir) {
   options.synchronous = true;
   std::unique_ptr<pvb::slam::System> system;
   std::size_t next = 0;
-  std::vector<double> tracking_ms, orb_ms, pe_ms, cpu_ms;
+  std::vector<double> tracking_ms, orb_ms, pe_ms, cpu_ms, align_ms;
+  double tried = 0, aligned = 0;
   int lost = 0;
   for (auto _ : state) {
     if (!system || next == frames) {
@@ -100,11 +101,16 @@ void BM_TrackFrame(benchmark::State& state, const std::string& dir) {
     orb_ms.push_back(r.orb_ms);
     if (r.tracking.method == pvb::slam::TrackingMethod::kMotionModel) pe_ms.push_back(r.tracking.pe_match_ms);
     lost += r.state == pvb::slam::TrackingState::kLost;
+    align_ms.push_back(r.tracking.align_ms);
+    tried += r.tracking.align_tried;
+    aligned += r.tracking.aligned;
   }
   state.counters["median_ms"] = median(tracking_ms);
   state.counters["cpu_median_ms"] = median(cpu_ms);
   state.counters["orb_median_ms"] = median(orb_ms);
   state.counters["pe_median_ms"] = median(pe_ms);
+  state.counters["align_median_ms"] = median(align_ms);
+  state.counters["aligned_share"] = tried > 0 ? aligned / tried : 0.0;
   state.counters["lost"] = lost;
 }
 

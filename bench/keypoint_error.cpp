@@ -39,6 +39,7 @@
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/features/orb_extractor.hpp"
+#include "pvb/slam/features/patch_align.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
 
 namespace {
@@ -86,106 +87,12 @@ struct Accumulator {
   double rot2_deg = 0, pos2_m = 0;
   Eigen::Vector3d rot_sum_deg = Eigen::Vector3d::Zero(), pos_sum_m = Eigen::Vector3d::Zero();
   int pairs = 0;
+  // Pairs whose ground-truth rotation exceeds kTurnDeg: a bias that only
+  // turns show (e.g. a camera mounted differently from its ground truth).
+  Eigen::Vector3d turn_rot_sum_deg = Eigen::Vector3d::Zero(), turn_gt_sum_deg = Eigen::Vector3d::Zero();
+  int turn_pairs = 0;
 };
-
-/// Bilinear grey value at (x, y); false outside the image.
-bool bilinear(const cv::Mat& img, double x, double y, double* value) {
-  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= img.cols || y0 + 1 >= img.rows) return false;
-  const double fx = x - x0, fy = y - y0;
-  const uchar* r0 = img.ptr<uchar>(y0) + x0;
-  const uchar* r1 = img.ptr<uchar>(y0 + 1) + x0;
-  *value = (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) + fy * ((1 - fx) * r1[0] + fx * r1[1]);
-  return true;
-}
-
-/// Deep copies of the extractor's level images after an extract().
-std::vector<cv::Mat> copy_pyramid(const pvb::slam::OrbExtractor& ex) {
-  std::vector<cv::Mat> levels;
-  for (const cv::Mat& level : ex.pyramid()) levels.push_back(level.clone());
-  return levels;
-}
-
-/// Level-l pixel of a level-0 position and back: the extractor's placement,
-/// level pixel x at level-0 (x + 0.5) * W0 / Wl - 0.5 (per axis).
-Eigen::Vector2d level_ratio(const std::vector<cv::Mat>& pyr, int l) {
-  return {static_cast<double>(pyr[0].cols) / pyr[l].cols, static_cast<double>(pyr[0].rows) / pyr[l].rows};
-}
-Eigen::Vector2d to_level(const Eigen::Vector2d& p0, const Eigen::Vector2d& ratio) {
-  return (p0.array() + 0.5) / ratio.array() - 0.5;
-}
-Eigen::Vector2d from_level(const Eigen::Vector2d& pl, const Eigen::Vector2d& ratio) {
-  return (pl.array() + 0.5) * ratio.array() - 0.5;
-}
-
-/// Moves `kb` (a keypoint of the second image, level-0 px) to where the
-/// patch of the first image around `pa` (level-0 px) lies.  A maps first-
-/// image offsets to second-image offsets (level-0 px) at the point.
-/// Returns false (kb unchanged) when the patch leaves an image, the
-/// alignment does not converge or it moves more than 1.5 level px.
-bool align_patch(const std::vector<cv::Mat>& pyr_a, const std::vector<cv::Mat>& pyr_b,
-                 const pvb::slam::OrbExtractor& ex, cv::Point2f pa, const Eigen::Matrix2d& A,
-                 cv::KeyPoint* kb) {
-  constexpr int kR = 4;  // 9x9 patch
-  const int lb = kb->octave;
-  const Eigen::Vector2d rb = level_ratio(pyr_b, lb);
-  // The first image's level whose scale matches the patch's size there.
-  const double zoom = std::sqrt(std::abs(A.determinant()));
-  const int la =
-      std::clamp(static_cast<int>(std::lround(lb + std::log(zoom) / std::log(ex.params().scale_factor))), 0,
-                 ex.params().num_levels - 1);
-  const Eigen::Vector2d ra = level_ratio(pyr_a, la);
-  const Eigen::Matrix2d A_inv = A.inverse();
-  std::vector<double> tmpl;
-  std::vector<Eigen::Vector2d> offsets;
-  for (int dy = -kR; dy <= kR; ++dy)
-    for (int dx = -kR; dx <= kR; ++dx) {
-      const Eigen::Vector2d off_b(dx, dy);
-      const Eigen::Vector2d p0 = Eigen::Vector2d(pa.x, pa.y) + A_inv * off_b.cwiseProduct(rb);
-      const Eigen::Vector2d q = to_level(p0, ra);
-      double v = 0;
-      if (!bilinear(pyr_a[la], q.x(), q.y(), &v)) return false;
-      tmpl.push_back(v);
-      offsets.push_back(off_b);
-    }
-  double t_mean = 0;
-  for (double v : tmpl) t_mean += v;
-  t_mean /= static_cast<double>(tmpl.size());
-  const cv::Mat& img = pyr_b[lb];
-  const Eigen::Vector2d start = to_level(Eigen::Vector2d(kb->pt.x, kb->pt.y), rb);
-  Eigen::Vector2d c = start;
-  std::vector<double> cur(tmpl.size());
-  for (int it = 0; it < 10; ++it) {
-    double c_mean = 0;
-    for (std::size_t i = 0; i < tmpl.size(); ++i) {
-      if (!bilinear(img, c.x() + offsets[i].x(), c.y() + offsets[i].y(), &cur[i])) return false;
-      c_mean += cur[i];
-    }
-    c_mean /= static_cast<double>(tmpl.size());
-    Eigen::Matrix2d H = Eigen::Matrix2d::Zero();
-    Eigen::Vector2d g = Eigen::Vector2d::Zero();
-    for (std::size_t i = 0; i < tmpl.size(); ++i) {
-      const double x = c.x() + offsets[i].x(), y = c.y() + offsets[i].y();
-      double xp = 0, xm = 0, yp = 0, ym = 0;
-      if (!bilinear(img, x + 0.5, y, &xp) || !bilinear(img, x - 0.5, y, &xm) ||
-          !bilinear(img, x, y + 0.5, &yp) || !bilinear(img, x, y - 0.5, &ym))
-        return false;
-      const Eigen::Vector2d grad(xp - xm, yp - ym);
-      const double e = (cur[i] - c_mean) - (tmpl[i] - t_mean);
-      H += grad * grad.transpose();
-      g += grad * e;
-    }
-    const Eigen::Vector2d step = -H.ldlt().solve(g);
-    if (!step.allFinite()) return false;
-    c += step;
-    if (step.norm() < 1e-3) break;
-  }
-  if ((c - start).norm() > 1.5) return false;
-  const Eigen::Vector2d p = from_level(c, rb);
-  kb->pt.x = static_cast<float>(p.x());
-  kb->pt.y = static_cast<float>(p.y());
-  return true;
-}
+constexpr double kTurnDeg = 1.5;
 
 void run(const Options& o) {
   const pvb::slam::Settings settings = pvb::slam::read_settings(o.dir + "/camera.yaml");
@@ -222,11 +129,11 @@ void run(const Options& o) {
   const int n = std::min<int>(o.frames, static_cast<int>(reader.size_hint()));
   for (int k = 0; k + o.gap < n; k += o.step) {
     const pvb::sensor::RgbdFrame f0 = reader.load(k), f1 = reader.load(k + o.gap);
-    std::vector<cv::Mat> pyr_a, pyr_b;
+    pvb::slam::ImagePyramid pyr_a, pyr_b;
     const pvb::slam::OrbFeatures a = extract(f0.rgb);
-    if (o.align_patches) pyr_a = copy_pyramid(extractor);
+    if (o.align_patches) pyr_a = pvb::slam::copy_pyramid(extractor.pyramid());
     const pvb::slam::OrbFeatures b = extract(f1.rgb);
-    if (o.align_patches) pyr_b = copy_pyramid(extractor);
+    if (o.align_patches) pyr_b = pvb::slam::copy_pyramid(extractor.pyramid());
     const pvb::geom::SE3d T_w_c0 = T_w_c_of(f0.t_ns), T_c1_w = T_w_c_of(f1.t_ns).inverse();
     std::vector<Eigen::Vector3d> points_w;
     std::vector<pvb::slam::Observation> obs;
@@ -260,7 +167,13 @@ void run(const Options& o) {
         Eigen::Matrix2d A;
         A.col(0) = 0.5 * (project_b(ka.pt.x + 1, ka.pt.y) - project_b(ka.pt.x - 1, ka.pt.y));
         A.col(1) = 0.5 * (project_b(ka.pt.x, ka.pt.y + 1) - project_b(ka.pt.x, ka.pt.y - 1));
-        align_patch(pyr_a, pyr_b, extractor, ka.pt, A, &kb);
+        pvb::slam::PatchAlignParams pa;
+        pa.scale_factor = extractor.params().scale_factor;
+        pa.min_eigen_ratio = 0;  // as before the SLAM version: edges too
+        Eigen::Vector2d aligned;
+        if (pvb::slam::align_patch(pyr_a, {ka.pt.x, ka.pt.y}, A, pyr_b, kb.octave, {kb.pt.x, kb.pt.y}, pa,
+                                   &aligned))
+          kb.pt = cv::Point2f(static_cast<float>(aligned.x()), static_cast<float>(aligned.y()));
       }
       const double scale = extractor.level_scale(kb.octave);
       const Eigen::Vector2d r = (Eigen::Vector2d(kb.pt.x, kb.pt.y) - uv) / scale;
@@ -286,6 +199,12 @@ void run(const Options& o) {
     acc.pos2_m += dp_w.squaredNorm();
     acc.pos_sum_m += T_c1_w.linear() * dp_w;  // in the camera frame: x right, y down, z forward
     ++acc.pairs;
+    const Eigen::AngleAxisd gt_rel((T_c1_w * T_w_c0).linear());  // frame k in frame k + gap
+    if (gt_rel.angle() * 180.0 / M_PI > kTurnDeg) {
+      acc.turn_rot_sum_deg += aa.axis() * rot_deg;
+      acc.turn_gt_sum_deg += gt_rel.axis() * gt_rel.angle() * 180.0 / M_PI;
+      ++acc.turn_pairs;
+    }
   }
   if (acc.pairs == 0) throw pvb::Error(o.dir + ": no frame pair with 30 matches");
   double all2 = 0;
@@ -301,6 +220,12 @@ void run(const Options& o) {
   std::printf(
       "mean pose error (camera frame): rotation (%.4f, %.4f, %.4f) deg, position (%.2f, %.2f, %.2f) mm\n",
       rot_mean.x(), rot_mean.y(), rot_mean.z(), pos_mean.x(), pos_mean.y(), pos_mean.z());
+  if (acc.turn_pairs > 0) {
+    const Eigen::Vector3d e = acc.turn_rot_sum_deg / acc.turn_pairs, g = acc.turn_gt_sum_deg / acc.turn_pairs;
+    std::printf("%d pairs turning over %.1f deg (mean rotation (%.2f, %.2f, %.2f) deg): mean rotation error "
+                "(%.4f, %.4f, %.4f) deg\n",
+                acc.turn_pairs, kTurnDeg, g.x(), g.y(), g.z(), e.x(), e.y(), e.z());
+  }
   std::printf("per level:");
   for (int l = 0; l < 8; ++l)
     if (acc.count[l] > 0)

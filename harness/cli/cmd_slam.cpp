@@ -172,7 +172,7 @@ int run_slam(const SlamArgs& a) {
   cam_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
   kf_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
   timing << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,inliers,keyframe,"
-            "mapping_ms,cpu_ms\n";
+            "mapping_ms,cpu_ms,align_tried,aligned,align_ms\n";
 
   std::unique_ptr<MotionMatchScorer> scorer;
   if (a.dump_matches) {
@@ -218,7 +218,8 @@ int run_slam(const SlamArgs& a) {
            << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << "," << fmt(r.tracking_ms)
            << "," << fmt(r.orb_ms) << "," << fmt(r.tracking.pe_match_ms) << "," << r.tracking.coarse_matches << ","
            << r.tracking.matches_kept << "," << r.tracking.inliers << "," << (r.tracking.new_keyframe ? 1 : 0)
-           << "," << fmt(r.mapping_ms) << "," << fmt(cpu_ms) << "\n"
+           << "," << fmt(r.mapping_ms) << "," << fmt(cpu_ms) << "," << r.tracking.align_tried << ","
+           << r.tracking.aligned << "," << fmt(r.tracking.align_ms) << "\n"
            << std::flush;
     if (scorer) scorer->add(*frame, r);
     bar.update(frames, slam::to_string(r.state));

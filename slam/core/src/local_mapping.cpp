@@ -6,6 +6,7 @@
 #include <set>
 
 #include "pvb/slam/core/matcher.hpp"
+#include "pvb/slam/core/patch_refine.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
 #include "pvb/common/threads.hpp"
 
@@ -102,6 +103,10 @@ void LocalMapping::process(const std::shared_ptr<KeyFrame>& kf) {
     cull_recent_points(kf);
     create_new_points(kf);
     if (queue_.size() == 0) fuse_with_neighbors(kf);
+    if (options_.align_patches) {
+      align_keyframe_observations(*kf, options_.patch_align);
+      for (const auto& k : kf->best_covisibles(-1)) align_keyframe_observations(*k, options_.patch_align);
+    }
   }
   if (queue_.size() == 0) {
     if (options_.local_ba) local_bundle_adjustment(kf);

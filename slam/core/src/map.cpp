@@ -246,6 +246,7 @@ bool KeyFrame::set_bad() {
     if (auto mp = frame_.map_points[i]) mp->erase_observation(id_);
   connections_.clear();
   ordered_.clear();
+  frame_.pyramid.reset();  // no longer a patch reference
 
   // Re-attach the children (ORB-SLAM2): repeatedly pick the child with the
   // strongest covisibility link to a keyframe already in the candidate

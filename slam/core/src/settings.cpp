@@ -93,6 +93,7 @@ Settings read_settings(const std::string& path) {
   s.orb.ini_fast_threshold = r.integer("ORBextractor.iniThFAST", true, 0);
   s.orb.min_fast_threshold = r.integer("ORBextractor.minThFAST", true, 0);
   s.orb.sub_pixel = r.flag("ORBextractor.subPixel", s.orb.sub_pixel);  // ours, optional
+  s.align_patches = r.flag("Tracking.alignPatches", s.align_patches);   // ours, optional
   r.positive("ORBextractor.nFeatures", s.orb.num_features);
   if (!(s.orb.scale_factor > 1.0))
     throw ConfigError(path, "ORBextractor.scaleFactor", "a value > 1", std::to_string(s.orb.scale_factor));

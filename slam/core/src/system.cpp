@@ -36,8 +36,13 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.max_frames = static_cast<int>(settings.fps);
   topt.kf_min_tracked_close = settings.keyframe.min_tracked_close;
   topt.kf_min_untracked_close = settings.keyframe.min_untracked_close;
+  topt.align_patches = settings.align_patches;
+  topt.patch_align.scale_factor = settings.orb.scale_factor;
   tracking_ = std::make_unique<Tracking>(map_, cam_, topt);
-  mapping_ = std::make_unique<LocalMapping>(map_, cam_);
+  LocalMappingOptions mopt;
+  mopt.align_patches = settings.align_patches;
+  mopt.patch_align = topt.patch_align;
+  mapping_ = std::make_unique<LocalMapping>(map_, cam_, mopt);
   if (settings.loop.enabled) {
     loop_ = std::make_unique<LoopClosing>(map_, settings.loop);
     mapping_->set_after_keyframe([this](const std::shared_ptr<KeyFrame>& kf) { loop_->process(kf); });
@@ -73,6 +78,7 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
   out.num_features = static_cast<int>(features.keypoints.size());
   out.orb_ms = ms_since(t0);
   Frame frame(next_frame_id_++, in.t_ns, std::move(features), in.depth_m, cam_);
+  if (settings_.align_patches) frame.pyramid = std::make_shared<const ImagePyramid>(copy_pyramid(extractor_.pyramid()));
   std::shared_ptr<KeyFrame> kf = tracking_->track(std::move(frame), mapping_->idle(), mapping_->queue_size());
   out.tracking_ms = ms_since(t0);
   out.state = tracking_->state();

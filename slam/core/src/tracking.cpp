@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "pvb/slam/core/patch_refine.hpp"
+
 namespace pvb::slam {
 
 const char* to_string(TrackingState s) {
@@ -398,6 +400,11 @@ bool Tracking::track_local_map(Frame& f) {
   }
   const double th = f.id < last_reloc_frame_id_ + 2 ? 5.0 : 3.0;
   search_local_points(f, proj, th);
+  if (options_.align_patches && f.pyramid) {
+    const auto t0 = std::chrono::steady_clock::now();
+    align_matches(f);
+    stats_.align_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
   optimize_frame_pose(f);
   matches_inliers_ = 0;
   for (std::size_t i = 0; i < f.size(); ++i) {
@@ -414,6 +421,15 @@ bool Tracking::track_local_map(Frame& f) {
   if (matches_inliers_ < 30)
     return fail("local map: only " + std::to_string(matches_inliers_) + " inliers after pose optimisation (need 30)");
   return true;
+}
+
+void Tracking::align_matches(Frame& f) {
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    const auto& mp = f.map_points[i];
+    if (!mp || mp->bad() || mp->num_observations() < 1) continue;
+    ++stats_.align_tried;
+    if (align_to_reference(f, i, *mp, options_.patch_align)) ++stats_.aligned;
+  }
 }
 
 bool Tracking::need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue) const {

@@ -103,6 +103,19 @@ TEST(Settings, ReadsOrbSubPixelFlag) {
   }
 }
 
+TEST(Settings, ReadsTrackingAlignPatchesFlag) {
+  EXPECT_TRUE(read_settings(kTum1).align_patches);  // absent: on
+  const Settings s = read_settings(temp_copy("align", read_file(kTum1) + "\nTracking.alignPatches: 0\n"));
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_FALSE(s.align_patches);
+  try {
+    read_settings(temp_copy("alignbad", read_file(kTum1) + "\nTracking.alignPatches: yes\n"));
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "Tracking.alignPatches");
+  }
+}
+
 TEST(Settings, ReadsLoopClosingSection) {
   const Settings d = read_settings(kTum1);  // absent: on, with the documented defaults
   EXPECT_TRUE(d.loop.enabled);

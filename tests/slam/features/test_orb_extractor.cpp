@@ -10,6 +10,7 @@
 
 #include "pvb/slam/features/coarse_match.hpp"
 #include "pvb/slam/features/orb_extractor.hpp"
+#include "texture.hpp"
 
 namespace pvb::slam {
 namespace {
@@ -28,25 +29,6 @@ cv::Matx33d load_h(const std::string& path) {
   for (int i = 0; i < 9; ++i) f >> H.val[i];
   EXPECT_TRUE(f.good() || f.eof()) << path;
   return H;
-}
-
-/// A 4x-oversampled test texture: 2500 anti-aliased grey rectangles at
-/// random positions, sizes and angles (box-filtering it down gives views
-/// whose pixel mapping is known exactly).
-cv::Mat random_rectangles(int width, int height, std::uint64_t seed) {
-  cv::Mat master(height, width, CV_8U, cv::Scalar(128));
-  cv::RNG rng(seed);
-  for (int i = 0; i < 2500; ++i) {
-    const cv::Point2f c(rng.uniform(0.f, static_cast<float>(master.cols)),
-                        rng.uniform(0.f, static_cast<float>(master.rows)));
-    const cv::Size2f sz(rng.uniform(12.f, 160.f), rng.uniform(12.f, 160.f));
-    cv::Point2f corners[4];
-    cv::RotatedRect(c, sz, rng.uniform(0.f, 180.f)).points(corners);
-    std::vector<cv::Point> poly;
-    for (const auto& p : corners) poly.emplace_back(cvRound(p.x * 16), cvRound(p.y * 16));
-    cv::fillConvexPoly(master, poly, cv::Scalar(rng.uniform(0, 256)), cv::LINE_AA, 4);
-  }
-  return master;
 }
 
 TEST(OrbExtractor, AtMostThousandWellDistributedFeatures) {

@@ -12,6 +12,7 @@
 
 #include "pvb/geometry/se3.hpp"
 #include "pvb/slam/features/orb_extractor.hpp"
+#include "pvb/slam/features/patch_align.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
 
 namespace pvb::slam {
@@ -86,6 +87,14 @@ class Frame {
   std::vector<std::uint8_t> outlier;  ///< per keypoint, set by pose optimisation
   geom::SE3d T_c_w = geom::SE3d::Identity();
   bool has_pose = false;
+  /// The grey image pyramid (raw, distorted pixels), for aligning matches
+  /// to keyframe patches; null when patch alignment is off.  Shared, never
+  /// modified.
+  std::shared_ptr<const ImagePyramid> pyramid;
+  /// Per keypoint, the id of the map point its patch alignment was last
+  /// tried for (kNotAligned: never; may be empty = none tried).
+  static constexpr std::uint64_t kNotAligned = ~std::uint64_t(0);
+  std::vector<std::uint64_t> aligned_for;
 
  private:
   std::vector<std::vector<std::uint32_t>> grid_;  ///< keypoint indices per cell, row-major

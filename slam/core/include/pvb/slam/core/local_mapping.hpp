@@ -18,6 +18,7 @@
 
 #include "pvb/common/closable_queue.hpp"
 #include "pvb/slam/core/map.hpp"
+#include "pvb/slam/features/patch_align.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
 
 namespace pvb::slam {
@@ -27,6 +28,12 @@ struct LocalMappingOptions {
   double redundant_ratio = 0.9;          ///< keyframe culling: share of points seen by >= 3 others
   int redundant_observers = 3;
   bool local_ba = true;
+  /// Before local BA, align the observations of the new keyframe and its
+  /// covisible keyframes not yet aligned (those that fusion and
+  /// triangulation added) to their points' reference patches
+  /// (patch_refine.hpp); the tracker aligns the rest.
+  bool align_patches = false;
+  PatchAlignParams patch_align;
 };
 
 /// Map-point culling rule (ORB-SLAM2 MapPointCulling, RGB-D): returns

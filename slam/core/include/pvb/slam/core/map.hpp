@@ -100,6 +100,9 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   std::uint64_t frame_id() const { return frame_.id; }
   std::int64_t t_ns() const { return frame_.t_ns; }
   const Frame& frame() const { return frame_; }
+  /// Write access for patch alignment of its keypoints only
+  /// (align_keyframe_observations), under the map lock.
+  Frame& frame_for_alignment() { return frame_; }
   const geom::SE3d& T_c_w() const { return frame_.T_c_w; }
   void set_T_c_w(const geom::SE3d& T) { frame_.T_c_w = T; }
   Eigen::Vector3d camera_center_w() const { return frame_.camera_center_w(); }

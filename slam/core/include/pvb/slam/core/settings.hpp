@@ -68,6 +68,10 @@ struct Settings {
   double th_depth = 40.0;           ///< ThDepth: close/far threshold in baselines
   double depth_map_factor = 5000.0; ///< DepthMapFactor: raw depth units per metre
   OrbParams orb;                    ///< ORBextractor.*
+  /// Tracking.alignPatches (0/1, ours, optional): align map-point matches
+  /// to their reference keyframe's patch before the local-map pose
+  /// optimisation (TrackingOptions::align_patches).
+  bool align_patches = true;
   PeMatchSettings pe_match;         ///< PEMatch.* (optional section)
   KeyFrameSettings keyframe;        ///< KeyFrame.* (optional section)
   PointCloudMappingSettings dense;  ///< PointCloudMapping.* (optional section)

@@ -36,6 +36,9 @@ struct TrackingStats {
   double translation_parallax_px = 0;
   bool pe_skipped = false;
   int inliers = 0;              ///< map-point inliers after the local-map optimisation
+  int align_tried = 0;          ///< map-point matches patch alignment was tried on
+  int aligned = 0;              ///< of those, the ones it moved (the others keep the keypoint)
+  double align_ms = 0;          ///< time in patch alignment
   bool new_keyframe = false;
   /// The motion model's coarse matches (empty when it did not run), for
   /// scoring PE-match against ground truth: pixel pairs (last frame,
@@ -74,6 +77,12 @@ struct TrackingOptions {
   int min_frames = 0;
   int kf_min_tracked_close = 200;    ///< KeyFrame.minTrackedClose (ORB-SLAM2: 100)
   int kf_min_untracked_close = 70;   ///< KeyFrame.minUntrackedClose
+  /// Beyond ORB-SLAM2: before the local-map pose optimisation, move each
+  /// map-point match to where the point's reference-keyframe patch,
+  /// warped by the predicted pose, aligns (needs Frame::pyramid; frames
+  /// without one are not aligned).  docs/slam.md, "Patch alignment".
+  bool align_patches = true;
+  PatchAlignParams patch_align;
 };
 
 /// "Already seen in this pass" marks for map-point ids: a pass stamp per
@@ -122,6 +131,8 @@ class Tracking {
   bool track_reference_keyframe(Frame& f);
   bool relocalize(Frame& f);
   bool track_local_map(Frame& f);
+  /// Patch alignment of f's map-point matches at its current pose.
+  void align_matches(Frame& f);
   void update_last_frame();
   void update_local_map(const Frame& f);
   bool need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue) const;

@@ -1,0 +1,146 @@
+#include "pvb/slam/features/patch_align.hpp"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+
+namespace pvb::slam {
+namespace {
+
+/// Bilinear sample of a CV_8U image; false outside [0, cols-1) x [0, rows-1).
+bool bilinear(const cv::Mat& img, double x, double y, double* value) {
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= img.cols || y0 + 1 >= img.rows) return false;
+  const double fx = x - x0, fy = y - y0;
+  const uchar* r0 = img.ptr<uchar>(y0) + x0;
+  const uchar* r1 = img.ptr<uchar>(y0 + 1) + x0;
+  *value = (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) + fy * ((1 - fx) * r1[0] + fx * r1[1]);
+  return true;
+}
+
+/// Level-0 px per level px, per axis.
+Eigen::Vector2d level_ratio(const ImagePyramid& pyr, int l) {
+  return {static_cast<double>(pyr[0].cols) / pyr[static_cast<std::size_t>(l)].cols,
+          static_cast<double>(pyr[0].rows) / pyr[static_cast<std::size_t>(l)].rows};
+}
+Eigen::Vector2d to_level(const Eigen::Vector2d& p0, const Eigen::Vector2d& ratio) {
+  return (p0.array() + 0.5) / ratio.array() - 0.5;
+}
+Eigen::Vector2d from_level(const Eigen::Vector2d& pl, const Eigen::Vector2d& ratio) {
+  return (pl.array() + 0.5) * ratio.array() - 0.5;
+}
+
+}  // namespace
+
+ImagePyramid copy_pyramid(const std::vector<cv::Mat>& levels) {
+  ImagePyramid out;
+  out.reserve(levels.size());
+  for (const cv::Mat& level : levels) out.push_back(level.clone());
+  return out;
+}
+
+bool align_patch(const ImagePyramid& ref, const Eigen::Vector2d& p_ref, const Eigen::Matrix2d& A_cur_ref,
+                 const ImagePyramid& cur, int level_cur, const Eigen::Vector2d& p_cur_start,
+                 const PatchAlignParams& params, Eigen::Vector2d* p_cur) {
+  const int num_levels = static_cast<int>(std::min(ref.size(), cur.size()));
+  if (level_cur < 0 || level_cur >= num_levels) return false;
+  const double det = A_cur_ref.determinant();
+  if (!(std::abs(det) > 1e-6) || !A_cur_ref.allFinite()) return false;
+  const int R = params.half_size;
+  const int W = 2 * R + 1;       // patch width
+  const int WT = W + 2;          // template width: one more ring for its gradient
+  const Eigen::Vector2d rb = level_ratio(cur, level_cur);
+  // A current-level pixel spans |A^-1| * rb reference level-0 px: the
+  // reference level whose pixels are that size.
+  const double zoom = std::sqrt(std::abs(det));
+  const int la = std::clamp(
+      static_cast<int>(std::lround(level_cur - std::log(zoom) / std::log(params.scale_factor))), 0,
+      num_levels - 1);
+  const Eigen::Vector2d ra = level_ratio(ref, la);
+  const Eigen::Matrix2d A_inv = A_cur_ref.inverse();
+  const cv::Mat& ref_img = ref[static_cast<std::size_t>(la)];
+
+  // Template on the current level's pixel grid: T(dx, dy) for offsets in
+  // [-R-1, R+1]^2 current-level px, sampled from the reference level.
+  double tmpl[(2 * 16 + 3) * (2 * 16 + 3)];
+  if (R < 1 || R > 16) return false;
+  // Reference-level position of offset (dx, dy): q0 + dx ex + dy ey.
+  const Eigen::Vector2d q0 = to_level(p_ref, ra);
+  const Eigen::Vector2d ex = (A_inv.col(0) * rb.x()).cwiseQuotient(ra);
+  const Eigen::Vector2d ey = (A_inv.col(1) * rb.y()).cwiseQuotient(ra);
+  for (int dy = -R - 1; dy <= R + 1; ++dy) {
+    const Eigen::Vector2d row = q0 + dy * ey;
+    for (int dx = -R - 1; dx <= R + 1; ++dx) {
+      const double qx = row.x() + dx * ex.x(), qy = row.y() + dx * ex.y();
+      if (!bilinear(ref_img, qx, qy, &tmpl[(dy + R + 1) * WT + (dx + R + 1)])) return false;
+    }
+  }
+  // Mean-subtracted template and its gradients on the inner W x W patch.
+  const int n = W * W;
+  double t[33 * 33], gx[33 * 33], gy[33 * 33];
+  double t_mean = 0, gx_mean = 0, gy_mean = 0;
+  for (int y = 0; y < W; ++y)
+    for (int x = 0; x < W; ++x) {
+      const int k = y * W + x, c = (y + 1) * WT + (x + 1);
+      t[k] = tmpl[c];
+      gx[k] = 0.5 * (tmpl[c + 1] - tmpl[c - 1]);
+      gy[k] = 0.5 * (tmpl[c + WT] - tmpl[c - WT]);
+      t_mean += t[k], gx_mean += gx[k], gy_mean += gy[k];
+    }
+  t_mean /= n, gx_mean /= n, gy_mean /= n;
+  Eigen::Matrix2d H = Eigen::Matrix2d::Zero();
+  for (int k = 0; k < n; ++k) {
+    t[k] -= t_mean;
+    gx[k] -= gx_mean;  // the gradient of the mean-subtracted patch
+    gy[k] -= gy_mean;
+    H(0, 0) += gx[k] * gx[k];
+    H(0, 1) += gx[k] * gy[k];
+    H(1, 1) += gy[k] * gy[k];
+  }
+  H(1, 0) = H(0, 1);
+  // Eigenvalues of the symmetric 2x2 H in closed form.
+  const double half_trace = 0.5 * (H(0, 0) + H(1, 1));
+  const double root = std::sqrt(0.25 * (H(0, 0) - H(1, 1)) * (H(0, 0) - H(1, 1)) + H(0, 1) * H(0, 1));
+  const double ev_min = half_trace - root, ev_max = half_trace + root;
+  if (!(ev_max > 0) || !(ev_min > params.min_eigen_ratio * ev_max)) return false;
+  const Eigen::Matrix2d H_inv = H.inverse();
+
+  const cv::Mat& img = cur[static_cast<std::size_t>(level_cur)];
+  const Eigen::Vector2d start = to_level(p_cur_start, rb);
+  Eigen::Vector2d c = start;
+  double cur_px[33 * 33];
+  for (int it = 0; it < params.max_iterations; ++it) {
+    // Integer offsets: every sample shares the same bilinear weights.
+    const int x0 = static_cast<int>(std::floor(c.x())) - R, y0 = static_cast<int>(std::floor(c.y())) - R;
+    if (x0 < 0 || y0 < 0 || x0 + W >= img.cols || y0 + W >= img.rows) return false;
+    const double fx = c.x() - std::floor(c.x()), fy = c.y() - std::floor(c.y());
+    const double w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
+    double c_mean = 0;
+    for (int y = 0; y < W; ++y) {
+      const uchar* r0 = img.ptr<uchar>(y0 + y) + x0;
+      const uchar* r1 = r0 + img.step[0];
+      for (int x = 0; x < W; ++x) {
+        const double v = w00 * r0[x] + w01 * r0[x + 1] + w10 * r1[x] + w11 * r1[x + 1];
+        cur_px[y * W + x] = v;
+        c_mean += v;
+      }
+    }
+    c_mean /= n;
+    Eigen::Vector2d b = Eigen::Vector2d::Zero();
+    for (int k = 0; k < n; ++k) {
+      const double e = (cur_px[k] - c_mean) - t[k];
+      b.x() += gx[k] * e;
+      b.y() += gy[k] * e;
+    }
+    // Inverse compositional: the template's step Δ = H^-1 b, composed
+    // inversely with the current warp.
+    const Eigen::Vector2d step = H_inv * b;
+    c -= step;
+    if ((c - start).norm() > params.max_shift_level_px) return false;
+    if (step.norm() < params.converged_level_px) break;
+  }
+  *p_cur = from_level(c, rb);
+  return true;
+}
+
+}  // namespace pvb::slam
