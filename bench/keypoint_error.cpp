@@ -125,6 +125,10 @@ void run(const Options& o) {
     return depth_m.at<float>(v, u);
   };
 
+  pvb::slam::PatchAlignParams align;
+  align.scale_factor = orb.scale_factor;
+  align.min_eigen_ratio = 0;  // edges too, as the check before SLAM had it
+
   Accumulator acc;
   const int n = std::min<int>(o.frames, static_cast<int>(reader.size_hint()));
   for (int k = 0; k + o.gap < n; k += o.step) {
@@ -141,7 +145,7 @@ void run(const Options& o) {
       const cv::KeyPoint& ka = a.keypoints[i];
       const float z = depth_at(f0.depth_m, ka.pt);
       if (!(z > 0)) continue;
-      const Eigen::Vector3d p_c0((ka.pt.x - K.cx) * z / K.fx, (ka.pt.y - K.cy) * z / K.fy, z);
+      const Eigen::Vector3d p_c0 = settings.K.unproject(ka.pt.x, ka.pt.y, z);
       const Eigen::Vector3d p_w = T_w_c0 * p_c0, p_c1 = T_c1_w * p_w;
       if (p_c1.z() < 0.1) continue;
       const Eigen::Vector2d uv = pvb::slam::project(K, p_c1);
@@ -161,17 +165,13 @@ void run(const Options& o) {
         // Affine map of first-image offsets at ka to second-image offsets,
         // for a fronto-parallel patch at depth z, from ground truth.
         const auto project_b = [&](double u, double v) {
-          const Eigen::Vector3d q_c0((u - K.cx) * z / K.fx, (v - K.cy) * z / K.fy, z);
-          return pvb::slam::project(K, T_c1_w * (T_w_c0 * q_c0));
+          return pvb::slam::project(K, T_c1_w * (T_w_c0 * settings.K.unproject(u, v, z)));
         };
         Eigen::Matrix2d A;
         A.col(0) = 0.5 * (project_b(ka.pt.x + 1, ka.pt.y) - project_b(ka.pt.x - 1, ka.pt.y));
         A.col(1) = 0.5 * (project_b(ka.pt.x, ka.pt.y + 1) - project_b(ka.pt.x, ka.pt.y - 1));
-        pvb::slam::PatchAlignParams pa;
-        pa.scale_factor = extractor.params().scale_factor;
-        pa.min_eigen_ratio = 0;  // as before the SLAM version: edges too
         Eigen::Vector2d aligned;
-        if (pvb::slam::align_patch(pyr_a, {ka.pt.x, ka.pt.y}, A, pyr_b, kb.octave, {kb.pt.x, kb.pt.y}, pa,
+        if (pvb::slam::align_patch(pyr_a, {ka.pt.x, ka.pt.y}, A, pyr_b, kb.octave, {kb.pt.x, kb.pt.y}, align,
                                    &aligned))
           kb.pt = cv::Point2f(static_cast<float>(aligned.x()), static_cast<float>(aligned.y()));
       }

@@ -80,6 +80,7 @@ Frame::Frame(std::uint64_t frame_id, std::int64_t time_ns, OrbFeatures features,
   }
   map_points.assign(n, nullptr);
   outlier.assign(n, 0);
+  aligned_for.assign(n, kNotAligned);
   grid_.assign(CameraModel::kGridCols * CameraModel::kGridRows, {});
   for (std::size_t i = 0; i < n; ++i) {
     const int cx = static_cast<int>(std::floor((keys_un[i].pt.x - cam->min_x) * cam->grid_inv_w));
@@ -125,10 +126,7 @@ std::vector<std::pair<float, std::size_t>> Frame::keypoints_by_depth() const {
 }
 
 Eigen::Vector3d Frame::unproject_world(std::size_t i) const {
-  const double z = depth_m[i];
-  const Eigen::Vector3d p_c((keys_un[i].pt.x - cam->K.cx) * z / cam->K.fx, (keys_un[i].pt.y - cam->K.cy) * z / cam->K.fy,
-                            z);
-  return T_c_w.inverse() * p_c;
+  return T_c_w.inverse() * cam->unproject(Eigen::Vector2d(keys_un[i].pt.x, keys_un[i].pt.y), depth_m[i]);
 }
 
 Observation Frame::observation(std::size_t i) const {

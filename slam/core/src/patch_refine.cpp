@@ -3,7 +3,6 @@
 namespace pvb::slam {
 
 bool align_to_reference(Frame& f, std::size_t i, const MapPoint& mp, const PatchAlignParams& params) {
-  if (f.aligned_for.size() != f.size()) f.aligned_for.assign(f.size(), Frame::kNotAligned);
   f.aligned_for[i] = mp.id();
   if (!f.pyramid) return false;
   const auto ref = mp.reference_keyframe();
@@ -12,19 +11,16 @@ bool align_to_reference(Frame& f, std::size_t i, const MapPoint& mp, const Patch
   if (idx < 0) return false;
   const Frame& rf = ref->frame();
   const auto j = static_cast<std::size_t>(idx);
-  const StereoIntrinsics& K = f.cam->K;
-  const auto unproject = [&](const Eigen::Vector2d& uv, double z) {
-    return Eigen::Vector3d((uv.x() - K.cx) * z / K.fx, (uv.y() - K.cy) * z / K.fy, z);
-  };
+  const CameraModel& cam = *f.cam;
   // The reference keypoint's ray at the point's depth there, and the affine
   // map of a fronto-parallel patch around it into f.
   const double z_ref = (rf.T_c_w * mp.p_w()).z();
   if (!(z_ref > 0)) return false;
   const geom::SE3d T_cur_ref = f.T_c_w * rf.T_c_w.inverse();
   const Eigen::Vector2d u_ref(rf.keys_un[j].pt.x, rf.keys_un[j].pt.y);
-  if (!((T_cur_ref * unproject(u_ref, z_ref)).z() > 0)) return false;
+  if (!((T_cur_ref * cam.unproject(u_ref, z_ref)).z() > 0)) return false;
   const auto to_cur = [&](double du, double dv) {
-    return f.cam->project(T_cur_ref * unproject(u_ref + Eigen::Vector2d(du, dv), z_ref));
+    return cam.project(T_cur_ref * cam.unproject(u_ref + Eigen::Vector2d(du, dv), z_ref));
   };
   Eigen::Matrix2d A;
   A.col(0) = 0.5 * (to_cur(1, 0) - to_cur(-1, 0));
@@ -42,14 +38,13 @@ bool align_to_reference(Frame& f, std::size_t i, const MapPoint& mp, const Patch
   key.pt.y = static_cast<float>(aligned.y());
   f.keys_un[i].pt.x += static_cast<float>(d.x());
   f.keys_un[i].pt.y += static_cast<float>(d.y());
-  if (f.depth_m[i] > 0) f.u_right[i] = static_cast<float>(f.keys_un[i].pt.x - K.bf / f.depth_m[i]);
+  if (f.depth_m[i] > 0) f.u_right[i] = static_cast<float>(f.keys_un[i].pt.x - cam.K.bf / f.depth_m[i]);
   return true;
 }
 
 std::pair<int, int> align_keyframe_observations(KeyFrame& kf, const PatchAlignParams& params) {
   Frame& f = kf.frame_for_alignment();
   if (!f.pyramid) return {0, 0};
-  if (f.aligned_for.size() != f.size()) f.aligned_for.assign(f.size(), Frame::kNotAligned);
   int tried = 0, aligned = 0;
   for (std::size_t i = 0; i < f.size(); ++i) {
     const auto& mp = f.map_points[i];

@@ -250,7 +250,7 @@ double Tracking::translation_parallax_px(const std::vector<IndexMatch>& m, const
     const double z = last_.depth_m[mm.i1];
     if (!(z > 0)) continue;
     const cv::Point2f& uv = last_.keys_un[mm.i1].pt;
-    const Eigen::Vector3d p((uv.x - K.cx) * z / K.fx, (uv.y - K.cy) * z / K.fy, z);
+    const Eigen::Vector3d p = cam_->unproject(Eigen::Vector2d(uv.x, uv.y), z);
     const Eigen::Vector3d a = R * p, b = a + t;
     if (!(a.z() > 0) || !(b.z() > 0)) continue;
     const double du = K.fx * (b.x() / b.z() - a.x() / a.z()), dv = K.fy * (b.y() / b.z() - a.y() / a.z());

@@ -44,6 +44,7 @@ bool align_patch(const ImagePyramid& ref, const Eigen::Vector2d& p_ref, const Ei
                  const PatchAlignParams& params, Eigen::Vector2d* p_cur) {
   const int num_levels = static_cast<int>(std::min(ref.size(), cur.size()));
   if (level_cur < 0 || level_cur >= num_levels) return false;
+  if (params.half_size < 1 || params.half_size > 16) return false;  // the fixed buffers below
   const double det = A_cur_ref.determinant();
   if (!(std::abs(det) > 1e-6) || !A_cur_ref.allFinite()) return false;
   const int R = params.half_size;
@@ -63,7 +64,6 @@ bool align_patch(const ImagePyramid& ref, const Eigen::Vector2d& p_ref, const Ei
   // Template on the current level's pixel grid: T(dx, dy) for offsets in
   // [-R-1, R+1]^2 current-level px, sampled from the reference level.
   double tmpl[(2 * 16 + 3) * (2 * 16 + 3)];
-  if (R < 1 || R > 16) return false;
   // Reference-level position of offset (dx, dy): q0 + dx ex + dy ey.
   const Eigen::Vector2d q0 = to_level(p_ref, ra);
   const Eigen::Vector2d ex = (A_inv.col(0) * rb.x()).cwiseQuotient(ra);

@@ -90,30 +90,29 @@ TEST(Settings, ReadsKeyFrameSection) {
   }
 }
 
-TEST(Settings, ReadsOrbSubPixelFlag) {
-  EXPECT_TRUE(read_settings(kTum1).orb.sub_pixel);  // absent: on
-  const Settings s = read_settings(temp_copy("subpx", read_file(kTum1) + "\nORBextractor.subPixel: 0\n"));
+/// An optional 0/1 key of ours: on when absent, off with 0 (no warning),
+/// a ConfigError naming the key for `bad_value`.
+void expect_optional_flag(const std::string& key, const std::string& bad_value, bool (*get)(const Settings&)) {
+  SCOPED_TRACE(key);
+  EXPECT_TRUE(get(read_settings(kTum1)));
+  const Settings s = read_settings(temp_copy("flag", read_file(kTum1) + "\n" + key + ": 0\n"));
   EXPECT_TRUE(s.warnings.empty());
-  EXPECT_FALSE(s.orb.sub_pixel);  // ORB-SLAM2's whole level pixels
+  EXPECT_FALSE(get(s));
   try {
-    read_settings(temp_copy("subpxbad", read_file(kTum1) + "\nORBextractor.subPixel: 2\n"));
+    read_settings(temp_copy("flagbad", read_file(kTum1) + "\n" + key + ": " + bad_value + "\n"));
     FAIL() << "expected ConfigError";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(e.key(), "ORBextractor.subPixel");
+    EXPECT_EQ(e.key(), key);
   }
 }
 
+TEST(Settings, ReadsOrbSubPixelFlag) {
+  // 0: ORB-SLAM2's whole level pixels
+  expect_optional_flag("ORBextractor.subPixel", "2", [](const Settings& s) { return s.orb.sub_pixel; });
+}
+
 TEST(Settings, ReadsTrackingAlignPatchesFlag) {
-  EXPECT_TRUE(read_settings(kTum1).align_patches);  // absent: on
-  const Settings s = read_settings(temp_copy("align", read_file(kTum1) + "\nTracking.alignPatches: 0\n"));
-  EXPECT_TRUE(s.warnings.empty());
-  EXPECT_FALSE(s.align_patches);
-  try {
-    read_settings(temp_copy("alignbad", read_file(kTum1) + "\nTracking.alignPatches: yes\n"));
-    FAIL() << "expected ConfigError";
-  } catch (const ConfigError& e) {
-    EXPECT_EQ(e.key(), "Tracking.alignPatches");
-  }
+  expect_optional_flag("Tracking.alignPatches", "yes", [](const Settings& s) { return s.align_patches; });
 }
 
 TEST(Settings, ReadsLoopClosingSection) {

@@ -91,7 +91,6 @@ TEST(PatchAlign, RecoversTheTruePositionUnderAZoomAndRotation) {
   const AlignFigures r = align_all(fx, S, t, 0.0);
   std::printf("start %.3f level px RMS; aligned %.3f level px RMS, %.0f %% aligned\n", r.rms_start, r.rms_aligned,
               100 * r.share_aligned);
-  EXPECT_NEAR(r.rms_start, 0.7, 1e-9);
   EXPECT_LT(r.rms_aligned, 0.1);
   EXPECT_GT(r.share_aligned, 0.8);
 }

@@ -44,6 +44,10 @@ struct CameraModel {
   Eigen::Vector2d project(const Eigen::Vector3d& p_c) const {
     return {K.fx * p_c.x() / p_c.z() + K.cx, K.fy * p_c.y() / p_c.z() + K.cy};
   }
+  /// Point in the camera frame of undistorted pixel uv at depth z_m.
+  Eigen::Vector3d unproject(const Eigen::Vector2d& uv, double z_m) const {
+    return {(uv.x() - K.cx) * z_m / K.fx, (uv.y() - K.cy) * z_m / K.fy, z_m};
+  }
   /// Predicted pyramid level of a point at `dist_m` with max distance `max_dist_m`.
   int predict_scale(double dist_m, double max_dist_m) const;
 };
@@ -92,7 +96,7 @@ class Frame {
   /// modified.
   std::shared_ptr<const ImagePyramid> pyramid;
   /// Per keypoint, the id of the map point its patch alignment was last
-  /// tried for (kNotAligned: never; may be empty = none tried).
+  /// tried for (kNotAligned: never).
   static constexpr std::uint64_t kNotAligned = ~std::uint64_t(0);
   std::vector<std::uint64_t> aligned_for;
 

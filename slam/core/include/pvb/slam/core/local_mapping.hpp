@@ -32,7 +32,7 @@ struct LocalMappingOptions {
   /// covisible keyframes not yet aligned (those that fusion and
   /// triangulation added) to their points' reference patches
   /// (patch_refine.hpp); the tracker aligns the rest.
-  bool align_patches = false;
+  bool align_patches = true;
   PatchAlignParams patch_align;
 };
 
