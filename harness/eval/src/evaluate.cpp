@@ -26,10 +26,26 @@ std::string stats_json(const Stats& s) {
          ", \"count\": " + std::to_string(s.count) + "}";
 }
 
+namespace {
+
+std::string vec_json(const geom::Vec3d& v) {
+  return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]";
+}
+
+std::string axes_json(const EvalResult& r) {
+  auto one = [](const AxisStats& a) {
+    return "{\"mean\": " + vec_json(a.mean) + ", \"std\": " + vec_json(a.std) + "}";
+  };
+  return "{\"rot_deg\": " + one(r.rpe_rot_axes_deg) + ", \"trans_m\": " + one(r.rpe_trans_axes_m) + "}";
+}
+
+}  // namespace
+
 std::string rpe_json(const EvalResult& r) {
   return "{\"delta\": " + num(r.rpe_options.delta) + ", \"unit\": \"" + delta_unit_name(r.rpe_options.unit) +
          "\", \"pairs\": \"" + (r.rpe_options.pairs == PairMode::kAll ? "all" : "consecutive") +
-         "\", \"trans\": " + stats_json(r.rpe_trans_m) + ", \"rot_deg\": " + stats_json(r.rpe_rot_deg) + "}";
+         "\", \"trans\": " + stats_json(r.rpe_trans_m) + ", \"rot_deg\": " + stats_json(r.rpe_rot_deg) +
+         ", \"axes\": " + axes_json(r) + "}";
 }
 
 namespace {
@@ -51,7 +67,8 @@ std::string result_fields_json(const EvalResult& r, const std::string& indent) {
          delta_unit_name(r.rpe_options.unit) + "\", \"pairs\": \"" +
          (r.rpe_options.pairs == PairMode::kAll ? "all" : "consecutive") + "\",\n";
   out += indent + "        \"trans\": " + stats_json(r.rpe_trans_m) + ",\n";
-  out += indent + "        \"rot_deg\": " + stats_json(r.rpe_rot_deg) + "},\n";
+  out += indent + "        \"rot_deg\": " + stats_json(r.rpe_rot_deg) + ",\n";
+  out += indent + "        \"axes\": " + axes_json(r) + "},\n";
   out += indent + "\"alignment\": {\"kind\": \"" + alignment_name(r.alignment_kind) + "\", \"R\": " + R +
          ", \"t\": [" + num(t.x()) + ", " + num(t.y()) + ", " + num(t.z()) + "], \"s\": " +
          num(r.alignment.s) + "}";
@@ -117,12 +134,17 @@ EvalResult evaluate(const Trajectory& gt, const Trajectory& est, const EvalOptio
   r.ate = compute_stats(r.ate_m);
   r.rpe_pairs = rpe(r.T_w_c_est, r.T_w_c_gt, r.t_ns, options.rpe);
   std::vector<double> trans, rot;
+  std::vector<geom::Vec3d> trans_axes, rot_axes;
   for (const RpePair& p : r.rpe_pairs) {
     trans.push_back(p.trans_m);
     rot.push_back(p.rot_deg);
+    trans_axes.push_back(p.trans_err_m);
+    rot_axes.push_back(p.rot_err_deg);
   }
   r.rpe_trans_m = compute_stats(trans);
   r.rpe_rot_deg = compute_stats(rot);
+  r.rpe_trans_axes_m = compute_axis_stats(trans_axes);
+  r.rpe_rot_axes_deg = compute_axis_stats(rot_axes);
   return r;
 }
 
@@ -150,6 +172,36 @@ std::string format_report(const EvalResult& r) {
   row("ATE [m]", r.ate);
   row("RPE trans [m]", r.rpe_trans_m);
   row("RPE rot [deg]", r.rpe_rot_deg);
+  out += format_rpe_axes(r);
+  return out;
+}
+
+std::string format_rpe_axes(const EvalResult& r) {
+  const bool consecutive = r.rpe_options.pairs == PairMode::kConsecutive;
+  const std::size_t n = r.rpe_rot_axes_deg.count;
+  std::string out = "\nRPE per axis of the start camera (signed: mean +- std over " + std::to_string(n) + " pairs" +
+                    (consecutive && n > 1 ? "; t = mean / (std / sqrt(n - 1))" : "") + ")\n";
+  auto row = [&](const char* name, const AxisStats& a, double scale, const char* unit) {
+    char cell[96];
+    std::snprintf(cell, sizeof cell, "%-6s", name);
+    out += cell;
+    for (int k = 0; k < 3; ++k) {
+      std::snprintf(cell, sizeof cell, "  %c %+9.5f +- %8.5f", "xyz"[k], a.mean(k) * scale, a.std(k) * scale);
+      out += cell;
+      // Non-overlapping pairs only: overlapping ones are not independent.
+      if (consecutive && n > 1) {
+        const double se = a.std(k) / std::sqrt(static_cast<double>(n - 1));
+        if (se > 0)
+          std::snprintf(cell, sizeof cell, " (t %+5.1f)", a.mean(k) / se);
+        else
+          std::snprintf(cell, sizeof cell, " (t   n/a)");
+        out += cell;
+      }
+    }
+    out += std::string("  ") + unit + "\n";
+  };
+  row("rot", r.rpe_rot_axes_deg, 1.0, "deg");
+  row("trans", r.rpe_trans_axes_m, 1000.0, "mm");
   return out;
 }
 

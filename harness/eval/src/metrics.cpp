@@ -45,6 +45,18 @@ Stats compute_stats(const std::vector<double>& values) {
   return s;
 }
 
+AxisStats compute_axis_stats(const std::vector<geom::Vec3d>& values) {
+  AxisStats s;
+  s.count = values.size();
+  if (values.empty()) return s;
+  for (const geom::Vec3d& v : values) s.mean += v;
+  s.mean /= static_cast<double>(values.size());
+  geom::Vec3d var = geom::Vec3d::Zero();
+  for (const geom::Vec3d& v : values) var += (v - s.mean).cwiseAbs2();
+  s.std = (var / static_cast<double>(values.size())).cwiseSqrt();
+  return s;
+}
+
 std::vector<double> ate_errors_m(const std::vector<geom::SE3d>& est, const std::vector<geom::SE3d>& gt) {
   if (est.size() != gt.size()) throw EvalError("ATE: pose lists differ in size");
   std::vector<double> out;
@@ -127,6 +139,8 @@ std::vector<RpePair> rpe(const std::vector<geom::SE3d>& est, const std::vector<g
     p.j = j;
     p.trans_m = E.translation().norm();
     p.rot_deg = geom::rotation_angle_rad(E.linear()) * kRadToDeg;
+    p.rot_err_deg = geom::so3_log(E.linear()) * kRadToDeg;
+    p.trans_err_m = E.translation();
     out.push_back(p);
   }
   if (out.empty())

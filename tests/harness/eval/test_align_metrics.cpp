@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "pvb/eval/evaluate.hpp"
 
@@ -177,6 +179,9 @@ TEST(Metrics, RpeHandComputedCase) {
   EXPECT_EQ(r[0].j, 1u);
   EXPECT_NEAR(r[0].trans_m, std::hypot(1 - std::cos(d10), 0.1 - std::sin(d10)), 1e-12);
   EXPECT_NEAR(r[0].rot_deg, 10.0, 1e-9);
+  // signed, on the start camera's axes
+  EXPECT_TRUE(r[0].rot_err_deg.isApprox(Vec3d(0, 0, 10.0), 1e-9));
+  EXPECT_TRUE(r[0].trans_err_m.isApprox(Vec3d(1 - std::cos(d10), 0.1 - std::sin(d10), 0), 1e-9));
   // Pair (1, 2): B = (I, Rz(-90)(0,1,0) = (1,0,0)), A = est_1^-1 est_2 has
   // rotation Rz(-10 deg) and translation Rz(-100 deg)(0, 0.9, 0).
   const Vec3d tA = geom::so3_exp(Vec3d(0, 0, -(M_PI / 2 + d10))) * Vec3d(0, 0.9, 0);
@@ -187,6 +192,45 @@ TEST(Metrics, RpeHandComputedCase) {
   RpeOptions consecutive;
   consecutive.pairs = PairMode::kConsecutive;
   EXPECT_EQ(rpe(est, gt, t_ns, consecutive).size(), 3u);  // (0,1) (1,2) (2,3)
+}
+
+// An estimate whose every step k is the true step B_k with a left error D_k,
+// est_k = est_{k-1} D_k B_k: then A = D_k B_k and E = A B^-1 = D_k exactly.
+TEST(Metrics, RpePerAxisSeparatesABiasFromAlternatingErrors) {
+  const Trajectory gt = loop(40);
+  const double eps_rad = 0.002, dy_m = 0.0005, dz_m = 0.003;
+  Trajectory est = gt;
+  est.source = "est";
+  for (std::size_t k = 1; k < est.poses.size(); ++k) {
+    const SE3d B = gt.poses[k - 1].T_w_c.inverse() * gt.poses[k].T_w_c;
+    const double sign = k % 2 ? 1.0 : -1.0;
+    const SE3d D = geom::make_se3(geom::so3_exp(Vec3d(eps_rad, 0, 0)), Vec3d(0, dy_m, sign * dz_m));
+    est.poses[k].T_w_c = est.poses[k - 1].T_w_c * D * B;
+  }
+  EvalOptions options;
+  options.rpe.pairs = PairMode::kConsecutive;
+  const EvalResult r = evaluate(gt, est, options);
+  ASSERT_EQ(r.rpe_rot_axes_deg.count, 39u);
+  const double eps_deg = eps_rad * 180.0 / M_PI;
+  EXPECT_TRUE(r.rpe_rot_axes_deg.mean.isApprox(Vec3d(eps_deg, 0, 0), 1e-6)) << r.rpe_rot_axes_deg.mean.transpose();
+  EXPECT_LT(r.rpe_rot_axes_deg.std.norm(), 1e-9);
+  // 20 steps at +dz and 19 at -dz
+  const double mean_z = dz_m / 39.0;
+  EXPECT_NEAR(r.rpe_trans_axes_m.mean.x(), 0.0, 1e-9);
+  EXPECT_NEAR(r.rpe_trans_axes_m.mean.y(), dy_m, 1e-9);
+  EXPECT_NEAR(r.rpe_trans_axes_m.mean.z(), mean_z, 1e-9);
+  EXPECT_NEAR(r.rpe_trans_axes_m.std.y(), 0.0, 1e-9);
+  EXPECT_NEAR(r.rpe_trans_axes_m.std.z(), std::sqrt(dz_m * dz_m - mean_z * mean_z), 1e-9);
+  // The report gives t only where the spread allows it: z's t is small.
+  const std::string text = format_rpe_axes(r);
+  EXPECT_NE(text.find("over 39 pairs; t = mean"), std::string::npos) << text;
+  const double t_z = mean_z / (r.rpe_trans_axes_m.std.z() / std::sqrt(38.0));
+  char expected[32];
+  std::snprintf(expected, sizeof expected, "(t %+5.1f)", t_z);
+  EXPECT_NE(text.find(expected), std::string::npos) << text;
+  // With overlapping pairs there is no t.
+  EvalOptions all;
+  EXPECT_EQ(format_rpe_axes(evaluate(gt, est, all)).find("(t"), std::string::npos);
 }
 
 TEST(Metrics, RpePairSelection) {

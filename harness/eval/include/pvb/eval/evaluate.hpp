@@ -31,6 +31,8 @@ struct EvalResult {
   std::vector<RpePair> rpe_pairs;        ///< evaluated RPE pairs
   Stats rpe_trans_m;                     ///< translational RPE, metres
   Stats rpe_rot_deg;                     ///< rotational RPE, degrees
+  AxisStats rpe_rot_axes_deg;            ///< signed rotational RPE per start-camera axis, degrees
+  AxisStats rpe_trans_axes_m;            ///< signed translational RPE per start-camera axis, metres
   RpeOptions rpe_options;
 };
 
@@ -42,6 +44,13 @@ EvalResult evaluate(const Trajectory& gt, const Trajectory& est, const EvalOptio
 
 /// A human-readable table of one result (association, alignment, ATE, RPE).
 std::string format_report(const EvalResult& result);
+
+/// The per-axis block of format_report: the signed RPE's mean and standard
+/// deviation on each start-camera axis, rotation in degrees and translation
+/// in millimetres.  With consecutive (non-overlapping) pairs it adds each
+/// mean's t statistic, mean / (std / sqrt(n - 1)): |t| well above 2 is a
+/// bias rather than random drift.  docs/evaluation.md, "Bias or drift".
+std::string format_rpe_axes(const EvalResult& result);
 
 /// Side-by-side table of several results against the same ground truth; every
 /// metric of the second and later estimates also shows its reduction in
@@ -57,7 +66,9 @@ double reduction_percent(double reference, double value);
 std::string stats_json(const Stats& s);
 
 /// JSON object of a result's RPE on one line: {"delta", "unit", "pairs",
-/// "trans": stats_json, "rot_deg": stats_json} (the "rpe" value of format_json).
+/// "trans": stats_json, "rot_deg": stats_json, "axes": {"rot_deg": {"mean":
+/// [x, y, z], "std": [...]}, "trans_m": {...}}} (the "rpe" value of
+/// format_json).
 std::string rpe_json(const EvalResult& result);
 
 /// JSON of one result: pairs, ate.{rmse,mean,median,std,min,max,count},

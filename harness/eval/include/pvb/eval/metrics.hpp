@@ -63,7 +63,23 @@ struct RpePair {
   std::size_t i = 0, j = 0;  ///< indices into the associated sequence
   double trans_m = 0.0;      ///< translational error, metres
   double rot_deg = 0.0;      ///< rotational error, degrees
+  /// The same error E signed, per axis of the start camera (x right, y down,
+  /// z forward for an optical frame): so3_log(R(E)) in degrees and t(E) in
+  /// metres.  Their means over many pairs separate a bias (a calibration or
+  /// model error repeats with the motion) from random drift.
+  geom::Vec3d rot_err_deg = geom::Vec3d::Zero();
+  geom::Vec3d trans_err_m = geom::Vec3d::Zero();
 };
+
+/// Per-axis mean and population standard deviation of signed 3-vectors.
+struct AxisStats {
+  geom::Vec3d mean = geom::Vec3d::Zero();
+  geom::Vec3d std = geom::Vec3d::Zero();
+  std::size_t count = 0;
+};
+
+/// AxisStats over `values`; all zero with count 0 for an empty list.
+AxisStats compute_axis_stats(const std::vector<geom::Vec3d>& values);
 
 /// Selects the RPE pose pairs.  `index` is the monotonic coordinate of each
 /// pose in the delta unit (frame number, seconds or metres travelled).
