@@ -75,7 +75,7 @@ Frame::Frame(std::uint64_t frame_id, std::int64_t time_ns, OrbFeatures features,
     const float d = depth.at<float>(v, u);
     if (d > 0 && std::isfinite(d)) {
       depth_m[i] = d;
-      u_right[i] = static_cast<float>(keys_un[i].pt.x - cam->K.bf / d);
+      u_right[i] = right_coordinate(keys_un[i].pt.x, d);
     }
   }
   map_points.assign(n, nullptr);
@@ -127,6 +127,15 @@ std::vector<std::pair<float, std::size_t>> Frame::keypoints_by_depth() const {
 
 Eigen::Vector3d Frame::unproject_world(std::size_t i) const {
   return T_c_w.inverse() * cam->unproject(Eigen::Vector2d(keys_un[i].pt.x, keys_un[i].pt.y), depth_m[i]);
+}
+
+void Frame::move_keypoint(std::size_t i, const Eigen::Vector2d& to_px) {
+  const Eigen::Vector2d shift = to_px - Eigen::Vector2d(keys[i].pt.x, keys[i].pt.y);
+  keys[i].pt.x = static_cast<float>(to_px.x());
+  keys[i].pt.y = static_cast<float>(to_px.y());
+  keys_un[i].pt.x += static_cast<float>(shift.x());
+  keys_un[i].pt.y += static_cast<float>(shift.y());
+  if (depth_m[i] > 0) u_right[i] = right_coordinate(keys_un[i].pt.x, depth_m[i]);
 }
 
 Observation Frame::observation(std::size_t i) const {

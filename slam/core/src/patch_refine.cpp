@@ -25,20 +25,12 @@ bool align_to_reference(Frame& f, std::size_t i, const MapPoint& mp, const Patch
   Eigen::Matrix2d A;
   A.col(0) = 0.5 * (to_cur(1, 0) - to_cur(-1, 0));
   A.col(1) = 0.5 * (to_cur(0, 1) - to_cur(0, -1));
-  cv::KeyPoint& key = f.keys[i];
-  const Eigen::Vector2d start(key.pt.x, key.pt.y);
+  const cv::KeyPoint& key = f.keys[i];
   Eigen::Vector2d aligned;
   if (!align_patch(*rf.pyramid, Eigen::Vector2d(rf.keys[j].pt.x, rf.keys[j].pt.y), A, *f.pyramid, key.octave,
-                   start, params, &aligned))
+                   Eigen::Vector2d(key.pt.x, key.pt.y), params, &aligned))
     return false;
-  // Distortion is locally a near-identity: the undistorted keypoint moves by
-  // the same amount.
-  const Eigen::Vector2d d = aligned - start;
-  key.pt.x = static_cast<float>(aligned.x());
-  key.pt.y = static_cast<float>(aligned.y());
-  f.keys_un[i].pt.x += static_cast<float>(d.x());
-  f.keys_un[i].pt.y += static_cast<float>(d.y());
-  if (f.depth_m[i] > 0) f.u_right[i] = static_cast<float>(f.keys_un[i].pt.x - cam.K.bf / f.depth_m[i]);
+  f.move_keypoint(i, aligned);
   return true;
 }
 

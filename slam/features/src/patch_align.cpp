@@ -7,6 +7,12 @@
 namespace pvb::slam {
 namespace {
 
+// The patch buffers are fixed-size arrays on the stack (per match, no
+// allocation): patches up to kMaxHalfSize, the template one ring wider.
+constexpr int kMaxHalfSize = 16;
+constexpr int kMaxPatch = (2 * kMaxHalfSize + 1) * (2 * kMaxHalfSize + 1);
+constexpr int kMaxTemplate = (2 * kMaxHalfSize + 3) * (2 * kMaxHalfSize + 3);
+
 /// Bilinear sample of a CV_8U image; false outside [0, cols-1) x [0, rows-1).
 bool bilinear(const cv::Mat& img, double x, double y, double* value) {
   const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
@@ -44,7 +50,7 @@ bool align_patch(const ImagePyramid& ref, const Eigen::Vector2d& p_ref, const Ei
                  const PatchAlignParams& params, Eigen::Vector2d* p_cur) {
   const int num_levels = static_cast<int>(std::min(ref.size(), cur.size()));
   if (level_cur < 0 || level_cur >= num_levels) return false;
-  if (params.half_size < 1 || params.half_size > 16) return false;  // the fixed buffers below
+  if (params.half_size < 1 || params.half_size > kMaxHalfSize) return false;
   const double det = A_cur_ref.determinant();
   if (!(std::abs(det) > 1e-6) || !A_cur_ref.allFinite()) return false;
   const int R = params.half_size;
@@ -63,7 +69,7 @@ bool align_patch(const ImagePyramid& ref, const Eigen::Vector2d& p_ref, const Ei
 
   // Template on the current level's pixel grid: T(dx, dy) for offsets in
   // [-R-1, R+1]^2 current-level px, sampled from the reference level.
-  double tmpl[(2 * 16 + 3) * (2 * 16 + 3)];
+  double tmpl[kMaxTemplate];
   // Reference-level position of offset (dx, dy): q0 + dx ex + dy ey.
   const Eigen::Vector2d q0 = to_level(p_ref, ra);
   const Eigen::Vector2d ex = (A_inv.col(0) * rb.x()).cwiseQuotient(ra);
@@ -77,7 +83,7 @@ bool align_patch(const ImagePyramid& ref, const Eigen::Vector2d& p_ref, const Ei
   }
   // Mean-subtracted template and its gradients on the inner W x W patch.
   const int n = W * W;
-  double t[33 * 33], gx[33 * 33], gy[33 * 33];
+  double t[kMaxPatch], gx[kMaxPatch], gy[kMaxPatch];
   double t_mean = 0, gx_mean = 0, gy_mean = 0;
   for (int y = 0; y < W; ++y)
     for (int x = 0; x < W; ++x) {
@@ -108,7 +114,7 @@ bool align_patch(const ImagePyramid& ref, const Eigen::Vector2d& p_ref, const Ei
   const cv::Mat& img = cur[static_cast<std::size_t>(level_cur)];
   const Eigen::Vector2d start = to_level(p_cur_start, rb);
   Eigen::Vector2d c = start;
-  double cur_px[33 * 33];
+  double cur_px[kMaxPatch];
   for (int it = 0; it < params.max_iterations; ++it) {
     // Integer offsets: every sample shares the same bilinear weights.
     const int x0 = static_cast<int>(std::floor(c.x())) - R, y0 = static_cast<int>(std::floor(c.y())) - R;

@@ -75,6 +75,12 @@ class Frame {
   std::vector<std::pair<float, std::size_t>> keypoints_by_depth() const;
   /// Observation of keypoint i for the optimiser.
   Observation observation(std::size_t i) const;
+  /// Moves keypoint i to image (distorted) position `to_px`: keys[i] is
+  /// set, keys_un[i] moves by the same shift (distortion is locally a
+  /// near-identity over the sub-pixel shifts this is for), and u_right[i]
+  /// follows.  The grid index is not rebuilt; the shifts are far smaller
+  /// than its cells.
+  void move_keypoint(std::size_t i, const Eigen::Vector2d& to_px);
   Eigen::Vector3d camera_center_w() const { return T_c_w.inverse().translation(); }
   /// Number of keypoints with a map point.
   int num_tracked() const;
@@ -101,6 +107,9 @@ class Frame {
   std::vector<std::uint64_t> aligned_for;
 
  private:
+  /// The virtual right-camera coordinate u - bf / depth (ORB-SLAM2's RGB-D uR).
+  float right_coordinate(float u_un, float depth) const { return static_cast<float>(u_un - cam->K.bf / depth); }
+
   std::vector<std::vector<std::uint32_t>> grid_;  ///< keypoint indices per cell, row-major
 };
 
