@@ -1,21 +1,19 @@
 // End to end: record ~300 frames of the default PV station with pvbench,
 // run `pvbench slam --sync` on them and check accuracy (ATE RMSE < 2 cm, no
 // lost frames); and check that synchronous mode gives a bit-identical
-// trajectory twice.
+// trajectory twice; and the command line's error and Ctrl-C handling.
 #include <gtest/gtest.h>
-
-#include <filesystem>
-
-#include <cstdio>
-#include <cstdlib>
-#include <regex>
-#include <sstream>
-#include <vector>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <optional>
+#include <regex>
+#include <sstream>
+#include <vector>
 
 #include "pvb/common/text.hpp"
 #include "run_pvbench.hpp"
