@@ -31,6 +31,15 @@ CameraModel CameraModel::make(const StereoIntrinsics& K, int width, int height, 
     c.max_x = std::max(un[1].x, un[3].x);
     c.min_y = std::min(un[0].y, un[1].y);
     c.max_y = std::max(un[2].y, un[3].y);
+    // One batch call for every pixel, so that keypoints moved after
+    // detection (patch alignment) are undistorted without a call each.
+    std::vector<cv::Point2f> px(static_cast<std::size_t>(width) * height);
+    for (int v = 0; v < height; ++v)
+      for (int u = 0; u < width; ++u) px[static_cast<std::size_t>(v) * width + u] = cv::Point2f(float(u), float(v));
+    std::vector<cv::Point2f> px_un;
+    cv::undistortPoints(px, px_un, c.K_cv, c.dist_cv, cv::noArray(), c.K_cv);
+    c.undistort_table = cv::Mat(height, width, CV_32FC2);
+    std::memcpy(c.undistort_table.data, px_un.data(), px_un.size() * sizeof(cv::Point2f));
   }
   c.grid_inv_w = kGridCols / (c.max_x - c.min_x);
   c.grid_inv_h = kGridRows / (c.max_y - c.min_y);
@@ -44,6 +53,18 @@ CameraModel CameraModel::make(const StereoIntrinsics& K, int width, int height, 
     s *= scale_factor;
   }
   return c;
+}
+
+Eigen::Vector2d CameraModel::undistort(const Eigen::Vector2d& px) const {
+  if (undistort_table.empty()) return px;
+  const double x = std::clamp(px.x(), 0.0, double(width - 1)), y = std::clamp(px.y(), 0.0, double(height - 1));
+  const int u0 = std::min(static_cast<int>(x), width - 2), v0 = std::min(static_cast<int>(y), height - 2);
+  const double a = x - u0, b = y - v0;
+  const auto at = [&](int v, int u) {
+    const cv::Vec2f& p = undistort_table.at<cv::Vec2f>(v, u);
+    return Eigen::Vector2d(p[0], p[1]);
+  };
+  return (1 - b) * ((1 - a) * at(v0, u0) + a * at(v0, u0 + 1)) + b * ((1 - a) * at(v0 + 1, u0) + a * at(v0 + 1, u0 + 1));
 }
 
 int CameraModel::predict_scale(double dist_m, double max_dist_m) const {
@@ -133,8 +154,14 @@ void Frame::move_keypoint(std::size_t i, const Eigen::Vector2d& to_px) {
   const Eigen::Vector2d shift = to_px - Eigen::Vector2d(keys[i].pt.x, keys[i].pt.y);
   keys[i].pt.x = static_cast<float>(to_px.x());
   keys[i].pt.y = static_cast<float>(to_px.y());
-  keys_un[i].pt.x += static_cast<float>(shift.x());
-  keys_un[i].pt.y += static_cast<float>(shift.y());
+  if (cam->undistort_table.empty()) {
+    keys_un[i].pt.x += static_cast<float>(shift.x());
+    keys_un[i].pt.y += static_cast<float>(shift.y());
+  } else {
+    const Eigen::Vector2d un = cam->undistort(to_px);
+    keys_un[i].pt.x = static_cast<float>(un.x());
+    keys_un[i].pt.y = static_cast<float>(un.y());
+  }
   if (depth_m[i] > 0) u_right[i] = right_coordinate(keys_un[i].pt.x, depth_m[i]);
 }
 

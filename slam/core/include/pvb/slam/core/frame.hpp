@@ -25,6 +25,9 @@ struct CameraModel {
   int width = 640, height = 480;
   cv::Mat K_cv;                ///< 3x3 CV_64F, for OpenCV calls
   cv::Mat dist_cv;             ///< 1x5 CV_64F (k1 k2 p1 p2 k3); empty: no distortion
+  /// With distortion: the undistorted position of every image pixel
+  /// (CV_32FC2, height x width), from cv::undistortPoints once per run.
+  cv::Mat undistort_table;
   double th_depth_m = 3.0;     ///< close/far threshold, metres
   /// Undistorted image bounds (ORB-SLAM2 ComputeImageBounds).
   double min_x = 0, max_x = 640, min_y = 0, max_y = 480;
@@ -48,6 +51,11 @@ struct CameraModel {
   Eigen::Vector3d unproject(const Eigen::Vector2d& uv, double z_m) const {
     return {(uv.x() - K.cx) * z_m / K.fx, (uv.y() - K.cy) * z_m / K.fy, z_m};
   }
+  /// Undistorted position of the image (distorted) position px: identity
+  /// without distortion, else the table read bilinearly (positions outside
+  /// the image are clamped to its border).  Within 2e-3 px of
+  /// cv::undistortPoints for TUM1.yaml's Kinect distortion (tested).
+  Eigen::Vector2d undistort(const Eigen::Vector2d& px) const;
   /// Predicted pyramid level of a point at `dist_m` with max distance `max_dist_m`.
   int predict_scale(double dist_m, double max_dist_m) const;
 };
@@ -76,10 +84,9 @@ class Frame {
   /// Observation of keypoint i for the optimiser.
   Observation observation(std::size_t i) const;
   /// Moves keypoint i to image (distorted) position `to_px`: keys[i] is
-  /// set, keys_un[i] moves by the same shift (distortion is locally a
-  /// near-identity over the sub-pixel shifts this is for), and u_right[i]
-  /// follows.  The grid index is not rebuilt; the shifts are far smaller
-  /// than its cells.
+  /// set, keys_un[i] becomes its undistorted position (CameraModel::
+  /// undistort), and u_right[i] follows.  The grid index is not rebuilt;
+  /// the shifts are far smaller than its cells.
   void move_keypoint(std::size_t i, const Eigen::Vector2d& to_px);
   Eigen::Vector3d camera_center_w() const { return T_c_w.inverse().translation(); }
   /// Number of keypoints with a map point.
