@@ -39,6 +39,7 @@ struct SlamArgs {
   std::size_t max_frames = 0;
   double max_missing = 0.1;
   bool dump_matches = false;
+  bool dump_map = false;
 };
 
 /// Ground-truth scoring of the motion model's coarse matches (--dump-matches):
@@ -234,6 +235,10 @@ int run_slam(const SlamArgs& a) {
   write_tum_file(a.out + "/KeyFrameTrajectory.txt", system.keyframe_trajectory());
   // ORB-SLAM2's way of saving: each frame relative to its (refined) reference keyframe.
   write_tum_file(a.out + "/CameraTrajectoryRefined.txt", system.refined_trajectory());
+  if (a.dump_map) {
+    std::ofstream map_out = open_out(a.out + "/Map.txt");
+    slam::write_map_snapshot(system.map_snapshot(), map_out, a.out + "/Map.txt");
+  }
   cam_traj.close();
   std::size_t cloud_points = 0;
   if (system.dense_enabled()) cloud_points = system.write_point_cloud(a.out + "/PointCloud.ply");
@@ -343,6 +348,8 @@ Command add_slam_command(CLI::App& app) {
   sub->add_flag("--dump-matches", args->dump_matches,
                 "score the motion model's coarse matches against groundtruth.txt: motion_matches.csv, "
                 "stats.json motion_matches");
+  sub->add_flag("--dump-map", args->dump_map,
+                "write the final sparse map with every keypoint measurement to Map.txt (for pvbench map-check)");
   sub->add_option("--max-missing", args->max_missing, "stop when more than this share of frames is missing")
       ->capture_default_str();
   return {sub, [args] { return run_slam(*args); }};

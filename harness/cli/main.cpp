@@ -17,6 +17,7 @@ Command add_camera_command(CLI::App& app);
 Command add_run_command(CLI::App& app);
 Command add_check_command(CLI::App& app);
 Command add_sweep_command(CLI::App& app);
+Command add_map_check_command(CLI::App& app);
 
 // Sub-commands register here (one line each).
 std::vector<Command> add_all_commands(CLI::App& app) {
@@ -31,6 +32,7 @@ std::vector<Command> add_all_commands(CLI::App& app) {
   cmds.push_back(add_run_command(app));
   cmds.push_back(add_check_command(app));
   cmds.push_back(add_sweep_command(app));
+  cmds.push_back(add_map_check_command(app));
   return cmds;
 }
 }  // namespace pvb::cli

@@ -121,6 +121,11 @@ std::vector<geom::StampedPose> System::keyframe_trajectory() {
   return out;
 }
 
+MapSnapshot System::map_snapshot() {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  return snapshot_map(map_, cam_->K, settings_.orb.scale_factor);
+}
+
 std::vector<geom::StampedPose> System::refined_trajectory() {
   std::lock_guard<std::mutex> lock(map_.mutex());
   std::vector<geom::StampedPose> out;

@@ -72,6 +72,40 @@ TEST(SlamScenario, SyncModeIsBitIdentical) {
   EXPECT_EQ(cloud, pvb::read_file(b + "/PointCloud.ply"));
 }
 
+// --dump-map writes the final map with every measurement; map-check reads it
+// and re-runs global BA from ground truth; a corrupted file fails on its line.
+TEST(SlamScenario, DumpedMapHoldsEveryKeyframeAndMapCheckReadsIt) {
+  const std::string seq = station_sequence();
+  const std::string out = dir("dump_map");
+  const Result r = run("slam --sequence " + seq + " --settings " + seq +
+                       "/camera.yaml --sync --no-dense --dump-map --max-frames 120 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string stats = pvb::read_file(out + "/stats.json");
+  const std::string map = pvb::read_file(out + "/Map.txt");
+  int frames = 0, points = 0, measurements = 0;
+  std::istringstream is(map);
+  for (std::string line; std::getline(is, line);) {
+    frames += line.rfind("F ", 0) == 0;
+    points += line.rfind("P ", 0) == 0;
+    measurements += line.rfind("O ", 0) == 0;
+  }
+  EXPECT_EQ(frames, json_number(stats, "keyframes"));
+  EXPECT_EQ(points, json_number(stats, "map_points"));
+  EXPECT_GT(measurements, 2 * points);
+  const Result c = run("map-check --map " + out + "/Map.txt --gt " + seq + "/groundtruth.txt --draws 2");
+  ASSERT_EQ(c.code, 0) << c.output;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(c.output, m, std::regex("measured, global BA from ground truth +([0-9.]+)")))
+      << c.output;
+  EXPECT_LT(std::stod(m[1]), 20.0) << c.output;  // mm, as the SLAM bound
+  EXPECT_NE(c.output.find("reading: "), std::string::npos) << c.output;
+  pvb::write_file(out + "/Bad.txt", map + "O 0 999999 1 2 -1 0\n");
+  const Result bad = run("map-check --map " + out + "/Bad.txt --gt " + seq + "/groundtruth.txt --draws 0");
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.output.find("Bad.txt:"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("point index 999999 out of range"), std::string::npos) << bad.output;
+}
+
 // Local mapping on its worker thread (the default mode): same accuracy
 // bounds on the first 150 frames, and a clean shutdown.
 TEST(SlamScenario, WorkerThreadModeTracks) {

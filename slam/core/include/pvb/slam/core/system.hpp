@@ -13,6 +13,7 @@
 #include "pvb/sensor/rgbd_frame.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/loop_closing.hpp"
+#include "pvb/slam/core/map_snapshot.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/tracking.hpp"
 #include "pvb/slam/dense/dense_mapper.hpp"
@@ -54,6 +55,9 @@ class System {
   std::vector<geom::StampedPose> keyframe_trajectory();
   std::size_t num_keyframes();
   std::size_t num_map_points();
+  /// The sparse map with every measurement (map_snapshot.hpp), under the
+  /// map lock; call after shutdown() for the final map.
+  MapSnapshot map_snapshot();
   /// Positions of the map points (world frame), by point id.
   std::vector<Eigen::Vector3d> map_point_positions();
   /// Time local mapping has spent on keyframes so far (inline or on its worker), ms.

@@ -1,0 +1,238 @@
+#include "pvb/run/map_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <sstream>
+
+#include "pvb/common/error.hpp"
+#include "pvb/eval/associate.hpp"
+#include "pvb/eval/evaluate.hpp"
+#include "pvb/slam/optim/optimizer.hpp"
+
+namespace pvb::run {
+namespace {
+
+using slam::BaOptions;
+using slam::BaProblem;
+using slam::MapSnapshot;
+
+eval::Trajectory keyframe_trajectory(const std::vector<geom::SE3d>& T_c_w, const MapSnapshot& map) {
+  eval::Trajectory t;
+  t.source = "keyframes";
+  for (std::size_t i = 0; i < T_c_w.size(); ++i) t.poses.push_back({map.keyframes[i].t_ns, T_c_w[i].inverse()});
+  std::sort(t.poses.begin(), t.poses.end(), [](const auto& a, const auto& b) { return a.t_ns < b.t_ns; });
+  return t;
+}
+
+MapCheckFit fit_of(const std::vector<geom::SE3d>& T_c_w, const MapSnapshot& map, const eval::Trajectory& gt,
+                   const eval::EvalOptions& eo) {
+  const eval::EvalResult r = eval::evaluate(gt, keyframe_trajectory(T_c_w, map), eo);
+  MapCheckFit f;
+  f.ate_rmse_m = r.ate.rmse;
+  const auto& ax = r.rpe_rot_axes_deg;
+  f.rot_mean_deg = ax.mean;
+  for (int k = 0; k < 3; ++k) {
+    const double se = ax.count > 1 ? ax.std[k] / std::sqrt(double(ax.count)) : 0.0;
+    f.rot_t[k] = se > 0 ? ax.mean[k] / se : 0.0;
+  }
+  return f;
+}
+
+BaProblem make_problem(const MapSnapshot& map, const std::vector<geom::SE3d>& T_c_w, bool fix_all) {
+  BaProblem p;
+  for (std::size_t i = 0; i < map.keyframes.size(); ++i)
+    p.keyframes.push_back({map.keyframes[i].id, T_c_w[i], fix_all || i == 0});
+  for (const auto& pt : map.points) p.points.push_back({pt.id, pt.p_w});
+  for (const auto& m : map.measurements) {
+    slam::Observation o;
+    o.uv = m.uv;
+    o.u_right = m.u_right;
+    o.inv_sigma2 = std::pow(map.scale_factor, -2.0 * m.octave);
+    p.edges.push_back({m.keyframe, m.point, o});
+  }
+  return p;
+}
+
+std::vector<geom::SE3d> poses_of(const BaProblem& p) {
+  std::vector<geom::SE3d> out;
+  for (const auto& k : p.keyframes) out.push_back(k.T_c_w);
+  return out;
+}
+
+std::string fit_line(const char* name, const MapCheckFit& f) {
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), "%-38s %8.2f   %+.4f (%+.1f)  %+.4f (%+.1f)  %+.4f (%+.1f)\n", name,
+                f.ate_rmse_m * 1000, f.rot_mean_deg.x(), f.rot_t.x(), f.rot_mean_deg.y(), f.rot_t.y(),
+                f.rot_mean_deg.z(), f.rot_t.z());
+  return buf;
+}
+
+std::string draws_line(const char* name, const std::vector<MapCheckFit>& fits) {
+  if (fits.empty()) return {};
+  std::vector<double> a;
+  for (const auto& f : fits) a.push_back(f.ate_rmse_m * 1000);
+  std::sort(a.begin(), a.end());
+  double mean = 0;
+  for (double x : a) mean += x;
+  mean /= a.size();
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), "%-38s %8.2f   (%zu draws: min %.2f, median %.2f, max %.2f mm)\n", name, mean,
+                a.size(), a.front(), a[a.size() / 2], a.back());
+  return buf;
+}
+
+}  // namespace
+
+MapCheckResult check_map(const MapSnapshot& map, const eval::Trajectory& gt, const MapCheckOptions& options) {
+  MapCheckResult out;
+  out.keyframes = map.keyframes.size();
+  out.points = map.points.size();
+  out.measurements = map.measurements.size();
+  if (map.keyframes.size() < 3) throw Error("map-check: the map has fewer than 3 keyframes");
+
+  // Ground truth of every keyframe, in the map's world frame (anchored at keyframe 0).
+  eval::Trajectory est_as_mapped;
+  std::vector<geom::SE3d> mapped;
+  for (const auto& k : map.keyframes) mapped.push_back(k.T_c_w);
+  eval::AssociationOptions ao;
+  ao.max_diff_s = options.max_time_diff_s;
+  std::vector<geom::SE3d> gt_T_w_c(map.keyframes.size());
+  {
+    eval::Trajectory kfs;
+    for (std::size_t i = 0; i < map.keyframes.size(); ++i)
+      kfs.poses.push_back({map.keyframes[i].t_ns, geom::SE3d::Identity()});
+    std::vector<std::size_t> order(kfs.poses.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return kfs.poses[a].t_ns < kfs.poses[b].t_ns; });
+    eval::Trajectory sorted;
+    for (std::size_t i : order) sorted.poses.push_back(kfs.poses[i]);
+    const auto pairs = eval::associate(gt, sorted, ao);
+    std::vector<bool> have(map.keyframes.size(), false);
+    for (const auto& pr : pairs) {
+      gt_T_w_c[order[pr.est]] = gt.poses[pr.gt].T_w_c;
+      have[order[pr.est]] = true;
+    }
+    for (std::size_t i = 0; i < have.size(); ++i)
+      if (!have[i])
+        throw Error("map-check: keyframe " + std::to_string(map.keyframes[i].id) + " (t " +
+                    std::to_string(map.keyframes[i].t_ns * 1e-9) + " s) has no ground truth within " +
+                    std::to_string(options.max_time_diff_s) + " s in " + gt.source);
+  }
+  const geom::SE3d T_gtw_w = gt_T_w_c[0] * map.keyframes[0].T_c_w;
+  std::vector<geom::SE3d> truth(map.keyframes.size());
+  for (std::size_t i = 0; i < truth.size(); ++i) truth[i] = gt_T_w_c[i].inverse() * T_gtw_w;
+
+  eval::EvalOptions eo;
+  eo.association = ao;
+  eo.rpe.pairs = eval::PairMode::kConsecutive;
+  out.estimate = fit_of(mapped, map, gt, eo);
+
+  BaOptions ba;
+  ba.sparse_schur = true;
+  ba.iterations_first = 10;
+  ba.iterations_second = 20;
+
+  // Points fitted to their measurements with every keyframe at the truth.
+  BaProblem at_truth = make_problem(map, truth, true);
+  slam::local_bundle_adjustment(&at_truth, map.K, ba);
+
+  // Measured: poses free from the truth.
+  {
+    BaProblem p = make_problem(map, truth, false);
+    for (std::size_t i = 0; i < p.points.size(); ++i) p.points[i].p_w = at_truth.points[i].p_w;
+    slam::local_bundle_adjustment(&p, map.K, ba);
+    out.measured = fit_of(poses_of(p), map, gt, eo);
+  }
+
+  // Whitened residuals at the truth, and the exact measurements of the fitted points.
+  const std::size_t n = at_truth.edges.size();
+  std::vector<Eigen::Vector3d> exact(n), residual(n);
+  Eigen::Vector3d sum2 = Eigen::Vector3d::Zero();
+  double count = 0, count_depth = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& e = at_truth.edges[k];
+    const Eigen::Vector3d p_c = at_truth.keyframes[e.keyframe].T_c_w * at_truth.points[e.point].p_w;
+    const Eigen::Vector2d uv = slam::project(map.K, p_c);
+    const double w = std::sqrt(e.obs.inv_sigma2);
+    exact[k] = Eigen::Vector3d(uv.x(), uv.y(), uv.x() - map.K.bf / p_c.z());
+    const bool depth = e.obs.u_right >= 0;
+    residual[k] = Eigen::Vector3d(e.obs.uv.x() - uv.x(), e.obs.uv.y() - uv.y(), depth ? e.obs.u_right - exact[k].z() : 0.0) * w;
+    if (residual[k].norm() < 3) {
+      sum2 += residual[k].cwiseProduct(residual[k]);
+      count += 1;
+      count_depth += depth ? 1 : 0;
+    }
+  }
+  if (count > 0)
+    out.residual_rms = Eigen::Vector3d(std::sqrt(sum2.x() / count), std::sqrt(sum2.y() / count),
+                                       count_depth > 0 ? std::sqrt(sum2.z() / count_depth) : 0.0);
+
+  const auto run_draw = [&](const std::vector<Eigen::Vector3d>& r) {
+    BaProblem p = make_problem(map, truth, false);
+    for (std::size_t i = 0; i < p.points.size(); ++i) p.points[i].p_w = at_truth.points[i].p_w;
+    for (std::size_t k = 0; k < n; ++k) {
+      auto& o = p.edges[k].obs;
+      const double w = std::sqrt(o.inv_sigma2);
+      o.uv = Eigen::Vector2d(exact[k].x() + r[k].x() / w, exact[k].y() + r[k].y() / w);
+      if (o.u_right >= 0) o.u_right = exact[k].z() + r[k].z() / w;
+    }
+    slam::local_bundle_adjustment(&p, map.K, ba);
+    return fit_of(poses_of(p), map, gt, eo);
+  };
+  for (int d = 0; d < options.draws; ++d) {
+    std::mt19937 rng(options.seed + static_cast<std::uint32_t>(d));
+    std::normal_distribution<double> normal(0.0, 1.0);
+    std::vector<Eigen::Vector3d> r(n);
+    for (auto& x : r) {
+      x.x() = normal(rng) * out.residual_rms.x();
+      x.y() = normal(rng) * out.residual_rms.y();
+      x.z() = normal(rng) * out.residual_rms.z();
+    }
+    out.gaussian.push_back(run_draw(r));
+    for (std::size_t k = 0; k < n; ++k) r[k] = (rng() & 1u) ? residual[k] : Eigen::Vector3d(-residual[k]);
+    out.sign_flipped.push_back(run_draw(r));
+  }
+  return out;
+}
+
+std::string format_map_check(const MapCheckResult& r) {
+  std::ostringstream os;
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), "map: %zu keyframes, %zu points, %zu measurements\n", r.keyframes, r.points,
+                r.measurements);
+  os << buf;
+  std::snprintf(buf, sizeof(buf),
+                "residual RMS at ground truth (px / 1.2^octave, under 3): u %.3f  v %.3f  u_right %.3f\n",
+                r.residual_rms.x(), r.residual_rms.y(), r.residual_rms.z());
+  os << buf;
+  os << "                                       KF ATE mm   rotation error per keyframe pair, deg (t)\n"
+        "                                                  pitch (x)        yaw (y)          roll (z)\n";
+  os << fit_line("estimate (as mapped)", r.estimate);
+  os << fit_line("measured, global BA from ground truth", r.measured);
+  os << draws_line("Gaussian noise of that RMS, mean", r.gaussian);
+  os << draws_line("measured sizes, random signs, mean", r.sign_flipped);
+  if (!r.sign_flipped.empty()) {
+    std::size_t better = 0;
+    for (const auto& f : r.sign_flipped) better += f.ate_rmse_m < r.measured.ate_rmse_m ? 1 : 0;
+    std::string biased;
+    static const char* kAxis[] = {"pitch", "yaw", "roll"};
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(r.measured.rot_t[k]) > 3) {
+        std::snprintf(buf, sizeof(buf), "%s%s t %+.1f", biased.empty() ? "" : ", ", kAxis[k], r.measured.rot_t[k]);
+        biased += buf;
+      }
+    std::snprintf(buf, sizeof(buf), "reading: the measured fit is worse than %zu of %zu sign-flipped draws", better,
+                  r.sign_flipped.size());
+    os << buf;
+    if (better == r.sign_flipped.size() || !biased.empty())
+      os << "; systematic error in the measurements" << (biased.empty() ? "" : " (rotation bias: " + biased + ")")
+         << "\n";
+    else
+      os << ", no rotation bias with |t| > 3: noise-limited\n";
+  }
+  return os.str();
+}
+
+}  // namespace pvb::run
