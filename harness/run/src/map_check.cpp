@@ -93,7 +93,6 @@ MapCheckResult check_map(const MapSnapshot& map, const eval::Trajectory& gt, con
   if (map.keyframes.size() < 3) throw Error("map-check: the map has fewer than 3 keyframes");
 
   // Ground truth of every keyframe, in the map's world frame (anchored at keyframe 0).
-  eval::Trajectory est_as_mapped;
   std::vector<geom::SE3d> mapped;
   for (const auto& k : map.keyframes) mapped.push_back(k.T_c_w);
   eval::AssociationOptions ao;
