@@ -99,17 +99,15 @@ MapCheckResult check_map(const MapSnapshot& map, const eval::Trajectory& gt, con
   ao.max_diff_s = options.max_time_diff_s;
   std::vector<geom::SE3d> gt_T_w_c(map.keyframes.size());
   {
-    eval::Trajectory kfs;
-    for (std::size_t i = 0; i < map.keyframes.size(); ++i)
-      kfs.poses.push_back({map.keyframes[i].t_ns, geom::SE3d::Identity()});
-    std::vector<std::size_t> order(kfs.poses.size());
+    // eval::associate wants both trajectories sorted by time; `order` maps back.
+    std::vector<std::size_t> order(map.keyframes.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return kfs.poses[a].t_ns < kfs.poses[b].t_ns; });
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t a, std::size_t b) { return map.keyframes[a].t_ns < map.keyframes[b].t_ns; });
     eval::Trajectory sorted;
-    for (std::size_t i : order) sorted.poses.push_back(kfs.poses[i]);
-    const auto pairs = eval::associate(gt, sorted, ao);
+    for (std::size_t i : order) sorted.poses.push_back({map.keyframes[i].t_ns, geom::SE3d::Identity()});
     std::vector<bool> have(map.keyframes.size(), false);
-    for (const auto& pr : pairs) {
+    for (const auto& pr : eval::associate(gt, sorted, ao)) {
       gt_T_w_c[order[pr.est]] = gt.poses[pr.gt].T_w_c;
       have[order[pr.est]] = true;
     }
@@ -137,14 +135,6 @@ MapCheckResult check_map(const MapSnapshot& map, const eval::Trajectory& gt, con
   BaProblem at_truth = make_problem(map, truth, true);
   slam::local_bundle_adjustment(&at_truth, map.K, ba);
 
-  // Measured: poses free from the truth.
-  {
-    BaProblem p = make_problem(map, truth, false);
-    for (std::size_t i = 0; i < p.points.size(); ++i) p.points[i].p_w = at_truth.points[i].p_w;
-    slam::local_bundle_adjustment(&p, map.K, ba);
-    out.measured = fit_of(poses_of(p), map, gt, eo);
-  }
-
   // Whitened residuals at the truth, and the exact measurements of the fitted points.
   const std::size_t n = at_truth.edges.size();
   std::vector<Eigen::Vector3d> exact(n), residual(n);
@@ -168,18 +158,23 @@ MapCheckResult check_map(const MapSnapshot& map, const eval::Trajectory& gt, con
     out.residual_rms = Eigen::Vector3d(std::sqrt(sum2.x() / count), std::sqrt(sum2.y() / count),
                                        count_depth > 0 ? std::sqrt(sum2.z() / count_depth) : 0.0);
 
-  const auto run_draw = [&](const std::vector<Eigen::Vector3d>& r) {
+  // Global BA with the poses free, from the truth and the fitted points;
+  // r == nullptr: the measurements as they are, else the exact ones plus r
+  // (whitened, per measurement).
+  const auto fit_from_truth = [&](const std::vector<Eigen::Vector3d>* r) {
     BaProblem p = make_problem(map, truth, false);
     for (std::size_t i = 0; i < p.points.size(); ++i) p.points[i].p_w = at_truth.points[i].p_w;
-    for (std::size_t k = 0; k < n; ++k) {
-      auto& o = p.edges[k].obs;
-      const double w = std::sqrt(o.inv_sigma2);
-      o.uv = Eigen::Vector2d(exact[k].x() + r[k].x() / w, exact[k].y() + r[k].y() / w);
-      if (o.u_right >= 0) o.u_right = exact[k].z() + r[k].z() / w;
-    }
+    if (r)
+      for (std::size_t k = 0; k < n; ++k) {
+        auto& o = p.edges[k].obs;
+        const double w = std::sqrt(o.inv_sigma2);
+        o.uv = Eigen::Vector2d(exact[k].x() + (*r)[k].x() / w, exact[k].y() + (*r)[k].y() / w);
+        if (o.u_right >= 0) o.u_right = exact[k].z() + (*r)[k].z() / w;
+      }
     slam::local_bundle_adjustment(&p, map.K, ba);
     return fit_of(poses_of(p), map, gt, eo);
   };
+  out.measured = fit_from_truth(nullptr);
   for (int d = 0; d < options.draws; ++d) {
     std::mt19937 rng(options.seed + static_cast<std::uint32_t>(d));
     std::normal_distribution<double> normal(0.0, 1.0);
@@ -189,9 +184,9 @@ MapCheckResult check_map(const MapSnapshot& map, const eval::Trajectory& gt, con
       x.y() = normal(rng) * out.residual_rms.y();
       x.z() = normal(rng) * out.residual_rms.z();
     }
-    out.gaussian.push_back(run_draw(r));
+    out.gaussian.push_back(fit_from_truth(&r));
     for (std::size_t k = 0; k < n; ++k) r[k] = (rng() & 1u) ? residual[k] : Eigen::Vector3d(-residual[k]);
-    out.sign_flipped.push_back(run_draw(r));
+    out.sign_flipped.push_back(fit_from_truth(&r));
   }
   return out;
 }
