@@ -285,6 +285,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
     l.ambient = r.number("ambient", l.ambient, 0, 1);
     l.shadows = r.boolean("shadows", l.shadows);
     l.shadow_map_px = r.integer("shadow_map_px", l.shadow_map_px, 256, 8192);
+    l.shadow_follows_robot = r.boolean("shadow_follows_robot", l.shadow_follows_robot);
     l.box_quads = r.integer("box_quads", l.box_quads, 1, 16);
   });
   with_map(top, "route", [&](MapReader& r) {

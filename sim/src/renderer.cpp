@@ -1,5 +1,7 @@
 #include "pvb/sim/renderer.hpp"
 
+#include <cmath>
+
 #include "pvb/common/error.hpp"
 
 namespace pvb::sim {
@@ -39,6 +41,58 @@ Renderer::~Renderer() {
   mjv_freeScene(&scene_);
 }
 
+namespace {
+
+void cross(float* a, const float* b, const float* c) {
+  a[0] = b[1] * c[2] - b[2] * c[1];
+  a[1] = b[2] * c[0] - b[0] * c[2];
+  a[2] = b[0] * c[1] - b[1] * c[0];
+}
+
+void normalize(float* v) {
+  const float n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (n < 1e-10f) {
+    v[0] = 0;
+    v[1] = 0;
+    v[2] = 1;
+    return;
+  }
+  for (int i = 0; i < 3; ++i) v[i] /= n;
+}
+
+}  // namespace
+
+double shadow_texel_m(double shadow_clip_m, int shadow_size_px) {
+  return 2.0 * shadow_clip_m / (shadow_size_px - 2);
+}
+
+void snap_to_shadow_texels(float pos[3], const float dir[3], double texel_m) {
+  // The light's view axes as MuJoCo builds them: up = dir x (-1, 0, 0)
+  // (or dir x (0, 1, 0) when dir is near the x axis), side = dir x up,
+  // up' = side x dir.
+  float f[3] = {dir[0], dir[1], dir[2]}, up[3], s[3], u[3];
+  float other[3] = {-1, 0, 0};
+  cross(up, dir, other);
+  if (up[0] * up[0] + up[1] * up[1] + up[2] * up[2] <= 0.01f) {
+    other[0] = 0;
+    other[1] = 1;
+    cross(up, dir, other);
+  }
+  normalize(up);
+  normalize(f);
+  cross(s, f, up);
+  normalize(s);
+  cross(u, s, f);
+  normalize(u);
+  double a = 0, b = 0;
+  for (int i = 0; i < 3; ++i) {
+    a += static_cast<double>(s[i]) * pos[i];
+    b += static_cast<double>(u[i]) * pos[i];
+  }
+  const double da = a - texel_m * std::round(a / texel_m), db = b - texel_m * std::round(b / texel_m);
+  for (int i = 0; i < 3; ++i) pos[i] = static_cast<float>(pos[i] - da * s[i] - db * u[i]);
+}
+
 void Renderer::set_shadows(bool on) { scene_.flags[mjRND_SHADOW] = on ? 1 : 0; }
 
 void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat* rgb, cv::Mat* depth_m) {
@@ -48,6 +102,13 @@ void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat
   camera_.type = mjCAMERA_FIXED;
   camera_.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
+  if (stable_shadows_) {
+    const double texel_m = shadow_texel_m(con_.shadowClip, con_.shadowSize);
+    for (int i = 0; i < scene_.nlight; ++i) {
+      mjvLight& light = scene_.lights[i];
+      if (light.directional && light.castshadow) snap_to_shadow_texels(light.pos, light.dir, texel_m);
+    }
+  }
   const mjrRect viewport{0, 0, width_, height_};
   mjr_render(viewport, &scene_, &con_);
   mjr_readPixels(rgb ? rgb_buf_.data() : nullptr, depth_m ? depth_buf_.data() : nullptr, viewport, &con_);

@@ -129,6 +129,29 @@ void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t 
 
 }  // namespace
 
+ShadowMap shadow_map_for(const scenes::Light& light, const std::vector<Eigen::Vector2d>& route_xy_m) {
+  ShadowMap m;
+  m.follows_robot = light.shadow_follows_robot;
+  if (!m.follows_robot && !route_xy_m.empty()) {
+    Eigen::Vector2d lo = route_xy_m.front(), hi = route_xy_m.front();
+    for (const auto& p : route_xy_m) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    m.centre_xy_m = 0.5 * (lo + hi);
+    // The map is a square turned with the sun's azimuth: a circle through
+    // the box's corners, plus the margin, fits in it whatever the turn.
+    m.half_width_m = 0.5 * (hi - lo).norm() + kShadowMarginM;
+  }
+  if (light.shadow_map_px > 0) {
+    m.size_px = light.shadow_map_px;
+  } else {
+    m.size_px = 1024;
+    while (m.size_px < 8192 && m.texel_m() > kShadowTexelTargetM) m.size_px *= 2;
+  }
+  return m;
+}
+
 SceneAssets build_scene(const scenes::Scenario& s) {
   SceneAssets out;
   const scenes::Camera& cam = s.camera;
@@ -146,6 +169,7 @@ SceneAssets build_scene(const scenes::Scenario& s) {
   const double znear_m = 0.05, zfar_m = 2.5 * diag;
 
   const std::vector<Eigen::Vector2d> route = scenes::route_polyline(s);
+  const ShadowMap shadow = shadow_map_for(s.light, route);
   for (const auto& p : route) {
     out.route_xy.push_back(p.x());
     out.route_xy.push_back(p.y());
@@ -183,10 +207,10 @@ SceneAssets build_scene(const scenes::Scenario& s) {
   // The subdivision only serves per-vertex lighting; with a directional sun
   // 1 changes the colour image by 0.004 of 255 on average and saves a
   // fifth of the render time (docs/run.md, "Where the time goes").
-  x.line("<quality shadowsize=\"" + std::to_string(s.light.shadow_map_px) + "\" offsamples=\"0\" numquads=\"" +
+  x.line("<quality shadowsize=\"" + std::to_string(shadow.size_px) + "\" offsamples=\"0\" numquads=\"" +
          std::to_string(s.light.box_quads) + "\"/>");
   x.line("<map znear=\"" + f(znear_m / extent) + "\" zfar=\"" + f(zfar_m / extent) + "\" shadowclip=\"" +
-         f(9.0 / extent) + "\" shadowscale=\"0.6\"/>");
+         f(shadow.half_width_m / extent) + "\" shadowscale=\"0.6\"/>");
   const double amb = s.light.ambient;
   x.line("<headlight ambient=\"" + v3(amb, amb, amb) + "\" diffuse=\"0 0 0\" specular=\"0 0 0\"/>");
   x.close("</visual>");
@@ -329,15 +353,22 @@ SceneAssets build_scene(const scenes::Scenario& s) {
   const Eigen::Vector3d up = right.cross(fwd);
   x.line("<camera name=\"" + std::string(kCameraName) + "\" pos=\"" + v3(cam.mount_forward_m, 0, mast_h) +
          "\" xyaxes=\"" + v3(right) + " " + v3(up) + "\" fovy=\"" + f(fovy_deg) + "\"/>");
-  // The sun follows the robot (mode track: fixed offset and orientation in
-  // the world frame) so its shadow map always covers what the camera sees.
+  // The sun: a directional light whose position only places its shadow
+  // map (ShadowMap).  Following the robot it sits in the robot's body with
+  // mode "track" (fixed offset and orientation in the world frame);
+  // otherwise in the world body above the map's centre.
   const double az = s.light.sun_azimuth_deg * kDeg, el = s.light.sun_elevation_deg * kDeg;
   const Eigen::Vector3d to_sun(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
   const double I = s.light.intensity;
-  x.line("<light name=\"sun\" mode=\"track\" directional=\"true\" castshadow=\"" +
-         std::string(s.light.shadows ? "true" : "false") + "\" pos=\"" + v3(to_sun * 20.0) + "\" dir=\"" +
-         v3(-to_sun) + "\" diffuse=\"" + v3(I, I, I * 0.96) + "\" specular=\"" + v3(0.5 * I, 0.5 * I, 0.5 * I) + "\"/>");
+  const auto sun_line = [&](const std::string& mode, const Eigen::Vector3d& pos) {
+    return "<light name=\"sun\" mode=\"" + mode + "\" directional=\"true\" castshadow=\"" +
+           std::string(s.light.shadows ? "true" : "false") + "\" pos=\"" + v3(pos) + "\" dir=\"" + v3(-to_sun) +
+           "\" diffuse=\"" + v3(I, I, I * 0.96) + "\" specular=\"" + v3(0.5 * I, 0.5 * I, 0.5 * I) + "\"/>";
+  };
+  if (shadow.follows_robot) x.line(sun_line("track", to_sun * 20.0));
   x.close("</body>");
+  if (!shadow.follows_robot)
+    x.line(sun_line("fixed", Eigen::Vector3d(shadow.centre_xy_m.x(), shadow.centre_xy_m.y(), 0) + to_sun * 20.0));
   x.close("</worldbody>");
 
   x.open("<actuator>");

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "pvb/common/error.hpp"
 #include "pvb/geometry/pinhole.hpp"
@@ -151,6 +153,72 @@ void check_two_renderers(sim::GlBackend backend) {
   EXPECT_NEAR(centre_depth(&a, 0.8), 0.8, 1e-4);
 }
 
+// A post's shadow on the ground, seen from above by a world camera, under a
+// sun that follows a movable carrier (as the scenes' sun follows the robot):
+// 9 m shadow clip at 1024 texels, 17.6 mm a texel, about 3 px here.
+std::string shadow_model_xml() {
+  scenes::Camera cam;
+  char buf[4096];
+  std::snprintf(buf, sizeof buf, R"(<mujoco>
+  <statistic extent="10" center="0 0 0"/>
+  <visual><global offwidth="%d" offheight="%d"/><quality offsamples="0" shadowsize="1024"/>
+    <map znear="0.005" zfar="10" shadowclip="0.9"/><headlight ambient="0.3 0.3 0.3" diffuse="0 0 0"/></visual>
+  <worldbody>
+    <geom type="plane" size="20 20 0.1" rgba="0.7 0.7 0.7 1"/>
+    <geom type="box" size="0.03 0.6 0.5" pos="0.3 0 0.5" euler="0 0 27" rgba="0.5 0.5 0.5 1"/>
+    <camera name="top" pos="1.0 0.8 3.0" xyaxes="0 -1 0 1 0 0" fovy="%.9f"/>
+    <body name="carrier" mocap="true" pos="0 0 0">
+      <light name="sun" mode="track" directional="true" castshadow="true" pos="-10.8 -3.9 16.4"
+             dir="0.54 0.196 -0.82" diffuse="0.8 0.8 0.8"/>
+    </body>
+  </worldbody></mujoco>)",
+                kW, kH, cam.fovy_deg());
+  return buf;
+}
+
+struct ShadowRun {
+  std::vector<int> changed_px;    ///< per offset: pixels that differ from offset 0
+  std::vector<double> shift_px;   ///< per offset: shift of the shadow's centroid, pixels
+};
+
+// Renders the post's shadow with the sun's carrier moved by each offset
+// (metres along `axis`) and compares each image with the first.
+ShadowRun move_the_sun(sim::GlBackend backend, bool stable, const std::vector<double>& offsets_m,
+                       const Eigen::Vector3d& axis) {
+  sim::SceneAssets a;
+  a.xml = shadow_model_xml();
+  sim::ModelPtr model = sim::compile_scene(a);
+  mjData* data = mj_makeData(model.get());
+  sim::Renderer renderer(model.get(), backend, kW, kH);
+  renderer.set_stable_shadows(stable);
+  const int mocap = model->body_mocapid[mj_name2id(model.get(), mjOBJ_BODY, "carrier")];
+  ShadowRun out;
+  cv::Mat first;
+  cv::Point2d first_centroid;
+
+  for (double d : offsets_m) {
+    for (int i = 0; i < 3; ++i) data->mocap_pos[3 * mocap + i] = d * axis[i];
+    mj_forward(model.get(), data);
+    cv::Mat rgb, grey;
+    renderer.render(model.get(), data, 0, &rgb, nullptr);
+    cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+    // the shadow on the ground (grey 70-110 here); the wall's shaded side is darker, the lit ground lighter
+    const cv::Moments m = cv::moments((grey > 60) & (grey < 130), true);
+    const cv::Point2d centroid(m.m10 / m.m00, m.m01 / m.m00);
+    if (first.empty()) {
+      first = grey;
+      first_centroid = centroid;
+      continue;
+    }
+    cv::Mat diff;
+    cv::absdiff(grey, first, diff);
+    out.changed_px.push_back(cv::countNonZero(diff > 8));
+    out.shift_px.push_back(cv::norm(centroid - first_centroid));
+  }
+  mj_deleteData(data);
+  return out;
+}
+
 }  // namespace
 
 TEST(Renderer, DepthFromBufferFormula) {
@@ -171,6 +239,60 @@ TEST(RendererEgl, TwoRenderersInOneProcessEachUseTheirOwnContext) {
 }
 TEST(RendererOsmesa, TwoRenderersInOneProcessEachUseTheirOwnContext) {
   check_two_renderers(sim::GlBackend::kOsmesa);
+}
+
+// A sun that follows the robot drags its shadow map's texel grid along, and
+// every shadow edge's texel steps crawl over the static ground.  Snapping
+// the light to a world-fixed grid stops that for moves of a fraction of a
+// texel...
+TEST(RendererOsmesa, SnappedSunKeepsShadowEdgesStillUnderSmallMoves) {
+  const std::vector<double> offsets_m = {0.0, 0.0041, 0.0093, 0.0137};
+  const ShadowRun dragged = move_the_sun(sim::GlBackend::kOsmesa, false, offsets_m, Eigen::Vector3d::UnitX());
+  const ShadowRun stable = move_the_sun(sim::GlBackend::kOsmesa, true, offsets_m, Eigen::Vector3d::UnitX());
+  for (std::size_t i = 0; i < stable.changed_px.size(); ++i) {
+    std::printf("sun moved %.4f m: %d pixels change as MuJoCo draws it, %d with the grid fixed\n",
+                offsets_m[i + 1], dragged.changed_px[i], stable.changed_px[i]);
+    EXPECT_GT(dragged.changed_px[i], 100) << "the control: a texel grid that moves must move the shadow edges";
+    EXPECT_LE(stable.changed_px[i], 5) << "shadow edges moved with the sun by " << offsets_m[i + 1] << " m";
+  }
+}
+
+// ...but not over metres: MuJoCo 2.2.2 renders the shadow map into its
+// inner size - 2 texels and samples it over the whole texture, so shadows
+// are drawn 2 / (size - 2) nearer the light's axis than they are, and move
+// with the light by that share of its travel, even in whole-texel steps.
+// This is why the scenes' sun is fixed in the world (sim::ShadowMap); if a
+// MuJoCo update makes this test fail, a following sun has become safe.
+TEST(RendererOsmesa, ShadowsCreepWithALightThatMovesMetres) {
+  const double texel_m = sim::shadow_texel_m(9.0, 1024);
+  const std::vector<double> offsets_m = {0.0, 200 * texel_m, 400 * texel_m};
+  const ShadowRun run = move_the_sun(sim::GlBackend::kOsmesa, true, offsets_m, Eigen::Vector3d::UnitY());
+  // the camera is 3 m above the ground: 3 / 525 m a pixel
+  for (std::size_t i = 0; i < run.shift_px.size(); ++i) {
+    const double creep_px = offsets_m[i + 1] * 2.0 / 1022 / (3.0 / 525.0);
+    std::printf("sun moved %.3f m: shadow moved %.2f px, %.2f px expected from the 2-texel mismatch\n",
+                offsets_m[i + 1], run.shift_px[i], creep_px);
+    EXPECT_GT(run.shift_px[i], 0.4 * creep_px);
+    EXPECT_LT(run.shift_px[i], 1.6 * creep_px);
+  }
+}
+
+TEST(Renderer, SnappingKeepsTheLightOnItsRayAndOnTheGrid) {
+  const float dir[3] = {0.54f, 0.196f, -0.82f};
+  float pos[3] = {3.217f, -1.403f, 16.4f};
+  const float before[3] = {pos[0], pos[1], pos[2]};
+  const double texel = sim::shadow_texel_m(9.0, 1024);
+  EXPECT_NEAR(texel, 18.0 / 1022, 1e-12);
+  sim::snap_to_shadow_texels(pos, dir, texel);
+  // moved across the light direction only, by at most half a texel diagonal
+  const Eigen::Vector3d d = Eigen::Vector3d(dir[0], dir[1], dir[2]).normalized();
+  const Eigen::Vector3d moved(pos[0] - before[0], pos[1] - before[1], pos[2] - before[2]);
+  EXPECT_NEAR(moved.dot(d), 0.0, 1e-5);
+  EXPECT_LE(moved.norm(), texel * std::sqrt(0.5) + 1e-6);
+  // snapping twice changes nothing
+  float again[3] = {pos[0], pos[1], pos[2]};
+  sim::snap_to_shadow_texels(again, dir, texel);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(again[i], pos[i], 2e-6);
 }
 
 TEST(GlContext, OneProcessNeverLoadsBothBackends) {

@@ -62,3 +62,37 @@ TEST(SceneBuilder, BoxQuadsSetMujocoTessellation) {
   s.light.box_quads = 4;  // MuJoCo's own default
   EXPECT_EQ(sim::compile_scene(sim::build_scene(s))->vis.quality.numquads, 4);
 }
+
+// The sun's shadow map is fixed in the world by default and covers the
+// route with kShadowMarginM around it; following the robot is the opt-in.
+TEST(SceneBuilder, SunShadowMapIsFixedOverTheRouteUnlessItFollowsTheRobot) {
+  scenes::Scenario s = station();
+  const sim::SceneAssets a = sim::build_scene(s);
+  const sim::ModelPtr m = sim::compile_scene(a);
+  ASSERT_EQ(m->nlight, 1);
+  EXPECT_EQ(m->light_bodyid[0], 0) << "the sun belongs to the world body";
+  EXPECT_EQ(m->light_mode[0], mjCAMLIGHT_FIXED);
+  const double half_width_m = m->vis.map.shadowclip * m->stat.extent;
+  const int size_px = m->vis.quality.shadowsize;
+  const double texel_m = 2 * half_width_m / (size_px - 2);
+  EXPECT_LE(texel_m, sim::kShadowTexelTargetM);
+  EXPECT_GT(texel_m, sim::kShadowTexelTargetM / 2) << "no larger map than the texel target needs";
+  // every route point lies at least the margin inside the square, whatever its turn
+  const Eigen::Vector2d centre(m->light_pos[0], m->light_pos[1]);
+  const Eigen::Vector3d to_sun = -Eigen::Vector3d(m->light_dir[0], m->light_dir[1], m->light_dir[2]).normalized();
+  const Eigen::Vector2d axis_xy = centre - 20.0 * to_sun.head<2>();  // the light sits 20 m towards the sun
+  for (std::size_t i = 0; i + 1 < a.route_xy.size(); i += 2) {
+    const Eigen::Vector2d p(a.route_xy[i], a.route_xy[i + 1]);
+    EXPECT_LE((p - axis_xy).norm() + sim::kShadowMarginM, half_width_m + 1e-9);
+  }
+
+  s.light.shadow_follows_robot = true;
+  const sim::ModelPtr f = sim::compile_scene(sim::build_scene(s));
+  EXPECT_EQ(f->light_bodyid[0], mj_name2id(f.get(), mjOBJ_BODY, sim::kRobotBody));
+  EXPECT_EQ(f->light_mode[0], mjCAMLIGHT_TRACK);
+  EXPECT_NEAR(f->vis.map.shadowclip * f->stat.extent, 9.0, 1e-4);
+  EXPECT_EQ(f->vis.quality.shadowsize, 1024);
+
+  s.light.shadow_map_px = 512;  // an explicit size wins
+  EXPECT_EQ(sim::compile_scene(sim::build_scene(s))->vis.quality.shadowsize, 512);
+}

@@ -75,7 +75,16 @@ struct Light {
   double intensity = 0.8;           ///< diffuse of the sun light, 0..1
   double ambient = 0.35;            ///< ambient light, 0..1
   bool shadows = true;
-  int shadow_map_px = 1024;  ///< shadow map resolution; the map covers 18 m around the robot
+  /// Shadow map side in texels; 0 picks the smallest power of two from 1024
+  /// that keeps texels at most 20 mm over the area the map covers.
+  int shadow_map_px = 0;
+  /// false (default): the shadow map is fixed in the world and covers the
+  /// route plus 9 m around it, so shadows are static.  true: MuJoCo's
+  /// tracking sun, a map of 18 m around the robot that moves with it;
+  /// MuJoCo 2.2.2 draws that map 2 texels smaller than it samples it, so
+  /// every shadow then creeps along with the robot by about 0.2 % of the
+  /// distance driven (docs/scenarios.md, "Static shadows").
+  bool shadow_follows_robot = false;
   /// Quads along each edge of a box face (MuJoCo vis.quality.numquads);
   /// only per-vertex lighting uses them.  1 renders faster (docs/run.md).
   int box_quads = 1;

@@ -36,6 +36,10 @@ class Renderer {
 
   /// Turns shadows on or off for the following renders.
   void set_shadows(bool on);
+  /// Keeps the shadow-map texel grid of each directional shadow-casting
+  /// light fixed in the world (on by default; see snap_to_shadow_texels).
+  /// Off is MuJoCo's own behaviour, kept for tests that show the difference.
+  void set_stable_shadows(bool on) { stable_shadows_ = on; }
   const std::string& description() const { return gl_->description(); }
   GlBackend backend() const { return gl_->backend(); }
   int width() const { return width_; }
@@ -49,9 +53,26 @@ class Renderer {
   mjvCamera camera_;
   int width_;
   int height_;
+  bool stable_shadows_ = true;
   std::vector<unsigned char> rgb_buf_;
   std::vector<float> depth_buf_;
 };
+
+/// Side of one shadow-map texel, metres, for a directional light: MuJoCo
+/// renders the light's orthographic view of half-width `shadow_clip_m`
+/// into the texture's inner shadow_size - 2 texels (one texel border).
+double shadow_texel_m(double shadow_clip_m, int shadow_size_px);
+
+/// Moves a directional light's position, across its direction only, to the
+/// nearest node of a texel grid fixed in the world.  A light that follows
+/// the robot (mode "track") otherwise drags the shadow map's texel grid
+/// with it, and every shadow edge, drawn at texel resolution, crawls over
+/// the static scene as the robot drives: image corners that are not fixed
+/// 3-D points.  Uses the light frame of MuJoCo 2.2.2's shadow pass (up from
+/// mjr_orthoVec, then mjr_lookAt).  The shadow's lit/dark pattern is then
+/// the same wherever the light is, up to which part of the world the map
+/// covers.
+void snap_to_shadow_texels(float pos[3], const float dir[3], double texel_m);
 
 /// Converts one standard-Z-buffer value to metric depth (0 for d >= 1).
 inline float depth_from_buffer(float d, double znear_m, double zfar_m) {

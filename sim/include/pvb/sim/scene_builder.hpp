@@ -21,6 +21,23 @@ struct SceneAssets {
   std::vector<double> route_xy;    ///< route polyline, x0 y0 x1 y1 ...
 };
 
+/// Where the sun's shadow map lies.  Fixed (the default): centred on the
+/// route's bounding box, reaching `kShadowMarginM` beyond its corners;
+/// its size, unless the scenario sets one, is the smallest power of two
+/// from 1024 that keeps texels at most kShadowTexelTargetM (up to 8192).
+/// Following the robot: 9 m around it (the centre is then the offset from
+/// the robot, zero).
+struct ShadowMap {
+  bool follows_robot = false;
+  Eigen::Vector2d centre_xy_m = Eigen::Vector2d::Zero();
+  double half_width_m = 9.0;  ///< MuJoCo's shadowclip, metres
+  int size_px = 1024;         ///< texture side
+  double texel_m() const { return 2.0 * half_width_m / (size_px - 2); }
+};
+inline constexpr double kShadowMarginM = 9.0;
+inline constexpr double kShadowTexelTargetM = 0.020;
+ShadowMap shadow_map_for(const scenes::Light& light, const std::vector<Eigen::Vector2d>& route_xy_m);
+
 /// Generates the scene.  Deterministic in the scenario (seed included).
 SceneAssets build_scene(const scenes::Scenario& scenario);
 
