@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "pvb/common/error.hpp"
+#include "pvb/sim/scene_builder.hpp"
 
 namespace pvb::sim {
 
@@ -61,10 +62,6 @@ void normalize(float* v) {
 }
 
 }  // namespace
-
-double shadow_texel_m(double shadow_clip_m, int shadow_size_px) {
-  return 2.0 * shadow_clip_m / (shadow_size_px - 2);
-}
 
 void snap_to_shadow_texels(float pos[3], const float dir[3], double texel_m) {
   // The light's view axes as MuJoCo builds them: up = dir x (-1, 0, 0)

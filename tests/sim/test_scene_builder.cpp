@@ -74,7 +74,7 @@ TEST(SceneBuilder, SunShadowMapIsFixedOverTheRouteUnlessItFollowsTheRobot) {
   EXPECT_EQ(m->light_mode[0], mjCAMLIGHT_FIXED);
   const double half_width_m = m->vis.map.shadowclip * m->stat.extent;
   const int size_px = m->vis.quality.shadowsize;
-  const double texel_m = 2 * half_width_m / (size_px - 2);
+  const double texel_m = sim::shadow_texel_m(half_width_m, size_px);
   EXPECT_LE(texel_m, sim::kShadowTexelTargetM);
   EXPECT_GT(texel_m, sim::kShadowTexelTargetM / 2) << "no larger map than the texel target needs";
   // every route point lies at least the margin inside the square, whatever its turn

@@ -58,11 +58,6 @@ class Renderer {
   std::vector<float> depth_buf_;
 };
 
-/// Side of one shadow-map texel, metres, for a directional light: MuJoCo
-/// renders the light's orthographic view of half-width `shadow_clip_m`
-/// into the texture's inner shadow_size - 2 texels (one texel border).
-double shadow_texel_m(double shadow_clip_m, int shadow_size_px);
-
 /// Moves a directional light's position, across its direction only, to the
 /// nearest node of a texel grid fixed in the world.  A light that follows
 /// the robot (mode "track") otherwise drags the shadow map's texel grid

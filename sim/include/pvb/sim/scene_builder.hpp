@@ -21,6 +21,13 @@ struct SceneAssets {
   std::vector<double> route_xy;    ///< route polyline, x0 y0 x1 y1 ...
 };
 
+/// Side of one shadow-map texel, metres, for a directional light: MuJoCo
+/// renders the light's orthographic view of half-width `shadow_clip_m`
+/// into the texture's inner shadow_size - 2 texels (one texel border).
+inline double shadow_texel_m(double shadow_clip_m, int shadow_size_px) {
+  return 2.0 * shadow_clip_m / (shadow_size_px - 2);
+}
+
 /// Where the sun's shadow map lies.  Fixed (the default): centred on the
 /// route's bounding box, reaching `kShadowMarginM` beyond its corners;
 /// its size, unless the scenario sets one, is the smallest power of two
@@ -32,7 +39,7 @@ struct ShadowMap {
   Eigen::Vector2d centre_xy_m = Eigen::Vector2d::Zero();
   double half_width_m = 9.0;  ///< MuJoCo's shadowclip, metres
   int size_px = 1024;         ///< texture side
-  double texel_m() const { return 2.0 * half_width_m / (size_px - 2); }
+  double texel_m() const { return shadow_texel_m(half_width_m, size_px); }
 };
 inline constexpr double kShadowMarginM = 9.0;
 inline constexpr double kShadowTexelTargetM = 0.020;
