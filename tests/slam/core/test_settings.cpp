@@ -15,6 +15,7 @@ namespace pvb::slam {
 namespace {
 
 const std::string kTum1 = std::string(PVB_SHARED_DIR) + "/data/tum/TUM1.yaml";
+const std::string kTum3 = std::string(PVB_SOURCE_DIR) + "/configs/tum/TUM3.yaml";
 
 std::string temp_copy(const std::string& name, const std::string& content) {
   const std::string path = ::testing::TempDir() + "pvb_settings_" + name + "_" + std::to_string(::getpid()) + ".yaml";
@@ -50,6 +51,22 @@ TEST(Settings, ReadsTum1Unchanged) {
   EXPECT_TRUE(s.pe_match.refine);
   EXPECT_FALSE(s.pe_match.skip_low_parallax);
   // Viewer.* keys are ORB-SLAM2's own: no warnings.
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+}
+
+// The freiburg3 file we ship is a complete settings file: TUM's fr3
+// calibration, no distortion (the dataset's fr3 images are undistorted),
+// and no key the reader does not know.
+TEST(Settings, ShippedTum3IsCompleteAndUndistorted) {
+  const Settings s = read_settings(kTum3);
+  EXPECT_DOUBLE_EQ(s.K.fx, 535.4);
+  EXPECT_DOUBLE_EQ(s.K.fy, 539.2);
+  EXPECT_DOUBLE_EQ(s.K.cx, 320.1);
+  EXPECT_DOUBLE_EQ(s.K.cy, 247.6);
+  EXPECT_FALSE(s.has_distortion());
+  EXPECT_DOUBLE_EQ(s.depth_map_factor, 5000.0);
+  EXPECT_NEAR(s.th_depth_m(), 40.0 * 40.0 / 535.4, 1e-12);
+  EXPECT_EQ(s.orb.num_features, 1000);
   EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
 }
 
