@@ -351,6 +351,12 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
       g.glare = n.number("glare", g.glare, 0, 1);
     });
   });
+  with_map(top, "slam", [&](MapReader& r) {
+    SlamTuning& t = s.slam;
+    t.orb_features = r.integer("orb_features", t.orb_features, 100, 20000);
+    if (r.has("keyframe_min_tracked_close"))
+      t.keyframe_min_tracked_close = r.integer("keyframe_min_tracked_close", 0, 1, 100000);
+  });
   with_map(top, "expect", [&](MapReader& r) {
     Expectations& e = s.expect;
     if (r.has("ate_rmse_m_max")) e.ate_rmse_m_max = r.number("ate_rmse_m_max", 0.0, 1e-6, 100);

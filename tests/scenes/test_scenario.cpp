@@ -136,6 +136,26 @@ TEST(Scenario, ExpectSectionIsStrict) {
             std::string::npos);
 }
 
+TEST(Scenario, SlamSectionIsReadAndOptional) {
+  const Scenario none = parse_scenario(kMinimal, "min.yaml");
+  EXPECT_EQ(none.slam.orb_features, 1000);
+  EXPECT_FALSE(none.slam.keyframe_min_tracked_close);
+
+  const Scenario s = parse_scenario(std::string(kMinimal) + "slam: {orb_features: 2000, keyframe_min_tracked_close: 400}\n",
+                                    "s.yaml");
+  EXPECT_EQ(s.slam.orb_features, 2000);
+  ASSERT_TRUE(s.slam.keyframe_min_tracked_close);
+  EXPECT_EQ(*s.slam.keyframe_min_tracked_close, 400);
+
+  const std::string base = std::string(kMinimal) + "slam:\n";
+  EXPECT_NE(error_of(base + "  orb_features: 50\n").find("bad.yaml:3: slam.orb_features: expected a value in"),
+            std::string::npos)
+      << error_of(base + "  orb_features: 50\n");
+  EXPECT_NE(error_of(base + "  keyframe_min_tracked_close: 0\n").find("slam.keyframe_min_tracked_close"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "  nFeatures: 2000\n").find("slam.nFeatures: expected a known key"), std::string::npos);
+}
+
 TEST(Scenario, WallFinish) {
   const std::string wall = "walls:\n  - {start_m: [0, 0], end_m: [4, 0]}\n  - {start_m: [0, 2], end_m: [4, 2], finish: plaster}\n";
   const Scenario s = parse_scenario(std::string(kMinimal) + wall, "w.yaml");

@@ -62,7 +62,11 @@ void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s) {
                 s.K.fx, s.K.fy, s.K.cx, s.K.cy, s.k1, s.k2, s.p1, s.p2, s.k3, s.K.width, s.K.height, s.fps, s.bf,
                 s.rgb_order, s.th_depth, s.depth_map_factor, s.n_features, s.scale_factor, s.n_levels,
                 s.ini_th_fast, s.min_th_fast);
-  write_file(path, buf);
+  std::string text = buf;
+  if (s.kf_min_tracked_close)
+    text += "\n# Keyframe decision (pvbench's own key; ORB-SLAM2 ignores it)\nKeyFrame.minTrackedClose: " +
+            std::to_string(*s.kf_min_tracked_close) + "\n";
+  write_file(path, text);
 }
 
 cv::Mat depth_to_u16(const cv::Mat& depth_m, double factor) {

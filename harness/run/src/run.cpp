@@ -293,6 +293,8 @@ dataset::OrbSlamSettings orbslam_settings_for(const scenes::Scenario& s) {
   // ThDepth is in baselines: points beyond depth_range max are "far".
   o.th_depth = s.camera.depth_range_m.y() / s.camera.depth_noise.baseline_m;
   o.rgb_order = 1;
+  o.n_features = s.slam.orb_features;
+  o.kf_min_tracked_close = s.slam.keyframe_min_tracked_close;
   return o;
 }
 

@@ -145,6 +145,15 @@ struct Robot {
   double max_wheel_speed_radps = 12.0;
 };
 
+/// SLAM settings the scenario asks for (the `slam:` section).  They go into
+/// the ORB-SLAM2 settings file written with every recording and run
+/// (camera.yaml), so a run and a replay of the recording use the same ones.
+struct SlamTuning {
+  int orb_features = 1000;  ///< ORBextractor.nFeatures
+  /// KeyFrame.minTrackedClose (pvbench's own key; unset: the SLAM default)
+  std::optional<int> keyframe_min_tracked_close;
+};
+
 /// What a run of this scenario must achieve (the `expect:` section).  The
 /// checker in harness/suite compares a run's metrics.json against it.  A
 /// bound that is not set (has_*) is not checked.
@@ -177,6 +186,7 @@ struct Scenario {
   Route route;
   Robot robot;
   Camera camera;
+  SlamTuning slam;
   Expectations expect;
 };
 

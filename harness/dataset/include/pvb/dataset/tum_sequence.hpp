@@ -5,6 +5,7 @@
 // read unchanged.
 #include <cstdint>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,9 @@ struct OrbSlamSettings {
   int n_levels = 8;
   int ini_th_fast = 20;
   int min_th_fast = 7;
+  /// pvbench's KeyFrame.minTrackedClose; written only when set (ORB-SLAM2
+  /// ignores keys it does not know).
+  std::optional<int> kf_min_tracked_close;
 };
 
 /// Writes settings as an OpenCV FileStorage YAML file ORB-SLAM2 reads.

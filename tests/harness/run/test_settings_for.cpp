@@ -1,0 +1,49 @@
+// The ORB-SLAM2 settings a scenario run writes (camera.yaml) and reads back:
+// the scenario's camera and its `slam:` section reach the SLAM settings.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <string>
+
+#include "pvb/dataset/tum_sequence.hpp"
+#include "pvb/run/run.hpp"
+#include "pvb/scenes/scenario.hpp"
+#include "pvb/slam/core/settings.hpp"
+
+namespace pvb::run {
+namespace {
+
+std::string temp_dir(const std::string& name) {
+  return "/tmp/pvb_test_settings_for_" + std::to_string(getpid()) + "_" + name;
+}
+
+slam::Settings written_and_read(const scenes::Scenario& s, const std::string& name) {
+  const std::string dir = temp_dir(name);
+  dataset::make_dirs(dir);
+  dataset::write_orbslam_settings(dir + "/camera.yaml", orbslam_settings_for(s));
+  return slam::read_settings(dir + "/camera.yaml");
+}
+
+TEST(SettingsFor, ScenarioWithoutSlamSectionGetsTheDefaults) {
+  const scenes::Scenario s = scenes::parse_scenario("route: {waypoints_m: [[0, 0], [5, 0]]}\n", "min.yaml");
+  const slam::Settings st = written_and_read(s, "default");
+  EXPECT_TRUE(st.warnings.empty());
+  EXPECT_EQ(st.orb.num_features, 1000);
+  EXPECT_EQ(st.keyframe.min_tracked_close, slam::KeyFrameSettings{}.min_tracked_close);
+  EXPECT_DOUBLE_EQ(st.K.fx, 525.0);
+  // ThDepth in baselines: the depth range's far end is the close/far threshold.
+  EXPECT_NEAR(st.th_depth_m(), 4.5, 1e-9);
+}
+
+TEST(SettingsFor, SlamSectionReachesTheSettings) {
+  const scenes::Scenario s = scenes::parse_scenario(
+      "route: {waypoints_m: [[0, 0], [5, 0]]}\nslam: {orb_features: 2000, keyframe_min_tracked_close: 400}\n",
+      "tuned.yaml");
+  const slam::Settings st = written_and_read(s, "tuned");
+  EXPECT_TRUE(st.warnings.empty());
+  EXPECT_EQ(st.orb.num_features, 2000);
+  EXPECT_EQ(st.keyframe.min_tracked_close, 400);
+}
+
+}  // namespace
+}  // namespace pvb::run
