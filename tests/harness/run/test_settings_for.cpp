@@ -45,5 +45,13 @@ TEST(SettingsFor, SlamSectionReachesTheSettings) {
   EXPECT_EQ(st.keyframe.min_tracked_close, 400);
 }
 
+TEST(SettingsFor, ShippedLawnmowerAsksForItsOwnSettings) {
+  const scenes::Scenario s = scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/lawnmower.yaml");
+  const slam::Settings st = written_and_read(s, "lawnmower");
+  EXPECT_EQ(st.orb.num_features, s.slam.orb_features);
+  ASSERT_TRUE(s.slam.keyframe_min_tracked_close);
+  EXPECT_EQ(st.keyframe.min_tracked_close, *s.slam.keyframe_min_tracked_close);
+}
+
 }  // namespace
 }  // namespace pvb::run
