@@ -13,15 +13,12 @@
 namespace pvb::run {
 namespace {
 
-std::string temp_dir(const std::string& name) {
-  return "/tmp/pvb_test_settings_for_" + std::to_string(getpid()) + "_" + name;
-}
-
+/// Writes the scenario's settings file as a run does, then reads it back.
 slam::Settings written_and_read(const scenes::Scenario& s, const std::string& name) {
-  const std::string dir = temp_dir(name);
-  dataset::make_dirs(dir);
-  dataset::write_orbslam_settings(dir + "/camera.yaml", orbslam_settings_for(s));
-  return slam::read_settings(dir + "/camera.yaml");
+  const std::string path =
+      ::testing::TempDir() + "pvb_settings_for_" + name + "_" + std::to_string(::getpid()) + ".yaml";
+  dataset::write_orbslam_settings(path, orbslam_settings_for(s));
+  return slam::read_settings(path);
 }
 
 TEST(SettingsFor, ScenarioWithoutSlamSectionGetsTheDefaults) {
