@@ -69,7 +69,7 @@ int run_match(const MatchOptions& o) {
     CameraSettings cam;
     std::string d1, d2;
     if (by_seq) {
-      const dataset::TumSequenceReader seq(o.sequence, 5000.0, 0.05);
+      const dataset::TumSequenceReader seq(o.sequence, sensor::kTumDepthFactor, 0.05);
       const auto& frames = seq.entries();
       const std::vector<std::string> ij = split_ws(o.frames, ",");
       int i = -1, j = -1;

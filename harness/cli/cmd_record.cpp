@@ -47,7 +47,7 @@ int run_record(const RecordOptions& opt) {
 
   sim::write_scene(sim.assets(), opt.out);
   dataset::write_orbslam_settings(opt.out + "/camera.yaml", run::orbslam_settings_for(scenario));
-  dataset::TumSequenceWriter writer(opt.out, 5000.0, std::string("pvbench ") + pvb::version());
+  dataset::TumSequenceWriter writer(opt.out, sensor::kTumDepthFactor, std::string("pvbench ") + pvb::version());
 
   double capture_ms = 0, write_ms = 0;
   const std::vector<int> sheet_frames = plot::spread_indices(n, 12);

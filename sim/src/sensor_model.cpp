@@ -6,6 +6,8 @@
 #include <cmath>
 #include <opencv2/core/utility.hpp>
 
+#include "pvb/sensor/depth_encoding.hpp"
+
 namespace pvb::sim {
 namespace {
 
@@ -58,7 +60,7 @@ cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, c
       float* o = out.ptr<float>(r);
       for (int c = 0; c < W; ++c) o[c] = (g[c] >= zmin && g[c] <= zmax) ? g[c] : 0.0f;
     }
-    return out;
+    return sensor::snap_depth_to_u16_grid(out, sensor::kTumDepthFactor);
   }
   const scenes::DepthNoise& p = cam.depth_noise;
   const auto& nt = normal_table();
@@ -112,7 +114,7 @@ cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, c
     }
   }
   });
-  return out;
+  return sensor::snap_depth_to_u16_grid(out, sensor::kTumDepthFactor);
 }
 
 void apply_rgb_model(cv::Mat* rgb, const scenes::RgbNoise& params, const std::optional<cv::Point2d>& sun_px,

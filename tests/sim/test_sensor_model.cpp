@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "pvb/sensor/depth_encoding.hpp"
 #include "pvb/sim/sensor_model.hpp"
 
 using namespace pvb;
@@ -32,9 +33,11 @@ TEST(SensorModel, KinectNoiseOnAPlaneHasTheModelledSpreadAndQuantisation) {
     for (int c = 10; c < 630; ++c) {
       const double v = out.at<float>(r, c);
       ASSERT_GT(v, 0);
-      // every value sits on the 1/8-pixel disparity grid
+      // every value sits on the 1/8-pixel disparity grid, up to the output
+      // grid: half a 0.2 mm depth step moves the disparity by bf dz / z^2
       const double disparity_steps = bf / v / 0.125;
-      ASSERT_NEAR(disparity_steps, std::round(disparity_steps), 1e-3);
+      const double output_step_tol = bf * (0.5 / sensor::kTumDepthFactor) / (v * v) / 0.125;
+      ASSERT_NEAR(disparity_steps, std::round(disparity_steps), output_step_tol + 1e-6);
       sum += v;
       sum2 += v * v;
       ++n;
@@ -76,8 +79,25 @@ TEST(SensorModel, NoneModelKeepsGroundTruthInRange) {
   cv::Mat gt(4, 4, CV_32FC1, cv::Scalar(2.345f));
   gt.at<float>(0, 0) = 9.0f;
   const cv::Mat out = sim::apply_depth_model(gt, K(), cam, 1, 0);
-  EXPECT_EQ(out.at<float>(1, 1), 2.345f);
+  EXPECT_NEAR(out.at<float>(1, 1), 2.345f, 1e-6);  // 11725 steps of 0.2 mm
   EXPECT_EQ(out.at<float>(0, 0), 0.0f);
+}
+
+// The sensor emits depth on the 16-bit grid of TUM PNGs, so a recorded
+// sequence gives back exactly the depth a live run passed to SLAM.
+TEST(SensorModel, DepthLiesOnTheTumPngGrid) {
+  cv::Mat gt(120, 160, CV_32FC1);
+  for (int r = 0; r < gt.rows; ++r)
+    for (int c = 0; c < gt.cols; ++c) gt.at<float>(r, c) = 1.0f + 0.0137f * static_cast<float>(r) + 1e-4f * c;
+  const geom::PinholeIntrinsics k{525, 525, 79.5, 59.5, 160, 120};
+  for (const auto model : {scenes::DepthNoiseModel::kKinect, scenes::DepthNoiseModel::kNone}) {
+    scenes::Camera cam;
+    cam.depth_noise.model = model;
+    const cv::Mat out = sim::apply_depth_model(gt, k, cam, 2, 0);
+    ASSERT_GT(cv::countNonZero(out), 1000);
+    const cv::Mat snapped = sensor::snap_depth_to_u16_grid(out, sensor::kTumDepthFactor);
+    EXPECT_EQ(cv::norm(out, snapped, cv::NORM_INF), 0.0);
+  }
 }
 
 TEST(SensorModel, RgbExposureAndNoise) {

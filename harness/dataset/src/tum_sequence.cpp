@@ -69,19 +69,6 @@ void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s) {
   write_file(path, text);
 }
 
-cv::Mat depth_to_u16(const cv::Mat& depth_m, double factor) {
-  cv::Mat out(depth_m.size(), CV_16UC1);
-  for (int r = 0; r < depth_m.rows; ++r) {
-    const float* d = depth_m.ptr<float>(r);
-    auto* o = out.ptr<std::uint16_t>(r);
-    for (int c = 0; c < depth_m.cols; ++c) {
-      const double v = std::round(static_cast<double>(d[c]) * factor);
-      o[c] = (d[c] > 0 && v <= 65535.0) ? static_cast<std::uint16_t>(v) : 0;
-    }
-  }
-  return out;
-}
-
 namespace {
 void open_list(std::ofstream* f, const std::string& path, const char* header) {
   f->open(path, std::ios::trunc);
@@ -111,7 +98,7 @@ void TumSequenceWriter::write(const sensor::RgbdFrame& frame, const geom::SE3d& 
   cv::Mat bgr;
   cv::cvtColor(frame.rgb, bgr, cv::COLOR_RGB2BGR);
   if (!cv::imwrite(dir_ + "/" + rgb_rel, bgr)) throw IoError(dir_ + "/" + rgb_rel, "cannot write image");
-  if (!cv::imwrite(dir_ + "/" + depth_rel, depth_to_u16(frame.depth_m, depth_factor_)))
+  if (!cv::imwrite(dir_ + "/" + depth_rel, sensor::depth_to_u16(frame.depth_m, depth_factor_)))
     throw IoError(dir_ + "/" + depth_rel, "cannot write image");
   rgb_txt_ << t << " " << rgb_rel << "\n";
   depth_txt_ << t << " " << depth_rel << "\n";
@@ -201,7 +188,7 @@ sensor::RgbdFrame TumSequenceReader::load(std::size_t i) const {
   if (d16.empty()) throw IoError(depth_path, "missing or unreadable depth image");
   if (d16.type() != CV_16UC1) throw IoError(depth_path, "expected a 16-bit single-channel depth image");
   if (d16.size() != f.rgb.size()) throw IoError(depth_path, "depth and colour images differ in size");
-  d16.convertTo(f.depth_m, CV_32FC1, 1.0 / depth_factor_);
+  f.depth_m = sensor::depth_from_u16(d16, depth_factor_);
   return f;
 }
 

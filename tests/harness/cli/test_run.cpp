@@ -1,6 +1,7 @@
 // pvbench run, end to end: the default station in synchronous mode (metrics
-// contract, report files, accuracy), bit-identical prefixes, --compare, the
-// closed loop, tracking loss with on_loss abort and wait, Ctrl-C, bad input.
+// contract, report files, accuracy), bit-identical prefixes, replay of the
+// recording, --compare, the closed loop, tracking loss with on_loss abort and
+// wait, Ctrl-C, bad input.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -105,6 +106,21 @@ void check_bit_identical_prefix(const std::string& d) {
   for (std::size_t i = 0; i < b.size(); ++i) EXPECT_EQ(a[i], b[i]) << "frame " << i;
 }
 
+// A recording replays what the live run saw: `pvbench slam` on `pvbench
+// record`'s folder gives the live run's trajectory bit for bit (the sensor
+// model emits depth on the PNG grid; settings travel through camera.yaml).
+void check_replay_of_recording(const std::string& d) {
+  const std::string rec = fresh("replay_rec"), out = fresh("replay_slam");
+  ASSERT_EQ(test::run_pvbench("record --scenario " + kStation + " --out " + rec + " --frames 40").code, 0);
+  const test::RunResult r = test::run_pvbench("slam --sequence " + rec + " --settings " + rec +
+                                              "/camera.yaml --out " + out + " --sync --seed 7 --no-dense");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::vector<std::string> live = data_lines(d + "/CameraTrajectory.txt"),
+                                 replay = data_lines(out + "/CameraTrajectory.txt");
+  ASSERT_EQ(replay.size(), 40u);
+  for (std::size_t i = 0; i < replay.size(); ++i) EXPECT_EQ(live[i], replay[i]) << "frame " << i;
+}
+
 // One 150-frame synchronous run of the default station (ctest runs every
 // test in its own process, so the checks share this test).
 TEST(RunCli, DefaultStationSync) {
@@ -123,6 +139,10 @@ TEST(RunCli, DefaultStationSync) {
   {
     SCOPED_TRACE("bit-identical prefix");
     check_bit_identical_prefix(d);
+  }
+  {
+    SCOPED_TRACE("replay of the recording");
+    check_replay_of_recording(d);
   }
 }
 

@@ -18,7 +18,9 @@ inline double kinect_axial_sigma_m(double z_m) { return 0.0012 + 0.0019 * (z_m -
 /// Model kinect, after ICL-NUIM: lateral jitter of the sampling position,
 /// axial Gaussian noise, disparity d = b f / z quantised to the step, invalid
 /// pixels at grazing angles and outside the depth range.  Model none: ground
-/// truth cut to the depth range.
+/// truth cut to the depth range.  Either way the result lies on the 16-bit
+/// grid of TUM PNGs (sensor::kTumDepthFactor, 0.2 mm): a recorded sequence
+/// replays bit for bit the depth a live run saw.
 cv::Mat apply_depth_model(const cv::Mat& depth_gt_m, const geom::PinholeIntrinsics& K, const scenes::Camera& cam,
                           std::uint64_t seed, std::uint64_t frame);
 

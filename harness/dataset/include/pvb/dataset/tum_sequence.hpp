@@ -11,6 +11,7 @@
 
 #include "pvb/geometry/pinhole.hpp"
 #include "pvb/geometry/se3.hpp"
+#include "pvb/sensor/depth_encoding.hpp"
 #include "pvb/sensor/frame_source.hpp"
 
 namespace pvb::dataset {
@@ -24,7 +25,7 @@ struct OrbSlamSettings {
   double bf = 40.0;            ///< baseline (m) x fx
   int rgb_order = 1;           ///< Camera.RGB: 1 = RGB, 0 = BGR
   double th_depth = 40.0;      ///< close/far threshold in baselines
-  double depth_map_factor = 5000.0;
+  double depth_map_factor = sensor::kTumDepthFactor;
   int n_features = 1000;
   double scale_factor = 1.2;
   int n_levels = 8;
@@ -43,7 +44,7 @@ void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s);
 class TumSequenceWriter {
  public:
   /// Creates `dir` (and parents), rgb/ and depth/.  Throws IoError when it cannot.
-  TumSequenceWriter(const std::string& dir, double depth_factor = 5000.0, const std::string& source = "pvbench");
+  TumSequenceWriter(const std::string& dir, double depth_factor = sensor::kTumDepthFactor, const std::string& source = "pvbench");
   /// Writes one frame and its ground-truth camera pose.
   void write(const sensor::RgbdFrame& frame, const geom::SE3d& T_w_c);
   int frames_written() const { return frames_; }
@@ -59,10 +60,6 @@ class TumSequenceWriter {
 /// Creates a folder and its parents; throws IoError naming it on failure.
 void make_dirs(const std::string& dir);
 
-/// Converts metric depth to the 16-bit PNG encoding (0 where invalid or
-/// beyond 65535 / factor).
-cv::Mat depth_to_u16(const cv::Mat& depth_m, double factor);
-
 /// Reads a TUM RGB-D folder as a frame source.  Pairs come from
 /// associations.txt when present, else rgb.txt and depth.txt are associated
 /// one to one by nearest timestamp within max_diff_s.
@@ -74,7 +71,7 @@ class TumSequenceReader : public sensor::FrameSource {
     std::int64_t depth_t_ns = 0;
     std::string depth;
   };
-  explicit TumSequenceReader(const std::string& dir, double depth_factor = 5000.0, double max_diff_s = 0.02);
+  explicit TumSequenceReader(const std::string& dir, double depth_factor = sensor::kTumDepthFactor, double max_diff_s = 0.02);
   std::optional<sensor::RgbdFrame> next() override;
   std::size_t size_hint() const override { return entries_.size(); }
   std::string describe() const override { return "tum:" + dir_; }
