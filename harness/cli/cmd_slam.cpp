@@ -172,8 +172,9 @@ int run_slam(const SlamArgs& a) {
   std::ofstream timing = open_out(a.out + "/timing.csv");
   cam_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
   kf_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
-  timing << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,inliers,keyframe,"
-            "mapping_ms,cpu_ms,align_tried,aligned,align_ms\n";
+  timing << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,"
+            "inliers,keyframe,mapping_ms,cpu_ms,align_tried,aligned,align_ms,"
+            "kf_tracked_close,kf_untracked_close,kf_ref_points,kf_ref_all,kf_ref_shared\n";
 
   std::unique_ptr<MotionMatchScorer> scorer;
   if (a.dump_matches) {
@@ -216,11 +217,14 @@ int run_slam(const SlamArgs& a) {
       kf_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
     static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc"};
     timing << frame->index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
-           << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << "," << fmt(r.tracking_ms)
-           << "," << fmt(r.orb_ms) << "," << fmt(r.tracking.pe_match_ms) << "," << r.tracking.coarse_matches << ","
-           << r.tracking.matches_kept << "," << r.tracking.inliers << "," << (r.tracking.new_keyframe ? 1 : 0)
-           << "," << fmt(r.mapping_ms) << "," << fmt(cpu_ms) << "," << r.tracking.align_tried << ","
-           << r.tracking.aligned << "," << fmt(r.tracking.align_ms) << "\n"
+           << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","
+           << fmt(r.tracking_ms) << "," << fmt(r.orb_ms) << "," << fmt(r.tracking.pe_match_ms) << ","
+           << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers << ","
+           << (r.tracking.new_keyframe ? 1 : 0) << "," << fmt(r.mapping_ms) << "," << fmt(cpu_ms) << ","
+           << r.tracking.align_tried << "," << r.tracking.aligned << "," << fmt(r.tracking.align_ms) << ","
+           << r.tracking.kf_tracked_close << "," << r.tracking.kf_untracked_close << ","
+           << r.tracking.kf_ref_points << "," << r.tracking.kf_ref_all << "," << r.tracking.kf_ref_shared
+           << "\n"
            << std::flush;
     if (scorer) scorer->add(*frame, r);
     bar.update(frames, slam::to_string(r.state));

@@ -356,6 +356,8 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
     t.orb_features = r.integer("orb_features", t.orb_features, 100, 20000);
     if (r.has("keyframe_min_tracked_close"))
       t.keyframe_min_tracked_close = r.integer("keyframe_min_tracked_close", 0, 1, 100000);
+    if (r.has("keyframe_ref_overlap"))
+      t.keyframe_ref_overlap = r.number("keyframe_ref_overlap", 0.0, 0.01, 0.99);
   });
   with_map(top, "expect", [&](MapReader& r) {
     Expectations& e = s.expect;

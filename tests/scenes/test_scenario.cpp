@@ -140,18 +140,25 @@ TEST(Scenario, SlamSectionIsReadAndOptional) {
   const Scenario none = parse_scenario(kMinimal, "min.yaml");
   EXPECT_EQ(none.slam.orb_features, 1000);
   EXPECT_FALSE(none.slam.keyframe_min_tracked_close);
+  EXPECT_FALSE(none.slam.keyframe_ref_overlap);
 
-  const Scenario s = parse_scenario(std::string(kMinimal) + "slam: {orb_features: 2000, keyframe_min_tracked_close: 400}\n",
-                                    "s.yaml");
+  const Scenario s = parse_scenario(
+      std::string(kMinimal) +
+          "slam: {orb_features: 2000, keyframe_min_tracked_close: 400, keyframe_ref_overlap: 0.4}\n",
+      "s.yaml");
   EXPECT_EQ(s.slam.orb_features, 2000);
   ASSERT_TRUE(s.slam.keyframe_min_tracked_close);
   EXPECT_EQ(*s.slam.keyframe_min_tracked_close, 400);
+  ASSERT_TRUE(s.slam.keyframe_ref_overlap);
+  EXPECT_DOUBLE_EQ(*s.slam.keyframe_ref_overlap, 0.4);
 
   const std::string base = std::string(kMinimal) + "slam:\n";
   EXPECT_NE(error_of(base + "  orb_features: 50\n").find("bad.yaml:3: slam.orb_features: expected a value in"),
             std::string::npos)
       << error_of(base + "  orb_features: 50\n");
   EXPECT_NE(error_of(base + "  keyframe_min_tracked_close: 0\n").find("slam.keyframe_min_tracked_close"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "  keyframe_ref_overlap: 1.5\n").find("slam.keyframe_ref_overlap"),
             std::string::npos);
   EXPECT_NE(error_of(base + "  nFeatures: 2000\n").find("slam.nFeatures: expected a known key"), std::string::npos);
 }

@@ -63,9 +63,15 @@ void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s) {
                 s.rgb_order, s.th_depth, s.depth_map_factor, s.n_features, s.scale_factor, s.n_levels,
                 s.ini_th_fast, s.min_th_fast);
   std::string text = buf;
+  if (s.kf_min_tracked_close || s.kf_ref_overlap)
+    text += "\n# Keyframe decision (pvbench's own keys; ORB-SLAM2 ignores them)\n";
   if (s.kf_min_tracked_close)
-    text += "\n# Keyframe decision (pvbench's own key; ORB-SLAM2 ignores it)\nKeyFrame.minTrackedClose: " +
-            std::to_string(*s.kf_min_tracked_close) + "\n";
+    text += "KeyFrame.minTrackedClose: " + std::to_string(*s.kf_min_tracked_close) + "\n";
+  if (s.kf_ref_overlap) {
+    char ov[32];
+    std::snprintf(ov, sizeof ov, "%.3f", *s.kf_ref_overlap);
+    text += std::string("KeyFrame.refOverlap: ") + ov + "\n";
+  }
   write_file(path, text);
 }
 

@@ -295,6 +295,7 @@ dataset::OrbSlamSettings orbslam_settings_for(const scenes::Scenario& s) {
   o.rgb_order = 1;
   o.n_features = s.slam.orb_features;
   o.kf_min_tracked_close = s.slam.keyframe_min_tracked_close;
+  o.kf_ref_overlap = s.slam.keyframe_ref_overlap;
   return o;
 }
 

@@ -118,6 +118,10 @@ Settings read_settings(const std::string& path) {
   kfs.min_untracked_close = r.integer("KeyFrame.minUntrackedClose", false, kfs.min_untracked_close);
   r.positive("KeyFrame.minTrackedClose", kfs.min_tracked_close);
   r.positive("KeyFrame.minUntrackedClose", kfs.min_untracked_close);
+  kfs.ref_overlap = r.real("KeyFrame.refOverlap", false, kfs.ref_overlap);
+  if (!(kfs.ref_overlap >= 0.0 && kfs.ref_overlap < 1.0))
+    throw ConfigError(path, "KeyFrame.refOverlap", "a number in [0, 1) (0: ORB-SLAM2's rule)",
+                      std::to_string(kfs.ref_overlap));
 
   PointCloudMappingSettings& pc = s.dense;
   pc.enabled = r.flag("PointCloudMapping.Enabled", pc.enabled);

@@ -36,6 +36,7 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.max_frames = static_cast<int>(settings.fps);
   topt.kf_min_tracked_close = settings.keyframe.min_tracked_close;
   topt.kf_min_untracked_close = settings.keyframe.min_untracked_close;
+  topt.kf_ref_overlap = settings.keyframe.ref_overlap;
   topt.align_patches = settings.align_patches;
   topt.patch_align.scale_factor = settings.orb.scale_factor;
   tracking_ = std::make_unique<Tracking>(map_, cam_, topt);

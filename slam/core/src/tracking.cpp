@@ -432,10 +432,9 @@ void Tracking::align_matches(Frame& f) {
   }
 }
 
-bool Tracking::need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue) const {
+bool Tracking::need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue) {
   const std::size_t num_kfs = map_.num_keyframes();
   const auto max_frames = static_cast<std::uint64_t>(options_.max_frames);
-  if (last_reloc_frame_id_ > 0 && f.id < last_reloc_frame_id_ + max_frames && num_kfs > max_frames) return false;
   const int min_obs = num_kfs <= 2 ? 2 : 3;
   const int ref_matches = ref_kf_ ? ref_kf_->num_tracked_points(min_obs) : 0;
   int tracked_close = 0, non_tracked_close = 0;
@@ -445,13 +444,37 @@ bool Tracking::need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t 
       else ++non_tracked_close;
     }
   }
+  stats_.kf_tracked_close = tracked_close;
+  stats_.kf_untracked_close = non_tracked_close;
+  stats_.kf_ref_points = ref_matches;
+  if (ref_kf_) {
+    stats_.kf_ref_all = ref_kf_->num_tracked_points(1);
+    for (std::size_t i = 0; i < f.size(); ++i)
+      if (f.map_points[i] && !f.outlier[i] && f.map_points[i]->index_in(ref_kf_->id()) >= 0)
+        ++stats_.kf_ref_shared;
+  }
+  if (last_reloc_frame_id_ > 0 && f.id < last_reloc_frame_id_ + max_frames && num_kfs > max_frames)
+    return false;
   const bool need_close =
       tracked_close < options_.kf_min_tracked_close && non_tracked_close > options_.kf_min_untracked_close;
-  const double ref_ratio = num_kfs < 2 ? 0.4 : 0.75;
+  // "Tracking has fallen off the reference keyframe": ORB-SLAM2 compares the
+  // inliers with 75 % (25 % when urgent) of the reference keyframe's points
+  // with min_obs observations; with refOverlap it compares the reference
+  // keyframe's points this frame tracks with that share (a third of it when
+  // urgent) of all its points.
+  bool weak = false, very_weak = false;
+  if (options_.kf_ref_overlap > 0 && ref_kf_ && num_kfs >= 2) {
+    weak = stats_.kf_ref_shared < options_.kf_ref_overlap * stats_.kf_ref_all;
+    very_weak = stats_.kf_ref_shared < options_.kf_ref_overlap / 3.0 * stats_.kf_ref_all;
+  } else {
+    const double ref_ratio = num_kfs < 2 ? 0.4 : 0.75;
+    weak = matches_inliers_ < ref_matches * ref_ratio;
+    very_weak = matches_inliers_ < ref_matches * 0.25;
+  }
   const bool c1a = f.id >= last_kf_frame_id_ + max_frames;
   const bool c1b = f.id >= last_kf_frame_id_ + static_cast<std::uint64_t>(options_.min_frames) && mapping_idle;
-  const bool c1c = matches_inliers_ < ref_matches * 0.25 || need_close;
-  const bool c2 = (matches_inliers_ < ref_matches * ref_ratio || need_close) && matches_inliers_ > 15;
+  const bool c1c = very_weak || need_close;
+  const bool c2 = (weak || need_close) && matches_inliers_ > 15;
   if (!((c1a || c1b || c1c) && c2)) return false;
   return mapping_idle || mapping_queue < 3;
 }

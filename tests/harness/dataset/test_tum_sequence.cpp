@@ -119,14 +119,17 @@ TEST(TumSequence, SettingsFileIsReadableByOpenCv) {
   EXPECT_EQ(static_cast<int>(fs["ORBextractor.nFeatures"]), 1000);
   EXPECT_EQ(static_cast<int>(fs["Camera.RGB"]), 1);
   EXPECT_TRUE(fs["KeyFrame.minTrackedClose"].empty());  // written only when set
+  EXPECT_TRUE(fs["KeyFrame.refOverlap"].empty());
 
   s.n_features = 2000;
   s.kf_min_tracked_close = 400;
+  s.kf_ref_overlap = 0.4;
   dataset::write_orbslam_settings(dir + "/tuned.yaml", s);
   cv::FileStorage tuned(dir + "/tuned.yaml", cv::FileStorage::READ);
   ASSERT_TRUE(tuned.isOpened());
   EXPECT_EQ(static_cast<int>(tuned["ORBextractor.nFeatures"]), 2000);
   EXPECT_EQ(static_cast<int>(tuned["KeyFrame.minTrackedClose"]), 400);
+  EXPECT_DOUBLE_EQ(static_cast<double>(tuned["KeyFrame.refOverlap"]), 0.4);
   EXPECT_DOUBLE_EQ(static_cast<double>(tuned["Camera.fx"]), 525.0);
 }
 

@@ -27,6 +27,7 @@ TEST(SettingsFor, ScenarioWithoutSlamSectionGetsTheDefaults) {
   EXPECT_TRUE(st.warnings.empty());
   EXPECT_EQ(st.orb.num_features, 1000);
   EXPECT_EQ(st.keyframe.min_tracked_close, slam::KeyFrameSettings{}.min_tracked_close);
+  EXPECT_EQ(st.keyframe.ref_overlap, 0.0);
   EXPECT_DOUBLE_EQ(st.K.fx, 525.0);
   // ThDepth in baselines: the depth range's far end is the close/far threshold.
   EXPECT_NEAR(st.th_depth_m(), 4.5, 1e-9);
@@ -34,12 +35,14 @@ TEST(SettingsFor, ScenarioWithoutSlamSectionGetsTheDefaults) {
 
 TEST(SettingsFor, SlamSectionReachesTheSettings) {
   const scenes::Scenario s = scenes::parse_scenario(
-      "route: {waypoints_m: [[0, 0], [5, 0]]}\nslam: {orb_features: 2000, keyframe_min_tracked_close: 400}\n",
+      "route: {waypoints_m: [[0, 0], [5, 0]]}\n"
+      "slam: {orb_features: 2000, keyframe_min_tracked_close: 400, keyframe_ref_overlap: 0.4}\n",
       "tuned.yaml");
   const slam::Settings st = written_and_read(s, "tuned");
   EXPECT_TRUE(st.warnings.empty());
   EXPECT_EQ(st.orb.num_features, 2000);
   EXPECT_EQ(st.keyframe.min_tracked_close, 400);
+  EXPECT_DOUBLE_EQ(st.keyframe.ref_overlap, 0.4);
 }
 
 TEST(SettingsFor, ShippedLawnmowerAsksForItsOwnSettings) {
@@ -48,6 +51,8 @@ TEST(SettingsFor, ShippedLawnmowerAsksForItsOwnSettings) {
   EXPECT_EQ(st.orb.num_features, s.slam.orb_features);
   ASSERT_TRUE(s.slam.keyframe_min_tracked_close);
   EXPECT_EQ(st.keyframe.min_tracked_close, *s.slam.keyframe_min_tracked_close);
+  ASSERT_TRUE(s.slam.keyframe_ref_overlap);
+  EXPECT_NEAR(st.keyframe.ref_overlap, *s.slam.keyframe_ref_overlap, 1e-9);
 }
 
 }  // namespace

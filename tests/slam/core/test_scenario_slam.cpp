@@ -10,6 +10,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <optional>
 #include <regex>
 #include <sstream>
@@ -147,6 +149,81 @@ TEST(SlamScenario, BaselineModeReportsNoPeMatch) {
     EXPECT_EQ(f[8], f[9]) << line;
   }
   EXPECT_GT(motion, 50);
+}
+
+/// timing.csv as rows of column name -> value.
+std::vector<std::map<std::string, std::string>> read_timing(const std::string& path) {
+  std::istringstream in(pvb::read_file(path));
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  {
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) header.push_back(c);
+  }
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::map<std::string, std::string> row;
+    std::size_t k = 0;
+    for (std::string c; std::getline(ss, c, ',') && k < header.size(); ++k) row[header[k]] = c;
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+/// In sync mode the local mapper is always idle, so ORB-SLAM2's decision
+/// reduces to "(tracking is weak against the reference keyframe, or too
+/// few close points are tracked) and more than 15 inliers".  timing.csv
+/// carries the decision's inputs; check every tracked frame against the
+/// rule (`weak` says which test applies) and return how many keyframes the
+/// weak-tracking test made alone (not the close-point test).
+int check_keyframe_rule(const std::string& timing_csv,
+                        const std::function<bool(const std::map<std::string, std::string>&)>& weak) {
+  // The station's camera.yaml sets no KeyFrame.* key: the defaults apply.
+  const int min_tracked_close = 200, min_untracked_close = 70;
+  int keyframes = 0, by_weak_alone = 0, checked = 0;
+  for (const auto& row : read_timing(timing_csv)) {
+    const bool is_kf = row.at("keyframe") == "1";
+    // The first keyframes use ORB-SLAM2's start-up ratio; check from the third on.
+    if (keyframes >= 3 && row.at("state") == "ok") {
+      const bool need_close = std::stoi(row.at("kf_tracked_close")) < min_tracked_close &&
+                              std::stoi(row.at("kf_untracked_close")) > min_untracked_close;
+      const bool w = weak(row);
+      EXPECT_EQ(is_kf, (w || need_close) && std::stoi(row.at("inliers")) > 15) << "frame " << row.at("frame");
+      by_weak_alone += is_kf && w && !need_close;
+      ++checked;
+    }
+    keyframes += is_kf;
+  }
+  EXPECT_GT(checked, 50);
+  return by_weak_alone;
+}
+
+// The keyframe decision as timing.csv reports it: ORB-SLAM2's 75 % rule by
+// default, the view-overlap rule with KeyFrame.refOverlap.
+TEST(SlamScenario, KeyframeDecisionFollowsItsRule) {
+  const std::string seq = station_sequence();
+  const std::string orb = dir("kf_orb");
+  Result r = run("slam --sequence " + seq + " --settings " + seq +
+                 "/camera.yaml --sync --no-dense --max-frames 120 --out " + orb);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const int orb_weak = check_keyframe_rule(orb + "/timing.csv", [](const auto& row) {
+    return std::stoi(row.at("inliers")) < 0.75 * std::stoi(row.at("kf_ref_points"));
+  });
+
+  const std::string overlap = dir("kf_overlap");
+  const std::string settings = overlap + "_settings.yaml";
+  pvb::write_file(settings, pvb::read_file(seq + "/camera.yaml") + "\nKeyFrame.refOverlap: 0.4\n");
+  r = run("slam --sequence " + seq + " --settings " + settings +
+          " --sync --no-dense --max-frames 120 --out " + overlap);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const int overlap_weak = check_keyframe_rule(overlap + "/timing.csv", [](const auto& row) {
+    return std::stoi(row.at("kf_ref_shared")) < 0.4 * std::stoi(row.at("kf_ref_all"));
+  });
+  // Each rule's own test made keyframes here, not only the close-point rule.
+  EXPECT_GT(orb_weak, 0);
+  EXPECT_GT(overlap_weak, 0);
 }
 
 // --dump-matches labels the motion model's coarse matches against ground

@@ -91,13 +91,17 @@ TEST(Settings, ReadsKeyFrameSection) {
   const Settings d = read_settings(kTum1);  // absent: the documented defaults
   EXPECT_EQ(d.keyframe.min_tracked_close, 200);
   EXPECT_EQ(d.keyframe.min_untracked_close, 70);
+  EXPECT_EQ(d.keyframe.ref_overlap, 0.0);  // ORB-SLAM2's 75 % rule
   const Settings s = read_settings(temp_copy("kf", read_file(kTum1) + "\nKeyFrame.minTrackedClose: 100\n"
-                                                                      "KeyFrame.minUntrackedClose: 50\n"));
+                                                                      "KeyFrame.minUntrackedClose: 50\n"
+                                                                      "KeyFrame.refOverlap: 0.4\n"));
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_EQ(s.keyframe.min_tracked_close, 100);  // ORB-SLAM2's value
   EXPECT_EQ(s.keyframe.min_untracked_close, 50);
+  EXPECT_DOUBLE_EQ(s.keyframe.ref_overlap, 0.4);
   for (const std::string bad :
-       {"KeyFrame.minTrackedClose: 0", "KeyFrame.minUntrackedClose: -3", "KeyFrame.minTrackedClose: 1.5"}) {
+       {"KeyFrame.minTrackedClose: 0", "KeyFrame.minUntrackedClose: -3", "KeyFrame.minTrackedClose: 1.5",
+        "KeyFrame.refOverlap: 1.0", "KeyFrame.refOverlap: -0.1", "KeyFrame.refOverlap: many"}) {
     try {
       read_settings(temp_copy("kfbad", read_file(kTum1) + "\n" + bad + "\n"));
       FAIL() << "expected ConfigError for " << bad;

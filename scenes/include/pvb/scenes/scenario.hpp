@@ -152,6 +152,8 @@ struct SlamTuning {
   int orb_features = 1000;  ///< ORBextractor.nFeatures
   /// KeyFrame.minTrackedClose (pvbench's own key; unset: the SLAM default)
   std::optional<int> keyframe_min_tracked_close;
+  /// KeyFrame.refOverlap (pvbench's own key; unset: ORB-SLAM2's 75 % rule)
+  std::optional<double> keyframe_ref_overlap;
 };
 
 /// What a run of this scenario must achieve (the `expect:` section).  The

@@ -34,6 +34,8 @@ struct OrbSlamSettings {
   /// pvbench's KeyFrame.minTrackedClose; written only when set (ORB-SLAM2
   /// ignores keys it does not know).
   std::optional<int> kf_min_tracked_close;
+  /// pvbench's KeyFrame.refOverlap; written only when set.
+  std::optional<double> kf_ref_overlap;
 };
 
 /// Writes settings as an OpenCV FileStorage YAML file ORB-SLAM2 reads.

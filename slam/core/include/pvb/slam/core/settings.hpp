@@ -23,6 +23,14 @@ struct KeyFrameSettings {
   /// spacing and drift").
   int min_tracked_close = 200;
   int min_untracked_close = 70;  ///< KeyFrame.minUntrackedClose (ORB-SLAM2: 70)
+  /// KeyFrame.refOverlap, in (0, 1); 0 (the default) keeps ORB-SLAM2's rule.
+  /// When set, the "tracking has fallen below 75 % of the reference
+  /// keyframe's points with three observations" test becomes "this frame
+  /// tracks fewer than refOverlap of the reference keyframe's map points".
+  /// ORB-SLAM2's count depends on how often keyframes were made before,
+  /// which makes the decision bistable; this one depends on the view
+  /// overlap only (docs/slam.md, "A keyframe rule on view overlap").
+  double ref_overlap = 0.0;
 };
 
 /// PEMatch.* section; defaults are the paper's SLAM values (sec. 5.2.2).

@@ -40,6 +40,17 @@ struct TrackingStats {
   int aligned = 0;              ///< of those, the ones it moved (the others keep the keypoint)
   double align_ms = 0;          ///< time in patch alignment
   bool new_keyframe = false;
+  /// Inputs of the keyframe decision (ORB-SLAM2 NeedNewKeyFrame), filled
+  /// whenever the frame was tracked: close keypoints (depth under ThDepth)
+  /// tracked and not tracked, and the reference keyframe's points with at
+  /// least 3 observations (2 while the map has at most 2 keyframes).
+  int kf_tracked_close = 0;
+  int kf_untracked_close = 0;
+  int kf_ref_points = 0;
+  /// The reference keyframe's map points (any number of observations) and
+  /// how many of them this frame tracks.
+  int kf_ref_all = 0;
+  int kf_ref_shared = 0;
   /// The motion model's coarse matches (empty when it did not run), for
   /// scoring PE-match against ground truth: pixel pairs (last frame,
   /// this frame), undistorted and as detected, the octaves of both
@@ -77,6 +88,7 @@ struct TrackingOptions {
   int min_frames = 0;
   int kf_min_tracked_close = 200;    ///< KeyFrame.minTrackedClose (ORB-SLAM2: 100)
   int kf_min_untracked_close = 70;   ///< KeyFrame.minUntrackedClose
+  double kf_ref_overlap = 0.0;       ///< KeyFrame.refOverlap (0: ORB-SLAM2's 75 % rule)
   /// Beyond ORB-SLAM2: before the local-map pose optimisation, move each
   /// map-point match to where the point's reference-keyframe patch,
   /// warped by the predicted pose, aligns (needs Frame::pyramid; frames
@@ -135,7 +147,8 @@ class Tracking {
   void align_matches(Frame& f);
   void update_last_frame();
   void update_local_map(const Frame& f);
-  bool need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue) const;
+  /// ORB-SLAM2's keyframe decision; also fills stats_.kf_* with its inputs.
+  bool need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue);
   std::shared_ptr<KeyFrame> create_keyframe(Frame& f);
   void discard_outliers(Frame& f, int* map_matches);
   void replace_in_last_frame();
