@@ -69,7 +69,7 @@ void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s) {
     text += "KeyFrame.minTrackedClose: " + std::to_string(*s.kf_min_tracked_close) + "\n";
   if (s.kf_ref_overlap) {
     char ov[32];
-    std::snprintf(ov, sizeof ov, "%.3f", *s.kf_ref_overlap);
+    std::snprintf(ov, sizeof ov, "%.6g", *s.kf_ref_overlap);  // as given, not rounded to a grid
     text += std::string("KeyFrame.refOverlap: ") + ov + "\n";
   }
   write_file(path, text);

@@ -123,13 +123,13 @@ TEST(TumSequence, SettingsFileIsReadableByOpenCv) {
 
   s.n_features = 2000;
   s.kf_min_tracked_close = 400;
-  s.kf_ref_overlap = 0.4;
+  s.kf_ref_overlap = 0.4375;  // written as given, not rounded
   dataset::write_orbslam_settings(dir + "/tuned.yaml", s);
   cv::FileStorage tuned(dir + "/tuned.yaml", cv::FileStorage::READ);
   ASSERT_TRUE(tuned.isOpened());
   EXPECT_EQ(static_cast<int>(tuned["ORBextractor.nFeatures"]), 2000);
   EXPECT_EQ(static_cast<int>(tuned["KeyFrame.minTrackedClose"]), 400);
-  EXPECT_DOUBLE_EQ(static_cast<double>(tuned["KeyFrame.refOverlap"]), 0.4);
+  EXPECT_DOUBLE_EQ(static_cast<double>(tuned["KeyFrame.refOverlap"]), 0.4375);
   EXPECT_DOUBLE_EQ(static_cast<double>(tuned["Camera.fx"]), 525.0);
 }
 
