@@ -251,20 +251,23 @@ int run_slam(const SlamArgs& a) {
   const double mean = tracking_ms.empty() ? 0 : std::accumulate(tracking_ms.begin(), tracking_ms.end(), 0.0) /
                                                       static_cast<double>(tracking_ms.size());
   std::ostringstream js;
-  js << "{\n  \"sequence\": \"" << json_escape(a.sequence) << "\",\n  \"pe_match\": "
-     << (settings.pe_match.enabled ? "true" : "false") << ",\n  \"sync\": " << (a.sync ? "true" : "false")
-     << ",\n  \"seed\": " << a.seed << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
-     << ",\n  \"frames\": " << frames << ",\n  \"lost_frames\": " << lost
-     << ",\n  \"not_initialized_frames\": " << not_init << ",\n  \"skipped_frames\": " << reader.skipped()
-     << ",\n  \"keyframes\": " << system.num_keyframes() << ",\n  \"map_points\": " << system.num_map_points()
-     << ",\n  \"tracking_ms\": {\"median\": " << fmt(percentile(tracking_ms, 0.5)) << ", \"mean\": " << fmt(mean)
-     << ", \"p95\": " << fmt(percentile(tracking_ms, 0.95)) << "},\n  \"pe_match_ms\": {\"median\": "
-     << fmt(percentile(pe_ms, 0.5)) << ", \"p95\": " << fmt(percentile(pe_ms, 0.95)) << "}"
+  js << "{\n  \"sequence\": \"" << json_escape(a.sequence)
+     << "\",\n  \"pe_match\": " << (settings.pe_match.enabled ? "true" : "false")
+     << ",\n  \"sync\": " << (a.sync ? "true" : "false") << ",\n  \"seed\": " << a.seed
+     << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"frames\": " << frames
+     << ",\n  \"lost_frames\": " << lost << ",\n  \"not_initialized_frames\": " << not_init
+     << ",\n  \"skipped_frames\": " << reader.skipped() << ",\n  \"keyframes\": " << system.num_keyframes()
+     << ",\n  \"map_points\": " << system.num_map_points()
+     << ",\n  \"tracking_ms\": {\"median\": " << fmt(percentile(tracking_ms, 0.5))
+     << ", \"mean\": " << fmt(mean) << ", \"p95\": " << fmt(percentile(tracking_ms, 0.95))
+     << "},\n  \"pe_match_ms\": {\"median\": " << fmt(percentile(pe_ms, 0.5))
+     << ", \"p95\": " << fmt(percentile(pe_ms, 0.95)) << "}"
      << ",\n  \"cpu_ms\": {\"median\": " << fmt(percentile(cpu_ms_all, 0.5)) << ", \"mean\": "
      << fmt(cpu_ms_all.empty() ? 0.0
                                : std::accumulate(cpu_ms_all.begin(), cpu_ms_all.end(), 0.0) /
                                      static_cast<double>(cpu_ms_all.size()))
-     << ", \"p95\": " << fmt(percentile(cpu_ms_all, 0.95)) << "}";
+     << ", \"p95\": " << fmt(percentile(cpu_ms_all, 0.95)) << "}"
+     << ",\n  \"local_mapping\": " << slam::to_json(system.mapping_stats());
   if (system.dense_enabled()) {
     const double per_kf_ms =
         dense_stats.keyframes ? dense_stats.total_ms / static_cast<double>(dense_stats.keyframes) : 0.0;
@@ -274,8 +277,11 @@ int run_slam(const SlamArgs& a) {
     std::printf("dense map: %zu points from %zu keyframes (%.1f ms per keyframe) -> %s/PointCloud.ply\n",
                 cloud_points, dense_stats.keyframes, per_kf_ms, a.out.c_str());
   }
-  std::printf("frames %zu, lost %zu, keyframes %zu, map points %zu\n", frames, lost, system.num_keyframes(),
-              system.num_map_points());
+  const slam::LocalMappingStats mapping = system.mapping_stats();
+  std::printf(
+      "frames %zu, lost %zu, keyframes %zu, map points %zu; local BA %lld (%lld stopped by a keyframe)\n",
+      frames, lost, system.num_keyframes(), system.num_map_points(), static_cast<long long>(mapping.local_ba),
+      static_cast<long long>(mapping.local_ba_stopped));
   if (system.loop_closing_enabled()) {
     const slam::LoopClosingStats loops = system.loop_stats();
     js << ",\n  \"loop_closing\": " << slam::to_json(loops);

@@ -51,6 +51,7 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
   if (run.refined_eval)
     out += in + "\"refined\": {\"ate_rmse\": " + num(run.refined_eval->ate.rmse) +
            ", \"rpe_trans_rmse\": " + num(run.refined_eval->rpe_trans_m.rmse) + "},\n";
+  if (!run.local_mapping_json.empty()) out += in + "\"local_mapping\": " + run.local_mapping_json + ",\n";
   if (!run.loop_closing_json.empty()) out += in + "\"loop_closing\": " + run.loop_closing_json + ",\n";
   out += in + "\"tracking_ms\": {\"median\": " + num(percentile(ms, 0.5)) +
          ", \"mean\": " + num(mean_of(ms)) + ", \"p95\": " + num(percentile(ms, 0.95)) + "},\n";

@@ -5,10 +5,11 @@
 #include <cmath>
 #include <set>
 
+#include "pvb/common/text.hpp"
+#include "pvb/common/threads.hpp"
 #include "pvb/slam/core/matcher.hpp"
 #include "pvb/slam/core/patch_refine.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
-#include "pvb/common/threads.hpp"
 
 namespace pvb::slam {
 
@@ -64,6 +65,7 @@ LocalMapping::~LocalMapping() { stop(); }
 
 void LocalMapping::start() {
   if (worker_.joinable()) return;
+  on_worker_ = true;  // before the thread starts, so it sees the value
   worker_ = std::thread([this] {
     set_thread_name("pvb-mapping");
     run();
@@ -78,10 +80,32 @@ void LocalMapping::stop() {
 void LocalMapping::insert(std::shared_ptr<KeyFrame> kf) {
   ++pending_;
   if (worker_.joinable()) {
-    if (!queue_.push(std::move(kf))) --pending_;
+    if (!queue_.push(std::move(kf))) {
+      --pending_;
+      return;
+    }
+    // After the push: the worker clears the flag before it checks the
+    // queue, so a keyframe pushed after that check always stops the BA.
+    stop_ba_ = true;
   } else {
     process(kf);
   }
+}
+
+std::string to_json(const LocalMappingStats& stats) {
+  return "{\"keyframes\": " + std::to_string(stats.keyframes) +
+         ", \"local_ba\": " + std::to_string(stats.local_ba) +
+         ", \"local_ba_stopped\": " + std::to_string(stats.local_ba_stopped) +
+         ", \"busy_ms\": " + json_number(stats.busy_ms, 6) + "}";
+}
+
+LocalMappingStats LocalMapping::stats() const {
+  LocalMappingStats s;
+  s.keyframes = processed_.load();
+  s.local_ba = ba_runs_.load();
+  s.local_ba_stopped = ba_stopped_.load();
+  s.busy_ms = busy_ms();
+  return s;
 }
 
 void LocalMapping::run() {
@@ -108,12 +132,14 @@ void LocalMapping::process(const std::shared_ptr<KeyFrame>& kf) {
       for (const auto& k : kf->best_covisibles(-1)) align_keyframe_observations(*k, options_.patch_align);
     }
   }
+  stop_ba_ = false;
   if (queue_.size() == 0) {
     if (options_.local_ba) local_bundle_adjustment(kf);
     std::lock_guard<std::mutex> lock(map_.mutex());
     cull_keyframes(kf);
   }
   if (after_keyframe_) after_keyframe_(kf);
+  ++processed_;
   --pending_;
 }
 
@@ -296,7 +322,11 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
   }
   if (problem.edges.empty()) return;
   // Optimise without holding the map: tracking goes on with the old poses.
-  const BaResult result = slam::local_bundle_adjustment(&problem, cam_->K);
+  BaOptions ba_options;
+  if (on_worker_) ba_options.abort_flag = &stop_ba_;  // inline (sync) mode: never stopped
+  const BaResult result = slam::local_bundle_adjustment(&problem, cam_->K, ba_options);
+  ++ba_runs_;
+  if (result.stopped) ++ba_stopped_;
 
   std::lock_guard<std::mutex> lock(map_.mutex());
   erase_outlier_observations(problem, result.outlier_edges, kfs, pts);

@@ -50,22 +50,26 @@ ceres::Problem::Options borrowed_problem_options() {
   return o;
 }
 
+bool aborted(const std::atomic<bool>* flag) { return flag != nullptr && flag->load(); }
+
 /// Stops a bundle-adjustment pass once *flag becomes true (ORB-SLAM2's
 /// pbStopFlag).  Returns SOLVER_TERMINATE_SUCCESSFULLY rather than
 /// SOLVER_ABORT: g2o's force-stop keeps the estimate reached so far, and
 /// SOLVER_ABORT would make Ceres discard the whole pass.
 class AbortCallback : public ceres::IterationCallback {
  public:
-  explicit AbortCallback(const bool* flag) : flag_(flag) {}
+  explicit AbortCallback(const std::atomic<bool>* flag) : flag_(flag) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& /*summary*/) override {
-    return (flag_ != nullptr && *flag_) ? ceres::SOLVER_TERMINATE_SUCCESSFULLY : ceres::SOLVER_CONTINUE;
+    if (!aborted(flag_)) return ceres::SOLVER_CONTINUE;
+    fired_ = true;
+    return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
   }
+  bool fired() const { return fired_; }
 
  private:
-  const bool* flag_;
+  const std::atomic<bool>* flag_;
+  bool fired_ = false;
 };
-
-bool aborted(const bool* flag) { return flag != nullptr && *flag; }
 
 /// Levenberg-Marquardt on one pose against fixed points, the way g2o's
 /// OptimizationAlgorithmLevenberg runs it for ORB-SLAM2's PoseOptimization:
@@ -221,6 +225,12 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
     result.converged = true;  // nothing to optimise
     return result;
   }
+  // Stopped before it began (ORB-SLAM2 returns here too): nothing is
+  // changed and no outlier is reported.
+  if (aborted(options.abort_flag)) {
+    result.stopped = true;
+    return result;
+  }
 
   std::vector<PoseBlock> poses(ba.keyframes.size());
   for (std::size_t k = 0; k < ba.keyframes.size(); ++k) poses[k] = PoseBlock::from_se3(ba.keyframes[k].T_c_w);
@@ -306,7 +316,9 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
 
   // Pass 1: all edges, Huber loss.
   solve_pass(options.iterations_first, true);
-  if (!aborted(options.abort_flag)) {
+  const bool skip_second = aborted(options.abort_flag);
+  result.stopped = abort_callback.fired() || skip_second;
+  if (!skip_second) {
     // Pass 2: without the outliers of pass 1 and without robust kernel.
     for (std::size_t e = 0; e < num_edges; ++e) {
       if (active[e] && edge_bad(e)) active[e] = 0;

@@ -42,6 +42,12 @@ double json_number(const std::string& json, const std::string& key) {
   return std::stod(m[1]);
 }
 
+/// The "local_mapping": {...} object of stats.json (empty when missing).
+std::string local_mapping_json(const std::string& stats) {
+  std::smatch m;
+  return std::regex_search(stats, m, std::regex("\"local_mapping\": *(\\{[^}]*\\})")) ? m[1].str() : "";
+}
+
 TEST(SlamScenario, PvStationSyncAccurateAndNeverLost) {
   const std::string seq = station_sequence();
   const std::string out = dir("run");
@@ -58,6 +64,13 @@ TEST(SlamScenario, PvStationSyncAccurateAndNeverLost) {
   std::printf("PE-SLAM on 300 frames of pv_station: ATE RMSE %.2f mm\n", ate * 1000);
   EXPECT_LT(ate, 0.02);
   EXPECT_GT(json_number(stats, "keyframes"), 1);
+  // Every keyframe made was processed (culling removes some from the map);
+  // inline mapping never cuts a local BA short.
+  const std::string mapping = local_mapping_json(stats);
+  ASSERT_FALSE(mapping.empty()) << stats;
+  EXPECT_GE(json_number(mapping, "keyframes"), json_number(stats, "keyframes")) << stats;
+  EXPECT_GT(json_number(mapping, "local_ba"), 0) << stats;
+  EXPECT_EQ(json_number(mapping, "local_ba_stopped"), 0) << stats;
 }
 
 TEST(SlamScenario, SyncModeIsBitIdentical) {
@@ -122,6 +135,11 @@ TEST(SlamScenario, WorkerThreadModeTracks) {
   std::smatch m;
   ASSERT_TRUE(std::regex_search(stats, m, std::regex("\"ate\": *\\{[^}]*\"rmse\": *([-0-9.eE+]+)"))) << stats;
   EXPECT_LT(std::stod(m[1]), 0.02);
+  // shutdown() let the worker finish every keyframe it was given
+  const std::string mapping = local_mapping_json(stats);
+  ASSERT_FALSE(mapping.empty()) << stats;
+  EXPECT_GE(json_number(mapping, "keyframes"), json_number(stats, "keyframes")) << stats;
+  EXPECT_LE(json_number(mapping, "local_ba_stopped"), json_number(mapping, "local_ba")) << stats;
 }
 
 // Baseline mode (--no-pe-match) runs the same pipeline without PE-match.

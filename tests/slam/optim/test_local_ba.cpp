@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <set>
 #include <stdexcept>
@@ -145,17 +146,27 @@ TEST(LocalBundleAdjustment, AllKeyframesFixedOptimisesPointsOnly) {
 TEST(LocalBundleAdjustment, AbortFlagStopsEarly) {
   auto s = make_ba_scene(5, 2, 200, 1.0, 34);
   perturb_ba(&s.problem, 0.05, 2.0, 0.05, 35);
+  s.problem.edges[3].obs.uv.x() += 30.0;  // an outlier a finished BA reports
+  const BaProblem before = s.problem;
   BaOptions options;
-  bool stop = true;
+  std::atomic<bool> stop{true};
   options.abort_flag = &stop;
+  // Set before the call: nothing is solved, changed or reported.
   const BaResult r = local_bundle_adjustment(&s.problem, testing::default_intrinsics(), options);
-  EXPECT_EQ(r.iterations, 0);  // stopped before the first step; second pass skipped
+  EXPECT_EQ(r.iterations, 0);
+  EXPECT_TRUE(r.stopped);
+  EXPECT_TRUE(r.outlier_edges.empty());
+  for (std::size_t k = 0; k < before.keyframes.size(); ++k)
+    EXPECT_TRUE(s.problem.keyframes[k].T_c_w.isApprox(before.keyframes[k].T_c_w, 0.0));
+  for (std::size_t p = 0; p < before.points.size(); ++p)
+    EXPECT_EQ(s.problem.points[p].p_w, before.points[p].p_w);
 
+  // Never set: both passes run and the outlier is found.
   stop = false;
-  auto s2 = make_ba_scene(5, 2, 200, 1.0, 34);
-  perturb_ba(&s2.problem, 0.05, 2.0, 0.05, 35);
-  const BaResult r2 = local_bundle_adjustment(&s2.problem, testing::default_intrinsics(), options);
+  const BaResult r2 = local_bundle_adjustment(&s.problem, testing::default_intrinsics(), options);
   EXPECT_GT(r2.iterations, 0);
+  EXPECT_FALSE(r2.stopped);
+  EXPECT_NE(std::find(r2.outlier_edges.begin(), r2.outlier_edges.end(), 3u), r2.outlier_edges.end());
 }
 
 TEST(LocalBundleAdjustment, PointBehindCameraEdgeIsOutlier) {

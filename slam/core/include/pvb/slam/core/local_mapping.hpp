@@ -6,14 +6,15 @@
 // thread; otherwise a worker thread started with start() takes keyframes
 // from a closable blocking queue until stop().
 #include <atomic>
-#include <cstdint>
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <list>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 
 #include "pvb/common/closable_queue.hpp"
@@ -57,6 +58,16 @@ void erase_outlier_observations(const BaProblem& problem, const std::vector<std:
                                 const std::vector<std::shared_ptr<KeyFrame>>& kfs,
                                 const std::vector<std::shared_ptr<MapPoint>>& pts);
 
+/// What local mapping has done so far (for stats and reports).
+struct LocalMappingStats {
+  std::int64_t keyframes = 0;         ///< keyframes processed
+  std::int64_t local_ba = 0;          ///< local bundle adjustments run
+  std::int64_t local_ba_stopped = 0;  ///< of which cut short by a new keyframe (worker mode only)
+  double busy_ms = 0;                 ///< time spent processing keyframes
+};
+/// {"keyframes", "local_ba", "local_ba_stopped", "busy_ms"} for stats.json and metrics.json.
+std::string to_json(const LocalMappingStats& stats);
+
 class LocalMapping {
  public:
   LocalMapping(Map& map, std::shared_ptr<const CameraModel> cam, const LocalMappingOptions& options = {});
@@ -74,7 +85,11 @@ class LocalMapping {
   void stop();
   bool running() const { return worker_.joinable(); }
 
-  /// Hands a keyframe over: processed now (synchronous) or queued.
+  /// Hands a keyframe over: processed now (synchronous) or queued.  A
+  /// keyframe queued while the worker runs a local BA stops that BA after
+  /// its current iteration (ORB-SLAM2's InsertKeyFrame / InterruptBA): the
+  /// estimate reached so far is kept and the second pass is skipped, so the
+  /// worker gets to the new keyframe sooner.
   void insert(std::shared_ptr<KeyFrame> kf);
   /// True when no keyframe is waiting or being processed.
   bool idle() const { return pending_.load() == 0; }
@@ -84,6 +99,10 @@ class LocalMapping {
   void process(const std::shared_ptr<KeyFrame>& kf);
   /// Total time spent in process() so far, milliseconds (for profiles).
   double busy_ms() const { return static_cast<double>(busy_us_.load()) / 1000.0; }
+  LocalMappingStats stats() const;
+  /// True from a keyframe queued in worker mode until the worker clears it
+  /// before its next local BA (exposed for tests).
+  bool ba_stop_requested() const { return stop_ba_.load(); }
 
  private:
   void run();
@@ -101,6 +120,9 @@ class LocalMapping {
   ClosableQueue<std::shared_ptr<KeyFrame>> queue_;
   std::atomic<int> pending_{0};  ///< keyframes inserted and not yet processed
   std::atomic<std::int64_t> busy_us_{0};  ///< time in process(), microseconds
+  bool on_worker_ = false;                ///< start() was called (set before the worker exists)
+  std::atomic<bool> stop_ba_{false};      ///< set by insert() in worker mode, cleared before each local BA
+  std::atomic<std::int64_t> processed_{0}, ba_runs_{0}, ba_stopped_{0};
   std::function<void(const std::shared_ptr<KeyFrame>&)> after_keyframe_;
   std::thread worker_;
 };

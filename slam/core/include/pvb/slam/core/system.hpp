@@ -62,6 +62,8 @@ class System {
   std::vector<Eigen::Vector3d> map_point_positions();
   /// Time local mapping has spent on keyframes so far (inline or on its worker), ms.
   double mapping_busy_ms() const { return mapping_->busy_ms(); }
+  /// Keyframes processed and local BAs run (and cut short) so far.
+  LocalMappingStats mapping_stats() const { return mapping_->stats(); }
   TrackingState state() const { return tracking_->state(); }
   /// Loops closed so far and detection totals (empty when LoopClosing.enabled is 0).
   LoopClosingStats loop_stats() const { return loop_ ? loop_->stats() : LoopClosingStats{}; }

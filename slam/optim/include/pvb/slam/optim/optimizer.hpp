@@ -10,6 +10,7 @@
 // An observation with u_right >= 0 is "stereo" (RGB-D: u_right = u - bf / z),
 // with a 3-D residual (u, v, u_right); else monocular (u, v).
 #include <Eigen/Core>
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -83,7 +84,12 @@ struct BaOptions {
   int iterations_second = 10; ///< without the outliers of the first pass
   double chi2_mono = 5.991;
   double chi2_stereo = 7.815;
-  const bool* abort_flag = nullptr;  ///< optional: stop early when it becomes true
+  /// Optional: stop early once it becomes true (ORB-SLAM2's pbStopFlag).
+  /// Another thread may set it while the solve runs (local mapping sets it
+  /// when a new keyframe arrives).  Set before the call: nothing changes and
+  /// no outlier is reported.  Set during the first pass: the estimate so far
+  /// is kept and the second pass skipped.
+  const std::atomic<bool>* abort_flag = nullptr;
   /// Sparse Schur complement (global BA over the whole map: many keyframes,
   /// each seeing a few others); false: dense (local BA, a few dozen keyframes).
   bool sparse_schur = false;
@@ -93,6 +99,8 @@ struct BaResult {
   std::vector<std::size_t> outlier_edges;  ///< edges to erase from the map (chi2 too big or point behind camera)
   int iterations = 0;
   bool converged = false;
+  /// The abort flag cut a pass short or skipped the second pass.
+  bool stopped = false;
 };
 
 /// Optimises the non-fixed keyframe poses and all points in place.

@@ -1,0 +1,111 @@
+// LocalMapping on its worker thread: keyframes queued while it works stop
+// its next local BA (ORB-SLAM2's InsertKeyFrame / InterruptBA), inline
+// (synchronous) mapping never does, and the counters add up.
+#include <gtest/gtest.h>
+
+#include <mutex>
+
+#include "pvb/slam/core/local_mapping.hpp"
+#include "pvb/slam/core/map.hpp"
+
+namespace pvb::slam {
+namespace {
+
+std::shared_ptr<const CameraModel> camera() {
+  static auto cam =
+      std::make_shared<const CameraModel>(CameraModel::make(StereoIntrinsics{}, 640, 480, {}, 3.0, 1.2, 8));
+  return cam;
+}
+
+/// A frame with n keypoints on a row, depth 1 m everywhere, at the origin.
+Frame make_frame(std::uint64_t id, int n) {
+  OrbFeatures f;
+  for (int i = 0; i < n; ++i)
+    f.keypoints.emplace_back(cv::Point2f(100.0f + 10.0f * i, 200.0f), 31.0f, 0.0f, 0.0f, 0);
+  f.descriptors = cv::Mat::zeros(n, 32, CV_8U);
+  const cv::Mat depth(480, 640, CV_32F, cv::Scalar(1.0f));
+  Frame fr(id, static_cast<std::int64_t>(id) * 1000, f, depth, camera());
+  fr.has_pose = true;
+  return fr;
+}
+
+/// Keyframe `id` observing every point of `pts` (created from the first
+/// keyframe when `pts` is empty).
+std::shared_ptr<KeyFrame> keyframe(Map& map, std::uint64_t id, std::vector<std::shared_ptr<MapPoint>>& pts) {
+  constexpr int kPoints = 30;
+  auto kf = map.create_keyframe(make_frame(id, kPoints));
+  for (int i = 0; i < kPoints; ++i) {
+    const auto idx = static_cast<std::size_t>(i);
+    if (pts.size() < kPoints) {
+      auto mp = map.create_point(kf->frame().unproject_world(idx), kf);
+      mp->add_observation(kf, idx);
+      mp->compute_distinctive_descriptor();
+      mp->update_normal_and_depth();
+      pts.push_back(mp);
+    }
+    kf->set_map_point(idx, pts[idx]);  // observations are added when local mapping processes kf
+  }
+  return kf;
+}
+
+LocalMappingOptions options() {
+  LocalMappingOptions o;
+  o.align_patches = false;  // no images in these frames
+  return o;
+}
+
+TEST(LocalMapping, InlineMappingNeverAsksToStopBa) {
+  Map map;
+  LocalMapping mapping(map, camera(), options());
+  std::vector<std::shared_ptr<MapPoint>> pts;
+  for (std::uint64_t id = 0; id < 3; ++id) {
+    mapping.insert(keyframe(map, id, pts));
+    EXPECT_FALSE(mapping.ba_stop_requested());
+  }
+  const LocalMappingStats s = mapping.stats();
+  EXPECT_EQ(s.keyframes, 3);
+  EXPECT_EQ(s.local_ba, 3);  // the queue is always empty inline
+  EXPECT_EQ(s.local_ba_stopped, 0);
+  EXPECT_TRUE(mapping.idle());
+}
+
+// The worker is held at the map lock with a keyframe in hand while two more
+// are queued: the queue raises the stop flag; the held keyframe skips its
+// BA (keyframes wait), the last one clears the flag and runs its BA to the end.
+TEST(LocalMapping, QueuedKeyframeRaisesTheStopFlagUntilTheNextBa) {
+  Map map;
+  LocalMapping mapping(map, camera(), options());
+  std::vector<std::shared_ptr<MapPoint>> pts;
+  mapping.insert(keyframe(map, 0, pts));  // inline: not started yet
+  auto kf1 = keyframe(map, 1, pts);
+  auto kf2 = keyframe(map, 2, pts);
+  {
+    std::unique_lock<std::mutex> lock(map.mutex());
+    mapping.start();
+    mapping.insert(kf1);
+    EXPECT_TRUE(mapping.ba_stop_requested());
+    mapping.insert(kf2);
+    EXPECT_TRUE(mapping.ba_stop_requested());
+    EXPECT_FALSE(mapping.idle());
+  }
+  mapping.stop();
+  EXPECT_FALSE(mapping.ba_stop_requested());  // cleared before kf2's BA
+  const LocalMappingStats s = mapping.stats();
+  EXPECT_EQ(s.keyframes, 3);
+  EXPECT_EQ(s.local_ba, 2);  // kf0 and kf2; kf1 found kf2 waiting
+  EXPECT_EQ(s.local_ba_stopped, 0);
+  EXPECT_TRUE(mapping.idle());
+  for (const auto& mp : pts) EXPECT_EQ(mp->num_observations(), 6);  // three RGB-D observations each
+}
+
+TEST(LocalMapping, StatsAsJson) {
+  LocalMappingStats s;
+  s.keyframes = 12;
+  s.local_ba = 9;
+  s.local_ba_stopped = 4;
+  s.busy_ms = 250.5;
+  EXPECT_EQ(to_json(s), "{\"keyframes\": 12, \"local_ba\": 9, \"local_ba_stopped\": 4, \"busy_ms\": 250.5}");
+}
+
+}  // namespace
+}  // namespace pvb::slam
