@@ -75,17 +75,21 @@ void LocalMapping::start() {
 void LocalMapping::stop() {
   queue_.close();
   if (worker_.joinable()) worker_.join();
+  on_worker_ = false;  // the worker is gone
 }
 
 void LocalMapping::insert(std::shared_ptr<KeyFrame> kf) {
   ++pending_;
-  if (worker_.joinable()) {
+  if (on_worker_) {
+    // Push and flag together, as the worker clears the flag and looks at
+    // the queue together: a keyframe queued before that look makes the
+    // worker skip the BA, one queued after it stops the BA, and no flag of
+    // an earlier keyframe can land on a later keyframe's BA.
+    std::lock_guard<std::mutex> lock(stop_mutex_);
     if (!queue_.push(std::move(kf))) {
       --pending_;
       return;
     }
-    // After the push: the worker clears the flag before it checks the
-    // queue, so a keyframe pushed after that check always stops the BA.
     stop_ba_ = true;
   } else {
     process(kf);
@@ -132,8 +136,13 @@ void LocalMapping::process(const std::shared_ptr<KeyFrame>& kf) {
       for (const auto& k : kf->best_covisibles(-1)) align_keyframe_observations(*k, options_.patch_align);
     }
   }
-  stop_ba_ = false;
-  if (queue_.size() == 0) {
+  bool queue_empty = false;
+  {
+    std::lock_guard<std::mutex> lock(stop_mutex_);
+    stop_ba_ = false;
+    queue_empty = queue_.size() == 0;
+  }
+  if (queue_empty) {
     if (options_.local_ba) local_bundle_adjustment(kf);
     std::lock_guard<std::mutex> lock(map_.mutex());
     cull_keyframes(kf);
@@ -322,10 +331,14 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
   }
   if (problem.edges.empty()) return;
   // Optimise without holding the map: tracking goes on with the old poses.
-  BaOptions ba_options;
-  if (on_worker_) ba_options.abort_flag = &stop_ba_;  // inline (sync) mode: never stopped
-  const BaResult result = slam::local_bundle_adjustment(&problem, cam_->K, ba_options);
+  BaOptions ba_options = options_.ba;
+  ba_options.abort_flag = on_worker_ ? &stop_ba_ : nullptr;  // inline (sync) mode: never stopped
   ++ba_runs_;
+  if (on_worker_ && stop_ba_.load()) {  // ORB-SLAM2 returns here too: the map is left alone
+    ++ba_stopped_;
+    return;
+  }
+  const BaResult result = slam::local_bundle_adjustment(&problem, cam_->K, ba_options);
   if (result.stopped) ++ba_stopped_;
 
   std::lock_guard<std::mutex> lock(map_.mutex());

@@ -9,6 +9,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -58,8 +59,10 @@ bool aborted(const std::atomic<bool>* flag) { return flag != nullptr && flag->lo
 /// SOLVER_ABORT would make Ceres discard the whole pass.
 class AbortCallback : public ceres::IterationCallback {
  public:
-  explicit AbortCallback(const std::atomic<bool>* flag) : flag_(flag) {}
+  AbortCallback(const std::atomic<bool>* flag, const std::function<void()>& on_iteration)
+      : flag_(flag), on_iteration_(on_iteration) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& /*summary*/) override {
+    if (on_iteration_) on_iteration_();
     if (!aborted(flag_)) return ceres::SOLVER_CONTINUE;
     fired_ = true;
     return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
@@ -68,6 +71,7 @@ class AbortCallback : public ceres::IterationCallback {
 
  private:
   const std::atomic<bool>* flag_;
+  const std::function<void()>& on_iteration_;
   bool fired_ = false;
 };
 
@@ -258,7 +262,7 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
   for (std::size_t e = 0; e < num_edges; ++e) active[e] = std::isfinite(edge_chi2(e)) ? 1 : 0;
 
   std::vector<std::uint8_t> keyframe_used(ba.keyframes.size(), 0), point_used(ba.points.size(), 0);
-  AbortCallback abort_callback(options.abort_flag);
+  AbortCallback abort_callback(options.abort_flag, options.on_iteration);
 
   const auto solve_pass = [&](int iterations, bool robust) {
     ceres::Problem prob(borrowed_problem_options());
@@ -302,7 +306,8 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
     solver_options.max_num_iterations = iterations;
     solver_options.num_threads = 1;  // deterministic
     solver_options.logging_type = ceres::SILENT;
-    if (options.abort_flag != nullptr) solver_options.callbacks.push_back(&abort_callback);
+    if (options.abort_flag != nullptr || options.on_iteration)
+      solver_options.callbacks.push_back(&abort_callback);
 
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &prob, &summary);
@@ -317,7 +322,6 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
   // Pass 1: all edges, Huber loss.
   solve_pass(options.iterations_first, true);
   const bool skip_second = aborted(options.abort_flag);
-  result.stopped = abort_callback.fired() || skip_second;
   if (!skip_second) {
     // Pass 2: without the outliers of pass 1 and without robust kernel.
     for (std::size_t e = 0; e < num_edges; ++e) {
@@ -325,6 +329,7 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
     }
     solve_pass(options.iterations_second, false);
   }
+  result.stopped = abort_callback.fired() || skip_second;
 
   // Outliers: excluded from the last pass, or chi2 too big / behind the
   // camera at the final estimate.

@@ -3,7 +3,9 @@
 // (synchronous) mapping never does, and the counters add up.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <mutex>
+#include <thread>
 
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/map.hpp"
@@ -96,6 +98,44 @@ TEST(LocalMapping, QueuedKeyframeRaisesTheStopFlagUntilTheNextBa) {
   EXPECT_EQ(s.local_ba_stopped, 0);
   EXPECT_TRUE(mapping.idle());
   for (const auto& mp : pts) EXPECT_EQ(mp->num_observations(), 6);  // three RGB-D observations each
+}
+
+// A keyframe queued while the worker's local BA runs (here from the BA's
+// first iteration, on the worker itself) stops that BA; the queued keyframe
+// then gets a BA of its own, run to the end.
+TEST(LocalMapping, KeyframeQueuedDuringTheBaStopsIt) {
+  Map map;
+  LocalMapping* self = nullptr;
+  std::shared_ptr<KeyFrame> late;
+  bool queued = false;
+  LocalMappingOptions opt = options();
+  opt.ba.on_iteration = [&] {
+    if (late && !queued) {
+      queued = true;
+      self->insert(late);
+    }
+  };
+  LocalMapping mapping(map, camera(), opt);
+  self = &mapping;
+  std::vector<std::shared_ptr<MapPoint>> pts;
+  mapping.insert(keyframe(map, 0, pts));  // inline, before start(): no keyframe to queue yet
+  auto kf1 = keyframe(map, 1, pts);
+  late = keyframe(map, 2, pts);
+  mapping.start();
+  mapping.insert(kf1);
+  // stop() would refuse kf2 if it closed the queue before the BA queued it:
+  // wait until both are done (kf2 is queued before kf1 counts as done).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!mapping.idle() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  mapping.stop();
+  const LocalMappingStats s = mapping.stats();
+  EXPECT_TRUE(queued);
+  EXPECT_EQ(s.keyframes, 3);
+  EXPECT_EQ(s.local_ba, 3);
+  EXPECT_EQ(s.local_ba_stopped, 1);
+  EXPECT_FALSE(mapping.ba_stop_requested());
+  EXPECT_TRUE(mapping.idle());
 }
 
 TEST(LocalMapping, StatsAsJson) {

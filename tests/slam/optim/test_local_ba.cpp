@@ -169,6 +169,57 @@ TEST(LocalBundleAdjustment, AbortFlagStopsEarly) {
   EXPECT_NE(std::find(r2.outlier_edges.begin(), r2.outlier_edges.end(), 3u), r2.outlier_edges.end());
 }
 
+// The flag raised during a pass (as local mapping's worker sees it when a
+// keyframe is queued): that pass ends after the iteration, the estimate
+// reached so far is kept, a stop in pass 1 skips pass 2.
+TEST(LocalBundleAdjustment, AbortFlagRaisedDuringAPassKeepsTheEstimateSoFar) {
+  const auto scene = [] {
+    auto s = make_ba_scene(5, 2, 200, 1.0, 38);
+    perturb_ba(&s.problem, 0.05, 2.0, 0.05, 39);
+    return s;
+  };
+  // Reference: no flag.  Count the iterations of each pass.
+  auto full = scene();
+  BaOptions count;
+  int calls = 0;
+  count.on_iteration = [&] { ++calls; };
+  const BaResult r_full = local_bundle_adjustment(&full.problem, testing::default_intrinsics(), count);
+  EXPECT_FALSE(r_full.stopped);
+  ASSERT_GE(r_full.iterations, 4);
+  const int total_calls = calls;  // iterations plus one start per pass
+
+  // Raised at the third call (pass 1, after two steps).
+  auto s1 = scene();
+  const BaProblem before = s1.problem;
+  std::atomic<bool> stop{false};
+  BaOptions options;
+  options.abort_flag = &stop;
+  calls = 0;
+  options.on_iteration = [&] {
+    if (++calls == 3) stop = true;
+  };
+  const BaResult r1 = local_bundle_adjustment(&s1.problem, testing::default_intrinsics(), options);
+  EXPECT_TRUE(r1.stopped);
+  EXPECT_EQ(calls, 3);  // no further iteration, no second pass
+  EXPECT_EQ(r1.iterations, 2);
+  // The two steps are kept: the free keyframes moved towards the truth.
+  for (std::size_t k = 2; k < 5; ++k)
+    EXPECT_LT(position_error_m(s1.problem.keyframes[k].T_c_w, s1.T_c_w_gt[k]),
+              position_error_m(before.keyframes[k].T_c_w, s1.T_c_w_gt[k]))
+        << "keyframe " << k;
+
+  // Raised at the last call of pass 2: reported as stopped too.
+  auto s2 = scene();
+  stop = false;
+  calls = 0;
+  options.on_iteration = [&] {
+    if (++calls == total_calls) stop = true;
+  };
+  const BaResult r2 = local_bundle_adjustment(&s2.problem, testing::default_intrinsics(), options);
+  EXPECT_TRUE(r2.stopped);
+  EXPECT_EQ(r2.iterations, r_full.iterations);
+}
+
 TEST(LocalBundleAdjustment, PointBehindCameraEdgeIsOutlier) {
   auto s = make_ba_scene(4, 1, 50, 0.5, 36);
   // Edge 0's point moved behind its keyframe's camera.

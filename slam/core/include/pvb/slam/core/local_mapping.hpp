@@ -35,6 +35,9 @@ struct LocalMappingOptions {
   /// (patch_refine.hpp); the tracker aligns the rest.
   bool align_patches = true;
   PatchAlignParams patch_align;
+  /// Local BA iterations and gates; its abort_flag is local mapping's own
+  /// (set on the worker thread only), whatever is given here.
+  BaOptions ba;
 };
 
 /// Map-point culling rule (ORB-SLAM2 MapPointCulling, RGB-D): returns
@@ -101,7 +104,7 @@ class LocalMapping {
   double busy_ms() const { return static_cast<double>(busy_us_.load()) / 1000.0; }
   LocalMappingStats stats() const;
   /// True from a keyframe queued in worker mode until the worker clears it
-  /// before its next local BA (exposed for tests).
+  /// before it decides on its next local BA (exposed for tests).
   bool ba_stop_requested() const { return stop_ba_.load(); }
 
  private:
@@ -120,7 +123,10 @@ class LocalMapping {
   ClosableQueue<std::shared_ptr<KeyFrame>> queue_;
   std::atomic<int> pending_{0};  ///< keyframes inserted and not yet processed
   std::atomic<std::int64_t> busy_us_{0};  ///< time in process(), microseconds
-  bool on_worker_ = false;                ///< start() was called (set before the worker exists)
+  /// Between start() and the end of stop(); set before the worker exists,
+  /// so the worker may read it too (insert() from a hook, its local BA).
+  bool on_worker_ = false;
+  std::mutex stop_mutex_;                 ///< insert(): push + raise; worker: clear + look at the queue
   std::atomic<bool> stop_ba_{false};      ///< set by insert() in worker mode, cleared before each local BA
   std::atomic<std::int64_t> processed_{0}, ba_runs_{0}, ba_stopped_{0};
   std::function<void(const std::shared_ptr<KeyFrame>&)> after_keyframe_;

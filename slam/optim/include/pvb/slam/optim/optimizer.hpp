@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "pvb/geometry/se3.hpp"
@@ -90,6 +91,10 @@ struct BaOptions {
   /// no outlier is reported.  Set during the first pass: the estimate so far
   /// is kept and the second pass skipped.
   const std::atomic<bool>* abort_flag = nullptr;
+  /// Optional: called after every iteration of either pass (iteration 0,
+  /// the start, included), before abort_flag is looked at.  Tests use it to
+  /// raise the flag at a chosen iteration.
+  std::function<void()> on_iteration;
   /// Sparse Schur complement (global BA over the whole map: many keyframes,
   /// each seeing a few others); false: dense (local BA, a few dozen keyframes).
   bool sparse_schur = false;
