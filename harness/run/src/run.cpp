@@ -693,7 +693,7 @@ RunReport run_scenario(const RunOptions& opt) {
         {"tracking" + suffix, sink->tracking_ms, frames, opt.sync ? "main" : "consumer"});
     report.profile.push_back(
         {"orb_extraction" + suffix, sink->orb_ms, frames, opt.sync ? "main" : "consumer"});
-    report.profile.push_back({"mapping" + suffix, sink->system->mapping_busy_ms(), sink->run.keyframes,
+    report.profile.push_back({"mapping" + suffix, sink->system->mapping_stats().busy_ms, sink->run.keyframes,
                               opt.sync ? "main" : "mapping"});
   }
   report.profile.push_back({"output", output_ms, frames, opt.sync ? "main" : "consumer"});

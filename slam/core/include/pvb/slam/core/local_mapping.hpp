@@ -64,7 +64,7 @@ void erase_outlier_observations(const BaProblem& problem, const std::vector<std:
 /// What local mapping has done so far (for stats and reports).
 struct LocalMappingStats {
   std::int64_t keyframes = 0;         ///< keyframes processed
-  std::int64_t local_ba = 0;          ///< local bundle adjustments run
+  std::int64_t local_ba = 0;          ///< local bundle adjustments started
   std::int64_t local_ba_stopped = 0;  ///< of which cut short by a new keyframe (worker mode only)
   double busy_ms = 0;                 ///< time spent processing keyframes
 };

@@ -60,9 +60,8 @@ class System {
   MapSnapshot map_snapshot();
   /// Positions of the map points (world frame), by point id.
   std::vector<Eigen::Vector3d> map_point_positions();
-  /// Time local mapping has spent on keyframes so far (inline or on its worker), ms.
-  double mapping_busy_ms() const { return mapping_->busy_ms(); }
-  /// Keyframes processed and local BAs run (and cut short) so far.
+  /// Keyframes processed, local BAs started (and cut short) and the time
+  /// spent so far (inline or on its worker).
   LocalMappingStats mapping_stats() const { return mapping_->stats(); }
   TrackingState state() const { return tracking_->state(); }
   /// Loops closed so far and detection totals (empty when LoopClosing.enabled is 0).
