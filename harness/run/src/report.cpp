@@ -51,7 +51,7 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
   if (run.refined_eval)
     out += in + "\"refined\": {\"ate_rmse\": " + num(run.refined_eval->ate.rmse) +
            ", \"rpe_trans_rmse\": " + num(run.refined_eval->rpe_trans_m.rmse) + "},\n";
-  if (!run.local_mapping_json.empty()) out += in + "\"local_mapping\": " + run.local_mapping_json + ",\n";
+  if (run.local_mapping) out += in + "\"local_mapping\": " + slam::to_json(*run.local_mapping) + ",\n";
   if (!run.loop_closing_json.empty()) out += in + "\"loop_closing\": " + run.loop_closing_json + ",\n";
   out += in + "\"tracking_ms\": {\"median\": " + num(percentile(ms, 0.5)) +
          ", \"mean\": " + num(mean_of(ms)) + ", \"p95\": " + num(percentile(ms, 0.95)) + "},\n";
@@ -318,6 +318,13 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
   row("frames", std::to_string(p.frames) + " (" + fixed(r.sim_s, 2) + " s simulated)");
   row("lost frames", std::to_string(p.lost_frames));
   row("keyframes / map points", std::to_string(p.keyframes) + " / " + std::to_string(p.map_points));
+  if (p.local_mapping) {
+    const slam::LocalMappingStats& lm = *p.local_mapping;
+    row("local mapping", std::to_string(lm.keyframes) + " keyframes processed, " + std::to_string(lm.local_ba) +
+                             " local BAs (" + std::to_string(lm.local_ba_stopped) + " stopped by a new keyframe), " +
+                             fixed(lm.busy_ms / 1000.0, 1) + " s busy");
+  }
+  if (!p.loop_closing_json.empty()) row("loops closed", std::to_string(p.loops_closed));
   if (p.eval) {
     row("ATE rmse / mean / max [m]", fixed(p.eval->ate.rmse, 4) + " / " + fixed(p.eval->ate.mean, 4) + " / " +
                                          fixed(p.eval->ate.max, 4) + " (" +
@@ -328,6 +335,9 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
   } else {
     row("ATE", "not evaluated: " + p.eval_note);
   }
+  if (p.refined_eval)
+    row("refined trajectory ATE rmse [m]",
+        fixed(p.refined_eval->ate.rmse, 4) + " (every frame re-anchored on its keyframe's final pose)");
   const std::vector<double> ms = tracking_times(p);
   row("tracking ms median / mean / p95",
       fixed(percentile(ms, 0.5), 2) + " / " + fixed(mean_of(ms), 2) + " / " + fixed(percentile(ms, 0.95), 2));

@@ -252,7 +252,7 @@ struct SystemSink {
     timing.close();
     run.keyframes = system->num_keyframes();
     run.map_points = system->num_map_points();
-    run.local_mapping_json = slam::to_json(system->mapping_stats());
+    run.local_mapping = system->mapping_stats();
   }
 
   void evaluate(const eval::Trajectory& gt) {

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
@@ -220,6 +221,34 @@ TEST(RunReport, IndexHtmlIsSelfContained) {
   EXPECT_EQ(html.find("http://"), std::string::npos);
   EXPECT_EQ(html.find("https://"), std::string::npos);
   EXPECT_EQ(html.find("src=\"/"), std::string::npos);  // relative links only
+}
+
+TEST(RunReport, LocalMappingLoopsAndRefinedAteInTheReport) {
+  RunReport r = hand_report();
+  EXPECT_FALSE(YAML::Load(metrics_json(r))["local_mapping"]);  // not known: no key, no row
+  EXPECT_EQ(index_html(r, {}).find("local mapping"), std::string::npos);
+
+  r.primary.local_mapping = slam::LocalMappingStats{41, 39, 5, 12345.0};
+  const YAML::Node m = YAML::Load(metrics_json(r));
+  ASSERT_TRUE(m["local_mapping"]);
+  EXPECT_EQ(m["local_mapping"]["keyframes"].as<int>(), 41);
+  EXPECT_EQ(m["local_mapping"]["local_ba"].as<int>(), 39);
+  EXPECT_EQ(m["local_mapping"]["local_ba_stopped"].as<int>(), 5);
+  EXPECT_NEAR(m["local_mapping"]["busy_ms"].as<double>(), 12345.0, 1e-6);
+  const std::string html = index_html(r, {});
+  EXPECT_NE(html.find("<th>local mapping</th><td>41 keyframes processed, 39 local BAs (5 stopped by a new "
+                      "keyframe), 12.3 s busy</td>"),
+            std::string::npos);
+  EXPECT_EQ(html.find("loops closed"), std::string::npos);  // loop closing off
+
+  r.primary.refined_eval = synthetic_eval(0.005);
+  char refined[32];
+  std::snprintf(refined, sizeof refined, "%.4f", r.primary.refined_eval->ate.rmse);
+  EXPECT_NE(index_html(r, {}).find(std::string("<th>refined trajectory ATE rmse [m]</th><td>") + refined),
+            std::string::npos);
+  r.primary.loop_closing_json = "{\"loops\": 2}";
+  r.primary.loops_closed = 2;
+  EXPECT_NE(index_html(r, {}).find("<th>loops closed</th><td>2</td>"), std::string::npos);
 }
 
 TEST(RunReport, WriteReportWritesEveryFile) {

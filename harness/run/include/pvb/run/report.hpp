@@ -11,6 +11,7 @@
 
 #include "pvb/eval/evaluate.hpp"
 #include "pvb/plot/contact_sheet.hpp"
+#include "pvb/slam/core/local_mapping.hpp"
 
 namespace pvb::run {
 
@@ -60,7 +61,7 @@ struct SlamRun {
   /// (local BA and loop closing), CameraTrajectoryRefined.txt; same alignment.
   std::optional<eval::EvalResult> refined_eval;
   std::string loop_closing_json;  ///< slam::to_json(LoopClosingStats); empty when loop closing is off
-  std::string local_mapping_json;  ///< slam::to_json(LocalMappingStats); empty when not known
+  std::optional<slam::LocalMappingStats> local_mapping;  ///< nullopt when not known
   std::size_t loops_closed = 0;
 };
 
