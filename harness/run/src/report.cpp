@@ -320,8 +320,9 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
   row("keyframes / map points", std::to_string(p.keyframes) + " / " + std::to_string(p.map_points));
   if (p.local_mapping) {
     const slam::LocalMappingStats& lm = *p.local_mapping;
-    row("local mapping", std::to_string(lm.keyframes) + " keyframes processed, " + std::to_string(lm.local_ba) +
-                             " local BAs (" + std::to_string(lm.local_ba_stopped) + " stopped by a new keyframe), " +
+    row("local mapping", std::to_string(lm.keyframes) + " keyframes processed, " +
+                             std::to_string(lm.local_ba) + " local BAs (" +
+                             std::to_string(lm.local_ba_stopped) + " stopped by a new keyframe), " +
                              fixed(lm.busy_ms / 1000.0, 1) + " s busy");
   }
   if (!p.loop_closing_json.empty()) row("loops closed", std::to_string(p.loops_closed));
