@@ -115,15 +115,8 @@ bool Tracking::initialize(Frame& f) {
   f.T_c_w = geom::SE3d::Identity();
   f.has_pose = true;
   auto kf = map_.create_keyframe(f);
-  for (std::size_t i = 0; i < f.size(); ++i) {
-    if (f.depth_m[i] <= 0) continue;
-    auto mp = map_.create_point(f.unproject_world(i), kf);
-    mp->add_observation(kf, i);
-    kf->set_map_point(i, mp);
-    mp->compute_distinctive_descriptor();
-    mp->update_normal_and_depth();
-    f.map_points[i] = mp;
-  }
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (f.depth_m[i] > 0) add_point_from_depth(f, kf, i);
   ref_kf_ = kf;
   local_kfs_ = {kf};
   return true;
@@ -479,6 +472,15 @@ bool Tracking::need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t 
   return mapping_idle || mapping_queue < 3;
 }
 
+void Tracking::add_point_from_depth(Frame& f, const std::shared_ptr<KeyFrame>& kf, std::size_t i) {
+  auto mp = map_.create_point(f.unproject_world(i), kf);
+  mp->add_observation(kf, i);
+  kf->set_map_point(i, mp);
+  mp->compute_distinctive_descriptor();
+  mp->update_normal_and_depth();
+  f.map_points[i] = mp;
+}
+
 std::shared_ptr<KeyFrame> Tracking::create_keyframe(Frame& f) {
   auto kf = map_.create_keyframe(f);
   ref_kf_ = kf;
@@ -489,12 +491,7 @@ std::shared_ptr<KeyFrame> Tracking::create_keyframe(Frame& f) {
   for (const auto& [d, i] : by_depth) {
     const auto& existing = f.map_points[i];
     if (!existing || existing->num_observations() < 1) {
-      auto mp = map_.create_point(f.unproject_world(i), kf);
-      mp->add_observation(kf, i);
-      kf->set_map_point(i, mp);
-      mp->compute_distinctive_descriptor();
-      mp->update_normal_and_depth();
-      f.map_points[i] = mp;
+      add_point_from_depth(f, kf, i);
       f.outlier[i] = 0;
     }
     ++n;

@@ -150,6 +150,8 @@ class Tracking {
   /// ORB-SLAM2's keyframe decision; also fills stats_.kf_* with its inputs.
   bool need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue);
   std::shared_ptr<KeyFrame> create_keyframe(Frame& f);
+  /// A new map point at keypoint i of f, from its depth, observed by kf (made from f).
+  void add_point_from_depth(Frame& f, const std::shared_ptr<KeyFrame>& kf, std::size_t i);
   void discard_outliers(Frame& f, int* map_matches);
   void replace_in_last_frame();
   /// Appends one step's failure to stats_.failure; returns false.
