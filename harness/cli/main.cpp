@@ -1,6 +1,7 @@
 // pvbench: simulation-in-the-loop test bench for visual SLAM on solar farms.
 #include <cstdio>
 #include <exception>
+#include <opencv2/core/utils/logger.hpp>
 #include <vector>
 
 #include "command.hpp"
@@ -42,6 +43,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("pvbench ") + pvb::version());
   app.require_subcommand(1);
   std::vector<pvb::cli::Command> cmds = pvb::cli::add_all_commands(app);
+  // pvbench reports bad input itself, one line each (a missing image is
+  // "pvbench: warning: skipping frame ..."); OpenCV's own log would say it
+  // again in its format.  Its errors still come through.
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

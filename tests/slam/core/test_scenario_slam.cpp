@@ -1,7 +1,7 @@
 // End to end: record ~300 frames of the default PV station with pvbench,
 // run `pvbench slam --sync` on them and check accuracy (ATE RMSE < 2 cm, no
 // lost frames); and check that synchronous mode gives a bit-identical
-// trajectory twice; and the command line's error and Ctrl-C handling.
+// trajectory twice; and the command line's error, missing-image and Ctrl-C handling.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -327,6 +327,54 @@ TEST(SlamCli, MissingSettingsKeyIsOneClearError) {
   const Result r = run("slam --sequence " + seq + " --settings " + bad + " --out " + dir("bad"));
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_NE(r.output.find("Camera.fy"), std::string::npos) << r.output;
+}
+
+/// The n-th image name (0-based) listed in a TUM list file (rgb.txt, depth.txt).
+std::string nth_listed(const std::string& list_file, std::size_t n) {
+  std::istringstream in(pvb::read_file(list_file));
+  std::string line;
+  std::size_t k = 0;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (k++ == n) return line.substr(line.find(' ') + 1);
+  }
+  return {};
+}
+
+// A corrupt colour image and a missing depth image: each is one warning
+// line naming the file (and nothing from OpenCV's own log); the run goes on
+// without those frames.
+TEST(SlamCli, MissingOrCorruptImagesAreOneWarningLineEach) {
+  const std::string seq = std::filesystem::absolute(station_sequence()).string();
+  const std::string copy = dir("holes");
+  ASSERT_EQ(std::system(("cp -rs " + seq + " " + copy).c_str()), 0);  // a tree of links to the recording
+  const std::string rgb = nth_listed(copy + "/rgb.txt", 10), depth = nth_listed(copy + "/depth.txt", 20);
+  ASSERT_FALSE(rgb.empty());
+  ASSERT_FALSE(depth.empty());
+  std::filesystem::remove(copy + "/" + rgb);
+  pvb::write_file(copy + "/" + rgb, "not a PNG");
+  std::filesystem::remove(copy + "/" + depth);
+
+  const std::string out = dir("holes_out");
+  const Result r = run("slam --sequence " + copy + " --settings " + copy +
+                       "/camera.yaml --sync --no-dense --max-frames 40 --out " + out);
+  EXPECT_EQ(r.code, 0) << r.output;
+  std::size_t warnings = 0;
+  for (std::size_t p = r.output.find("pvbench: warning: skipping frame"); p != std::string::npos;
+       p = r.output.find("pvbench: warning: skipping frame", p + 1))
+    ++warnings;
+  EXPECT_EQ(warnings, 2u) << r.output;
+  EXPECT_NE(r.output.find(rgb + ": missing or unreadable colour image"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(depth + ": missing or unreadable depth image"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("WARN"), std::string::npos) << r.output;  // OpenCV's log stays quiet
+  // --max-frames counts the frames read, so 40 are tracked; the two broken ones are not among them.
+  EXPECT_NEAR(json_number(pvb::read_file(out + "/stats.json"), "frames"), 40, 0.5);
+  const std::string traj = pvb::read_file(out + "/CameraTrajectory.txt");
+  for (const std::string& image : {rgb, depth})
+    EXPECT_EQ(traj.find("\n" + std::filesystem::path(image).stem().string() + " "), std::string::npos)
+        << image;
+  EXPECT_NE(traj.find("\n" + std::filesystem::path(nth_listed(copy + "/rgb.txt", 11)).stem().string() + " "),
+            std::string::npos);  // the next frame is
 }
 
 }  // namespace
