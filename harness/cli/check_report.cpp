@@ -15,8 +15,10 @@ int check_and_print(const std::string& scenario_file, const std::string& metrics
     return no_expect_code;
   }
   std::vector<std::string> notes;
-  const std::vector<suite::Violation> violations =
-      suite::check_expectations(s.expect, metrics_path, scenes::frame_count(s), &notes);
+  const std::vector<suite::Violation> violations = suite::check_expectations(s.expect, metrics_path, &notes);
+  if (s.expect.sweep.any())
+    notes.push_back("expect.sweep is judged over seeds: pvbench sweep --scenario " + scenario_file +
+                    " --compare --check");
   for (const auto& n : notes) std::printf("%s: note: %s\n", metrics_path.c_str(), n.c_str());
   for (const auto& v : violations) std::printf("%s: %s\n", metrics_path.c_str(), v.line().c_str());
   if (violations.empty()) std::printf("%s: ok (%s)\n", metrics_path.c_str(), s.name.c_str());

@@ -31,6 +31,7 @@
 #include "pvb/plot/png.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/suite/aggregate.hpp"
+#include "pvb/suite/check.hpp"
 #include "pvb/suite/seeds.hpp"
 
 namespace pvb::cli {
@@ -38,7 +39,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// Exit status when at least one seed failed (the aggregate is still written).
+/// Exit status when at least one seed failed or, with --check, a bound is
+/// violated (the aggregate is still written).
 constexpr int kSeedFailedExit = 3;
 /// Exit status after Ctrl-C / SIGTERM (the aggregate of what finished is written).
 constexpr int kInterruptedExit = 130;
@@ -55,6 +57,7 @@ struct SweepArgs {
   std::string gl;
   bool print_commands = false;
   bool aggregate_only = false;
+  bool check = false;
 };
 
 volatile std::sig_atomic_t g_stop_signal = 0;
@@ -241,8 +244,9 @@ std::vector<std::uint64_t> discover_seeds(const std::string& out) {
   return seeds;
 }
 
-int write_aggregate(const SweepArgs& a, const std::string& scenario_name,
-                    const std::vector<std::uint64_t>& seeds, const std::map<std::uint64_t, int>& exit_codes) {
+suite::SweepAggregate write_aggregate(const SweepArgs& a, const std::string& scenario_name,
+                                      const std::vector<std::uint64_t>& seeds,
+                                      const std::map<std::uint64_t, int>& exit_codes) {
   std::vector<suite::SeedRun> runs;
   for (std::uint64_t s : seeds) {
     const auto it = exit_codes.find(s);
@@ -271,7 +275,21 @@ int write_aggregate(const SweepArgs& a, const std::string& scenario_name,
   // With --compare, the paired PE-SLAM − baseline figure is the sweep's answer: last.
   if (agg.has_baseline) std::printf("%s\n", suite::format_paired_line(agg.paired).c_str());
   std::fflush(stdout);
-  return agg.failed;
+  return agg;
+}
+
+/// --check: every seed against the scenario's single-run bounds and the sweep
+/// against expect.sweep; one line per violation (or one "ok" line).  Returns
+/// true when everything holds.
+bool check_sweep_and_print(const std::string& scenario_file, const suite::SweepAggregate& agg) {
+  const scenes::Scenario s = scenes::load_scenario(scenario_file);
+  std::vector<std::string> notes;
+  const std::vector<suite::Violation> violations = suite::check_sweep(s.expect, agg, &notes);
+  for (const auto& n : notes) std::printf("check: note: %s\n", n.c_str());
+  for (const auto& v : violations) std::printf("check: %s\n", v.line().c_str());
+  if (violations.empty()) std::printf("check: ok (%s, %zu seeds)\n", s.name.c_str(), agg.runs.size());
+  std::fflush(stdout);
+  return violations.empty();
 }
 
 int run_sweep(SweepArgs a) {
@@ -284,12 +302,15 @@ int run_sweep(SweepArgs a) {
   else if (!a.aggregate_only)
     throw ConfigError("command line", "--scenario", "a scenario file");
 
+  if (a.check && a.scenario.empty())
+    throw ConfigError("command line", "--check", "a --scenario whose expect: section judges the sweep");
   if (a.aggregate_only) {
     const std::vector<std::uint64_t> seeds =
         a.seeds.empty() ? discover_seeds(a.out) : suite::parse_seed_list(a.seeds);
     if (seeds.empty()) throw ConfigError(a.out, "seed_*/metrics.json", "at least one seed folder", "none");
-    const int failed = write_aggregate(a, scenario_name, seeds, {});
-    return failed > 0 ? kSeedFailedExit : 0;
+    const suite::SweepAggregate agg = write_aggregate(a, scenario_name, seeds, {});
+    const bool holds = !a.check || check_sweep_and_print(a.scenario, agg);
+    return agg.failed > 0 || !holds ? kSeedFailedExit : 0;
   }
   if (a.seeds.empty()) throw ConfigError("command line", "--seeds", "a seed list like 1-20, 1,3,5 or 1-5,9");
   const std::vector<std::uint64_t> seeds = suite::parse_seed_list(a.seeds);
@@ -304,14 +325,15 @@ int run_sweep(SweepArgs a) {
   std::printf("sweep: %s, %zu seed(s), %d at once, into %s\n", scenario_name.c_str(), seeds.size(), a.jobs,
               a.out.c_str());
   const std::map<std::uint64_t, int> exit_codes = run_seeds(a, seeds);
-  const int failed = write_aggregate(a, scenario_name, seeds, exit_codes);
+  const suite::SweepAggregate agg = write_aggregate(a, scenario_name, seeds, exit_codes);
   if (g_stop_signal != 0) {
     std::printf("sweep: stopped by signal %d; the aggregate covers the seeds that wrote metrics\n",
                 static_cast<int>(g_stop_signal));
     return kInterruptedExit;
   }
-  if (failed > 0) std::printf("sweep: %d seed(s) failed\n", failed);
-  return failed > 0 ? kSeedFailedExit : 0;
+  if (agg.failed > 0) std::printf("sweep: %d seed(s) failed\n", agg.failed);
+  const bool holds = !a.check || check_sweep_and_print(a.scenario, agg);
+  return agg.failed > 0 || !holds ? kSeedFailedExit : 0;
 }
 
 }  // namespace
@@ -335,6 +357,8 @@ Command add_sweep_command(CLI::App& app) {
                 "print one self-contained shell command per seed (for Slurm, GNU parallel) and exit");
   sub->add_flag("--aggregate-only", args->aggregate_only,
                 "only aggregate existing DIR/seed_*/metrics.json (after a cluster run)");
+  sub->add_flag("--check", args->check,
+                "judge every seed by the scenario's expect: bounds and the sweep by expect.sweep (exit 3)");
   return {sub, [args] { return run_sweep(*args); }};
 }
 

@@ -364,12 +364,21 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
     if (r.has("ate_rmse_m_max")) e.ate_rmse_m_max = r.number("ate_rmse_m_max", 0.0, 1e-6, 100);
     if (r.has("rpe_trans_rmse_m_max")) e.rpe_trans_rmse_m_max = r.number("rpe_trans_rmse_m_max", 0.0, 1e-6, 100);
     if (r.has("lost_frames_max")) e.lost_frames_max = r.integer("lost_frames_max", 0, 0, 1000000);
-    e.pe_not_worse_than_baseline = r.boolean("pe_not_worse_than_baseline", e.pe_not_worse_than_baseline);
+    if (r.has("pe_not_worse_than_baseline"))
+      r.fail(r.full("pe_not_worse_than_baseline"), r.child("pe_not_worse_than_baseline"),
+             "expect.sweep.pe_not_significantly_worse instead (PE-SLAM against the baseline is judged over "
+             "a seed sweep, not one run; docs/scenarios.md)",
+             "a single-run comparison");
     e.tracking_loss_expected = r.boolean("tracking_loss_expected", e.tracking_loss_expected);
     e.ci_frames = r.integer("ci_frames", e.ci_frames, 0, 1000000);
     if (e.ci_frames == 1) r.fail(r.full("ci_frames"), YAML::Node(), "0 (not in the fast subset) or at least 2 frames", "1");
     if (e.tracking_loss_expected && e.lost_frames_max == 0)
       r.fail(r.full("lost_frames_max"), YAML::Node(), "a value >= 1 when tracking_loss_expected is true", "0");
+    with_map(r, "sweep", [&](MapReader& w) {
+      SweepExpectations& sw = e.sweep;
+      sw.pe_not_significantly_worse = w.boolean("pe_not_significantly_worse", sw.pe_not_significantly_worse);
+      sw.min_seeds = w.integer("min_seeds", sw.min_seeds, 10, 100000);
+    });
   });
   top.finish();
 

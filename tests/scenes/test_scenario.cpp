@@ -100,8 +100,8 @@ TEST(Scenario, ExpectSectionIsReadAndOptional) {
                                         "  ate_rmse_m_max: 0.01\n"
                                         "  rpe_trans_rmse_m_max: 0.005\n"
                                         "  lost_frames_max: 0\n"
-                                        "  pe_not_worse_than_baseline: true\n"
-                                        "  ci_frames: 240\n",
+                                        "  ci_frames: 240\n"
+                                        "  sweep: {pe_not_significantly_worse: true, min_seeds: 12}\n",
                                     "e.yaml");
   EXPECT_TRUE(s.expect.any());
   ASSERT_TRUE(s.expect.ate_rmse_m_max);
@@ -110,9 +110,17 @@ TEST(Scenario, ExpectSectionIsReadAndOptional) {
   EXPECT_DOUBLE_EQ(*s.expect.rpe_trans_rmse_m_max, 0.005);
   ASSERT_TRUE(s.expect.lost_frames_max);
   EXPECT_EQ(*s.expect.lost_frames_max, 0);
-  EXPECT_TRUE(s.expect.pe_not_worse_than_baseline);
   EXPECT_FALSE(s.expect.tracking_loss_expected);
   EXPECT_EQ(s.expect.ci_frames, 240);
+  EXPECT_TRUE(s.expect.sweep.pe_not_significantly_worse);
+  EXPECT_EQ(s.expect.sweep.min_seeds, 12);
+  EXPECT_EQ(none.expect.sweep.min_seeds, 10);
+
+  // A sweep expectation alone sets no bound on a single run.
+  const Scenario only_sweep = parse_scenario(
+      std::string(kMinimal) + "expect:\n  sweep: {pe_not_significantly_worse: true}\n", "w.yaml");
+  EXPECT_TRUE(only_sweep.expect.any());
+  EXPECT_FALSE(only_sweep.expect.any_run_bound());
 }
 
 TEST(Scenario, ExpectSectionIsStrict) {
@@ -126,9 +134,19 @@ TEST(Scenario, ExpectSectionIsStrict) {
             std::string::npos);
   EXPECT_NE(error_of(base + "  lost_frames_max: 2.5\n").find("expect.lost_frames_max: expected an integer, got 2.5"),
             std::string::npos);
-  EXPECT_NE(error_of(base + "  pe_not_worse_than_baseline: maybe\n")
-                .find("expect.pe_not_worse_than_baseline: expected true or false, got maybe"),
+  EXPECT_NE(error_of(base + "  sweep: {pe_not_significantly_worse: maybe}\n")
+                .find("expect.sweep.pe_not_significantly_worse: expected true or false, got maybe"),
             std::string::npos);
+  EXPECT_NE(
+      error_of(base + "  sweep: {min_seeds: 5}\n").find("expect.sweep.min_seeds: expected a value in [10, "),
+      std::string::npos)
+      << error_of(base + "  sweep: {min_seeds: 5}\n");
+  // The single-run comparison is gone; an old file is told where it went.
+  const std::string old_key = error_of(base + "  pe_not_worse_than_baseline: true\n");
+  EXPECT_NE(old_key.find("bad.yaml:3: expect.pe_not_worse_than_baseline: expected "
+                         "expect.sweep.pe_not_significantly_worse instead"),
+            std::string::npos)
+      << old_key;
   EXPECT_NE(error_of(base + "  ci_frames: 1\n").find("expect.ci_frames"), std::string::npos);
   EXPECT_NE(error_of(base + "  tracking_loss_expected: true\n  lost_frames_max: 0\n").find("expect.lost_frames_max"),
             std::string::npos);

@@ -56,7 +56,12 @@ std::string paired_json(const PairedComparison& p) {
   return "{\"count\": " + std::to_string(p.count) + ", \"mean_m\": " + json_num(p.mean_m) +
          ", \"sd_m\": " + json_num(p.sd_m) + ", \"se_m\": " + json_num(p.se_m) +
          ", \"t_quantile\": " + ci(p.t_quantile) + ", \"ci95_low_m\": " + ci(p.ci_low_m) +
-         ", \"ci95_high_m\": " + ci(p.ci_high_m) + ", \"pe_not_worse\": " + std::to_string(p.pe_not_worse) +
+         ", \"ci95_high_m\": " + ci(p.ci_high_m) + ", \"effect_size_dz\": " + json_num(p.effect_size_dz) +
+         ", \"pe_not_worse\": " + std::to_string(p.pe_not_worse) +
+         ", \"pe_better\": " + std::to_string(p.pe_better) + ", \"pe_worse\": " + std::to_string(p.pe_worse) +
+         ", \"sign_test_p\": " + json_num(p.sign_test_p) +
+         ", \"baseline_mean_m\": " + json_num(p.baseline_mean_m) + ", \"margin_m\": " + json_num(p.margin_m) +
+         ", \"not_significantly_worse\": " + (p.has_ci ? (p.not_worse ? "true" : "false") : "null") +
          ", \"verdict\": \"" + json_escape(verdict_text(p.verdict)) + "\"}";
 }
 
@@ -142,20 +147,45 @@ std::optional<double> paired_ate_difference_m(const SeedRun& r) {
   return *r.metrics->primary.ate_rmse_m - *r.metrics->baseline->ate_rmse_m;
 }
 
+double not_worse_margin_m(double baseline_mean_ate_m) {
+  return std::max(kNotWorseFloorM, kNotWorseShare * baseline_mean_ate_m);
+}
+
+double sign_test_p(int negative, int n) {
+  if (n <= 0) return 1.0;
+  // P(X <= k) for X ~ Binomial(n, 1/2), summed in log space (n may be large).
+  const auto cdf = [n](int k) {
+    double sum = 0.0;
+    for (int i = 0; i <= k; ++i)
+      sum += std::exp(std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) -
+                      n * std::log(2.0));
+    return sum;
+  };
+  const int k = std::min(negative, n - negative);  // the rarer sign
+  return std::min(1.0, 2.0 * cdf(k));
+}
+
 PairedComparison compare_paired(const std::vector<SeedRun>& runs) {
   PairedComparison p;
-  std::vector<double> d;
+  std::vector<double> d, baseline;
   for (const SeedRun& r : runs) {
     const std::optional<double> diff = paired_ate_difference_m(r);
     if (!diff) continue;
     d.push_back(*diff);
-    if (*r.metrics->primary.ate_rmse_m <= *r.metrics->baseline->ate_rmse_m) ++p.pe_not_worse;
+    baseline.push_back(*r.metrics->baseline->ate_rmse_m);
+    if (*diff <= 0.0) ++p.pe_not_worse;
+    if (*diff < 0.0) ++p.pe_better;
+    if (*diff > 0.0) ++p.pe_worse;
   }
   const Summary s = summarize(d);
   p.count = s.count;
   p.mean_m = s.mean;
   p.sd_m = s.sd;
   if (p.count > 0) p.se_m = s.sd / std::sqrt(static_cast<double>(p.count));
+  if (p.sd_m > 0.0) p.effect_size_dz = p.mean_m / p.sd_m;
+  p.sign_test_p = sign_test_p(p.pe_better, p.pe_better + p.pe_worse);
+  p.baseline_mean_m = summarize(baseline).mean;
+  p.margin_m = not_worse_margin_m(p.baseline_mean_m);
   if (p.count < 2) return p;  // verdict stays kTooFewSeeds
   p.has_ci = true;
   p.t_quantile = student_t_quantile(0.975, p.count - 1);
@@ -164,6 +194,7 @@ PairedComparison compare_paired(const std::vector<SeedRun>& runs) {
   p.verdict = p.ci_high_m < 0.0  ? PairedVerdict::kPeBetter
               : p.ci_low_m > 0.0 ? PairedVerdict::kBaselineBetter
                                  : PairedVerdict::kNoSignificantDifference;
+  p.not_worse = p.ci_high_m <= p.margin_m;
   return p;
 }
 
@@ -172,9 +203,14 @@ std::string format_paired_line(const PairedComparison& p) {
   if (p.count == 0) return out + "no seed with both ATEs; " + verdict_text(p.verdict);
   out += "mean " + mm2(p.mean_m) + " mm";
   if (p.has_ci) out += ", 95 % CI [" + mm2(p.ci_low_m) + ", " + mm2(p.ci_high_m) + "] mm";
-  out += " over " + std::to_string(p.count) + (p.count == 1 ? " seed" : " seeds") + " (PE ≤ baseline on " +
-         std::to_string(p.pe_not_worse) + "); " + verdict_text(p.verdict);
-  return out;
+  out += " over " + std::to_string(p.count) + (p.count == 1 ? " seed" : " seeds");
+  if (!p.has_ci)
+    return out + " (PE ≤ baseline on " + std::to_string(p.pe_not_worse) + "); " + verdict_text(p.verdict);
+  out += " (effect size d_z " + fmt("%.2f", p.effect_size_dz) + "; PE ≤ baseline on " +
+         std::to_string(p.pe_not_worse) + ", sign test p = " + fmt("%.2f", p.sign_test_p) + "); " +
+         verdict_text(p.verdict);
+  return out + "; not significantly worse: " + (p.not_worse ? "yes (upper end " : "no (upper end ") +
+         mm2(p.ci_high_m) + (p.not_worse ? " mm ≤ margin " : " mm > margin ") + mm2(p.margin_m) + " mm)";
 }
 
 Summary summarize(const std::vector<double>& values) {
@@ -250,7 +286,9 @@ std::string format_markdown(const SweepAggregate& a) {
     if (a.paired.count > 0)
       out += "\nPaired per seed (both runs track the same frames): d = PE-SLAM − baseline ATE RMSE, SD " +
              mm2(a.paired.sd_m) + " mm, standard error " + mm2(a.paired.se_m) +
-             " mm; the interval is mean ± t(0.975, n − 1) · SE.\n";
+             " mm; the interval is mean ± t(0.975, n − 1) · SE. Not significantly worse: the upper end is at "
+             "most max(0.5 mm, 10 % of the baseline's mean " +
+             mm2(a.paired.baseline_mean_m) + " mm).\n";
   }
 
   out +=

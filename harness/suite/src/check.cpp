@@ -11,10 +11,23 @@ std::string metres(double v) {
   return buf;
 }
 
+/// Millimetres with two decimals; `sign` writes + before a positive value.
+std::string millimetres(double v_m, bool sign = true) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, sign ? "%+.2f mm" : "%.2f mm", v_m * 1000.0);
+  return buf;
+}
+
+std::string pe_against_baseline_note(double pe_m, double baseline_m) {
+  return "PE-SLAM − baseline ATE RMSE " + millimetres(pe_m - baseline_m) + " (PE-SLAM " + metres(pe_m) +
+         ", baseline " + metres(baseline_m) +
+         "); one run does not judge this, a seed sweep does (expect.sweep, pvbench sweep --compare --check)";
+}
+
 }  // namespace
 
 std::vector<Violation> check_expectations(const scenes::Expectations& expect, const MetricsFile& metrics,
-                                          int scenario_frames, std::vector<std::string>* notes) {
+                                          std::vector<std::string>* notes) {
   std::vector<Violation> out;
   const RunMetrics& run = metrics.primary;
 
@@ -56,34 +69,46 @@ std::vector<Violation> check_expectations(const scenes::Expectations& expect, co
     out.push_back({"lost_frames_max", std::to_string(run.lost_frames) + " lost frames > " +
                                           std::to_string(*expect.lost_frames_max)});
 
-  const bool cut_short = scenario_frames > 0 && run.frames < scenario_frames;
-  if (expect.pe_not_worse_than_baseline && cut_short) {
-    if (notes != nullptr) {
-      std::string both = "no ATE";
-      if (metrics.baseline && metrics.baseline->ate_rmse_m && run.ate_rmse_m)
-        both = "PE-SLAM ATE RMSE " + metres(*run.ate_rmse_m) + ", baseline " + metres(*metrics.baseline->ate_rmse_m);
-      notes->push_back("pe_not_worse_than_baseline: not judged on a run cut to " + std::to_string(run.frames) +
-                       " of " + std::to_string(scenario_frames) + " frames (" + both + ")");
-    }
-  } else if (expect.pe_not_worse_than_baseline) {
-    if (!metrics.baseline)
-      out.push_back({"pe_not_worse_than_baseline", "no baseline in the metrics (run with --compare)"});
-    else if (!metrics.baseline->ate_rmse_m)
-      out.push_back({"pe_not_worse_than_baseline", "the baseline has no ATE (ate is null)"});
-    else if (!run.ate_rmse_m)
-      out.push_back({"pe_not_worse_than_baseline", "PE-SLAM has no ATE (ate is null)"});
-    else if (!(*run.ate_rmse_m <= *metrics.baseline->ate_rmse_m))
-      out.push_back({"pe_not_worse_than_baseline", "PE-SLAM ATE RMSE " + metres(*run.ate_rmse_m) +
-                                                       " > baseline " +
-                                                       metres(*metrics.baseline->ate_rmse_m)});
-  }
+  if (notes != nullptr && metrics.baseline && metrics.baseline->ate_rmse_m && run.ate_rmse_m)
+    notes->push_back(pe_against_baseline_note(*run.ate_rmse_m, *metrics.baseline->ate_rmse_m));
   return out;
 }
 
 std::vector<Violation> check_expectations(const scenes::Expectations& expect,
-                                          const std::string& metrics_json_path, int scenario_frames,
+                                          const std::string& metrics_json_path,
                                           std::vector<std::string>* notes) {
-  return check_expectations(expect, read_metrics_file(metrics_json_path), scenario_frames, notes);
+  return check_expectations(expect, read_metrics_file(metrics_json_path), notes);
+}
+
+std::vector<Violation> check_sweep(const scenes::Expectations& expect, const SweepAggregate& sweep,
+                                   std::vector<std::string>* notes) {
+  std::vector<Violation> out;
+  for (const SeedRun& r : sweep.runs) {
+    const std::string seed = "seed " + std::to_string(r.seed) + ": ";
+    if (!r.metrics) {
+      out.push_back({seed + "metrics", "none (" + r.error + ")"});
+      continue;
+    }
+    for (Violation v : check_expectations(expect, *r.metrics)) out.push_back({seed + v.key, v.message});
+  }
+  if (!expect.sweep.pe_not_significantly_worse) return out;
+  const std::string key = "sweep.pe_not_significantly_worse";
+  const PairedComparison& p = sweep.paired;
+  if (!sweep.has_baseline) {
+    out.push_back({key, "no baseline in the sweep (run it with --compare)"});
+  } else if (p.count < expect.sweep.min_seeds) {
+    out.push_back({key, "needs " + std::to_string(expect.sweep.min_seeds) + " seeds with both ATEs, got " +
+                            std::to_string(p.count)});
+  } else if (!p.not_worse) {
+    out.push_back({key, "the paired 95 % interval of PE-SLAM − baseline ATE reaches " +
+                            millimetres(p.ci_high_m) + " > margin " + millimetres(p.margin_m, false) +
+                            " over " + std::to_string(p.count) + " seeds"});
+  } else if (notes != nullptr) {
+    notes->push_back(key + ": holds, the paired 95 % interval of PE-SLAM − baseline ATE reaches " +
+                     millimetres(p.ci_high_m) + " <= margin " + millimetres(p.margin_m, false) + " over " +
+                     std::to_string(p.count) + " seeds");
+  }
+  return out;
 }
 
 }  // namespace pvb::suite

@@ -89,10 +89,21 @@ TEST(PairedComparison, ClearPeWin) {
   EXPECT_NEAR(p.ci_low_m, -0.0032992, 1e-6);
   EXPECT_NEAR(p.ci_high_m, -0.0007008, 1e-6);
   EXPECT_EQ(p.pe_not_worse, 4);
+  EXPECT_EQ(p.pe_better, 4);
+  EXPECT_EQ(p.pe_worse, 0);
+  EXPECT_NEAR(p.effect_size_dz, -2.0 / std::sqrt(2.0 / 3.0), 1e-9);
+  EXPECT_NEAR(p.sign_test_p, 2.0 / 16.0, 1e-12);  // all four signs negative
+  // Baseline mean 6.25 mm: the margin is 10 % of it, above the 0.5 mm floor.
+  EXPECT_NEAR(p.baseline_mean_m, 0.00625, 1e-12);
+  EXPECT_NEAR(p.margin_m, 0.000625, 1e-12);
+  EXPECT_TRUE(p.not_worse);
   EXPECT_EQ(p.verdict, suite::PairedVerdict::kPeBetter);
-  EXPECT_EQ(suite::format_paired_line(p),
-            "PE-SLAM − baseline ATE: mean -2.00 mm, 95 % CI [-3.30, -0.70] mm over 4 seeds "
-            "(PE ≤ baseline on 4); PE-SLAM better");
+  const std::string line = suite::format_paired_line(p);
+  EXPECT_EQ(line.find("PE-SLAM − baseline ATE: mean -2.00 mm, 95 % CI [-3.30, -0.70] mm over 4 seeds "
+                      "(effect size d_z -2.45; PE ≤ baseline on 4, sign test p = 0.12); PE-SLAM better; "
+                      "not significantly worse: yes (upper end -0.70 mm ≤ margin 0.6"),
+            0u)
+      << line;
 }
 
 TEST(PairedComparison, ClearLoss) {
@@ -106,10 +117,15 @@ TEST(PairedComparison, ClearLoss) {
   EXPECT_NEAR(p.ci_low_m, 0.0015159, 1e-6);
   EXPECT_NEAR(p.ci_high_m, 0.0064841, 1e-6);
   EXPECT_EQ(p.pe_not_worse, 0);
+  EXPECT_EQ(p.pe_worse, 3);
+  EXPECT_NEAR(p.sign_test_p, 0.25, 1e-12);
+  EXPECT_FALSE(p.not_worse);
   EXPECT_EQ(p.verdict, suite::PairedVerdict::kBaselineBetter);
+  // Baseline mean 19/3 mm: margin 0.633 mm.
   EXPECT_EQ(suite::format_paired_line(p),
             "PE-SLAM − baseline ATE: mean 4.00 mm, 95 % CI [1.52, 6.48] mm over 3 seeds "
-            "(PE ≤ baseline on 0); baseline better");
+            "(effect size d_z 4.00; PE ≤ baseline on 0, sign test p = 0.25); baseline better; "
+            "not significantly worse: no (upper end 6.48 mm > margin 0.63 mm)");
 }
 
 TEST(PairedComparison, TieStraddlesZeroAndEqualCountsAsNotWorse) {
@@ -125,10 +141,15 @@ TEST(PairedComparison, TieStraddlesZeroAndEqualCountsAsNotWorse) {
   EXPECT_NEAR(p.ci_low_m, -0.0010942, 1e-6);
   EXPECT_NEAR(p.ci_high_m, 0.0012942, 1e-6);
   EXPECT_EQ(p.pe_not_worse, 3);
+  // The sign test leaves the tie out: 2 better, 2 worse.
+  EXPECT_EQ(p.pe_better, 2);
+  EXPECT_EQ(p.pe_worse, 2);
+  EXPECT_DOUBLE_EQ(p.sign_test_p, 1.0);
   EXPECT_EQ(p.verdict, suite::PairedVerdict::kNoSignificantDifference);
   EXPECT_EQ(suite::format_paired_line(p),
             "PE-SLAM − baseline ATE: mean 0.10 mm, 95 % CI [-1.09, 1.29] mm over 5 seeds "
-            "(PE ≤ baseline on 3); no significant difference at 95 %");
+            "(effect size d_z 0.10; PE ≤ baseline on 3, sign test p = 1.00); no significant difference at "
+            "95 %; not significantly worse: no (upper end 1.29 mm > margin 0.50 mm)");
 }
 
 TEST(PairedComparison, SeedsWithoutBothAtesAreLeftOut) {
@@ -159,6 +180,31 @@ TEST(PairedComparison, SeedsWithoutBothAtesAreLeftOut) {
   // The per-system means still use every ATE they have.
   EXPECT_EQ(a.primary.ate_rmse_m.count, 4);
   EXPECT_EQ(a.baseline.ate_rmse_m.count, 3);
+}
+
+TEST(PairedComparison, SignTestIsTheExactTwoSidedBinomial) {
+  EXPECT_DOUBLE_EQ(suite::sign_test_p(0, 0), 1.0);
+  EXPECT_NEAR(suite::sign_test_p(0, 10), 2.0 / 1024.0, 1e-12);
+  EXPECT_NEAR(suite::sign_test_p(10, 10), 2.0 / 1024.0, 1e-12);  // symmetric
+  EXPECT_NEAR(suite::sign_test_p(2, 10), 2.0 * (1 + 10 + 45) / 1024.0, 1e-12);
+  EXPECT_NEAR(suite::sign_test_p(11, 14), 2.0 * (1 + 14 + 91 + 364) / 16384.0, 1e-12);
+  EXPECT_DOUBLE_EQ(suite::sign_test_p(5, 10), 1.0);       // capped at 1
+  EXPECT_NEAR(suite::sign_test_p(0, 2000), 0.0, 1e-300);  // no overflow for large n
+}
+
+TEST(PairedComparison, NotWorseMarginIsHalfAMillimetreOrTenPercent) {
+  EXPECT_DOUBLE_EQ(suite::not_worse_margin_m(0.003), 0.0005);
+  EXPECT_DOUBLE_EQ(suite::not_worse_margin_m(0.0), 0.0005);
+  EXPECT_NEAR(suite::not_worse_margin_m(0.012), 0.0012, 1e-15);
+  // d = +0.4, +0.6 mm, +0.5 mm around a 4 mm baseline: the upper end
+  // 0.5 + 4.3027 · 0.1 / sqrt(3) = 0.748 mm is over the 0.5 mm floor.
+  auto p = suite::compare_paired({compare_run(1, 4.4, 4), compare_run(2, 4.6, 4), compare_run(3, 4.5, 4)});
+  EXPECT_NEAR(p.ci_high_m, 0.0005 + 4.3027 * 0.0001 / std::sqrt(3.0), 1e-7);
+  EXPECT_FALSE(p.not_worse);
+  // The same differences around a 10 mm baseline: the margin is 1 mm.
+  p = suite::compare_paired({compare_run(1, 10.4, 10), compare_run(2, 10.6, 10), compare_run(3, 10.5, 10)});
+  EXPECT_NEAR(p.margin_m, 0.001, 1e-12);
+  EXPECT_TRUE(p.not_worse);
 }
 
 TEST(PairedComparison, OneSeedHasNoInterval) {
@@ -241,8 +287,11 @@ TEST(SweepAggregate, MarkdownHasSummaryAndPerSeedRows) {
   // Paired: d = -0.9 and +8.5 mm; mean 3.8, sd 6.6468, se 4.7, t(0.975, 1)
   // = 12.7062 -> half width 59.72 mm.  Right after the summary table.
   const std::size_t line = md.find(
-      "\nPE-SLAM − baseline ATE: mean 3.80 mm, 95 % CI [-55.92, 63.52] mm over 2 seeds (PE ≤ baseline on 1); "
-      "no significant difference at 95 %\n");
+      "\nPE-SLAM − baseline ATE: mean 3.80 mm, 95 % CI [-55.92, 63.52] mm over 2 seeds (effect size d_z "
+      "0.57; "
+      "PE ≤ baseline on 1, sign test p = 1.00); no significant difference at 95 %; not significantly worse: "
+      "no "
+      "(upper end 63.52 mm > margin 1.0");
   EXPECT_NE(line, std::string::npos) << md;
   EXPECT_LT(md.find("| ORB-SLAM2 baseline | 2 |"), line);
   EXPECT_LT(line, md.find("## Per seed"));
@@ -288,6 +337,9 @@ TEST(SweepAggregate, JsonParsesAndCarriesTheSummaries) {
   EXPECT_NEAR(j["paired"]["ci95_low_m"].as<double>(), 0.0038 - 12.7062 * 0.0047, 1e-6);
   EXPECT_NEAR(j["paired"]["ci95_high_m"].as<double>(), 0.0038 + 12.7062 * 0.0047, 1e-6);
   EXPECT_EQ(j["paired"]["pe_not_worse"].as<int>(), 1);
+  EXPECT_EQ(j["paired"]["pe_better"].as<int>(), 1);
+  EXPECT_NEAR(j["paired"]["sign_test_p"].as<double>(), 1.0, 1e-12);
+  EXPECT_FALSE(j["paired"]["not_significantly_worse"].as<bool>());
   EXPECT_EQ(j["paired"]["verdict"].as<std::string>(), "no significant difference at 95 %");
 }
 

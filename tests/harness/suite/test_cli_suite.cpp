@@ -32,7 +32,7 @@ std::string scenario_file() {
   pvb::write_file(path,
                   "name: s\nroute: {waypoints_m: [[0, 0], [5, 0]]}\n"
                   "expect:\n  ate_rmse_m_max: 0.01\n  rpe_trans_rmse_m_max: 0.005\n  lost_frames_max: 0\n"
-                  "  pe_not_worse_than_baseline: true\n");
+                  "  sweep: {pe_not_significantly_worse: true}\n");
   return path;
 }
 
@@ -55,7 +55,15 @@ TEST(CliCheck, ViolationsExitThreeWithOneLineEach) {
   const auto r = run_pvbench("check --scenario " + scenario_file() + " --metrics " +
                              fixture("worse_than_baseline.json"));
   EXPECT_EQ(r.code, 3) << r.output;
-  EXPECT_EQ(count_lines(r.output), 4) << r.output;
+  // Three violations and two notes: PE against the baseline (never judged on
+  // one run) and where the sweep expectation is judged.
+  EXPECT_EQ(count_lines(r.output), 5) << r.output;
+  EXPECT_NE(r.output.find("worse_than_baseline.json: note: PE-SLAM − baseline ATE RMSE +8.50 mm"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("note: expect.sweep is judged over seeds: pvbench sweep --scenario "),
+            std::string::npos)
+      << r.output;
   EXPECT_NE(r.output.find("worse_than_baseline.json: ate_rmse_m_max: ATE RMSE 0.0235 m > 0.01 m"),
             std::string::npos)
       << r.output;
@@ -128,12 +136,15 @@ TEST(CliSweep, AggregateOnlyCollectsSeedFolders) {
   EXPECT_LT(csv.find("\n1,"), csv.find("\n2,"));
   EXPECT_LT(csv.find("\n2,"), csv.find("\n10,"));
   // Both seeds ran --compare: the paired line is the last thing printed
-  // (d = -0.9 and +8.5 mm, CI from t(0.975, 1) = 12.706).
+  // (d = -0.9 and +8.5 mm, CI from t(0.975, 1) = 12.706, d_z = 3.8 / 6.647).
   const std::string paired =
-      "PE-SLAM − baseline ATE: mean 3.80 mm, 95 % CI [-55.92, 63.52] mm over 2 seeds (PE ≤ baseline on 1); "
-      "no significant difference at 95 %\n";
-  ASSERT_GE(r.output.size(), paired.size());
-  EXPECT_EQ(r.output.substr(r.output.size() - paired.size()), paired) << r.output;
+      "PE-SLAM − baseline ATE: mean 3.80 mm, 95 % CI [-55.92, 63.52] mm over 2 seeds (effect size d_z 0.57; "
+      "PE ≤ baseline on 1, sign test p = 1.00); no significant difference at 95 %; not significantly worse: "
+      "no (upper end 63.52 mm > margin 1.0";
+  const std::size_t last = r.output.rfind("PE-SLAM − baseline ATE: ");
+  ASSERT_NE(last, std::string::npos) << r.output;
+  EXPECT_EQ(r.output.substr(last, paired.size()), paired) << r.output;
+  EXPECT_EQ(r.output.find('\n', last), r.output.size() - 1) << r.output;  // the last line
 
   // An explicit list aggregates only those seeds.
   const auto two = run_pvbench("sweep --out " + out + " --aggregate-only --seeds 1-2");
@@ -149,4 +160,59 @@ TEST(CliSweep, AggregateOnlyWithoutSeedFoldersIsAnError) {
   EXPECT_NE(r.output.find("seed_*/metrics.json: expected at least one seed folder, got none"),
             std::string::npos)
       << r.output;
+}
+
+namespace {
+
+// DIR/seed_1..seed_N/metrics.json from fixtures: `good` copies of
+// good_compare.json (PE 4.2 mm, baseline 5.1 mm), then worse_than_baseline.json.
+std::string sweep_folder(const std::string& name, int good, int worse) {
+  const std::string out = scratch(name);
+  for (int i = 1; i <= good + worse; ++i) {
+    const std::string dir = out + "/seed_" + std::to_string(i);
+    fs::create_directories(dir);
+    fs::copy_file(fixture(i <= good ? "good_compare.json" : "worse_than_baseline.json"),
+                  dir + "/metrics.json");
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(CliSweep, CheckJudgesEverySeedAndTheSweep) {
+  const std::string scenario = scenario_file();
+  const auto ok = run_pvbench("sweep --scenario " + scenario + " --out " + sweep_folder("check_ok", 10, 0) +
+                              " --aggregate-only --check");
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  EXPECT_NE(
+      ok.output.find("check: note: sweep.pe_not_significantly_worse: holds, the paired 95 % interval of "
+                     "PE-SLAM − baseline ATE reaches -0.90 mm <= margin 0.51 mm over 10 seeds\n"),
+      std::string::npos)
+      << ok.output;
+  EXPECT_NE(ok.output.find("check: ok (s, 10 seeds)\n"), std::string::npos) << ok.output;
+
+  // One seed breaks three run bounds and drags the paired interval's upper
+  // end to 2.17 mm, past the margin of 10 % of the baseline's 6.09 mm.
+  const auto bad = run_pvbench("sweep --scenario " + scenario + " --out " + sweep_folder("check_bad", 9, 1) +
+                               " --aggregate-only --check");
+  EXPECT_EQ(bad.code, 3) << bad.output;
+  EXPECT_NE(bad.output.find("check: seed 10: ate_rmse_m_max: ATE RMSE 0.0235 m > 0.01 m\n"),
+            std::string::npos)
+      << bad.output;
+  EXPECT_NE(bad.output.find("check: seed 10: lost_frames_max: 4 lost frames > 0\n"), std::string::npos)
+      << bad.output;
+  EXPECT_NE(bad.output.find("check: sweep.pe_not_significantly_worse: the paired 95 % interval of PE-SLAM − "
+                            "baseline ATE reaches +2.17 mm > margin 0.61 mm over 10 seeds\n"),
+            std::string::npos)
+      << bad.output;
+  EXPECT_EQ(bad.output.find("check: ok"), std::string::npos) << bad.output;
+}
+
+TEST(CliSweep, CheckNeedsTheScenario) {
+  const auto r =
+      run_pvbench("sweep --out " + sweep_folder("check_noscenario", 2, 0) + " --aggregate-only --check");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(r.output,
+            "pvbench: error: command line: --check: expected a --scenario whose expect: section judges the "
+            "sweep\n");
 }

@@ -45,7 +45,7 @@ TEST(SweepRun, TwoSeedsThenASlurmTaskThenAggregateOnly) {
   ASSERT_NE(last, std::string::npos) << r.output;
   const std::string paired = r.output.substr(last + 1);
   EXPECT_EQ(paired.rfind("PE-SLAM − baseline ATE: mean ", 0), 0u) << r.output;
-  EXPECT_NE(paired.find(" mm over 2 seeds (PE ≤ baseline on "), std::string::npos) << paired;
+  EXPECT_NE(paired.find(" mm over 2 seeds (effect size d_z "), std::string::npos) << paired;
   EXPECT_NE(md.find("\n" + paired), std::string::npos) << md;
   for (const char* f : {"aggregate.csv", "aggregate.json", "aggregate.svg", "aggregate.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
@@ -65,6 +65,6 @@ TEST(SweepRun, TwoSeedsThenASlurmTaskThenAggregateOnly) {
   EXPECT_EQ(agg.code, 0) << agg.output;
   EXPECT_NE(pvb::read_file((out / "aggregate.md").string()).find("3 seeds, 3 with metrics, 0 failed"),
             std::string::npos);
-  EXPECT_NE(agg.output.find(" mm over 3 seeds (PE ≤ baseline on "), std::string::npos) << agg.output;
+  EXPECT_NE(agg.output.find(" mm over 3 seeds (effect size d_z "), std::string::npos) << agg.output;
   fs::remove_all(out);
 }
