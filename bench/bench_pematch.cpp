@@ -1,5 +1,5 @@
 // PE-match time per call on synthetic two-view data with 50 % outliers
-// (issue 4 target: <= 1 ms at 500 coarse matches on one core).
+// (target: <= 1 ms at 500 coarse matches on one core).
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Geometry>

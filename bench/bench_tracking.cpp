@@ -1,4 +1,4 @@
-// Tracking cost per frame at 640x480 with 1000 ORB features (issue 5:
+// Tracking cost per frame at 640x480 with 1000 ORB features (target:
 // median tracking <= 20 ms on one core, PE-match adding <= 10 %).
 //
 // Runs on a recorded TUM folder (`pvbench record`), named by the
@@ -16,7 +16,7 @@
 // cpu_median_ms: the calling thread's CPU time in System::track over the
 // frames that made no keyframe (so without inline mapping), which other
 // processes on the same core do not inflate as they do wall time.
-// Pin to one core for the issue's figure: `taskset -c 1 build/bin/bench_tracking`.
+// Pin to one core, as docs/slam.md, "Speed" does: `taskset -c 1 build/bin/bench_tracking`.
 #include <benchmark/benchmark.h>
 #include <time.h>
 

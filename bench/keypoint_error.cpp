@@ -19,7 +19,8 @@
 // warped by the affine map that ground truth and depth predict (fronto-
 // parallel patch), to frame k + gap: Gauss-Newton on the translation,
 // mean-subtracted, from the FAST keypoint, moves over 1.5 level px
-// rejected.  The check behind docs/slam.md, "a pitch bias per keyframe".
+// rejected.  The check behind
+// docs/experiments/2026-11-21-lawnmower-pitch-bias-per-keyframe.md.
 // The mean pose error (camera frame) is printed too: a bias shows there.
 //
 //   keypoint_error DIR [--gap N] [--step N] [--frames N] [--whole-pixels] [--align-patches]

@@ -1,5 +1,5 @@
 #pragma once
-// Ground truth for feature matches (issue 4): homography pairs (Oxford) and
+// Ground truth for feature matches: homography pairs (Oxford) and
 // RGB-D pairs with depth, poses and intrinsics (TUM layout, simulator).
 #include <Eigen/Core>
 #include <cstdint>
