@@ -4,6 +4,11 @@
 // Outputs (folder --out): camera.yaml (the settings used), CameraTrajectory.txt
 // (flushed frame by frame), KeyFrameTrajectory.txt, map.ply (the sparse map
 // points), stats.json, and for sim:// sources groundtruth.txt and the ATE.
+//
+// Stages of a run: inputs (scenario, .oni check, where --record may write),
+// settings, the tracking loop (outputs flushed as they grow), the final
+// files, and the checks that fail the run after everything was written
+// (stream error, recording short of frames, SLAM never initialised).
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -13,7 +18,7 @@
 #include <string>
 
 #include "command.hpp"
-#include "stop_signals.hpp"
+#include "count_option.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
@@ -22,12 +27,14 @@
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/openni/oni_file.hpp"
 #include "pvb/openni/openni_source.hpp"
+#include "pvb/openni/record_target.hpp"
 #include "pvb/openni/sim_uri.hpp"
 #include "pvb/run/run.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/simulator.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
+#include "stop_signals.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -38,12 +45,16 @@ struct CameraArgs {
   std::string settings;
   std::string out;
   std::string record;
-  std::size_t frames = 0;
+  std::string frames = "0";  ///< checked by parse_count: 0 = until the stream ends
   bool sync = false;
   std::uint32_t seed = 1;
   bool no_pe_match = false;
-  int timeout_ms = 10000;
+  std::string timeout_ms = "10000";  ///< checked by parse_count
 };
+
+/// Files written into --out (a recording must not land on one of them).
+const char* const kOutputs[] = {"camera.yaml", "CameraTrajectory.txt", "KeyFrameTrajectory.txt",
+                                "map.ply",     "stats.json",           "groundtruth.txt"};
 
 using Clock = std::chrono::steady_clock;
 
@@ -57,13 +68,6 @@ std::string fmt(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.6g", v);
   return buf;
-}
-
-/// The scenario of a sim:// URI with the URI's seed applied.
-scenes::Scenario sim_scenario(const openni::SimUri& uri) {
-  scenes::Scenario s = scenes::load_scenario(uri.scenario_path);
-  if (uri.seed) s.seed = *uri.seed;
-  return s;
 }
 
 void write_map_ply(const std::string& path, const std::vector<Eigen::Vector3d>& points) {
@@ -80,40 +84,65 @@ void write_tum_file(const std::string& path, const std::vector<geom::StampedPose
   write_file(path, text);
 }
 
-int run_camera(const CameraArgs& a) {
-  const bool from_file = !a.oni.empty();
-  const bool is_sim = !from_file && openni::is_sim_uri(a.uri);
-  std::optional<openni::SimUri> sim_uri;
-  std::optional<scenes::Scenario> scenario;
-  if (is_sim) {
-    sim_uri = openni::parse_sim_uri(a.uri);
-    scenario = sim_scenario(*sim_uri);
-  }
-  if (from_file) openni::check_oni_complete(a.oni, openni::scan_oni_file(a.oni));  // before anything else
-  dataset::make_dirs(a.out);
+// ---- inputs and settings ---------------------------------------------------
 
-  // Settings: given, or derived from the scenario's camera.  The file used
-  // is saved as camera.yaml; intrinsics never come from the driver.
-  const std::string settings_path = a.out + "/camera.yaml";
+/// The scenario of a sim:// source (with the URI's seed), else nullopt.  Also
+/// checks an .oni input and where --record may write, before anything is
+/// written: a recording never lands on an input or an output of the run.
+std::optional<scenes::Scenario> check_inputs(const CameraArgs& a) {
+  std::optional<scenes::Scenario> scenario;
+  std::string scenario_path;
+  if (a.oni.empty() && openni::is_sim_uri(a.uri)) {
+    const openni::SimUri uri = openni::parse_sim_uri(a.uri);
+    scenario = scenes::load_scenario(uri.scenario_path);
+    if (uri.seed) scenario->seed = *uri.seed;
+    scenario_path = uri.scenario_path;
+  }
+  if (!a.oni.empty()) openni::check_oni_complete(a.oni, openni::scan_oni_file(a.oni));
+  if (!a.record.empty()) {
+    std::vector<openni::RunFile> files = {
+        {a.oni, "the --oni recording"}, {a.settings, "the --settings file"}, {scenario_path, "the scenario"}};
+    for (const char* name : kOutputs) files.push_back({a.out + "/" + name, "an output of this run"});
+    openni::check_record_not_on(a.record, files);
+  }
+  return scenario;
+}
+
+/// The SLAM settings and the file they came from (the one named in errors):
+/// the user's --settings, or the scenario's camera for sim:// sources.  The
+/// file used is saved as camera.yaml; intrinsics never come from the driver.
+struct CameraSettings {
+  slam::Settings slam;
+  std::string file;
+};
+
+CameraSettings prepare_settings(const CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
+  const std::string saved = a.out + "/camera.yaml";
+  CameraSettings s;
   if (!a.settings.empty()) {
     std::ifstream probe(a.settings);
     if (!probe) throw IoError(a.settings, "cannot read the settings file");
     const std::string text = read_file(a.settings);
-    if (a.settings != settings_path) write_file(settings_path, text);
+    if (!openni::same_file(a.settings, saved)) write_file(saved, text);
+    s.file = a.settings;
   } else if (scenario) {
     dataset::OrbSlamSettings o = run::orbslam_settings_for(*scenario);
     o.depth_map_factor = 1000.0;  // OpenNI2 depth is in millimetres
-    dataset::write_orbslam_settings(settings_path, o);
+    dataset::write_orbslam_settings(saved, o);
+    s.file = saved;
   } else {
     throw ConfigError(
         "pvbench camera", "--settings",
         "a settings file with the camera's calibrated intrinsics (only sim:// devices have their own)");
   }
-  slam::Settings settings = slam::read_settings(settings_path);
-  for (const std::string& w : settings.warnings)
+  s.slam = slam::read_settings(s.file);
+  for (const std::string& w : s.slam.warnings)
     std::fprintf(stderr, "pvbench camera: warning: %s\n", w.c_str());
-  if (a.no_pe_match) settings.pe_match.enabled = false;
+  if (a.no_pe_match) s.slam.pe_match.enabled = false;
+  return s;
+}
 
+openni::OpenniOptions source_options(const CameraArgs& a, const slam::Settings& settings, int timeout_ms) {
   openni::OpenniOptions so;
   so.uri = a.uri == "any" ? std::string() : a.uri;
   so.oni_path = a.oni;
@@ -121,95 +150,142 @@ int run_camera(const CameraArgs& a) {
   so.height = settings.K.height;
   so.fps = static_cast<int>(std::lround(settings.fps));
   so.record_path = a.record;
-  so.timeout_ms = a.timeout_ms;
+  so.timeout_ms = timeout_ms;
   so.stop_requested = [] { return StopSignals::requested(); };  // Ctrl-C also ends a wait for frames
-  openni::OpenniSource source(so);
+  return so;
+}
 
-  slam::SystemOptions options;
-  options.synchronous = a.sync;
-  options.seed = a.seed;
-  slam::System system(settings, options);
+// ---- tracking --------------------------------------------------------------
 
-  std::ofstream cam_traj = open_out(a.out + "/CameraTrajectory.txt");
-  cam_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n" << std::flush;
-  // Ground truth of a sim:// device: the harness re-runs the scenario's
-  // physics (deterministic, no rendering) beside the device, so nothing but
-  // images travels through OpenNI2 (docs/openni.md).
+/// The files that grow frame by frame.  Ground truth of a sim:// device: the
+/// harness re-runs the scenario's physics (deterministic, no rendering)
+/// beside the device, so nothing but images travels through OpenNI2
+/// (docs/openni.md).
+struct LiveOutputs {
+  std::ofstream cam_traj;
   std::unique_ptr<sim::Simulator> gt_sim;
   std::ofstream gt_file;
-  if (scenario) {
-    gt_sim = std::make_unique<sim::Simulator>(*scenario);
-    gt_file = open_out(a.out + "/groundtruth.txt");
-    gt_file << "# timestamp tx ty tz qx qy qz qw (T_w_c, simulator ground truth)\n" << std::flush;
-  }
+};
 
+LiveOutputs open_live_outputs(const std::string& out, const std::optional<scenes::Scenario>& scenario) {
+  LiveOutputs o;
+  o.cam_traj = open_out(out + "/CameraTrajectory.txt");
+  o.cam_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n" << std::flush;
+  if (scenario) {
+    o.gt_sim = std::make_unique<sim::Simulator>(*scenario);
+    o.gt_file = open_out(out + "/groundtruth.txt");
+    o.gt_file << "# timestamp tx ty tz qx qy qz qw (T_w_c, simulator ground truth)\n" << std::flush;
+  }
+  return o;
+}
+
+struct TrackCounts {
+  std::size_t frames = 0;
+  std::size_t lost = 0;
+  std::size_t not_initialized = 0;
+  double elapsed_s = 0;
+  std::optional<IoError> stream_error;  ///< unplugged camera or broken file
+};
+
+/// Tracks one frame and appends its poses (ground truth first).
+slam::TrackingState track_frame(const sensor::RgbdFrame& frame, const CameraSettings& settings,
+                                slam::System& system, LiveOutputs& live, TrackCounts& counts) {
+  const geom::PinholeIntrinsics& K = settings.slam.K;
+  if (frame.rgb.cols != K.width || frame.rgb.rows != K.height)
+    throw ConfigError(settings.file, "Camera.width/height",
+                      std::to_string(frame.rgb.cols) + "x" + std::to_string(frame.rgb.rows) + " (the stream)",
+                      std::to_string(K.width) + "x" + std::to_string(K.height));
+  if (live.gt_sim) {
+    while (live.gt_sim->frame_index() < static_cast<int>(frame.index)) live.gt_sim->advance();
+    live.gt_file << geom::format_tum_line({frame.t_ns, live.gt_sim->T_w_c()}) << "\n" << std::flush;
+  }
+  const slam::FrameResult r = system.track(frame);
+  ++counts.frames;
+  if (r.state == slam::TrackingState::kLost) ++counts.lost;
+  if (r.state == slam::TrackingState::kNotInitialized) ++counts.not_initialized;
+  if (r.T_w_c) live.cam_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+  return r.state;
+}
+
+/// Reads and tracks frames until the stream ends, `max_frames` (0: no limit)
+/// or Ctrl-C / SIGTERM, which end a live run cleanly (exit 0).  A stream
+/// error ends the loop too and is kept in the counts: what was tracked so far
+/// is still written.
+TrackCounts track_frames(openni::OpenniSource& source, std::size_t max_frames, const CameraSettings& settings,
+                         slam::System& system, LiveOutputs& live) {
   const std::size_t hint = source.size_hint();
-  const std::size_t total = a.frames ? (hint ? std::min(a.frames, hint) : a.frames) : hint;
-  std::size_t frames = 0, lost = 0;
-  std::optional<IoError> stream_error;
+  const std::size_t total = max_frames ? (hint ? std::min(max_frames, hint) : max_frames) : hint;
+  TrackCounts counts;
   const auto t0 = Clock::now();
   {
-    // Ctrl-C (or SIGTERM) ends a live run cleanly: the loop stops, the
-    // recorder is closed and every output is written (exit 0).
     const StopSignals stop_signals;
     ProgressBar bar("camera " + source.describe(), total);
     try {
-      while ((a.frames == 0 || frames < a.frames) && !StopSignals::requested()) {
+      while ((max_frames == 0 || counts.frames < max_frames) && !StopSignals::requested()) {
         std::optional<sensor::RgbdFrame> frame = source.next();
         if (!frame) break;
-        if (frame->rgb.cols != settings.K.width || frame->rgb.rows != settings.K.height)
-          throw ConfigError(
-              settings_path, "Camera.width/height",
-              std::to_string(frame->rgb.cols) + "x" + std::to_string(frame->rgb.rows) + " (the stream)",
-              std::to_string(settings.K.width) + "x" + std::to_string(settings.K.height));
-        if (gt_sim) {
-          while (gt_sim->frame_index() < static_cast<int>(frame->index)) gt_sim->advance();
-          gt_file << geom::format_tum_line({frame->t_ns, gt_sim->T_w_c()}) << "\n" << std::flush;
-        }
-        const slam::FrameResult r = system.track(*frame);
-        ++frames;
-        if (r.state == slam::TrackingState::kLost) ++lost;
-        if (r.T_w_c) cam_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+        const slam::TrackingState state = track_frame(*frame, settings, system, live, counts);
         const double elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
         char status[128];
         std::snprintf(status, sizeof status, "%.1f fps, %s, %zu keyframes",
-                      elapsed_s > 0 ? static_cast<double>(frames) / elapsed_s : 0.0, slam::to_string(r.state),
-                      system.num_keyframes());
-        bar.update(frames, status);
+                      elapsed_s > 0 ? static_cast<double>(counts.frames) / elapsed_s : 0.0,
+                      slam::to_string(state), system.num_keyframes());
+        bar.update(counts.frames, status);
       }
     } catch (const IoError& e) {
-      // Unplugged camera or broken file: keep everything tracked so far.
-      stream_error = e;
+      counts.stream_error = e;
     }
   }
-  const double elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  std::optional<openni::RecordingSummary> rec;
-  if (!stream_error) {
-    rec = source.stop();
-  } else {
-    try {
-      rec = source.stop();
-    } catch (const Error&) {
-      // the stream error is the one to report
-    }
-  }
-  system.shutdown();
-  cam_traj.close();
-  write_tum_file(a.out + "/KeyFrameTrajectory.txt", system.keyframe_trajectory());
-  write_map_ply(a.out + "/map.ply", system.map_point_positions());
+  counts.elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  return counts;
+}
 
-  const double fps = elapsed_s > 0 ? static_cast<double>(frames) / elapsed_s : 0.0;
+/// Stops the source; after a stream error, an error of the stop itself is
+/// dropped (the stream error is the one to report).
+std::optional<openni::RecordingSummary> stop_source(openni::OpenniSource& source, bool after_error) {
+  if (!after_error) return source.stop();
+  try {
+    return source.stop();
+  } catch (const Error&) {
+    return std::nullopt;
+  }
+}
+
+// ---- results ---------------------------------------------------------------
+
+bool never_initialized(const TrackCounts& c) { return c.frames > 0 && c.not_initialized == c.frames; }
+
+/// The ATE against the simulator's ground truth, appended to stats.json.
+void evaluate_against_ground_truth(const std::string& out, std::ostringstream& js) {
+  try {
+    const eval::Trajectory gt = eval::read_tum(out + "/groundtruth.txt");
+    const eval::Trajectory est = eval::read_tum(out + "/CameraTrajectory.txt");
+    const eval::EvalResult res = eval::evaluate(gt, est, eval::EvalOptions{});
+    std::printf("ATE RMSE %.4f m over %zu poses\n", res.ate.rmse, est.size());
+    js << ",\n  \"ate_rmse_m\": " << fmt(res.ate.rmse)
+       << ",\n  \"rpe_trans_rmse_m\": " << fmt(res.rpe_trans_m.rmse);
+  } catch (const Error& e) {
+    std::fprintf(stderr, "pvbench camera: warning: no evaluation: %s\n", e.what());
+  }
+}
+
+/// Prints the summary and writes stats.json (and the ATE for sim:// runs).
+void report_run(const CameraArgs& a, const slam::Settings& settings, openni::OpenniSource& source,
+                slam::System& system, const TrackCounts& c,
+                const std::optional<openni::RecordingSummary>& rec, LiveOutputs& live) {
+  const double fps = c.elapsed_s > 0 ? static_cast<double>(c.frames) / c.elapsed_s : 0.0;
   std::ostringstream js;
   js << "{\n  \"source\": \"" << json_escape(source.describe())
      << "\",\n  \"pe_match\": " << (settings.pe_match.enabled ? "true" : "false")
      << ",\n  \"sync\": " << (a.sync ? "true" : "false") << ",\n  \"seed\": " << a.seed
-     << ",\n  \"frames\": " << frames << ",\n  \"lost_frames\": " << lost
+     << ",\n  \"frames\": " << c.frames << ",\n  \"lost_frames\": " << c.lost
+     << ",\n  \"not_initialized_frames\": " << c.not_initialized
      << ",\n  \"dropped_colour\": " << source.dropped_colour()
      << ",\n  \"dropped_depth\": " << source.dropped_depth()
      << ",\n  \"keyframes\": " << system.num_keyframes() << ",\n  \"map_points\": " << system.num_map_points()
      << ",\n  \"fps\": " << fmt(fps);
-  std::printf("camera: %zu frames (%.1f fps), lost %zu, keyframes %zu, map points %zu%s\n", frames, fps, lost,
-              system.num_keyframes(), system.num_map_points(),
+  std::printf("camera: %zu frames (%.1f fps), lost %zu, keyframes %zu, map points %zu%s\n", c.frames, fps,
+              c.lost, system.num_keyframes(), system.num_map_points(),
               StopSignals::requested() ? " (stopped by a signal)" : "");
   if (rec) {
     std::printf("recorded %u depth and %u colour frames to %s\n", rec->depth_frames, rec->colour_frames,
@@ -217,29 +293,55 @@ int run_camera(const CameraArgs& a) {
     js << ",\n  \"recorded\": {\"depth_frames\": " << rec->depth_frames
        << ", \"colour_frames\": " << rec->colour_frames << "}";
   }
-
-  if (gt_sim && frames > 0) {
-    gt_file.close();
-    try {
-      const eval::Trajectory gt = eval::read_tum(a.out + "/groundtruth.txt");
-      const eval::Trajectory est = eval::read_tum(a.out + "/CameraTrajectory.txt");
-      const eval::EvalResult res = eval::evaluate(gt, est, eval::EvalOptions{});
-      std::printf("ATE RMSE %.4f m over %zu poses\n", res.ate.rmse, est.size());
-      js << ",\n  \"ate_rmse_m\": " << fmt(res.ate.rmse)
-         << ",\n  \"rpe_trans_rmse_m\": " << fmt(res.rpe_trans_m.rmse);
-    } catch (const Error& e) {
-      std::fprintf(stderr, "pvbench camera: warning: no evaluation: %s\n", e.what());
-    }
+  if (live.gt_sim && c.frames > 0 && !never_initialized(c)) {
+    live.gt_file.close();
+    evaluate_against_ground_truth(a.out, js);
   }
   js << "\n}\n";
   write_file(a.out + "/stats.json", js.str());
   std::printf("wrote %s/{camera.yaml,CameraTrajectory.txt,KeyFrameTrajectory.txt,map.ply,stats.json%s}\n",
-              a.out.c_str(), gt_sim ? ",groundtruth.txt" : "");
-  if (stream_error) throw IoError(*stream_error);
-  if (rec && (rec->depth_frames < frames || rec->colour_frames < frames))
+              a.out.c_str(), live.gt_sim ? ",groundtruth.txt" : "");
+}
+
+/// After every output is written: the problems that fail the run.
+void fail_on_problems(const std::string& source, const TrackCounts& c,
+                      const std::optional<openni::RecordingSummary>& rec) {
+  if (c.stream_error) throw IoError(*c.stream_error);
+  if (rec && (rec->depth_frames < c.frames || rec->colour_frames < c.frames))
     throw IoError(rec->path, "the recording lost frames: " + std::to_string(rec->depth_frames) +
                                  " depth and " + std::to_string(rec->colour_frames) + " colour for " +
-                                 std::to_string(frames) + " tracked");
+                                 std::to_string(c.frames) + " tracked");
+  if (never_initialized(c))
+    throw IoError(source, "SLAM never initialised in " + std::to_string(c.frames) +
+                              " frames (too few points with valid depth: is the depth stream all zeros?)");
+}
+
+int run_camera(const CameraArgs& a) {
+  const std::size_t max_frames =
+      parse_count("camera", "--frames", a.frames, 0, 1'000'000'000, " (0: until the stream ends)");
+  const int timeout_ms = static_cast<int>(parse_count("camera", "--timeout-ms", a.timeout_ms, 1, 86'400'000));
+  // pvbench's MuJoCo handlers before the sim:// driver plug-in's own copy,
+  // which OpenNI2 unloads at shutdown.
+  sim::install_mujoco_handlers();
+  const std::optional<scenes::Scenario> scenario = check_inputs(a);
+  dataset::make_dirs(a.out);
+  const CameraSettings settings = prepare_settings(a, scenario);
+  openni::OpenniSource source(source_options(a, settings.slam, timeout_ms));
+
+  slam::SystemOptions options;
+  options.synchronous = a.sync;
+  options.seed = a.seed;
+  slam::System system(settings.slam, options);
+  LiveOutputs live = open_live_outputs(a.out, scenario);
+
+  const TrackCounts counts = track_frames(source, max_frames, settings, system, live);
+  const std::optional<openni::RecordingSummary> rec = stop_source(source, counts.stream_error.has_value());
+  system.shutdown();
+  live.cam_traj.close();
+  write_tum_file(a.out + "/KeyFrameTrajectory.txt", system.keyframe_trajectory());
+  write_map_ply(a.out + "/map.ply", system.map_point_positions());
+  report_run(a, settings.slam, source, system, counts, rec, live);
+  fail_on_problems(source.describe(), counts, rec);
   return 0;
 }
 
@@ -259,16 +361,17 @@ Command add_camera_command(CLI::App& app) {
                   "ORB-SLAM2 RGB-D settings YAML with the calibrated intrinsics (default for sim://: the "
                   "scenario's camera)");
   sub->add_option("--out", args->out, "output folder")->required();
-  sub->add_option("--record", args->record,
-                  "record the depth and colour streams to this .oni while tracking");
+  sub->add_option(
+      "--record", args->record,
+      "record the depth and colour streams to this new .oni file while tracking (an existing file "
+      "is never replaced)");
   sub->add_option("--frames", args->frames, "stop after N frames (0: until the stream ends)")
       ->capture_default_str();
   sub->add_flag("--sync", args->sync, "synchronous mode: no worker threads, bit-identical runs");
   sub->add_option("--seed", args->seed, "PE-match seed")->capture_default_str();
   sub->add_flag("--no-pe-match", args->no_pe_match, "baseline: ORB-SLAM2 motion model without PE-match");
   sub->add_option("--timeout-ms", args->timeout_ms, "no frame for this long is an error")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->capture_default_str();
   return {sub, [args, uri, oni] {
             if (uri->count() == 0 && oni->count() == 0)
               throw ConfigError("pvbench camera", "--uri/--oni", "one of them");

@@ -1,4 +1,9 @@
 // pvbench record: render a scenario into a TUM RGB-D sequence folder.
+//
+// Ctrl-C (SIGINT) or SIGTERM stops at the next frame: the lists (rgb.txt,
+// depth.txt, groundtruth.txt, associations.txt) hold the frames written,
+// meta.json says "interrupted": true with that frame count, and the exit
+// code is 130, as for `pvbench run` and `pvbench slam`.
 #include <mujoco/mujoco.h>
 
 #include <algorithm>
@@ -8,6 +13,7 @@
 #include <optional>
 
 #include "command.hpp"
+#include "count_option.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
@@ -17,6 +23,7 @@
 #include "pvb/run/run.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/sim_frame_source.hpp"
+#include "stop_signals.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -24,7 +31,7 @@ namespace {
 struct RecordOptions {
   std::string scenario;
   std::string out;
-  int frames = 0;
+  std::string frames;  ///< empty: the scenario's duration; else checked by parse_count
   std::optional<std::uint64_t> seed;
   std::string gl = "auto";
 };
@@ -32,54 +39,58 @@ struct RecordOptions {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-int run_record(const RecordOptions& opt) {
-  const sim::GlBackend backend = sim::parse_gl_backend(opt.gl);
-  scenes::Scenario scenario = scenes::load_scenario(opt.scenario);
-  if (opt.seed) scenario.seed = *opt.seed;
-  dataset::make_dirs(opt.out);  // fail early on an unwritable folder
+/// What the frame loop did.
+struct RecordLoop {
+  int frames = 0;  ///< frames written
+  bool interrupted = false;
+  double capture_ms = 0, write_ms = 0, loop_s = 0;
+  std::vector<plot::Thumbnail> thumbs;  ///< for the contact sheet
+};
 
-  const auto t_start = Clock::now();
-  const int n = scenes::frame_count(scenario, opt.frames);
-  geom::StampedPose gt;  // ground truth arrives through its own sink
-  sim::SimFrameSource source(scenario, backend, n, [&gt](const geom::StampedPose& p) { gt = p; });
-  const double setup_ms = ms_since(t_start);
-  const sim::Simulator& sim = source.simulator();
-
-  sim::write_scene(sim.assets(), opt.out);
-  dataset::write_orbslam_settings(opt.out + "/camera.yaml", run::orbslam_settings_for(scenario));
-  dataset::TumSequenceWriter writer(opt.out, sensor::kTumDepthFactor, std::string("pvbench ") + pvb::version());
-
-  double capture_ms = 0, write_ms = 0;
+/// Renders and writes up to n frames; stops early at the end of the source
+/// or, before the next frame, on Ctrl-C / SIGTERM.
+RecordLoop record_frames(sim::SimFrameSource& source, const geom::StampedPose& gt,
+                         dataset::TumSequenceWriter& writer, const std::string& name, int n) {
+  RecordLoop loop;
   const std::vector<int> sheet_frames = plot::spread_indices(n, 12);
-  std::vector<plot::Thumbnail> thumbs;
   const auto t_loop = Clock::now();
-  {
-    ProgressBar bar("record " + scenario.name, static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) {
-      auto t0 = Clock::now();
-      const std::optional<sensor::RgbdFrame> frame = source.next();
-      capture_ms += ms_since(t0);
-      if (!frame) break;
-      t0 = Clock::now();
-      writer.write(*frame, gt.T_w_c);
-      write_ms += ms_since(t0);
-      if (std::find(sheet_frames.begin(), sheet_frames.end(), i) != sheet_frames.end()) {
-        char label[64];
-        std::snprintf(label, sizeof label, "frame %d  t=%.2f s", i, geom::ns_to_seconds(frame->t_ns));
-        thumbs.push_back({frame->rgb.clone(), label});
-      }
-      bar.update(static_cast<std::size_t>(i + 1));
+  ProgressBar bar("record " + name, static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    if (StopSignals::requested()) {
+      loop.interrupted = true;
+      break;
     }
+    auto t0 = Clock::now();
+    const std::optional<sensor::RgbdFrame> frame = source.next();
+    loop.capture_ms += ms_since(t0);
+    if (!frame) break;
+    t0 = Clock::now();
+    writer.write(*frame, gt.T_w_c);
+    loop.write_ms += ms_since(t0);
+    if (std::find(sheet_frames.begin(), sheet_frames.end(), i) != sheet_frames.end()) {
+      char label[64];
+      std::snprintf(label, sizeof label, "frame %d  t=%.2f s", i, geom::ns_to_seconds(frame->t_ns));
+      loop.thumbs.push_back({frame->rgb.clone(), label});
+    }
+    loop.frames = writer.frames_written();
+    bar.update(static_cast<std::size_t>(i + 1));
   }
-  const double loop_s = ms_since(t_loop) / 1000.0;
-  const double total_s = ms_since(t_start) / 1000.0;
+  bar.finish();
+  loop.loop_s = ms_since(t_loop) / 1000.0;
+  return loop;
+}
 
+void write_meta(const std::string& path, const RecordOptions& opt, const scenes::Scenario& scenario,
+                sim::SimFrameSource& source, const RecordLoop& loop, double total_s, double setup_ms) {
+  const sim::Simulator& sim = source.simulator();
+  const double per_frame = loop.frames > 0 ? 1.0 / loop.frames : 0.0;
   char meta[4096];
   std::snprintf(meta, sizeof meta,
                 "{\n"
                 "  \"scenario\": {\"name\": \"%s\", \"file\": \"%s\"},\n"
                 "  \"seed\": %llu,\n"
                 "  \"frames\": %d,\n"
+                "  \"interrupted\": %s,\n"
                 "  \"fps\": %.6g,\n"
                 "  \"versions\": {\"pvbench\": \"%s\", \"mujoco\": \"%s\"},\n"
                 "  \"renderer\": {\"backend\": \"%s\", \"description\": \"%s\"},\n"
@@ -89,17 +100,46 @@ int run_record(const RecordOptions& opt) {
                 "\"write_ms_per_frame\": %.3f, \"frames_per_s\": %.2f}\n"
                 "}\n",
                 json_escape(scenario.name).c_str(), json_escape(opt.scenario).c_str(),
-                static_cast<unsigned long long>(scenario.seed), n, scenario.camera.fps, pvb::version(),
-                mj_versionString(), sim::to_string(source.camera().backend()),
-                json_escape(source.camera().description()).c_str(),
+                static_cast<unsigned long long>(scenario.seed), loop.frames,
+                loop.interrupted ? "true" : "false", scenario.camera.fps, pvb::version(), mj_versionString(),
+                sim::to_string(source.camera().backend()), json_escape(source.camera().description()).c_str(),
                 sim.assets().timestep_s, sim.assets().substeps, sim.kinematics().wheel_radius_m,
-                sim.kinematics().track_m, total_s, setup_ms, capture_ms / n, write_ms / n, n / loop_s);
-  write_file(opt.out + "/meta.json", meta);
-  plot::write_rgb_png(plot::make_contact_sheet(thumbs, 4, 320), opt.out + "/contact_sheet.png");
-  std::printf("recorded %d frames of %s to %s (%s; %.1f frames/s, capture %.1f ms/frame)\n", n,
-              scenario.name.c_str(), opt.out.c_str(), source.camera().description().c_str(), n / loop_s,
-              capture_ms / n);
-  return 0;
+                sim.kinematics().track_m, total_s, setup_ms, loop.capture_ms * per_frame,
+                loop.write_ms * per_frame, loop.loop_s > 0 ? loop.frames / loop.loop_s : 0.0);
+  write_file(path, meta);
+}
+
+int run_record(const RecordOptions& opt, bool frames_given) {
+  const int max_frames =
+      frames_given ? static_cast<int>(parse_count("record", "--frames", opt.frames, 1, 1'000'000'000)) : 0;
+  const sim::GlBackend backend = sim::parse_gl_backend(opt.gl);
+  scenes::Scenario scenario = scenes::load_scenario(opt.scenario);
+  if (opt.seed) scenario.seed = *opt.seed;
+  dataset::make_dirs(opt.out);     // fail early on an unwritable folder
+  const StopSignals stop_signals;  // Ctrl-C during the set-up stops before the first frame
+
+  const auto t_start = Clock::now();
+  const int n = scenes::frame_count(scenario, max_frames);
+  geom::StampedPose gt;  // ground truth arrives through its own sink
+  sim::SimFrameSource source(scenario, backend, n, [&gt](const geom::StampedPose& p) { gt = p; });
+  const double setup_ms = ms_since(t_start);
+
+  sim::write_scene(source.simulator().assets(), opt.out);
+  dataset::write_orbslam_settings(opt.out + "/camera.yaml", run::orbslam_settings_for(scenario));
+  dataset::TumSequenceWriter writer(opt.out, sensor::kTumDepthFactor,
+                                    std::string("pvbench ") + pvb::version());
+  const RecordLoop loop = record_frames(source, gt, writer, scenario.name, n);
+  if (loop.interrupted)
+    std::printf("record: stopped by a signal after %d of %d frames; writing meta.json for them\n",
+                loop.frames, n);
+
+  write_meta(opt.out + "/meta.json", opt, scenario, source, loop, ms_since(t_start) / 1000.0, setup_ms);
+  plot::write_rgb_png(plot::make_contact_sheet(loop.thumbs, 4, 320), opt.out + "/contact_sheet.png");
+  std::printf("recorded %d frames of %s to %s (%s; %.1f frames/s, capture %.1f ms/frame)\n", loop.frames,
+              scenario.name.c_str(), opt.out.c_str(), source.camera().description().c_str(),
+              loop.loop_s > 0 ? loop.frames / loop.loop_s : 0.0,
+              loop.frames > 0 ? loop.capture_ms / loop.frames : 0.0);
+  return loop.interrupted ? 130 : 0;
 }
 
 }  // namespace
@@ -109,11 +149,11 @@ Command add_record_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("record", "Render a scenario into a TUM RGB-D sequence folder");
   sub->add_option("--scenario", opt->scenario, "scenario YAML file")->required();
   sub->add_option("--out", opt->out, "output folder (created)")->required();
-  sub->add_option("--frames", opt->frames, "record at most N frames (default: the scenario's duration)")
-      ->check(CLI::PositiveNumber);
+  CLI::Option* frames =
+      sub->add_option("--frames", opt->frames, "record at most N frames (default: the scenario's duration)");
   sub->add_option("--seed", opt->seed, "override the scenario's seed");
   sub->add_option("--gl", opt->gl, "rendering backend")->check(CLI::IsMember({"auto", "egl", "osmesa"}));
-  return {sub, [opt] { return run_record(*opt); }};
+  return {sub, [opt, frames] { return run_record(*opt, frames->count() > 0); }};
 }
 
 }  // namespace pvb::cli

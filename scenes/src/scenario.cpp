@@ -198,6 +198,52 @@ PvArray read_array(MapReader& r) {
   return a;
 }
 
+// ---- scene size ----------------------------------------------------------
+
+/// Geoms the scene builder makes for what the scenario asks for (keep in step
+/// with sim/src/scene_builder.cpp): per table its panels, one backsheet, two
+/// rails and four posts; one per wall; two per shrub or tree.  The ground and
+/// the robot add about ten.
+long long table_geoms(const PvArray& a) {
+  const long long backsheet = 1, rails = a.rails ? 2 : 0, posts = a.posts ? 4 : 0;
+  return static_cast<long long>(a.panels_per_table) * a.panel_lines + backsheet + rails + posts;
+}
+
+/// MuJoCo's renderer draws at most 4000 geoms a frame (sim/src/renderer.cpp)
+/// and leaves the rest out of the image, with one warning.  Far larger scenes
+/// also take minutes in MuJoCo's compiler: 50 x 50 tables of 240 panels
+/// (617 500 geoms) were not compiled after 5 minutes.
+constexpr long long kMaxSceneGeoms = 3800;
+
+/// Refuses a scenario whose scene would not fit the renderer: one line naming
+/// the limit, the total and the largest array.
+void check_scene_size(const Scenario& s, const std::string& origin) {
+  long long total = 2LL * (s.vegetation.shrubs + s.vegetation.trees) + static_cast<long long>(s.walls.size());
+  long long largest = -1;
+  std::size_t largest_index = 0;
+  for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) {
+    const PvArray& a = s.pv_arrays[i];
+    const long long n = static_cast<long long>(a.rows) * a.tables_per_row * table_geoms(a);
+    total += n;
+    if (n > largest) {
+      largest = n;
+      largest_index = i;
+    }
+  }
+  if (total <= kMaxSceneGeoms) return;
+  std::string got = std::to_string(total);
+  if (largest >= 0) {
+    const PvArray& a = s.pv_arrays[largest_index];
+    got += " (pv_arrays[" + std::to_string(largest_index) + "]: " + std::to_string(a.rows) + " rows x " +
+           std::to_string(a.tables_per_row) + " tables x " + std::to_string(table_geoms(a)) + " geoms)";
+  }
+  throw ConfigError(origin, "pv_arrays",
+                    "at most " + std::to_string(kMaxSceneGeoms) +
+                        " geoms in the scene (MuJoCo's renderer draws 4000; a table is panels_per_table x "
+                        "panel_lines panels + up to 7 parts, a wall 1, a shrub or tree 2)",
+                    got);
+}
+
 }  // namespace
 
 double Camera::fovy_deg() const { return 2.0 * std::atan(0.5 * height / fy) * 180.0 / M_PI; }
@@ -381,6 +427,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
     });
   });
   top.finish();
+  check_scene_size(s, origin);
 
   // Cross-field checks.
   const Route& rt = s.route;

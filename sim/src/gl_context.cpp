@@ -80,12 +80,14 @@ bool can_render(GlBackend b) {
 // MuJoCo calls mju_user_error on fatal GL problems and would exit(); in the
 // probe child that just means "this backend does not work".
 void probe_error_handler(const char*) { _exit(3); }
+void probe_warning_handler(const char*) {}
 
 bool probe_in_child(GlBackend b) {
   const pid_t pid = fork();
   if (pid < 0) return false;
   if (pid == 0) {
     mju_user_error = probe_error_handler;
+    mju_user_warning = probe_warning_handler;  // never MUJOCO_LOG.TXT in the user's folder
     // silence the child: its failure is an expected outcome
     if (FILE* f = std::freopen("/dev/null", "w", stderr)) (void)f;
     _exit(can_render(b) ? 0 : 1);

@@ -4,11 +4,13 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/sim/scene_builder.hpp"
+#include "pvb/sim/simulator.hpp"
 
 namespace pvb::sim {
 
 Renderer::Renderer(const mjModel* model, GlBackend backend, int width, int height)
     : width_(width), height_(height) {
+  install_mujoco_handlers();  // MuJoCo's log goes to stderr, not MUJOCO_LOG.TXT
   if (width > model->vis.global.offwidth || height > model->vis.global.offheight)
     throw ConfigError("model", "visual.global.offwidth/offheight",
                       "at least " + std::to_string(width) + "x" + std::to_string(height),

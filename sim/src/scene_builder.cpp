@@ -15,6 +15,7 @@
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/scenes/route.hpp"
+#include "pvb/sim/simulator.hpp"
 #include "pvb/sim/textures.hpp"
 
 namespace pvb::sim {
@@ -382,6 +383,7 @@ SceneAssets build_scene(const scenes::Scenario& s) {
 }
 
 ModelPtr compile_scene(const SceneAssets& assets) {
+  install_mujoco_handlers();  // MuJoCo's log goes to stderr, not MUJOCO_LOG.TXT
   mjVFS vfs;
   mj_defaultVFS(&vfs);
   auto add = [&](const std::string& name, const void* data, std::size_t size) {

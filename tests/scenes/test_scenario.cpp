@@ -207,3 +207,42 @@ TEST(Scenario, EveryShippedScenarioHasBoundsAndTheCiSubsetIsSmall) {
   EXPECT_GE(in_ci, 1);
   EXPECT_LE(in_ci, 2);
 }
+
+// A scene larger than MuJoCo's renderer draws (4000 geoms) is refused with
+// one line naming the key, the limit and the largest array, even when every
+// key is within its own range: 50 x 50 tables of 240 panels did not compile
+// in 5 minutes, and 50 x 50 tables of 16 panels lose geoms in the image.
+TEST(Scenario, SceneLargerThanTheRendererDrawsIsRefused) {
+  const std::string big = std::string(kMinimal) + "pv_arrays:\n  - {rows: 50, tables_per_row: 50}\n";
+  const std::string e = error_of(big);
+  EXPECT_EQ(e.rfind("bad.yaml: pv_arrays: expected at most 3800 geoms in the scene", 0), 0u) << e;
+  // 2500 tables x (16 panels + backsheet + 2 rails + 4 posts)
+  EXPECT_NE(e.find("got 57500 (pv_arrays[0]: 50 rows x 50 tables x 23 geoms)"), std::string::npos) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+
+  const std::string huge =
+      std::string(kMinimal) +
+      "pv_arrays:\n  - {rows: 50, tables_per_row: 50, panels_per_table: 60, panel_lines: 4, "
+      "row_pitch_m: 9}\n";
+  EXPECT_NE(error_of(huge).find("got 617500 (pv_arrays[0]: 50 rows x 50 tables x 247 geoms)"),
+            std::string::npos)
+      << error_of(huge);
+}
+
+// The limit counts every array, wall, shrub and tree: a scene of exactly
+// 3800 geoms loads, one more shrub (two geoms) does not.
+TEST(Scenario, SceneSizeLimitCountsEveryPart) {
+  const std::string arrays =
+      "pv_arrays:\n"
+      "  - {rows: 5, tables_per_row: 10, panels_per_table: 30, panel_lines: 1}\n"  // 50 x 37 = 1850
+      "  - {origin_m: [0, 100], rows: 5, tables_per_row: 10, panels_per_table: 30, panel_lines: 1,"
+      " posts: false, rails: false}\n";  // 50 x 31 = 1550
+  const std::string walls =
+      "walls:\n  - {start_m: [0, -5], end_m: [5, -5]}\n  - {start_m: [0, -8], end_m: [5, -8]}\n";
+  const auto with_shrubs = [&](int n) {
+    return std::string(kMinimal) + arrays + walls + "vegetation: {shrubs: " + std::to_string(n) + "}\n";
+  };
+  EXPECT_EQ(error_of(with_shrubs(199)), "");  // 1850 + 1550 + 2 + 398 = 3800
+  const std::string e = error_of(with_shrubs(200));
+  EXPECT_NE(e.find("got 3802 (pv_arrays[0]: 5 rows x 10 tables x 37 geoms)"), std::string::npos) << e;
+}

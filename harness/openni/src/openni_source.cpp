@@ -15,6 +15,7 @@
 #include "pvb/common/error.hpp"
 #include "pvb/openni/frame_pairer.hpp"
 #include "pvb/openni/oni_file.hpp"
+#include "pvb/openni/record_target.hpp"
 
 namespace pvb::openni {
 namespace {
@@ -199,8 +200,15 @@ void OpenniSource::Impl::open() {
 
 void OpenniSource::Impl::start_recorder() {
   const std::string& path = options.record_path;
-  if (recorder.create(path.c_str()) != ::openni::STATUS_OK)
+  // OpenNI2 truncates what is there and crashes when it cannot create the
+  // file: it only ever gets a new, empty file that we created.
+  check_record_not_on(path, {{options.oni_path, "the recording played back"}});
+  create_new_recording_file(path);
+  if (recorder.create(path.c_str()) != ::openni::STATUS_OK) {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);  // still the empty file made above
     throw IoError(path, "cannot record: " + oni_error());
+  }
   // Lossless: depth goes through 16z, colour uncompressed, so a replay feeds
   // SLAM the very same pixels.
   if (recorder.attach(depth, false) != ::openni::STATUS_OK ||

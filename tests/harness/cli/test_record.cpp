@@ -149,3 +149,101 @@ TEST(RecordCli, MissingScenarioFile) {
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find("/nonexistent.yaml: cannot open for reading"), std::string::npos) << r.output;
 }
+
+namespace {
+
+// Lines of a TUM list that are not comments.
+std::size_t data_lines(const std::string& path) {
+  std::ifstream in(path);
+  std::size_t n = 0;
+  for (std::string l; std::getline(in, l);) n += !l.empty() && l[0] != '#';
+  return n;
+}
+
+// Runs `pvbench ARGS` with the working directory `cwd`.
+Result run_in(const std::string& cwd, const std::string& args) {
+  const std::string log = ::testing::TempDir() + "pvb_rec_cwd_" + std::to_string(::getpid()) + ".txt";
+  const int status = std::system(("cd " + cwd + " && " + kBin + " " + args + " > " + log + " 2>&1").c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(log)};
+}
+
+}  // namespace
+
+// A bad --frames is one line and exit 1, like any bad input (CLI11's own
+// check printed a 309-digit range and exited 105).
+TEST(RecordCli, FramesMustBeAWholeNumberAtLeastOne) {
+  const std::string d = fresh("frames");
+  for (const char* frames : {"0", "-3", "abc", "2.5"}) {
+    const Result r = run("record --scenario " + kStation + " --out " + d + " --frames " + frames);
+    EXPECT_EQ(r.code, 1) << frames << ": " << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_NE(
+        r.output.find(std::string("pvbench: error: pvbench record: --frames: expected a whole number in [1, "
+                                  "1000000000], got ") +
+                      frames),
+        std::string::npos)
+        << r.output;
+  }
+  EXPECT_NE(::access(d.c_str(), F_OK), 0) << "nothing is written for a bad option";
+}
+
+// Ctrl-C stops at the next frame: exit 130, one line saying so, meta.json
+// marked interrupted with the frames written, and the lists hold those frames.
+TEST(RecordCli, CtrlCStopsAtTheNextFrameAndWritesMeta) {
+  const std::string d = fresh("sigint");
+  const std::string log = ::testing::TempDir() + "pvb_rec_sigint_" + std::to_string(::getpid()) + ".txt";
+  const pid_t pid =
+      test::spawn_pvbench({"record", "--scenario", kStation, "--out", d, "--frames", "600"}, log);
+  ASSERT_GE(pid, 0);
+  ASSERT_TRUE(test::wait_until(
+      pid, [&] { return data_lines(d + "/associations.txt") >= 3; }, 300))
+      << "pvbench ended early or wrote nothing: " << read_file(log);
+  const std::optional<int> ended = test::interrupt_and_wait(pid, 120);
+  ASSERT_TRUE(ended.has_value()) << "pvbench did not stop within 120 s of SIGINT";
+  ASSERT_TRUE(WIFEXITED(*ended)) << "killed by a signal: " << read_file(log);
+  EXPECT_EQ(WEXITSTATUS(*ended), 130) << read_file(log);
+  const std::string out = read_file(log);
+  EXPECT_NE(out.find("record: stopped by a signal after "), std::string::npos) << out;
+
+  const std::string meta = read_file(d + "/meta.json");
+  EXPECT_NE(meta.find("\"interrupted\": true"), std::string::npos) << meta;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(meta, m, std::regex("\"frames\": ([0-9]+)"))) << meta;
+  const std::size_t frames = std::stoul(m[1]);
+  EXPECT_GE(frames, 3u);
+  EXPECT_LT(frames, 600u);
+  for (const char* list : {"rgb.txt", "depth.txt", "groundtruth.txt", "associations.txt"})
+    EXPECT_EQ(data_lines(d + "/" + list), frames) << list;
+  EXPECT_EQ(::access((d + "/contact_sheet.png").c_str(), R_OK), 0);
+}
+
+// A scenario within every key's range but far larger than the renderer
+// draws (50 x 50 tables, 57 500 geoms) is refused at once with one line.
+TEST(RecordCli, SceneLargerThanTheRendererDrawsIsOneClearLine) {
+  const std::string bad = ::testing::TempDir() + "pvb_big_scenario_" + std::to_string(::getpid()) + ".yaml";
+  write_file(bad, "route: {waypoints_m: [[0, 0], [5, 0]]}\npv_arrays:\n  - {rows: 50, tables_per_row: 50}\n");
+  const Result r = run("record --scenario " + bad + " --out " + fresh("big") + " --frames 2");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  EXPECT_NE(r.output.find("pvbench: error: " + bad + ": pv_arrays: expected at most 3800 geoms"),
+            std::string::npos)
+      << r.output;
+}
+
+// A scene at the size limit is drawn whole: MuJoCo says nothing (it warns
+// when its visual scene is full and leaves geoms out), and no command leaves
+// MuJoCo's MUJOCO_LOG.TXT in the working directory.
+TEST(RecordCli, SceneAtTheSizeLimitRendersWholeAndLeavesNoMujocoLog) {
+  const std::string cwd = fresh("limit_cwd");
+  std::system(("mkdir -p " + cwd).c_str());
+  write_file(cwd + "/limit.yaml",
+             "route: {waypoints_m: [[-0.5, -3.1], [9.5, -2.95]]}\n"
+             "pv_arrays:\n  - {origin_m: [-1.0, -1.2], rows: 10, tables_per_row: 10, panels_per_table: 30, "
+             "panel_lines: 1}\n"  // 100 tables x 37 geoms
+             "vegetation: {shrubs: 50, area_m: [-30, -30, 30, 30], keep_out_m: 0}\n");  // 100 geoms
+  const Result r = run_in(cwd, "record --scenario limit.yaml --out seq --frames 1");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.find("MuJoCo"), std::string::npos) << r.output;
+  EXPECT_NE(::access((cwd + "/MUJOCO_LOG.TXT").c_str(), F_OK), 0);
+  EXPECT_EQ(data_lines(cwd + "/seq/rgb.txt"), 1u);
+}

@@ -233,3 +233,91 @@ TEST(PVB_CAMERA_SUITE, MissingOniIsOneErrorLine) {
   expect_one_error_line(run("camera --oni " + d + "/none.oni --settings " + settings_file(d) + " --out " + d),
                         "none.oni");
 }
+
+// --record to a path OpenNI2's recorder cannot create (under a regular file,
+// in a missing folder, a folder) is one error line: the recorder used to
+// crash (SIGSEGV) on the first two.
+TEST(PVB_CAMERA_SUITE, UnwritableRecordTargetIsOneErrorLine) {
+  const std::string d = fresh("unwritable");
+  const std::string plain = d + "/plain";
+  pvb::write_file(plain, "x");
+  const std::string cmd =
+      "camera --uri 'sim://scenes/pv_station.yaml?frames=3' --sync --out " + d + "/out --record ";
+  expect_one_error_line(run(cmd + plain + "/run.oni"), "is not a folder");
+  expect_one_error_line(run(cmd + d + "/missing/run.oni"), "does not exist");
+  expect_one_error_line(run(cmd + d), "is a folder");
+  EXPECT_EQ(pvb::read_file(plain), "x");
+}
+
+// A recording never lands on an input (also through a link) nor replaces an
+// existing file: the input .oni used to be overwritten (60 MB became 2 KB).
+TEST(PVB_CAMERA_SUITE, RecordingNeverReplacesAnInputOrAnExistingFile) {
+  const std::string d = fresh("noclobber");
+  const std::string oni = d + "/in.oni";
+  const Result live = run("camera --uri 'sim://scenes/pv_station.yaml?frames=3' --sync --record " + oni +
+                          " --out " + d + "/live");
+  ASSERT_EQ(live.code, 0) << live.output;
+  const std::string bytes = pvb::read_file(oni);
+  ASSERT_GT(bytes.size(), 100000u);
+  ASSERT_EQ(std::system(("ln -s in.oni " + d + "/link.oni").c_str()), 0);
+  const std::string replay = "camera --oni " + oni + " --settings " + d + "/live/camera.yaml --sync --out " +
+                             d + "/replay --record ";
+  expect_one_error_line(run(replay + oni), "is the --oni recording");
+  expect_one_error_line(run(replay + d + "/link.oni"), "is the --oni recording");
+  expect_one_error_line(run(replay + d + "/live/camera.yaml"), "is the --settings file");
+  expect_one_error_line(run(replay + d + "/replay/stats.json"), "is an output of this run");
+  expect_one_error_line(run(replay + d + "/live/stats.json"), "already exists");
+  EXPECT_TRUE(pvb::read_file(oni) == bytes) << "the input recording changed";
+  // the scenario of a sim:// run (a copy: a broken build must not truncate the shipped one)
+  const std::string scenario = d + "/scene.yaml";
+  const std::string scenario_text = pvb::read_file(std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml");
+  pvb::write_file(scenario, scenario_text);
+  expect_one_error_line(
+      run("camera --uri 'sim://" + scenario + "?frames=3' --sync --out " + d + "/x --record " + scenario),
+      "is the scenario");
+  EXPECT_EQ(pvb::read_file(scenario), scenario_text);
+  if (!::testing::Test::HasFailure()) std::system(("rm -rf " + d).c_str());
+}
+
+// A bad --frames or --timeout-ms is one error line, exit 1, before anything
+// is written: "-3" used to wrap around and run the whole stream.
+TEST(PVB_CAMERA_SUITE, BadCountsAreOneErrorLine) {
+  const std::string d = fresh("counts");
+  for (const char* bad :
+       {"--frames -3", "--frames abc", "--frames 1.5", "--timeout-ms 0", "--timeout-ms -1"}) {
+    const Result r =
+        run("camera --uri 'sim://scenes/pv_station.yaml?frames=3' --sync --out " + d + "/out " + bad);
+    EXPECT_EQ(r.code, 1) << bad << ": " << r.output;
+    expect_one_error_line(r, "expected a whole number in [");
+  }
+  EXPECT_FALSE(std::ifstream(d + "/out/stats.json").good());
+}
+
+// Depth that is all zeros (nothing within the depth range): SLAM never
+// initialises.  The run says so in one line and exits non-zero, and keeps
+// what it wrote.
+TEST(PVB_CAMERA_SUITE, NeverInitialisedIsOneErrorLineAndKeepsTheOutputs) {
+  const std::string d = fresh("zerodepth");
+  pvb::write_file(d + "/zero.yaml",
+                  "route: {waypoints_m: [[0, 0], [5, 0]]}\ncamera: {depth_range_m: [0.05, 0.06]}\n");
+  const Result r = run("camera --uri 'sim://" + d + "/zero.yaml?frames=6' --sync --out " + d + "/out");
+  expect_one_error_line(r, "SLAM never initialised in 6 frames");
+  EXPECT_EQ(r.code, 1);
+  const std::string stats = pvb::read_file(d + "/out/stats.json");
+  EXPECT_EQ(json_number(stats, "frames"), 6) << stats;
+  EXPECT_EQ(json_number(stats, "not_initialized_frames"), 6) << stats;
+  EXPECT_EQ(data_lines(d + "/out/groundtruth.txt").size(), 6u);
+  EXPECT_TRUE(std::ifstream(d + "/out/map.ply").good());
+}
+
+// An error in the user's --settings file names that file, not the copy
+// written into the output folder.
+TEST(PVB_CAMERA_SUITE, SettingsErrorsNameTheUsersFile) {
+  const std::string d = fresh("settings");
+  const std::string good = pvb::read_file(settings_file(d));
+  const std::string user = d + "/mine.yaml";
+  pvb::write_file(user, std::regex_replace(good, std::regex("Camera.fx: 525.0\n"), ""));
+  const Result r = run("camera --uri 'nonsense://device' --settings " + user + " --out " + d + "/out");
+  expect_one_error_line(r, user + ": Camera.fx");
+  EXPECT_EQ(r.output.find("out/camera.yaml"), std::string::npos) << r.output;
+}

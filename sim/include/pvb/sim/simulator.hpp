@@ -130,8 +130,12 @@ class RgbdCamera {
   SensorModel sensor_;
 };
 
-/// Installs MuJoCo error/warning handlers that throw pvb::Error instead of
-/// printing and exiting (idempotent).
+/// Installs MuJoCo's error and warning handlers where none is set: an error
+/// throws pvb::Error, a warning is one `pvbench: warning: MuJoCo: ...` line
+/// on stderr.  Without them MuJoCo prints, appends to MUJOCO_LOG.TXT in the
+/// working directory and exits on errors.  Every entry point of this library
+/// that calls MuJoCo (compile_scene, Renderer, Simulator) installs them first
+/// (idempotent).
 void install_mujoco_handlers();
 
 }  // namespace pvb::sim

@@ -1,0 +1,60 @@
+#include "pvb/openni/record_target.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+
+#include "pvb/common/error.hpp"
+
+namespace pvb::openni {
+
+namespace fs = std::filesystem;
+
+bool same_file(const std::string& a, const std::string& b) {
+  struct stat sa {
+  }, sb{};
+  if (::stat(a.c_str(), &sa) == 0 && ::stat(b.c_str(), &sb) == 0)
+    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+  std::error_code ea, eb;
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ea), ea);
+  const fs::path cb = fs::weakly_canonical(fs::absolute(b, eb), eb);
+  return !ea && !eb && ca == cb;
+}
+
+void check_record_not_on(const std::string& record_path, const std::vector<RunFile>& files) {
+  for (const RunFile& f : files)
+    if (!f.path.empty() && same_file(record_path, f.path))
+      throw IoError(record_path, "is " + f.role + " (" + f.path + "); record to a new file");
+}
+
+void create_new_recording_file(const std::string& record_path) {
+  const fs::path p(record_path);
+  std::error_code ec;
+  if (record_path.empty() || fs::is_directory(p, ec) || !p.has_filename())
+    throw IoError(record_path, "is a folder; --record takes the path of a new .oni file");
+  const fs::path folder = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  const fs::file_status st = fs::status(folder, ec);
+  if (!fs::exists(st)) {
+    const bool missing =
+        !ec || ec == std::errc::no_such_file_or_directory || ec == std::errc::not_a_directory;
+    throw IoError(record_path, "cannot record: the folder " + folder.string() +
+                                   (missing ? " does not exist" : ": " + ec.message()));
+  }
+  if (!fs::is_directory(st))
+    throw IoError(record_path, "cannot record: " + folder.string() + " is not a folder");
+  const int fd = ::open(record_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    const int err = errno;
+    if (err == EEXIST)
+      throw IoError(record_path,
+                    "already exists; a recording never replaces a file (remove it or record to a new name)");
+    throw IoError(record_path, std::string("cannot create the recording: ") + std::strerror(err));
+  }
+  ::close(fd);
+}
+
+}  // namespace pvb::openni
