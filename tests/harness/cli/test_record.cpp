@@ -1,4 +1,4 @@
-// pvbench record, end to end: the acceptance run (120 frames of the
+// pvbench record, end to end: the acceptance run (120 frames of the
 // default station), byte-identical output, depth/pose consistency, errors.
 #include <gtest/gtest.h>
 

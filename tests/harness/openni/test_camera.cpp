@@ -4,7 +4,7 @@
 // inputs give one error line and a non-zero exit.
 //
 // PVB_CAMERA_FRAMES sets the run length: the default CI set uses a short
-// drive, the scenario-full build the 300 frames.
+// drive, the scenario-full build 300 frames.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -31,7 +31,7 @@ struct Result {
 };
 
 // Runs pvbench from the source folder (so that sim://scenes/... resolves as
-// in the command line).
+// in the README's command line).
 Result run(const std::string& args) {
   const std::string log = ::testing::TempDir() + "pvb_cam_" + std::to_string(::getpid()) + ".txt";
   const std::string cmd =
@@ -93,7 +93,7 @@ std::string settings_file(const std::string& dir) {
 
 }  // namespace
 
-// The acceptance run: sim:// device -> SLAM -> ATE, recording an
+// The acceptance run: sim:// device -> SLAM -> ATE, recording an
 // .oni; then the replay of that .oni gives the same poses, and the same
 // recording cut in half is refused.  One test, so the live run is made once.
 TEST(PVB_CAMERA_SUITE, SimDeviceTracksRecordsAndReplaysIdentically) {

@@ -2,9 +2,8 @@
 // each): loop closing closes the loop around the array, the refined
 // trajectory is within the 1 cm bound with no lost frame, and --sync with
 // loop closing on gives a bit-identical trajectory twice.
-// As of 2026-11-21 the ATE check FAILS: refined ATE 10.7 mm (15.3 mm after
-// the tracking-speed and box-tessellation changes) against issue
-// 5's 1 cm (docs/slam.md, "Loop closing"); a finding, left failing.
+// It has passed since sub-pixel keypoints (2026-11-21: refined ATE 7.63 mm;
+// docs/experiments/2026-11-21-scenarios-after-sub-pixel-keypoints.md).
 #include <gtest/gtest.h>
 
 #include <cstdio>
