@@ -8,6 +8,7 @@
 
 #include "check_report.hpp"
 #include "command.hpp"
+#include "count_option.hpp"
 #include "stop_signals.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
@@ -18,6 +19,7 @@ namespace {
 
 struct RunArgs {
   run::RunOptions options;
+  std::string frames;  ///< --frames, checked by parse_count
   std::optional<std::uint64_t> seed;
   bool baseline = false;
   bool no_loop_closing = false;
@@ -30,6 +32,8 @@ int run_run(RunArgs& a) {
   if (a.baseline && a.compare)
     throw ConfigError("pvbench run", "--baseline/--compare", "at most one of them");
   run::RunOptions& o = a.options;
+  if (!a.frames.empty())
+    o.max_frames = static_cast<int>(parse_count("run", "--frames", a.frames, 1, 10'000'000));
   o.seed = a.seed;
   o.pace = !a.no_pace;
   o.loop_closing = !a.no_loop_closing;
@@ -66,9 +70,7 @@ Command add_run_command(CLI::App& app) {
   sub->add_option("--scenario", args->options.scenario_file, "scenario YAML file")->required();
   sub->add_option("--out", args->options.out_dir, "report folder (created)")->required();
   sub->add_option("--seed", args->seed, "override the scenario's seed (also seeds PE-match)");
-  sub->add_option("--frames", args->options.max_frames,
-                  "stop after N frames (default: the scenario's duration)")
-      ->check(CLI::PositiveNumber);
+  sub->add_option("--frames", args->frames, "stop after N frames (default: the scenario's duration)");
   sub->add_flag("--sync", args->options.sync, "synchronous: no threads, bit-identical runs");
   sub->add_flag("--no-loop-closing", args->no_loop_closing, "switch loop closing off (LoopClosing.enabled: 0)");
   sub->add_flag("--baseline", args->baseline, "run the ORB-SLAM2 baseline (no PE-match) instead of PE-SLAM");

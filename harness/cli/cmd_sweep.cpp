@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "command.hpp"
+#include "count_option.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/eval/plot.hpp"
@@ -48,8 +49,10 @@ constexpr int kInterruptedExit = 130;
 struct SweepArgs {
   std::string scenario;
   std::string seeds;
+  std::string jobs_text = "1";  ///< --jobs, checked by parse_count
   int jobs = 1;
   std::string out;
+  std::string frames_text;  ///< --frames, checked by parse_count
   int frames = 0;
   bool compare = false;
   bool baseline = false;
@@ -293,7 +296,8 @@ bool check_sweep_and_print(const std::string& scenario_file, const suite::SweepA
 }
 
 int run_sweep(SweepArgs a) {
-  if (a.jobs < 1) throw ConfigError("command line", "--jobs", "a value >= 1", std::to_string(a.jobs));
+  a.jobs = static_cast<int>(parse_count("sweep", "--jobs", a.jobs_text, 1, 1024));
+  if (!a.frames_text.empty()) a.frames = static_cast<int>(parse_count("sweep", "--frames", a.frames_text, 1, 10'000'000));
   if (a.compare && a.baseline)
     throw ConfigError("command line", "--baseline", "either --compare or --baseline, not both");
   std::string scenario_name;
@@ -344,10 +348,9 @@ Command add_sweep_command(CLI::App& app) {
       "sweep", "Run a scenario over many seeds in parallel processes and aggregate the results");
   sub->add_option("--scenario", args->scenario, "scenario YAML file");
   sub->add_option("--seeds", args->seeds, "seed list: 1-20, 1,3,5 or 1-5,9");
-  sub->add_option("--jobs,-j", args->jobs, "seeds run at once")->capture_default_str();
+  sub->add_option("--jobs,-j", args->jobs_text, "seeds run at once")->capture_default_str();
   sub->add_option("--out", args->out, "sweep folder (DIR/seed_S per seed, DIR/aggregate.*)")->required();
-  sub->add_option("--frames", args->frames, "passed to pvbench run: at most N frames")
-      ->check(CLI::PositiveNumber);
+  sub->add_option("--frames", args->frames_text, "passed to pvbench run: at most N frames");
   sub->add_flag("--compare", args->compare, "passed to pvbench run: PE-SLAM and the ORB-SLAM2 baseline");
   sub->add_flag("--baseline", args->baseline, "passed to pvbench run: the ORB-SLAM2 baseline alone");
   sub->add_flag("--sync", args->sync, "passed to pvbench run: synchronous, bit-reproducible SLAM");

@@ -336,6 +336,15 @@ TEST(RunCli, BadInputIsOneClearError) {
   r = test::run_pvbench("run --scenario " + kStation + " --out " + d + " --compare --baseline");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find("pvbench: error:"), std::string::npos) << r.output;
+  // A count that is not a positive whole number is one line and exit 1
+  // (CLI11's own check printed a 309-digit range and exited 105).
+  for (const char* frames : {"0", "-3", "1e3", "x"}) {
+    r = test::run_pvbench("run --scenario " + kStation + " --out " + d + " --frames " + frames);
+    EXPECT_EQ(r.code, 1) << frames << ": " << r.output;
+    EXPECT_EQ(r.output, std::string("pvbench: error: pvbench run: --frames: expected a whole number in [1, ") +
+                            "10000000], got " + frames + "\n")
+        << r.output;
+  }
 }
 
 }  // namespace

@@ -100,6 +100,17 @@ TEST(CliSweep, BadSeedListIsOneErrorLine) {
   EXPECT_FALSE(fs::exists(out + "/seed_5"));
 }
 
+TEST(CliSweep, BadCountsAreOneErrorLine) {
+  const std::string out = scratch("bad_counts");
+  for (const char* option : {"--jobs 0", "--jobs -2", "--frames 0", "--frames -3"}) {
+    const auto r = run_pvbench("sweep --scenario " + scenario_file() + " --seeds 1 --out " + out + " " + option);
+    EXPECT_EQ(r.code, 1) << option << ": " << r.output;
+    EXPECT_EQ(r.output.rfind("pvbench: error: pvbench sweep: --", 0), 0u) << r.output;
+    EXPECT_EQ(count_lines(r.output), 1) << r.output;
+  }
+  EXPECT_FALSE(fs::exists(out + "/seed_1"));
+}
+
 TEST(CliSweep, PrintCommandsGivesOneSelfContainedLinePerSeed) {
   const std::string out = scratch("print");
   const std::string scenario = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
