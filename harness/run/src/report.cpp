@@ -292,8 +292,15 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
   return written;
 }
 
-std::string index_html(const RunReport& r, const std::vector<std::string>& figures) {
-  const SlamRun& p = r.primary;
+namespace {
+
+/// One row of a two-column HTML table, escaped.
+std::string table_row(const std::string& key, const std::string& value) {
+  return "<tr><th>" + html_escape(key) + "</th><td>" + html_escape(value) + "</td></tr>\n";
+}
+
+/// The page's head, its title and the run's status.
+std::string html_head(const RunReport& r) {
   std::string h;
   h += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>pvbench run: " +
        html_escape(r.scenario) +
@@ -305,54 +312,71 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
   const std::string status_class = r.status == RunStatus::kCompleted ? "" : " class=\"bad\"";
   h += "<p>Status: <b" + status_class + ">" + to_string(r.status) + "</b>";
   if (!r.status_detail.empty()) h += " (" + html_escape(r.status_detail) + ")";
-  h += "</p>\n<table>\n";
-  auto row = [&h](const std::string& k, const std::string& v) {
-    h += "<tr><th>" + html_escape(k) + "</th><td>" + html_escape(v) + "</td></tr>\n";
-  };
-  row("scenario file", r.scenario_file);
-  row("seed", std::to_string(r.seed));
-  row("mode", p.mode + (r.baseline ? " (compared with " + r.baseline->mode + ")" : std::string()) +
-                  (r.closed_loop ? ", closed loop" : ", open loop") +
-                  (r.sync ? ", synchronous" : ", pipelined"));
-  row("renderer", r.renderer);
-  row("frames", std::to_string(p.frames) + " (" + fixed(r.sim_s, 2) + " s simulated)");
-  row("lost frames", std::to_string(p.lost_frames));
-  row("keyframes / map points", std::to_string(p.keyframes) + " / " + std::to_string(p.map_points));
+  h += "</p>\n";
+  return h;
+}
+
+/// Summary rows: what ran, and the primary system's map.
+std::string run_rows(const RunReport& r) {
+  const SlamRun& p = r.primary;
+  std::string h;
+  h += table_row("scenario file", r.scenario_file);
+  h += table_row("seed", std::to_string(r.seed));
+  h += table_row("mode", p.mode + (r.baseline ? " (compared with " + r.baseline->mode + ")" : std::string()) +
+                             (r.closed_loop ? ", closed loop" : ", open loop") +
+                             (r.sync ? ", synchronous" : ", pipelined"));
+  h += table_row("renderer", r.renderer);
+  h += table_row("frames", std::to_string(p.frames) + " (" + fixed(r.sim_s, 2) + " s simulated)");
+  h += table_row("lost frames", std::to_string(p.lost_frames));
+  h +=
+      table_row("keyframes / map points", std::to_string(p.keyframes) + " / " + std::to_string(p.map_points));
   if (p.local_mapping) {
     const slam::LocalMappingStats& lm = *p.local_mapping;
-    row("local mapping", std::to_string(lm.keyframes) + " keyframes processed, " +
-                             std::to_string(lm.local_ba) + " local BAs (" +
-                             std::to_string(lm.local_ba_stopped) + " stopped by a new keyframe), " +
-                             fixed(lm.busy_ms / 1000.0, 1) + " s busy");
+    h += table_row("local mapping",
+                   std::to_string(lm.keyframes) + " keyframes processed, " + std::to_string(lm.local_ba) +
+                       " local BAs (" + std::to_string(lm.local_ba_stopped) +
+                       " stopped by a new keyframe), " + fixed(lm.busy_ms / 1000.0, 1) + " s busy");
   }
-  if (!p.loop_closing_json.empty()) row("loops closed", std::to_string(p.loops_closed));
+  if (!p.loop_closing_json.empty()) h += table_row("loops closed", std::to_string(p.loops_closed));
+  return h;
+}
+
+/// Summary rows: the primary system's accuracy and speed, and the closed loop's path error.
+std::string accuracy_rows(const RunReport& r) {
+  const SlamRun& p = r.primary;
+  std::string h;
   if (p.eval) {
-    row("ATE rmse / mean / max [m]", fixed(p.eval->ate.rmse, 4) + " / " + fixed(p.eval->ate.mean, 4) + " / " +
-                                         fixed(p.eval->ate.max, 4) + " (" +
-                                         eval::alignment_name(p.eval->alignment_kind) + " alignment, " +
-                                         std::to_string(p.eval->ate.count) + " poses)");
-    row("RPE trans rmse [m] / rot rmse [deg]",
-        fixed(p.eval->rpe_trans_m.rmse, 4) + " / " + fixed(p.eval->rpe_rot_deg.rmse, 3));
+    h += table_row("ATE rmse / mean / max [m]",
+                   fixed(p.eval->ate.rmse, 4) + " / " + fixed(p.eval->ate.mean, 4) + " / " +
+                       fixed(p.eval->ate.max, 4) + " (" + eval::alignment_name(p.eval->alignment_kind) +
+                       " alignment, " + std::to_string(p.eval->ate.count) + " poses)");
+    h += table_row("RPE trans rmse [m] / rot rmse [deg]",
+                   fixed(p.eval->rpe_trans_m.rmse, 4) + " / " + fixed(p.eval->rpe_rot_deg.rmse, 3));
   } else {
-    row("ATE", "not evaluated: " + p.eval_note);
+    h += table_row("ATE", "not evaluated: " + p.eval_note);
   }
   if (p.refined_eval)
-    row("refined trajectory ATE rmse [m]",
+    h += table_row(
+        "refined trajectory ATE rmse [m]",
         fixed(p.refined_eval->ate.rmse, 4) + " (every frame re-anchored on its keyframe's final pose)");
   const std::vector<double> ms = tracking_times(p);
-  row("tracking ms median / mean / p95",
+  h += table_row(
+      "tracking ms median / mean / p95",
       fixed(percentile(ms, 0.5), 2) + " / " + fixed(mean_of(ms), 2) + " / " + fixed(percentile(ms, 0.95), 2));
-  row("realtime factor", fixed(realtime_factor(r.sim_s, r.wall_s), 2) + " (" + fixed(r.sim_s, 2) +
-                             " s simulated in " + fixed(r.wall_s, 2) + " s)");
+  h += table_row("realtime factor", fixed(realtime_factor(r.sim_s, r.wall_s), 2) + " (" + fixed(r.sim_s, 2) +
+                                        " s simulated in " + fixed(r.wall_s, 2) + " s)");
   if (r.closed_loop)
-    row("path error rmse / max [m]", fixed(r.closed_loop->path_error_rmse_m, 4) + " / " +
-                                         fixed(r.closed_loop->path_error_max_m, 4) + " (held " +
-                                         std::to_string(r.closed_loop->hold_frames) + " frames)");
-  h += "</table>\n";
+    h += table_row("path error rmse / max [m]", fixed(r.closed_loop->path_error_rmse_m, 4) + " / " +
+                                                    fixed(r.closed_loop->path_error_max_m, 4) + " (held " +
+                                                    std::to_string(r.closed_loop->hold_frames) + " frames)");
+  return h;
+}
 
-  std::vector<const SlamRun*> runs{&p};
+/// Every loss of every system, with its reason and recovery.
+std::string loss_section(const RunReport& r) {
+  std::vector<const SlamRun*> runs{&r.primary};
   if (r.baseline) runs.push_back(&*r.baseline);
-  h += "<h2>Tracking loss</h2>\n";
+  std::string h = "<h2>Tracking loss</h2>\n";
   for (const SlamRun* run : runs) {
     if (run->loss_events.empty()) {
       h += "<p>" + html_escape(run->mode) + ": tracking was never lost.</p>\n";
@@ -367,25 +391,36 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
            (e.recovered_frame ? std::to_string(*e.recovered_frame) : std::string("never")) + "</td></tr>\n";
     h += "</table>\n";
   }
-  const std::string table = comparison_table(r);
-  if (!table.empty()) h += "<h2>PE-SLAM vs ORB-SLAM2</h2>\n<pre>" + html_escape(table) + "</pre>\n";
+  return h;
+}
 
-  h += "<h2>Figures</h2>\n";
+/// The figures (PNG linking to the SVG) and the contact sheet.
+std::string figures_section(const std::vector<std::string>& figures) {
+  std::string h = "<h2>Figures</h2>\n";
   for (const std::string& f : figures)
     h += "<p><a href=\"" + f + ".svg\"><img src=\"" + f + ".png\" alt=\"" + f + "\"></a><br>" + f +
          " (<a href=\"" + f + ".svg\">SVG</a>, <a href=\"" + f + ".png\">PNG</a>)</p>\n";
   h += "<h2>Frames</h2>\n<p><img src=\"contact_sheet.png\" alt=\"contact sheet\"></p>\n";
+  return h;
+}
 
-  if (!r.profile.empty()) {
-    h += "<h2>Where the time went</h2>\n<table><tr><th>stage</th><th>thread</th><th>total [ms]</th>"
-         "<th>per frame [ms]</th></tr>\n";
-    const double frames = std::max<double>(1.0, static_cast<double>(p.frames));
-    for (const StageTime& s : r.profile)
-      h += "<tr><td>" + html_escape(s.name) + "</td><td>" + html_escape(s.thread) + "</td><td>" +
-           fixed(s.total_ms, 1) + "</td><td>" + fixed(s.total_ms / frames, 2) + "</td></tr>\n";
-    h += "</table>\n";
-  }
-  h += "<h2>Files</h2>\n<ul>\n";
+/// "Where the time went": the profile (nothing when there is none).
+std::string profile_section(const RunReport& r) {
+  if (r.profile.empty()) return {};
+  std::string h =
+      "<h2>Where the time went</h2>\n<table><tr><th>stage</th><th>thread</th><th>total [ms]</th>"
+      "<th>per frame [ms]</th></tr>\n";
+  const double frames = std::max<double>(1.0, static_cast<double>(r.primary.frames));
+  for (const StageTime& s : r.profile)
+    h += "<tr><td>" + html_escape(s.name) + "</td><td>" + html_escape(s.thread) + "</td><td>" +
+         fixed(s.total_ms, 1) + "</td><td>" + fixed(s.total_ms / frames, 2) + "</td></tr>\n";
+  h += "</table>\n";
+  return h;
+}
+
+/// Links to the report's files, then the log; closes the page.
+std::string files_and_log(const RunReport& r) {
+  std::string h = "<h2>Files</h2>\n<ul>\n";
   for (const char* f : {"metrics.json", "groundtruth.txt", "CameraTrajectory.txt", "KeyFrameTrajectory.txt",
                         "timing.csv", "camera.yaml", "run.log"})
     h += std::string("<li><a href=\"") + f + "\">" + f + "</a></li>\n";
@@ -396,6 +431,20 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
   h += "</ul>\n<h2>Log</h2>\n<pre>";
   for (const std::string& l : r.log_lines) h += html_escape(l) + "\n";
   h += "</pre>\n</body></html>\n";
+  return h;
+}
+
+}  // namespace
+
+std::string index_html(const RunReport& r, const std::vector<std::string>& figures) {
+  std::string h = html_head(r);
+  h += "<table>\n" + run_rows(r) + accuracy_rows(r) + "</table>\n";
+  h += loss_section(r);
+  const std::string table = comparison_table(r);
+  if (!table.empty()) h += "<h2>PE-SLAM vs ORB-SLAM2</h2>\n<pre>" + html_escape(table) + "</pre>\n";
+  h += figures_section(figures);
+  h += profile_section(r);
+  h += files_and_log(r);
   return h;
 }
 

@@ -243,41 +243,58 @@ bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
   return true;
 }
 
-void LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf,
-                          const LoopMatch& m, LoopEvent* event) {
-  kf->update_connections();
+namespace {
 
-  // 1. Move the new keyframe's neighbourhood with it (ORB-SLAM2 CorrectLoop,
-  //    scale 1): T_iw' = T_i_cur * T_cur_w', points with the keyframe that
-  //    corrected them first.
-  std::vector<std::shared_ptr<KeyFrame>> connected = {kf};
-  for (const auto& n : kf->best_covisibles(-1)) connected.push_back(n);
+using KeyFramePtr = std::shared_ptr<KeyFrame>;
+/// New covisibility links of the corrected neighbourhood, by keyframe id.
+using LoopLinks = std::map<std::uint64_t, std::vector<KeyFramePtr>>;
+
+/// Step 4.1: the new keyframe's covisibility neighbourhood, moved with it.
+struct MovedGroup {
+  std::vector<KeyFramePtr> keyframes;                   ///< the new keyframe, then its covisibles
+  std::map<std::uint64_t, geom::SE3d> uncorrected;      ///< T_c_w before the move, by keyframe id
+  std::map<std::uint64_t, std::uint64_t> corrected_by;  ///< point id -> keyframe id it moved with
+};
+
+/// Moves the new keyframe's neighbourhood with it (ORB-SLAM2 CorrectLoop,
+/// scale 1): T_iw' = T_i_cur * T_cur_w', points with the keyframe that
+/// corrected them first.  `T_cur_w` is the new keyframe's verified pose.
+MovedGroup move_neighbourhood(const KeyFramePtr& kf, const geom::SE3d& T_cur_w) {
+  MovedGroup g;
+  g.keyframes = {kf};
+  for (const auto& n : kf->best_covisibles(-1)) g.keyframes.push_back(n);
   const geom::SE3d T_w_cur = kf->T_c_w().inverse();
-  std::map<std::uint64_t, geom::SE3d> corrected, uncorrected;  // T_c_w by keyframe id
-  for (const auto& k : connected) {
-    uncorrected[k->id()] = k->T_c_w();
-    corrected[k->id()] = k->T_c_w() * T_w_cur * m.T_c_w;
+  std::map<std::uint64_t, geom::SE3d> corrected;  // T_c_w by keyframe id
+  for (const auto& k : g.keyframes) {
+    g.uncorrected[k->id()] = k->T_c_w();
+    corrected[k->id()] = k->T_c_w() * T_w_cur * T_cur_w;
   }
-  std::map<std::uint64_t, std::uint64_t> corrected_by;  // point id -> keyframe id it moved with
-  for (const auto& k : connected) {
-    const geom::SE3d move = corrected.at(k->id()).inverse() * uncorrected.at(k->id());
+  for (const auto& k : g.keyframes) {
+    const geom::SE3d move = corrected.at(k->id()).inverse() * g.uncorrected.at(k->id());
     for (const auto& mp : k->map_points()) {
-      if (!mp || mp->bad() || corrected_by.count(mp->id())) continue;
+      if (!mp || mp->bad() || g.corrected_by.count(mp->id())) continue;
       mp->set_p_w(move * mp->p_w());
-      corrected_by[mp->id()] = k->id();
+      g.corrected_by[mp->id()] = k->id();
     }
   }
-  for (const auto& k : connected) k->set_T_c_w(corrected.at(k->id()));
-  for (const auto& k : connected)
+  for (const auto& k : g.keyframes) k->set_T_c_w(corrected.at(k->id()));
+  for (const auto& k : g.keyframes)
     for (const auto& mp : k->map_points())
       if (mp && !mp->bad()) mp->update_normal_and_depth();
+  return g;
+}
 
-  // 2. Fuse: the verified matches first (the loop-side point replaces the
-  //    current one), then the loop neighbourhood's points projected into
-  //    the corrected neighbourhood.
-  std::map<std::uint64_t, std::set<std::uint64_t>> neighbours_before;
-  for (const auto& k : connected)
-    for (const auto& n : k->best_covisibles(-1)) neighbours_before[k->id()].insert(n->id());
+/// Covisible keyframe ids of each keyframe of `group`.
+std::map<std::uint64_t, std::set<std::uint64_t>> neighbour_ids(const std::vector<KeyFramePtr>& group) {
+  std::map<std::uint64_t, std::set<std::uint64_t>> ids;
+  for (const auto& k : group)
+    for (const auto& n : k->best_covisibles(-1)) ids[k->id()].insert(n->id());
+  return ids;
+}
+
+/// The verified matches: the loop-side point replaces the current one, or
+/// joins the new keyframe where it has none.  Returns how many.
+int fuse_verified_matches(const KeyFramePtr& kf, const LoopMatch& m) {
   int fused = 0;
   for (std::size_t i = 0; i < m.points.size(); ++i) {
     const auto& lp = m.points[i];
@@ -294,126 +311,179 @@ void LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared
       ++fused;
     }
   }
-  std::vector<std::shared_ptr<MapPoint>> loop_points;
-  {
-    std::set<std::uint64_t> seen;
-    std::vector<std::shared_ptr<KeyFrame>> loop_group = {loop_kf};
-    for (const auto& n : loop_kf->best_covisibles(-1)) loop_group.push_back(n);
-    for (const auto& g : loop_group)
-      for (const auto& mp : g->map_points())
-        if (mp && !mp->bad() && seen.insert(mp->id()).second) loop_points.push_back(mp);
-  }
-  for (const auto& k : connected)
-    if (!k->bad()) fused += fuse(map_, k, loop_points, 4.0, FusePolicy::kIncomingWins);
-  map_.remove_bad_points();
-  event->fused_points = fused;
+  return fused;
+}
 
-  // 3. New links: neighbours each keyframe of the group has gained, outside the group.
-  std::set<std::uint64_t> connected_ids;
-  for (const auto& k : connected) connected_ids.insert(k->id());
-  std::map<std::uint64_t, std::vector<std::shared_ptr<KeyFrame>>> loop_links;
-  for (const auto& k : connected) {
+/// Step 4.2: fuses the duplicated points: the verified matches first, then
+/// the loop neighbourhood's points projected into the corrected
+/// neighbourhood.  Returns how many.
+int fuse_loop_points(Map& map, const KeyFramePtr& kf, const KeyFramePtr& loop_kf, const LoopMatch& m,
+                     const std::vector<KeyFramePtr>& group) {
+  int fused = fuse_verified_matches(kf, m);
+  std::vector<std::shared_ptr<MapPoint>> loop_points;
+  std::set<std::uint64_t> seen;
+  std::vector<KeyFramePtr> loop_group = {loop_kf};
+  for (const auto& n : loop_kf->best_covisibles(-1)) loop_group.push_back(n);
+  for (const auto& g : loop_group)
+    for (const auto& mp : g->map_points())
+      if (mp && !mp->bad() && seen.insert(mp->id()).second) loop_points.push_back(mp);
+  for (const auto& k : group)
+    if (!k->bad()) fused += fuse(map, k, loop_points, 4.0, FusePolicy::kIncomingWins);
+  map.remove_bad_points();
+  return fused;
+}
+
+/// Step 4.3: the neighbours each keyframe of the group has gained, outside the group.
+LoopLinks new_loop_links(const std::vector<KeyFramePtr>& group,
+                         std::map<std::uint64_t, std::set<std::uint64_t>> neighbours_before) {
+  std::set<std::uint64_t> group_ids;
+  for (const auto& k : group) group_ids.insert(k->id());
+  LoopLinks links;
+  for (const auto& k : group) {
     if (k->bad()) continue;
     k->update_connections();
     for (const auto& n : k->best_covisibles(-1))
-      if (!neighbours_before[k->id()].count(n->id()) && !connected_ids.count(n->id())) loop_links[k->id()].push_back(n);
+      if (!neighbours_before[k->id()].count(n->id()) && !group_ids.count(n->id()))
+        links[k->id()].push_back(n);
+  }
+  return links;
+}
+
+/// Step 4.4: the essential graph as an SE(3) pose graph.  Nodes: keyframes
+/// in the spanning tree (and the loop keyframe, held fixed: the gauge).
+/// Measurements come from the poses before the correction (the odometry as
+/// it was); the new loop links from the corrected poses.  An edge between
+/// two nodes is added once.
+class EssentialGraph {
+ public:
+  EssentialGraph(const Map& map, const KeyFramePtr& loop_kf, double rotation_weight)
+      : rotation_weight_(rotation_weight) {
+    for (const auto& [id, k] : map.keyframes()) {
+      if (k->bad()) continue;
+      const bool in_tree = id == 0 || k->parent() != nullptr || k == loop_kf;
+      initial[id] = k->T_c_w();
+      if (!in_tree) continue;  // queued, not yet processed by local mapping: moved in step 4.5
+      node[id] = problem.nodes.size();
+      problem.nodes.push_back({id, k->T_c_w(), k == loop_kf});
+      node_kf.push_back(k);
+    }
   }
 
-  // 4. The essential graph as an SE(3) pose graph.  Nodes: keyframes in the
-  //    spanning tree (and the loop keyframe, held fixed: the gauge).
-  //    Measurements come from the poses before the correction (the odometry
-  //    as it was); the new loop links from the corrected poses.
-  PoseGraphProblem graph;
-  std::map<std::uint64_t, std::size_t> node;
-  std::vector<std::shared_ptr<KeyFrame>> node_kf;
-  std::map<std::uint64_t, geom::SE3d> initial;  // T_c_w at the start of the optimisation
-  for (const auto& [id, k] : map_.keyframes()) {
-    if (k->bad()) continue;
-    const bool in_tree = id == 0 || k->parent() != nullptr || k == loop_kf;
-    initial[id] = k->T_c_w();
-    if (!in_tree) continue;  // queued, not yet processed by local mapping: moved below
-    node[id] = graph.nodes.size();
-    graph.nodes.push_back({id, k->T_c_w(), k == loop_kf});
-    node_kf.push_back(k);
+  /// The new links of weight >= essential_weight, and the loop itself, from the corrected poses.
+  void add_loop_links(const LoopLinks& links, const KeyFramePtr& kf, const KeyFramePtr& loop_kf,
+                      int essential_weight) {
+    for (const auto& [id, linked] : links) {
+      auto it = node.find(id);
+      if (it == node.end()) continue;
+      const auto& k = node_kf[it->second];
+      for (const auto& n : linked) {
+        auto jt = node.find(n->id());
+        if (jt == node.end()) continue;
+        const bool the_loop = k == kf && n == loop_kf;
+        if (!the_loop && k->weight(n->id()) < essential_weight) continue;
+        add_edge(it->second, jt->second, k->T_c_w(), n->T_c_w());
+      }
+    }
+    if (node.count(kf->id()) && node.count(loop_kf->id()))
+      add_edge(node.at(kf->id()), node.at(loop_kf->id()), kf->T_c_w(), loop_kf->T_c_w());
   }
-  const auto measured = [&](const std::shared_ptr<KeyFrame>& k) {
-    auto it = uncorrected.find(k->id());
-    return it != uncorrected.end() ? it->second : k->T_c_w();
-  };
-  std::set<std::pair<std::size_t, std::size_t>> inserted;
-  const auto add_edge = [&](std::size_t i, std::size_t j, const geom::SE3d& T_iw, const geom::SE3d& T_jw) {
-    const auto key = std::minmax(i, j);
-    if (!inserted.insert(key).second) return;
-    graph.edges.push_back({i, j, T_iw * T_jw.inverse(), 1.0, options_.rotation_weight});
-  };
-  for (const auto& [id, links] : loop_links) {
-    auto it = node.find(id);
-    if (it == node.end()) continue;
-    const auto& k = node_kf[it->second];
-    for (const auto& n : links) {
-      auto jt = node.find(n->id());
-      if (jt == node.end()) continue;
-      const bool the_loop = k == kf && n == loop_kf;
-      if (!the_loop && k->weight(n->id()) < options_.essential_weight) continue;
-      add_edge(it->second, jt->second, k->T_c_w(), n->T_c_w());  // corrected poses
-    }
-  }
-  if (node.count(kf->id()) && node.count(loop_kf->id()))
-    add_edge(node.at(kf->id()), node.at(loop_kf->id()), kf->T_c_w(), loop_kf->T_c_w());
-  for (std::size_t i = 0; i < node_kf.size(); ++i) {
-    const auto& k = node_kf[i];
-    const geom::SE3d T_iw = measured(k);
-    if (auto p = k->parent()) {
-      auto jt = node.find(p->id());
-      if (jt != node.end()) add_edge(i, jt->second, T_iw, measured(p));
-    }
-    for (const auto& l : k->loop_edges()) {
-      auto jt = node.find(l->id());
-      if (jt != node.end() && l->id() < k->id()) add_edge(i, jt->second, T_iw, measured(l));
-    }
-    for (const auto& n : k->best_covisibles(-1)) {
-      if (k->weight(n->id()) < options_.essential_weight) break;  // sorted by weight
-      if (n->id() >= k->id()) continue;
-      auto jt = node.find(n->id());
-      if (jt != node.end()) add_edge(i, jt->second, T_iw, measured(n));
-    }
-  }
-  event->graph_keyframes = static_cast<int>(graph.nodes.size());
-  event->graph_edges = static_cast<int>(graph.edges.size());
-  optimize_pose_graph(&graph);
 
-  // 5. Write the poses back; every point moves with its reference keyframe
-  //    (or the keyframe that corrected it in step 1).  Keyframes not in the
-  //    graph (queued for local mapping) move as the new keyframe did.
+  /// Spanning tree, earlier loop edges and covisibility edges of weight >=
+  /// essential_weight, measured from `uncorrected` poses where given.
+  void add_odometry_edges(const std::map<std::uint64_t, geom::SE3d>& uncorrected, int essential_weight) {
+    const auto measured = [&](const KeyFramePtr& k) {
+      auto it = uncorrected.find(k->id());
+      return it != uncorrected.end() ? it->second : k->T_c_w();
+    };
+    for (std::size_t i = 0; i < node_kf.size(); ++i) {
+      const auto& k = node_kf[i];
+      const geom::SE3d T_iw = measured(k);
+      if (auto p = k->parent()) {
+        auto jt = node.find(p->id());
+        if (jt != node.end()) add_edge(i, jt->second, T_iw, measured(p));
+      }
+      for (const auto& l : k->loop_edges()) {
+        auto jt = node.find(l->id());
+        if (jt != node.end() && l->id() < k->id()) add_edge(i, jt->second, T_iw, measured(l));
+      }
+      for (const auto& n : k->best_covisibles(-1)) {
+        if (k->weight(n->id()) < essential_weight) break;  // sorted by weight
+        if (n->id() >= k->id()) continue;
+        auto jt = node.find(n->id());
+        if (jt != node.end()) add_edge(i, jt->second, T_iw, measured(n));
+      }
+    }
+  }
+
+  PoseGraphProblem problem;
+  std::map<std::uint64_t, std::size_t> node;    ///< keyframe id -> node index
+  std::vector<KeyFramePtr> node_kf;             ///< node index -> keyframe
+  std::map<std::uint64_t, geom::SE3d> initial;  ///< T_c_w of every good keyframe at the start
+
+ private:
+  void add_edge(std::size_t i, std::size_t j, const geom::SE3d& T_iw, const geom::SE3d& T_jw) {
+    if (!inserted_.insert(std::minmax(i, j)).second) return;
+    problem.edges.push_back({i, j, T_iw * T_jw.inverse(), 1.0, rotation_weight_});
+  }
+
+  double rotation_weight_;
+  std::set<std::pair<std::size_t, std::size_t>> inserted_;
+};
+
+/// Step 4.5: writes the optimised poses back; every point moves with its
+/// reference keyframe (or the keyframe that corrected it in step 4.1).
+/// Keyframes not in the graph (queued for local mapping) move as the new
+/// keyframe did.
+void write_back(Map& map, const EssentialGraph& g, const KeyFramePtr& kf, const MovedGroup& moved) {
   std::map<std::uint64_t, geom::SE3d> final_pose;
-  for (std::size_t i = 0; i < node_kf.size(); ++i) final_pose[node_kf[i]->id()] = graph.nodes[i].T_c_w;
-  const geom::SE3d kf_move = final_pose.count(kf->id()) ? geom::SE3d(final_pose.at(kf->id()).inverse() * uncorrected.at(kf->id()))
-                                                        : geom::SE3d::Identity();
-  for (const auto& [id, k] : map_.keyframes()) {
-    if (k->bad() || final_pose.count(id) || !initial.count(id)) continue;
-    final_pose[id] = (kf_move * initial.at(id).inverse()).inverse();  // T_c_w' = T_c_w * kf_move^-1
+  for (std::size_t i = 0; i < g.node_kf.size(); ++i)
+    final_pose[g.node_kf[i]->id()] = g.problem.nodes[i].T_c_w;
+  const geom::SE3d kf_move =
+      final_pose.count(kf->id())
+          ? geom::SE3d(final_pose.at(kf->id()).inverse() * moved.uncorrected.at(kf->id()))
+          : geom::SE3d::Identity();
+  for (const auto& [id, k] : map.keyframes()) {
+    if (k->bad() || final_pose.count(id) || !g.initial.count(id)) continue;
+    final_pose[id] = (kf_move * g.initial.at(id).inverse()).inverse();  // T_c_w' = T_c_w * kf_move^-1
   }
-  for (const auto& [id, mp] : map_.points()) {
+  for (const auto& [id, mp] : map.points()) {
     if (mp->bad()) continue;
     std::uint64_t ref_id;
-    auto cb = corrected_by.find(id);
-    if (cb != corrected_by.end()) {
+    auto cb = moved.corrected_by.find(id);
+    if (cb != moved.corrected_by.end()) {
       ref_id = cb->second;
     } else {
       auto ref = mp->reference_keyframe();
       if (!ref) continue;
       ref_id = ref->id();
     }
-    auto it0 = initial.find(ref_id);
+    auto it0 = g.initial.find(ref_id);
     auto it1 = final_pose.find(ref_id);
-    if (it0 == initial.end() || it1 == final_pose.end()) continue;
+    if (it0 == g.initial.end() || it1 == final_pose.end()) continue;
     mp->set_p_w(it1->second.inverse() * (it0->second * mp->p_w()));
   }
-  for (const auto& [id, k] : map_.keyframes())
+  for (const auto& [id, k] : map.keyframes())
     if (!k->bad() && final_pose.count(id)) k->set_T_c_w(final_pose.at(id));
-  for (const auto& [id, mp] : map_.points())
+  for (const auto& [id, mp] : map.points())
     if (!mp->bad()) mp->update_normal_and_depth();
+}
 
+}  // namespace
+
+void LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf,
+                          const LoopMatch& m, LoopEvent* event) {
+  kf->update_connections();
+  const MovedGroup moved = move_neighbourhood(kf, m.T_c_w);
+  auto neighbours_before = neighbour_ids(moved.keyframes);
+  event->fused_points = fuse_loop_points(map_, kf, loop_kf, m, moved.keyframes);
+  const LoopLinks links = new_loop_links(moved.keyframes, std::move(neighbours_before));
+  EssentialGraph graph(map_, loop_kf, options_.rotation_weight);
+  graph.add_loop_links(links, kf, loop_kf, options_.essential_weight);
+  graph.add_odometry_edges(moved.uncorrected, options_.essential_weight);
+  event->graph_keyframes = static_cast<int>(graph.problem.nodes.size());
+  event->graph_edges = static_cast<int>(graph.problem.edges.size());
+  optimize_pose_graph(&graph.problem);
+  write_back(map_, graph, kf, moved);
   kf->add_loop_edge(loop_kf);
   loop_kf->add_loop_edge(kf);
 }

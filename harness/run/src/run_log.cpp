@@ -1,0 +1,41 @@
+#include "run_log.hpp"
+
+#include <cstdio>
+#include <ctime>
+
+#include "pvb/common/error.hpp"
+
+namespace pvb::run {
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+double process_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+std::string fmt(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::ofstream open_out(const std::string& path) {
+  std::ofstream f(path);
+  if (!f) throw IoError(path, "cannot open for writing");
+  return f;
+}
+
+RunLog::RunLog(const std::string& path, std::function<void(const std::string&)> echo)
+    : file_(open_out(path)), echo_(std::move(echo)) {}
+
+void RunLog::line(const std::string& text) {
+  file_ << text << "\n" << std::flush;
+  lines_.push_back(text);
+  if (echo_) echo_(text);
+}
+
+}  // namespace pvb::run

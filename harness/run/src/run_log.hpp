@@ -1,0 +1,39 @@
+#pragma once
+// Small pieces every stage of a scenario run uses: the clock, the process
+// CPU time, number formatting, output files and run.log.
+#include <chrono>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace pvb::run {
+
+using Clock = std::chrono::steady_clock;
+
+/// Milliseconds from t0 to now.
+double ms_since(Clock::time_point t0);
+
+/// CPU time of the whole process (every thread, GL workers included), seconds.
+double process_cpu_s();
+
+/// A number as "%.6g" (timing.csv, log lines).
+std::string fmt(double v);
+
+/// Opens `path` for writing; throws pvb::IoError when it cannot.
+std::ofstream open_out(const std::string& path);
+
+/// run.log, flushed line by line; also kept for index.html and echoed.
+class RunLog {
+ public:
+  RunLog(const std::string& path, std::function<void(const std::string&)> echo);
+  void line(const std::string& text);
+  const std::vector<std::string>& lines() const { return lines_; }
+
+ private:
+  std::ofstream file_;
+  std::function<void(const std::string&)> echo_;
+  std::vector<std::string> lines_;
+};
+
+}  // namespace pvb::run

@@ -1,0 +1,166 @@
+#include "system_sink.hpp"
+
+#include <cstdio>
+
+#include "pvb/common/text.hpp"
+#include "pvb/geometry/stamped_pose.hpp"
+#include "pvb/geometry/time.hpp"
+
+namespace pvb::run {
+namespace {
+
+/// Loss and recovery: a loss event when tracking is lost (from Ok or not
+/// initialised), its recovery when it is Ok again, and the log lines of
+/// those and of initialisation.
+void record_state_change(SlamRun& run, slam::TrackingState prev_state, const slam::FrameResult& r, int index,
+                         double t_s, RunLog& log) {
+  char head_buf[96];
+  std::snprintf(head_buf, sizeof head_buf, "frame %d (t = %.3f s): %s ", index, t_s, run.mode.c_str());
+  const std::string head = head_buf;
+  const std::string reason = r.tracking.failure.empty() ? "no reason given" : r.tracking.failure;
+  if (r.state == slam::TrackingState::kLost && prev_state != slam::TrackingState::kLost) {
+    run.loss_events.push_back({index, t_s, reason, std::nullopt});
+    log.line(head + std::string("lost tracking: ") + reason);
+  } else if (r.state == slam::TrackingState::kOk && prev_state == slam::TrackingState::kLost) {
+    if (!run.loss_events.empty()) run.loss_events.back().recovered_frame = index;
+    log.line(head + std::string("relocalised"));
+  } else if (r.state == slam::TrackingState::kNotInitialized && run.frames == 1) {
+    log.line(head + "not initialised: " + reason);
+  } else if (r.state == slam::TrackingState::kOk && prev_state == slam::TrackingState::kNotInitialized) {
+    log.line(head + "initialised");
+  }
+}
+
+void write_tum(const std::string& path, const std::string& header,
+               const std::vector<geom::StampedPose>& poses) {
+  std::string text = header;
+  for (const auto& p : poses) text += geom::format_tum_line(p) + "\n";
+  write_file(path, text);
+}
+
+}  // namespace
+
+SystemSink::SystemSink(const std::string& mode, const slam::Settings& settings, bool sync, std::uint32_t seed,
+                       const std::string& out_dir)
+    : dir(out_dir) {
+  run.mode = mode;
+  slam::SystemOptions options;
+  options.synchronous = sync;
+  options.seed = seed;
+  system = std::make_unique<slam::System>(settings, options);
+  cam_traj = open_out(dir + "/CameraTrajectory.txt");
+  kf_traj = open_out(dir + "/KeyFrameTrajectory.txt");
+  timing = open_out(dir + "/timing.csv");
+  cam_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c; w = camera frame of the first tracked frame)\n";
+  kf_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
+  timing << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,"
+            "inliers,"
+            "keyframe,mapping_ms\n";
+  est.source = dir + "/CameraTrajectory.txt";
+}
+
+slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log) {
+  const slam::FrameResult r = system->track(frame);
+  const int index = static_cast<int>(frame.index);
+  const double t_s = geom::ns_to_seconds(frame.t_ns);
+  count(r, index, t_s);
+  write_lines(r, index);
+  record_state_change(run, prev_state, r, index, t_s, log);
+  prev_state = r.state;
+  return r;
+}
+
+void SystemSink::count(const slam::FrameResult& r, int index, double t_s) {
+  ++run.frames;
+  if (r.state == slam::TrackingState::kLost) ++run.lost_frames;
+  if (r.state == slam::TrackingState::kNotInitialized) ++run.not_initialized_frames;
+  tracking_ms += r.tracking_ms;
+  orb_ms += r.orb_ms;
+  inline_mapping_ms += r.mapping_ms;
+  run.per_frame.push_back(
+      {index, t_s, r.T_w_c.has_value(), r.tracking_ms, r.tracking.coarse_matches, r.tracking.matches_kept});
+}
+
+void SystemSink::write_lines(const slam::FrameResult& r, int index) {
+  if (r.T_w_c) {
+    cam_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+    est.poses.push_back({r.t_ns, *r.T_w_c});
+    if (r.tracking.new_keyframe) kf_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+  }
+  static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc"};
+  timing << index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
+         << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","
+         << fmt(r.tracking_ms) << "," << fmt(r.orb_ms) << "," << fmt(r.tracking.pe_match_ms) << ","
+         << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers << ","
+         << (r.tracking.new_keyframe ? 1 : 0) << "," << fmt(r.mapping_ms) << "\n"
+         << std::flush;
+}
+
+void SystemSink::finish() {
+  system->shutdown();
+  kf_traj.close();
+  write_tum(dir + "/KeyFrameTrajectory.txt",
+            "# timestamp tx ty tz qx qy qz qw (T_w_c, refined by local BA; culled keyframes left out)\n",
+            system->keyframe_trajectory());
+  // Each frame re-anchored on its reference keyframe's final pose (local
+  // BA, loop closing), as ORB-SLAM2 saves its trajectory.
+  refined.source = dir + "/CameraTrajectoryRefined.txt";
+  refined.poses = system->refined_trajectory();
+  write_tum(refined.source,
+            "# timestamp tx ty tz qx qy qz qw (T_w_c, re-anchored on the final keyframe poses)\n",
+            refined.poses);
+  if (system->loop_closing_enabled()) {
+    const slam::LoopClosingStats loops = system->loop_stats();
+    run.loop_closing_json = slam::to_json(loops);
+    run.loops_closed = loops.loops.size();
+  }
+  cam_traj.close();
+  timing.close();
+  run.keyframes = system->num_keyframes();
+  run.map_points = system->num_map_points();
+  run.local_mapping = system->mapping_stats();
+}
+
+void SystemSink::evaluate(const eval::Trajectory& gt) {
+  if (est.poses.size() < 3) {
+    run.eval_note = "only " + std::to_string(est.poses.size()) + " tracked frames (need 3)";
+    return;
+  }
+  eval::EvalOptions eo;
+  try {
+    run.eval = eval::evaluate(gt, est, eo);
+  } catch (const eval::EvalError& e) {
+    // A numerically degenerate set (a robot that did not move): the SLAM
+    // world is its first camera frame, so align that instead.
+    eo.alignment = eval::Alignment::kOrigin;
+    try {
+      run.eval = eval::evaluate(gt, est, eo);
+      run.eval_note = std::string("se3 alignment impossible (") + e.what() + "); origin alignment";
+    } catch (const eval::EvalError& e2) {
+      run.eval_note = e2.what();
+    }
+  }
+  if (run.eval && refined.poses.size() >= 3) {
+    try {
+      run.refined_eval = eval::evaluate(gt, refined, eo);
+    } catch (const eval::EvalError&) {
+      // left out of the report: the primary evaluation stands
+    }
+  }
+}
+
+SystemSinks make_systems(const slam::Settings& settings, const RunOptions& opt, std::uint32_t seed) {
+  SystemSinks sinks;
+  slam::Settings s = settings;
+  s.loop.enabled = s.loop.enabled && opt.loop_closing;
+  s.pe_match.enabled = opt.mode != SlamMode::kBaseline;
+  sinks.push_back(std::make_unique<SystemSink>(s.pe_match.enabled ? "pe-slam" : "orb-slam2", s, opt.sync,
+                                               seed, opt.out_dir));
+  if (opt.mode == SlamMode::kCompare) {
+    s.pe_match.enabled = false;
+    sinks.push_back(std::make_unique<SystemSink>("orb-slam2", s, opt.sync, seed, opt.out_dir + "/baseline"));
+  }
+  return sinks;
+}
+
+}  // namespace pvb::run

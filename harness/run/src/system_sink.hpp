@@ -1,0 +1,57 @@
+#pragma once
+// The SLAM systems of a run: each with its output files (CameraTrajectory,
+// KeyFrameTrajectory, timing.csv), its per-frame bookkeeping and its loss
+// and recovery events, finished and evaluated at the end.
+#include <cstdint>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pvb/eval/trajectory.hpp"
+#include "pvb/run/report.hpp"
+#include "pvb/run/run.hpp"
+#include "pvb/slam/core/settings.hpp"
+#include "pvb/slam/core/system.hpp"
+#include "run_log.hpp"
+
+namespace pvb::run {
+
+/// One SLAM system with its output files and bookkeeping.
+struct SystemSink {
+  SlamRun run;
+  std::unique_ptr<slam::System> system;
+  std::string dir;
+  std::ofstream cam_traj, kf_traj, timing;
+  eval::Trajectory est;
+  eval::Trajectory refined;  ///< filled by finish()
+  slam::TrackingState prev_state = slam::TrackingState::kNotInitialized;
+  double tracking_ms = 0, orb_ms = 0, inline_mapping_ms = 0;
+
+  SystemSink(const std::string& mode, const slam::Settings& settings, bool sync, std::uint32_t seed,
+             const std::string& out_dir);
+
+  /// Tracks one frame, writes its lines and records loss and recovery.
+  slam::FrameResult track(const sensor::RgbdFrame& frame, RunLog& log);
+
+  /// Stops mapping, rewrites the keyframe trajectory with refined poses.
+  void finish();
+
+  /// ATE/RPE of the trajectory (and of the refined one) against `gt`.
+  void evaluate(const eval::Trajectory& gt);
+
+ private:
+  /// The counters and the per-frame record.
+  void count(const slam::FrameResult& r, int index, double t_s);
+  /// The frame's lines in CameraTrajectory, KeyFrameTrajectory and timing.csv.
+  void write_lines(const slam::FrameResult& r, int index);
+};
+
+using SystemSinks = std::vector<std::unique_ptr<SystemSink>>;
+
+/// The systems that see the frames (options.mode): PE-SLAM or the baseline
+/// in out_dir, and with kCompare the baseline beside PE-SLAM in
+/// out_dir/baseline.  The first is the primary run.
+SystemSinks make_systems(const slam::Settings& settings, const RunOptions& options, std::uint32_t seed);
+
+}  // namespace pvb::run
