@@ -4,7 +4,7 @@
 #   1. render the station (751 frames) into a TUM RGB-D sequence that
 #      ORB-SLAM2 and other systems read unchanged;
 #   2. simulation in the loop: render again and feed PE-SLAM and the
-#      ORB-SLAM2 baseline in memory, evaluate against ground truth, print the
+#      baseline (PE-match off, ORB-SLAM2 motion model) in memory, evaluate against ground truth, print the
 #      ATE/RPE comparison and write the report (index.html, metrics.json,
 #      figures, trajectories, contact sheet, run.log).
 # Output goes to ./out/pv_station (override the root with PVB_OUT).
@@ -18,7 +18,7 @@ rm -rf "$OUT"
 mkdir -p "$OUT"
 echo "== 1/2 rendering scenes/pv_station.yaml into a TUM RGB-D sequence"
 $B record --scenario scenes/pv_station.yaml --out "$OUT/sequence"
-echo "== 2/2 PE-SLAM against the ORB-SLAM2 baseline, simulator in the loop"
+echo "== 2/2 PE-SLAM against the baseline (ORB-SLAM2 motion model), simulator in the loop"
 $B run --scenario scenes/pv_station.yaml --compare --out "$OUT/report" | tee "$OUT/summary.txt"
 echo "sequence: $OUT/sequence (TUM RGB-D, camera.yaml for ORB-SLAM2)"
 echo "report:   $OUT/report/index.html (metrics.json, figures, trajectories, run.log)"

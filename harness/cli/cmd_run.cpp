@@ -73,7 +73,8 @@ Command add_run_command(CLI::App& app) {
   sub->add_option("--frames", args->frames, "stop after N frames (default: the scenario's duration)");
   sub->add_flag("--sync", args->options.sync, "synchronous: no threads, bit-identical runs");
   sub->add_flag("--no-loop-closing", args->no_loop_closing, "switch loop closing off (LoopClosing.enabled: 0)");
-  sub->add_flag("--baseline", args->baseline, "run the ORB-SLAM2 baseline (no PE-match) instead of PE-SLAM");
+  sub->add_flag("--baseline", args->baseline,
+                "run the baseline (PE-match off: ORB-SLAM2's motion model) instead of PE-SLAM");
   sub->add_flag("--compare", args->compare, "run PE-SLAM and the baseline on the same rendered frames");
   sub->add_flag("--closed-loop", args->options.closed_loop,
                 "the route follower steers from the SLAM pose instead of ground truth");

@@ -351,8 +351,8 @@ Command add_sweep_command(CLI::App& app) {
   sub->add_option("--jobs,-j", args->jobs_text, "seeds run at once")->capture_default_str();
   sub->add_option("--out", args->out, "sweep folder (DIR/seed_S per seed, DIR/aggregate.*)")->required();
   sub->add_option("--frames", args->frames_text, "passed to pvbench run: at most N frames");
-  sub->add_flag("--compare", args->compare, "passed to pvbench run: PE-SLAM and the ORB-SLAM2 baseline");
-  sub->add_flag("--baseline", args->baseline, "passed to pvbench run: the ORB-SLAM2 baseline alone");
+  sub->add_flag("--compare", args->compare, "passed to pvbench run: PE-SLAM and the baseline (PE-match off)");
+  sub->add_flag("--baseline", args->baseline, "passed to pvbench run: the baseline alone (PE-match off)");
   sub->add_flag("--sync", args->sync, "passed to pvbench run: synchronous, bit-reproducible SLAM");
   sub->add_option("--gl", args->gl, "passed to pvbench run: rendering backend")
       ->check(CLI::IsMember({"auto", "egl", "osmesa"}));

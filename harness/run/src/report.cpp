@@ -8,6 +8,7 @@
 
 #include "pvb/common/text.hpp"
 #include "pvb/eval/plot.hpp"
+#include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/plot/png.hpp"
 
@@ -173,7 +174,7 @@ double percentile(std::vector<double> v, double p) {
 double realtime_factor(double sim_s, double wall_s) { return wall_s > 0 ? sim_s / wall_s : 0.0; }
 
 std::string metrics_json(const RunReport& r) {
-  std::string out = "{\n";
+  std::string out = "{\n  \"metrics_version\": " + std::to_string(eval::kMetricsVersion) + ",\n";
   out += run_fields(r, "  ");
   out += slam_fields(r.primary, "  ");
   if (r.closed_loop) out += ",\n  \"closed_loop\": " + closed_loop_json(*r.closed_loop);
@@ -188,8 +189,8 @@ std::string metrics_json(const RunReport& r) {
         (both ? num(eval::reduction_percent(r.baseline->eval->rpe_trans_m.rmse,
                                             r.primary.eval->rpe_trans_m.rmse))
               : "null") +
-        ", \"tracking_ms_median\": {\"pe-slam\": " + num(percentile(pe_ms, 0.5)) +
-        ", \"orb-slam2\": " + num(percentile(base_ms, 0.5)) + "}}";
+        ", \"tracking_ms_median\": {\"" + eval::kPeSlamMode + "\": " + num(percentile(pe_ms, 0.5)) + ", \"" +
+        eval::kBaselineMode + "\": " + num(percentile(base_ms, 0.5)) + "}}";
   }
   out += ",\n  \"profile\": {";
   const double frames = std::max<double>(1.0, static_cast<double>(r.primary.frames));
@@ -207,8 +208,9 @@ std::string metrics_json(const RunReport& r) {
 std::string comparison_table(const RunReport& r) {
   if (!r.baseline || !r.baseline->eval || !r.primary.eval) return {};
   eval::EvalResult base = *r.baseline->eval, pe = *r.primary.eval;
-  base.est_source = "ORB-SLAM2";
-  pe.est_source = "PE-SLAM";
+  // Short column names: the heading above the table names the baseline in full.
+  base.est_source = eval::kBaselineMode;
+  pe.est_source = eval::kPeSlamLabel;
   std::string out = eval::format_comparison({base, pe});
   // Tracking time and lost frames go above format_comparison's footnote.
   std::string footnote;
@@ -238,14 +240,14 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
   // Trajectory with error (top view + ATE over time), one per run.
   for (const SlamRun* run : runs)
     if (run->eval)
-      write_figure(eval::make_error_figure(*run->eval, r.scenario + ": " + run->mode), dir,
+      write_figure(eval::make_error_figure(*run->eval, r.scenario + ": " + eval::mode_label(run->mode)), dir,
                    run == &r.primary ? "trajectory_error" : "trajectory_error_" + run->mode, &written);
   // ATE over time, every run on one chart.
   {
     std::vector<eval::Series> series;
     for (const SlamRun* run : runs) {
       if (!run->eval) continue;
-      eval::Series s{run->mode, {}, {}, eval::series_color(series.size())};
+      eval::Series s{eval::mode_label(run->mode), {}, {}, eval::series_color(series.size())};
       for (std::size_t i = 0; i < run->eval->t_ns.size(); ++i) {
         s.x.push_back(geom::ns_to_seconds(run->eval->t_ns[i]));
         s.y.push_back(run->eval->ate_m[i]);
@@ -260,15 +262,17 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
   // Tracking time histogram, one per run.
   for (const SlamRun* run : runs) {
     const std::vector<double> ms = tracking_times(*run);
-    write_figure(eval::make_histogram("tracking time per frame: " + run->mode, "tracking time [ms]", ms, 40),
+    write_figure(eval::make_histogram("tracking time per frame: " + eval::mode_label(run->mode),
+                                      "tracking time [ms]", ms, 40),
                  dir, run == &r.primary ? "tracking_time_hist" : "tracking_time_hist_" + run->mode, &written);
   }
   // Coarse and kept motion-model matches per frame (gaps: other methods or lost).
   {
     std::vector<eval::Series> series;
     for (const SlamRun* run : runs) {
-      eval::Series coarse{run->mode + " coarse", {}, {}, eval::series_color(series.size())};
-      eval::Series kept{run->mode + " kept", {}, {}, eval::series_color(series.size() + 1)};
+      const std::string label = eval::mode_label(run->mode);
+      eval::Series coarse{label + " coarse", {}, {}, eval::series_color(series.size())};
+      eval::Series kept{label + " kept", {}, {}, eval::series_color(series.size() + 1)};
       for (const FrameRecord& f : run->per_frame) {
         const double nan = std::numeric_limits<double>::quiet_NaN();
         coarse.x.push_back(f.frame);
@@ -277,7 +281,8 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
         kept.y.push_back(f.coarse_matches > 0 ? f.matches_kept : nan);
       }
       series.push_back(std::move(coarse));
-      if (run->mode == "pe-slam") series.push_back(std::move(kept));  // the baseline keeps every coarse match
+      if (run->mode == eval::kPeSlamMode)
+        series.push_back(std::move(kept));  // the baseline keeps every coarse match
     }
     write_figure(eval::make_line_chart("motion-model matches per frame (coarse, and kept by PE-match)",
                                        "frame", "matches", series),
@@ -322,9 +327,11 @@ std::string run_rows(const RunReport& r) {
   std::string h;
   h += table_row("scenario file", r.scenario_file);
   h += table_row("seed", std::to_string(r.seed));
-  h += table_row("mode", p.mode + (r.baseline ? " (compared with " + r.baseline->mode + ")" : std::string()) +
-                             (r.closed_loop ? ", closed loop" : ", open loop") +
-                             (r.sync ? ", synchronous" : ", pipelined"));
+  h += table_row(
+      "mode",
+      eval::mode_label(p.mode) +
+          (r.baseline ? " (compared with the " + eval::mode_label(r.baseline->mode) + ")" : std::string()) +
+          (r.closed_loop ? ", closed loop" : ", open loop") + (r.sync ? ", synchronous" : ", pipelined"));
   h += table_row("renderer", r.renderer);
   h += table_row("frames", std::to_string(p.frames) + " (" + fixed(r.sim_s, 2) + " s simulated)");
   h += table_row("lost frames", std::to_string(p.lost_frames));
@@ -379,10 +386,10 @@ std::string loss_section(const RunReport& r) {
   std::string h = "<h2>Tracking loss</h2>\n";
   for (const SlamRun* run : runs) {
     if (run->loss_events.empty()) {
-      h += "<p>" + html_escape(run->mode) + ": tracking was never lost.</p>\n";
+      h += "<p>" + html_escape(eval::mode_label(run->mode)) + ": tracking was never lost.</p>\n";
       continue;
     }
-    h += "<p>" + html_escape(run->mode) +
+    h += "<p>" + html_escape(eval::mode_label(run->mode)) +
          ":</p>\n<table><tr><th>frame</th><th>t [s]</th><th>reason</th>"
          "<th>recovered at frame</th></tr>\n";
     for (const LossEvent& e : run->loss_events)
@@ -441,7 +448,9 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
   h += "<table>\n" + run_rows(r) + accuracy_rows(r) + "</table>\n";
   h += loss_section(r);
   const std::string table = comparison_table(r);
-  if (!table.empty()) h += "<h2>PE-SLAM vs ORB-SLAM2</h2>\n<pre>" + html_escape(table) + "</pre>\n";
+  if (!table.empty())
+    h += "<h2>PE-SLAM against the " + std::string(eval::kBaselineLabel) + "</h2>\n<pre>" +
+         html_escape(table) + "</pre>\n";
   h += figures_section(figures);
   h += profile_section(r);
   h += files_and_log(r);

@@ -9,6 +9,7 @@
 #include "frame_pipeline.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
+#include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/slam/core/settings.hpp"
@@ -49,7 +50,8 @@ std::string start_line(const RunOptions& opt, const scenes::Scenario& scenario, 
   const bool compare = opt.mode == SlamMode::kCompare;
   return "pvbench run: scenario " + scenario.name + " (" + opt.scenario_file + "), seed " +
          std::to_string(scenario.seed) + ", " + std::to_string(frames) + " frames, " +
-         (compare ? "pe-slam and orb-slam2" : mode) +
+         (compare ? std::string(eval::kPeSlamLabel) + " and the " + eval::kBaselineLabel
+                  : eval::mode_label(mode)) +
          (opt.closed_loop
               ? ", closed loop (on loss: " +
                     std::string(scenario.route.on_loss == scenes::OnLoss::kAbort ? "abort" : "wait") + ")"
@@ -264,7 +266,7 @@ void log_summary(const RunReport& report, RunLog& log) {
   log.line(summary_line(report));
   for (const SlamRun* r : {&report.primary, report.baseline ? &*report.baseline : nullptr}) {
     if (!r || (!r->refined_eval && r->loop_closing_json.empty())) continue;
-    log.line(r->mode + ": refined trajectory ATE rmse " +
+    log.line(eval::mode_label(r->mode) + ": refined trajectory ATE rmse " +
              (r->refined_eval ? fmt(r->refined_eval->ate.rmse) : "n/a") + " m, " +
              std::to_string(r->loops_closed) + " loops closed");
   }
@@ -274,7 +276,7 @@ void log_summary(const RunReport& report, RunLog& log) {
              std::to_string(report.closed_loop->hold_frames) + " frames");
   const std::string table = comparison_table(report);
   if (table.empty()) return;
-  log.line("PE-SLAM against the ORB-SLAM2 baseline on the same frames:");
+  log.line(std::string("PE-SLAM against the ") + eval::kBaselineLabel + " on the same frames:");
   for (std::size_t a = 0, b; a < table.size(); a = b + 1) {
     b = table.find('\n', a);
     if (b == std::string::npos) b = table.size();

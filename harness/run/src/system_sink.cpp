@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "pvb/common/text.hpp"
+#include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
 
@@ -154,11 +155,12 @@ SystemSinks make_systems(const slam::Settings& settings, const RunOptions& opt, 
   slam::Settings s = settings;
   s.loop.enabled = s.loop.enabled && opt.loop_closing;
   s.pe_match.enabled = opt.mode != SlamMode::kBaseline;
-  sinks.push_back(std::make_unique<SystemSink>(s.pe_match.enabled ? "pe-slam" : "orb-slam2", s, opt.sync,
-                                               seed, opt.out_dir));
+  sinks.push_back(std::make_unique<SystemSink>(s.pe_match.enabled ? eval::kPeSlamMode : eval::kBaselineMode,
+                                               s, opt.sync, seed, opt.out_dir));
   if (opt.mode == SlamMode::kCompare) {
     s.pe_match.enabled = false;
-    sinks.push_back(std::make_unique<SystemSink>("orb-slam2", s, opt.sync, seed, opt.out_dir + "/baseline"));
+    sinks.push_back(
+        std::make_unique<SystemSink>(eval::kBaselineMode, s, opt.sync, seed, opt.out_dir + "/baseline"));
   }
   return sinks;
 }

@@ -6,6 +6,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/eval/slam_mode.hpp"
 
 namespace pvb::suite {
 namespace {
@@ -275,12 +276,12 @@ std::string format_markdown(const SweepAggregate& a) {
   std::string primary_name = "PE-SLAM";
   for (const SeedRun& r : a.runs)
     if (r.metrics && !r.metrics->primary.mode.empty()) {
-      if (r.metrics->primary.mode == "orb-slam2") primary_name = "ORB-SLAM2 baseline";
+      if (r.metrics->primary.mode == eval::kBaselineMode) primary_name = eval::kBaselineLabel;
       break;
     }
   row(primary_name.c_str(), a.primary);
   if (a.has_baseline) {
-    row("ORB-SLAM2 baseline", a.baseline);
+    row(eval::kBaselineLabel, a.baseline);
     // The paired figure (docs/sweeps.md): per seed d = PE − baseline on the same frames.
     out += "\n" + format_paired_line(a.paired) + "\n";
     if (a.paired.count > 0)
@@ -472,7 +473,7 @@ eval::Figure make_sweep_figure(const SweepAggregate& a) {
         {{{lx - 5, top - 13}, {lx + 5, top - 13}, {lx + 5, top - 3}, {lx - 5, top - 3}, {lx - 5, top - 13}},
          orange,
          1.5});
-    f.texts.push_back({lx + 10, top - 4, "ORB-SLAM2", 11, eval::TextAnchor::kStart, false, black});
+    f.texts.push_back({lx + 10, top - 4, "baseline", 11, eval::TextAnchor::kStart, false, black});
   }
   f.texts.push_back({right, top - 4 + 14, "dashed: mean", 10, eval::TextAnchor::kEnd, false, black});
   return f;

@@ -6,6 +6,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/eval/slam_mode.hpp"
 
 namespace pvb::suite {
 namespace {
@@ -78,7 +79,7 @@ class Reader {
   RunMetrics run(const YAML::Node& obj) const {
     if (!obj.IsMap()) fail(obj, "(top level)", "expected a JSON object");
     RunMetrics r;
-    if (obj["mode"].IsDefined()) r.mode = text(obj, "mode");
+    if (obj["mode"].IsDefined()) r.mode = eval::normalized_mode(text(obj, "mode"));
     r.status = text(obj, "status");
     if (r.status != "completed" && r.status != "interrupted" && r.status != "aborted")
       fail(obj["status"], "status", "expected completed, interrupted or aborted, got " + r.status);

@@ -110,10 +110,10 @@ TEST(RunReport, MetricsJsonHasTheContractKeys) {
 
 TEST(RunReport, CompareAddsBaselineAndReductions) {
   RunReport r = hand_report();
-  r.baseline = slam_run("orb-slam2", 0.04);
+  r.baseline = slam_run("baseline", 0.04);
   const YAML::Node m = YAML::Load(metrics_json(r));
   ASSERT_TRUE(m["baseline"]);
-  EXPECT_EQ(m["baseline"]["mode"].as<std::string>(), "orb-slam2");
+  EXPECT_EQ(m["baseline"]["mode"].as<std::string>(), "baseline");
   EXPECT_EQ(m["baseline"]["frames"].as<int>(), 50);
   EXPECT_EQ(m["baseline"]["status"].as<std::string>(), "completed");
   EXPECT_NEAR(m["baseline"]["ate"]["rmse"].as<double>(), r.baseline->eval->ate.rmse, 1e-12);
@@ -124,7 +124,8 @@ TEST(RunReport, CompareAddsBaselineAndReductions) {
   EXPECT_TRUE(m["comparison"]["rpe_trans_rmse_reduction_pct"].IsScalar());
 
   const std::string table = comparison_table(r);
-  EXPECT_NE(table.find("ORB-SLAM2"), std::string::npos);
+  EXPECT_NE(table.find("[1] baseline"), std::string::npos) << table;
+  EXPECT_EQ(table.find("ORB-SLAM2"), std::string::npos) << table;
   EXPECT_NE(table.find("PE-SLAM"), std::string::npos);
   EXPECT_NE(table.find("tracking ms median"), std::string::npos);
   EXPECT_NE(table.find("ATE rmse"), std::string::npos);
@@ -207,7 +208,7 @@ TEST(ClosedLoop, RobotPoseFromCameraPoseRoundTrip) {
 
 TEST(RunReport, IndexHtmlIsSelfContained) {
   RunReport r = hand_report();
-  r.baseline = slam_run("orb-slam2", 0.04);
+  r.baseline = slam_run("baseline", 0.04);
   r.log_lines = {"frame 20 (t = 0.667 s): pe-slam lost tracking: <reason & more>"};
   const std::string html = index_html(r, {"trajectory_error", "matches"});
   EXPECT_NE(html.find("<img src=\"trajectory_error.png\""), std::string::npos);
@@ -216,7 +217,8 @@ TEST(RunReport, IndexHtmlIsSelfContained) {
   EXPECT_NE(html.find("href=\"metrics.json\""), std::string::npos);
   EXPECT_NE(html.find("&lt;reason &amp; more&gt;"), std::string::npos);  // log text is escaped
   EXPECT_NE(html.find("21 inliers"), std::string::npos);                 // the loss event and its reason
-  EXPECT_NE(html.find("PE-SLAM vs ORB-SLAM2"), std::string::npos);
+  EXPECT_NE(html.find("PE-SLAM against the baseline (ORB-SLAM2 motion model)"), std::string::npos);
+  EXPECT_NE(html.find("PE-SLAM (compared with the baseline (ORB-SLAM2 motion model))"), std::string::npos);
   EXPECT_EQ(html.find("<script"), std::string::npos);
   EXPECT_EQ(html.find("http://"), std::string::npos);
   EXPECT_EQ(html.find("https://"), std::string::npos);
@@ -255,10 +257,10 @@ TEST(RunReport, WriteReportWritesEveryFile) {
   const std::string dir = ::testing::TempDir() + "pvb_run_report_" + std::to_string(::getpid());
   std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());
   RunReport r = hand_report();
-  r.baseline = slam_run("orb-slam2", 0.04);
+  r.baseline = slam_run("baseline", 0.04);
   r.closed_loop = ClosedLoopMetrics{{0, 1}, {0.01, 0.03}, 0.0224, 0.03, 0};
   const std::vector<std::string> figures = write_report(r, dir);
-  for (const char* f : {"trajectory_error", "trajectory_error_orb-slam2", "ate_over_time",
+  for (const char* f : {"trajectory_error", "trajectory_error_baseline", "ate_over_time",
                         "tracking_time_hist", "matches", "path_error"}) {
     EXPECT_NE(std::find(figures.begin(), figures.end(), f), figures.end()) << f;
     for (const char* ext : {".svg", ".png"})

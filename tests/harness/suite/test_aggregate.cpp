@@ -37,7 +37,7 @@ suite::SeedRun compare_run(std::uint64_t seed, std::optional<double> pe_mm, std:
   m.primary.frames = 100;
   if (pe_mm) m.primary.ate_rmse_m = *pe_mm / 1000.0;
   suite::RunMetrics b;
-  b.mode = "orb-slam2";
+  b.mode = "baseline";
   b.status = "completed";
   b.frames = 100;
   if (base_mm) b.ate_rmse_m = *base_mm / 1000.0;
@@ -280,7 +280,7 @@ TEST(SweepAggregate, MarkdownHasSummaryAndPerSeedRows) {
   EXPECT_NE(md.find("4 seeds, 3 with metrics, 1 failed"), std::string::npos) << md;
   // PE-SLAM ATE mean 13.85 mm, sd 19.3 / sqrt(2) = 13.65 mm.
   EXPECT_NE(md.find("| PE-SLAM | 3 | 13.85 ± 13.65 |"), std::string::npos) << md;
-  EXPECT_NE(md.find("| ORB-SLAM2 baseline | 2 | 10.05 ± 7.00 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| baseline (ORB-SLAM2 motion model) | 2 | 10.05 ± 7.00 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| 2 | 0 | completed | 600 | 4 | 23.50 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| 3 | 1 |"), std::string::npos) << md;
   EXPECT_NE(md.find("first loss at frame 141"), std::string::npos) << md;
@@ -293,7 +293,7 @@ TEST(SweepAggregate, MarkdownHasSummaryAndPerSeedRows) {
       "no "
       "(upper end 63.52 mm > margin 1.0");
   EXPECT_NE(line, std::string::npos) << md;
-  EXPECT_LT(md.find("| ORB-SLAM2 baseline | 2 |"), line);
+  EXPECT_LT(md.find("| baseline (ORB-SLAM2 motion model) | 2 |"), line);
   EXPECT_LT(line, md.find("## Per seed"));
   EXPECT_NE(md.find("SD 6.65 mm, standard error 4.70 mm"), std::string::npos) << md;
   EXPECT_NE(md.find("| 15.00 | 8.50 |"), std::string::npos) << md;  // seed 2's baseline ATE and d
@@ -348,7 +348,7 @@ TEST(SweepAggregate, FigureShowsEverySeedAndBothModes) {
   const eval::Figure f = make_sweep_figure(a);
   const std::string svg = eval::format_svg(f);
   EXPECT_NE(svg.find("<svg"), std::string::npos);
-  for (const char* label : {">1<", ">2<", ">3<", ">4<", "ORB-SLAM2", "PE-SLAM"})
+  for (const char* label : {">1<", ">2<", ">3<", ">4<", ">baseline<", "PE-SLAM"})
     EXPECT_NE(svg.find(label), std::string::npos) << label;
   // One hollow square per baseline value plus the legend's.
   EXPECT_EQ(f.polylines.size(), 3u);

@@ -65,7 +65,7 @@ TEST(SuiteCheck, ReadsTheContractKeys) {
   ASSERT_TRUE(m.primary.realtime_factor.has_value());
   EXPECT_DOUBLE_EQ(*m.primary.realtime_factor, 1.12);
   ASSERT_TRUE(m.baseline.has_value());
-  EXPECT_EQ(m.baseline->mode, "orb-slam2");
+  EXPECT_EQ(m.baseline->mode, "baseline");  // a version 1 file's "orb-slam2"
   EXPECT_DOUBLE_EQ(*m.baseline->ate_rmse_m, 0.0051);
   EXPECT_FALSE(m.baseline->realtime_factor.has_value());
 }

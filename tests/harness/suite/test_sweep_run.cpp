@@ -39,7 +39,7 @@ TEST(SweepRun, TwoSeedsThenASlurmTaskThenAggregateOnly) {
   }
   const std::string md = pvb::read_file((out / "aggregate.md").string());
   EXPECT_NE(md.find("2 seeds, 2 with metrics, 0 failed"), std::string::npos) << md;
-  EXPECT_NE(md.find("| ORB-SLAM2 baseline | 2 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| baseline (ORB-SLAM2 motion model) | 2 |"), std::string::npos) << md;
   // --compare: the paired PE − baseline line is printed last and is the one in aggregate.md.
   const std::size_t last = r.output.rfind('\n', r.output.size() - 2);
   ASSERT_NE(last, std::string::npos) << r.output;

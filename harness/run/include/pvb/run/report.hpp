@@ -45,9 +45,9 @@ struct FrameRecord {
   int matches_kept = 0;
 };
 
-/// One SLAM system's run (PE-SLAM, or the ORB-SLAM2 baseline).
+/// One SLAM system's run (PE-SLAM, or the baseline: PE-match off, ORB-SLAM2's motion model).
 struct SlamRun {
-  std::string mode;  ///< "pe-slam" or "orb-slam2"
+  std::string mode;  ///< eval::kPeSlamMode or eval::kBaselineMode ("pe-slam", "baseline")
   std::size_t frames = 0;
   std::size_t lost_frames = 0;  ///< frames in state Lost
   std::size_t not_initialized_frames = 0;

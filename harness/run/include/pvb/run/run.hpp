@@ -27,7 +27,7 @@ namespace pvb::run {
 /// Which SLAM systems see the frames.
 enum class SlamMode {
   kPeSlam,    ///< PE-SLAM only
-  kBaseline,  ///< the ORB-SLAM2 baseline only (--no-pe-match motion model)
+  kBaseline,  ///< the baseline only (PE-match off: ORB-SLAM2's motion model)
   kCompare,   ///< both on the same rendered frames; PE-SLAM is the primary run
 };
 

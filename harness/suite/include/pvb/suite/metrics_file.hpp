@@ -16,7 +16,7 @@ struct LossEvent {
 
 /// One SLAM run's figures (the top level, or the "baseline" object).
 struct RunMetrics {
-  std::string mode;    ///< "pe-slam" or "orb-slam2"
+  std::string mode;    ///< "pe-slam" or "baseline" ("orb-slam2" in version 1 files is read as "baseline")
   std::string status;  ///< "completed", "interrupted" or "aborted"
   int frames = 0;
   int lost_frames = 0;
