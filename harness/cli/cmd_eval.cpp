@@ -1,5 +1,6 @@
 // pvbench eval: ATE/RPE of one or more estimated trajectories against ground
 // truth, as a table on stdout, optionally as JSON and as plots.
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -9,6 +10,7 @@
 #include "pvb/common/text.hpp"
 #include "pvb/eval/evaluate.hpp"
 #include "pvb/eval/plot.hpp"
+#include "pvb/geometry/time.hpp"
 #include "pvb/plot/png.hpp"
 
 namespace pvb::cli {
@@ -53,6 +55,12 @@ std::string base_name(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
+std::string text_of(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 int run_eval(const EvalArgs& a) {
   eval::TrajectoryFormat format = eval::TrajectoryFormat::kTum;
   if (a.format == "kitti") format = eval::TrajectoryFormat::kKitti;
@@ -72,8 +80,12 @@ int run_eval(const EvalArgs& a) {
   options.rpe.delta = a.delta;
   options.rpe.unit = eval::parse_delta_unit(a.delta_unit);
   options.rpe.pairs = eval::parse_pair_mode(a.rpe_pairs);
-  if (!(a.max_diff_s > 0.0)) throw ConfigError("command line", "--max-diff", "a positive number of seconds");
-  if (!(a.delta > 0.0)) throw ConfigError("command line", "--delta", "a positive number");
+  if (!(a.max_diff_s > 0.0 && a.max_diff_s <= eval::kMaxAssociationDiffS))
+    throw ConfigError("command line", "--max-diff", "a number of seconds in (0, 1e9]", text_of(a.max_diff_s));
+  if (!(std::fabs(a.offset_s) <= geom::kMaxAbsTimeS))
+    throw ConfigError("command line", "--offset", "a number of seconds in [-9e9, 9e9]", text_of(a.offset_s));
+  if (!(a.delta > 0.0 && std::isfinite(a.delta)))
+    throw ConfigError("command line", "--delta", "a positive number", text_of(a.delta));
 
   const eval::Trajectory gt = eval::read_trajectory(a.gt, format, a.gt_timestamps);
   std::vector<eval::EvalResult> results;

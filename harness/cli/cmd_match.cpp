@@ -4,10 +4,11 @@
 #include <string>
 
 #include "command.hpp"
-#include "pvb/dataset/tum_sequence.hpp"
-#include "pvb/geometry/time.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/dataset/image_file.hpp"
+#include "pvb/dataset/tum_sequence.hpp"
+#include "pvb/geometry/time.hpp"
 #include "pvb/harness/matching/experiment.hpp"
 
 namespace pvb::cli {
@@ -25,9 +26,17 @@ struct MatchOptions {
 };
 
 cv::Mat read_image(const std::string& path) {
-  cv::Mat m = cv::imread(path, cv::IMREAD_COLOR);
-  if (m.empty()) throw IoError(path, "cannot read image");
+  cv::Mat m = dataset::read_image(path, cv::IMREAD_COLOR, "image");
+  harness::check_image_size(m, path);
   return m;
+}
+
+/// A depth image must cover its colour image pixel for pixel.
+void check_depth_size(const cv::Mat& depth_m, const std::string& depth_path, const cv::Mat& image) {
+  if (depth_m.size() == image.size()) return;
+  throw IoError(depth_path, "depth image is " + std::to_string(depth_m.cols) + "x" +
+                                std::to_string(depth_m.rows) + "; expected the size of its colour image, " +
+                                std::to_string(image.cols) + "x" + std::to_string(image.rows));
 }
 
 /// A pose argument: "tx ty tz qx qy qz qw" (T_w_c, TUM order) or
@@ -42,6 +51,61 @@ geom::SE3d resolve_pose(const std::string& arg, const std::string& what) {
     return harness::tum_pose_at(arg.substr(0, at), t);
   }
   return harness::parse_tum_pose(arg, what);
+}
+
+/// The coarse matches of an RGB-D pair (--sequence, or --img1/--depth1/
+/// --pose1 ...) labelled from depth and poses; the images go to img1, img2.
+harness::CoarseSet rgbd_coarse_set(const MatchOptions& o, cv::Mat* img1, cv::Mat* img2) {
+  using namespace pvb::harness;
+  RgbdGroundTruth gt;
+  CameraSettings cam;
+  std::string d1, d2;
+  if (!o.sequence.empty()) {
+    const dataset::TumSequenceReader seq(o.sequence, sensor::kTumDepthFactor, 0.05);
+    const auto& frames = seq.entries();
+    const std::vector<std::string> ij = split_ws(o.frames, ",");
+    int i = -1, j = -1;
+    if (ij.size() == 2) {
+      i = std::atoi(ij[0].c_str());
+      j = std::atoi(ij[1].c_str());
+    }
+    if (i < 0 || j < 0 || i >= int(frames.size()) || j >= int(frames.size()))
+      throw ConfigError("<command line>", "--frames", "I,J with 0 <= I,J < " + std::to_string(frames.size()),
+                        o.frames);
+    const std::string yaml = o.settings.empty() ? o.sequence + "/camera.yaml" : o.settings;
+    cam = load_camera_settings(yaml);
+    *img1 = read_image(o.sequence + "/" + frames[i].rgb);
+    *img2 = read_image(o.sequence + "/" + frames[j].rgb);
+    d1 = o.sequence + "/" + frames[i].depth;
+    d2 = o.sequence + "/" + frames[j].depth;
+    const std::string gtf = o.sequence + "/groundtruth.txt";
+    // Poses at the rgb stamps (+ offset), up to 0.1 s from a ground-truth sample.
+    const double dt = o.gt_time_offset_s;
+    const double t1_s = geom::ns_to_seconds(frames[i].t_ns), t2_s = geom::ns_to_seconds(frames[j].t_ns);
+    gt.T_c2_c1 = tum_pose_at(gtf, t2_s + dt, 0.1).inverse() * tum_pose_at(gtf, t1_s + dt, 0.1);
+  } else {
+    if (o.img1.empty() || o.img2.empty() || o.depth1.empty() || o.depth2.empty() || o.pose1.empty() ||
+        o.pose2.empty() || o.settings.empty())
+      throw ConfigError("<command line>", "RGB-D ground truth",
+                        "--img1 --img2 --depth1 --depth2 --pose1 --pose2 --settings all given");
+    cam = load_camera_settings(o.settings);
+    *img1 = read_image(o.img1);
+    *img2 = read_image(o.img2);
+    d1 = o.depth1;
+    d2 = o.depth2;
+    gt.T_c2_c1 = resolve_pose(o.pose2, "--pose2").inverse() * resolve_pose(o.pose1, "--pose1");
+  }
+  gt.K = cam.K;
+  gt.dist_coeffs = cam.dist_coeffs;
+  gt.depth1_m = load_depth_m(d1, cam.depth_map_factor);
+  gt.depth2_m = load_depth_m(d2, cam.depth_map_factor);
+  check_depth_size(gt.depth1_m, d1, *img1);
+  check_depth_size(gt.depth2_m, d2, *img2);
+  CoarseSet cs = make_coarse_set(*img1, *img2);
+  // Filters see undistorted pixels (as ORB-SLAM2 undistorts keypoints).
+  cs.points = undistort_matches(cs.raw, cam.K, cam.dist_coeffs);
+  cs.labels = label_by_rgbd(cs.raw, cs.points, gt);
+  return cs;
 }
 
 int run_match(const MatchOptions& o) {
@@ -65,52 +129,7 @@ int run_match(const MatchOptions& o) {
     cs = make_coarse_set(img1, img2);
     cs.labels = label_by_homography(cs.points, load_homography(o.homography));
   } else {
-    RgbdGroundTruth gt;
-    CameraSettings cam;
-    std::string d1, d2;
-    if (by_seq) {
-      const dataset::TumSequenceReader seq(o.sequence, sensor::kTumDepthFactor, 0.05);
-      const auto& frames = seq.entries();
-      const std::vector<std::string> ij = split_ws(o.frames, ",");
-      int i = -1, j = -1;
-      if (ij.size() == 2) {
-        i = std::atoi(ij[0].c_str());
-        j = std::atoi(ij[1].c_str());
-      }
-      if (i < 0 || j < 0 || i >= int(frames.size()) || j >= int(frames.size()))
-        throw ConfigError("<command line>", "--frames", "I,J with 0 <= I,J < " + std::to_string(frames.size()),
-                          o.frames);
-      const std::string yaml = o.settings.empty() ? o.sequence + "/camera.yaml" : o.settings;
-      cam = load_camera_settings(yaml);
-      img1 = read_image(o.sequence + "/" + frames[i].rgb);
-      img2 = read_image(o.sequence + "/" + frames[j].rgb);
-      d1 = o.sequence + "/" + frames[i].depth;
-      d2 = o.sequence + "/" + frames[j].depth;
-      const std::string gtf = o.sequence + "/groundtruth.txt";
-      // Poses at the rgb stamps (+ offset), up to 0.1 s from a ground-truth sample.
-      const double dt = o.gt_time_offset_s;
-      const double t1_s = geom::ns_to_seconds(frames[i].t_ns), t2_s = geom::ns_to_seconds(frames[j].t_ns);
-      gt.T_c2_c1 = tum_pose_at(gtf, t2_s + dt, 0.1).inverse() * tum_pose_at(gtf, t1_s + dt, 0.1);
-    } else {
-      if (o.img1.empty() || o.img2.empty() || o.depth1.empty() || o.depth2.empty() || o.pose1.empty() ||
-          o.pose2.empty() || o.settings.empty())
-        throw ConfigError("<command line>", "RGB-D ground truth",
-                          "--img1 --img2 --depth1 --depth2 --pose1 --pose2 --settings all given");
-      cam = load_camera_settings(o.settings);
-      img1 = read_image(o.img1);
-      img2 = read_image(o.img2);
-      d1 = o.depth1;
-      d2 = o.depth2;
-      gt.T_c2_c1 = resolve_pose(o.pose2, "--pose2").inverse() * resolve_pose(o.pose1, "--pose1");
-    }
-    gt.K = cam.K;
-    gt.dist_coeffs = cam.dist_coeffs;
-    gt.depth1_m = load_depth_m(d1, cam.depth_map_factor);
-    gt.depth2_m = load_depth_m(d2, cam.depth_map_factor);
-    cs = make_coarse_set(img1, img2);
-    // Filters see undistorted pixels (as ORB-SLAM2 undistorts keypoints).
-    cs.points = undistort_matches(cs.raw, cam.K, cam.dist_coeffs);
-    cs.labels = label_by_rgbd(cs.raw, cs.points, gt);
+    cs = rgbd_coarse_set(o, &img1, &img2);
   }
 
   const auto reports = run_experiment(cs, methods, o.runs, o.seed);

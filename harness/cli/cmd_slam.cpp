@@ -3,8 +3,9 @@
 // a groundtruth.txt in the folder it also evaluates ATE and RPE.  Unless
 // disabled, the dense map goes to PointCloud.ply.
 #include <algorithm>
-#include <ctime>
+#include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <memory>
 #include <numeric>
@@ -13,7 +14,6 @@
 #include <vector>
 
 #include "command.hpp"
-#include "stop_signals.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
@@ -24,6 +24,7 @@
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"
+#include "stop_signals.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -36,7 +37,7 @@ struct SlamArgs {
   bool sync = false;
   bool no_dense = false;
   std::uint32_t seed = 1;
-  std::size_t max_frames = 0;
+  long long max_frames = 0;  ///< frames to track, 0: all (a negative count is an error, not a wrap)
   double max_missing = 0.1;
   bool dump_matches = false;
   bool dump_map = false;
@@ -154,136 +155,279 @@ void write_tum_file(const std::string& path, const std::vector<geom::StampedPose
   write_file(path, text);
 }
 
-int run_slam(const SlamArgs& a) {
+/// Why the frame loop ended.
+enum class StopReason {
+  kEnd,             ///< every frame of the sequence (or --max-frames of them)
+  kSignal,          ///< Ctrl-C or SIGTERM
+  kTooManyMissing,  ///< more than --max-missing of the frames skipped
+  kImageSize,       ///< an image differs from Camera.width x Camera.height
+};
+
+const char* stop_name(StopReason r) {
+  switch (r) {
+    case StopReason::kEnd:
+      return "end";
+    case StopReason::kSignal:
+      return "signal";
+    case StopReason::kTooManyMissing:
+      return "missing_frames";
+    case StopReason::kImageSize:
+      return "image_size";
+  }
+  return "?";
+}
+
+/// Counts and per-frame series of one run.
+struct Tally {
+  std::size_t frames = 0, lost = 0, not_init = 0, poses = 0;
+  std::vector<double> tracking_ms, pe_ms;
+  std::vector<double> cpu_ms;  ///< caller-thread CPU per frame: tracking, plus inline mapping in sync mode
+  std::string init_failure;    ///< why the last frame failed to initialise
+};
+
+double mean_of(const std::vector<double>& v) {
+  return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+
+/// One `pvbench slam` run, in stages: inputs and outputs are opened by the
+/// constructor, run() tracks, writes the final outputs and stats.json, and
+/// then reports a run that stopped early or never initialised as an error
+/// (after everything is written).
+class SlamRun {
+ public:
+  explicit SlamRun(const SlamArgs& a);
+  int run();
+
+ private:
+  void open_outputs();
+  StopReason track_frames();
+  slam::TrackingState track_one(const sensor::RgbdFrame& frame);
+  std::string write_final_outputs();
+  std::string stats_json(StopReason stop, const std::string& dense_json);
+  void evaluate(std::ostringstream* js);
+  void fail_if_incomplete(StopReason stop) const;
+
+  const SlamArgs& a_;
+  slam::Settings settings_;
+  dataset::TumSequenceReader reader_;
+  std::unique_ptr<slam::System> system_;
+  std::ofstream cam_traj_, kf_traj_, timing_;
+  std::unique_ptr<MotionMatchScorer> scorer_;
+  Tally tally_;
+  std::string image_size_error_;  ///< set when the loop stopped on an image of the wrong size
+};
+
+/// Missing frames always allowed, whatever --max-missing says.
+constexpr std::size_t kMinMissingAllowed = 5;
+
+slam::Settings settings_for(const SlamArgs& a) {
+  if (a.max_frames < 0)
+    throw ConfigError("command line", "--max-frames", "a number of frames >= 0 (0: all)",
+                      std::to_string(a.max_frames));
+  if (!(a.max_missing >= 0.0 && a.max_missing <= 1.0))  // NaN fails too
+    throw ConfigError("command line", "--max-missing", "a share of the frames in [0, 1]", fmt(a.max_missing));
   slam::Settings settings = slam::read_settings(a.settings);
   for (const std::string& w : settings.warnings) std::fprintf(stderr, "pvbench slam: warning: %s\n", w.c_str());
   if (a.no_pe_match) settings.pe_match.enabled = false;
   if (a.no_dense) settings.dense.enabled = false;
-  dataset::TumSequenceReader reader(a.sequence, settings.depth_map_factor);
-  dataset::make_dirs(a.out);
+  return settings;
+}
 
+SlamRun::SlamRun(const SlamArgs& a)
+    : a_(a), settings_(settings_for(a)), reader_(a.sequence, settings_.depth_map_factor) {
+  // One rule for missing frames (docs/slam.md): more than --max-missing of
+  // the sequence's frames, and more than 5, ends the run.
+  reader_.set_max_skipped(std::max<std::size_t>(
+      kMinMissingAllowed,
+      static_cast<std::size_t>(std::floor(a.max_missing * static_cast<double>(reader_.size_hint())))));
+  dataset::make_dirs(a.out);
   slam::SystemOptions options;
   options.synchronous = a.sync;
   options.seed = a.seed;
-  slam::System system(settings, options);
+  system_ = std::make_unique<slam::System>(settings_, options);
+  open_outputs();
+}
 
-  std::ofstream cam_traj = open_out(a.out + "/CameraTrajectory.txt");
-  std::ofstream kf_traj = open_out(a.out + "/KeyFrameTrajectory.txt");
-  std::ofstream timing = open_out(a.out + "/timing.csv");
-  cam_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
-  kf_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
-  timing << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,"
-            "inliers,keyframe,mapping_ms,cpu_ms,align_tried,aligned,align_ms,"
-            "kf_tracked_close,kf_untracked_close,kf_ref_points,kf_ref_all,kf_ref_shared\n";
-
-  std::unique_ptr<MotionMatchScorer> scorer;
-  if (a.dump_matches) {
-    const std::string gt = a.sequence + "/groundtruth.txt";
+void SlamRun::open_outputs() {
+  cam_traj_ = open_out(a_.out + "/CameraTrajectory.txt");
+  kf_traj_ = open_out(a_.out + "/KeyFrameTrajectory.txt");
+  timing_ = open_out(a_.out + "/timing.csv");
+  cam_traj_ << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
+  kf_traj_ << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
+  timing_ << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,"
+             "inliers,keyframe,mapping_ms,cpu_ms,align_tried,aligned,align_ms,"
+             "kf_tracked_close,kf_untracked_close,kf_ref_points,kf_ref_all,kf_ref_shared\n";
+  if (a_.dump_matches) {
+    const std::string gt = a_.sequence + "/groundtruth.txt";
     if (!std::ifstream(gt)) throw IoError(gt, "--dump-matches needs the sequence's ground truth");
-    scorer = std::make_unique<MotionMatchScorer>(a.out, gt, settings);
+    scorer_ = std::make_unique<MotionMatchScorer>(a_.out, gt, settings_);
   }
+}
 
-  const std::size_t total = a.max_frames ? std::min(a.max_frames, reader.size_hint()) : reader.size_hint();
-  ProgressBar bar(std::string("slam") + (settings.pe_match.enabled ? " (PE-match)" : " (baseline)"), total);
-  std::vector<double> tracking_ms, pe_ms;
-  std::vector<double> cpu_ms_all;  ///< caller-thread CPU per frame: tracking, plus inline mapping in sync mode
-  std::size_t frames = 0, lost = 0, not_init = 0;
-  const std::size_t max_missing =
-      std::max<std::size_t>(5, static_cast<std::size_t>(a.max_missing * static_cast<double>(reader.size_hint())));
-  // Ctrl-C (or SIGTERM) stops taking frames; everything tracked so far is
-  // still written and evaluated, and the exit code is 130.
-  const StopSignals stop_signals;
-  while ((frames < total || total == 0) && !StopSignals::requested()) {
-    std::optional<sensor::RgbdFrame> frame = reader.next();
-    if (!frame) break;
-    if (reader.skipped() > max_missing) {
-      system.shutdown();  // keep the partial dense map too
-      if (system.dense_enabled()) system.write_point_cloud(a.out + "/PointCloud.ply");
-      throw IoError(a.sequence, std::to_string(reader.skipped()) + " frames missing or corrupt (more than " +
-                                    std::to_string(max_missing) + "); the trajectory so far is in " + a.out);
+StopReason SlamRun::track_frames() {
+  const std::size_t n = reader_.size_hint();
+  const std::size_t total = a_.max_frames > 0 ? std::min(static_cast<std::size_t>(a_.max_frames), n) : n;
+  ProgressBar bar(std::string("slam") + (settings_.pe_match.enabled ? " (PE-match)" : " (baseline)"), total);
+  StopReason stop = StopReason::kEnd;
+  while (tally_.frames < total) {
+    if (StopSignals::requested()) {
+      stop = StopReason::kSignal;
+      break;
     }
-    const double cpu0_ms = thread_cpu_ms();
-    const slam::FrameResult r = system.track(*frame);
-    const double cpu_ms = thread_cpu_ms() - cpu0_ms;
-    cpu_ms_all.push_back(cpu_ms);
-    ++frames;
-    if (r.state == slam::TrackingState::kLost) ++lost;
-    if (r.state == slam::TrackingState::kNotInitialized) ++not_init;
-    tracking_ms.push_back(r.tracking_ms);
-    if (settings.pe_match.enabled && r.tracking.method == slam::TrackingMethod::kMotionModel)
-      pe_ms.push_back(r.tracking.pe_match_ms);
-    if (r.T_w_c) cam_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
-    if (r.tracking.new_keyframe && r.T_w_c)
-      kf_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
-    static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc"};
-    timing << frame->index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
-           << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","
-           << fmt(r.tracking_ms) << "," << fmt(r.orb_ms) << "," << fmt(r.tracking.pe_match_ms) << ","
-           << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers << ","
-           << (r.tracking.new_keyframe ? 1 : 0) << "," << fmt(r.mapping_ms) << "," << fmt(cpu_ms) << ","
-           << r.tracking.align_tried << "," << r.tracking.aligned << "," << fmt(r.tracking.align_ms) << ","
-           << r.tracking.kf_tracked_close << "," << r.tracking.kf_untracked_close << ","
-           << r.tracking.kf_ref_points << "," << r.tracking.kf_ref_all << "," << r.tracking.kf_ref_shared
-           << "\n"
-           << std::flush;
-    if (scorer) scorer->add(*frame, r);
-    bar.update(frames, slam::to_string(r.state));
+    const std::optional<sensor::RgbdFrame> frame = reader_.next();
+    if (!frame) {
+      if (reader_.skip_limit_reached()) stop = StopReason::kTooManyMissing;
+      break;
+    }
+    if (frame->rgb.cols != settings_.K.width || frame->rgb.rows != settings_.K.height) {
+      image_size_error_ = std::to_string(frame->rgb.cols) + "x" + std::to_string(frame->rgb.rows) +
+                          " (the images, " + frame->rgb_name + ")";
+      if (tally_.frames == 0) fail_if_incomplete(StopReason::kImageSize);  // nothing tracked to keep
+      stop = StopReason::kImageSize;
+      break;
+    }
+    const slam::TrackingState state = track_one(*frame);
+    bar.update(tally_.frames, slam::to_string(state));
   }
+  if (stop == StopReason::kEnd && StopSignals::requested()) stop = StopReason::kSignal;
   bar.finish();
-  const bool interrupted = StopSignals::requested();
-  if (interrupted) std::printf("slam: stopped by a signal after %zu frames; writing what was tracked\n", frames);
-  system.shutdown();
-  kf_traj.close();
+  return stop;
+}
+
+slam::TrackingState SlamRun::track_one(const sensor::RgbdFrame& frame) {
+  const double cpu0_ms = thread_cpu_ms();
+  const slam::FrameResult r = system_->track(frame);
+  const double cpu_ms = thread_cpu_ms() - cpu0_ms;
+  tally_.cpu_ms.push_back(cpu_ms);
+  ++tally_.frames;
+  if (r.state == slam::TrackingState::kLost) ++tally_.lost;
+  if (r.state == slam::TrackingState::kNotInitialized) {
+    ++tally_.not_init;
+    tally_.init_failure = r.tracking.failure;
+  }
+  tally_.tracking_ms.push_back(r.tracking_ms);
+  if (settings_.pe_match.enabled && r.tracking.method == slam::TrackingMethod::kMotionModel)
+    tally_.pe_ms.push_back(r.tracking.pe_match_ms);
+  if (r.T_w_c) {
+    cam_traj_ << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+    ++tally_.poses;
+  }
+  if (r.tracking.new_keyframe && r.T_w_c)
+    kf_traj_ << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+  static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc"};
+  timing_ << frame.index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
+          << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","
+          << fmt(r.tracking_ms) << "," << fmt(r.orb_ms) << "," << fmt(r.tracking.pe_match_ms) << ","
+          << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers << ","
+          << (r.tracking.new_keyframe ? 1 : 0) << "," << fmt(r.mapping_ms) << "," << fmt(cpu_ms) << ","
+          << r.tracking.align_tried << "," << r.tracking.aligned << "," << fmt(r.tracking.align_ms) << ","
+          << r.tracking.kf_tracked_close << "," << r.tracking.kf_untracked_close << ","
+          << r.tracking.kf_ref_points << "," << r.tracking.kf_ref_all << "," << r.tracking.kf_ref_shared
+          << "\n"
+          << std::flush;
+  if (scorer_) scorer_->add(frame, r);
+  return r.state;
+}
+
+/// Stops the workers and writes the outputs that exist only at the end (the
+/// refined keyframe and frame trajectories, Map.txt, PointCloud.ply).
+/// Returns the "dense" part of stats.json (empty when dense mapping is off).
+std::string SlamRun::write_final_outputs() {
+  system_->shutdown();
+  kf_traj_.close();
   // Rewrite the keyframe trajectory with the poses refined by local BA
   // (culled keyframes are left out, as ORB-SLAM2 does).
-  write_tum_file(a.out + "/KeyFrameTrajectory.txt", system.keyframe_trajectory());
+  write_tum_file(a_.out + "/KeyFrameTrajectory.txt", system_->keyframe_trajectory());
   // ORB-SLAM2's way of saving: each frame relative to its (refined) reference keyframe.
-  write_tum_file(a.out + "/CameraTrajectoryRefined.txt", system.refined_trajectory());
-  if (a.dump_map) {
-    std::ofstream map_out = open_out(a.out + "/Map.txt");
-    slam::write_map_snapshot(system.map_snapshot(), map_out, a.out + "/Map.txt");
+  write_tum_file(a_.out + "/CameraTrajectoryRefined.txt", system_->refined_trajectory());
+  if (a_.dump_map) {
+    std::ofstream map_out = open_out(a_.out + "/Map.txt");
+    slam::write_map_snapshot(system_->map_snapshot(), map_out, a_.out + "/Map.txt");
   }
-  cam_traj.close();
-  std::size_t cloud_points = 0;
-  if (system.dense_enabled()) cloud_points = system.write_point_cloud(a.out + "/PointCloud.ply");
-  const slam::dense::DenseMapperStats dense_stats = system.dense_stats();
-
-  const double mean = tracking_ms.empty() ? 0 : std::accumulate(tracking_ms.begin(), tracking_ms.end(), 0.0) /
-                                                      static_cast<double>(tracking_ms.size());
+  cam_traj_.close();
+  if (!system_->dense_enabled()) return {};
+  const std::size_t cloud_points = system_->write_point_cloud(a_.out + "/PointCloud.ply");
+  const slam::dense::DenseMapperStats dense = system_->dense_stats();
+  const double per_kf_ms = dense.keyframes ? dense.total_ms / static_cast<double>(dense.keyframes) : 0.0;
+  std::printf("dense map: %zu points from %zu keyframes (%.1f ms per keyframe) -> %s/PointCloud.ply\n",
+              cloud_points, dense.keyframes, per_kf_ms, a_.out.c_str());
   std::ostringstream js;
-  js << "{\n  \"sequence\": \"" << json_escape(a.sequence)
-     << "\",\n  \"pe_match\": " << (settings.pe_match.enabled ? "true" : "false")
-     << ",\n  \"sync\": " << (a.sync ? "true" : "false") << ",\n  \"seed\": " << a.seed
-     << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"frames\": " << frames
-     << ",\n  \"lost_frames\": " << lost << ",\n  \"not_initialized_frames\": " << not_init
-     << ",\n  \"skipped_frames\": " << reader.skipped() << ",\n  \"keyframes\": " << system.num_keyframes()
-     << ",\n  \"map_points\": " << system.num_map_points()
-     << ",\n  \"tracking_ms\": {\"median\": " << fmt(percentile(tracking_ms, 0.5))
-     << ", \"mean\": " << fmt(mean) << ", \"p95\": " << fmt(percentile(tracking_ms, 0.95))
-     << "},\n  \"pe_match_ms\": {\"median\": " << fmt(percentile(pe_ms, 0.5))
-     << ", \"p95\": " << fmt(percentile(pe_ms, 0.95)) << "}"
-     << ",\n  \"cpu_ms\": {\"median\": " << fmt(percentile(cpu_ms_all, 0.5)) << ", \"mean\": "
-     << fmt(cpu_ms_all.empty() ? 0.0
-                               : std::accumulate(cpu_ms_all.begin(), cpu_ms_all.end(), 0.0) /
-                                     static_cast<double>(cpu_ms_all.size()))
-     << ", \"p95\": " << fmt(percentile(cpu_ms_all, 0.95)) << "}"
-     << ",\n  \"local_mapping\": " << slam::to_json(system.mapping_stats());
-  if (system.dense_enabled()) {
-    const double per_kf_ms =
-        dense_stats.keyframes ? dense_stats.total_ms / static_cast<double>(dense_stats.keyframes) : 0.0;
-    js << ",\n  \"dense\": {\"keyframes\": " << dense_stats.keyframes << ", \"points\": " << cloud_points
-       << ", \"keyframe_points\": " << dense_stats.points << ", \"ms_per_keyframe\": " << fmt(per_kf_ms)
-       << ", \"resolution_m\": " << fmt(settings.dense.resolution_m) << "}";
-    std::printf("dense map: %zu points from %zu keyframes (%.1f ms per keyframe) -> %s/PointCloud.ply\n",
-                cloud_points, dense_stats.keyframes, per_kf_ms, a.out.c_str());
+  js << ",\n  \"dense\": {\"keyframes\": " << dense.keyframes << ", \"points\": " << cloud_points
+     << ", \"keyframe_points\": " << dense.points << ", \"ms_per_keyframe\": " << fmt(per_kf_ms)
+     << ", \"resolution_m\": " << fmt(settings_.dense.resolution_m) << "}";
+  return js.str();
+}
+
+/// Evaluates CameraTrajectory.txt (and the refined one) against the
+/// sequence's groundtruth.txt, when there is one; prints the report and
+/// appends its fields to stats.json.  A failed evaluation is a warning.
+void SlamRun::evaluate(std::ostringstream* js) {
+  const std::string gt_path = a_.sequence + "/groundtruth.txt";
+  if (!std::ifstream(gt_path) || tally_.poses == 0) return;
+  try {
+    const eval::Trajectory gt = eval::read_tum(gt_path);
+    const eval::Trajectory est = eval::read_tum(a_.out + "/CameraTrajectory.txt");
+    eval::EvalOptions eo;
+    eval::EvalResult res;
+    try {
+      res = eval::evaluate(gt, est, eo);
+    } catch (const eval::EvalError& e) {
+      // Only a numerically degenerate set lands here (a robot that never
+      // moved, fewer than 3 poses); nearly straight drives align with se3.
+      // The SLAM estimate starts at its first frame, so align that instead.
+      std::fprintf(stderr, "pvbench slam: note: se3 alignment impossible (%s); using origin alignment\n",
+                   e.what());
+      eo.alignment = eval::Alignment::kOrigin;
+      res = eval::evaluate(gt, est, eo);
+    }
+    std::printf("\n%s", eval::format_report(res).c_str());
+    std::string ev = eval::format_json(res);
+    const std::size_t open = ev.find('{'), close = ev.rfind('}');
+    ev = ev.substr(open + 1, close - open - 1);
+    while (!ev.empty() && (ev.back() == '\n' || ev.back() == ' ')) ev.pop_back();
+    *js << "," << ev;
+    try {
+      const eval::EvalResult ref =
+          eval::evaluate(gt, eval::read_tum(a_.out + "/CameraTrajectoryRefined.txt"), eo);
+      std::printf("refined trajectory (frames re-anchored to bundle-adjusted keyframes): ATE RMSE %.4f m\n",
+                  ref.ate.rmse);
+      *js << ",\n  \"refined\": {\"ate_rmse\": " << fmt(ref.ate.rmse)
+          << ", \"rpe_trans_rmse\": " << fmt(ref.rpe_trans_m.rmse) << "}";
+    } catch (const Error& e) {
+      std::fprintf(stderr, "pvbench slam: warning: refined trajectory not evaluated: %s\n", e.what());
+    }
+  } catch (const Error& e) {
+    std::fprintf(stderr, "pvbench slam: warning: no evaluation: %s\n", e.what());
   }
-  const slam::LocalMappingStats mapping = system.mapping_stats();
+}
+
+/// The run's counts, timings and mapping statistics for stats.json (without
+/// the closing brace), printing the summary lines on the way.
+std::string SlamRun::stats_json(StopReason stop, const std::string& dense_json) {
+  const Tally& t = tally_;
+  std::ostringstream js;
+  js << "{\n  \"sequence\": \"" << json_escape(a_.sequence)
+     << "\",\n  \"pe_match\": " << (settings_.pe_match.enabled ? "true" : "false")
+     << ",\n  \"sync\": " << (a_.sync ? "true" : "false") << ",\n  \"seed\": " << a_.seed
+     << ",\n  \"interrupted\": " << (stop == StopReason::kSignal ? "true" : "false") << ",\n  \"stop\": \""
+     << stop_name(stop) << "\",\n  \"frames\": " << t.frames << ",\n  \"lost_frames\": " << t.lost
+     << ",\n  \"not_initialized_frames\": " << t.not_init << ",\n  \"skipped_frames\": " << reader_.skipped()
+     << ",\n  \"keyframes\": " << system_->num_keyframes()
+     << ",\n  \"map_points\": " << system_->num_map_points()
+     << ",\n  \"tracking_ms\": {\"median\": " << fmt(percentile(t.tracking_ms, 0.5))
+     << ", \"mean\": " << fmt(mean_of(t.tracking_ms)) << ", \"p95\": " << fmt(percentile(t.tracking_ms, 0.95))
+     << "},\n  \"pe_match_ms\": {\"median\": " << fmt(percentile(t.pe_ms, 0.5))
+     << ", \"p95\": " << fmt(percentile(t.pe_ms, 0.95)) << "}"
+     << ",\n  \"cpu_ms\": {\"median\": " << fmt(percentile(t.cpu_ms, 0.5))
+     << ", \"mean\": " << fmt(mean_of(t.cpu_ms)) << ", \"p95\": " << fmt(percentile(t.cpu_ms, 0.95)) << "}"
+     << ",\n  \"local_mapping\": " << slam::to_json(system_->mapping_stats()) << dense_json;
+  const slam::LocalMappingStats mapping = system_->mapping_stats();
   std::printf(
       "frames %zu, lost %zu, keyframes %zu, map points %zu; local BA %lld (%lld stopped by a keyframe)\n",
-      frames, lost, system.num_keyframes(), system.num_map_points(), static_cast<long long>(mapping.local_ba),
-      static_cast<long long>(mapping.local_ba_stopped));
-  if (system.loop_closing_enabled()) {
-    const slam::LoopClosingStats loops = system.loop_stats();
+      t.frames, t.lost, system_->num_keyframes(), system_->num_map_points(),
+      static_cast<long long>(mapping.local_ba), static_cast<long long>(mapping.local_ba_stopped));
+  if (system_->loop_closing_enabled()) {
+    const slam::LoopClosingStats loops = system_->loop_stats();
     js << ",\n  \"loop_closing\": " << slam::to_json(loops);
     std::printf("loop closing: %zu loops closed (%d consistent detections, %d refused by geometry)\n",
                 loops.loops.size(), loops.consistent, loops.rejected);
@@ -295,50 +439,52 @@ int run_slam(const SlamArgs& a) {
                   e.inliers, e.correction_m, e.correction_deg, e.detect_ms + e.correct_ms);
   }
   std::printf("tracking ms: median %.2f, mean %.2f, p95 %.2f; PE-match ms: median %.2f\n",
-              percentile(tracking_ms, 0.5), mean, percentile(tracking_ms, 0.95), percentile(pe_ms, 0.5));
+              percentile(t.tracking_ms, 0.5), mean_of(t.tracking_ms), percentile(t.tracking_ms, 0.95),
+              percentile(t.pe_ms, 0.5));
+  return js.str();
+}
 
-  const std::string gt_path = a.sequence + "/groundtruth.txt";
-  if (std::ifstream(gt_path)) {
-    try {
-      const eval::Trajectory gt = eval::read_tum(gt_path);
-      const eval::Trajectory est = eval::read_tum(a.out + "/CameraTrajectory.txt");
-      eval::EvalOptions eo;
-      eval::EvalResult res;
-      try {
-        res = eval::evaluate(gt, est, eo);
-      } catch (const eval::EvalError& e) {
-        // Only a numerically degenerate set lands here (a robot that never
-        // moved, fewer than 3 poses); nearly straight drives align with se3.
-        // The SLAM estimate starts at its first frame, so align that instead.
-        std::fprintf(stderr, "pvbench slam: note: se3 alignment impossible (%s); using origin alignment\n", e.what());
-        eo.alignment = eval::Alignment::kOrigin;
-        res = eval::evaluate(gt, est, eo);
-      }
-      std::printf("\n%s", eval::format_report(res).c_str());
-      std::string ev = eval::format_json(res);
-      const std::size_t open = ev.find('{'), close = ev.rfind('}');
-      ev = ev.substr(open + 1, close - open - 1);
-      while (!ev.empty() && (ev.back() == '\n' || ev.back() == ' ')) ev.pop_back();
-      js << "," << ev;
-      try {
-        const eval::EvalResult ref =
-            eval::evaluate(gt, eval::read_tum(a.out + "/CameraTrajectoryRefined.txt"), eo);
-        std::printf("refined trajectory (frames re-anchored to bundle-adjusted keyframes): ATE RMSE %.4f m\n",
-                    ref.ate.rmse);
-        js << ",\n  \"refined\": {\"ate_rmse\": " << fmt(ref.ate.rmse) << ", \"rpe_trans_rmse\": "
-           << fmt(ref.rpe_trans_m.rmse) << "}";
-      } catch (const Error& e) {
-        std::fprintf(stderr, "pvbench slam: warning: refined trajectory not evaluated: %s\n", e.what());
-      }
-    } catch (const Error& e) {
-      std::fprintf(stderr, "pvbench slam: warning: no evaluation: %s\n", e.what());
-    }
-  }
-  if (scorer) js << ",\n  " << scorer->json();
+/// After everything is written: a run that stopped on bad input or never
+/// initialised is an error (one line, exit 1).
+void SlamRun::fail_if_incomplete(StopReason stop) const {
+  const std::string kept = "; what was tracked is in " + a_.out;
+  if (stop == StopReason::kImageSize)
+    throw ConfigError(a_.settings, "Camera.width/height", image_size_error_,
+                      std::to_string(settings_.K.width) + "x" + std::to_string(settings_.K.height));
+  if (stop == StopReason::kTooManyMissing)
+    throw IoError(a_.sequence, std::to_string(reader_.skipped()) + " frames missing or corrupt (more than " +
+                                   std::to_string(reader_.max_skipped()) + ", --max-missing " +
+                                   fmt(a_.max_missing) + ")" + kept);
+  if (stop != StopReason::kSignal && tally_.frames > 0 && tally_.not_init == tally_.frames)
+    throw IoError(a_.sequence, "tracking never initialised in " + std::to_string(tally_.frames) +
+                                   " frames (" + tally_.init_failure + ")" + kept);
+}
+
+int SlamRun::run() {
+  // Ctrl-C (or SIGTERM) stops taking frames; everything tracked so far is
+  // still written and evaluated, and the exit code is 130.
+  const StopSignals stop_signals;
+  const StopReason stop = track_frames();
+  if (stop == StopReason::kSignal)
+    std::printf("slam: stopped by a signal after %zu frames; writing what was tracked\n", tally_.frames);
+  const std::string dense_json = write_final_outputs();
+  std::ostringstream js;
+  js << stats_json(stop, dense_json);
+  evaluate(&js);
+  if (scorer_) js << ",\n  " << scorer_->json();
   js << "\n}\n";
-  write_file(a.out + "/stats.json", js.str());
-  std::printf("wrote %s/{CameraTrajectory.txt,CameraTrajectoryRefined.txt,KeyFrameTrajectory.txt,timing.csv,stats.json}\n", a.out.c_str());
-  return interrupted ? 130 : 0;
+  write_file(a_.out + "/stats.json", js.str());
+  std::printf(
+      "wrote "
+      "%s/{CameraTrajectory.txt,CameraTrajectoryRefined.txt,KeyFrameTrajectory.txt,timing.csv,stats.json}\n",
+      a_.out.c_str());
+  fail_if_incomplete(stop);
+  return stop == StopReason::kSignal ? 130 : 0;
+}
+
+int run_slam(const SlamArgs& a) {
+  SlamRun run(a);
+  return run.run();
 }
 
 }  // namespace
@@ -360,7 +506,10 @@ Command add_slam_command(CLI::App& app) {
                 "stats.json motion_matches");
   sub->add_flag("--dump-map", args->dump_map,
                 "write the final sparse map with every keypoint measurement to Map.txt (for pvbench map-check)");
-  sub->add_option("--max-missing", args->max_missing, "stop when more than this share of frames is missing")
+  sub->add_option(
+         "--max-missing", args->max_missing,
+         "stop (exit 1, outputs kept) when more than this share of the frames, 0 to 1, and more than 5 "
+         "frames are missing or corrupt")
       ->capture_default_str();
   return {sub, [args] { return run_slam(*args); }};
 }

@@ -11,9 +11,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
+#include <tuple>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/dataset/image_file.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
 
@@ -117,67 +119,125 @@ void TumSequenceWriter::write(const sensor::RgbdFrame& frame, const geom::SE3d& 
   ++frames_;
 }
 
-std::vector<std::pair<std::int64_t, std::string>> read_tum_list(const std::string& path) {
-  const std::string text = read_file(path);
-  std::vector<std::pair<std::int64_t, std::string>> out;
-  std::istringstream in(text);
+namespace {
+
+/// A time stamp field of a list file in ns; IoError naming the file and line
+/// when it is not a number of seconds within +-geom::kMaxAbsTimeS.
+std::int64_t parse_stamp_ns(const std::string& field, const std::string& path, int line) {
+  char* end = nullptr;
+  const double t_s = std::strtod(field.c_str(), &end);
+  const std::optional<std::int64_t> t_ns = geom::checked_seconds_to_ns(t_s);
+  if (end == field.c_str() || *end != '\0' || !t_ns) {
+    char range[32];
+    std::snprintf(range, sizeof range, "%g", geom::kMaxAbsTimeS);
+    throw IoError(path,
+                  "time stamp '" + field + "' is not a number of seconds in [-" + range + ", " + range + "]",
+                  line);
+  }
+  return *t_ns;
+}
+
+/// Data lines of a list file: (1-based line number, fields); '#' comments
+/// and blank lines skipped.
+std::vector<std::pair<int, std::vector<std::string>>> list_lines(const std::string& path) {
+  std::vector<std::pair<int, std::vector<std::string>>> out;
+  std::istringstream in(read_file(path));
   std::string line;
-  int n = 0;
-  while (std::getline(in, line)) {
-    ++n;
-    const auto fields = split_ws(line, " \t\r");
-    if (fields.empty() || fields[0][0] == '#') continue;
-    char* end = nullptr;
-    const double t = std::strtod(fields[0].c_str(), &end);
-    if (fields.size() < 2 || end == fields[0].c_str() || *end != '\0' || !std::isfinite(t))
-      throw IoError(path, "expected 'timestamp filename', got '" + line + "'", n);
-    out.emplace_back(geom::seconds_to_ns(t), fields[1]);
+  for (int n = 1; std::getline(in, line); ++n) {
+    std::vector<std::string> fields = split_ws(line, " \t\r");
+    if (!fields.empty() && fields[0][0] != '#') out.emplace_back(n, std::move(fields));
+  }
+  return out;
+}
+
+/// associations.txt: "t_rgb rgb t_depth depth" lines with increasing t_rgb
+/// (the order frames are tracked in).
+std::vector<TumSequenceReader::Entry> read_associations(const std::string& path) {
+  std::vector<TumSequenceReader::Entry> entries;
+  int last_line = 0;
+  for (const auto& [n, f] : list_lines(path)) {
+    if (f.size() < 4)
+      throw IoError(
+          path, "expected 't_rgb rgb_file t_depth depth_file', got " + std::to_string(f.size()) + " fields",
+          n);
+    const std::int64_t t_rgb_ns = parse_stamp_ns(f[0], path, n), t_depth_ns = parse_stamp_ns(f[2], path, n);
+    if (!entries.empty() && t_rgb_ns <= entries.back().t_ns)
+      throw IoError(path,
+                    "time stamps must increase: " + f[0] + " is not after " +
+                        geom::format_tum_time(entries.back().t_ns) + " (line " + std::to_string(last_line) +
+                        ")",
+                    n);
+    entries.push_back({t_rgb_ns, f[1], t_depth_ns, f[3]});
+    last_line = n;
+  }
+  return entries;
+}
+
+/// One-to-one nearest-time association of rgb.txt and depth.txt, closest
+/// pairs first; the result is sorted by rgb time.
+std::vector<TumSequenceReader::Entry> associate_lists(const std::string& dir, double max_diff_s) {
+  const auto rgb = read_tum_list(dir + "/rgb.txt");
+  const auto depth = read_tum_list(dir + "/depth.txt");  // sorted: lower_bound below needs it
+  const std::optional<std::int64_t> max_diff_ns = geom::checked_seconds_to_ns(max_diff_s);
+  if (!max_diff_ns || *max_diff_ns < 0) throw IoError(dir, "association window out of range");
+  std::vector<std::tuple<std::int64_t, std::size_t, std::size_t>> cand;
+  for (std::size_t i = 0; i < rgb.size(); ++i) {
+    auto it = std::lower_bound(depth.begin(), depth.end(), rgb[i].first - *max_diff_ns,
+                               [](const auto& a, std::int64_t t) { return a.first < t; });
+    for (; it != depth.end() && it->first <= rgb[i].first + *max_diff_ns; ++it)
+      cand.emplace_back(std::llabs(it->first - rgb[i].first), i, static_cast<std::size_t>(it - depth.begin()));
+  }
+  std::sort(cand.begin(), cand.end());
+  std::vector<bool> used_r(rgb.size()), used_d(depth.size());
+  std::vector<TumSequenceReader::Entry> entries;
+  for (const auto& [d, i, j] : cand) {
+    if (used_r[i] || used_d[j]) continue;
+    used_r[i] = used_d[j] = true;
+    entries.push_back({rgb[i].first, rgb[i].second, depth[j].first, depth[j].second});
+  }
+  std::sort(
+      entries.begin(), entries.end(),
+      [](const TumSequenceReader::Entry& a, const TumSequenceReader::Entry& b) { return a.t_ns < b.t_ns; });
+  if (entries.empty())
+    throw IoError(dir + "/rgb.txt", "no colour image has a depth image within " + std::to_string(max_diff_s) + " s");
+  return entries;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::int64_t, std::string>> read_tum_list(const std::string& path) {
+  std::vector<std::pair<std::int64_t, std::string>> out;
+  std::vector<int> line_of;
+  for (const auto& [n, fields] : list_lines(path)) {
+    if (fields.size() < 2) throw IoError(path, "expected 'timestamp filename', got '" + fields[0] + "'", n);
+    out.emplace_back(parse_stamp_ns(fields[0], path, n), fields[1]);
+    line_of.push_back(n);
   }
   if (out.empty()) throw IoError(path, "no entries");
-  return out;
+  // Sorted by time (stable: equal stamps keep their order, and are an error).
+  std::vector<std::size_t> order(out.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return out[a].first < out[b].first; });
+  std::vector<std::pair<std::int64_t, std::string>> sorted;
+  sorted.reserve(out.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    if (k > 0 && out[order[k]].first == out[order[k - 1]].first)
+      throw IoError(path,
+                    "duplicate time stamp " + geom::format_tum_time(out[order[k]].first) + " (also on line " +
+                        std::to_string(line_of[order[k - 1]]) + ")",
+                    line_of[order[k]]);
+    sorted.push_back(std::move(out[order[k]]));
+  }
+  return sorted;
 }
 
 TumSequenceReader::TumSequenceReader(const std::string& dir, double depth_factor, double max_diff_s)
     : dir_(dir), depth_factor_(depth_factor) {
   const std::string assoc = dir + "/associations.txt";
-  if (::access(assoc.c_str(), R_OK) == 0) {
-    std::istringstream in(read_file(assoc));
-    std::string line;
-    int n = 0;
-    while (std::getline(in, line)) {
-      ++n;
-      const auto f = split_ws(line, " \t\r");
-      if (f.empty() || f[0][0] == '#') continue;
-      if (f.size() < 4) throw IoError(assoc, "expected 't_rgb rgb_file t_depth depth_file', got '" + line + "'", n);
-      char* e1 = nullptr;
-      char* e2 = nullptr;
-      const double t1 = std::strtod(f[0].c_str(), &e1), t2 = std::strtod(f[2].c_str(), &e2);
-      if (*e1 != '\0' || *e2 != '\0') throw IoError(assoc, "malformed timestamp in '" + line + "'", n);
-      entries_.push_back({geom::seconds_to_ns(t1), f[1], geom::seconds_to_ns(t2), f[3]});
-    }
-    if (!entries_.empty()) return;
-  }
-  const auto rgb = read_tum_list(dir + "/rgb.txt");
-  const auto depth = read_tum_list(dir + "/depth.txt");
-  // One-to-one nearest-time association, closest pairs first.
-  const auto max_diff_ns = geom::seconds_to_ns(max_diff_s);
-  std::vector<std::tuple<std::int64_t, std::size_t, std::size_t>> cand;
-  for (std::size_t i = 0; i < rgb.size(); ++i) {
-    auto it = std::lower_bound(depth.begin(), depth.end(), rgb[i].first - max_diff_ns,
-                               [](const auto& a, std::int64_t t) { return a.first < t; });
-    for (; it != depth.end() && it->first <= rgb[i].first + max_diff_ns; ++it)
-      cand.emplace_back(std::llabs(it->first - rgb[i].first), i, static_cast<std::size_t>(it - depth.begin()));
-  }
-  std::sort(cand.begin(), cand.end());
-  std::vector<bool> used_r(rgb.size()), used_d(depth.size());
-  for (const auto& [d, i, j] : cand) {
-    if (used_r[i] || used_d[j]) continue;
-    used_r[i] = used_d[j] = true;
-    entries_.push_back({rgb[i].first, rgb[i].second, depth[j].first, depth[j].second});
-  }
-  std::sort(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) { return a.t_ns < b.t_ns; });
-  if (entries_.empty())
-    throw IoError(dir + "/rgb.txt", "no colour image has a depth image within " + std::to_string(max_diff_s) + " s");
+  if (::access(assoc.c_str(), R_OK) == 0) entries_ = read_associations(assoc);
+  if (entries_.empty()) entries_ = associate_lists(dir, max_diff_s);
+  max_skipped_ = std::max<std::size_t>(10, entries_.size() / 10);
 }
 
 sensor::RgbdFrame TumSequenceReader::load(std::size_t i) const {
@@ -187,11 +247,9 @@ sensor::RgbdFrame TumSequenceReader::load(std::size_t i) const {
   f.index = i;
   f.rgb_name = e.rgb;
   const std::string rgb_path = dir_ + "/" + e.rgb, depth_path = dir_ + "/" + e.depth;
-  const cv::Mat bgr = cv::imread(rgb_path, cv::IMREAD_COLOR);
-  if (bgr.empty()) throw IoError(rgb_path, "missing or unreadable colour image");
+  const cv::Mat bgr = read_image(rgb_path, cv::IMREAD_COLOR, "colour image");
   cv::cvtColor(bgr, f.rgb, cv::COLOR_BGR2RGB);
-  const cv::Mat d16 = cv::imread(depth_path, cv::IMREAD_ANYDEPTH);
-  if (d16.empty()) throw IoError(depth_path, "missing or unreadable depth image");
+  const cv::Mat d16 = read_image(depth_path, cv::IMREAD_ANYDEPTH, "depth image");
   if (d16.type() != CV_16UC1) throw IoError(depth_path, "expected a 16-bit single-channel depth image");
   if (d16.size() != f.rgb.size()) throw IoError(depth_path, "depth and colour images differ in size");
   f.depth_m = sensor::depth_from_u16(d16, depth_factor_);
@@ -199,15 +257,13 @@ sensor::RgbdFrame TumSequenceReader::load(std::size_t i) const {
 }
 
 std::optional<sensor::RgbdFrame> TumSequenceReader::next() {
-  while (pos_ < entries_.size()) {
+  while (pos_ < entries_.size() && !skip_limit_reached()) {
     const std::size_t i = pos_++;
     try {
       return load(i);
     } catch (const IoError& e) {
       ++skipped_;
       std::fprintf(stderr, "pvbench: warning: skipping frame %zu: %s\n", i, e.what());
-      if (skipped_ > std::max<std::size_t>(10, entries_.size() / 10))
-        throw IoError(dir_, "too many missing or corrupt images (" + std::to_string(skipped_) + ")");
     }
   }
   return std::nullopt;

@@ -55,6 +55,9 @@ Sim3Transform umeyama(const std::vector<geom::Vec3d>& est, const std::vector<geo
   if (n < 3)
     throw EvalError("cannot align: " + std::to_string(n) +
                     " associated pose pair(s), at least 3 are needed for se3/sim3 alignment");
+  for (std::size_t i = 0; i < n; ++i)
+    if (!plausible_position(est[i]) || !plausible_position(gt[i]))
+      throw EvalError("cannot align: a position is not finite or lies beyond 1e8 m");
   geom::Vec3d mu_est = geom::Vec3d::Zero(), mu_gt = geom::Vec3d::Zero();
   for (std::size_t i = 0; i < n; ++i) {
     mu_est += est[i];

@@ -2,16 +2,40 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <tuple>
+#include <utility>
 
 #include "pvb/geometry/time.hpp"
 
 namespace pvb::eval {
 
+namespace {
+
+/// max_diff and offset in ns; EvalError when they are out of range.
+std::pair<std::int64_t, std::int64_t> checked_window_ns(const AssociationOptions& options) {
+  char text[160];
+  if (!(options.max_diff_s > 0.0 && options.max_diff_s <= kMaxAssociationDiffS)) {
+    std::snprintf(text, sizeof text, "association: max-diff %g s is not in (0, %g] s", options.max_diff_s,
+                  kMaxAssociationDiffS);
+    throw EvalError(text);
+  }
+  const std::optional<std::int64_t> offset_ns = geom::checked_seconds_to_ns(options.offset_s);
+  if (!offset_ns) {
+    std::snprintf(text, sizeof text, "association: offset %g s is not in [-%g, %g] s", options.offset_s,
+                  geom::kMaxAbsTimeS, geom::kMaxAbsTimeS);
+    throw EvalError(text);
+  }
+  return {geom::seconds_to_ns(options.max_diff_s), *offset_ns};
+}
+
+}  // namespace
+
 std::vector<IndexPair> associate(const Trajectory& gt, const Trajectory& est,
                                  const AssociationOptions& options) {
-  const std::int64_t max_diff_ns = geom::seconds_to_ns(options.max_diff_s);
-  const std::int64_t offset_ns = geom::seconds_to_ns(options.offset_s);
+  // An estimate whose time plus offset leaves int64 has no partner; the
+  // window ends saturate, and |t_gt - t| < max_diff <= 1e9 s: no overflow.
+  const auto [max_diff_ns, offset_ns] = checked_window_ns(options);
   struct Candidate {
     std::int64_t diff_ns;
     std::size_t gt, est;
@@ -21,9 +45,13 @@ std::vector<IndexPair> associate(const Trajectory& gt, const Trajectory& est,
   // only moves forward.
   std::size_t lo = 0;
   for (std::size_t e = 0; e < est.size(); ++e) {
-    const std::int64_t t = est.poses[e].t_ns + offset_ns;
-    while (lo < gt.size() && gt.poses[lo].t_ns <= t - max_diff_ns) ++lo;
-    for (std::size_t g = lo; g < gt.size() && gt.poses[g].t_ns < t + max_diff_ns; ++g) {
+    const std::optional<std::int64_t> t_checked = geom::checked_add_ns(est.poses[e].t_ns, offset_ns);
+    if (!t_checked) continue;
+    const std::int64_t t = *t_checked;
+    const std::int64_t t_lo = geom::saturating_add_ns(t, -max_diff_ns),
+                       t_hi = geom::saturating_add_ns(t, max_diff_ns);
+    while (lo < gt.size() && gt.poses[lo].t_ns <= t_lo) ++lo;
+    for (std::size_t g = lo; g < gt.size() && gt.poses[g].t_ns < t_hi; ++g) {
       const std::int64_t d = gt.poses[g].t_ns - t;
       candidates.push_back({d < 0 ? -d : d, g, e});
     }

@@ -113,9 +113,23 @@ std::string column_label(const std::vector<EvalResult>& results, std::size_t k) 
   return base_name(path.substr(0, slash)) + "/" + name;
 }
 
+/// Throws EvalError for a pose that is not finite or lies beyond
+/// kMaxAbsCoordinateM (trajectories built in memory; the readers check files
+/// line by line).
+void check_poses(const Trajectory& traj, const char* which) {
+  for (const geom::StampedPose& p : traj.poses) {
+    if (plausible_position(p.T_w_c.translation()) && p.T_w_c.linear().allFinite()) continue;
+    throw EvalError(std::string(which) + " '" + traj.source +
+                    "': the pose at t = " + geom::format_tum_time(p.t_ns) +
+                    " s is not finite or lies beyond " + fmt("%g", kMaxAbsCoordinateM) + " m");
+  }
+}
+
 }  // namespace
 
 EvalResult evaluate(const Trajectory& gt, const Trajectory& est, const EvalOptions& options) {
+  check_poses(gt, "ground truth");
+  check_poses(est, "estimate");
   EvalResult r;
   r.est_source = est.source;
   r.alignment_kind = options.alignment;

@@ -1,12 +1,16 @@
 #include "pvb/eval/trajectory.hpp"
 
-#include <algorithm>
+#include <sys/stat.h>
+
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 
 #include "pvb/common/text.hpp"
 #include "pvb/geometry/time.hpp"
@@ -66,12 +70,34 @@ void sort_and_check(Trajectory* traj, const std::vector<int>& line_of_pose) {
   traj->poses = std::move(sorted);
 }
 
+std::string bad_time(const std::string& field) {
+  char range[32];
+  std::snprintf(range, sizeof range, "%g", geom::kMaxAbsTimeS);
+  return "time stamp '" + field + "' is not a number of seconds in [-" + range + ", " + range + "]";
+}
+
+/// "position (X Y Z) is beyond 1e+08 m" from the three fields at `first`.
+std::string bad_position(const std::vector<std::string>& fields, std::size_t first, std::size_t step = 1) {
+  char limit[32];
+  std::snprintf(limit, sizeof limit, "%g", kMaxAbsCoordinateM);
+  return "position (" + fields[first] + " " + fields[first + step] + " " + fields[first + 2 * step] +
+         ") is beyond " + limit + " m";
+}
+
+/// Reads a whole trajectory file; a folder is an error of its own (reading
+/// one gives no text, which would read as an empty trajectory).
+std::string read_text_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) throw IoError(path, "is a folder, not a file");
+  return read_file(path);
+}
+
 std::vector<std::int64_t> read_timestamps(const std::string& path) {
   std::vector<std::int64_t> out;
-  for (const Line& l : data_lines(read_file(path))) {
+  for (const Line& l : data_lines(read_text_file(path))) {
     std::int64_t t_ns = 0;
-    if (l.fields.size() != 1 || !parse_seconds_to_ns(l.fields[0], &t_ns))
-      throw IoError(path, "expected one time stamp in seconds per line", l.number);
+    if (l.fields.size() != 1) throw IoError(path, "expected one time stamp in seconds per line", l.number);
+    if (!parse_seconds_to_ns(l.fields[0], &t_ns)) throw IoError(path, bad_time(l.fields[0]), l.number);
     out.push_back(t_ns);
   }
   if (out.empty()) throw IoError(path, "empty timestamps file: no time stamps found");
@@ -79,6 +105,11 @@ std::vector<std::int64_t> read_timestamps(const std::string& path) {
 }
 
 }  // namespace
+
+bool plausible_position(const geom::Vec3d& p_m) {
+  return std::fabs(p_m.x()) <= kMaxAbsCoordinateM && std::fabs(p_m.y()) <= kMaxAbsCoordinateM &&
+         std::fabs(p_m.z()) <= kMaxAbsCoordinateM;  // false for NaN too
+}
 
 bool parse_seconds_to_ns(const std::string& text, std::int64_t* t_ns) {
   if (text.empty()) return false;
@@ -90,8 +121,10 @@ bool parse_seconds_to_ns(const std::string& text, std::int64_t* t_ns) {
   int int_digits = 0, frac_digits = 0;
   bool exact = true;
   for (; i < text.size() && std::isdigit(static_cast<unsigned char>(text[i])); ++i, ++int_digits) {
-    if (int_digits >= 10) exact = false;  // beyond ~300 years: leave it to strtod
-    whole = whole * 10 + (text[i] - '0');
+    if (int_digits >= 10)
+      exact = false;  // beyond ~300 years: leave it to strtod (whole stays < 1e10)
+    else
+      whole = whole * 10 + (text[i] - '0');
   }
   if (i < text.size() && text[i] == '.') {
     ++i;
@@ -102,14 +135,17 @@ bool parse_seconds_to_ns(const std::string& text, std::int64_t* t_ns) {
   }
   if (int_digits + frac_digits == 0) return false;
   if (i == text.size() && exact) {
+    if (static_cast<double>(whole) > geom::kMaxAbsTimeS) return false;  // whole * 1e9 would leave int64
     for (int d = std::min(frac_digits, 9); d < 9; ++d) frac_ns *= 10;
     const std::int64_t v = whole * 1000000000LL + frac_ns;
     *t_ns = negative ? -v : v;
     return true;
   }
   double t_s = 0.0;
-  if (!parse_double(text, &t_s) || std::fabs(t_s) > 9.0e9) return false;
-  *t_ns = geom::seconds_to_ns(t_s);
+  if (!parse_double(text, &t_s)) return false;
+  const std::optional<std::int64_t> checked = geom::checked_seconds_to_ns(t_s);
+  if (!checked) return false;
+  *t_ns = *checked;
   return true;
 }
 
@@ -123,16 +159,22 @@ Trajectory parse_tum(const std::string& text, const std::string& source) {
                     "expected 8 fields 't tx ty tz qx qy qz qw', got " + std::to_string(l.fields.size()),
                     l.number);
     geom::StampedPose p;
-    if (!parse_seconds_to_ns(l.fields[0], &p.t_ns))
-      throw IoError(source, "time stamp '" + l.fields[0] + "' is not a number", l.number);
+    if (!parse_seconds_to_ns(l.fields[0], &p.t_ns)) throw IoError(source, bad_time(l.fields[0]), l.number);
     double v[7];
     for (int k = 0; k < 7; ++k)
       if (!parse_double(l.fields[k + 1], &v[k]))
         throw IoError(source, "field " + std::to_string(k + 2) + " '" + l.fields[k + 1] +
                                   "' is not a finite number", l.number);
+    const geom::Vec3d t(v[0], v[1], v[2]);
+    if (!plausible_position(t)) throw IoError(source, bad_position(l.fields, 1), l.number);
     const geom::Quatd q(v[6], v[3], v[4], v[5]);  // (w, x, y, z)
-    if (q.norm() < 1e-9) throw IoError(source, "zero quaternion", l.number);
-    p.T_w_c = geom::make_se3(q, geom::Vec3d(v[0], v[1], v[2]));
+    const double q_norm2 = q.squaredNorm();
+    if (!(q_norm2 >= 1e-18 && std::isfinite(q_norm2)))
+      throw IoError(source,
+                    "quaternion (" + l.fields[4] + " " + l.fields[5] + " " + l.fields[6] + " " + l.fields[7] +
+                        ") is zero or too large to normalise",
+                    l.number);
+    p.T_w_c = geom::make_se3(q, t);
     traj.poses.push_back(p);
     line_of_pose.push_back(l.number);
   }
@@ -141,14 +183,14 @@ Trajectory parse_tum(const std::string& text, const std::string& source) {
   return traj;
 }
 
-Trajectory read_tum(const std::string& path) { return parse_tum(read_file(path), path); }
+Trajectory read_tum(const std::string& path) { return parse_tum(read_text_file(path), path); }
 
 Trajectory read_kitti(const std::string& poses_path, const std::string& timestamps_path) {
   const std::vector<std::int64_t> times_ns = read_timestamps(timestamps_path);
   Trajectory traj;
   traj.source = poses_path;
   std::vector<int> line_of_pose;
-  for (const Line& l : data_lines(read_file(poses_path))) {
+  for (const Line& l : data_lines(read_text_file(poses_path))) {
     if (l.fields.size() != 12)
       throw IoError(poses_path, "expected 12 numbers (3x4 [R|t] row-major), got " +
                                     std::to_string(l.fields.size()), l.number);
@@ -157,6 +199,8 @@ Trajectory read_kitti(const std::string& poses_path, const std::string& timestam
       if (!parse_double(l.fields[k], &v[k]))
         throw IoError(poses_path, "field " + std::to_string(k + 1) + " '" + l.fields[k] +
                                       "' is not a finite number", l.number);
+    if (!plausible_position(geom::Vec3d(v[3], v[7], v[11])))
+      throw IoError(poses_path, bad_position(l.fields, 3, 4), l.number);
     geom::Mat3d R;
     R << v[0], v[1], v[2], v[4], v[5], v[6], v[8], v[9], v[10];
     if (std::fabs(R.determinant() - 1.0) > 1e-3 || !(R.transpose() * R).isIdentity(1e-3))

@@ -66,7 +66,18 @@ std::vector<MatchMethod> parse_methods(const std::string& s) {
   return out;
 }
 
+void check_image_size(const cv::Mat& image, const std::string& path) {
+  if (image.cols >= kMinImageSidePx && image.rows >= kMinImageSidePx) return;
+  throw IoError(path, "image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                          " pixels; the matching experiment needs at least " +
+                          std::to_string(kMinImageSidePx) + "x" + std::to_string(kMinImageSidePx));
+}
+
 CoarseSet make_coarse_set(const cv::Mat& img1, const cv::Mat& img2, double ratio) {
+  for (const cv::Mat* image : {&img1, &img2})
+    if (image->cols < kMinImageSidePx || image->rows < kMinImageSidePx)
+      throw Error("make_coarse_set: an image is smaller than " + std::to_string(kMinImageSidePx) +
+                  " px on a side");
   CoarseSet cs;
   slam::OrbExtractor ex;
   const auto t0 = Clock::now();

@@ -3,18 +3,28 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 #include <sstream>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+#include "pvb/dataset/image_file.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/geometry/time.hpp"
-#include "pvb/common/text.hpp"
 
 namespace pvb::harness {
+namespace {
+std::string in_range(double lo, double hi) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, " in [%g, %g]", lo, hi);
+  return buf;
+}
+}  // namespace
 
 Eigen::Matrix3d load_homography(const std::string& path) {
   const std::string text = read_file(path);
@@ -22,7 +32,13 @@ Eigen::Matrix3d load_homography(const std::string& path) {
   Eigen::Matrix3d H;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c)
-      if (!(in >> H(r, c))) throw IoError(path, "expected a 3x3 homography (nine numbers)");
+      if (!(in >> H(r, c)) || !std::isfinite(H(r, c)))
+        throw IoError(path, "expected a 3x3 homography (nine finite numbers)");
+  // Scale-free test: |det H| against the cube of its size (H and kH are the same map).
+  const double size = H.norm();
+  if (!(std::abs(H.determinant()) > 1e-12 * size * size * size))
+    throw IoError(
+        path, "the homography is singular (determinant 0 at its scale); expected an invertible 3x3 matrix");
   return H;
 }
 
@@ -56,28 +72,44 @@ CameraSettings load_camera_settings(const std::string& path) {
     if (!n.isReal() && !n.isInt()) throw ConfigError(path, key, "a number");
     return static_cast<double>(n);
   };
+  // The ranges of slam::read_settings (slam/core/src/settings.cpp).
+  auto in = [&](const char* key, double v, double lo, double hi, const char* what) {
+    if (!(v >= lo && v <= hi))
+      throw ConfigError(path, key, std::string(what) + in_range(lo, hi), std::to_string(v));
+    return v;
+  };
   CameraSettings s;
-  s.K.fx = req("Camera.fx");
-  s.K.fy = req("Camera.fy");
-  s.K.cx = req("Camera.cx");
-  s.K.cy = req("Camera.cy");
-  s.K.width = static_cast<int>(opt("Camera.width", 640));
-  s.K.height = static_cast<int>(opt("Camera.height", 480));
-  const double k[5] = {opt("Camera.k1", 0), opt("Camera.k2", 0), opt("Camera.p1", 0), opt("Camera.p2", 0),
-                       opt("Camera.k3", 0)};
+  s.K.fx = in("Camera.fx", req("Camera.fx"), 1, 1e6, "a focal length in pixels");
+  s.K.fy = in("Camera.fy", req("Camera.fy"), 1, 1e6, "a focal length in pixels");
+  const double width = in("Camera.width", opt("Camera.width", 640), 16, 16384, "an image width in pixels");
+  const double height =
+      in("Camera.height", opt("Camera.height", 480), 16, 16384, "an image height in pixels");
+  s.K.width = static_cast<int>(width);  // in range: representable
+  s.K.height = static_cast<int>(height);
+  s.K.cx = in("Camera.cx", req("Camera.cx"), 0, width, "a pixel column inside the image (Camera.width)");
+  s.K.cy = in("Camera.cy", req("Camera.cy"), 0, height, "a pixel row inside the image (Camera.height)");
+  const char* keys[5] = {"Camera.k1", "Camera.k2", "Camera.p1", "Camera.p2", "Camera.k3"};
+  double k[5];
+  for (int i = 0; i < 5; ++i) k[i] = in(keys[i], opt(keys[i], 0), -100, 100, "a distortion coefficient");
   if (std::any_of(k, k + 5, [](double v) { return v != 0.0; })) s.dist_coeffs = cv::Mat(1, 5, CV_64F, (void*)k).clone();
   s.depth_map_factor = opt("DepthMapFactor", 5000.0);
-  if (!(s.depth_map_factor > 0)) throw ConfigError(path, "DepthMapFactor", "a positive number");
+  if (!(s.depth_map_factor > 0 && s.depth_map_factor <= 1e6))
+    throw ConfigError(path, "DepthMapFactor", "raw depth units per metre in (0, 1e+06]",
+                      std::to_string(s.depth_map_factor));
   return s;
 }
 
 cv::Mat load_depth_m(const std::string& path, double depth_map_factor) {
-  const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (raw.empty()) throw IoError(path, "cannot read depth image");
+  const cv::Mat raw = dataset::read_image(path, cv::IMREAD_UNCHANGED, "depth image");
   if (raw.channels() != 1 || (raw.depth() != CV_16U && raw.depth() != CV_32F))
     throw IoError(path, "expected a single-channel 16-bit (or float) depth image");
   cv::Mat d;
   raw.convertTo(d, CV_32F, raw.depth() == CV_16U ? 1.0 / depth_map_factor : 1.0);
+  cv::Mat valid = d > 0;  // false for NaN
+  valid &= d < std::numeric_limits<float>::infinity();
+  if (cv::countNonZero(valid) == 0)
+    throw IoError(path,
+                  "depth image holds no valid depth (every pixel is 0 or not finite); expected depths > 0");
   return d;
 }
 
@@ -97,9 +129,14 @@ geom::SE3d parse_tum_pose(const std::string& text, const std::string& what) {
 }
 
 geom::SE3d tum_pose_at(const std::string& path, double t_s, double max_gap_s) {
+  const std::optional<std::int64_t> t_checked_ns = geom::checked_seconds_to_ns(t_s);
+  const std::optional<std::int64_t> gap_checked_ns = geom::checked_seconds_to_ns(max_gap_s);
+  if (!t_checked_ns || !gap_checked_ns || *gap_checked_ns < 0)
+    throw IoError(path, "pose wanted at t = " + std::to_string(t_s) + " s within " +
+                            std::to_string(max_gap_s) + " s: expected times of at most 9e9 s");
   const eval::Trajectory gt = eval::read_tum(path);
-  const std::int64_t t_ns = geom::seconds_to_ns(t_s);
-  const auto max_gap_ns = geom::seconds_to_ns(max_gap_s);
+  const std::int64_t t_ns = *t_checked_ns;
+  const std::int64_t max_gap_ns = *gap_checked_ns;
   const auto& p = gt.poses;
   const auto after = std::lower_bound(p.begin(), p.end(), t_ns,
                                       [](const geom::StampedPose& a, std::int64_t t) { return a.t_ns < t; });

@@ -1,7 +1,15 @@
 #include "pvb/slam/core/settings.hpp"
 
+#include <algorithm>
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
+#include <map>
 #include <opencv2/core.hpp>
+#include <regex>
 #include <set>
 
 #include "pvb/common/error.hpp"
@@ -9,44 +17,213 @@
 namespace pvb::slam {
 namespace {
 
+/// An interval of accepted values; NaN is in none.
+struct Range {
+  double lo, hi;
+  bool lo_open = false;  ///< (lo, ... instead of [lo, ...
+  bool hi_open = false;  ///< ..., hi) instead of ..., hi]
+  bool contains(double v) const { return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi); }
+  std::string text() const {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%c%g, %g%c", lo_open ? '(' : '[', lo, hi, hi_open ? ')' : ']');
+    return buf;
+  }
+};
+Range closed(double lo, double hi) { return {lo, hi, false, false}; }
+Range above(double lo, double hi) { return {lo, hi, true, false}; }  ///< (lo, hi]
+
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+/// Integer literals beyond int's range, by key: OpenCV's YAML parser wraps
+/// them (4294967297 reads as 1), so the reader reports them itself.
+std::map<std::string, std::string> wide_integer_literals(const std::string& path) {
+  static const std::regex key_int(R"(^\s*([A-Za-z][\w.]*)\s*:\s*([-+]?\d+)\s*(#.*)?\r?$)");
+  std::map<std::string, std::string> out;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);) {
+    std::smatch m;
+    if (!std::regex_match(line, m, key_int)) continue;
+    errno = 0;
+    const long long v = std::strtoll(m[2].str().c_str(), nullptr, 10);
+    if (errno == ERANGE || v < INT_MIN || v > INT_MAX) out[m[1].str()] = m[2].str();
+  }
+  return out;
+}
+
+/// Reads typed, range-checked values of one settings file and remembers the
+/// keys it was asked for.  A value outside its range is a ConfigError naming
+/// the key and the range, before any cast (a double outside int's range must
+/// not be converted).
 class Reader {
  public:
-  Reader(const cv::FileStorage& fs, std::string path) : fs_(fs), path_(std::move(path)) {}
+  Reader(const cv::FileStorage& fs, std::string path)
+      : fs_(fs), path_(std::move(path)), wide_literals_(wide_integer_literals(path_)) {}
 
-  double real(const std::string& key, bool required, double fallback) {
-    seen_.insert(key);
-    const cv::FileNode n = fs_[key];
-    if (n.empty()) {
-      if (required) throw ConfigError(path_, key, "a number (required key is missing)");
-      return fallback;
-    }
-    if (!n.isReal() && !n.isInt()) throw ConfigError(path_, key, "a number");
-    return static_cast<double>(n);
+  /// A number in `range`; `fallback` when the key is absent and not required.
+  double real(const std::string& key, bool required, double fallback, const Range& range,
+              const std::string& what = "a number") {
+    const double v = raw(key, required, fallback, what + " in " + range.text());
+    if (!range.contains(v)) throw ConfigError(path_, key, what + " in " + range.text(), number_text(v));
+    return v;
   }
-  int integer(const std::string& key, bool required, int fallback) {
-    const double v = real(key, required, fallback);
-    if (v != static_cast<double>(static_cast<int>(v))) throw ConfigError(path_, key, "an integer", std::to_string(v));
-    return static_cast<int>(v);
+  /// An integer in [lo, hi].
+  int integer(const std::string& key, bool required, int fallback, int lo, int hi,
+              const std::string& what = "an integer") {
+    return integral(key, required, fallback, lo, hi,
+                    what + " in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
   }
-  bool flag(const std::string& key, bool fallback) {
-    const int v = integer(key, false, fallback ? 1 : 0);
-    if (v != 0 && v != 1) throw ConfigError(path_, key, "0 or 1", std::to_string(v));
-    return v == 1;
+  bool flag(const std::string& key, bool required, bool fallback) {
+    return integral(key, required, fallback ? 1 : 0, 0, 1, "0 or 1") == 1;
   }
-  void positive(const std::string& key, double v) {
-    if (!(v > 0)) throw ConfigError(path_, key, "a positive value", std::to_string(v));
+  /// Checks a value read before against a range known only later.
+  void check(const std::string& key, double v, const Range& range, const std::string& what) const {
+    if (!range.contains(v)) throw ConfigError(path_, key, what + " in " + range.text(), number_text(v));
   }
+  const std::string& path() const { return path_; }
   const std::set<std::string>& seen() const { return seen_; }
 
  private:
+  int integral(const std::string& key, bool required, int fallback, int lo, int hi,
+               const std::string& expected) {
+    const double v = raw(key, required, fallback, expected);
+    if (!(v >= lo && v <= hi && v == std::floor(v))) throw ConfigError(path_, key, expected, number_text(v));
+    return static_cast<int>(v);  // in [lo, hi]: representable
+  }
+  double raw(const std::string& key, bool required, double fallback, const std::string& expected) {
+    seen_.insert(key);
+    const cv::FileNode n = fs_[key];
+    if (n.empty()) {
+      if (required) throw ConfigError(path_, key, expected + " (required key is missing)");
+      return fallback;
+    }
+    if (!n.isReal() && !n.isInt()) throw ConfigError(path_, key, expected);
+    const auto wide = wide_literals_.find(key);
+    if (n.isInt() && wide != wide_literals_.end()) throw ConfigError(path_, key, expected, wide->second);
+    return static_cast<double>(n);
+  }
+
   const cv::FileStorage& fs_;
   std::string path_;
+  std::map<std::string, std::string> wide_literals_;
   std::set<std::string> seen_;
 };
 
 // Keys ORB-SLAM2 files carry that the RGB-D core does not use.
 bool ignored_key(const std::string& key) {
   return key.rfind("Viewer.", 0) == 0 || key == "Camera.type" || key == "Camera.bFishEye";
+}
+
+/// Smallest side, in pixels, of the coarsest ORB pyramid level.
+constexpr double kMinLevelSidePx = 8;
+
+/// Camera.*, ThDepth, DepthMapFactor (ORB-SLAM2's keys, all required but k3).
+void read_camera(Reader& r, Settings* s) {
+  s->K.fx = r.real("Camera.fx", true, 0, closed(1, 1e6), "a focal length in pixels");
+  s->K.fy = r.real("Camera.fy", true, 0, closed(1, 1e6), "a focal length in pixels");
+  s->K.cx = r.real("Camera.cx", true, 0, closed(0, 16384), "a pixel column");
+  s->K.cy = r.real("Camera.cy", true, 0, closed(0, 16384), "a pixel row");
+  const Range distortion = closed(-100, 100);
+  s->k1 = r.real("Camera.k1", true, 0, distortion);
+  s->k2 = r.real("Camera.k2", true, 0, distortion);
+  s->p1 = r.real("Camera.p1", true, 0, distortion);
+  s->p2 = r.real("Camera.p2", true, 0, distortion);
+  s->k3 = r.real("Camera.k3", false, 0, distortion);  // optional in ORB-SLAM2 too
+  s->K.width = r.integer("Camera.width", true, 0, 16, 16384, "an image width in pixels");
+  s->K.height = r.integer("Camera.height", true, 0, 16, 16384, "an image height in pixels");
+  r.check("Camera.cx", s->K.cx, closed(0, s->K.width), "a pixel column inside the image (Camera.width)");
+  r.check("Camera.cy", s->K.cy, closed(0, s->K.height), "a pixel row inside the image (Camera.height)");
+  s->fps = r.real("Camera.fps", true, 30, closed(1, 1000), "frames per second");
+  s->bf = r.real("Camera.bf", true, 0, above(0, 1e7), "baseline (m) x fx");
+  s->rgb_order = r.flag("Camera.RGB", true, true);
+  s->th_depth = r.real("ThDepth", true, 0, above(0, 1e4), "a depth threshold in baselines");
+  s->depth_map_factor = r.real("DepthMapFactor", true, 0, above(0, 1e6), "raw depth units per metre");
+}
+
+/// ORBextractor.* (ORB-SLAM2's keys, required, plus our subPixel).  The
+/// pyramid's coarsest level must keep kMinLevelSidePx on the image's shorter
+/// side.
+void read_orb(Reader& r, Settings* s) {
+  OrbParams& orb = s->orb;
+  orb.num_features = r.integer("ORBextractor.nFeatures", true, 0, 1, 100000);
+  orb.scale_factor =
+      r.real("ORBextractor.scaleFactor", true, 0, above(1, 2), "a scale between pyramid levels");
+  int max_levels = 1;
+  for (double side = std::min(s->K.width, s->K.height);
+       max_levels < 32 && side / orb.scale_factor >= kMinLevelSidePx; side /= orb.scale_factor)
+    ++max_levels;
+  orb.num_levels =
+      r.integer("ORBextractor.nLevels", true, 0, 1, max_levels,
+                "a number of pyramid levels (the smallest at least 8 px at Camera.width/height and "
+                "ORBextractor.scaleFactor)");
+  orb.ini_fast_threshold = r.integer("ORBextractor.iniThFAST", true, 0, 1, 255, "a FAST threshold");
+  orb.min_fast_threshold = r.integer("ORBextractor.minThFAST", true, 0, 1, 255, "a FAST threshold");
+  orb.sub_pixel = r.flag("ORBextractor.subPixel", false, orb.sub_pixel);  // ours, optional
+}
+
+void read_pe_match(Reader& r, PeMatchSettings* pe) {
+  pe->enabled = r.flag("PEMatch.enabled", false, pe->enabled);
+  pe->population = r.integer("PEMatch.population", false, pe->population, 2, 1000);
+  pe->num_fitness_samples = r.integer("PEMatch.j", false, pe->num_fitness_samples, 1, 100000);
+  pe->stall_iterations = r.integer("PEMatch.stallIterations", false, pe->stall_iterations, 1, 10000);
+  pe->threshold_px =
+      r.real("PEMatch.threshold", false, pe->threshold_px, above(0, 1000), "a distance in pixels");
+  pe->refine = r.flag("PEMatch.refine", false, pe->refine);
+  pe->sampson = r.flag("PEMatch.sampson", false, pe->sampson);
+  pe->skip_low_parallax = r.flag("PEMatch.skipLowParallax", false, pe->skip_low_parallax);
+}
+
+void read_keyframe(Reader& r, KeyFrameSettings* kfs) {
+  kfs->min_tracked_close = r.integer("KeyFrame.minTrackedClose", false, kfs->min_tracked_close, 1, 100000);
+  kfs->min_untracked_close =
+      r.integer("KeyFrame.minUntrackedClose", false, kfs->min_untracked_close, 1, 100000);
+  kfs->ref_overlap = r.real("KeyFrame.refOverlap", false, kfs->ref_overlap, {0, 1, false, true},
+                            "a share (0: ORB-SLAM2's rule)");
+}
+
+void read_point_cloud(Reader& r, PointCloudMappingSettings* pc) {
+  pc->enabled = r.flag("PointCloudMapping.Enabled", false, pc->enabled);
+  pc->resolution_m =
+      r.real("PointCloudMapping.Resolution", false, pc->resolution_m, closed(1e-4, 100), "metres");
+  pc->stride_px = r.integer("PointCloudMapping.Stride", false, pc->stride_px, 1, 1000, "pixels");
+  pc->min_depth_m = r.real("PointCloudMapping.MinDepth", false, pc->min_depth_m, closed(0, 1000), "metres");
+  pc->max_depth_m = r.real("PointCloudMapping.MaxDepth", false, pc->max_depth_m, above(pc->min_depth_m, 1000),
+                           "metres beyond PointCloudMapping.MinDepth");
+}
+
+void read_loop_closing(Reader& r, LoopClosingOptions* lc) {
+  lc->enabled = r.flag("LoopClosing.enabled", false, lc->enabled);
+  lc->search_radius_m =
+      r.real("LoopClosing.searchRadius", false, lc->search_radius_m, above(0, 1e4), "metres");
+  lc->max_angle_deg = r.real("LoopClosing.maxAngle", false, lc->max_angle_deg, above(0, 180), "degrees");
+  lc->min_keyframe_gap = r.integer("LoopClosing.minKeyFrameGap", false, lc->min_keyframe_gap, 1, 1000000);
+  lc->max_candidates = r.integer("LoopClosing.maxCandidates", false, lc->max_candidates, 1, 1000);
+  lc->min_matches = r.integer("LoopClosing.minMatches", false, lc->min_matches, 6, 100000);
+  lc->consistency = r.integer("LoopClosing.consistency", false, lc->consistency, 0, 1000);
+  lc->min_inliers = r.integer("LoopClosing.minInliers", false, lc->min_inliers, 6, 100000);
+  lc->max_correction_m =
+      r.real("LoopClosing.maxCorrection", false, lc->max_correction_m, above(0, 1e4), "metres");
+  lc->max_correction_deg =
+      r.real("LoopClosing.maxCorrectionAngle", false, lc->max_correction_deg, above(0, 180), "degrees");
+  lc->essential_weight = r.integer("LoopClosing.essentialWeight", false, lc->essential_weight, 1, 1000000);
+  lc->global_ba = r.flag("LoopClosing.globalBA", false, lc->global_ba);
+  lc->rotation_weight = r.real("LoopClosing.rotationWeight", false, lc->rotation_weight, above(0, 1e6));
+}
+
+/// "FILE(LINE): REASON" from a cv::FileStorage parse error.  OpenCV 4.6
+/// passes its function name as the error text and the message as the
+/// function name, so both fields are searched.
+IoError parse_error(const std::string& path, const cv::Exception& e) {
+  static const std::regex located(R"(\((\d+)\): (.*)$)");
+  for (const std::string& field : {e.func, e.err}) {
+    std::smatch m;
+    if (std::regex_search(field, m, located))
+      return IoError(path, "cannot parse settings file: " + m[2].str(), std::stoi(m[1].str()));
+  }
+  return IoError(path, "cannot parse settings file: " + e.err + (e.func.empty() ? "" : " (" + e.func + ")"));
 }
 
 }  // namespace
@@ -57,113 +234,18 @@ Settings read_settings(const std::string& path) {
   try {
     if (!fs.open(path, cv::FileStorage::READ)) throw IoError(path, "cannot open settings file");
   } catch (const cv::Exception& e) {
-    throw IoError(path, std::string("cannot parse settings file: ") + e.err);
+    throw parse_error(path, e);
   }
   Settings s;
   s.source = path;
   Reader r(fs, path);
-  s.K.fx = r.real("Camera.fx", true, 0);
-  s.K.fy = r.real("Camera.fy", true, 0);
-  s.K.cx = r.real("Camera.cx", true, 0);
-  s.K.cy = r.real("Camera.cy", true, 0);
-  r.positive("Camera.fx", s.K.fx);
-  r.positive("Camera.fy", s.K.fy);
-  s.k1 = r.real("Camera.k1", true, 0);
-  s.k2 = r.real("Camera.k2", true, 0);
-  s.p1 = r.real("Camera.p1", true, 0);
-  s.p2 = r.real("Camera.p2", true, 0);
-  s.k3 = r.real("Camera.k3", false, 0);  // optional in ORB-SLAM2 too
-  s.K.width = r.integer("Camera.width", true, 0);
-  s.K.height = r.integer("Camera.height", true, 0);
-  r.positive("Camera.width", s.K.width);
-  r.positive("Camera.height", s.K.height);
-  s.fps = r.real("Camera.fps", true, 30);
-  r.positive("Camera.fps", s.fps);
-  s.bf = r.real("Camera.bf", true, 0);
-  r.positive("Camera.bf", s.bf);
-  s.rgb_order = r.flag("Camera.RGB", true);
-  if (fs["Camera.RGB"].empty()) throw ConfigError(path, "Camera.RGB", "0 or 1 (required key is missing)");
-  s.th_depth = r.real("ThDepth", true, 0);
-  r.positive("ThDepth", s.th_depth);
-  s.depth_map_factor = r.real("DepthMapFactor", true, 0);
-  r.positive("DepthMapFactor", s.depth_map_factor);
-  s.orb.num_features = r.integer("ORBextractor.nFeatures", true, 0);
-  s.orb.scale_factor = r.real("ORBextractor.scaleFactor", true, 0);
-  s.orb.num_levels = r.integer("ORBextractor.nLevels", true, 0);
-  s.orb.ini_fast_threshold = r.integer("ORBextractor.iniThFAST", true, 0);
-  s.orb.min_fast_threshold = r.integer("ORBextractor.minThFAST", true, 0);
-  s.orb.sub_pixel = r.flag("ORBextractor.subPixel", s.orb.sub_pixel);  // ours, optional
-  s.align_patches = r.flag("Tracking.alignPatches", s.align_patches);   // ours, optional
-  r.positive("ORBextractor.nFeatures", s.orb.num_features);
-  if (!(s.orb.scale_factor > 1.0))
-    throw ConfigError(path, "ORBextractor.scaleFactor", "a value > 1", std::to_string(s.orb.scale_factor));
-  r.positive("ORBextractor.nLevels", s.orb.num_levels);
-
-  PeMatchSettings& pe = s.pe_match;
-  pe.enabled = r.flag("PEMatch.enabled", pe.enabled);
-  pe.population = r.integer("PEMatch.population", false, pe.population);
-  pe.num_fitness_samples = r.integer("PEMatch.j", false, pe.num_fitness_samples);
-  pe.stall_iterations = r.integer("PEMatch.stallIterations", false, pe.stall_iterations);
-  pe.threshold_px = r.real("PEMatch.threshold", false, pe.threshold_px);
-  pe.refine = r.flag("PEMatch.refine", pe.refine);
-  pe.sampson = r.flag("PEMatch.sampson", pe.sampson);
-  pe.skip_low_parallax = r.flag("PEMatch.skipLowParallax", pe.skip_low_parallax);
-  if (pe.population < 2) throw ConfigError(path, "PEMatch.population", "an integer >= 2");
-  r.positive("PEMatch.j", pe.num_fitness_samples);
-  r.positive("PEMatch.stallIterations", pe.stall_iterations);
-  r.positive("PEMatch.threshold", pe.threshold_px);
-
-  KeyFrameSettings& kfs = s.keyframe;
-  kfs.min_tracked_close = r.integer("KeyFrame.minTrackedClose", false, kfs.min_tracked_close);
-  kfs.min_untracked_close = r.integer("KeyFrame.minUntrackedClose", false, kfs.min_untracked_close);
-  r.positive("KeyFrame.minTrackedClose", kfs.min_tracked_close);
-  r.positive("KeyFrame.minUntrackedClose", kfs.min_untracked_close);
-  kfs.ref_overlap = r.real("KeyFrame.refOverlap", false, kfs.ref_overlap);
-  if (!(kfs.ref_overlap >= 0.0 && kfs.ref_overlap < 1.0))
-    throw ConfigError(path, "KeyFrame.refOverlap", "a number in [0, 1) (0: ORB-SLAM2's rule)",
-                      std::to_string(kfs.ref_overlap));
-
-  PointCloudMappingSettings& pc = s.dense;
-  pc.enabled = r.flag("PointCloudMapping.Enabled", pc.enabled);
-  pc.resolution_m = r.real("PointCloudMapping.Resolution", false, pc.resolution_m);
-  pc.stride_px = r.integer("PointCloudMapping.Stride", false, pc.stride_px);
-  pc.min_depth_m = r.real("PointCloudMapping.MinDepth", false, pc.min_depth_m);
-  pc.max_depth_m = r.real("PointCloudMapping.MaxDepth", false, pc.max_depth_m);
-  r.positive("PointCloudMapping.Resolution", pc.resolution_m);
-  r.positive("PointCloudMapping.Stride", pc.stride_px);
-  if (!(pc.min_depth_m >= 0))
-    throw ConfigError(path, "PointCloudMapping.MinDepth", "a value >= 0", std::to_string(pc.min_depth_m));
-  if (!(pc.max_depth_m > pc.min_depth_m))
-    throw ConfigError(path, "PointCloudMapping.MaxDepth", "a value > PointCloudMapping.MinDepth",
-                      std::to_string(pc.max_depth_m));
-
-  LoopClosingOptions& lc = s.loop;
-  lc.enabled = r.flag("LoopClosing.enabled", lc.enabled);
-  lc.search_radius_m = r.real("LoopClosing.searchRadius", false, lc.search_radius_m);
-  lc.max_angle_deg = r.real("LoopClosing.maxAngle", false, lc.max_angle_deg);
-  lc.min_keyframe_gap = r.integer("LoopClosing.minKeyFrameGap", false, lc.min_keyframe_gap);
-  lc.max_candidates = r.integer("LoopClosing.maxCandidates", false, lc.max_candidates);
-  lc.min_matches = r.integer("LoopClosing.minMatches", false, lc.min_matches);
-  lc.consistency = r.integer("LoopClosing.consistency", false, lc.consistency);
-  lc.min_inliers = r.integer("LoopClosing.minInliers", false, lc.min_inliers);
-  lc.max_correction_m = r.real("LoopClosing.maxCorrection", false, lc.max_correction_m);
-  lc.max_correction_deg = r.real("LoopClosing.maxCorrectionAngle", false, lc.max_correction_deg);
-  lc.essential_weight = r.integer("LoopClosing.essentialWeight", false, lc.essential_weight);
-  lc.global_ba = r.flag("LoopClosing.globalBA", lc.global_ba);
-  lc.rotation_weight = r.real("LoopClosing.rotationWeight", false, lc.rotation_weight);
-  r.positive("LoopClosing.rotationWeight", lc.rotation_weight);
-  r.positive("LoopClosing.searchRadius", lc.search_radius_m);
-  if (!(lc.max_angle_deg > 0 && lc.max_angle_deg <= 180))
-    throw ConfigError(path, "LoopClosing.maxAngle", "a value in (0, 180]", std::to_string(lc.max_angle_deg));
-  r.positive("LoopClosing.minKeyFrameGap", lc.min_keyframe_gap);
-  r.positive("LoopClosing.maxCandidates", lc.max_candidates);
-  if (lc.min_matches < 6) throw ConfigError(path, "LoopClosing.minMatches", "an integer >= 6", std::to_string(lc.min_matches));
-  if (lc.consistency < 0) throw ConfigError(path, "LoopClosing.consistency", "an integer >= 0", std::to_string(lc.consistency));
-  if (lc.min_inliers < 6) throw ConfigError(path, "LoopClosing.minInliers", "an integer >= 6", std::to_string(lc.min_inliers));
-  r.positive("LoopClosing.maxCorrection", lc.max_correction_m);
-  r.positive("LoopClosing.maxCorrectionAngle", lc.max_correction_deg);
-  r.positive("LoopClosing.essentialWeight", lc.essential_weight);
-
+  read_camera(r, &s);
+  read_orb(r, &s);
+  s.align_patches = r.flag("Tracking.alignPatches", false, s.align_patches);  // ours, optional
+  read_pe_match(r, &s.pe_match);
+  read_keyframe(r, &s.keyframe);
+  read_point_cloud(r, &s.dense);
+  read_loop_closing(r, &s.loop);
   const cv::FileNode root = fs.root();
   for (auto it = root.begin(); it != root.end(); ++it) {
     const std::string key = (*it).name();

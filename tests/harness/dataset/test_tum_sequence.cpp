@@ -143,3 +143,123 @@ TEST(TumSequence, UnwritableFolderIsAClearError) {
     EXPECT_THROW(dataset::TumSequenceWriter w("/proc/pvb_no"), IoError);
   }
 }
+
+namespace {
+/// The IoError message of f(), or "" when it does not throw one.
+template <class F>
+std::string io_error_of(F f) {
+  try {
+    f();
+  } catch (const IoError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+/// A three-frame sequence whose associations.txt is replaced by `assoc`.
+std::string with_associations(const std::string& name, const std::string& assoc) {
+  const std::string dir = temp_dir(name);
+  {
+    dataset::TumSequenceWriter w(dir);
+    for (int i = 0; i < 3; ++i) w.write(synthetic(i), geom::SE3d::Identity());
+  }
+  write_file(dir + "/associations.txt", assoc);
+  return dir;
+}
+}  // namespace
+
+// A time stamp that is not finite or beyond +-9e9 s (t_ns would leave
+// int64) names the file and line, in every list the reader takes.
+TEST(TumSequence, NonFiniteOrHugeTimeStampsNameFileAndLine) {
+  const std::string a = "0.000000 rgb/0.000000.png 0.000000 depth/0.000000.png\n";
+  for (const std::string bad : {"nan", "inf", "-inf", "9.3e9", "1e300", "-9.3e9"}) {
+    const std::string dir =
+        with_associations("assoc_t", "# c\n" + a + bad + " rgb/0.033333.png 0.033333 depth/0.033333.png\n");
+    const std::string what = io_error_of([&] { dataset::TumSequenceReader r(dir); });
+    EXPECT_NE(what.find("associations.txt:3: time stamp '" + bad + "'"), std::string::npos)
+        << bad << ": " << what;
+    const std::string depth_bad =
+        with_associations("assoc_d", a + "0.033333 rgb/0.033333.png " + bad + " depth/x.png\n");
+    EXPECT_NE(io_error_of([&] { dataset::TumSequenceReader r(depth_bad); }).find("associations.txt:2:"),
+              std::string::npos)
+        << bad;
+    write_file(dir + "/rgb.txt", "0.1 rgb/a.png\n" + bad + " rgb/b.png\n");
+    EXPECT_NE(io_error_of([&] { dataset::read_tum_list(dir + "/rgb.txt"); }).find("rgb.txt:2: time stamp"),
+              std::string::npos)
+        << bad;
+  }
+}
+
+// associations.txt is tracked in its order: a stamp that does not increase
+// is an error naming its line (it would be tracked backwards in time).
+TEST(TumSequence, OutOfOrderAssociationsAreAnError) {
+  const std::string dir = with_associations("assoc_order",
+                                            "0.000000 rgb/0.000000.png 0.000000 depth/0.000000.png\n"
+                                            "0.066667 rgb/0.066667.png 0.066667 depth/0.066667.png\n"
+                                            "0.033333 rgb/0.033333.png 0.033333 depth/0.033333.png\n");
+  const std::string what = io_error_of([&] { dataset::TumSequenceReader r(dir); });
+  EXPECT_NE(what.find("associations.txt:3: time stamps must increase"), std::string::npos) << what;
+  write_file(dir + "/associations.txt",
+             "0.000000 rgb/0.000000.png 0.000000 depth/0.000000.png\n"
+             "0.000000 rgb/0.033333.png 0.033333 depth/0.033333.png\n");
+  EXPECT_NE(io_error_of([&] { dataset::TumSequenceReader r(dir); }).find("associations.txt:2:"),
+            std::string::npos);
+}
+
+// Without associations.txt, rgb.txt and depth.txt may come in any order:
+// they are sorted before the nearest-time association (which searches the
+// depth list by bisection), so no frame is lost; a repeated stamp is an error.
+TEST(TumSequence, UnsortedListsAreSortedAndRepeatedStampsRejected) {
+  const std::string dir = temp_dir("unsorted");
+  {
+    dataset::TumSequenceWriter w(dir);
+    for (int i = 0; i < 8; ++i) w.write(synthetic(i), geom::SE3d::Identity());
+  }
+  std::remove((dir + "/associations.txt").c_str());
+  const auto depth = dataset::read_tum_list(dir + "/depth.txt");
+  const auto rgb = dataset::read_tum_list(dir + "/rgb.txt");
+  std::string depth_text = "# depth, newest first\n", rgb_text;
+  for (std::size_t i = depth.size(); i-- > 0;)
+    depth_text += geom::format_tum_time(depth[i].first) + " " + depth[i].second + "\n";
+  for (std::size_t i : {3, 0, 7, 1, 6, 2, 5, 4})
+    rgb_text += geom::format_tum_time(rgb[i].first) + " " + rgb[i].second + "\n";
+  write_file(dir + "/depth.txt", depth_text);
+  write_file(dir + "/rgb.txt", rgb_text);
+  const auto sorted = dataset::read_tum_list(dir + "/rgb.txt");
+  for (std::size_t i = 0; i < sorted.size(); ++i) EXPECT_EQ(sorted[i], rgb[i]);
+  dataset::TumSequenceReader r(dir);
+  ASSERT_EQ(r.entries().size(), 8u);
+  for (std::size_t i = 0; i < 8; ++i) {
+    EXPECT_EQ(r.entries()[i].t_ns, rgb[i].first);
+    EXPECT_EQ(r.entries()[i].depth_t_ns, depth[i].first);
+  }
+  write_file(dir + "/rgb.txt", rgb_text + geom::format_tum_time(rgb[5].first) + " rgb/again.png\n");
+  EXPECT_NE(
+      io_error_of([&] { dataset::read_tum_list(dir + "/rgb.txt"); }).find("rgb.txt:9: duplicate time stamp"),
+      std::string::npos);
+}
+
+// The caller decides how many frames may be skipped; past that next() stops
+// (nullopt) and says why, instead of throwing.
+TEST(TumSequence, SkipLimitIsTheCallersAndStopsTheStream) {
+  const std::string dir = temp_dir("skiplimit");
+  {
+    dataset::TumSequenceWriter w(dir);
+    for (int i = 0; i < 6; ++i) w.write(synthetic(i), geom::SE3d::Identity());
+  }
+  for (const char* f : {"/rgb/0.033333.png", "/rgb/0.066667.png", "/depth/0.100000.png"})
+    std::remove((dir + f).c_str());
+  dataset::TumSequenceReader loose(dir);
+  loose.set_max_skipped(3);
+  int n = 0;
+  while (loose.next()) ++n;
+  EXPECT_EQ(n, 3);
+  EXPECT_FALSE(loose.skip_limit_reached());
+  dataset::TumSequenceReader strict(dir);
+  strict.set_max_skipped(1);
+  n = 0;
+  while (strict.next()) ++n;
+  EXPECT_EQ(n, 1);  // frame 0; frames 1 and 2 are skipped, and 2 is one too many
+  EXPECT_TRUE(strict.skip_limit_reached());
+  EXPECT_EQ(strict.skipped(), 2u);
+}

@@ -147,6 +147,28 @@ TEST(Align, DegenerateSetsAreErrors) {
   EXPECT_THROW(evaluate(gt, gt, {}), EvalError);
 }
 
+// One estimated position at 1e300 (or NaN) is named as such, not reported
+// as "all estimated positions are the same point".
+TEST(Align, AbsurdPositionIsNamed) {
+  const Trajectory gt = loop(20);
+  for (const double bad : {1e300, std::nan("")}) {
+    Trajectory est = transformed(gt, kOffset);
+    est.poses[7].T_w_c.translation().x() = bad;
+    try {
+      evaluate(gt, est, {});
+      FAIL() << bad;
+    } catch (const EvalError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("estimate 'est': the pose at t = 1.700000 s is not finite or lies beyond 1e+08 m"),
+                std::string::npos)
+          << what;
+    }
+    std::vector<Vec3d> pts;
+    for (const auto& p : est.poses) pts.push_back(p.T_w_c.translation());
+    EXPECT_THROW(umeyama(pts, pts, false), EvalError);
+  }
+}
+
 TEST(Metrics, StatsMatchNumpyConventions) {
   const Stats s = compute_stats({3.0, 1.0, 4.0, 2.0});
   EXPECT_DOUBLE_EQ(s.mean, 2.5);

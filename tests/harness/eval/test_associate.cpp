@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
 #include "pvb/eval/associate.hpp"
 
 using namespace pvb;
@@ -71,4 +75,31 @@ TEST(Associate, NoOverlapErrorGivesRangesAndHints) {
     EXPECT_NE(msg.find("--offset"), std::string::npos) << msg;
     EXPECT_NE(msg.find("--max-diff"), std::string::npos) << msg;
   }
+}
+
+// Times near the end of int64 with an offset: the sum saturates instead of
+// wrapping round to a time that would pair with a negative ground truth.
+TEST(Associate, OffsetSumsDoNotWrap) {
+  const std::int64_t t_est = 9'000'000'000'000'000'000;  // 9e9 s
+  const std::int64_t offset = 9'000'000'000'000'000'000;
+  const std::int64_t wrapped =
+      static_cast<std::int64_t>(static_cast<std::uint64_t>(t_est) + static_cast<std::uint64_t>(offset));
+  AssociationOptions o;
+  o.offset_s = 9e9;
+  EXPECT_TRUE(associate(stamps({wrapped}, "gt"), stamps({t_est}, "est"), o).empty());
+  EXPECT_TRUE(
+      associate(stamps({std::numeric_limits<std::int64_t>::max() - 5 * kMs}, "gt"), stamps({t_est}, "est"), o)
+          .empty());
+}
+
+TEST(Associate, WindowOutOfRangeIsAnError) {
+  const Trajectory a = stamps({0, 33 * kMs}, "a");
+  for (const double bad : {0.0, -1.0, 2e9, std::nan("")}) {
+    AssociationOptions o;
+    o.max_diff_s = bad;
+    EXPECT_THROW(associate(a, a, o), EvalError) << bad;
+  }
+  AssociationOptions o;
+  o.offset_s = 1e300;
+  EXPECT_THROW(associate(a, a, o), EvalError);
 }

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <sstream>
+#include <vector>
 
 #include "pvb/common/text.hpp"
 
@@ -75,4 +77,35 @@ TEST(CliEval, ErrorsGiveOneLineAndNonZeroExit) {
   // The same files associate with the right offset.
   EXPECT_EQ(run("eval --gt " + d + "/gt.txt --est " + d + "/late.txt --offset -4990", &err), 0) << err;
   EXPECT_NE(run("eval --gt " + d + "/gt.txt --est " + d + "/gt.txt --align bogus", &err), 0);
+}
+
+// A folder given as --gt, an absurd estimated position and out-of-range
+// association options are each one clear error line.
+TEST(CliEval, FolderAbsurdPositionAndBadOptionsAreOneLineEach) {
+  const std::string d = temp_dir();
+  pvb::write_file(d + "/gt.txt", tum_loop(0.0, 10.0));
+  std::string far;  // the loop with x = 1e300 on line 6
+  std::istringstream loop(tum_loop(0.0, 10.0));
+  int number = 1;
+  for (std::string line; std::getline(loop, line); ++number) {
+    std::vector<std::string> f = pvb::split_ws(line);
+    if (number == 6) f[1] = "1e300";
+    for (const std::string& field : f) far += field + " ";
+    far.back() = '\n';
+  }
+  pvb::write_file(d + "/far.txt", far);
+  std::string err;
+  EXPECT_EQ(run("eval --gt " + d + " --est " + d + "/gt.txt", &err), 1);
+  EXPECT_NE(err.find(d + ": is a folder, not a file"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_EQ(run("eval --gt " + d + "/gt.txt --est " + d + "/far.txt", &err), 1);
+  EXPECT_NE(err.find(d + "/far.txt:6: position (1e300 "), std::string::npos) << err;
+  EXPECT_EQ(err.find("same point"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  for (const std::string bad :
+       {"--max-diff 1e30", "--max-diff nan", "--offset 1e300", "--offset nan", "--delta inf"}) {
+    EXPECT_EQ(run("eval --gt " + d + "/gt.txt --est " + d + "/gt.txt " + bad, &err), 1) << bad;
+    EXPECT_NE(err.find("command line: " + bad.substr(0, bad.find(' '))), std::string::npos) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  }
 }

@@ -126,3 +126,51 @@ TEST(Trajectory, ParsesSecondsExactly) {
   EXPECT_FALSE(parse_seconds_to_ns("1.0x", &t));
   EXPECT_FALSE(parse_seconds_to_ns(".", &t));
 }
+
+// A time stamp beyond +-9e9 s would leave int64 as t_ns: an error naming
+// the line, including the ten-digit decimals converted exactly.
+TEST(Trajectory, TimeStampsBeyondRangeAreErrors) {
+  std::int64_t t = 0;
+  ASSERT_TRUE(parse_seconds_to_ns("8999999999.999999999", &t));
+  EXPECT_EQ(t, 8999999999999999999);
+  for (const char* bad :
+       {"9999999999.5", "9300000000", "9.3e9", "-9999999999", "99999999999999999999", "1e300", "nan", "inf"})
+    EXPECT_FALSE(parse_seconds_to_ns(bad, &t)) << bad << " -> " << t;
+  try {
+    parse_tum("1.0 0 0 0 0 0 0 1\n9999999999.5 0 0 0 0 0 0 1\n", "late.txt");
+    FAIL() << "no error";
+  } catch (const IoError& e) {
+    EXPECT_EQ(e.line(), 2);
+    EXPECT_NE(std::string(e.what()).find("time stamp '9999999999.5'"), std::string::npos) << e.what();
+  }
+}
+
+// An absurd position (one estimate at 1e300) or a quaternion too large to
+// normalise is an error naming the file and line, not a degenerate alignment.
+TEST(Trajectory, AbsurdPositionsAndQuaternionsAreErrors) {
+  const std::string head = "1.0 0 0 0 0 0 0 1\n";
+  for (const std::string bad : {"2.0 1e300 0 0 0 0 0 1", "2.0 0 -2e8 0 0 0 0 1", "2.0 0 0 0 1e300 0 0 1"}) {
+    try {
+      parse_tum(head + bad + "\n", "est.txt");
+      FAIL() << bad;
+    } catch (const IoError& e) {
+      EXPECT_EQ(e.line(), 2) << bad;
+      const std::string what = e.what();
+      EXPECT_TRUE(what.find("position (") != std::string::npos ||
+                  what.find("quaternion (") != std::string::npos)
+          << what;
+    }
+  }
+  EXPECT_NO_THROW(
+      parse_tum(head + "2.0 6378137.0 -4.5e6 120.25 0 0 0 1\n", "ecef.txt"));  // Earth-scale is fine
+}
+
+TEST(Trajectory, FolderIsNotAnEmptyTrajectory) {
+  const std::string dir = std::filesystem::path(temp_path("x")).parent_path().string();
+  try {
+    read_tum(dir);
+    FAIL() << "no error";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a folder, not a file"), std::string::npos) << e.what();
+  }
+}

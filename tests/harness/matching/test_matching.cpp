@@ -1,10 +1,15 @@
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+#include <regex>
 #include <sstream>
+#include <vector>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
@@ -154,6 +159,112 @@ TEST(MatchCli, TumSequencePair) {
   const std::string j = slurp(json);
   EXPECT_NE(j.find("\"name\":\"pe\""), std::string::npos);
   EXPECT_EQ(j.find("\"name\":\"ransac\""), std::string::npos);
+}
+
+std::string temp_file(const std::string& name) {
+  return ::testing::TempDir() + "pvb_match_" + std::to_string(::getpid()) + "_" + name;
+}
+
+TEST(MatchGroundTruth, SingularOrNonFiniteHomographyIsAnError) {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"1 2 3\n2 4 6\n0 0 1\n", "singular"},  // rank 2
+      {"0 0 0\n0 0 0\n0 0 0\n", "singular"},
+      {"1e-300 0 0\n0 1e-300 0\n0 0 1\n", "singular"},
+      {"1 0 nan\n0 1 0\n0 0 1\n", "nine finite numbers"},
+      {"1 0 0\n0 1 0\n", "nine finite numbers"}};
+  for (const auto& [text, why] : bad) {
+    const std::string path = temp_file("H");
+    write_file(path, text);
+    try {
+      load_homography(path);
+      ADD_FAILURE() << text;
+    } catch (const IoError& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+  }
+  const std::string scaled = temp_file("Hs");
+  write_file(scaled, "1e-6 0 1e-4\n0 2e-6 0\n0 0 1e-6\n");  // a valid map at a small scale
+  EXPECT_NO_THROW(load_homography(scaled));
+}
+
+TEST(MatchGroundTruth, DepthWithoutValidPixelsIsAnError) {
+  const std::string zero = temp_file("zero.png");
+  ASSERT_TRUE(cv::imwrite(zero, cv::Mat(48, 64, CV_16UC1, cv::Scalar(0))));
+  try {
+    load_depth_m(zero, 5000);
+    FAIL() << "accepted";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("zero.png: depth image holds no valid depth"), std::string::npos)
+        << e.what();
+  }
+  cv::Mat one(48, 64, CV_16UC1, cv::Scalar(0));
+  one.at<std::uint16_t>(3, 4) = 10000;
+  ASSERT_TRUE(cv::imwrite(zero, one));
+  EXPECT_FLOAT_EQ(load_depth_m(zero, 5000).at<float>(3, 4), 2.0f);
+}
+
+TEST(MatchGroundTruth, CameraSettingsOutOfRangeAreErrors) {
+  const std::string good = "%YAML:1.0\nCamera.fx: 500\nCamera.fy: 500\nCamera.cx: 320\nCamera.cy: 240\n";
+  for (const std::string extra : {"Camera.width: 1e10\n", "Camera.k1: .nan\n", "DepthMapFactor: .inf\n"}) {
+    const std::string path = temp_file("cam.yaml");
+    write_file(path, good + extra);
+    EXPECT_THROW(load_camera_settings(path), ConfigError) << extra;
+  }
+  const std::string path = temp_file("cam.yaml");
+  write_file(path, std::regex_replace(good, std::regex("cx: 320"), "cx: 1e9"));
+  EXPECT_THROW(load_camera_settings(path), ConfigError);
+}
+
+TEST(MatchExperiment, TinyImagesAreAClearError) {
+  const cv::Mat dot(1, 1, CV_8UC3, cv::Scalar::all(128));
+  EXPECT_THROW(check_image_size(dot, "dot.png"), IoError);
+  EXPECT_THROW(make_coarse_set(dot, dot), pvb::Error);  // not an OpenCV assertion
+  cv::Mat small(kMinImageSidePx, kMinImageSidePx, CV_8UC3);
+  cv::RNG(3).fill(small, cv::RNG::UNIFORM, 0, 255);
+  EXPECT_NO_THROW(check_image_size(small, "small.png"));
+  EXPECT_NO_THROW(make_coarse_set(small, small));
+}
+
+/// Runs pvbench with `args`; stdout and stderr together in *out.
+int run_pvbench(const std::string& args, std::string* out) {
+  const std::string log = temp_file("log.txt");
+  const int status =
+      std::system((std::string(PVB_BINARY_DIR) + "/bin/pvbench " + args + " > " + log + " 2>&1").c_str());
+  *out = read_file(log);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// A 1x1 image, a truncated PPM, a singular homography and an all-zero
+// depth image are each one error line naming the file (exit 1, not an
+// internal error, and nothing from OpenCV or libpng).
+TEST(MatchCli, BadInputsAreOneErrorLineEach) {
+  const std::string wall = kShared + "/data/oxford/wall/";
+  const std::string dot = temp_file("dot.ppm"), cut = temp_file("cut.ppm"), H = temp_file("H"),
+                    zero = temp_file("zero.png");
+  ASSERT_TRUE(cv::imwrite(dot, cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(9))));
+  const std::string ppm = read_file(wall + "img2.ppm");
+  write_file(cut, ppm.substr(0, ppm.size() / 2));
+  write_file(H, "1 2 3\n2 4 6\n0 0 1\n");
+  const cv::Mat img1 = cv::imread(wall + "img1.ppm");
+  ASSERT_TRUE(cv::imwrite(zero, cv::Mat(img1.size(), CV_16UC1, cv::Scalar(0))));
+  const std::string pose = "\"0 0 0 0 0 0 1\"";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--img1 " + dot + " --img2 " + wall + "img2.ppm --homography " + wall + "H1to2p",
+       dot + ": image is 1x1"},
+      {"--img1 " + wall + "img1.ppm --img2 " + cut + " --homography " + wall + "H1to2p",
+       cut + ": damaged image: truncated PNM"},
+      {"--img1 " + wall + "img1.ppm --img2 " + wall + "img2.ppm --homography " + H,
+       H + ": the homography is singular"},
+      {"--img1 " + wall + "img1.ppm --img2 " + wall + "img1.ppm --depth1 " + zero + " --depth2 " + zero +
+           " --pose1 " + pose + " --pose2 " + pose + " --settings " + kShared +
+           "/data/tum/TUM1.yaml --runs 1",
+       zero + ": depth image holds no valid depth"}};
+  for (const auto& [args, expected] : cases) {
+    std::string out;
+    EXPECT_EQ(run_pvbench("match " + args, &out), 1) << args << "\n" << out;
+    EXPECT_NE(out.find("pvbench: error: " + expected), std::string::npos) << out;
+    EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+  }
 }
 
 }  // namespace

@@ -240,6 +240,98 @@ TEST(Settings, PointCloudMappingSection) {
   }
 }
 
+/// TUM1.yaml with `key` set to `value` (replaced where TUM1 has it, else appended).
+std::string tum1_with(const std::string& key, const std::string& value) {
+  const std::string text = read_file(kTum1);
+  const std::regex line("(^|\n)" + std::regex_replace(key, std::regex("\\."), "\\.") + ":[^\n]*");
+  if (std::regex_search(text, line)) return std::regex_replace(text, line, "$1" + key + ": " + value);
+  return text + "\n" + key + ": " + value + "\n";
+}
+
+// Every key is range-checked when the file is read: a value that would
+// reach an OpenCV assertion, a bad_alloc, a float-to-int overflow or a
+// silently useless camera is a ConfigError naming the key and the range.
+TEST(Settings, OutOfRangeValuesAreErrorsNamingKeyAndRange) {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"ORBextractor.nLevels", "100"},
+      {"ORBextractor.nLevels", "-2147483649"},
+      {"ORBextractor.nLevels", "24"},  // 480 px / 1.2^23 < 8 px
+      {"ORBextractor.scaleFactor", "1e300"},
+      {"ORBextractor.scaleFactor", "-2147483649"},
+      {"ORBextractor.scaleFactor", ".nan"},
+      {"ORBextractor.nFeatures", "2000000000"},
+      {"ORBextractor.nFeatures", "1e300"},
+      {"ORBextractor.iniThFAST", "-5"},
+      {"ORBextractor.minThFAST", "256"},
+      {"Camera.k1", ".nan"},
+      {"Camera.k3", "-.inf"},
+      {"Camera.cx", ".inf"},
+      {"Camera.cx", "700"},
+      {"Camera.cy", "-1"},
+      {"Camera.fx", "1e308"},
+      {"Camera.fy", "0"},
+      {"Camera.width", "1e10"},
+      {"Camera.height", "8"},
+      {"Camera.fps", ".inf"},
+      {"Camera.bf", ".nan"},
+      {"ThDepth", ".inf"},
+      {"DepthMapFactor", "1e300"},
+      {"PEMatch.population", "1000000000"},
+      {"PEMatch.j", "-1"},
+      {"PEMatch.stallIterations", "1e12"},
+      {"PEMatch.threshold", ".inf"},
+      {"KeyFrame.minTrackedClose", "3e9"},
+      {"KeyFrame.refOverlap", ".nan"},
+      {"PointCloudMapping.Resolution", "1e-300"},
+      {"PointCloudMapping.MaxDepth", ".inf"},
+      {"PointCloudMapping.Stride", "1e10"},
+      {"LoopClosing.searchRadius", ".inf"},
+      {"LoopClosing.maxCandidates", "4294967297"},
+      {"LoopClosing.maxCorrectionAngle", "1e300"},
+      {"LoopClosing.essentialWeight", "-7"},
+      {"LoopClosing.rotationWeight", ".nan"}};
+  for (const auto& [key, value] : bad) {
+    try {
+      read_settings(temp_copy("range", tum1_with(key, value)));
+      ADD_FAILURE() << key << ": " << value << " accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), key) << e.what();
+      EXPECT_NE(std::string(e.what()).find(" in "), std::string::npos) << "no range in: " << e.what();
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << key << ": " << value << " gave " << e.what();
+    }
+  }
+}
+
+// The limits let real files through: a pyramid as deep as 640x480 allows
+// at scaleFactor 1.2, a 2x pyramid, distortion and a principal point on the
+// image border.
+TEST(Settings, RangesAcceptRealFiles) {
+  const Settings deep = read_settings(temp_copy("deep", tum1_with("ORBextractor.nLevels", "23")));
+  EXPECT_EQ(deep.orb.num_levels, 23);
+  const Settings twice =
+      read_settings(temp_copy("twice", std::regex_replace(tum1_with("ORBextractor.scaleFactor", "2"),
+                                                          std::regex("nLevels: 8"), "nLevels: 6")));
+  EXPECT_EQ(twice.orb.num_levels, 6);
+  const Settings edge = read_settings(temp_copy("edge", tum1_with("Camera.cx", "640")));
+  EXPECT_DOUBLE_EQ(edge.K.cx, 640);
+}
+
+// A YAML syntax error names the file, the line and OpenCV's reason (not
+// OpenCV's function name).
+TEST(Settings, SyntaxErrorNamesLineAndReason) {
+  const std::string path = temp_copy("syntax", "%YAML:1.0\nCamera.fx: 500\nCamera.fy 500\nCamera.cx: 320\n");
+  try {
+    read_settings(path);
+    FAIL() << "expected IoError";
+  } catch (const IoError& e) {
+    EXPECT_EQ(e.line(), 3) << e.what();
+    const std::string what = e.what();
+    EXPECT_EQ(what.find("parseKey"), std::string::npos) << what;
+    EXPECT_NE(what.find(path + ":3: cannot parse settings file: "), std::string::npos) << what;
+  }
+}
+
 TEST(Settings, MissingFileIsAnIoError) { EXPECT_THROW(read_settings("/nonexistent/settings.yaml"), IoError); }
 
 }  // namespace

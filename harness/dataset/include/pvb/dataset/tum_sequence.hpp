@@ -63,8 +63,12 @@ class TumSequenceWriter {
 void make_dirs(const std::string& dir);
 
 /// Reads a TUM RGB-D folder as a frame source.  Pairs come from
-/// associations.txt when present, else rgb.txt and depth.txt are associated
-/// one to one by nearest timestamp within max_diff_s.
+/// associations.txt when present (rgb.txt and depth.txt are then not read),
+/// else rgb.txt and depth.txt are associated one to one by nearest timestamp
+/// within max_diff_s.  Every time stamp must be a number of seconds within
+/// +-geom::kMaxAbsTimeS.  associations.txt is tracked in its own order, so
+/// its colour time stamps must increase (IoError naming the line otherwise);
+/// rgb.txt and depth.txt are sorted by time (a repeated stamp is an error).
 class TumSequenceReader : public sensor::FrameSource {
  public:
   struct Entry {
@@ -74,11 +78,20 @@ class TumSequenceReader : public sensor::FrameSource {
     std::string depth;
   };
   explicit TumSequenceReader(const std::string& dir, double depth_factor = sensor::kTumDepthFactor, double max_diff_s = 0.02);
+  /// The next frame whose images load; a frame whose image is missing or
+  /// damaged is skipped with one warning line on stderr.  nullopt at the
+  /// end, and once more than max_skipped() frames were skipped
+  /// (skip_limit_reached() tells the two apart).
   std::optional<sensor::RgbdFrame> next() override;
+  /// Frames next() may skip before it stops; default max(10, frames / 10).
+  std::size_t max_skipped() const { return max_skipped_; }
+  void set_max_skipped(std::size_t n) { max_skipped_ = n; }
+  /// True once more than max_skipped() frames were skipped.
+  bool skip_limit_reached() const { return skipped_ > max_skipped_; }
   std::size_t size_hint() const override { return entries_.size(); }
   std::string describe() const override { return "tum:" + dir_; }
   const std::vector<Entry>& entries() const { return entries_; }
-  /// Loads frame i (throws IoError for a missing or unreadable image).
+  /// Loads frame i (throws IoError for a missing, damaged or unreadable image).
   sensor::RgbdFrame load(std::size_t i) const;
   /// Number of frames skipped because an image was missing or corrupt.
   std::size_t skipped() const { return skipped_; }
@@ -89,9 +102,13 @@ class TumSequenceReader : public sensor::FrameSource {
   std::vector<Entry> entries_;
   std::size_t pos_ = 0;
   std::size_t skipped_ = 0;
+  std::size_t max_skipped_ = 0;
 };
 
 /// Parses a TUM list file (rgb.txt / depth.txt): "t path" lines, # comments.
+/// The result is sorted by time.  Throws IoError naming the file and line for
+/// a malformed line, a time stamp that is not a number of seconds within
+/// +-geom::kMaxAbsTimeS, and a repeated time stamp.
 std::vector<std::pair<std::int64_t, std::string>> read_tum_list(const std::string& path);
 
 }  // namespace pvb::dataset

@@ -40,8 +40,9 @@ struct Sim3Transform {
 /// With with_scale == false s is fixed to 1 (this is the same optimum as
 /// Horn's method used by TUM's evaluate_ate.py).  Inputs are not modified.
 /// Throws EvalError when the sizes differ, when there are fewer than 3 pairs,
-/// or when either point set is degenerate (all points on one line or one
-/// point), since the rotation is then not determined.
+/// when a position is not finite or beyond kMaxAbsCoordinateM, or when
+/// either point set is degenerate (all points on one line or one point),
+/// since the rotation is then not determined.
 Sim3Transform umeyama(const std::vector<geom::Vec3d>& est, const std::vector<geom::Vec3d>& gt,
                       bool with_scale);
 

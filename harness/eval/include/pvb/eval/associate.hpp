@@ -9,6 +9,9 @@
 
 namespace pvb::eval {
 
+/// Largest max_diff_s associate() accepts, seconds.
+constexpr double kMaxAssociationDiffS = 1e9;
+
 struct AssociationOptions {
   double max_diff_s = 0.02;  ///< a pair must satisfy |t_gt - (t_est + offset)| < max_diff
   double offset_s = 0.0;     ///< added to every estimate time stamp
@@ -24,6 +27,8 @@ struct IndexPair {
 /// max_diff is a candidate; candidates are taken closest first (ties by
 /// ground-truth time, then estimate time), each stamp at most once.  The
 /// result is sorted by time.  Returns an empty vector when nothing associates.
+/// Throws EvalError when max_diff_s is not in (0, kMaxAssociationDiffS] or
+/// |offset_s| > geom::kMaxAbsTimeS.
 std::vector<IndexPair> associate(const Trajectory& gt, const Trajectory& est,
                                  const AssociationOptions& options = {});
 

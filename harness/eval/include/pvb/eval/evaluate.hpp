@@ -36,7 +36,9 @@ struct EvalResult {
   RpeOptions rpe_options;
 };
 
-/// Evaluates `est` against `gt` (neither is modified): associates them
+/// Evaluates `est` against `gt` (neither is modified): checks every pose
+/// (EvalError naming the trajectory and time for one that is not finite or
+/// beyond kMaxAbsCoordinateM), associates them
 /// (EvalError when nothing associates), aligns the estimate, and computes ATE
 /// and RPE.  The RPE is computed on the associated, aligned poses; it does not
 /// depend on se3/origin alignment, and with sim3 it uses the recovered scale.

@@ -37,22 +37,32 @@ enum class TrajectoryFormat {
   kKitti,  ///< 12 numbers per line (row-major 3x4 [R|t]); times in a separate file
 };
 
+/// Largest |coordinate| of a position accepted from a trajectory, metres:
+/// beyond any map on Earth (ECEF coordinates stay below 6.4e6 m), and far
+/// from where squared distances lose the millimetres ATE is made of.
+constexpr double kMaxAbsCoordinateM = 1e8;
+
+/// True when every coordinate is finite and within kMaxAbsCoordinateM.
+bool plausible_position(const geom::Vec3d& p_m);
+
 /// Parses a time in seconds written in decimal ("1305031102.175304",
 /// "-0.5", "1e-3") into nanoseconds.  Plain decimals are converted exactly
 /// (no double rounding); exponent forms go through double.  Returns false
-/// when the text is not a number.
+/// when the text is not a number or |t| > geom::kMaxAbsTimeS.
 bool parse_seconds_to_ns(const std::string& text, std::int64_t* t_ns);
 
 /// Parses TUM trajectory text.  Fields are separated by spaces, tabs or
 /// commas; lines starting with '#' and blank lines are skipped.  Quaternions
 /// are normalised.  Throws pvb::IoError naming `source` and the 1-based line
-/// for a malformed line (wrong field count, not a number, zero quaternion,
-/// non-finite value, duplicate time), and when no pose is found at all.
+/// for a malformed line (wrong field count, not a number, a time beyond
+/// geom::kMaxAbsTimeS, a position beyond kMaxAbsCoordinateM, a zero or
+/// overflowing quaternion, non-finite value, duplicate time), and when no
+/// pose is found at all.
 /// The result is sorted by time.
 Trajectory parse_tum(const std::string& text, const std::string& source);
 
 /// Reads a TUM trajectory file (see parse_tum()); throws pvb::IoError when the
-/// file cannot be read.
+/// file cannot be read or is a folder.
 Trajectory read_tum(const std::string& path);
 
 /// Reads a KITTI odometry pose file (12 numbers per line, the first three

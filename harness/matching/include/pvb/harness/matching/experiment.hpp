@@ -31,7 +31,17 @@ struct CoarseSet {
   double extract_match_ms = 0;           ///< ORB on both images + coarse matching
 };
 
+/// Smallest image side the experiment takes, pixels: ORB detects nothing
+/// within 16 px of a border, and its default 8-level pyramid (scale 1.2)
+/// must keep a level of at least a pixel.
+constexpr int kMinImageSidePx = 64;
+
+/// Throws IoError naming `path` when `image` is smaller than
+/// kMinImageSidePx on a side.
+void check_image_size(const cv::Mat& image, const std::string& path);
+
 /// Extracts ORB features on both images and matches them (ratio test).
+/// Throws pvb::Error when an image is smaller than kMinImageSidePx.
 CoarseSet make_coarse_set(const cv::Mat& img1, const cv::Mat& img2, double ratio = 0.9);
 
 /// Keep-mask of one method on a coarse set.  `seed` drives the randomised

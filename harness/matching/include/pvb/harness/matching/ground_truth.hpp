@@ -21,7 +21,8 @@ enum class MatchLabel : std::uint8_t {
 };
 
 /// Reads a 3x3 homography written as nine numbers (Oxford H1toNp files).
-/// Throws IoError when the file is missing or malformed.
+/// Throws IoError when the file is missing or malformed, a number is not
+/// finite, or the matrix is singular.
 Eigen::Matrix3d load_homography(const std::string& path);
 
 /// Correct when H maps p1 to within threshold_px of p2.
@@ -37,10 +38,13 @@ struct CameraSettings {
   double depth_map_factor = 5000.0;  ///< raw depth units per metre
 };
 
-/// Loads CameraSettings; throws IoError (unreadable) or ConfigError (missing key).
+/// Loads CameraSettings; throws IoError (unreadable) or ConfigError (missing
+/// key, or a value outside the ranges slam::read_settings accepts).
 CameraSettings load_camera_settings(const std::string& path);
 
-/// Loads a 16-bit depth PNG as metres (CV_32F, 0 = invalid).  Throws IoError.
+/// Loads a 16-bit depth PNG as metres (CV_32F, 0 = invalid).  Throws IoError
+/// for a missing, damaged or unreadable file and for an image without any
+/// valid depth (all zero).
 cv::Mat load_depth_m(const std::string& path, double depth_map_factor);
 
 /// Parses a TUM pose "tx ty tz qx qy qz qw" (T_w_c); throws ConfigError

@@ -93,8 +93,14 @@ struct Settings {
 };
 
 /// Reads an ORB-SLAM2 RGB-D settings file.  Throws IoError when the file
-/// cannot be opened or parsed and ConfigError naming the first missing or
-/// invalid key.
+/// cannot be opened or parsed (with the line and OpenCV's reason for a
+/// syntax error) and ConfigError naming the first missing or invalid key and
+/// the range it accepts.  Every key is range-checked here, so that the
+/// values the SLAM code sees are safe: intrinsics finite and positive with
+/// cx, cy inside Camera.width x height, distortion within +-100,
+/// ORBextractor.nLevels small enough that the coarsest pyramid level keeps
+/// 8 px, nFeatures at most 100000, FAST thresholds in [1, 255], and bounded
+/// counts and distances in the optional sections.
 Settings read_settings(const std::string& path);
 
 }  // namespace pvb::slam
