@@ -2,8 +2,8 @@
 
 namespace pvb {
 namespace {
-std::string config_message(const std::string& file, const std::string& key,
-                           const std::string& expected, const std::string& got) {
+std::string config_message(const std::string& file, const std::string& key, const std::string& expected,
+                           const std::string& got) {
   std::string msg = file + ": " + key + ": expected " + expected;
   if (!got.empty()) msg += ", got " + got;
   return msg;
@@ -17,7 +17,10 @@ ConfigError::ConfigError(std::string file, std::string key, std::string expected
     : Error(config_message(file, key, expected, got)), file_(std::move(file)), key_(std::move(key)) {}
 
 IoError::IoError(std::string file, std::string message, int line)
-    : Error(io_message(file, message, line)), file_(std::move(file)), line_(line) {}
+    : Error(io_message(file, message, line)),
+      file_(std::move(file)),
+      message_(std::move(message)),
+      line_(line) {}
 
 const char* version() { return PVB_VERSION; }
 

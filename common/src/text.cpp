@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_file.hpp"
 
 namespace pvb {
 
@@ -20,16 +21,7 @@ std::string read_file(const std::string& path) {
 }
 
 void write_file(const std::string& path, const std::string& content) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw IoError(path, std::string("cannot open for writing: ") + std::strerror(errno));
-    out << content;
-    out.flush();
-    if (!out) throw IoError(path, "write failed");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0)
-    throw IoError(path, std::string("cannot rename temporary file: ") + std::strerror(errno));
+  write_file_via_temp(path, [&](OutputFile& out) { out.append(content); });
 }
 
 std::vector<std::string> split_ws(const std::string& line, const char* seps) {
@@ -50,11 +42,21 @@ std::string json_escape(const std::string& s) {
   out.reserve(s.size() + 8);
   for (char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buf[8];
@@ -66,6 +68,24 @@ std::string json_escape(const std::string& s) {
     }
   }
   return out;
+}
+
+std::string format_number(const char* printf_format, double v) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, printf_format, v);
+  return buf;
+}
+
+std::string format_g(double v, int significant_digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", significant_digits, v);
+  return buf;
+}
+
+std::string format_fixed(double v, int decimals) {
+  char buf[352];  // %f of the largest double: 309 digits, the point and the decimals
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
 }
 
 std::string json_number(double v, int significant_digits) {

@@ -20,6 +20,7 @@
 #include "command.hpp"
 #include "count_option.hpp"
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_file.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
@@ -58,23 +59,12 @@ const char* const kOutputs[] = {"camera.yaml", "CameraTrajectory.txt", "KeyFrame
 
 using Clock = std::chrono::steady_clock;
 
-std::ofstream open_out(const std::string& path) {
-  std::ofstream f(path);
-  if (!f) throw IoError(path, "cannot open for writing");
-  return f;
-}
-
-std::string fmt(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 void write_map_ply(const std::string& path, const std::vector<Eigen::Vector3d>& points) {
   std::ostringstream s;
   s << "ply\nformat ascii 1.0\ncomment PE-SLAM sparse map, world frame, metres\nelement vertex "
     << points.size() << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-  for (const Eigen::Vector3d& p : points) s << fmt(p.x()) << " " << fmt(p.y()) << " " << fmt(p.z()) << "\n";
+  for (const Eigen::Vector3d& p : points)
+    s << format_g(p.x()) << " " << format_g(p.y()) << " " << format_g(p.z()) << "\n";
   write_file(path, s.str());
 }
 
@@ -104,6 +94,7 @@ std::optional<scenes::Scenario> check_inputs(const CameraArgs& a) {
         {a.oni, "the --oni recording"}, {a.settings, "the --settings file"}, {scenario_path, "the scenario"}};
     for (const char* name : kOutputs) files.push_back({a.out + "/" + name, "an output of this run"});
     openni::check_record_not_on(a.record, files);
+    openni::check_new_recording_path(a.record);  // before any device is open
   }
   return scenario;
 }
@@ -162,19 +153,19 @@ openni::OpenniOptions source_options(const CameraArgs& a, const slam::Settings& 
 /// beside the device, so nothing but images travels through OpenNI2
 /// (docs/openni.md).
 struct LiveOutputs {
-  std::ofstream cam_traj;
+  OutputFile cam_traj;
   std::unique_ptr<sim::Simulator> gt_sim;
-  std::ofstream gt_file;
+  OutputFile gt_file;
 };
 
 LiveOutputs open_live_outputs(const std::string& out, const std::optional<scenes::Scenario>& scenario) {
   LiveOutputs o;
-  o.cam_traj = open_out(out + "/CameraTrajectory.txt");
-  o.cam_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n" << std::flush;
+  o.cam_traj = OutputFile(out + "/CameraTrajectory.txt");
+  o.cam_traj.append("# timestamp tx ty tz qx qy qz qw (T_w_c)\n");
   if (scenario) {
     o.gt_sim = std::make_unique<sim::Simulator>(*scenario);
-    o.gt_file = open_out(out + "/groundtruth.txt");
-    o.gt_file << "# timestamp tx ty tz qx qy qz qw (T_w_c, simulator ground truth)\n" << std::flush;
+    o.gt_file = OutputFile(out + "/groundtruth.txt");
+    o.gt_file.append("# timestamp tx ty tz qx qy qz qw (T_w_c, simulator ground truth)\n");
   }
   return o;
 }
@@ -197,13 +188,13 @@ slam::TrackingState track_frame(const sensor::RgbdFrame& frame, const CameraSett
                       std::to_string(K.width) + "x" + std::to_string(K.height));
   if (live.gt_sim) {
     while (live.gt_sim->frame_index() < static_cast<int>(frame.index)) live.gt_sim->advance();
-    live.gt_file << geom::format_tum_line({frame.t_ns, live.gt_sim->T_w_c()}) << "\n" << std::flush;
+    live.gt_file.append(geom::format_tum_line({frame.t_ns, live.gt_sim->T_w_c()}) + "\n");
   }
   const slam::FrameResult r = system.track(frame);
   ++counts.frames;
   if (r.state == slam::TrackingState::kLost) ++counts.lost;
   if (r.state == slam::TrackingState::kNotInitialized) ++counts.not_initialized;
-  if (r.T_w_c) live.cam_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+  if (r.T_w_c) live.cam_traj.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
   return r.state;
 }
 
@@ -220,20 +211,22 @@ TrackCounts track_frames(openni::OpenniSource& source, std::size_t max_frames, c
   {
     const StopSignals stop_signals;
     ProgressBar bar("camera " + source.describe(), total);
-    try {
-      while ((max_frames == 0 || counts.frames < max_frames) && !StopSignals::requested()) {
-        std::optional<sensor::RgbdFrame> frame = source.next();
-        if (!frame) break;
-        const slam::TrackingState state = track_frame(*frame, settings, system, live, counts);
-        const double elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
-        char status[128];
-        std::snprintf(status, sizeof status, "%.1f fps, %s, %zu keyframes",
-                      elapsed_s > 0 ? static_cast<double>(counts.frames) / elapsed_s : 0.0,
-                      slam::to_string(state), system.num_keyframes());
-        bar.update(counts.frames, status);
+    while ((max_frames == 0 || counts.frames < max_frames) && !StopSignals::requested()) {
+      std::optional<sensor::RgbdFrame> frame;
+      try {
+        frame = source.next();
+      } catch (const IoError& e) {  // an error of the stream, not of our outputs
+        counts.stream_error = e;
+        break;
       }
-    } catch (const IoError& e) {
-      counts.stream_error = e;
+      if (!frame) break;
+      const slam::TrackingState state = track_frame(*frame, settings, system, live, counts);
+      const double elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
+      char status[128];
+      std::snprintf(status, sizeof status, "%.1f fps, %s, %zu keyframes",
+                    elapsed_s > 0 ? static_cast<double>(counts.frames) / elapsed_s : 0.0,
+                    slam::to_string(state), system.num_keyframes());
+      bar.update(counts.frames, status);
     }
   }
   counts.elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
@@ -262,8 +255,8 @@ void evaluate_against_ground_truth(const std::string& out, std::ostringstream& j
     const eval::Trajectory est = eval::read_tum(out + "/CameraTrajectory.txt");
     const eval::EvalResult res = eval::evaluate(gt, est, eval::EvalOptions{});
     std::printf("ATE RMSE %.4f m over %zu poses\n", res.ate.rmse, est.size());
-    js << ",\n  \"ate_rmse_m\": " << fmt(res.ate.rmse)
-       << ",\n  \"rpe_trans_rmse_m\": " << fmt(res.rpe_trans_m.rmse);
+    js << ",\n  \"ate_rmse_m\": " << format_g(res.ate.rmse)
+       << ",\n  \"rpe_trans_rmse_m\": " << format_g(res.rpe_trans_m.rmse);
   } catch (const Error& e) {
     std::fprintf(stderr, "pvbench camera: warning: no evaluation: %s\n", e.what());
   }
@@ -283,7 +276,7 @@ void report_run(const CameraArgs& a, const slam::Settings& settings, openni::Ope
      << ",\n  \"dropped_colour\": " << source.dropped_colour()
      << ",\n  \"dropped_depth\": " << source.dropped_depth()
      << ",\n  \"keyframes\": " << system.num_keyframes() << ",\n  \"map_points\": " << system.num_map_points()
-     << ",\n  \"fps\": " << fmt(fps);
+     << ",\n  \"fps\": " << format_g(fps);
   std::printf("camera: %zu frames (%.1f fps), lost %zu, keyframes %zu, map points %zu%s\n", c.frames, fps,
               c.lost, system.num_keyframes(), system.num_map_points(),
               StopSignals::requested() ? " (stopped by a signal)" : "");

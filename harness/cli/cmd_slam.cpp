@@ -15,6 +15,7 @@
 
 #include "command.hpp"
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_file.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
@@ -52,8 +53,7 @@ class MotionMatchScorer {
  public:
   MotionMatchScorer(const std::string& out_dir, const std::string& gt_path, const slam::Settings& s)
       : gt_path_(gt_path), csv_(out_dir + "/motion_matches.csv") {
-    if (!csv_) throw IoError(out_dir + "/motion_matches.csv", "cannot open for writing");
-    csv_ << "frame,octave1,octave2,u1,v1,u2,v2,label,pe_keep,pose_inlier\n";
+    csv_.append("frame,octave1,octave2,u1,v1,u2,v2,label,pe_keep,pose_inlier\n");
     gt_.K = s.K;
     if (s.has_distortion()) gt_.dist_coeffs = (cv::Mat_<double>(1, 5) << s.k1, s.k2, s.p1, s.p2, s.k3);
     gt_.threshold_px = kThresholdPx;
@@ -71,49 +71,49 @@ class MotionMatchScorer {
     gt_.depth2_m = frame.depth_m;
     gt_.T_c2_c1 = T_w_c.inverse() * prev_T_w_c_;
     const std::vector<harness::MatchLabel> labels = harness::label_by_rgbd(m.raw, m.undistorted, gt_);
+    std::ostringstream rows;
     for (std::size_t k = 0; k < labels.size(); ++k) {
       const int label = static_cast<int>(labels[k]);
       const int keep = m.pe_keep[k];
       const int inlier = k < m.pose_inlier.size() ? m.pose_inlier[k] : 0;
-      csv_ << frame.index << "," << m.octaves[k][0] << "," << m.octaves[k][1] << "," << m.undistorted[k].p1.x()
-           << "," << m.undistorted[k].p1.y() << "," << m.undistorted[k].p2.x() << "," << m.undistorted[k].p2.y()
-           << "," << label << "," << keep << "," << inlier << "\n";
+      rows << frame.index << "," << m.octaves[k][0] << "," << m.octaves[k][1] << ","
+           << m.undistorted[k].p1.x() << "," << m.undistorted[k].p1.y() << "," << m.undistorted[k].p2.x()
+           << "," << m.undistorted[k].p2.y() << "," << label << "," << keep << "," << inlier << "\n";
       if (labels[k] == harness::MatchLabel::kUnknown) continue;
       const bool correct = labels[k] == harness::MatchLabel::kCorrect;
       (correct ? correct_ : wrong_) += 1;
       if (keep) (correct ? kept_correct_ : kept_wrong_) += 1;
       if (inlier) (correct ? inlier_correct_ : inlier_wrong_) += 1;
     }
-    csv_.flush();
+    csv_.append(rows.str());
     remember(frame, T_w_c);
   }
 
   /// "motion_matches": {...} for stats.json.
   std::string json() const {
-    const auto ratio = [](long a, long b) { return b > 0 ? static_cast<double>(a) / static_cast<double>(b) : 0.0; };
+    const auto ratio = [](long a, long b) {
+      return b > 0 ? static_cast<double>(a) / static_cast<double>(b) : 0.0;
+    };
     std::ostringstream js;
     js << "\"motion_matches\": {\"threshold_px\": " << kThresholdPx << ", \"correct\": " << correct_
-       << ", \"wrong\": " << wrong_ << ", \"kept_correct\": " << kept_correct_ << ", \"kept_wrong\": " << kept_wrong_
-       << ", \"pe_precision\": " << fmt(ratio(kept_correct_, kept_correct_ + kept_wrong_))
-       << ", \"pe_recall\": " << fmt(ratio(kept_correct_, correct_))
-       << ", \"pose_inlier_correct\": " << inlier_correct_ << ", \"pose_inlier_wrong\": " << inlier_wrong_ << "}";
+       << ", \"wrong\": " << wrong_ << ", \"kept_correct\": " << kept_correct_
+       << ", \"kept_wrong\": " << kept_wrong_
+       << ", \"pe_precision\": " << format_g(ratio(kept_correct_, kept_correct_ + kept_wrong_))
+       << ", \"pe_recall\": " << format_g(ratio(kept_correct_, correct_))
+       << ", \"pose_inlier_correct\": " << inlier_correct_ << ", \"pose_inlier_wrong\": " << inlier_wrong_
+       << "}";
     return js.str();
   }
 
  private:
   static constexpr double kThresholdPx = 4.0;  ///< reprojection error of a correct match
-  static std::string fmt(double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.6g", v);
-    return buf;
-  }
   void remember(const sensor::RgbdFrame& frame, const geom::SE3d& T_w_c) {
     prev_depth_m_ = frame.depth_m.clone();
     prev_T_w_c_ = T_w_c;
   }
 
   std::string gt_path_;
-  std::ofstream csv_;
+  OutputFile csv_;
   harness::RgbdGroundTruth gt_;
   cv::Mat prev_depth_m_;
   geom::SE3d prev_T_w_c_ = geom::SE3d::Identity();
@@ -128,12 +128,6 @@ double thread_cpu_ms() {
   return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
-std::ofstream open_out(const std::string& path) {
-  std::ofstream f(path);
-  if (!f) throw IoError(path, "cannot open for writing");
-  return f;
-}
-
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -141,12 +135,6 @@ double percentile(std::vector<double> v, double p) {
   const std::size_t lo = static_cast<std::size_t>(pos);
   const std::size_t hi = std::min(lo + 1, v.size() - 1);
   return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
-
-std::string fmt(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
 }
 
 void write_tum_file(const std::string& path, const std::vector<geom::StampedPose>& poses) {
@@ -211,7 +199,7 @@ class SlamRun {
   slam::Settings settings_;
   dataset::TumSequenceReader reader_;
   std::unique_ptr<slam::System> system_;
-  std::ofstream cam_traj_, kf_traj_, timing_;
+  OutputFile cam_traj_, kf_traj_, timing_;
   std::unique_ptr<MotionMatchScorer> scorer_;
   Tally tally_;
   std::string image_size_error_;  ///< set when the loop stopped on an image of the wrong size
@@ -225,9 +213,11 @@ slam::Settings settings_for(const SlamArgs& a) {
     throw ConfigError("command line", "--max-frames", "a number of frames >= 0 (0: all)",
                       std::to_string(a.max_frames));
   if (!(a.max_missing >= 0.0 && a.max_missing <= 1.0))  // NaN fails too
-    throw ConfigError("command line", "--max-missing", "a share of the frames in [0, 1]", fmt(a.max_missing));
+    throw ConfigError("command line", "--max-missing", "a share of the frames in [0, 1]",
+                      format_g(a.max_missing));
   slam::Settings settings = slam::read_settings(a.settings);
-  for (const std::string& w : settings.warnings) std::fprintf(stderr, "pvbench slam: warning: %s\n", w.c_str());
+  for (const std::string& w : settings.warnings)
+    std::fprintf(stderr, "pvbench slam: warning: %s\n", w.c_str());
   if (a.no_pe_match) settings.pe_match.enabled = false;
   if (a.no_dense) settings.dense.enabled = false;
   return settings;
@@ -249,14 +239,15 @@ SlamRun::SlamRun(const SlamArgs& a)
 }
 
 void SlamRun::open_outputs() {
-  cam_traj_ = open_out(a_.out + "/CameraTrajectory.txt");
-  kf_traj_ = open_out(a_.out + "/KeyFrameTrajectory.txt");
-  timing_ = open_out(a_.out + "/timing.csv");
-  cam_traj_ << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
-  kf_traj_ << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
-  timing_ << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,"
-             "inliers,keyframe,mapping_ms,cpu_ms,align_tried,aligned,align_ms,"
-             "kf_tracked_close,kf_untracked_close,kf_ref_points,kf_ref_all,kf_ref_shared\n";
+  cam_traj_ = OutputFile(a_.out + "/CameraTrajectory.txt");
+  kf_traj_ = OutputFile(a_.out + "/KeyFrameTrajectory.txt");
+  timing_ = OutputFile(a_.out + "/timing.csv");
+  cam_traj_.append("# timestamp tx ty tz qx qy qz qw (T_w_c)\n");
+  kf_traj_.append("# timestamp tx ty tz qx qy qz qw (T_w_c)\n");
+  timing_.append(
+      "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,"
+      "inliers,keyframe,mapping_ms,cpu_ms,align_tried,aligned,align_ms,"
+      "kf_tracked_close,kf_untracked_close,kf_ref_points,kf_ref_all,kf_ref_shared\n");
   if (a_.dump_matches) {
     const std::string gt = a_.sequence + "/groundtruth.txt";
     if (!std::ifstream(gt)) throw IoError(gt, "--dump-matches needs the sequence's ground truth");
@@ -309,22 +300,21 @@ slam::TrackingState SlamRun::track_one(const sensor::RgbdFrame& frame) {
   if (settings_.pe_match.enabled && r.tracking.method == slam::TrackingMethod::kMotionModel)
     tally_.pe_ms.push_back(r.tracking.pe_match_ms);
   if (r.T_w_c) {
-    cam_traj_ << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+    cam_traj_.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
     ++tally_.poses;
   }
-  if (r.tracking.new_keyframe && r.T_w_c)
-    kf_traj_ << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+  if (r.tracking.new_keyframe && r.T_w_c) kf_traj_.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
   static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc"};
-  timing_ << frame.index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
-          << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","
-          << fmt(r.tracking_ms) << "," << fmt(r.orb_ms) << "," << fmt(r.tracking.pe_match_ms) << ","
-          << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers << ","
-          << (r.tracking.new_keyframe ? 1 : 0) << "," << fmt(r.mapping_ms) << "," << fmt(cpu_ms) << ","
-          << r.tracking.align_tried << "," << r.tracking.aligned << "," << fmt(r.tracking.align_ms) << ","
-          << r.tracking.kf_tracked_close << "," << r.tracking.kf_untracked_close << ","
-          << r.tracking.kf_ref_points << "," << r.tracking.kf_ref_all << "," << r.tracking.kf_ref_shared
-          << "\n"
-          << std::flush;
+  std::ostringstream line;
+  line << frame.index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
+       << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","
+       << format_g(r.tracking_ms) << "," << format_g(r.orb_ms) << "," << format_g(r.tracking.pe_match_ms)
+       << "," << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers
+       << "," << (r.tracking.new_keyframe ? 1 : 0) << "," << format_g(r.mapping_ms) << "," << format_g(cpu_ms)
+       << "," << r.tracking.align_tried << "," << r.tracking.aligned << "," << format_g(r.tracking.align_ms)
+       << "," << r.tracking.kf_tracked_close << "," << r.tracking.kf_untracked_close << ","
+       << r.tracking.kf_ref_points << "," << r.tracking.kf_ref_all << "," << r.tracking.kf_ref_shared << "\n";
+  timing_.append(line.str());
   if (scorer_) scorer_->add(frame, r);
   return r.state;
 }
@@ -341,8 +331,9 @@ std::string SlamRun::write_final_outputs() {
   // ORB-SLAM2's way of saving: each frame relative to its (refined) reference keyframe.
   write_tum_file(a_.out + "/CameraTrajectoryRefined.txt", system_->refined_trajectory());
   if (a_.dump_map) {
-    std::ofstream map_out = open_out(a_.out + "/Map.txt");
-    slam::write_map_snapshot(system_->map_snapshot(), map_out, a_.out + "/Map.txt");
+    std::ostringstream map_text;
+    slam::write_map_snapshot(system_->map_snapshot(), map_text, a_.out + "/Map.txt");
+    write_file(a_.out + "/Map.txt", map_text.str());
   }
   cam_traj_.close();
   if (!system_->dense_enabled()) return {};
@@ -353,8 +344,8 @@ std::string SlamRun::write_final_outputs() {
               cloud_points, dense.keyframes, per_kf_ms, a_.out.c_str());
   std::ostringstream js;
   js << ",\n  \"dense\": {\"keyframes\": " << dense.keyframes << ", \"points\": " << cloud_points
-     << ", \"keyframe_points\": " << dense.points << ", \"ms_per_keyframe\": " << fmt(per_kf_ms)
-     << ", \"resolution_m\": " << fmt(settings_.dense.resolution_m) << "}";
+     << ", \"keyframe_points\": " << dense.points << ", \"ms_per_keyframe\": " << format_g(per_kf_ms)
+     << ", \"resolution_m\": " << format_g(settings_.dense.resolution_m) << "}";
   return js.str();
 }
 
@@ -391,8 +382,8 @@ void SlamRun::evaluate(std::ostringstream* js) {
           eval::evaluate(gt, eval::read_tum(a_.out + "/CameraTrajectoryRefined.txt"), eo);
       std::printf("refined trajectory (frames re-anchored to bundle-adjusted keyframes): ATE RMSE %.4f m\n",
                   ref.ate.rmse);
-      *js << ",\n  \"refined\": {\"ate_rmse\": " << fmt(ref.ate.rmse)
-          << ", \"rpe_trans_rmse\": " << fmt(ref.rpe_trans_m.rmse) << "}";
+      *js << ",\n  \"refined\": {\"ate_rmse\": " << format_g(ref.ate.rmse)
+          << ", \"rpe_trans_rmse\": " << format_g(ref.rpe_trans_m.rmse) << "}";
     } catch (const Error& e) {
       std::fprintf(stderr, "pvbench slam: warning: refined trajectory not evaluated: %s\n", e.what());
     }
@@ -414,12 +405,14 @@ std::string SlamRun::stats_json(StopReason stop, const std::string& dense_json) 
      << ",\n  \"not_initialized_frames\": " << t.not_init << ",\n  \"skipped_frames\": " << reader_.skipped()
      << ",\n  \"keyframes\": " << system_->num_keyframes()
      << ",\n  \"map_points\": " << system_->num_map_points()
-     << ",\n  \"tracking_ms\": {\"median\": " << fmt(percentile(t.tracking_ms, 0.5))
-     << ", \"mean\": " << fmt(mean_of(t.tracking_ms)) << ", \"p95\": " << fmt(percentile(t.tracking_ms, 0.95))
-     << "},\n  \"pe_match_ms\": {\"median\": " << fmt(percentile(t.pe_ms, 0.5))
-     << ", \"p95\": " << fmt(percentile(t.pe_ms, 0.95)) << "}"
-     << ",\n  \"cpu_ms\": {\"median\": " << fmt(percentile(t.cpu_ms, 0.5))
-     << ", \"mean\": " << fmt(mean_of(t.cpu_ms)) << ", \"p95\": " << fmt(percentile(t.cpu_ms, 0.95)) << "}"
+     << ",\n  \"tracking_ms\": {\"median\": " << format_g(percentile(t.tracking_ms, 0.5))
+     << ", \"mean\": " << format_g(mean_of(t.tracking_ms))
+     << ", \"p95\": " << format_g(percentile(t.tracking_ms, 0.95))
+     << "},\n  \"pe_match_ms\": {\"median\": " << format_g(percentile(t.pe_ms, 0.5))
+     << ", \"p95\": " << format_g(percentile(t.pe_ms, 0.95)) << "}"
+     << ",\n  \"cpu_ms\": {\"median\": " << format_g(percentile(t.cpu_ms, 0.5))
+     << ", \"mean\": " << format_g(mean_of(t.cpu_ms)) << ", \"p95\": " << format_g(percentile(t.cpu_ms, 0.95))
+     << "}"
      << ",\n  \"local_mapping\": " << slam::to_json(system_->mapping_stats()) << dense_json;
   const slam::LocalMappingStats mapping = system_->mapping_stats();
   std::printf(
@@ -432,11 +425,13 @@ std::string SlamRun::stats_json(StopReason stop, const std::string& dense_json) 
     std::printf("loop closing: %zu loops closed (%d consistent detections, %d refused by geometry)\n",
                 loops.loops.size(), loops.consistent, loops.rejected);
     for (const slam::LoopEvent& e : loops.loops)
-      std::printf("  frame %llu (keyframe %llu) -> frame %llu (keyframe %llu): %d inliers, moved %.3f m / %.2f deg, "
-                  "%.0f ms\n",
-                  static_cast<unsigned long long>(e.frame_id), static_cast<unsigned long long>(e.keyframe_id),
-                  static_cast<unsigned long long>(e.loop_frame_id), static_cast<unsigned long long>(e.loop_keyframe_id),
-                  e.inliers, e.correction_m, e.correction_deg, e.detect_ms + e.correct_ms);
+      std::printf(
+          "  frame %llu (keyframe %llu) -> frame %llu (keyframe %llu): %d inliers, moved %.3f m / %.2f deg, "
+          "%.0f ms\n",
+          static_cast<unsigned long long>(e.frame_id), static_cast<unsigned long long>(e.keyframe_id),
+          static_cast<unsigned long long>(e.loop_frame_id),
+          static_cast<unsigned long long>(e.loop_keyframe_id), e.inliers, e.correction_m, e.correction_deg,
+          e.detect_ms + e.correct_ms);
   }
   std::printf("tracking ms: median %.2f, mean %.2f, p95 %.2f; PE-match ms: median %.2f\n",
               percentile(t.tracking_ms, 0.5), mean_of(t.tracking_ms), percentile(t.tracking_ms, 0.95),
@@ -454,7 +449,7 @@ void SlamRun::fail_if_incomplete(StopReason stop) const {
   if (stop == StopReason::kTooManyMissing)
     throw IoError(a_.sequence, std::to_string(reader_.skipped()) + " frames missing or corrupt (more than " +
                                    std::to_string(reader_.max_skipped()) + ", --max-missing " +
-                                   fmt(a_.max_missing) + ")" + kept);
+                                   format_g(a_.max_missing) + ")" + kept);
   if (stop != StopReason::kSignal && tally_.frames > 0 && tally_.not_init == tally_.frames)
     throw IoError(a_.sequence, "tracking never initialised in " + std::to_string(tally_.frames) +
                                    " frames (" + tally_.init_failure + ")" + kept);
@@ -500,12 +495,14 @@ Command add_slam_command(CLI::App& app) {
   sub->add_flag("--no-dense", args->no_dense, "skip the dense point-cloud map (PointCloud.ply)");
   sub->add_flag("--sync", args->sync, "synchronous mode: no worker threads, bit-identical runs");
   sub->add_option("--seed", args->seed, "PE-match seed")->capture_default_str();
-  sub->add_option("--max-frames", args->max_frames, "stop after this many frames (0: all)")->capture_default_str();
+  sub->add_option("--max-frames", args->max_frames, "stop after this many frames (0: all)")
+      ->capture_default_str();
   sub->add_flag("--dump-matches", args->dump_matches,
                 "score the motion model's coarse matches against groundtruth.txt: motion_matches.csv, "
                 "stats.json motion_matches");
-  sub->add_flag("--dump-map", args->dump_map,
-                "write the final sparse map with every keypoint measurement to Map.txt (for pvbench map-check)");
+  sub->add_flag(
+      "--dump-map", args->dump_map,
+      "write the final sparse map with every keypoint measurement to Map.txt (for pvbench map-check)");
   sub->add_option(
          "--max-missing", args->max_missing,
          "stop (exit 1, outputs kept) when more than this share of the frames, 0 to 1, and more than 5 "

@@ -156,10 +156,7 @@ std::string seed_summary(const suite::SeedRun& r) {
   if (!r.metrics) return "no metrics: " + r.error;
   const suite::RunMetrics& m = r.metrics->primary;
   auto mm = [](const std::optional<double>& v) {
-    if (!v) return std::string("n/a");
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.2f mm", *v * 1000.0);
-    return std::string(buf);
+    return v ? format_number("%.2f mm", *v * 1000.0) : std::string("n/a");
   };
   std::string s =
       m.status + ", ATE RMSE " + mm(m.ate_rmse_m) + ", " + std::to_string(m.lost_frames) + " lost";
@@ -297,7 +294,8 @@ bool check_sweep_and_print(const std::string& scenario_file, const suite::SweepA
 
 int run_sweep(SweepArgs a) {
   a.jobs = static_cast<int>(parse_count("sweep", "--jobs", a.jobs_text, 1, 1024));
-  if (!a.frames_text.empty()) a.frames = static_cast<int>(parse_count("sweep", "--frames", a.frames_text, 1, 10'000'000));
+  if (!a.frames_text.empty())
+    a.frames = static_cast<int>(parse_count("sweep", "--frames", a.frames_text, 1, 10'000'000));
   if (a.compare && a.baseline)
     throw ConfigError("command line", "--baseline", "either --compare or --baseline, not both");
   std::string scenario_name;

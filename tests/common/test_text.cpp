@@ -21,3 +21,14 @@ TEST(Text, WriteThenReadRoundTrips) {
   std::remove(path.c_str());
   EXPECT_THROW(pvb::read_file(path), pvb::IoError);
 }
+
+TEST(Text, NumberFormatting) {
+  EXPECT_EQ(pvb::format_number("%.2f mm", 3.14159), "3.14 mm");
+  EXPECT_EQ(pvb::format_number("%+.1f", 2.0), "+2.0");
+  EXPECT_EQ(pvb::format_g(0.0123456789), "0.0123457");
+  EXPECT_EQ(pvb::format_g(1234567.0, 3), "1.23e+06");
+  EXPECT_EQ(pvb::format_fixed(2.5, 2), "2.50");
+  EXPECT_EQ(pvb::format_fixed(-0.004, 2), "-0.00");
+  // The largest double in %f has 309 digits: nothing is cut.
+  EXPECT_EQ(pvb::format_fixed(1e308, 1).size(), 311u);
+}

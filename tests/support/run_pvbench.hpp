@@ -37,6 +37,17 @@ inline RunResult run_pvbench(const std::string& args) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(log)};
 }
 
+/// Runs `pvbench ARGS` with every file it writes capped at `max_kib` KiB
+/// (a disk that fills up): SIGXFSZ ignored, so a write past the cap fails
+/// with EFBIG instead of killing the program.
+inline RunResult run_pvbench_with_file_limit(const std::string& args, int max_kib) {
+  const std::string log = ::testing::TempDir() + "pvb_run_" + std::to_string(::getpid()) + ".txt";
+  const std::string inner = "trap '' XFSZ; ulimit -f " + std::to_string(max_kib) + "; exec " +
+                            pvbench_path() + " " + args + " > " + log + " 2>&1";
+  const int status = std::system(("bash -c \"" + inner + "\"").c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(log)};
+}
+
 /// Starts `pvbench ARGS...` as a child process, its stdout and stderr going
 /// to log_path; returns the child's pid (-1 when fork fails).
 inline pid_t spawn_pvbench(const std::vector<std::string>& args, const std::string& log_path) {

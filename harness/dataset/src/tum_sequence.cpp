@@ -14,6 +14,7 @@
 #include <tuple>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_file.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/image_file.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
@@ -35,35 +36,37 @@ void make_dirs(const std::string& dir) {
   }
   struct stat st {};
   if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) throw IoError(dir, "not a folder");
-  if (::access(dir.c_str(), W_OK) != 0) throw IoError(dir, std::string("folder is not writable: ") + std::strerror(errno));
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw IoError(dir, std::string("folder is not writable: ") + std::strerror(errno));
 }
 
 void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s) {
   char buf[4096];
-  std::snprintf(buf, sizeof buf,
-                "%%YAML:1.0\n"
-                "# ORB-SLAM2 RGB-D settings written by pvbench\n"
-                "\n"
-                "# Camera calibration and distortion parameters (OpenCV)\n"
-                "Camera.fx: %.6f\nCamera.fy: %.6f\nCamera.cx: %.6f\nCamera.cy: %.6f\n\n"
-                "Camera.k1: %.6f\nCamera.k2: %.6f\nCamera.p1: %.6f\nCamera.p2: %.6f\nCamera.k3: %.6f\n\n"
-                "Camera.width: %d\nCamera.height: %d\n\n"
-                "# Camera frames per second\nCamera.fps: %.1f\n\n"
-                "# IR projector baseline times fx (approx.)\nCamera.bf: %.6f\n\n"
-                "# Color order of the images (0: BGR, 1: RGB. It is ignored if images are grayscale)\n"
-                "Camera.RGB: %d\n\n"
-                "# Close/Far threshold. Baseline times.\nThDepth: %.1f\n\n"
-                "# Depthmap values factor\nDepthMapFactor: %.1f\n\n"
-                "# ORB Parameters\n"
-                "ORBextractor.nFeatures: %d\nORBextractor.scaleFactor: %.2f\nORBextractor.nLevels: %d\n"
-                "ORBextractor.iniThFAST: %d\nORBextractor.minThFAST: %d\n\n"
-                "# Viewer Parameters (ORB-SLAM2 reads these too)\n"
-                "Viewer.KeyFrameSize: 0.05\nViewer.KeyFrameLineWidth: 1\nViewer.GraphLineWidth: 0.9\n"
-                "Viewer.PointSize: 2\nViewer.CameraSize: 0.08\nViewer.CameraLineWidth: 3\n"
-                "Viewer.ViewpointX: 0\nViewer.ViewpointY: -0.7\nViewer.ViewpointZ: -1.8\nViewer.ViewpointF: 500\n",
-                s.K.fx, s.K.fy, s.K.cx, s.K.cy, s.k1, s.k2, s.p1, s.p2, s.k3, s.K.width, s.K.height, s.fps, s.bf,
-                s.rgb_order, s.th_depth, s.depth_map_factor, s.n_features, s.scale_factor, s.n_levels,
-                s.ini_th_fast, s.min_th_fast);
+  std::snprintf(
+      buf, sizeof buf,
+      "%%YAML:1.0\n"
+      "# ORB-SLAM2 RGB-D settings written by pvbench\n"
+      "\n"
+      "# Camera calibration and distortion parameters (OpenCV)\n"
+      "Camera.fx: %.6f\nCamera.fy: %.6f\nCamera.cx: %.6f\nCamera.cy: %.6f\n\n"
+      "Camera.k1: %.6f\nCamera.k2: %.6f\nCamera.p1: %.6f\nCamera.p2: %.6f\nCamera.k3: %.6f\n\n"
+      "Camera.width: %d\nCamera.height: %d\n\n"
+      "# Camera frames per second\nCamera.fps: %.1f\n\n"
+      "# IR projector baseline times fx (approx.)\nCamera.bf: %.6f\n\n"
+      "# Color order of the images (0: BGR, 1: RGB. It is ignored if images are grayscale)\n"
+      "Camera.RGB: %d\n\n"
+      "# Close/Far threshold. Baseline times.\nThDepth: %.1f\n\n"
+      "# Depthmap values factor\nDepthMapFactor: %.1f\n\n"
+      "# ORB Parameters\n"
+      "ORBextractor.nFeatures: %d\nORBextractor.scaleFactor: %.2f\nORBextractor.nLevels: %d\n"
+      "ORBextractor.iniThFAST: %d\nORBextractor.minThFAST: %d\n\n"
+      "# Viewer Parameters (ORB-SLAM2 reads these too)\n"
+      "Viewer.KeyFrameSize: 0.05\nViewer.KeyFrameLineWidth: 1\nViewer.GraphLineWidth: 0.9\n"
+      "Viewer.PointSize: 2\nViewer.CameraSize: 0.08\nViewer.CameraLineWidth: 3\n"
+      "Viewer.ViewpointX: 0\nViewer.ViewpointY: -0.7\nViewer.ViewpointZ: -1.8\nViewer.ViewpointF: 500\n",
+      s.K.fx, s.K.fy, s.K.cx, s.K.cy, s.k1, s.k2, s.p1, s.p2, s.k3, s.K.width, s.K.height, s.fps, s.bf,
+      s.rgb_order, s.th_depth, s.depth_map_factor, s.n_features, s.scale_factor, s.n_levels, s.ini_th_fast,
+      s.min_th_fast);
   std::string text = buf;
   if (s.kf_min_tracked_close || s.kf_ref_overlap)
     text += "\n# Keyframe decision (pvbench's own keys; ORB-SLAM2 ignores them)\n";
@@ -78,11 +81,25 @@ void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s) {
 }
 
 namespace {
-void open_list(std::ofstream* f, const std::string& path, const char* header) {
-  f->open(path, std::ios::trunc);
-  if (!*f) throw IoError(path, std::string("cannot open for writing: ") + std::strerror(errno));
-  *f << header;
-  f->flush();
+OutputFile open_list(const std::string& path, const std::string& header) {
+  OutputFile f(path);
+  f.append(header);
+  return f;
+}
+
+/// Writes an image; a failed write (disk full) leaves no partial file.
+void write_image(const std::string& path, const cv::Mat& image) {
+  bool ok = false;
+  try {
+    ok = cv::imwrite(path, image);
+  } catch (const cv::Exception& e) {
+    std::remove(path.c_str());
+    throw IoError(path, "cannot write image: " + e.msg);
+  }
+  if (!ok) {
+    std::remove(path.c_str());
+    throw IoError(path, "cannot write image (disk full?)");
+  }
 }
 }  // namespace
 
@@ -92,12 +109,12 @@ TumSequenceWriter::TumSequenceWriter(const std::string& dir, double depth_factor
   make_dirs(dir_ + "/rgb");
   make_dirs(dir_ + "/depth");
   const std::string tag = "# written by " + source + "\n";
-  open_list(&rgb_txt_, dir_ + "/rgb.txt", ("# color images\n" + tag + "# timestamp filename\n").c_str());
-  open_list(&depth_txt_, dir_ + "/depth.txt", ("# depth maps\n" + tag + "# timestamp filename\n").c_str());
-  open_list(&gt_txt_, dir_ + "/groundtruth.txt",
-            ("# ground truth trajectory: camera optical frame in the world\n" + tag +
-             "# timestamp tx ty tz qx qy qz qw\n").c_str());
-  open_list(&assoc_txt_, dir_ + "/associations.txt", "");
+  rgb_txt_ = open_list(dir_ + "/rgb.txt", "# color images\n" + tag + "# timestamp filename\n");
+  depth_txt_ = open_list(dir_ + "/depth.txt", "# depth maps\n" + tag + "# timestamp filename\n");
+  gt_txt_ =
+      open_list(dir_ + "/groundtruth.txt", "# ground truth trajectory: camera optical frame in the world\n" +
+                                               tag + "# timestamp tx ty tz qx qy qz qw\n");
+  assoc_txt_ = open_list(dir_ + "/associations.txt", "");
 }
 
 void TumSequenceWriter::write(const sensor::RgbdFrame& frame, const geom::SE3d& T_w_c) {
@@ -105,17 +122,13 @@ void TumSequenceWriter::write(const sensor::RgbdFrame& frame, const geom::SE3d& 
   const std::string rgb_rel = "rgb/" + t + ".png", depth_rel = "depth/" + t + ".png";
   cv::Mat bgr;
   cv::cvtColor(frame.rgb, bgr, cv::COLOR_RGB2BGR);
-  if (!cv::imwrite(dir_ + "/" + rgb_rel, bgr)) throw IoError(dir_ + "/" + rgb_rel, "cannot write image");
-  if (!cv::imwrite(dir_ + "/" + depth_rel, sensor::depth_to_u16(frame.depth_m, depth_factor_)))
-    throw IoError(dir_ + "/" + depth_rel, "cannot write image");
-  rgb_txt_ << t << " " << rgb_rel << "\n";
-  depth_txt_ << t << " " << depth_rel << "\n";
-  gt_txt_ << geom::format_tum_line({frame.t_ns, T_w_c}) << "\n";
-  assoc_txt_ << t << " " << rgb_rel << " " << t << " " << depth_rel << "\n";
-  for (std::ofstream* f : {&rgb_txt_, &depth_txt_, &gt_txt_, &assoc_txt_}) {
-    f->flush();
-    if (!*f) throw IoError(dir_, "write failed (disk full?)");
-  }
+  write_image(dir_ + "/" + rgb_rel, bgr);
+  write_image(dir_ + "/" + depth_rel, sensor::depth_to_u16(frame.depth_m, depth_factor_));
+  // associations.txt last: a frame it lists is in every other list.
+  rgb_txt_.append(t + " " + rgb_rel + "\n");
+  depth_txt_.append(t + " " + depth_rel + "\n");
+  gt_txt_.append(geom::format_tum_line({frame.t_ns, T_w_c}) + "\n");
+  assoc_txt_.append(t + " " + rgb_rel + " " + t + " " + depth_rel + "\n");
   ++frames_;
 }
 
@@ -185,7 +198,8 @@ std::vector<TumSequenceReader::Entry> associate_lists(const std::string& dir, do
     auto it = std::lower_bound(depth.begin(), depth.end(), rgb[i].first - *max_diff_ns,
                                [](const auto& a, std::int64_t t) { return a.first < t; });
     for (; it != depth.end() && it->first <= rgb[i].first + *max_diff_ns; ++it)
-      cand.emplace_back(std::llabs(it->first - rgb[i].first), i, static_cast<std::size_t>(it - depth.begin()));
+      cand.emplace_back(std::llabs(it->first - rgb[i].first), i,
+                        static_cast<std::size_t>(it - depth.begin()));
   }
   std::sort(cand.begin(), cand.end());
   std::vector<bool> used_r(rgb.size()), used_d(depth.size());
@@ -199,7 +213,8 @@ std::vector<TumSequenceReader::Entry> associate_lists(const std::string& dir, do
       entries.begin(), entries.end(),
       [](const TumSequenceReader::Entry& a, const TumSequenceReader::Entry& b) { return a.t_ns < b.t_ns; });
   if (entries.empty())
-    throw IoError(dir + "/rgb.txt", "no colour image has a depth image within " + std::to_string(max_diff_s) + " s");
+    throw IoError(dir + "/rgb.txt",
+                  "no colour image has a depth image within " + std::to_string(max_diff_s) + " s");
   return entries;
 }
 

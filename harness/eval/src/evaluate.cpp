@@ -9,12 +9,6 @@
 namespace pvb::eval {
 namespace {
 
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
-
 /// JSON number: finite values with full precision, null otherwise.
 std::string num(double v) { return json_number(v, 17); }
 
@@ -70,8 +64,8 @@ std::string result_fields_json(const EvalResult& r, const std::string& indent) {
   out += indent + "        \"rot_deg\": " + stats_json(r.rpe_rot_deg) + ",\n";
   out += indent + "        \"axes\": " + axes_json(r) + "},\n";
   out += indent + "\"alignment\": {\"kind\": \"" + alignment_name(r.alignment_kind) + "\", \"R\": " + R +
-         ", \"t\": [" + num(t.x()) + ", " + num(t.y()) + ", " + num(t.z()) + "], \"s\": " +
-         num(r.alignment.s) + "}";
+         ", \"t\": [" + num(t.x()) + ", " + num(t.y()) + ", " + num(t.z()) +
+         "], \"s\": " + num(r.alignment.s) + "}";
   return out;
 }
 
@@ -121,7 +115,7 @@ void check_poses(const Trajectory& traj, const char* which) {
     if (plausible_position(p.T_w_c.translation()) && p.T_w_c.linear().allFinite()) continue;
     throw EvalError(std::string(which) + " '" + traj.source +
                     "': the pose at t = " + geom::format_tum_time(p.t_ns) +
-                    " s is not finite or lies beyond " + fmt("%g", kMaxAbsCoordinateM) + " m");
+                    " s is not finite or lies beyond " + format_number("%g", kMaxAbsCoordinateM) + " m");
   }
 }
 
@@ -167,12 +161,13 @@ std::string format_report(const EvalResult& r) {
   out += "estimate     " + r.est_source + "\n";
   out += "pairs        " + std::to_string(r.pairs.size()) + " associated poses";
   if (!r.t_ns.empty())
-    out += ", " + fmt("%.3f", geom::ns_to_seconds(r.t_ns.back() - r.t_ns.front())) + " s";
+    out += ", " + format_number("%.3f", geom::ns_to_seconds(r.t_ns.back() - r.t_ns.front())) + " s";
   out += "\n";
   out += std::string("alignment    ") + alignment_name(r.alignment_kind) +
-         fmt(" (scale %.6f", r.alignment.s) + fmt(", |t| %.4f m", r.alignment.t.norm()) +
-         fmt(", rotation %.3f deg)", geom::rotation_angle_rad(r.alignment.R) * 180.0 / M_PI) + "\n";
-  out += "RPE delta    " + fmt("%g", r.rpe_options.delta) + " " + delta_unit_name(r.rpe_options.unit) +
+         format_number(" (scale %.6f", r.alignment.s) + format_number(", |t| %.4f m", r.alignment.t.norm()) +
+         format_number(", rotation %.3f deg)", geom::rotation_angle_rad(r.alignment.R) * 180.0 / M_PI) + "\n";
+  out += "RPE delta    " + format_number("%g", r.rpe_options.delta) + " " +
+         delta_unit_name(r.rpe_options.unit) +
          (r.rpe_options.pairs == PairMode::kAll ? ", all pairs" : ", consecutive pairs") + "\n\n";
   char line[256];
   std::snprintf(line, sizeof line, "%-18s %10s %10s %10s %10s %10s %10s %7s\n", "metric", "rmse", "mean",
@@ -193,8 +188,8 @@ std::string format_report(const EvalResult& r) {
 std::string format_rpe_axes(const EvalResult& r) {
   const bool consecutive = r.rpe_options.pairs == PairMode::kConsecutive;
   const std::size_t n = r.rpe_rot_axes_deg.count;
-  std::string out = "\nRPE per axis of the start camera (signed: mean +- std over " + std::to_string(n) + " pairs" +
-                    (consecutive && n > 1 ? "; t = mean / (std / sqrt(n - 1))" : "") + ")\n";
+  std::string out = "\nRPE per axis of the start camera (signed: mean +- std over " + std::to_string(n) +
+                    " pairs" + (consecutive && n > 1 ? "; t = mean / (std / sqrt(n - 1))" : "") + ")\n";
   auto row = [&](const char* name, const AxisStats& a, double scale, const char* unit) {
     char cell[96];
     std::snprintf(cell, sizeof cell, "%-6s", name);
@@ -244,8 +239,8 @@ std::string format_comparison(const std::vector<EvalResult>& results) {
     const double ref = m.get(results.front());
     for (std::size_t k = 0; k < results.size(); ++k) {
       const double v = m.get(results[k]);
-      std::string text = fmt("%.4f", v);
-      if (k > 0) text += fmt(" (%+6.1f%%)", reduction_percent(ref, v));
+      std::string text = format_number("%.4f", v);
+      if (k > 0) text += format_number(" (%+6.1f%%)", reduction_percent(ref, v));
       std::snprintf(cell, sizeof cell, "%*s", kCol, text.c_str());
       out += cell;
     }
@@ -261,7 +256,9 @@ std::string format_comparison(const std::vector<EvalResult>& results) {
   return out;
 }
 
-std::string format_json(const EvalResult& result) { return "{\n" + result_fields_json(result, "  ") + "\n}\n"; }
+std::string format_json(const EvalResult& result) {
+  return "{\n" + result_fields_json(result, "  ") + "\n}\n";
+}
 
 std::string format_json_document(const std::string& gt_source, const std::vector<EvalResult>& results) {
   if (results.empty()) return "{}\n";
@@ -273,9 +270,10 @@ std::string format_json_document(const std::string& gt_source, const std::vector
       out += "    {\n" + result_fields_json(results[k], "      ") + ",\n      \"reduction_percent\": {";
       for (std::size_t m = 0; m < std::size(kMetrics); ++m) {
         std::string key = kMetrics[m].name;
-        for (char& c : key) c = c == ' ' ? '_' : static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-        out += (m ? ", \"" : "\"") + key + "\": " +
-               num(reduction_percent(kMetrics[m].get(results.front()), kMetrics[m].get(results[k])));
+        for (char& c : key)
+          c = c == ' ' ? '_' : static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        out += (m ? ", \"" : "\"") + key +
+               "\": " + num(reduction_percent(kMetrics[m].get(results.front()), kMetrics[m].get(results[k])));
       }
       out += "}\n    }";
       out += k + 1 < results.size() ? ",\n" : "\n";

@@ -18,8 +18,8 @@ constexpr double kTickFont = 15.0;
 constexpr double kLabelFont = 17.0;
 
 struct Panel {
-  double left, top, width, height;     // pixel box of the plotting area
-  double x_lo, x_hi, y_lo, y_hi;       // data range
+  double left, top, width, height;  // pixel box of the plotting area
+  double x_lo, x_hi, y_lo, y_hi;    // data range
   double px(double x) const { return left + (x - x_lo) / (x_hi - x_lo) * width; }
   double py(double y) const { return top + height - (y - y_lo) / (y_hi - y_lo) * height; }
 };
@@ -31,12 +31,14 @@ void draw_axes(Figure* f, const Panel& p, const std::string& x_label, const std:
   for (double x : xt) {
     f->lines.push_back({p.px(x), p.top, p.px(x), p.top + p.height, kGrid, 1.0});
     f->lines.push_back({p.px(x), p.top + p.height, p.px(x), p.top + p.height + 5, kAxis, 1.0});
-    f->texts.push_back({p.px(x), p.top + p.height + 21, tick_label(x, sx), kTickFont, TextAnchor::kMiddle, false, kAxis});
+    f->texts.push_back(
+        {p.px(x), p.top + p.height + 21, tick_label(x, sx), kTickFont, TextAnchor::kMiddle, false, kAxis});
   }
   for (double y : yt) {
     f->lines.push_back({p.left, p.py(y), p.left + p.width, p.py(y), kGrid, 1.0});
     f->lines.push_back({p.left - 5, p.py(y), p.left, p.py(y), kAxis, 1.0});
-    f->texts.push_back({p.left - 8, p.py(y) + 5, tick_label(y, sy), kTickFont, TextAnchor::kEnd, false, kAxis});
+    f->texts.push_back(
+        {p.left - 8, p.py(y) + 5, tick_label(y, sy), kTickFont, TextAnchor::kEnd, false, kAxis});
   }
   // Frame.
   const double l = p.left, t = p.top, r = p.left + p.width, b = p.top + p.height;
@@ -45,7 +47,8 @@ void draw_axes(Figure* f, const Panel& p, const std::string& x_label, const std:
   f->lines.push_back({l, t, l, b, kAxis, 1.0});
   f->lines.push_back({r, t, r, b, kAxis, 1.0});
   f->texts.push_back({p.left + p.width / 2, b + 46, x_label, kLabelFont, TextAnchor::kMiddle, false, kBlack});
-  f->texts.push_back({p.left - 62, p.top + p.height / 2, y_label, kLabelFont, TextAnchor::kMiddle, true, kBlack});
+  f->texts.push_back(
+      {p.left - 62, p.top + p.height / 2, y_label, kLabelFont, TextAnchor::kMiddle, true, kBlack});
 }
 
 std::string rgb(const Rgb& c) {
@@ -67,15 +70,14 @@ std::vector<double> nice_ticks(double lo, double hi, int target, double* step) {
     }
   *step = s;
   std::vector<double> out;
-  for (double v = std::ceil(lo / s - 1e-9) * s; v <= hi + 1e-9 * s; v += s) out.push_back(std::fabs(v) < 1e-12 * s ? 0.0 : v);
+  for (double v = std::ceil(lo / s - 1e-9) * s; v <= hi + 1e-9 * s; v += s)
+    out.push_back(std::fabs(v) < 1e-12 * s ? 0.0 : v);
   return out;
 }
 
 std::string tick_label(double v, double step) {
   const int decimals = std::max(0, static_cast<int>(std::ceil(-std::log10(step) - 1e-9)));
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
+  return format_fixed(v, decimals);
 }
 
 Figure make_error_figure(const EvalResult& r, const std::string& title) {
@@ -109,20 +111,23 @@ Figure make_error_figure(const EvalResult& r, const std::string& title) {
   }
   FigPolyline gt_line{{}, kBlack, 2.0}, est_line{{}, kBlue, 2.0};
   for (std::size_t i = 0; i < r.T_w_c_gt.size(); ++i) {
-    gt_line.points.emplace_back(top.px(r.T_w_c_gt[i].translation().x()), top.py(r.T_w_c_gt[i].translation().y()));
-    est_line.points.emplace_back(top.px(r.T_w_c_est[i].translation().x()), top.py(r.T_w_c_est[i].translation().y()));
+    gt_line.points.emplace_back(top.px(r.T_w_c_gt[i].translation().x()),
+                                top.py(r.T_w_c_gt[i].translation().y()));
+    est_line.points.emplace_back(top.px(r.T_w_c_est[i].translation().x()),
+                                 top.py(r.T_w_c_est[i].translation().y()));
   }
   f.polylines.push_back(gt_line);
   f.polylines.push_back(est_line);
   f.texts.push_back({f.width_px / 2.0, 32, title, 20.0, TextAnchor::kMiddle, false, kBlack});
   char sub[200];
-  std::snprintf(sub, sizeof sub, "top view, %s alignment, %zu pairs, ATE rmse %.4f m", alignment_name(r.alignment_kind),
-                r.pairs.size(), r.ate.rmse);
+  std::snprintf(sub, sizeof sub, "top view, %s alignment, %zu pairs, ATE rmse %.4f m",
+                alignment_name(r.alignment_kind), r.pairs.size(), r.ate.rmse);
   f.texts.push_back({f.width_px / 2.0, 56, sub, 15.0, TextAnchor::kMiddle, false, kAxis});
   // Legend (top-left of the panel, on a white box drawn as thick lines).
   {
     const double lx = top.left + 12, ly = top.top + 12;
-    for (int k = 0; k < 84; k += 2) f.lines.push_back({lx, ly + k, lx + 175, ly + k, Rgb{255, 255, 255}, 2.0});
+    for (int k = 0; k < 84; k += 2)
+      f.lines.push_back({lx, ly + k, lx + 175, ly + k, Rgb{255, 255, 255}, 2.0});
     const struct {
       const char* name;
       Rgb color;
@@ -156,15 +161,17 @@ Figure make_error_figure(const EvalResult& r, const std::string& title) {
 std::string format_svg(const Figure& f) {
   std::string out;
   char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\">\n"
-                "<rect width=\"100%%\" height=\"100%%\" fill=\"#ffffff\"/>\n",
-                f.width_px, f.height_px, f.width_px, f.height_px);
+  std::snprintf(
+      buf, sizeof buf,
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\">\n"
+      "<rect width=\"100%%\" height=\"100%%\" fill=\"#ffffff\"/>\n",
+      f.width_px, f.height_px, f.width_px, f.height_px);
   out += buf;
   for (const FigLine& l : f.lines) {
-    std::snprintf(buf, sizeof buf,
-                  "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"%s\" stroke-width=\"%.2g\"/>\n",
-                  l.x0, l.y0, l.x1, l.y1, rgb(l.color).c_str(), l.width_px);
+    std::snprintf(
+        buf, sizeof buf,
+        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"%s\" stroke-width=\"%.2g\"/>\n", l.x0,
+        l.y0, l.x1, l.y1, rgb(l.color).c_str(), l.width_px);
     out += buf;
   }
   for (const FigPolyline& p : f.polylines) {
@@ -177,7 +184,9 @@ std::string format_svg(const Figure& f) {
     out += "\"/>\n";
   }
   for (const FigText& t : f.texts) {
-    const char* anchor = t.anchor == TextAnchor::kStart ? "start" : t.anchor == TextAnchor::kMiddle ? "middle" : "end";
+    const char* anchor = t.anchor == TextAnchor::kStart    ? "start"
+                         : t.anchor == TextAnchor::kMiddle ? "middle"
+                                                           : "end";
     std::snprintf(buf, sizeof buf,
                   "<text x=\"%.2f\" y=\"%.2f\" font-family=\"sans-serif\" font-size=\"%.1f\" fill=\"%s\" "
                   "text-anchor=\"%s\"",
@@ -189,10 +198,14 @@ std::string format_svg(const Figure& f) {
     }
     std::string esc;
     for (char c : t.text) {
-      if (c == '<') esc += "&lt;";
-      else if (c == '>') esc += "&gt;";
-      else if (c == '&') esc += "&amp;";
-      else esc += c;
+      if (c == '<')
+        esc += "&lt;";
+      else if (c == '>')
+        esc += "&gt;";
+      else if (c == '&')
+        esc += "&amp;";
+      else
+        esc += c;
     }
     out += ">" + esc + "</text>\n";
   }

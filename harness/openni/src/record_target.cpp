@@ -14,6 +14,15 @@ namespace pvb::openni {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+[[noreturn]] void throw_exists(const std::string& record_path) {
+  throw IoError(record_path,
+                "already exists; a recording never replaces a file (remove it or record to a new name)");
+}
+
+}  // namespace
+
 bool same_file(const std::string& a, const std::string& b) {
   struct stat sa {
   }, sb{};
@@ -31,7 +40,7 @@ void check_record_not_on(const std::string& record_path, const std::vector<RunFi
       throw IoError(record_path, "is " + f.role + " (" + f.path + "); record to a new file");
 }
 
-void create_new_recording_file(const std::string& record_path) {
+void check_new_recording_path(const std::string& record_path) {
   const fs::path p(record_path);
   std::error_code ec;
   if (record_path.empty() || fs::is_directory(p, ec) || !p.has_filename())
@@ -46,12 +55,15 @@ void create_new_recording_file(const std::string& record_path) {
   }
   if (!fs::is_directory(st))
     throw IoError(record_path, "cannot record: " + folder.string() + " is not a folder");
+  if (fs::exists(fs::symlink_status(p, ec))) throw_exists(record_path);
+}
+
+void create_new_recording_file(const std::string& record_path) {
+  check_new_recording_path(record_path);
   const int fd = ::open(record_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) {
     const int err = errno;
-    if (err == EEXIST)
-      throw IoError(record_path,
-                    "already exists; a recording never replaces a file (remove it or record to a new name)");
+    if (err == EEXIST) throw_exists(record_path);
     throw IoError(record_path, std::string("cannot create the recording: ") + std::strerror(err));
   }
   ::close(fd);

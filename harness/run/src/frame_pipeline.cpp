@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "pvb/common/closable_queue.hpp"
+#include "pvb/common/text.hpp"
 #include "pvb/common/threads.hpp"
 
 namespace pvb::run {
@@ -86,7 +87,7 @@ class MappingPriority {
     set_nice(nice);
     ++changes_;
     if (changes_ <= 10)
-      log_.line("frame " + std::to_string(index) + ": tracked " + fmt(latency_ms) +
+      log_.line("frame " + std::to_string(index) + ": tracked " + format_g(latency_ms) +
                 " ms after it was due; mapping workers at nice " + std::to_string(nice));
   }
 
@@ -173,7 +174,7 @@ LoopTimes FramePipeline::run(FrameConsumer& consumer) {
   info_ = ready.get();  // rethrows a setup error (the destructor joins)
   announce(info_, consumer, log_);
   MappingPriority priority(opt_, scenario_.camera.fps, log_);
-  log_.line(opt_.pace ? "frames paced at " + fmt(scenario_.camera.fps) + " Hz"
+  log_.line(opt_.pace ? "frames paced at " + format_g(scenario_.camera.fps) + " Hz"
                       : "frames not paced (as fast as the stages go)");
   if (sensor_thread_on_) sensor_thread_ = std::thread([this] { sensor_stage(); });
   times_.start = pace_start_;  // when frame 0 began (set before `ready`, so visible here)

@@ -109,12 +109,7 @@ std::string html_escape(const std::string& s) {
   return out;
 }
 
-std::string fixed(double v, int decimals) {
-  if (!std::isfinite(v)) return "-";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
+std::string fixed(double v, int decimals) { return std::isfinite(v) ? format_fixed(v, decimals) : "-"; }
 
 void write_figure(const eval::Figure& f, const std::string& dir, const std::string& name,
                   std::vector<std::string>* written) {

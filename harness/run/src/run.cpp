@@ -65,20 +65,20 @@ std::string start_line(const RunOptions& opt, const scenes::Scenario& scenario, 
 /// trajectory the systems are evaluated against.
 class GroundTruthSink {
  public:
-  explicit GroundTruthSink(const std::string& path) : file_(open_out(path)) {
-    file_ << "# timestamp tx ty tz qx qy qz qw (T_w_c: camera optical frame in the site frame, ground "
-             "truth)\n";
+  explicit GroundTruthSink(const std::string& path) : file_(path) {
+    file_.append(
+        "# timestamp tx ty tz qx qy qz qw (T_w_c: camera optical frame in the site frame, ground truth)\n");
     trajectory_.source = path;
   }
   void add(const geom::StampedPose& pose) {
-    file_ << geom::format_tum_line(pose) << "\n" << std::flush;
+    file_.append(geom::format_tum_line(pose) + "\n");
     trajectory_.poses.push_back(pose);
   }
   void close() { file_.close(); }
   const eval::Trajectory& trajectory() const { return trajectory_; }
 
  private:
-  std::ofstream file_;
+  OutputFile file_;
   eval::Trajectory trajectory_;
 };
 
@@ -256,7 +256,7 @@ std::string summary_line(const RunReport& report) {
       "%s: %zu frames, %zu lost, %zu keyframes, ATE rmse %s m, tracking median %.2f ms, realtime factor "
       "%.2f (%.2f s simulated in %.2f s wall, %.2f s CPU)",
       to_string(report.status), p.frames, p.lost_frames, p.keyframes,
-      p.eval ? fmt(p.eval->ate.rmse).c_str() : "n/a", percentile(tracking_ms, 0.5),
+      p.eval ? format_g(p.eval->ate.rmse).c_str() : "n/a", percentile(tracking_ms, 0.5),
       realtime_factor(report.sim_s, report.wall_s), report.sim_s, report.wall_s, report.cpu_s);
   return summary;
 }
@@ -267,12 +267,12 @@ void log_summary(const RunReport& report, RunLog& log) {
   for (const SlamRun* r : {&report.primary, report.baseline ? &*report.baseline : nullptr}) {
     if (!r || (!r->refined_eval && r->loop_closing_json.empty())) continue;
     log.line(eval::mode_label(r->mode) + ": refined trajectory ATE rmse " +
-             (r->refined_eval ? fmt(r->refined_eval->ate.rmse) : "n/a") + " m, " +
+             (r->refined_eval ? format_g(r->refined_eval->ate.rmse) : "n/a") + " m, " +
              std::to_string(r->loops_closed) + " loops closed");
   }
   if (report.closed_loop)
-    log.line("closed loop: path error rmse " + fmt(report.closed_loop->path_error_rmse_m) + " m, max " +
-             fmt(report.closed_loop->path_error_max_m) + " m, held " +
+    log.line("closed loop: path error rmse " + format_g(report.closed_loop->path_error_rmse_m) + " m, max " +
+             format_g(report.closed_loop->path_error_max_m) + " m, held " +
              std::to_string(report.closed_loop->hold_frames) + " frames");
   const std::string table = comparison_table(report);
   if (table.empty()) return;

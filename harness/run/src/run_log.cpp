@@ -17,23 +17,11 @@ double process_cpu_s() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-std::string fmt(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
-std::ofstream open_out(const std::string& path) {
-  std::ofstream f(path);
-  if (!f) throw IoError(path, "cannot open for writing");
-  return f;
-}
-
 RunLog::RunLog(const std::string& path, std::function<void(const std::string&)> echo)
-    : file_(open_out(path)), echo_(std::move(echo)) {}
+    : file_(path), echo_(std::move(echo)) {}
 
 void RunLog::line(const std::string& text) {
-  file_ << text << "\n" << std::flush;
+  file_.append(text + "\n");
   lines_.push_back(text);
   if (echo_) echo_(text);
 }

@@ -2,10 +2,11 @@
 // Small pieces every stage of a scenario run uses: the clock, the process
 // CPU time, number formatting, output files and run.log.
 #include <chrono>
-#include <fstream>
 #include <functional>
 #include <string>
 #include <vector>
+
+#include "pvb/common/output_file.hpp"
 
 namespace pvb::run {
 
@@ -17,12 +18,6 @@ double ms_since(Clock::time_point t0);
 /// CPU time of the whole process (every thread, GL workers included), seconds.
 double process_cpu_s();
 
-/// A number as "%.6g" (timing.csv, log lines).
-std::string fmt(double v);
-
-/// Opens `path` for writing; throws pvb::IoError when it cannot.
-std::ofstream open_out(const std::string& path);
-
 /// run.log, flushed line by line; also kept for index.html and echoed.
 class RunLog {
  public:
@@ -31,7 +26,7 @@ class RunLog {
   const std::vector<std::string>& lines() const { return lines_; }
 
  private:
-  std::ofstream file_;
+  OutputFile file_;
   std::function<void(const std::string&)> echo_;
   std::vector<std::string> lines_;
 };

@@ -1,6 +1,7 @@
 #include "system_sink.hpp"
 
 #include <cstdio>
+#include <sstream>
 
 #include "pvb/common/text.hpp"
 #include "pvb/eval/slam_mode.hpp"
@@ -49,14 +50,14 @@ SystemSink::SystemSink(const std::string& mode, const slam::Settings& settings, 
   options.synchronous = sync;
   options.seed = seed;
   system = std::make_unique<slam::System>(settings, options);
-  cam_traj = open_out(dir + "/CameraTrajectory.txt");
-  kf_traj = open_out(dir + "/KeyFrameTrajectory.txt");
-  timing = open_out(dir + "/timing.csv");
-  cam_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c; w = camera frame of the first tracked frame)\n";
-  kf_traj << "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
-  timing << "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,"
-            "inliers,"
-            "keyframe,mapping_ms\n";
+  cam_traj = OutputFile(dir + "/CameraTrajectory.txt");
+  kf_traj = OutputFile(dir + "/KeyFrameTrajectory.txt");
+  timing = OutputFile(dir + "/timing.csv");
+  cam_traj.append("# timestamp tx ty tz qx qy qz qw (T_w_c; w = camera frame of the first tracked frame)\n");
+  kf_traj.append("# timestamp tx ty tz qx qy qz qw (T_w_c)\n");
+  timing.append(
+      "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,inliers,"
+      "keyframe,mapping_ms\n");
   est.source = dir + "/CameraTrajectory.txt";
 }
 
@@ -84,17 +85,18 @@ void SystemSink::count(const slam::FrameResult& r, int index, double t_s) {
 
 void SystemSink::write_lines(const slam::FrameResult& r, int index) {
   if (r.T_w_c) {
-    cam_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+    cam_traj.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
     est.poses.push_back({r.t_ns, *r.T_w_c});
-    if (r.tracking.new_keyframe) kf_traj << geom::format_tum_line({r.t_ns, *r.T_w_c}) << "\n" << std::flush;
+    if (r.tracking.new_keyframe) kf_traj.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
   }
   static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc"};
-  timing << index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
-         << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","
-         << fmt(r.tracking_ms) << "," << fmt(r.orb_ms) << "," << fmt(r.tracking.pe_match_ms) << ","
-         << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers << ","
-         << (r.tracking.new_keyframe ? 1 : 0) << "," << fmt(r.mapping_ms) << "\n"
-         << std::flush;
+  std::ostringstream line;
+  line << index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
+       << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","
+       << format_g(r.tracking_ms) << "," << format_g(r.orb_ms) << "," << format_g(r.tracking.pe_match_ms)
+       << "," << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers
+       << "," << (r.tracking.new_keyframe ? 1 : 0) << "," << format_g(r.mapping_ms) << "\n";
+  timing.append(line.str());
 }
 
 void SystemSink::finish() {

@@ -3,11 +3,11 @@
 // KeyFrameTrajectory, timing.csv), its per-frame bookkeeping and its loss
 // and recovery events, finished and evaluated at the end.
 #include <cstdint>
-#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "pvb/common/output_file.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/run/report.hpp"
 #include "pvb/run/run.hpp"
@@ -22,7 +22,7 @@ struct SystemSink {
   SlamRun run;
   std::unique_ptr<slam::System> system;
   std::string dir;
-  std::ofstream cam_traj, kf_traj, timing;
+  OutputFile cam_traj, kf_traj, timing;
   eval::Trajectory est;
   eval::Trajectory refined;  ///< filled by finish()
   slam::TrackingState prev_state = slam::TrackingState::kNotInitialized;

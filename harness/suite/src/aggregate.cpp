@@ -11,13 +11,8 @@
 namespace pvb::suite {
 namespace {
 
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
 std::string opt(const std::optional<double>& v, const char* f, double scale = 1.0) {
-  return v ? fmt(f, *v * scale) : "";
+  return v ? format_number(f, *v * scale) : "";
 }
 std::string json_num(double v) { return json_number(v, 9); }
 std::string json_opt(const std::optional<double>& v) { return v ? json_num(*v) : "null"; }
@@ -35,7 +30,7 @@ RunSummary summarize_runs(const std::vector<const RunMetrics*>& runs) {
 
 std::string pm(const Summary& s, const char* f, double scale = 1.0) {
   if (s.count == 0) return "n/a";
-  return fmt(f, s.mean * scale) + " ± " + fmt(f, s.sd * scale);
+  return format_number(f, s.mean * scale) + " ± " + format_number(f, s.sd * scale);
 }
 
 std::string summary_json(const Summary& s) {
@@ -105,7 +100,7 @@ double t_central_mass(double t, int dof) {
   return 2.0 / kPi * (theta + s * sum);
 }
 
-std::string mm2(double v_m) { return fmt("%.2f", v_m * 1000.0); }
+std::string mm2(double v_m) { return format_number("%.2f", v_m * 1000.0); }
 
 }  // namespace
 
@@ -207,8 +202,8 @@ std::string format_paired_line(const PairedComparison& p) {
   out += " over " + std::to_string(p.count) + (p.count == 1 ? " seed" : " seeds");
   if (!p.has_ci)
     return out + " (PE ≤ baseline on " + std::to_string(p.pe_not_worse) + "); " + verdict_text(p.verdict);
-  out += " (effect size d_z " + fmt("%.2f", p.effect_size_dz) + "; PE ≤ baseline on " +
-         std::to_string(p.pe_not_worse) + ", sign test p = " + fmt("%.2f", p.sign_test_p) + "); " +
+  out += " (effect size d_z " + format_number("%.2f", p.effect_size_dz) + "; PE ≤ baseline on " +
+         std::to_string(p.pe_not_worse) + ", sign test p = " + format_number("%.2f", p.sign_test_p) + "); " +
          verdict_text(p.verdict);
   return out + "; not significantly worse: " + (p.not_worse ? "yes (upper end " : "no (upper end ") +
          mm2(p.ci_high_m) + (p.not_worse ? " mm ≤ margin " : " mm > margin ") + mm2(p.margin_m) + " mm)";

@@ -2,20 +2,16 @@
 
 #include <cstdio>
 
+#include "pvb/common/text.hpp"
+
 namespace pvb::suite {
 namespace {
 
-std::string metres(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g m", v);
-  return buf;
-}
+std::string metres(double v) { return format_number("%.4g m", v); }
 
 /// Millimetres with two decimals; `sign` writes + before a positive value.
 std::string millimetres(double v_m, bool sign = true) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, sign ? "%+.2f mm" : "%.2f mm", v_m * 1000.0);
-  return buf;
+  return format_number(sign ? "%+.2f mm" : "%.2f mm", v_m * 1000.0);
 }
 
 std::string pe_against_baseline_note(double pe_m, double baseline_m) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_file.hpp"
 
 namespace pvb::slam::dense {
 namespace {
@@ -30,33 +31,35 @@ float get_float_le(const unsigned char* src) {
 }  // namespace
 
 void write_ply(const std::string& path, const PointCloud& cloud) {
-  std::ofstream f(path, std::ios::binary);
-  if (!f) throw IoError(path, "cannot open for writing");
-  f << "ply\nformat binary_little_endian 1.0\ncomment PE-SLAM Bench dense map (T_w_c of the keyframes), "
-       "metres\n"
-    << "element vertex " << cloud.size() << "\n"
-    << "property float x\nproperty float y\nproperty float z\n"
-    << "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
-  std::vector<unsigned char> buf;
-  constexpr std::size_t kChunk = 65536;
-  buf.reserve(kChunk * kVertexBytes);
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const CloudPoint& p = cloud[i];
-    unsigned char v[kVertexBytes];
-    put_float_le(v, p.x);
-    put_float_le(v + 4, p.y);
-    put_float_le(v + 8, p.z);
-    v[12] = p.r;
-    v[13] = p.g;
-    v[14] = p.b;
-    buf.insert(buf.end(), v, v + kVertexBytes);
-    if (buf.size() >= kChunk * kVertexBytes || i + 1 == cloud.size()) {
-      f.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
-      buf.clear();
+  std::ostringstream header;
+  header << "ply\nformat binary_little_endian 1.0\ncomment PE-SLAM Bench dense map (T_w_c of the keyframes), "
+            "metres\n"
+         << "element vertex " << cloud.size() << "\n"
+         << "property float x\nproperty float y\nproperty float z\n"
+         << "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+  // Through a temporary file: a write that fails (disk full) leaves no PLY
+  // whose header announces vertices its body lacks.
+  write_file_via_temp(path, [&](OutputFile& f) {
+    f.append(header.str());
+    std::vector<unsigned char> buf;
+    constexpr std::size_t kChunk = 65536;
+    buf.reserve(kChunk * kVertexBytes);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const CloudPoint& p = cloud[i];
+      unsigned char v[kVertexBytes];
+      put_float_le(v, p.x);
+      put_float_le(v + 4, p.y);
+      put_float_le(v + 8, p.z);
+      v[12] = p.r;
+      v[13] = p.g;
+      v[14] = p.b;
+      buf.insert(buf.end(), v, v + kVertexBytes);
+      if (buf.size() >= kChunk * kVertexBytes || i + 1 == cloud.size()) {
+        f.append(reinterpret_cast<const char*>(buf.data()), buf.size());
+        buf.clear();
+      }
     }
-  }
-  f.flush();
-  if (!f) throw IoError(path, "write failed");
+  });
 }
 
 PointCloud read_ply(const std::string& path) {

@@ -1,6 +1,7 @@
 // pvbench record, end to end: the acceptance run (120 frames of the
 // default station), byte-identical output, depth/pose consistency, errors.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -8,12 +9,11 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <regex>
-#include <unistd.h>
 
 #include "pvb/common/text.hpp"
-#include "run_pvbench.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/trajectory.hpp"
+#include "run_pvbench.hpp"
 
 using namespace pvb;
 
@@ -58,8 +58,8 @@ const std::string& station_run() {
 
 TEST(RecordCli, WritesAConsistentTumSequence) {
   const std::string& d = station_run();
-  for (const char* f : {"rgb.txt", "depth.txt", "groundtruth.txt", "associations.txt", "camera.yaml", "scene.xml",
-                        "meta.json", "textures/brick.png"})
+  for (const char* f : {"rgb.txt", "depth.txt", "groundtruth.txt", "associations.txt", "camera.yaml",
+                        "scene.xml", "meta.json", "textures/brick.png"})
     EXPECT_EQ(::access((d + "/" + f).c_str(), R_OK), 0) << f;
   const auto rgb = dataset::read_tum_list(d + "/rgb.txt");
   ASSERT_EQ(rgb.size(), 120u);
@@ -130,8 +130,7 @@ TEST(RecordCli, BadScenarioGivesOneClearLine) {
   const Result r = run("record --scenario " + bad + " --out " + fresh("bad") + " --frames 2");
   EXPECT_EQ(r.code, 1);
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
-  EXPECT_NE(r.output.find(bad + ":3: camera.fps: expected a value in [1, 240], got -30"),
-            std::string::npos)
+  EXPECT_NE(r.output.find(bad + ":3: camera.fps: expected a value in [1, 240], got -30"), std::string::npos)
       << r.output;
 }
 
@@ -141,7 +140,8 @@ TEST(RecordCli, UnwritableOutputGivesOneClearLine) {
   const Result r = run("record --scenario " + kStation + " --out " + file + "/seq --frames 2");
   EXPECT_EQ(r.code, 1);
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
-  EXPECT_NE(r.output.find("pvbench: error: " + file + "/seq: cannot create folder"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("pvbench: error: " + file + "/seq: cannot create folder"), std::string::npos)
+      << r.output;
 }
 
 TEST(RecordCli, MissingScenarioFile) {
@@ -246,4 +246,23 @@ TEST(RecordCli, SceneAtTheSizeLimitRendersWholeAndLeavesNoMujocoLog) {
   EXPECT_EQ(r.output.find("MuJoCo"), std::string::npos) << r.output;
   EXPECT_NE(::access((cwd + "/MUJOCO_LOG.TXT").c_str(), F_OK), 0);
   EXPECT_EQ(data_lines(cwd + "/seq/rgb.txt"), 1u);
+}
+
+// A disk that fills up while the textures and images are written (every
+// file capped at 64 KiB): one error naming the file, which is not left
+// half-written, and the lists name no frame that is not whole.
+TEST(RecordCli, FullDiskIsOneErrorNamingTheFileAndLeavesNoPartialFile) {
+  const std::string d = fresh("full");
+  const Result r =
+      test::run_pvbench_with_file_limit("record --scenario " + kStation + " --out " + d + " --frames 3", 64);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  std::smatch m;
+  ASSERT_TRUE(
+      std::regex_search(r.output, m,
+                        std::regex("pvbench: error: (" + d +
+                                   "/[^:]+\\.png): (write failed: File too large|cannot write image)")))
+      << r.output;
+  EXPECT_NE(::access(m[1].str().c_str(), F_OK), 0) << "a partial file is left under its final name";
+  EXPECT_EQ(data_lines(d + "/associations.txt"), 0u);
 }

@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -263,3 +264,35 @@ TEST(SlamInput, TruncatedPngIsOneWarningLine) {
 }
 
 }  // namespace
+
+// A disk that fills up mid-run (every file capped at 1 KiB): the first
+// failed write stops the run with one error naming that file, and every
+// output holds whole lines only: the trajectory so far stays valid TUM.
+TEST(SlamInput, FullDiskIsOneErrorNamingTheFileAndKeepsWholeLines) {
+  const std::string seq = make_sequence("full");
+  const std::string out = fresh("full_out");
+  std::filesystem::create_directories(out);
+  const Result r = test::run_pvbench_with_file_limit(
+      "slam --sequence " + seq + " --settings " + seq + "/camera.yaml --out " + out + " --sync --no-dense",
+      1);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(count(r.output, "pvbench: error: "), 1u) << r.output;
+  EXPECT_EQ(count(r.output, "\n"), 1u) << r.output;
+  const std::regex failed("pvbench: error: " + out +
+                          "/([A-Za-z]+\\.(txt|csv|json)): write failed: File too large\n");
+  EXPECT_TRUE(std::regex_match(r.output, failed)) << r.output;
+  std::size_t poses = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(out)) {
+    const std::string text = read_file(entry.path().string());
+    EXPECT_TRUE(text.empty() || text.back() == '\n') << entry.path();
+    EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();
+    if (entry.path().filename() != "CameraTrajectory.txt") continue;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) {
+      if (line.empty() || line[0] == '#') continue;
+      EXPECT_EQ(split_ws(line, " ").size(), 8u) << line;
+      ++poses;
+    }
+  }
+  EXPECT_GE(poses, 1u);  // what was tracked before the disk filled is kept
+}

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "file_size_limit.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/slam/dense/ply.hpp"
@@ -101,3 +102,25 @@ TEST(Ply, MalformedFilesAreClearErrors) {
 }
 
 }  // namespace
+
+// A full disk while the body is written: an error naming the PLY, and no
+// file whose header announces vertices its body lacks (the old map stays).
+TEST(Ply, FullDiskLeavesNoTruncatedPly) {
+  const std::string path = temp("full");
+  pvb::slam::dense::write_ply(path, sample());
+  const std::string old_bytes = pvb::read_file(path);
+  PointCloud big(100000, CloudPoint{1.0f, 2.0f, 3.0f, 4, 5, 6});
+  std::string err = "(no error)";
+  {
+    const pvb::test::FileSizeLimit limit(64 * 1024);
+    try {
+      pvb::slam::dense::write_ply(path, big);
+    } catch (const pvb::IoError& e) {
+      err = e.what();
+    }
+  }
+  EXPECT_EQ(err, path + ": write failed: File too large");
+  EXPECT_EQ(pvb::read_file(path), old_bytes);
+  EXPECT_FALSE(std::ifstream(path + ".tmp").good());
+  std::remove(path.c_str());
+}

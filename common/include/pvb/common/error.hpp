@@ -34,9 +34,12 @@ class IoError : public Error {
   IoError(std::string file, std::string message, int line = 0);
   const std::string& file() const { return file_; }
   int line() const { return line_; }
+  /// The message without the file and line.
+  const std::string& message() const { return message_; }
 
  private:
   std::string file_;
+  std::string message_;
   int line_;
 };
 

@@ -7,8 +7,9 @@ namespace pvb {
 
 /// Reads a whole file; throws IoError when it cannot.
 std::string read_file(const std::string& path);
-/// Writes a whole file atomically enough for our use (write then rename);
-/// throws IoError when it cannot.
+/// Writes a whole file through `path`.tmp, renamed over `path` once whole
+/// (write_file_via_temp); throws IoError naming `path` when it cannot, and
+/// leaves neither a half-written file nor the temporary one behind.
 void write_file(const std::string& path, const std::string& content);
 /// Splits on any run of the given separator characters, skipping empty fields.
 std::vector<std::string> split_ws(const std::string& line, const char* seps = " \t\r,");
@@ -16,5 +17,13 @@ std::vector<std::string> split_ws(const std::string& line, const char* seps = " 
 std::string json_escape(const std::string& s);
 /// A JSON number with `significant_digits` digits (%.Ng); null when not finite.
 std::string json_number(double v, int significant_digits = 17);
+
+/// One number through a printf format with one double conversion, e.g.
+/// format_number("%.2f mm", 3.14159) = "3.14 mm".
+std::string format_number(const char* printf_format, double v);
+/// `significant_digits` significant digits (%.Ng): format_g(0.0123456) = "0.0123456".
+std::string format_g(double v, int significant_digits = 6);
+/// `decimals` digits after the point (%.Nf): format_fixed(2.5, 2) = "2.50".
+std::string format_fixed(double v, int decimals);
 
 }  // namespace pvb

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "pvb/common/output_file.hpp"
 #include "pvb/geometry/pinhole.hpp"
 #include "pvb/geometry/se3.hpp"
 #include "pvb/sensor/depth_encoding.hpp"
@@ -22,9 +23,9 @@ struct OrbSlamSettings {
   geom::PinholeIntrinsics K;
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
   double fps = 30;
-  double bf = 40.0;            ///< baseline (m) x fx
-  int rgb_order = 1;           ///< Camera.RGB: 1 = RGB, 0 = BGR
-  double th_depth = 40.0;      ///< close/far threshold in baselines
+  double bf = 40.0;        ///< baseline (m) x fx
+  int rgb_order = 1;       ///< Camera.RGB: 1 = RGB, 0 = BGR
+  double th_depth = 40.0;  ///< close/far threshold in baselines
   double depth_map_factor = sensor::kTumDepthFactor;
   int n_features = 1000;
   double scale_factor = 1.2;
@@ -46,7 +47,8 @@ void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s);
 class TumSequenceWriter {
  public:
   /// Creates `dir` (and parents), rgb/ and depth/.  Throws IoError when it cannot.
-  TumSequenceWriter(const std::string& dir, double depth_factor = sensor::kTumDepthFactor, const std::string& source = "pvbench");
+  TumSequenceWriter(const std::string& dir, double depth_factor = sensor::kTumDepthFactor,
+                    const std::string& source = "pvbench");
   /// Writes one frame and its ground-truth camera pose.
   void write(const sensor::RgbdFrame& frame, const geom::SE3d& T_w_c);
   int frames_written() const { return frames_; }
@@ -55,7 +57,7 @@ class TumSequenceWriter {
  private:
   std::string dir_;
   double depth_factor_;
-  std::ofstream rgb_txt_, depth_txt_, gt_txt_, assoc_txt_;
+  OutputFile rgb_txt_, depth_txt_, gt_txt_, assoc_txt_;
   int frames_ = 0;
 };
 
@@ -72,12 +74,13 @@ void make_dirs(const std::string& dir);
 class TumSequenceReader : public sensor::FrameSource {
  public:
   struct Entry {
-    std::int64_t t_ns = 0;       ///< rgb time stamp
-    std::string rgb;             ///< path relative to the folder
+    std::int64_t t_ns = 0;  ///< rgb time stamp
+    std::string rgb;        ///< path relative to the folder
     std::int64_t depth_t_ns = 0;
     std::string depth;
   };
-  explicit TumSequenceReader(const std::string& dir, double depth_factor = sensor::kTumDepthFactor, double max_diff_s = 0.02);
+  explicit TumSequenceReader(const std::string& dir, double depth_factor = sensor::kTumDepthFactor,
+                             double max_diff_s = 0.02);
   /// The next frame whose images load; a frame whose image is missing or
   /// damaged is skipped with one warning line on stderr.  nullopt at the
   /// end, and once more than max_skipped() frames were skipped

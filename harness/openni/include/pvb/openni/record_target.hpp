@@ -26,6 +26,12 @@ bool same_file(const std::string& a, const std::string& b);
 /// land on one of `files` (empty paths are skipped).
 void check_record_not_on(const std::string& record_path, const std::vector<RunFile>& files);
 
+/// The checks of create_new_recording_file without creating anything, for a
+/// command to run before it opens a device: an error thrown while OpenNI2
+/// has a device open can crash libOpenNI2's teardown (seen with a recording
+/// being played back), so every refusal that can come first comes first.
+void check_new_recording_path(const std::string& record_path);
+
 /// Creates record_path as a new, empty file (O_CREAT | O_EXCL, so a link is
 /// not followed either).  Throws IoError(record_path, ...) with one line when
 /// the path is a folder, its folder is missing or not a folder, or a file or
