@@ -19,8 +19,8 @@ struct KeyFrameSettings {
   /// than this are tracked (and more than minUntrackedClose are not).
   /// ORB-SLAM2: 100. Default 200: with a Kinect-range sensor every depth
   /// point is close, and at 100 a forward drive waits until tracking is down
-  /// to about 100 inliers before each keyframe (docs/slam.md, "Keyframe
-  /// spacing and drift").
+  /// to about 100 inliers before each keyframe
+  /// (docs/experiments/2026-11-21-keyframe-spacing-and-drift.md).
   int min_tracked_close = 200;
   int min_untracked_close = 70;  ///< KeyFrame.minUntrackedClose (ORB-SLAM2: 70)
   /// KeyFrame.refOverlap, in (0, 1); 0 (the default) keeps ORB-SLAM2's rule.
@@ -41,7 +41,8 @@ struct PeMatchSettings {
   int stall_iterations = 6;        ///< PEMatch.stallIterations: stop after this many without improvement
   // Defaults below differ from the paper's (eq. 8 point-line distance, 3 px,
   // no refinement): scored against ground truth on the motion model's coarse
-  // matches of the simulated sequences (docs/slam.md, bench/pematch_tracking_eval),
+  // matches of the simulated sequences (bench/pematch_tracking_eval,
+  // docs/experiments/2026-11-21-pe-match-in-tracking.md),
   // Sampson 2 px + refinement discards half as many correct matches for the
   // same share of wrong ones removed.
   double threshold_px = 2.0;       ///< PEMatch.threshold: epipolar distance threshold, pixels
@@ -49,7 +50,8 @@ struct PeMatchSettings {
   bool refine = true;              ///< PEMatch.refine (0/1): IRLS refinement of gbest's F
   /// PEMatch.skipLowParallax (0/1): skip PE-match on frames whose predicted
   /// translation moves the matches by less than the threshold (an
-  /// experiment; it did not help on fast_turns, docs/slam.md).
+  /// experiment; it did not help on fast_turns,
+  /// docs/experiments/2026-11-21-pe-match-on-fast-turns.md).
   bool skip_low_parallax = false;
 };
 

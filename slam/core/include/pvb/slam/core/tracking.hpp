@@ -79,7 +79,7 @@ struct TrackingOptions {
   /// matches (the motion is a homography within the noise), so an F from
   /// eight of them says little about the others.  Off by default: on
   /// fast_turns it changed neither the turn-frame errors nor the ATE
-  /// (docs/slam.md, "PE-match on fast_turns").
+  /// (docs/experiments/2026-11-21-pe-match-on-fast-turns.md).
   bool pe_skip_low_parallax = false;
   double motion_th = 7.0;      ///< ORB-SLAM2 window for stereo / RGB-D, x scale of the octave
   double motion_ratio = 0.9;   ///< paper sec. 3 step 1

@@ -7,8 +7,8 @@
 //
 // Why: FAST corners lag when the image zooms, so keypoints matched across a
 // forward drive expand less than the scene and bundle adjustment reads the
-// shortfall as pitch (docs/slam.md, "a pitch bias per keyframe").  A match
-// aligned to its map point's reference patch is consistent with the
+// shortfall as pitch (docs/experiments/2026-11-21-lawnmower-pitch-bias-per-keyframe.md).
+// A match aligned to its map point's reference patch is consistent with the
 // reference keypoint instead, whatever that keypoint's own error.
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
