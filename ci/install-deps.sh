@@ -9,6 +9,7 @@ PKGS=(
   libegl-dev libegl-mesa0 libgl-dev libgles-dev libosmesa6-dev libgl1-mesa-dri
   libopenni2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang libclang-rt-14-dev   # the libFuzzer targets (ci/fuzz.sh)
 )
 missing=()
 for p in "${PKGS[@]}"; do
