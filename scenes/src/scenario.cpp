@@ -121,6 +121,7 @@ class MapReader {
   /// Rejects keys that were never read.
   void finish() const {
     for (const auto& kv : node_) {
+      if (!kv.first.IsScalar()) fail(full("?"), kv.first, "a key name", "a list or a map as a key");
       const std::string key = kv.first.as<std::string>();
       if (read_.count(key) == 0) {
         std::string known;

@@ -51,6 +51,16 @@ TEST(Scenario, UnknownKeyIsNamedWithFileAndLine) {
   EXPECT_NE(msg.find("unknown key"), std::string::npos) << msg;
 }
 
+// A list or a map used as a key (found by fuzz_scenario) is a ConfigError
+// naming the line, not a yaml-cpp conversion error escaping the reader.
+TEST(Scenario, NonScalarKeyIsNamedWithFileAndLine) {
+  const std::string msg = error_of(std::string(kMinimal) + "ground: {type: gravel, [1, 2]: 3}\n");
+  EXPECT_NE(msg.find("bad.yaml:2"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("ground.?: expected a key name, got a list or a map as a key"), std::string::npos) << msg;
+  const std::string top = error_of(std::string(kMinimal) + "? [a, b]\n: 1\n");
+  EXPECT_NE(top.find("expected a key name"), std::string::npos) << top;
+}
+
 TEST(Scenario, WrongTypeIsNamed) {
   const std::string msg = error_of(std::string(kMinimal) + "light:\n  shadows: maybe\n");
   EXPECT_NE(msg.find("light.shadows: expected true or false, got maybe"), std::string::npos) << msg;
