@@ -236,6 +236,10 @@ Settings read_settings(const std::string& path) {
   } catch (const cv::Exception& e) {
     throw parse_error(path, e);
   }
+  // cv::FileStorage asserts (an internal error) when a key is looked up
+  // in a root that is a list or a scalar (found by fuzz_settings).
+  if (!fs.root().isMap())
+    throw IoError(path, "expected ORB-SLAM2 settings: keys and values (a YAML map) at the top level");
   Settings s;
   s.source = path;
   Reader r(fs, path);
@@ -249,7 +253,8 @@ Settings read_settings(const std::string& path) {
   const cv::FileNode root = fs.root();
   for (auto it = root.begin(); it != root.end(); ++it) {
     const std::string key = (*it).name();
-    if (!r.seen().count(key) && !ignored_key(key)) s.warnings.push_back(path + ": unknown key '" + key + "' ignored");
+    if (!r.seen().count(key) && !ignored_key(key))
+      s.warnings.push_back(path + ": unknown key '" + key + "' ignored");
   }
   return s;
 }

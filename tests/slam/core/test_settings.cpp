@@ -332,6 +332,20 @@ TEST(Settings, SyntaxErrorNamesLineAndReason) {
   }
 }
 
+// A file whose top level is a list, a scalar or nothing (found by
+// fuzz_settings: OpenCV asserted, an internal error) is one IoError.
+TEST(Settings, TopLevelMustBeAMap) {
+  for (const char* text : {"%YAML:1.0\n- Camera.fx\n- 500\n", "%YAML:1.0\n---\n", "just words\n"}) {
+    const std::string path = temp_copy("toplevel", text);
+    try {
+      read_settings(path);
+      ADD_FAILURE() << "expected IoError for " << text;
+    } catch (const IoError& e) {
+      EXPECT_EQ(e.file(), path);
+    }
+  }
+}
+
 TEST(Settings, MissingFileIsAnIoError) { EXPECT_THROW(read_settings("/nonexistent/settings.yaml"), IoError); }
 
 }  // namespace
