@@ -228,8 +228,23 @@ IoError parse_error(const std::string& path, const cv::Exception& e) {
 
 }  // namespace
 
+/// Lines OpenCV's YAML parser cannot read: it loops for ever on a line that
+/// starts with "----" and goes on (found by fuzz_settings), so a line that
+/// starts with "---" must be the document marker alone.
+void check_document_markers(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (line.rfind("---", 0) != 0) continue;
+    const std::size_t rest = line.find_first_not_of(" \t\r", 3);
+    if (rest != std::string::npos && line[rest] != '#')
+      throw IoError(path, "expected the document marker '---' alone on its line, got '" + line + "'", n);
+  }
+}
+
 Settings read_settings(const std::string& path) {
   if (!std::ifstream(path)) throw IoError(path, "cannot open settings file");
+  check_document_markers(path);
   cv::FileStorage fs;
   try {
     if (!fs.open(path, cv::FileStorage::READ)) throw IoError(path, "cannot open settings file");

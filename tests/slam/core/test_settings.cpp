@@ -1,11 +1,11 @@
 // The settings reader on ORB-SLAM2's own TUM1.yaml and on broken copies.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <fstream>
 #include <regex>
 #include <utility>
 #include <vector>
-#include <unistd.h>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
@@ -18,7 +18,8 @@ const std::string kTum1 = std::string(PVB_SHARED_DIR) + "/data/tum/TUM1.yaml";
 const std::string kTum3 = std::string(PVB_SOURCE_DIR) + "/configs/tum/TUM3.yaml";
 
 std::string temp_copy(const std::string& name, const std::string& content) {
-  const std::string path = ::testing::TempDir() + "pvb_settings_" + name + "_" + std::to_string(::getpid()) + ".yaml";
+  const std::string path =
+      ::testing::TempDir() + "pvb_settings_" + name + "_" + std::to_string(::getpid()) + ".yaml";
   write_file(path, content);
   return path;
 }
@@ -71,10 +72,11 @@ TEST(Settings, ShippedTum3IsCompleteAndUndistorted) {
 }
 
 TEST(Settings, ReadsPeMatchSection) {
-  const std::string path = temp_copy("pe", read_file(kTum1) +
-                                               "\nPEMatch.enabled: 0\nPEMatch.population: 30\nPEMatch.j: 80\n"
-                                               "PEMatch.stallIterations: 9\nPEMatch.threshold: 2.5\nPEMatch.refine: 0\n"
-                                               "PEMatch.sampson: 0\nPEMatch.skipLowParallax: 1\n");
+  const std::string path =
+      temp_copy("pe", read_file(kTum1) +
+                          "\nPEMatch.enabled: 0\nPEMatch.population: 30\nPEMatch.j: 80\n"
+                          "PEMatch.stallIterations: 9\nPEMatch.threshold: 2.5\nPEMatch.refine: 0\n"
+                          "PEMatch.sampson: 0\nPEMatch.skipLowParallax: 1\n");
   const Settings s = read_settings(path);
   EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
   EXPECT_TRUE(s.pe_match.skip_low_parallax);
@@ -83,7 +85,7 @@ TEST(Settings, ReadsPeMatchSection) {
   EXPECT_EQ(s.pe_match.num_fitness_samples, 80);
   EXPECT_EQ(s.pe_match.stall_iterations, 9);
   EXPECT_DOUBLE_EQ(s.pe_match.threshold_px, 2.5);
-  EXPECT_FALSE(s.pe_match.refine);   // the paper's filter: eq. 8, no refinement
+  EXPECT_FALSE(s.pe_match.refine);  // the paper's filter: eq. 8, no refinement
   EXPECT_FALSE(s.pe_match.sampson);
 }
 
@@ -113,7 +115,8 @@ TEST(Settings, ReadsKeyFrameSection) {
 
 /// An optional 0/1 key of ours: on when absent, off with 0 (no warning),
 /// a ConfigError naming the key for `bad_value`.
-void expect_optional_flag(const std::string& key, const std::string& bad_value, bool (*get)(const Settings&)) {
+void expect_optional_flag(const std::string& key, const std::string& bad_value,
+                          bool (*get)(const Settings&)) {
   SCOPED_TRACE(key);
   EXPECT_TRUE(get(read_settings(kTum1)));
   const Settings s = read_settings(temp_copy("flag", read_file(kTum1) + "\n" + key + ": 0\n"));
@@ -140,14 +143,15 @@ TEST(Settings, ReadsLoopClosingSection) {
   const Settings d = read_settings(kTum1);  // absent: on, with the documented defaults
   EXPECT_TRUE(d.loop.enabled);
   EXPECT_EQ(d.loop.min_inliers, 40);
-  const std::string path = temp_copy("loop", read_file(kTum1) +
-                                                 "\nLoopClosing.enabled: 0\nLoopClosing.searchRadius: 2.5\n"
-                                                 "LoopClosing.maxAngle: 45\nLoopClosing.minKeyFrameGap: 20\n"
-                                                 "LoopClosing.maxCandidates: 3\nLoopClosing.minMatches: 25\n"
-                                                 "LoopClosing.consistency: 3\nLoopClosing.minInliers: 60\n"
-                                                 "LoopClosing.maxCorrection: 0.2\nLoopClosing.maxCorrectionAngle: 5\n"
-                                                 "LoopClosing.essentialWeight: 80\nLoopClosing.globalBA: 1\n"
-                                                 "LoopClosing.rotationWeight: 3\n");
+  const std::string path =
+      temp_copy("loop", read_file(kTum1) +
+                            "\nLoopClosing.enabled: 0\nLoopClosing.searchRadius: 2.5\n"
+                            "LoopClosing.maxAngle: 45\nLoopClosing.minKeyFrameGap: 20\n"
+                            "LoopClosing.maxCandidates: 3\nLoopClosing.minMatches: 25\n"
+                            "LoopClosing.consistency: 3\nLoopClosing.minInliers: 60\n"
+                            "LoopClosing.maxCorrection: 0.2\nLoopClosing.maxCorrectionAngle: 5\n"
+                            "LoopClosing.essentialWeight: 80\nLoopClosing.globalBA: 1\n"
+                            "LoopClosing.rotationWeight: 3\n");
   const Settings s = read_settings(path);
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_FALSE(s.loop.enabled);
@@ -164,8 +168,9 @@ TEST(Settings, ReadsLoopClosingSection) {
   EXPECT_FALSE(d.loop.global_ba);  // off by default: it made the loop scenario worse (docs/slam.md)
   EXPECT_TRUE(s.loop.global_ba);
   EXPECT_DOUBLE_EQ(s.loop.rotation_weight, 3);
-  for (const std::string bad : {"LoopClosing.enabled: 2", "LoopClosing.searchRadius: -1", "LoopClosing.minInliers: 3",
-                                "LoopClosing.maxAngle: 200", "LoopClosing.consistency: 1.5", "LoopClosing.rotationWeight: 0"}) {
+  for (const std::string bad :
+       {"LoopClosing.enabled: 2", "LoopClosing.searchRadius: -1", "LoopClosing.minInliers: 3",
+        "LoopClosing.maxAngle: 200", "LoopClosing.consistency: 1.5", "LoopClosing.rotationWeight: 0"}) {
     const std::string key = bad.substr(0, bad.find(':'));
     try {
       read_settings(temp_copy("loopbad", read_file(kTum1) + "\n" + bad + "\n"));
@@ -196,11 +201,12 @@ TEST(Settings, UnknownKeyIsAWarning) {
 }
 
 TEST(Settings, WrongTypeAndBadValuesAreErrors) {
-  EXPECT_THROW(read_settings(temp_copy("type", std::regex_replace(read_file(kTum1), std::regex("Camera.fx: 517.306408"),
-                                                                        "Camera.fx: \"abc\""))),
+  EXPECT_THROW(read_settings(
+                   temp_copy("type", std::regex_replace(read_file(kTum1), std::regex("Camera.fx: 517.306408"),
+                                                        "Camera.fx: \"abc\""))),
                ConfigError);
-  EXPECT_THROW(read_settings(temp_copy("lev", std::regex_replace(read_file(kTum1), std::regex("nLevels: 8"),
-                                                                       "nLevels: 0"))),
+  EXPECT_THROW(read_settings(temp_copy(
+                   "lev", std::regex_replace(read_file(kTum1), std::regex("nLevels: 8"), "nLevels: 0"))),
                ConfigError);
 }
 
@@ -211,10 +217,10 @@ TEST(Settings, PointCloudMappingSection) {
   EXPECT_DOUBLE_EQ(d.dense.resolution_m, 0.02);
   EXPECT_EQ(d.dense.stride_px, 3);
   EXPECT_DOUBLE_EQ(d.dense.max_depth_m, 4.0);
-  const Settings s = read_settings(temp_copy("pc", read_file(kTum1) +
-                                                       "\nPointCloudMapping.Enabled: 0\nPointCloudMapping.Resolution: 0.05\n"
-                                                       "PointCloudMapping.Stride: 2\nPointCloudMapping.MinDepth: 0.3\n"
-                                                       "PointCloudMapping.MaxDepth: 6.5\n"));
+  const Settings s = read_settings(temp_copy(
+      "pc", read_file(kTum1) + "\nPointCloudMapping.Enabled: 0\nPointCloudMapping.Resolution: 0.05\n"
+                               "PointCloudMapping.Stride: 2\nPointCloudMapping.MinDepth: 0.3\n"
+                               "PointCloudMapping.MaxDepth: 6.5\n"));
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_FALSE(s.dense.enabled);
   EXPECT_DOUBLE_EQ(s.dense.resolution_m, 0.05);
@@ -222,14 +228,16 @@ TEST(Settings, PointCloudMappingSection) {
   EXPECT_DOUBLE_EQ(s.dense.min_depth_m, 0.3);
   EXPECT_DOUBLE_EQ(s.dense.max_depth_m, 6.5);
   // unknown key in the section: a warning naming it
-  const Settings w = read_settings(temp_copy("pcw", read_file(kTum1) + "\nPointCloudMapping.Resolutoin: 0.05\n"));
+  const Settings w =
+      read_settings(temp_copy("pcw", read_file(kTum1) + "\nPointCloudMapping.Resolutoin: 0.05\n"));
   ASSERT_EQ(w.warnings.size(), 1u);
   EXPECT_NE(w.warnings[0].find("PointCloudMapping.Resolutoin"), std::string::npos);
   // wrong type or value: an error naming the key
-  const std::vector<std::pair<std::string, std::string>> bad = {
-      {"PointCloudMapping.Resolution", "\"fine\""}, {"PointCloudMapping.Resolution", "0"},
-      {"PointCloudMapping.Stride", "1.5"},          {"PointCloudMapping.Enabled", "2"},
-      {"PointCloudMapping.MaxDepth", "0.05"}};
+  const std::vector<std::pair<std::string, std::string>> bad = {{"PointCloudMapping.Resolution", "\"fine\""},
+                                                                {"PointCloudMapping.Resolution", "0"},
+                                                                {"PointCloudMapping.Stride", "1.5"},
+                                                                {"PointCloudMapping.Enabled", "2"},
+                                                                {"PointCloudMapping.MaxDepth", "0.05"}};
   for (const auto& [key, value] : bad) {
     try {
       read_settings(temp_copy("pcbad", read_file(kTum1) + "\n" + key + ": " + value + "\n"));
@@ -343,6 +351,26 @@ TEST(Settings, TopLevelMustBeAMap) {
     } catch (const IoError& e) {
       EXPECT_EQ(e.file(), path);
     }
+  }
+}
+
+// OpenCV's parser loops for ever on a line such as "----x" (found by
+// fuzz_settings): such a line is an error naming it, before OpenCV reads.
+TEST(Settings, DocumentMarkerMustStandAlone) {
+  const std::string path = temp_copy("marker", "%YAML:1.0\n----x\nCamera.fx: 500\n");
+  try {
+    read_settings(path);
+    FAIL() << "expected IoError";
+  } catch (const IoError& e) {
+    EXPECT_EQ(e.line(), 2) << e.what();
+    EXPECT_NE(std::string(e.what()).find("document marker '---' alone"), std::string::npos) << e.what();
+  }
+  // The marker itself, with spaces or a comment after it, is fine.
+  const std::string ok = temp_copy("marker_ok", "%YAML:1.0\n--- # settings\nCamera.fx: 500\n");
+  try {
+    read_settings(ok);
+  } catch (const ConfigError& e) {  // the missing keys, not the marker
+    EXPECT_EQ(std::string(e.what()).find("document marker"), std::string::npos) << e.what();
   }
 }
 
