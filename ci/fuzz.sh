@@ -18,9 +18,10 @@ TARGETS=("$@")
 JOBS="${PVB_JOBS:-$(nproc)}"
 B=build-fuzz
 
+mkdir -p "$B"
 CC=clang CXX=clang++ cmake -S . -B "$B" -DCMAKE_BUILD_TYPE=Release -DPVB_FUZZ=ON \
-  -DPVB_BUILD_TESTS=OFF -DPVB_BUILD_BENCHMARKS=OFF > "$B.configure.log" 2>&1 ||
-  { cat "$B.configure.log"; exit 1; }
+  -DPVB_BUILD_TESTS=OFF -DPVB_BUILD_BENCHMARKS=OFF > "$B/configure.log" 2>&1 ||
+  { cat "$B/configure.log"; exit 1; }
 cmake --build "$B" -j "$JOBS" --target "${TARGETS[@]}"
 
 # Seeds: the corpus in the repository plus the repository's own files of

@@ -41,7 +41,8 @@ class MapReader {
     const YAML::Node n = take(key);
     if (!n) return def;
     long long v = 0;
-    if (!n.IsScalar() || !YAML::convert<long long>::decode(n, v)) fail(full(key), n, "an integer", scalar_text(n));
+    if (!n.IsScalar() || !YAML::convert<long long>::decode(n, v))
+      fail(full(key), n, "an integer", scalar_text(n));
     check_range(key, n, static_cast<double>(v), lo, hi);
     return static_cast<int>(v);
   }
@@ -60,7 +61,8 @@ class MapReader {
     const YAML::Node n = take(key);
     if (!n) return def;
     bool v = false;
-    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v)) fail(full(key), n, "true or false", scalar_text(n));
+    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v))
+      fail(full(key), n, "true or false", scalar_text(n));
     return v;
   }
 
@@ -182,9 +184,9 @@ PvArray read_array(MapReader& r) {
   a.tables_per_row = r.integer("tables_per_row", a.tables_per_row, 1, 50);
   a.panels_per_table = r.integer("panels_per_table", a.panels_per_table, 1, 60);
   a.panel_lines = r.integer("panel_lines", a.panel_lines, 1, 4);
-  a.orientation = r.choice<PanelOrientation>("orientation", a.orientation,
-                                              {{"portrait", PanelOrientation::kPortrait},
-                                               {"landscape", PanelOrientation::kLandscape}});
+  a.orientation = r.choice<PanelOrientation>(
+      "orientation", a.orientation,
+      {{"portrait", PanelOrientation::kPortrait}, {"landscape", PanelOrientation::kLandscape}});
   a.cells = r.integer("cells", a.cells, 60, 144);
   if (a.cells != 60 && a.cells != 72 && a.cells != 144)
     r.fail(r.full("cells"), YAML::Node(), "one of 60, 72, 144", std::to_string(a.cells));
@@ -262,38 +264,26 @@ double PvArray::panel_height_m() const {
   return orientation == PanelOrientation::kPortrait ? long_m : short_m;
 }
 constexpr double kPanelGapM = 0.02;
-double PvArray::table_length_m() const { return panels_per_table * (panel_width_m() + kPanelGapM) - kPanelGapM; }
+double PvArray::table_length_m() const {
+  return panels_per_table * (panel_width_m() + kPanelGapM) - kPanelGapM;
+}
 double PvArray::table_depth_m() const { return panel_lines * (panel_height_m() + kPanelGapM) - kPanelGapM; }
 
-Scenario parse_scenario(const std::string& yaml_text, const std::string& origin) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(origin + ":" + std::to_string(e.mark.line + 1), "(syntax)", "valid YAML", e.msg);
-  }
-  if (!root.IsDefined() || root.IsNull()) throw ConfigError(origin, "(top level)", "a scenario mapping", "an empty file");
-  Scenario s;
-  s.source_file = origin;
-  MapReader top(root, origin, "");
-  s.name = top.string("name", s.name);
-  s.description = top.string("description", s.description);
-  s.seed = top.seed("seed", s.seed);
-  s.duration_s = top.number("duration_s", s.duration_s, 0.1, 3600);
+namespace {
 
-  with_map(top, "ground", [&](MapReader& r) {
-    s.ground.type = r.choice<GroundType>("type", s.ground.type, {{"soil", GroundType::kSoil}, {"gravel", GroundType::kGravel}});
-    s.ground.size_m = r.vec2("size_m", s.ground.size_m, 5, 2000);
-  });
-
+/// The sections of a scenario file, one reader each.
+void read_arrays(MapReader& top, const std::string& origin, std::vector<PvArray>& out) {
   if (const YAML::Node arrays = top.child("pv_arrays")) {
     if (!arrays.IsSequence()) top.fail("pv_arrays", arrays, "a list of arrays");
     for (std::size_t i = 0; i < arrays.size(); ++i) {
       MapReader r(arrays[i], origin, "pv_arrays[" + std::to_string(i) + "]");
-      s.pv_arrays.push_back(read_array(r));
+      out.push_back(read_array(r));
       r.finish();
     }
   }
+}
+
+void read_walls(MapReader& top, const std::string& origin, std::vector<Wall>& out) {
   if (const YAML::Node walls = top.child("walls")) {
     if (!walls.IsSequence()) top.fail("walls", walls, "a list of walls");
     for (std::size_t i = 0; i < walls.size(); ++i) {
@@ -305,131 +295,137 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
       w.thickness_m = r.number("thickness_m", w.thickness_m, 0.05, 2);
       w.finish = r.choice<WallFinish>("finish", w.finish,
                                       {{"brick", WallFinish::kBrick}, {"plaster", WallFinish::kPlaster}});
-      if ((w.end_m - w.start_m).norm() < 0.2) r.fail(r.full("end_m"), walls[i]["end_m"], "an end at least 0.2 m from start_m");
+      if ((w.end_m - w.start_m).norm() < 0.2)
+        r.fail(r.full("end_m"), walls[i]["end_m"], "an end at least 0.2 m from start_m");
       r.finish();
-      s.walls.push_back(w);
+      out.push_back(w);
     }
   }
-  with_map(top, "vegetation", [&](MapReader& r) {
-    Vegetation& v = s.vegetation;
-    v.shrubs = r.integer("shrubs", v.shrubs, 0, 500);
-    v.shrub_size_m = r.range("shrub_size_m", v.shrub_size_m, 0.05, 5);
-    v.trees = r.integer("trees", v.trees, 0, 200);
-    v.tree_height_m = r.range("tree_height_m", v.tree_height_m, 0.5, 30);
-    const auto area = r.numbers("area_m", 4, -1e4, 1e4);
-    if (!area.empty()) {
-      v.area_m = Eigen::Vector4d(area[0], area[1], area[2], area[3]);
-      if (area[0] >= area[2] || area[1] >= area[3])
-        r.fail(r.full("area_m"), YAML::Node(), "[xmin, ymin, xmax, ymax] with xmin < xmax and ymin < ymax");
-    }
-    v.keep_out_m = r.number("keep_out_m", v.keep_out_m, 0, 50);
-  });
-  with_map(top, "light", [&](MapReader& r) {
-    Light& l = s.light;
-    l.sun_azimuth_deg = r.number("sun_azimuth_deg", l.sun_azimuth_deg, -360, 360);
-    l.sun_elevation_deg = r.number("sun_elevation_deg", l.sun_elevation_deg, 1, 90);
-    l.intensity = r.number("intensity", l.intensity, 0, 1);
-    l.ambient = r.number("ambient", l.ambient, 0, 1);
-    l.shadows = r.boolean("shadows", l.shadows);
-    l.shadow_map_px = r.integer("shadow_map_px", l.shadow_map_px, 256, 8192);
-    l.shadow_follows_robot = r.boolean("shadow_follows_robot", l.shadow_follows_robot);
-    l.box_quads = r.integer("box_quads", l.box_quads, 1, 16);
-  });
-  with_map(top, "route", [&](MapReader& r) {
-    Route& rt = s.route;
-    rt.pattern = r.choice<RoutePattern>("pattern", rt.pattern,
-                                         {{"waypoints", RoutePattern::kWaypoints},
-                                          {"along_row", RoutePattern::kAlongRow},
-                                          {"lawnmower", RoutePattern::kLawnmower},
-                                          {"loop", RoutePattern::kLoop}});
-    if (const YAML::Node wps = r.child("waypoints_m")) {
-      if (!wps.IsSequence() || wps.size() < 2) r.fail(r.full("waypoints_m"), wps, "a list of at least 2 [x, y] points");
-      for (std::size_t i = 0; i < wps.size(); ++i) {
-        double x = 0, y = 0;
-        if (!wps[i].IsSequence() || wps[i].size() != 2 || !YAML::convert<double>::decode(wps[i][0], x) ||
-            !YAML::convert<double>::decode(wps[i][1], y))
-          r.fail(r.full("waypoints_m") + "[" + std::to_string(i) + "]", wps[i], "[x, y] in metres");
-        rt.waypoints_m.emplace_back(x, y);
-      }
-    }
-    rt.array = r.integer("array", rt.array, 0, 1000);
-    rt.aisle = r.integer("aisle", rt.aisle, 0, 1000);
-    rt.aisles = r.integer("aisles", rt.aisles, 1, 100);
-    rt.offset_m = r.number("offset_m", rt.offset_m, 0.3, 20);
-    rt.margin_m = r.number("margin_m", rt.margin_m, 0, 50);
-    rt.speed_mps = r.number("speed_mps", rt.speed_mps, 0.05, 3);
-    rt.lookahead_m = r.number("lookahead_m", rt.lookahead_m, 0.1, 5);
-    rt.on_loss = r.choice<OnLoss>("on_loss", rt.on_loss, {{"wait", OnLoss::kWait}, {"abort", OnLoss::kAbort}});
-  });
-  with_map(top, "robot", [&](MapReader& r) {
-    Robot& rb = s.robot;
-    rb.wheel_radius_m = r.number("wheel_radius_m", rb.wheel_radius_m, 0.03, 0.5);
-    rb.track_m = r.number("track_m", rb.track_m, 0.1, 2);
-    rb.max_wheel_speed_radps = r.number("max_wheel_speed_radps", rb.max_wheel_speed_radps, 1, 100);
-  });
-  with_map(top, "camera", [&](MapReader& r) {
-    Camera& c = s.camera;
-    c.width = r.integer("width", c.width, 32, 4096);
-    c.height = r.integer("height", c.height, 32, 4096);
-    const bool has_fx = r.has("fx");
-    c.fy = r.number("fy", c.fy, 10, 1e5);
-    c.fx = r.number("fx", has_fx ? c.fx : c.fy, 10, 1e5);
-    if (std::abs(c.fx - c.fy) > 1e-9)
-      r.fail(r.full("fx"), YAML::Node(), "fx equal to fy (MuJoCo 2.2.2 renders square pixels)");
-    c.fps = r.number("fps", c.fps, 1, 240);
-    c.mount_height_m = r.number("mount_height_m", c.mount_height_m, 0.1, 5);
-    c.mount_forward_m = r.number("mount_forward_m", c.mount_forward_m, -1, 1);
-    c.pitch_deg = r.number("pitch_deg", c.pitch_deg, -89, 89);
-    c.yaw_deg = r.number("yaw_deg", c.yaw_deg, -180, 180);
-    c.depth_range_m = r.range("depth_range_m", c.depth_range_m, 0.05, 100);
-    with_map(r, "depth_noise", [&](MapReader& n) {
-      DepthNoise& d = c.depth_noise;
-      d.model = n.choice<DepthNoiseModel>("model", d.model, {{"none", DepthNoiseModel::kNone}, {"kinect", DepthNoiseModel::kKinect}});
-      d.baseline_m = n.number("baseline_m", d.baseline_m, 0.01, 1);
-      d.disparity_step_px = n.number("disparity_step_px", d.disparity_step_px, 0, 1);
-      d.lateral_sigma_px = n.number("lateral_sigma_px", d.lateral_sigma_px, 0, 5);
-      d.axial_scale = n.number("axial_scale", d.axial_scale, 0, 100);
-      d.max_incidence_deg = n.number("max_incidence_deg", d.max_incidence_deg, 1, 90);
-    });
-    with_map(r, "rgb", [&](MapReader& n) {
-      RgbNoise& g = c.rgb;
-      g.sigma = n.number("sigma", g.sigma, 0, 100);
-      g.exposure = n.number("exposure", g.exposure, 0.05, 10);
-      g.glare = n.number("glare", g.glare, 0, 1);
-    });
-  });
-  with_map(top, "slam", [&](MapReader& r) {
-    SlamTuning& t = s.slam;
-    t.orb_features = r.integer("orb_features", t.orb_features, 100, 20000);
-    if (r.has("keyframe_min_tracked_close"))
-      t.keyframe_min_tracked_close = r.integer("keyframe_min_tracked_close", 0, 1, 100000);
-    if (r.has("keyframe_ref_overlap"))
-      t.keyframe_ref_overlap = r.number("keyframe_ref_overlap", 0.0, 0.01, 0.99);
-  });
-  with_map(top, "expect", [&](MapReader& r) {
-    Expectations& e = s.expect;
-    if (r.has("ate_rmse_m_max")) e.ate_rmse_m_max = r.number("ate_rmse_m_max", 0.0, 1e-6, 100);
-    if (r.has("rpe_trans_rmse_m_max")) e.rpe_trans_rmse_m_max = r.number("rpe_trans_rmse_m_max", 0.0, 1e-6, 100);
-    if (r.has("lost_frames_max")) e.lost_frames_max = r.integer("lost_frames_max", 0, 0, 1000000);
-    if (r.has("pe_not_worse_than_baseline"))
-      r.fail(r.full("pe_not_worse_than_baseline"), r.child("pe_not_worse_than_baseline"),
-             "expect.sweep.pe_not_significantly_worse instead (PE-SLAM against the baseline is judged over "
-             "a seed sweep, not one run; docs/scenarios.md)",
-             "a single-run comparison");
-    e.tracking_loss_expected = r.boolean("tracking_loss_expected", e.tracking_loss_expected);
-    e.ci_frames = r.integer("ci_frames", e.ci_frames, 0, 1000000);
-    if (e.ci_frames == 1) r.fail(r.full("ci_frames"), YAML::Node(), "0 (not in the fast subset) or at least 2 frames", "1");
-    if (e.tracking_loss_expected && e.lost_frames_max == 0)
-      r.fail(r.full("lost_frames_max"), YAML::Node(), "a value >= 1 when tracking_loss_expected is true", "0");
-    with_map(r, "sweep", [&](MapReader& w) {
-      SweepExpectations& sw = e.sweep;
-      sw.pe_not_significantly_worse = w.boolean("pe_not_significantly_worse", sw.pe_not_significantly_worse);
-      sw.min_seeds = w.integer("min_seeds", sw.min_seeds, 10, 100000);
-    });
-  });
-  top.finish();
-  check_scene_size(s, origin);
+}
 
+void read_vegetation(MapReader& r, Vegetation& v) {
+  v.shrubs = r.integer("shrubs", v.shrubs, 0, 500);
+  v.shrub_size_m = r.range("shrub_size_m", v.shrub_size_m, 0.05, 5);
+  v.trees = r.integer("trees", v.trees, 0, 200);
+  v.tree_height_m = r.range("tree_height_m", v.tree_height_m, 0.5, 30);
+  const auto area = r.numbers("area_m", 4, -1e4, 1e4);
+  if (!area.empty()) {
+    v.area_m = Eigen::Vector4d(area[0], area[1], area[2], area[3]);
+    if (area[0] >= area[2] || area[1] >= area[3])
+      r.fail(r.full("area_m"), YAML::Node(), "[xmin, ymin, xmax, ymax] with xmin < xmax and ymin < ymax");
+  }
+  v.keep_out_m = r.number("keep_out_m", v.keep_out_m, 0, 50);
+}
+
+void read_light(MapReader& r, Light& l) {
+  l.sun_azimuth_deg = r.number("sun_azimuth_deg", l.sun_azimuth_deg, -360, 360);
+  l.sun_elevation_deg = r.number("sun_elevation_deg", l.sun_elevation_deg, 1, 90);
+  l.intensity = r.number("intensity", l.intensity, 0, 1);
+  l.ambient = r.number("ambient", l.ambient, 0, 1);
+  l.shadows = r.boolean("shadows", l.shadows);
+  l.shadow_map_px = r.integer("shadow_map_px", l.shadow_map_px, 256, 8192);
+  l.shadow_follows_robot = r.boolean("shadow_follows_robot", l.shadow_follows_robot);
+  l.box_quads = r.integer("box_quads", l.box_quads, 1, 16);
+}
+
+void read_route(MapReader& r, Route& rt) {
+  rt.pattern = r.choice<RoutePattern>("pattern", rt.pattern,
+                                      {{"waypoints", RoutePattern::kWaypoints},
+                                       {"along_row", RoutePattern::kAlongRow},
+                                       {"lawnmower", RoutePattern::kLawnmower},
+                                       {"loop", RoutePattern::kLoop}});
+  if (const YAML::Node wps = r.child("waypoints_m")) {
+    if (!wps.IsSequence() || wps.size() < 2)
+      r.fail(r.full("waypoints_m"), wps, "a list of at least 2 [x, y] points");
+    for (std::size_t i = 0; i < wps.size(); ++i) {
+      double x = 0, y = 0;
+      if (!wps[i].IsSequence() || wps[i].size() != 2 || !YAML::convert<double>::decode(wps[i][0], x) ||
+          !YAML::convert<double>::decode(wps[i][1], y))
+        r.fail(r.full("waypoints_m") + "[" + std::to_string(i) + "]", wps[i], "[x, y] in metres");
+      rt.waypoints_m.emplace_back(x, y);
+    }
+  }
+  rt.array = r.integer("array", rt.array, 0, 1000);
+  rt.aisle = r.integer("aisle", rt.aisle, 0, 1000);
+  rt.aisles = r.integer("aisles", rt.aisles, 1, 100);
+  rt.offset_m = r.number("offset_m", rt.offset_m, 0.3, 20);
+  rt.margin_m = r.number("margin_m", rt.margin_m, 0, 50);
+  rt.speed_mps = r.number("speed_mps", rt.speed_mps, 0.05, 3);
+  rt.lookahead_m = r.number("lookahead_m", rt.lookahead_m, 0.1, 5);
+  rt.on_loss = r.choice<OnLoss>("on_loss", rt.on_loss, {{"wait", OnLoss::kWait}, {"abort", OnLoss::kAbort}});
+}
+
+void read_robot(MapReader& r, Robot& rb) {
+  rb.wheel_radius_m = r.number("wheel_radius_m", rb.wheel_radius_m, 0.03, 0.5);
+  rb.track_m = r.number("track_m", rb.track_m, 0.1, 2);
+  rb.max_wheel_speed_radps = r.number("max_wheel_speed_radps", rb.max_wheel_speed_radps, 1, 100);
+}
+
+void read_camera(MapReader& r, Camera& c) {
+  c.width = r.integer("width", c.width, 32, 4096);
+  c.height = r.integer("height", c.height, 32, 4096);
+  const bool has_fx = r.has("fx");
+  c.fy = r.number("fy", c.fy, 10, 1e5);
+  c.fx = r.number("fx", has_fx ? c.fx : c.fy, 10, 1e5);
+  if (std::abs(c.fx - c.fy) > 1e-9)
+    r.fail(r.full("fx"), YAML::Node(), "fx equal to fy (MuJoCo 2.2.2 renders square pixels)");
+  c.fps = r.number("fps", c.fps, 1, 240);
+  c.mount_height_m = r.number("mount_height_m", c.mount_height_m, 0.1, 5);
+  c.mount_forward_m = r.number("mount_forward_m", c.mount_forward_m, -1, 1);
+  c.pitch_deg = r.number("pitch_deg", c.pitch_deg, -89, 89);
+  c.yaw_deg = r.number("yaw_deg", c.yaw_deg, -180, 180);
+  c.depth_range_m = r.range("depth_range_m", c.depth_range_m, 0.05, 100);
+  with_map(r, "depth_noise", [&](MapReader& n) {
+    DepthNoise& d = c.depth_noise;
+    d.model = n.choice<DepthNoiseModel>(
+        "model", d.model, {{"none", DepthNoiseModel::kNone}, {"kinect", DepthNoiseModel::kKinect}});
+    d.baseline_m = n.number("baseline_m", d.baseline_m, 0.01, 1);
+    d.disparity_step_px = n.number("disparity_step_px", d.disparity_step_px, 0, 1);
+    d.lateral_sigma_px = n.number("lateral_sigma_px", d.lateral_sigma_px, 0, 5);
+    d.axial_scale = n.number("axial_scale", d.axial_scale, 0, 100);
+    d.max_incidence_deg = n.number("max_incidence_deg", d.max_incidence_deg, 1, 90);
+  });
+  with_map(r, "rgb", [&](MapReader& n) {
+    RgbNoise& g = c.rgb;
+    g.sigma = n.number("sigma", g.sigma, 0, 100);
+    g.exposure = n.number("exposure", g.exposure, 0.05, 10);
+    g.glare = n.number("glare", g.glare, 0, 1);
+  });
+}
+
+void read_slam(MapReader& r, SlamTuning& t) {
+  t.orb_features = r.integer("orb_features", t.orb_features, 100, 20000);
+  if (r.has("keyframe_min_tracked_close"))
+    t.keyframe_min_tracked_close = r.integer("keyframe_min_tracked_close", 0, 1, 100000);
+  if (r.has("keyframe_ref_overlap"))
+    t.keyframe_ref_overlap = r.number("keyframe_ref_overlap", 0.0, 0.01, 0.99);
+}
+
+void read_expect(MapReader& r, Expectations& e) {
+  if (r.has("ate_rmse_m_max")) e.ate_rmse_m_max = r.number("ate_rmse_m_max", 0.0, 1e-6, 100);
+  if (r.has("rpe_trans_rmse_m_max"))
+    e.rpe_trans_rmse_m_max = r.number("rpe_trans_rmse_m_max", 0.0, 1e-6, 100);
+  if (r.has("lost_frames_max")) e.lost_frames_max = r.integer("lost_frames_max", 0, 0, 1000000);
+  if (r.has("pe_not_worse_than_baseline"))
+    r.fail(r.full("pe_not_worse_than_baseline"), r.child("pe_not_worse_than_baseline"),
+           "expect.sweep.pe_not_significantly_worse instead (PE-SLAM against the baseline is judged over "
+           "a seed sweep, not one run; docs/scenarios.md)",
+           "a single-run comparison");
+  e.tracking_loss_expected = r.boolean("tracking_loss_expected", e.tracking_loss_expected);
+  e.ci_frames = r.integer("ci_frames", e.ci_frames, 0, 1000000);
+  if (e.ci_frames == 1)
+    r.fail(r.full("ci_frames"), YAML::Node(), "0 (not in the fast subset) or at least 2 frames", "1");
+  if (e.tracking_loss_expected && e.lost_frames_max == 0)
+    r.fail(r.full("lost_frames_max"), YAML::Node(), "a value >= 1 when tracking_loss_expected is true", "0");
+  with_map(r, "sweep", [&](MapReader& w) {
+    SweepExpectations& sw = e.sweep;
+    sw.pe_not_significantly_worse = w.boolean("pe_not_significantly_worse", sw.pe_not_significantly_worse);
+    sw.min_seeds = w.integer("min_seeds", sw.min_seeds, 10, 100000);
+  });
+}
+
+/// Checks between fields: the route against the arrays it names.
+void check_route(const Scenario& s, const std::string& origin) {
   // Cross-field checks.
   const Route& rt = s.route;
   if (rt.pattern == RoutePattern::kWaypoints && rt.waypoints_m.size() < 2)
@@ -449,6 +445,46 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
       throw ConfigError(origin, "route.aisles", "at most rows + 1 = " + std::to_string(a.rows + 1),
                         std::to_string(rt.aisles));
   }
+}
+
+}  // namespace
+
+Scenario parse_scenario(const std::string& yaml_text, const std::string& origin) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(origin + ":" + std::to_string(e.mark.line + 1), "(syntax)", "valid YAML", e.msg);
+  }
+  if (!root.IsDefined() || root.IsNull())
+    throw ConfigError(origin, "(top level)", "a scenario mapping", "an empty file");
+  Scenario s;
+  s.source_file = origin;
+  MapReader top(root, origin, "");
+  s.name = top.string("name", s.name);
+  s.description = top.string("description", s.description);
+  s.seed = top.seed("seed", s.seed);
+  s.duration_s = top.number("duration_s", s.duration_s, 0.1, 3600);
+
+  with_map(top, "ground", [&](MapReader& r) {
+    s.ground.type = r.choice<GroundType>("type", s.ground.type,
+                                         {{"soil", GroundType::kSoil}, {"gravel", GroundType::kGravel}});
+    s.ground.size_m = r.vec2("size_m", s.ground.size_m, 5, 2000);
+  });
+
+  read_arrays(top, origin, s.pv_arrays);
+  read_walls(top, origin, s.walls);
+  with_map(top, "vegetation", [&](MapReader& r) { read_vegetation(r, s.vegetation); });
+  with_map(top, "light", [&](MapReader& r) { read_light(r, s.light); });
+  with_map(top, "route", [&](MapReader& r) { read_route(r, s.route); });
+  with_map(top, "robot", [&](MapReader& r) { read_robot(r, s.robot); });
+  with_map(top, "camera", [&](MapReader& r) { read_camera(r, s.camera); });
+  with_map(top, "slam", [&](MapReader& r) { read_slam(r, s.slam); });
+  with_map(top, "expect", [&](MapReader& r) { read_expect(r, s.expect); });
+  top.finish();
+  check_scene_size(s, origin);
+
+  check_route(s, origin);
   return s;
 }
 
@@ -461,10 +497,14 @@ int frame_count(const Scenario& s, int max_frames) {
 
 const char* to_string(RoutePattern p) {
   switch (p) {
-    case RoutePattern::kWaypoints: return "waypoints";
-    case RoutePattern::kAlongRow: return "along_row";
-    case RoutePattern::kLawnmower: return "lawnmower";
-    case RoutePattern::kLoop: return "loop";
+    case RoutePattern::kWaypoints:
+      return "waypoints";
+    case RoutePattern::kAlongRow:
+      return "along_row";
+    case RoutePattern::kLawnmower:
+      return "lawnmower";
+    case RoutePattern::kLoop:
+      return "loop";
   }
   return "?";
 }
