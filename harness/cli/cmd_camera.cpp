@@ -361,7 +361,9 @@ Command add_camera_command(CLI::App& app) {
   sub->add_option("--frames", args->frames, "stop after N frames (0: until the stream ends)")
       ->capture_default_str();
   sub->add_flag("--sync", args->sync, "synchronous mode: no worker threads, bit-identical runs");
-  sub->add_option("--seed", args->seed, "PE-match seed")->capture_default_str();
+  sub->add_option("--seed", args->seed, "PE-match seed")
+      ->capture_default_str()
+      ->check(seed_check("camera", "--seed"));
   sub->add_flag("--no-pe-match", args->no_pe_match, "baseline: ORB-SLAM2 motion model without PE-match");
   sub->add_option("--timeout-ms", args->timeout_ms, "no frame for this long is an error")
       ->capture_default_str();

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "command.hpp"
+#include "count_option.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/run/map_check.hpp"
@@ -46,10 +47,14 @@ Command add_map_check_command(CLI::App& app) {
       "map-check", "global BA of a dumped map (pvbench slam --dump-map) from ground truth: bias or noise?");
   sub->add_option("--map", args->map, "Map.txt written by pvbench slam --dump-map")->required();
   sub->add_option("--gt", args->gt, "ground-truth trajectory (TUM format)")->required();
-  sub->add_option("--draws", args->draws, "synthetic draws per noise kind")->capture_default_str()->check(
-      CLI::Range(0, 1000));
-  sub->add_option("--seed", args->seed, "seed of the first draw")->capture_default_str();
-  sub->add_option("--max-diff", args->max_diff_s, "keyframe to ground-truth association, s")->capture_default_str();
+  sub->add_option("--draws", args->draws, "synthetic draws per noise kind")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
+  sub->add_option("--seed", args->seed, "seed of the first draw")
+      ->capture_default_str()
+      ->check(seed_check("map-check", "--seed"));
+  sub->add_option("--max-diff", args->max_diff_s, "keyframe to ground-truth association, s")
+      ->capture_default_str();
   return {sub, [args] { return run_map_check(*args); }};
 }
 

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "command.hpp"
+#include "count_option.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/image_file.hpp"
@@ -119,11 +120,13 @@ int run_match(const MatchOptions& o) {
   const bool by_seq = !o.sequence.empty();
   const bool by_depth = !o.depth1.empty() || !o.depth2.empty() || !o.pose1.empty() || !o.pose2.empty();
   if (int(by_h) + int(by_seq) + int(by_depth) != 1)
-    throw ConfigError("<command line>", "ground truth",
-                      "exactly one of --homography, --depth1/--depth2/--pose1/--pose2/--settings, --sequence");
+    throw ConfigError(
+        "<command line>", "ground truth",
+        "exactly one of --homography, --depth1/--depth2/--pose1/--pose2/--settings, --sequence");
 
   if (by_h) {
-    if (o.img1.empty() || o.img2.empty()) throw ConfigError("<command line>", "--img1/--img2", "two image paths");
+    if (o.img1.empty() || o.img2.empty())
+      throw ConfigError("<command line>", "--img1/--img2", "two image paths");
     img1 = read_image(o.img1);
     img2 = read_image(o.img2);
     cs = make_coarse_set(img1, img2);
@@ -135,14 +138,14 @@ int run_match(const MatchOptions& o) {
   const auto reports = run_experiment(cs, methods, o.runs, o.seed);
   std::printf("coarse matches: %zu (ORB + ratio test, %.1f ms for both images)\n", cs.raw.size(),
               cs.extract_match_ms);
-  std::printf("%-11s %9s %8s %9s %8s %8s %10s %9s\n", "method", "precision", "+-std", "recall", "+-std", "kept",
-              "time_ms", "+-std");
+  std::printf("%-11s %9s %8s %9s %8s %8s %10s %9s\n", "method", "precision", "+-std", "recall", "+-std",
+              "kept", "time_ms", "+-std");
   for (const auto& r : reports)
     std::printf("%-11s %9.4f %8.4f %9.4f %8.4f %8.1f %10.3f %9.3f\n", r.name.c_str(), r.precision.mean,
                 r.precision.std, r.recall.mean, r.recall.std, r.kept.mean, r.time_ms.mean, r.time_ms.std);
   if (!reports.empty())
-    std::printf("correct among coarse: %d of %d checked (%d without ground truth)\n", reports[0].coarse_correct,
-                reports[0].coarse, reports[0].unknown);
+    std::printf("correct among coarse: %d of %d checked (%d without ground truth)\n",
+                reports[0].coarse_correct, reports[0].coarse, reports[0].unknown);
   if (!o.json.empty()) write_file(o.json, reports_to_json(reports, o.runs, o.seed, cs.extract_match_ms));
   if (!o.draw.empty()) {
     // Draw the last method given (e.g. --method pe), with the first seed.
@@ -165,8 +168,9 @@ int run_match(const MatchOptions& o) {
 Command add_match_command(CLI::App& app) {
   auto opts = std::make_shared<MatchOptions>();
   CLI::App* sub = app.add_subcommand(
-      "match", "Feature-matching experiment (paper sec. 5.1): ORB coarse matches filtered by each method, "
-               "scored against ground truth");
+      "match",
+      "Feature-matching experiment (paper sec. 5.1): ORB coarse matches filtered by each method, "
+      "scored against ground truth");
   sub->add_option("--img1", opts->img1, "first image");
   sub->add_option("--img2", opts->img2, "second image");
   sub->add_option("--homography", opts->homography, "ground truth: 3x3 homography file mapping img1 to img2");
@@ -183,12 +187,14 @@ Command add_match_command(CLI::App& app) {
   sub->add_option("--gt-time-offset", opts->gt_time_offset_s,
                   "with --sequence: seconds added to the rgb stamps before looking up ground-truth poses "
                   "(camera/mocap clock offset; default 0)");
-  sub->add_option("--method", opts->method, "all|orb|hamming|ransac|magsac|pe|pe-refined (comma list allowed)");
+  sub->add_option("--method", opts->method,
+                  "all|orb|hamming|ransac|magsac|pe|pe-refined (comma list allowed)");
   sub->add_option("--runs", opts->runs, "repetitions with seeds S, S+1, ... (default 10)");
-  sub->add_option("--seed", opts->seed, "first seed (default 1)");
+  sub->add_option("--seed", opts->seed, "first seed (default 1)")->check(seed_check("match", "--seed"));
   sub->add_option("--json", opts->json, "write the results as JSON");
-  sub->add_option("--draw", opts->draw, "write an image of the kept matches of the last method (green correct, "
-                                        "red wrong, yellow unchecked)");
+  sub->add_option("--draw", opts->draw,
+                  "write an image of the kept matches of the last method (green correct, "
+                  "red wrong, yellow unchecked)");
   return {sub, [opts] { return run_match(*opts); }};
 }
 

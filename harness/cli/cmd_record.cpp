@@ -37,7 +37,9 @@ struct RecordOptions {
 };
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
 
 /// What the frame loop did.
 struct RecordLoop {
@@ -151,7 +153,8 @@ Command add_record_command(CLI::App& app) {
   sub->add_option("--out", opt->out, "output folder (created)")->required();
   CLI::Option* frames =
       sub->add_option("--frames", opt->frames, "record at most N frames (default: the scenario's duration)");
-  sub->add_option("--seed", opt->seed, "override the scenario's seed");
+  sub->add_option("--seed", opt->seed, "override the scenario's seed")
+      ->check(seed_check("record", "--seed", std::numeric_limits<std::uint64_t>::max()));
   sub->add_option("--gl", opt->gl, "rendering backend")->check(CLI::IsMember({"auto", "egl", "osmesa"}));
   return {sub, [opt, frames] { return run_record(*opt, frames->count() > 0); }};
 }

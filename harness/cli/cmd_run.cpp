@@ -9,10 +9,10 @@
 #include "check_report.hpp"
 #include "command.hpp"
 #include "count_option.hpp"
-#include "stop_signals.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/run/run.hpp"
+#include "stop_signals.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -69,10 +69,12 @@ Command add_run_command(CLI::App& app) {
       "run", "simulate a scenario and run PE-SLAM on it in memory; write a report folder (index.html)");
   sub->add_option("--scenario", args->options.scenario_file, "scenario YAML file")->required();
   sub->add_option("--out", args->options.out_dir, "report folder (created)")->required();
-  sub->add_option("--seed", args->seed, "override the scenario's seed (also seeds PE-match)");
+  sub->add_option("--seed", args->seed, "override the scenario's seed (also seeds PE-match)")
+      ->check(seed_check("run", "--seed", std::numeric_limits<std::uint64_t>::max()));
   sub->add_option("--frames", args->frames, "stop after N frames (default: the scenario's duration)");
   sub->add_flag("--sync", args->options.sync, "synchronous: no threads, bit-identical runs");
-  sub->add_flag("--no-loop-closing", args->no_loop_closing, "switch loop closing off (LoopClosing.enabled: 0)");
+  sub->add_flag("--no-loop-closing", args->no_loop_closing,
+                "switch loop closing off (LoopClosing.enabled: 0)");
   sub->add_flag("--baseline", args->baseline,
                 "run the baseline (PE-match off: ORB-SLAM2's motion model) instead of PE-SLAM");
   sub->add_flag("--compare", args->compare, "run PE-SLAM and the baseline on the same rendered frames");

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "command.hpp"
+#include "count_option.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/output_file.hpp"
 #include "pvb/common/progress.hpp"
@@ -494,7 +495,9 @@ Command add_slam_command(CLI::App& app) {
   sub->add_flag("--no-pe-match", args->no_pe_match, "baseline: ORB-SLAM2 motion model without PE-match");
   sub->add_flag("--no-dense", args->no_dense, "skip the dense point-cloud map (PointCloud.ply)");
   sub->add_flag("--sync", args->sync, "synchronous mode: no worker threads, bit-identical runs");
-  sub->add_option("--seed", args->seed, "PE-match seed")->capture_default_str();
+  sub->add_option("--seed", args->seed, "PE-match seed")
+      ->capture_default_str()
+      ->check(seed_check("slam", "--seed"));
   sub->add_option("--max-frames", args->max_frames, "stop after this many frames (0: all)")
       ->capture_default_str();
   sub->add_flag("--dump-matches", args->dump_matches,

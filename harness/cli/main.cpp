@@ -51,6 +51,9 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const pvb::Error& e) {  // an option's own check (count_option.hpp)
+    std::fprintf(stderr, "pvbench: error: %s\n", e.what());
+    return 1;
   }
   try {
     for (auto& c : cmds)

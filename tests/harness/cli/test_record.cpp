@@ -266,3 +266,15 @@ TEST(RecordCli, FullDiskIsOneErrorNamingTheFileAndLeavesNoPartialFile) {
   EXPECT_NE(::access(m[1].str().c_str(), F_OK), 0) << "a partial file is left under its final name";
   EXPECT_EQ(data_lines(d + "/associations.txt"), 0u);
 }
+
+// record and run take 64-bit scenario seeds; "-1" is an error, not
+// 18446744073709551615.
+TEST(RecordCli, SeedMustBeAWholeNumberInRange) {
+  for (const char* cmd : {"record", "run"}) {
+    const Result r = run(std::string(cmd) + " --scenario " + kStation + " --out " + fresh("seed") +
+                         " --frames 2 --seed=-1");
+    EXPECT_EQ(r.code, 1) << r.output;
+    EXPECT_EQ(r.output, std::string("pvbench: error: pvbench ") + cmd +
+                            ": --seed: expected a whole number in [0, 18446744073709551615], got -1\n");
+  }
+}

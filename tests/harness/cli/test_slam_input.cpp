@@ -296,3 +296,19 @@ TEST(SlamInput, FullDiskIsOneErrorNamingTheFileAndKeepsWholeLines) {
   }
   EXPECT_GE(poses, 1u);  // what was tracked before the disk filled is kept
 }
+
+// A seed is a whole number in range: CLI11 wrapped "-1" to 4294967295 and
+// ran.  Now every bad seed is one error line before anything is written.
+TEST(SlamInput, SeedMustBeAWholeNumberInRange) {
+  const std::string seq = make_sequence("seed");
+  for (const std::string bad : {"-1", "abc", "1e3", "4294967296"}) {
+    const std::string out = fresh("seed_out");
+    const Result r = slam(seq, out, "--seed " + bad);
+    EXPECT_EQ(r.code, 1) << bad << ": " << r.output;
+    EXPECT_EQ(r.output,
+              "pvbench: error: pvbench slam: --seed: expected a whole number in [0, 4294967295], got " + bad +
+                  "\n");
+    EXPECT_FALSE(std::filesystem::exists(out + "/CameraTrajectory.txt"));
+  }
+  EXPECT_EQ(slam(seq, fresh("seed_ok"), "--seed 4294967295").code, 0);
+}
