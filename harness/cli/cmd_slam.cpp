@@ -139,9 +139,7 @@ double percentile(std::vector<double> v, double p) {
 }
 
 void write_tum_file(const std::string& path, const std::vector<geom::StampedPose>& poses) {
-  std::string text = "# timestamp tx ty tz qx qy qz qw (T_w_c)\n";
-  for (const auto& p : poses) text += geom::format_tum_line(p) + "\n";
-  write_file(path, text);
+  write_file(path, geom::format_tum(poses, "# timestamp tx ty tz qx qy qz qw (T_w_c)\n"));
 }
 
 /// Why the frame loop ended.

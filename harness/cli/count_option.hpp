@@ -13,24 +13,6 @@
 
 namespace pvb::cli {
 
-/// The whole number in `text`, in [min_value, max_value]; otherwise throws
-/// ConfigError("pvbench COMMAND", OPTION, "a whole number in [min, max]" + note, text).
-inline std::size_t parse_count(const std::string& command, const std::string& option, const std::string& text,
-                               std::size_t min_value, std::size_t max_value, const std::string& note = {}) {
-  std::size_t value = 0;
-  bool ok = !text.empty() && text.size() <= 18;
-  for (char c : text) {
-    ok = ok && c >= '0' && c <= '9';
-    if (ok) value = value * 10 + static_cast<std::size_t>(c - '0');
-  }
-  if (!ok || value < min_value || value > max_value)
-    throw ConfigError(
-        "pvbench " + command, option,
-        "a whole number in [" + std::to_string(min_value) + ", " + std::to_string(max_value) + "]" + note,
-        text);
-  return value;
-}
-
 /// The whole number in `text` if it is one in [0, max_value].
 inline bool parse_whole(const std::string& text, std::uint64_t max_value, std::uint64_t* value) {
   if (text.empty() || text.size() > 20) return false;
@@ -43,6 +25,19 @@ inline bool parse_whole(const std::string& text, std::uint64_t max_value, std::u
   }
   *value = v;
   return true;
+}
+
+/// The whole number in `text`, in [min_value, max_value]; otherwise throws
+/// ConfigError("pvbench COMMAND", OPTION, "a whole number in [min, max]" + note, text).
+inline std::size_t parse_count(const std::string& command, const std::string& option, const std::string& text,
+                               std::size_t min_value, std::size_t max_value, const std::string& note = {}) {
+  std::uint64_t value = 0;
+  if (!parse_whole(text, max_value, &value) || value < min_value)
+    throw ConfigError(
+        "pvbench " + command, option,
+        "a whole number in [" + std::to_string(min_value) + ", " + std::to_string(max_value) + "]" + note,
+        text);
+  return static_cast<std::size_t>(value);
 }
 
 /// A CLI11 check for a seed option (`--seed S`): a whole number in

@@ -235,12 +235,7 @@ Trajectory read_trajectory(const std::string& path, TrajectoryFormat format,
 }
 
 std::string format_tum(const Trajectory& trajectory) {
-  std::string out = "# timestamp tx ty tz qx qy qz qw\n";
-  for (const geom::StampedPose& p : trajectory.poses) {
-    out += geom::format_tum_line(p);
-    out += '\n';
-  }
-  return out;
+  return geom::format_tum(trajectory.poses, "# timestamp tx ty tz qx qy qz qw\n");
 }
 
 void write_tum(const std::string& path, const Trajectory& trajectory) {

@@ -1,6 +1,6 @@
 #pragma once
 // Small pieces every stage of a scenario run uses: the clock, the process
-// CPU time, number formatting, output files and run.log.
+// CPU time and run.log.
 #include <chrono>
 #include <functional>
 #include <string>

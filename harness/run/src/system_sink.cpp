@@ -35,9 +35,7 @@ void record_state_change(SlamRun& run, slam::TrackingState prev_state, const sla
 
 void write_tum(const std::string& path, const std::string& header,
                const std::vector<geom::StampedPose>& poses) {
-  std::string text = header;
-  for (const auto& p : poses) text += geom::format_tum_line(p) + "\n";
-  write_file(path, text);
+  write_file(path, geom::format_tum(poses, header));
 }
 
 }  // namespace

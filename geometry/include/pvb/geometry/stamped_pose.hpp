@@ -2,6 +2,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "pvb/geometry/se3.hpp"
 #include "pvb/geometry/time.hpp"
@@ -24,6 +25,16 @@ inline std::string format_tum_line(const StampedPose& p) {
   std::snprintf(buf, sizeof buf, "%s %.9f %.9f %.9f %.9f %.9f %.9f %.9f", format_tum_time(p.t_ns).c_str(),
                 t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
   return buf;
+}
+
+/// A whole TUM file: `header` (with its newline) and one line per pose.
+inline std::string format_tum(const std::vector<StampedPose>& poses, const std::string& header) {
+  std::string out = header;
+  for (const StampedPose& p : poses) {
+    out += format_tum_line(p);
+    out += '\n';
+  }
+  return out;
 }
 
 }  // namespace pvb::geom
