@@ -1,0 +1,48 @@
+#pragma once
+// The keyframe database: an inverted index from words to the keyframes
+// (by id) whose bag of words holds them, with each keyframe's bag kept for
+// scoring.  The first two steps of ORB-SLAM2's DetectLoopCandidates /
+// DetectRelocalizationCandidates: keyframes sharing words with a query,
+// those sharing at least `min_common_ratio` of the most shared words,
+// scored; covisibility accumulation is the caller's (it owns the graph).
+// Thread-safe: every member takes an internal mutex.
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <unordered_map>
+#include <vector>
+
+#include "pvb/slam/place/vocabulary.hpp"
+
+namespace pvb::slam::place {
+
+struct Candidate {
+  std::uint64_t id = 0;  ///< keyframe id
+  int common_words = 0;  ///< words shared with the query
+  double score = 0;      ///< Vocabulary::score(query, keyframe's bag)
+};
+
+class Database {
+ public:
+  /// Adds (or replaces) a keyframe's bag.
+  void add(std::uint64_t id, const BowVector& bow);
+  /// Removes a keyframe (no-op when absent).
+  void erase(std::uint64_t id);
+  std::size_t size() const;
+  /// The keyframes sharing at least one word with `query`, except those for
+  /// which `skip(id)` is true; of those, the ones sharing at least
+  /// min_common_ratio x the largest count, scored, and kept when score >=
+  /// min_score.  Ordered by descending score, then ascending id
+  /// (deterministic).
+  std::vector<Candidate> query(const BowVector& query, double min_score, double min_common_ratio = 0.8,
+                               const std::function<bool(std::uint64_t)>& skip = {}) const;
+  /// Keyframes (ids, ascending) listed under `word`.
+  std::vector<std::uint64_t> keyframes_with(WordId word) const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::unordered_map<WordId, std::vector<std::uint64_t>> inverted_;  ///< word -> keyframe ids
+  std::unordered_map<std::uint64_t, BowVector> bows_;                ///< keyframe id -> bag
+};
+
+}  // namespace pvb::slam::place

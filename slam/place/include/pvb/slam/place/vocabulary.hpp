@@ -1,0 +1,101 @@
+#pragma once
+// A bag-of-binary-words vocabulary for 256-bit ORB descriptors (Galvez-Lopez
+// & Tardos 2012, DBoW2; the design ORB-SLAM2 uses): a tree of k branches and
+// L levels built by hierarchical k-means++ with binary k-medians centres,
+// TF-IDF word weights and the L1 score.
+//
+// Nodes are numbered breadth-first as DBoW2 numbers them: node 0 is the
+// root, children follow their parent's siblings.  Words are the leaves,
+// numbered 0..size()-1 in node order.  Level 0 is the leaves' level for the
+// direct index: transform(..., levels_up) groups features by their ancestor
+// `levels_up` levels above the leaf (ORB-SLAM2 uses 4 with L = 6).
+#include <array>
+#include <cstdint>
+#include <map>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace pvb::slam::place {
+
+using WordId = std::uint32_t;
+using NodeId = std::uint32_t;
+
+/// A normalised bag of words: word -> weight, the weights summing to 1 (L1).
+using BowVector = std::map<WordId, double>;
+/// The direct index of one image: node -> indices of its features (rows
+/// of the descriptor matrix), ascending.
+using FeatureVector = std::map<NodeId, std::vector<std::uint32_t>>;
+
+struct TrainParams {
+  int k = 10;                 ///< branching factor, in [2, 64]
+  int levels = 6;             ///< depth L, in [1, 8]
+  std::uint64_t seed = 1;     ///< k-means++ seeding; equal inputs and seed give equal vocabularies
+  int max_iterations = 10;    ///< k-medians iterations per node (stops earlier when stable)
+};
+
+/// What train() did, for `pvbench vocab`.
+struct TrainReport {
+  std::size_t images = 0, descriptors = 0, nodes = 0, words = 0;
+  double seconds = 0;
+};
+
+class Vocabulary {
+ public:
+  Vocabulary() = default;
+
+  /// Trains from the descriptors of each image (CV_8U, N x 32 each; empty
+  /// images are skipped).  The IDF weight of a word is ln(N / N_i), N the
+  /// images and N_i the images with at least one descriptor in the word.
+  /// Throws pvb::ConfigError on bad params, no descriptors or a wrong type.
+  static Vocabulary train(const std::vector<cv::Mat>& descriptors_per_image, const TrainParams& params,
+                          TrainReport* report = nullptr);
+
+  /// Reads either format, told apart by the first bytes: our binary format
+  /// or DBoW2's text format (ORB-SLAM2's ORBvoc.txt).  A missing, bad or
+  /// truncated file throws pvb::IoError naming the file and the line (text)
+  /// or byte offset (binary).
+  static Vocabulary load(const std::string& path);
+  /// Our binary format (docs/place_recognition.md).  Written through a
+  /// temporary file: a failed write keeps the old file.
+  void save_binary(const std::string& path) const;
+  /// DBoW2's text format: "k L scoring weighting", then one line per node
+  /// after the root: "parent is_leaf d0 ... d31 weight".
+  void save_text(const std::string& path) const;
+
+  bool empty() const { return words_.empty(); }
+  int k() const { return k_; }
+  int levels() const { return levels_; }
+  std::size_t size() const { return words_.size(); }        ///< words
+  std::size_t node_count() const { return nodes_.size(); }  ///< including the root
+
+  /// Bag of words of an image's descriptors (CV_8U, N x 32), L1-normalised
+  /// TF-IDF, and its direct index at `levels_up` above the leaves (fv may be null).
+  void transform(const cv::Mat& descriptors, BowVector* bow, FeatureVector* fv = nullptr, int levels_up = 4) const;
+  /// The word of one descriptor (32 bytes), and its weight.
+  WordId word_of(const unsigned char* descriptor, double* weight = nullptr, NodeId* node_at_level = nullptr,
+                 int levels_up = 0) const;
+  /// DBoW2's L1 score of two normalised vectors: 1 - 0.5 * |a - b|_1, in [0, 1].
+  static double score(const BowVector& a, const BowVector& b);
+
+  /// Access for tests and tools.
+  const std::vector<NodeId>& children(NodeId n) const { return nodes_.at(n).children; }
+  const unsigned char* centre(NodeId n) const { return nodes_.at(n).descriptor.data(); }
+  double word_weight(WordId w) const { return nodes_.at(words_.at(w)).weight; }
+  NodeId word_node(WordId w) const { return words_.at(w); }
+
+ private:
+  struct Node {
+    NodeId parent = 0;
+    std::vector<NodeId> children;
+    std::array<unsigned char, 32> descriptor{};
+    double weight = 0;    ///< IDF, leaves only
+    WordId word = 0;      ///< leaves only
+    bool leaf = false;
+  };
+  int k_ = 0, levels_ = 0;
+  std::vector<Node> nodes_;
+  std::vector<NodeId> words_;  ///< word -> node
+};
+
+}  // namespace pvb::slam::place
