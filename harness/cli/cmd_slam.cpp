@@ -21,6 +21,7 @@
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/evaluate.hpp"
+#include "pvb/run/place_recognition.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/harness/matching/ground_truth.hpp"
 #include "pvb/slam/core/settings.hpp"
@@ -170,6 +171,7 @@ struct Tally {
   std::vector<double> tracking_ms, pe_ms;
   std::vector<double> cpu_ms;  ///< caller-thread CPU per frame: tracking, plus inline mapping in sync mode
   std::string init_failure;    ///< why the last frame failed to initialise
+  std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made
 };
 
 double mean_of(const std::vector<double>& v) {
@@ -192,6 +194,8 @@ class SlamRun {
   std::string write_final_outputs();
   std::string stats_json(StopReason stop, const std::string& dense_json);
   void evaluate(std::ostringstream* js);
+  /// Labels the loops and relocalisations against `gt` and prints them.
+  void label_places(const eval::Trajectory& gt);
   void fail_if_incomplete(StopReason stop) const;
 
   const SlamArgs& a_;
@@ -201,6 +205,7 @@ class SlamRun {
   OutputFile cam_traj_, kf_traj_, timing_;
   std::unique_ptr<MotionMatchScorer> scorer_;
   Tally tally_;
+  run::PlaceRecognition place_;  ///< collected after the run, labelled when there is ground truth
   std::string image_size_error_;  ///< set when the loop stopped on an image of the wrong size
 };
 
@@ -302,7 +307,10 @@ slam::TrackingState SlamRun::track_one(const sensor::RgbdFrame& frame) {
     cam_traj_.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
     ++tally_.poses;
   }
-  if (r.tracking.new_keyframe && r.T_w_c) kf_traj_.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
+  if (r.tracking.new_keyframe && r.T_w_c) {
+    kf_traj_.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
+    tally_.keyframe_t_ns.push_back(r.t_ns);
+  }
   static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc"};
   std::ostringstream line;
   line << frame.index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
@@ -371,6 +379,7 @@ void SlamRun::evaluate(std::ostringstream* js) {
       res = eval::evaluate(gt, est, eo);
     }
     std::printf("\n%s", eval::format_report(res).c_str());
+    label_places(gt);
     std::string ev = eval::format_json(res);
     const std::size_t open = ev.find('{'), close = ev.rfind('}');
     ev = ev.substr(open + 1, close - open - 1);
@@ -389,6 +398,15 @@ void SlamRun::evaluate(std::ostringstream* js) {
   } catch (const Error& e) {
     std::fprintf(stderr, "pvbench slam: warning: no evaluation: %s\n", e.what());
   }
+}
+
+void SlamRun::label_places(const eval::Trajectory& gt) {
+  run::label_place_recognition(&place_, gt);
+  const eval::PlaceLabels& l = *place_.labels;
+  std::printf("place recognition: loops %d true, %d false, %d missed of %zu true revisits; "
+              "relocalisations %d true, %d false\n",
+              l.loops_true, l.loops_false, l.loops_missed, l.revisits.size(), l.relocalisations_true,
+              l.relocalisations_false);
 }
 
 /// The run's counts, timings and mapping statistics for stats.json (without
@@ -464,7 +482,9 @@ int SlamRun::run() {
   const std::string dense_json = write_final_outputs();
   std::ostringstream js;
   js << stats_json(stop, dense_json);
+  place_ = run::collect_place_recognition(*system_, tally_.keyframe_t_ns);
   evaluate(&js);
+  js << ",\n  \"place_recognition\": " << run::place_json(place_);
   if (scorer_) js << ",\n  " << scorer_->json();
   js << "\n}\n";
   write_file(a_.out + "/stats.json", js.str());

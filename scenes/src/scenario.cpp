@@ -406,6 +406,12 @@ void read_expect(MapReader& r, Expectations& e) {
   if (r.has("rpe_trans_rmse_m_max"))
     e.rpe_trans_rmse_m_max = r.number("rpe_trans_rmse_m_max", 0.0, 1e-6, 100);
   if (r.has("lost_frames_max")) e.lost_frames_max = r.integer("lost_frames_max", 0, 0, 1000000);
+  if (r.has("refined_ate_rmse_m_max"))
+    e.refined_ate_rmse_m_max = r.number("refined_ate_rmse_m_max", 0.0, 1e-6, 100);
+  if (r.has("false_loops_max")) e.false_loops_max = r.integer("false_loops_max", 0, 0, 1000000);
+  if (r.has("relocalised_within_frames"))
+    e.relocalised_within_frames = r.integer("relocalised_within_frames", 0, 1, 1000000);
+  if (r.has("loops_min")) e.loops_min = r.integer("loops_min", 0, 1, 1000000);
   if (r.has("pe_not_worse_than_baseline"))
     r.fail(r.full("pe_not_worse_than_baseline"), r.child("pe_not_worse_than_baseline"),
            "expect.sweep.pe_not_significantly_worse instead (PE-SLAM against the baseline is judged over "

@@ -54,6 +54,7 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
            ", \"rpe_trans_rmse\": " + num(run.refined_eval->rpe_trans_m.rmse) + "},\n";
   if (run.local_mapping) out += in + "\"local_mapping\": " + slam::to_json(*run.local_mapping) + ",\n";
   if (!run.loop_closing_json.empty()) out += in + "\"loop_closing\": " + run.loop_closing_json + ",\n";
+  if (run.place) out += in + "\"place_recognition\": " + place_json(*run.place) + ",\n";
   out += in + "\"tracking_ms\": {\"median\": " + num(percentile(ms, 0.5)) +
          ", \"mean\": " + num(mean_of(ms)) + ", \"p95\": " + num(percentile(ms, 0.95)) + "},\n";
   out += in + "\"loss_events\": [";
@@ -82,8 +83,26 @@ std::string run_fields(const RunReport& r, const std::string& in) {
   out += in + "\"sim_s\": " + num(r.sim_s) + ",\n";
   out += in + "\"wall_s\": " + num(r.wall_s) + ",\n";
   out += in + "\"cpu_s\": " + num(r.cpu_s) + ",\n";
+  if (r.camera_covered_frames)
+    out += in + "\"camera_covered_frames\": [" + std::to_string(r.camera_covered_frames->first) + ", " +
+           std::to_string(r.camera_covered_frames->second) + "],\n";
   return out;
 }
+
+}  // namespace
+
+std::string place_json(const PlaceRecognition& p) {
+  std::string out = "{\"loops_proposed\": " + std::to_string(p.loops_proposed) +
+                    ", \"loops_accepted\": " + std::to_string(p.loops_accepted) +
+                    ", \"relocalisations\": " + std::to_string(p.relocalisations);
+  if (p.labels) {
+    const std::string labels = eval::to_json(*p.labels, p.label_options);  // "{...}": merged into this object
+    out += ", " + labels.substr(1, labels.size() - 2);
+  }
+  return out + "}";
+}
+
+namespace {
 
 std::string closed_loop_json(const ClosedLoopMetrics& c) {
   return "{\"path_error_rmse_m\": " + num(c.path_error_rmse_m) +
@@ -317,6 +336,22 @@ std::string html_head(const RunReport& r) {
 }
 
 /// Summary rows: what ran, and the primary system's map.
+/// Place recognition: the detectors' counts and, with ground truth, the labels.
+std::string place_rows(const PlaceRecognition& pr) {
+  std::string h = table_row("loops proposed / accepted", std::to_string(pr.loops_proposed) + " / " +
+                                                            std::to_string(pr.loops_accepted));
+  if (!pr.labels) return h + table_row("relocalisations", std::to_string(pr.relocalisations));
+  const eval::PlaceLabels& l = *pr.labels;
+  h += table_row("loops true / false / missed",
+                 std::to_string(l.loops_true) + " / " + std::to_string(l.loops_false) + " / " +
+                     std::to_string(l.loops_missed) + " (" + std::to_string(l.revisits.size()) +
+                     " true revisits; a match is true within " + fixed(pr.label_options.max_translation_m, 2) +
+                     " m and " + fixed(pr.label_options.max_rotation_deg, 1) + " deg of ground truth)");
+  h += table_row("relocalisations true / false",
+                 std::to_string(l.relocalisations_true) + " / " + std::to_string(l.relocalisations_false));
+  return h;
+}
+
 std::string run_rows(const RunReport& r) {
   const SlamRun& p = r.primary;
   std::string h;
@@ -340,6 +375,7 @@ std::string run_rows(const RunReport& r) {
                        " stopped by a new keyframe), " + fixed(lm.busy_ms / 1000.0, 1) + " s busy");
   }
   if (!p.loop_closing_json.empty()) h += table_row("loops closed", std::to_string(p.loops_closed));
+  if (p.place) h += place_rows(*p.place);
   return h;
 }
 

@@ -7,6 +7,7 @@
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
+#include "pvb/run/place_recognition.hpp"
 
 namespace pvb::run {
 namespace {
@@ -64,6 +65,7 @@ slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log)
   const int index = static_cast<int>(frame.index);
   const double t_s = geom::ns_to_seconds(frame.t_ns);
   count(r, index, t_s);
+  if (r.tracking.new_keyframe) keyframe_t_ns.push_back(r.t_ns);
   write_lines(r, index);
   record_state_change(run, prev_state, r, index, t_s, log);
   prev_state = r.state;
@@ -115,6 +117,7 @@ void SystemSink::finish() {
     run.loop_closing_json = slam::to_json(loops);
     run.loops_closed = loops.loops.size();
   }
+  run.place = collect_place_recognition(*system, keyframe_t_ns);
   cam_traj.close();
   timing.close();
   run.keyframes = system->num_keyframes();
@@ -123,6 +126,7 @@ void SystemSink::finish() {
 }
 
 void SystemSink::evaluate(const eval::Trajectory& gt) {
+  if (run.place) label_place_recognition(&*run.place, gt);
   if (est.poses.size() < 3) {
     run.eval_note = "only " + std::to_string(est.poses.size()) + " tracked frames (need 3)";
     return;

@@ -27,6 +27,7 @@ struct SystemSink {
   eval::Trajectory refined;  ///< filled by finish()
   slam::TrackingState prev_state = slam::TrackingState::kNotInitialized;
   double tracking_ms = 0, orb_ms = 0, inline_mapping_ms = 0;
+  std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made, for the revisit labels
 
   SystemSink(const std::string& mode, const slam::Settings& settings, bool sync, std::uint32_t seed,
              const std::string& out_dir);

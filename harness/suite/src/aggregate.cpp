@@ -18,14 +18,36 @@ std::string json_num(double v) { return json_number(v, 9); }
 std::string json_opt(const std::optional<double>& v) { return v ? json_num(*v) : "null"; }
 
 RunSummary summarize_runs(const std::vector<const RunMetrics*>& runs) {
-  std::vector<double> ate, lost, ms, rtf;
+  std::vector<double> ate, lost, ms, rtf, refined;
   for (const RunMetrics* r : runs) {
     if (r->ate_rmse_m) ate.push_back(*r->ate_rmse_m);
+    if (r->refined_ate_rmse_m) refined.push_back(*r->refined_ate_rmse_m);
     lost.push_back(r->lost_frames);
     if (r->tracking_ms_median) ms.push_back(*r->tracking_ms_median);
     if (r->realtime_factor) rtf.push_back(*r->realtime_factor);
   }
-  return {summarize(ate), summarize(lost), summarize(ms), summarize(rtf)};
+  return {summarize(ate), summarize(lost), summarize(ms), summarize(rtf), summarize(refined)};
+}
+
+std::string place_totals_json(const PlaceTotals& p) {
+  return "{\"seeds\": " + std::to_string(p.seeds) + ", \"loops_proposed\": " + std::to_string(p.loops_proposed) +
+         ", \"loops_accepted\": " + std::to_string(p.loops_accepted) +
+         ", \"loops_true\": " + std::to_string(p.loops_true) + ", \"loops_false\": " + std::to_string(p.loops_false) +
+         ", \"loops_missed\": " + std::to_string(p.loops_missed) + ", \"revisits\": " + std::to_string(p.revisits) +
+         ", \"relocalisations_true\": " + std::to_string(p.relocalisations_true) +
+         ", \"relocalisations_false\": " + std::to_string(p.relocalisations_false) +
+         ", \"seeds_with_true_loop\": " + std::to_string(p.seeds_with_true_loop) +
+         ", \"seeds_with_false_match\": " + std::to_string(p.seeds_with_false_match) + "}";
+}
+
+std::string place_totals_line(const PlaceTotals& p) {
+  return "Place recognition over " + std::to_string(p.seeds) + " seeds with ground-truth labels: loops " +
+         std::to_string(p.loops_proposed) + " proposed, " + std::to_string(p.loops_accepted) + " accepted, " +
+         std::to_string(p.loops_true) + " true, " + std::to_string(p.loops_false) + " false, " +
+         std::to_string(p.loops_missed) + " missed of " + std::to_string(p.revisits) +
+         " true revisits (a true loop on " + std::to_string(p.seeds_with_true_loop) + " seeds); relocalisations " +
+         std::to_string(p.relocalisations_true) + " true, " + std::to_string(p.relocalisations_false) +
+         " false; seeds with a false match: " + std::to_string(p.seeds_with_false_match) + ".\n";
 }
 
 std::string pm(const Summary& s, const char* f, double scale = 1.0) {
@@ -42,6 +64,7 @@ std::string summary_json(const Summary& s) {
 
 std::string run_summary_json(const RunSummary& r) {
   return "{\"ate_rmse_m\": " + summary_json(r.ate_rmse_m) +
+         ", \"refined_ate_rmse_m\": " + summary_json(r.refined_ate_rmse_m) +
          ", \"lost_frames\": " + summary_json(r.lost_frames) +
          ", \"tracking_ms_median\": " + summary_json(r.tracking_ms_median) +
          ", \"realtime_factor\": " + summary_json(r.realtime_factor) + "}";
@@ -236,6 +259,26 @@ SeedRun read_seed_run(std::uint64_t seed, const std::string& metrics_path, int e
   return r;
 }
 
+PlaceTotals total_place(const std::vector<const RunMetrics*>& runs) {
+  PlaceTotals t;
+  for (const RunMetrics* r : runs) {
+    if (!r->place || !r->place->loops_false || !r->place->relocalisations_false) continue;
+    const PlaceMetrics& p = *r->place;
+    ++t.seeds;
+    t.loops_proposed += p.loops_proposed;
+    t.loops_accepted += p.loops_accepted;
+    t.loops_true += p.loops_true.value_or(0);
+    t.loops_false += *p.loops_false;
+    t.loops_missed += p.loops_missed.value_or(0);
+    t.revisits += p.revisits.value_or(0);
+    t.relocalisations_true += p.relocalisations_true.value_or(0);
+    t.relocalisations_false += *p.relocalisations_false;
+    t.seeds_with_true_loop += p.loops_true.value_or(0) > 0 ? 1 : 0;
+    t.seeds_with_false_match += (*p.loops_false + *p.relocalisations_false) > 0 ? 1 : 0;
+  }
+  return t;
+}
+
 SweepAggregate aggregate(const std::string& scenario, std::vector<SeedRun> runs) {
   SweepAggregate a;
   a.scenario = scenario;
@@ -248,6 +291,7 @@ SweepAggregate aggregate(const std::string& scenario, std::vector<SeedRun> runs)
     if (r.metrics->baseline) baseline.push_back(&*r.metrics->baseline);
   }
   a.primary = summarize_runs(primary);
+  a.primary_place = total_place(primary);
   a.has_baseline = !baseline.empty();
   if (a.has_baseline) a.baseline = summarize_runs(baseline);
   a.paired = compare_paired(a.runs);
@@ -275,6 +319,11 @@ std::string format_markdown(const SweepAggregate& a) {
       break;
     }
   row(primary_name.c_str(), a.primary);
+  if (a.primary.refined_ate_rmse_m.count > 0)
+    out += "\nRefined trajectory (frames re-anchored on the final keyframe poses, after loop closing): ATE RMSE " +
+           pm(a.primary.refined_ate_rmse_m, "%.2f", 1000.0) + " mm, max " +
+           format_number("%.2f", a.primary.refined_ate_rmse_m.max * 1000.0) + " mm.\n";
+  if (a.primary_place.seeds > 0) out += "\n" + place_totals_line(a.primary_place);
   if (a.has_baseline) {
     row(eval::kBaselineLabel, a.baseline);
     // The paired figure (docs/sweeps.md): per seed d = PE − baseline on the same frames.
@@ -356,6 +405,7 @@ std::string format_json(const SweepAggregate& a) {
                     "\",\n  \"seeds\": " + std::to_string(a.runs.size()) +
                     ",\n  \"failed\": " + std::to_string(a.failed) + ",\n";
   out += "  \"primary\": " + run_summary_json(a.primary) + ",\n";
+  out += "  \"place_recognition\": " + place_totals_json(a.primary_place) + ",\n";
   out += "  \"baseline\": " + (a.has_baseline ? run_summary_json(a.baseline) : std::string("null")) + ",\n";
   out += "  \"paired\": " + (a.has_baseline ? paired_json(a.paired) : std::string("null")) + ",\n";
   out += "  \"runs\": [\n";

@@ -1,5 +1,6 @@
 #include "pvb/suite/check.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "pvb/common/text.hpp"
@@ -18,6 +19,49 @@ std::string pe_against_baseline_note(double pe_m, double baseline_m) {
   return "PE-SLAM − baseline ATE RMSE " + millimetres(pe_m - baseline_m) + " (PE-SLAM " + metres(pe_m) +
          ", baseline " + metres(baseline_m) +
          "); one run does not judge this, a seed sweep does (expect.sweep, pvbench sweep --compare --check)";
+}
+
+/// The place-recognition bounds: labels must be there to judge them.
+void check_place(const scenes::Expectations& expect, const RunMetrics& run, std::vector<Violation>* out) {
+  const bool wanted = expect.false_loops_max || expect.loops_min;
+  if (!wanted) return;
+  const std::string key = expect.false_loops_max ? "false_loops_max" : "loops_min";
+  if (!run.place || !run.place->loops_false || !run.place->relocalisations_false) {
+    out->push_back({key, "no ground-truth labels of loops in the metrics (place_recognition)"});
+    return;
+  }
+  const PlaceMetrics& p = *run.place;
+  if (expect.false_loops_max && *p.loops_false > *expect.false_loops_max)
+    out->push_back({"false_loops_max", std::to_string(*p.loops_false) + " false loops > " +
+                                           std::to_string(*expect.false_loops_max)});
+  if (expect.false_loops_max && *p.relocalisations_false > *expect.false_loops_max)
+    out->push_back({"false_loops_max", std::to_string(*p.relocalisations_false) + " false relocalisations > " +
+                                           std::to_string(*expect.false_loops_max)});
+  if (expect.loops_min && p.loops_true.value_or(0) < *expect.loops_min)
+    out->push_back({"loops_min", std::to_string(p.loops_true.value_or(0)) + " true loops < " +
+                                     std::to_string(*expect.loops_min)});
+}
+
+/// relocalised_within_frames: each loss, counted from the camera's return.
+void check_relocalisation(const scenes::Expectations& expect, const RunMetrics& run, std::vector<Violation>* out) {
+  if (!expect.relocalised_within_frames) return;
+  const int bound = *expect.relocalised_within_frames;
+  for (const LossEvent& e : run.loss_events) {
+    int from = e.frame;
+    if (run.camera_covered_frames && run.camera_covered_frames->first <= e.frame + bound &&
+        run.camera_covered_frames->second + 1 > from)
+      from = std::max(from, run.camera_covered_frames->second + 1);
+    if (!e.recovered_frame) {
+      out->push_back({"relocalised_within_frames", "the loss at frame " + std::to_string(e.frame) +
+                                                       " was never recovered"});
+    } else if (*e.recovered_frame - from > bound) {
+      out->push_back({"relocalised_within_frames",
+                      "the loss at frame " + std::to_string(e.frame) + " was recovered at frame " +
+                          std::to_string(*e.recovered_frame) + ", " + std::to_string(*e.recovered_frame - from) +
+                          " frames after the camera's return at frame " + std::to_string(from) + " > " +
+                          std::to_string(bound)});
+    }
+  }
 }
 
 }  // namespace
@@ -64,6 +108,15 @@ std::vector<Violation> check_expectations(const scenes::Expectations& expect, co
   if (expect.lost_frames_max && run.lost_frames > *expect.lost_frames_max)
     out.push_back({"lost_frames_max", std::to_string(run.lost_frames) + " lost frames > " +
                                           std::to_string(*expect.lost_frames_max)});
+  if (expect.refined_ate_rmse_m_max) {
+    if (!run.refined_ate_rmse_m)
+      out.push_back({"refined_ate_rmse_m_max", "no refined ATE in the metrics (refined is absent)"});
+    else if (!(*run.refined_ate_rmse_m <= *expect.refined_ate_rmse_m_max))
+      out.push_back({"refined_ate_rmse_m_max", "refined ATE RMSE " + metres(*run.refined_ate_rmse_m) + " > " +
+                                                   metres(*expect.refined_ate_rmse_m_max)});
+  }
+  check_place(expect, run, &out);
+  check_relocalisation(expect, run, &out);
 
   if (notes != nullptr && metrics.baseline && metrics.baseline->ate_rmse_m && run.ate_rmse_m)
     notes->push_back(pe_against_baseline_note(*run.ate_rmse_m, *metrics.baseline->ate_rmse_m));

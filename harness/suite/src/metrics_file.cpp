@@ -101,10 +101,41 @@ class Reader {
         if (events[i]["t_s"].IsDefined()) e.t_s = inner.number(events[i], "t_s");
         const YAML::Node reason = events[i]["reason"];
         if (reason.IsDefined() && !reason.IsNull()) e.reason = inner.text(events[i], "reason");
+        const YAML::Node rec = events[i]["recovered_frame"];
+        if (rec.IsDefined() && !rec.IsNull()) e.recovered_frame = inner.integer(events[i], "recovered_frame");
         r.loss_events.push_back(e);
       }
     }
+    r.refined_ate_rmse_m = optional_number(obj, "refined", "ate_rmse");
+    r.place = place(obj);
+    const YAML::Node cover = obj["camera_covered_frames"];
+    if (cover.IsDefined() && !cover.IsNull()) {
+      if (!cover.IsSequence() || cover.size() != 2) fail(cover, "camera_covered_frames", "expected [first, last]");
+      r.camera_covered_frames = {cover[0].as<int>(-1), cover[1].as<int>(-1)};
+    }
     return r;
+  }
+
+  /// "place_recognition": counts always, labels when judged against ground truth.
+  std::optional<PlaceMetrics> place(const YAML::Node& obj) const {
+    const YAML::Node n = obj["place_recognition"];
+    if (!n.IsDefined() || n.IsNull()) return std::nullopt;
+    if (!n.IsMap()) fail(n, "place_recognition", "expected an object or null");
+    const Reader in(path_, prefix_ + "place_recognition.");
+    PlaceMetrics p;
+    p.loops_proposed = in.integer(n, "loops_proposed");
+    p.loops_accepted = in.integer(n, "loops_accepted");
+    p.relocalisations = in.integer(n, "relocalisations");
+    const auto opt = [&](const char* key, std::optional<int>* v) {
+      if (n[key].IsDefined()) *v = in.integer(n, key);
+    };
+    opt("loops_true", &p.loops_true);
+    opt("loops_false", &p.loops_false);
+    opt("loops_missed", &p.loops_missed);
+    opt("revisits", &p.revisits);
+    opt("relocalisations_true", &p.relocalisations_true);
+    opt("relocalisations_false", &p.relocalisations_false);
+    return p;
   }
 
  private:

@@ -224,6 +224,9 @@ bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
   event.frame_id = kf->frame_id();
   event.loop_keyframe_id = loop_kf->id();
   event.loop_frame_id = loop_kf->frame_id();
+  event.t_ns = kf->t_ns();
+  event.loop_t_ns = loop_kf->t_ns();
+  event.T_cur_loop = best.T_c_w * loop_kf->T_c_w().inverse();
   event.inliers = best.inliers;
   pose_difference(best.T_c_w, kf->T_c_w(), &event.correction_m, &event.correction_deg);
   event.detect_ms = detect_ms;

@@ -77,6 +77,7 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
     if (ok) stats_.method = TrackingMethod::kRelocalization;
   }
   if (ok) ok = track_local_map(f);
+  if (ok && stats_.method == TrackingMethod::kRelocalization) record_relocalisation(f);
   state_ = ok ? TrackingState::kOk : TrackingState::kLost;
 
   if (ok) {
@@ -104,6 +105,19 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
   last_ = std::move(f);
   if (!ok) last_.has_pose = false;
   return new_kf;
+}
+
+void Tracking::record_relocalisation(const Frame& f) {
+  RelocEvent e;
+  e.frame_id = f.id;
+  e.t_ns = f.t_ns;
+  e.keyframe_id = reloc_kf_->id();
+  e.keyframe_frame_id = reloc_kf_->frame_id();
+  e.keyframe_t_ns = reloc_kf_->t_ns();
+  e.candidates = reloc_candidates_;
+  e.inliers = stats_.inliers;
+  e.T_f_kf = f.T_c_w * reloc_kf_->T_c_w().inverse();
+  relocs_.push_back(e);
 }
 
 bool Tracking::initialize(Frame& f) {
@@ -313,6 +327,8 @@ bool Tracking::relocalize(Frame& f) {
     best_inliers = std::max(best_inliers, good);
     if (good >= 50) {
       last_reloc_frame_id_ = f.id;
+      reloc_kf_ = kf;
+      reloc_candidates_ = static_cast<int>(cands.size());
       return true;
     }
   }

@@ -295,5 +295,30 @@ TEST(Charts, LineChartBreaksAtNonFiniteValues) {
   EXPECT_NE(eval::format_svg(f).find("<polyline"), std::string::npos);
 }
 
+TEST(RunReport, PlaceRecognitionInMetricsAndReport) {
+  RunReport r = hand_report();
+  PlaceRecognition p;
+  p.loops_proposed = 4;
+  p.loops_accepted = 2;
+  p.relocalisations = 1;
+  r.camera_covered_frames = std::make_pair(30, 39);
+  r.primary.place = p;
+  YAML::Node m = YAML::Load(metrics_json(r));
+  EXPECT_EQ(m["place_recognition"]["loops_proposed"].as<int>(), 4);
+  EXPECT_FALSE(m["place_recognition"]["loops_false"].IsDefined());  // no labels without ground truth
+  EXPECT_EQ(m["camera_covered_frames"][1].as<int>(), 39);
+
+  eval::PlaceLabels labels;
+  labels.loops_true = 1;
+  labels.loops_false = 1;
+  labels.relocalisations_true = 1;
+  r.primary.place->labels = labels;
+  m = YAML::Load(metrics_json(r));
+  EXPECT_EQ(m["place_recognition"]["loops_false"].as<int>(), 1);
+  EXPECT_EQ(m["place_recognition"]["relocalisations_true"].as<int>(), 1);
+  EXPECT_TRUE(m["place_recognition"]["loop_events"].IsSequence());
+  EXPECT_NE(index_html(r, {}).find("<th>loops true / false / missed</th><td>1 / 1 / 0"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace pvb::run

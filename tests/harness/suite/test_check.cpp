@@ -203,3 +203,92 @@ TEST(SuiteCheckSweep, EverySeedIsJudgedByTheRunBounds) {
   EXPECT_EQ(v[0].line(), "seed 2: ate_rmse_m_max: ATE RMSE 0.012 m > 0.01 m");
   EXPECT_EQ(v[1].line(), "seed 3: metrics: none (cannot open seed_3/metrics.json)");
 }
+
+namespace {
+
+suite::MetricsFile kidnapped() { return suite::read_metrics_file(fixture("kidnapped.json")); }
+
+}  // namespace
+
+TEST(SuiteCheckPlace, ReadsPlaceRecognitionAndCover) {
+  const suite::MetricsFile m = kidnapped();
+  ASSERT_TRUE(m.primary.place.has_value());
+  EXPECT_EQ(m.primary.place->loops_accepted, 1);
+  EXPECT_EQ(m.primary.place->loops_true.value_or(-1), 1);
+  EXPECT_EQ(m.primary.place->relocalisations_false.value_or(-1), 0);
+  ASSERT_TRUE(m.primary.camera_covered_frames.has_value());
+  EXPECT_EQ(m.primary.camera_covered_frames->second, 659);
+  ASSERT_EQ(m.primary.loss_events.size(), 1u);
+  EXPECT_EQ(m.primary.loss_events[0].recovered_frame.value_or(-1), 675);
+  EXPECT_NEAR(m.primary.refined_ate_rmse_m.value_or(0), 0.0068, 1e-12);
+}
+
+TEST(SuiteCheckPlace, FalseLoopsAndRelocalisationsAreCounted) {
+  scenes::Expectations e;
+  e.false_loops_max = 0;
+  suite::MetricsFile m = kidnapped();
+  EXPECT_TRUE(suite::check_expectations(e, m).empty());
+  m.primary.place->loops_false = 1;
+  EXPECT_TRUE(has_key(suite::check_expectations(e, m), "false_loops_max"));
+  m.primary.place->loops_false = 0;
+  m.primary.place->relocalisations_false = 1;
+  EXPECT_TRUE(has_key(suite::check_expectations(e, m), "false_loops_max"));
+  m.primary.place->loops_false.reset();  // no ground truth: cannot be judged
+  EXPECT_TRUE(has_key(suite::check_expectations(e, m), "false_loops_max"));
+}
+
+TEST(SuiteCheckPlace, LoopsMinCountsTrueLoops) {
+  scenes::Expectations e;
+  e.loops_min = 1;
+  suite::MetricsFile m = kidnapped();
+  EXPECT_TRUE(suite::check_expectations(e, m).empty());
+  m.primary.place->loops_true = 0;
+  EXPECT_TRUE(has_key(suite::check_expectations(e, m), "loops_min"));
+}
+
+TEST(SuiteCheckPlace, RelocalisationIsCountedFromTheCamerasReturn) {
+  scenes::Expectations e;
+  suite::MetricsFile m = kidnapped();
+  // Recovered at 675, the camera back at 660: 15 frames.
+  e.relocalised_within_frames = 15;
+  EXPECT_TRUE(suite::check_expectations(e, m).empty());
+  e.relocalised_within_frames = 14;
+  const auto v = suite::check_expectations(e, m);
+  ASSERT_TRUE(has_key(v, "relocalised_within_frames"));
+  EXPECT_NE(v[0].message.find("15 frames after the camera's return at frame 660"), std::string::npos)
+      << v[0].message;
+  // Without a cover the loss's own frame counts: 74 frames.
+  m.primary.camera_covered_frames.reset();
+  e.relocalised_within_frames = 74;
+  EXPECT_TRUE(suite::check_expectations(e, m).empty());
+  e.relocalised_within_frames = 73;
+  EXPECT_TRUE(has_key(suite::check_expectations(e, m), "relocalised_within_frames"));
+  // Never recovered.
+  m.primary.loss_events[0].recovered_frame.reset();
+  e.relocalised_within_frames = 1000;
+  EXPECT_TRUE(has_key(suite::check_expectations(e, m), "relocalised_within_frames"));
+}
+
+TEST(SuiteCheckPlace, RefinedAteBound) {
+  scenes::Expectations e;
+  suite::MetricsFile m = kidnapped();
+  e.refined_ate_rmse_m_max = 0.0068;
+  EXPECT_TRUE(suite::check_expectations(e, m).empty());
+  e.refined_ate_rmse_m_max = 0.0067;
+  EXPECT_TRUE(has_key(suite::check_expectations(e, m), "refined_ate_rmse_m_max"));
+  m.primary.refined_ate_rmse_m.reset();
+  EXPECT_TRUE(has_key(suite::check_expectations(e, m), "refined_ate_rmse_m_max"));
+}
+
+TEST(SuiteCheckPlace, SweepTotals) {
+  std::vector<suite::SeedRun> runs;
+  for (int s = 1; s <= 3; ++s) runs.push_back(suite::read_seed_run(s, fixture("kidnapped.json")));
+  runs[1].metrics->primary.place->loops_false = 2;
+  const suite::SweepAggregate a = suite::aggregate("kidnapped", runs);
+  EXPECT_EQ(a.primary_place.seeds, 3);
+  EXPECT_EQ(a.primary_place.loops_true, 3);
+  EXPECT_EQ(a.primary_place.loops_false, 2);
+  EXPECT_EQ(a.primary_place.seeds_with_false_match, 1);
+  EXPECT_EQ(a.primary.refined_ate_rmse_m.count, 3);
+  EXPECT_NE(suite::format_markdown(a).find("2 false"), std::string::npos);
+}

@@ -177,12 +177,25 @@ struct Expectations {
   std::optional<double> ate_rmse_m_max;        ///< ATE RMSE of the primary run, metres
   std::optional<double> rpe_trans_rmse_m_max;  ///< RPE translation RMSE of the primary run, metres
   std::optional<int> lost_frames_max;          ///< frames in the Lost state
+  /// ATE RMSE of the refined trajectory (every frame re-anchored on its
+  /// keyframe's final pose, after local BA and loop closing), metres.
+  std::optional<double> refined_ate_rmse_m_max;
+  /// Place recognition, judged against ground truth: at most this many
+  /// false loops, and at most this many false relocalisations.
+  std::optional<int> false_loops_max;
+  /// Every loss must end in a true relocalisation within this many frames
+  /// of the camera's return (the loss's first frame, or the end of a
+  /// scenario's camera cover, whichever is later).
+  std::optional<int> relocalised_within_frames;
+  /// At least this many true loops (found by the place recognition).
+  std::optional<int> loops_min;
   bool tracking_loss_expected = false;         ///< the run must report a loss with a reason
   int ci_frames = 0;                           ///< frames of the fast CI run; 0 = not in the fast subset
   SweepExpectations sweep;                     ///< judged over a seed sweep only
   /// True when a bound on a single run is set.
   bool any_run_bound() const {
-    return ate_rmse_m_max || rpe_trans_rmse_m_max || lost_frames_max || tracking_loss_expected;
+    return ate_rmse_m_max || rpe_trans_rmse_m_max || lost_frames_max || tracking_loss_expected ||
+           refined_ate_rmse_m_max || false_loops_max || relocalised_within_frames || loops_min;
   }
   /// True when any bound or flag is set.
   bool any() const { return any_run_bound() || sweep.any(); }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "pvb/eval/evaluate.hpp"
+#include "pvb/eval/place_labels.hpp"
 #include "pvb/plot/contact_sheet.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 
@@ -45,6 +46,21 @@ struct FrameRecord {
   int matches_kept = 0;
 };
 
+/// Place recognition of one run (loop closing on): what the detectors
+/// did, and with ground truth, whether each match was right.
+struct PlaceRecognition {
+  int loops_proposed = 0;   ///< consistent detections sent to geometric verification
+  int loops_accepted = 0;   ///< loops closed
+  int relocalisations = 0;
+  std::vector<eval::PlaceEvent> loops, relocalisation_events;  ///< as the system reported them
+  std::vector<std::int64_t> keyframe_t_ns;                     ///< every keyframe made, in order
+  eval::PlaceLabelOptions label_options;
+  std::optional<eval::PlaceLabels> labels;  ///< with ground truth
+};
+
+/// The place-recognition object of metrics.json.
+std::string place_json(const PlaceRecognition& p);
+
 /// One SLAM system's run (PE-SLAM, or the baseline: PE-match off, ORB-SLAM2's motion model).
 struct SlamRun {
   std::string mode;  ///< eval::kPeSlamMode or eval::kBaselineMode ("pe-slam", "baseline")
@@ -63,6 +79,7 @@ struct SlamRun {
   std::string loop_closing_json;  ///< slam::to_json(LoopClosingStats); empty when loop closing is off
   std::optional<slam::LocalMappingStats> local_mapping;  ///< nullopt when not known
   std::size_t loops_closed = 0;
+  std::optional<PlaceRecognition> place;  ///< nullopt when loop closing is off
 };
 
 /// Closed loop: distance of the ground-truth robot (axle centre) from the
@@ -98,6 +115,8 @@ struct RunReport {
   SlamRun primary;
   std::optional<SlamRun> baseline;  ///< --compare
   std::optional<ClosedLoopMetrics> closed_loop;
+  /// First and last frame of the scenario's camera cover (a kidnap), if any.
+  std::optional<std::pair<int, int>> camera_covered_frames;
   std::vector<StageTime> profile;
   std::vector<plot::Thumbnail> thumbnails;  ///< for the contact sheet
   std::vector<std::string> log_lines;       ///< shown in index.html (run.log holds them too)

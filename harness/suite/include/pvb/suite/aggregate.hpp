@@ -102,12 +102,25 @@ struct RunSummary {
   Summary lost_frames;
   Summary tracking_ms_median;
   Summary realtime_factor;
+  Summary refined_ate_rmse_m;  ///< seeds with a refined evaluation
 };
+
+/// Place recognition summed over the seeds whose metrics carry
+/// ground-truth labels (docs/place_recognition.md).
+struct PlaceTotals {
+  int seeds = 0;  ///< seeds with labels
+  int loops_proposed = 0, loops_accepted = 0, loops_true = 0, loops_false = 0, loops_missed = 0, revisits = 0;
+  int relocalisations_true = 0, relocalisations_false = 0;
+  int seeds_with_true_loop = 0;   ///< seeds where at least one true loop was closed
+  int seeds_with_false_match = 0; ///< seeds with a false loop or a false relocalisation
+};
+PlaceTotals total_place(const std::vector<const RunMetrics*>& runs);
 
 struct SweepAggregate {
   std::string scenario;
   std::vector<SeedRun> runs;  ///< in seed-list order
   RunSummary primary;
+  PlaceTotals primary_place;
   bool has_baseline = false;  ///< any seed ran with --compare
   RunSummary baseline;
   PairedComparison paired;  ///< meaningful when has_baseline

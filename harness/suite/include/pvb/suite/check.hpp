@@ -25,6 +25,13 @@ struct Violation {
 /// - ate_rmse_m_max / rpe_trans_rmse_m_max: the primary run's RMSE <= bound
 ///   (a null ate / rpe is a violation);
 /// - lost_frames_max: the primary run's lost_frames <= bound;
+/// - refined_ate_rmse_m_max: the refined trajectory's ATE RMSE <= bound;
+/// - false_loops_max: loops_false <= bound and relocalisations_false <=
+///   bound (the run must carry ground-truth labels);
+/// - loops_min: loops_true >= bound;
+/// - relocalised_within_frames: every loss recovered, by a relocalisation,
+///   within the bound of the camera's return (the loss's frame, or the
+///   last covered frame + 1 when camera_covered_frames overlaps the loss);
 /// - tracking_loss_expected: the run must report at least one loss event,
 ///   each with a frame and a non-empty reason, and must not be "interrupted".
 /// PE-SLAM against the baseline is never judged on one run: when both ATEs

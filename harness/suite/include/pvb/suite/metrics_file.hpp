@@ -4,6 +4,7 @@
 // read.  JSON is read with yaml-cpp, which parses JSON.
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pvb::suite {
@@ -12,6 +13,15 @@ struct LossEvent {
   int frame = -1;
   double t_s = 0.0;
   std::string reason;
+  std::optional<int> recovered_frame;  ///< absent when never recovered
+};
+
+/// metrics.json's "place_recognition" (loop closing on).  The true/false
+/// counts are there only when the run had ground truth.
+struct PlaceMetrics {
+  int loops_proposed = 0, loops_accepted = 0, relocalisations = 0;
+  std::optional<int> loops_true, loops_false, loops_missed, revisits;
+  std::optional<int> relocalisations_true, relocalisations_false;
 };
 
 /// One SLAM run's figures (the top level, or the "baseline" object).
@@ -22,6 +32,10 @@ struct RunMetrics {
   int lost_frames = 0;
   std::optional<double> ate_rmse_m;        ///< absent when "ate" is null
   std::optional<double> rpe_trans_rmse_m;  ///< absent when "rpe" is null
+  std::optional<double> refined_ate_rmse_m;  ///< "refined.ate_rmse", absent when not evaluated
+  std::optional<PlaceMetrics> place;       ///< absent when loop closing was off
+  /// "camera_covered_frames": [first, last] of a scenario's camera cover.
+  std::optional<std::pair<int, int>> camera_covered_frames;
   std::optional<double> tracking_ms_median;
   std::optional<double> realtime_factor;
   std::vector<LossEvent> loss_events;

@@ -62,6 +62,11 @@ struct LoopClosingOptions {
 struct LoopEvent {
   std::uint64_t keyframe_id = 0, frame_id = 0;            ///< the new keyframe
   std::uint64_t loop_keyframe_id = 0, loop_frame_id = 0;  ///< the old keyframe it matched
+  std::int64_t t_ns = 0, loop_t_ns = 0;                   ///< their frames' times
+  /// The new keyframe's pose relative to the old one as the verification
+  /// found it (T_cur_w' * T_loop_w^-1, before the correction): what ground
+  /// truth can judge.
+  geom::SE3d T_cur_loop;
   int inliers = 0;            ///< after the guided search
   double correction_m = 0;    ///< how far the new keyframe moved
   double correction_deg = 0;

@@ -67,6 +67,8 @@ class System {
   /// Loops closed so far and detection totals (empty when LoopClosing.enabled is 0).
   LoopClosingStats loop_stats() const { return loop_ ? loop_->stats() : LoopClosingStats{}; }
   bool loop_closing_enabled() const { return loop_ != nullptr; }
+  /// Every relocalisation so far (call from the thread that calls track()).
+  const std::vector<RelocEvent>& relocalisations() const { return tracking_->relocalisations(); }
 
   // Dense point-cloud mapping (Settings::dense; off: the functions below
   // return empty results) ----------------------------------------------------

@@ -70,6 +70,20 @@ struct TrackingStats {
   std::string failure;
 };
 
+/// One relocalisation: a frame tracked again after a loss, and the
+/// keyframe whose points found it.
+struct RelocEvent {
+  std::uint64_t frame_id = 0;
+  std::int64_t t_ns = 0;
+  std::uint64_t keyframe_id = 0, keyframe_frame_id = 0;
+  std::int64_t keyframe_t_ns = 0;
+  int candidates = 0;  ///< keyframes tried
+  int inliers = 0;     ///< after the local-map optimisation
+  /// The frame's pose relative to the keyframe's, as estimated when it was
+  /// found (T_f_w * T_kf_w^-1): what ground truth can judge.
+  geom::SE3d T_f_kf;
+};
+
 struct TrackingOptions {
   bool use_pe_match = true;    ///< false: ORB-SLAM2 baseline motion model
   PeMatchParams pe_match = PeMatchParams::for_slam();
@@ -130,6 +144,8 @@ class Tracking {
   const TrackingStats& stats() const { return stats_; }
   /// Pose of the last frame tracked (valid when state() == kOk).
   const Frame& last_frame() const { return last_; }
+  /// Every relocalisation so far, in order.
+  const std::vector<RelocEvent>& relocalisations() const { return relocs_; }
   /// Reference keyframe of the last frame tracked.
   std::shared_ptr<KeyFrame> reference_keyframe() const { return ref_kf_; }
 
@@ -142,6 +158,8 @@ class Tracking {
   double translation_parallax_px(const std::vector<IndexMatch>& m, const geom::SE3d& T_cur_last) const;
   bool track_reference_keyframe(Frame& f);
   bool relocalize(Frame& f);
+  /// Appends the RelocEvent of f, just relocalised and tracked.
+  void record_relocalisation(const Frame& f);
   bool track_local_map(Frame& f);
   /// Patch alignment of f's map-point matches at its current pose.
   void align_matches(Frame& f);
@@ -171,6 +189,9 @@ class Tracking {
   geom::SE3d T_last_ref_ = geom::SE3d::Identity();  ///< last frame relative to its reference keyframe
   std::uint64_t last_kf_frame_id_ = 0;
   std::uint64_t last_reloc_frame_id_ = 0;
+  std::shared_ptr<KeyFrame> reloc_kf_;  ///< the keyframe the last relocalize() matched
+  int reloc_candidates_ = 0;
+  std::vector<RelocEvent> relocs_;
   int matches_inliers_ = 0;
   std::uint64_t next_temp_point_id_ = std::uint64_t(1) << 62;  ///< ids of visual-odometry points (not in the map)
 
