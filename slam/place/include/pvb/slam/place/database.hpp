@@ -33,7 +33,8 @@ class Database {
   /// which `skip(id)` is true; of those, the ones sharing at least
   /// min_common_ratio x the largest count, scored, and kept when score >=
   /// min_score.  Ordered by descending score, then ascending id
-  /// (deterministic).
+  /// (deterministic).  `skip` is asked at most once per keyframe, with the
+  /// database's mutex held: it must not call back into the database.
   std::vector<Candidate> query(const BowVector& query, double min_score, double min_common_ratio = 0.8,
                                const std::function<bool(std::uint64_t)>& skip = {}) const;
   /// Keyframes (ids, ascending) listed under `word`.

@@ -4,11 +4,18 @@
 // L levels built by hierarchical k-means++ with binary k-medians centres,
 // TF-IDF word weights and the L1 score.
 //
-// Nodes are numbered breadth-first as DBoW2 numbers them: node 0 is the
-// root, children follow their parent's siblings.  Words are the leaves,
-// numbered 0..size()-1 in node order.  Level 0 is the leaves' level for the
-// direct index: transform(..., levels_up) groups features by their ancestor
-// `levels_up` levels above the leaf (ORB-SLAM2 uses 4 with L = 6).
+// Node 0 is the root and a node's children have consecutive ids.  train()
+// numbers breadth-first (the root's children, then their children in
+// order); DBoW2's own training numbers a node's children when it splits the
+// node, depth first.  load() keeps a file's numbering, whichever it is (a
+// parent always comes before its children).  Words are the leaves,
+// numbered 0..size()-1 in node order.  A leaf is at depth L or above (a
+// node with at most one training descriptor is not split).
+//
+// The direct index: transform(..., levels_up) groups features by the node
+// at depth L - levels_up on their path from the root, as DBoW2 does
+// (ORB-SLAM2 uses 4 with L = 6); the root when L - levels_up <= 0, and the
+// leaf itself when the path ends above that depth.
 #include <array>
 #include <cstdint>
 #include <map>
@@ -28,10 +35,10 @@ using BowVector = std::map<WordId, double>;
 using FeatureVector = std::map<NodeId, std::vector<std::uint32_t>>;
 
 struct TrainParams {
-  int k = 10;                 ///< branching factor, in [2, 64]
-  int levels = 6;             ///< depth L, in [1, 8]
-  std::uint64_t seed = 1;     ///< k-means++ seeding; equal inputs and seed give equal vocabularies
-  int max_iterations = 10;    ///< k-medians iterations per node (stops earlier when stable)
+  int k = 10;               ///< branching factor, in [2, 64]
+  int levels = 6;           ///< depth L, in [1, 8]
+  std::uint64_t seed = 1;   ///< k-means++ seeding; equal inputs and seed give equal vocabularies
+  int max_iterations = 10;  ///< k-medians iterations per node (stops earlier when stable)
 };
 
 /// What train() did, for `pvbench vocab`.
@@ -71,7 +78,8 @@ class Vocabulary {
 
   /// Bag of words of an image's descriptors (CV_8U, N x 32), L1-normalised
   /// TF-IDF, and its direct index at `levels_up` above the leaves (fv may be null).
-  void transform(const cv::Mat& descriptors, BowVector* bow, FeatureVector* fv = nullptr, int levels_up = 4) const;
+  void transform(const cv::Mat& descriptors, BowVector* bow, FeatureVector* fv = nullptr,
+                 int levels_up = 4) const;
   /// The word of one descriptor (32 bytes), and its weight.
   WordId word_of(const unsigned char* descriptor, double* weight = nullptr, NodeId* node_at_level = nullptr,
                  int levels_up = 0) const;
@@ -89,10 +97,12 @@ class Vocabulary {
     NodeId parent = 0;
     std::vector<NodeId> children;
     std::array<unsigned char, 32> descriptor{};
-    double weight = 0;    ///< IDF, leaves only
-    WordId word = 0;      ///< leaves only
+    double weight = 0;  ///< IDF, leaves only
+    WordId word = 0;    ///< leaves only
     bool leaf = false;
   };
+  friend struct VocabularyBuilder;  ///< training and file formats (src/vocabulary_builder.hpp)
+
   int k_ = 0, levels_ = 0;
   std::vector<Node> nodes_;
   std::vector<NodeId> words_;  ///< word -> node
