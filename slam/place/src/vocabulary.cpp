@@ -155,7 +155,7 @@ double Vocabulary::score(const BowVector& a, const BowVector& b) {
       ++ib;
     }
   }
-  return -0.5 * sum;
+  return 0.0 - 0.5 * sum;  // +0, not -0, when nothing is in common
 }
 
 }  // namespace pvb::slam::place

@@ -155,8 +155,10 @@ class KMedians {
     std::size_t out = 0;
     for (std::size_t g = 0; g < c.groups.size(); ++g) {
       if (c.groups[g].empty()) continue;
-      c.centres[out] = c.centres[g];
-      c.groups[out] = std::move(c.groups[g]);
+      if (out != g) {  // no self-move: it would empty the group
+        c.centres[out] = c.centres[g];
+        c.groups[out] = std::move(c.groups[g]);
+      }
       ++out;
     }
     c.centres.resize(out);

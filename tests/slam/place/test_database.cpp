@@ -1,0 +1,116 @@
+// Keyframe database: inverted index, candidates' filters and order.
+#include <gtest/gtest.h>
+
+#include "pvb/slam/place/database.hpp"
+
+namespace {
+
+using namespace pvb::slam::place;
+
+std::vector<std::uint64_t> ids(const std::vector<Candidate>& c) {
+  std::vector<std::uint64_t> out;
+  for (const Candidate& x : c) out.push_back(x.id);
+  return out;
+}
+
+// The query q = {1: .25, 2: .25, 3: .25, 4: .25}; with each keyframe's
+// common words and L1 score (the sum of min(q_i, k_i) over common words):
+//   kf 10 = q                           4 words, score 1
+//   kf 11 = {1: .5, 2: .5}              2 words, score .5
+//   kf 12 = {1: .25, 2: .25, 3: .5}     3 words, score .75
+//   kf 13 = {5: 1}                      0 words
+//   kf 14 = {1: .1, 2: .1, 3: .1, 9: .7} 3 words, score .3
+//   kf  9 = kf 12                       3 words, score .75 (ties with 12: id order)
+const BowVector kQuery{{1, .25}, {2, .25}, {3, .25}, {4, .25}};
+
+void fill(Database& db) {
+  db.add(10, kQuery);
+  db.add(11, {{1, .5}, {2, .5}});
+  db.add(12, {{1, .25}, {2, .25}, {3, .5}});
+  db.add(13, {{5, 1.0}});
+  db.add(14, {{1, .1}, {2, .1}, {3, .1}, {9, .7}});
+  db.add(9, {{1, .25}, {2, .25}, {3, .5}});
+}
+
+TEST(Database, QueryScoresAndOrders) {
+  Database db;
+  fill(db);
+  EXPECT_EQ(db.size(), 6U);
+  // min_common_ratio 0: every keyframe sharing a word.
+  const std::vector<Candidate> all = db.query(kQuery, 0.0, 0.0);
+  EXPECT_EQ(ids(all), (std::vector<std::uint64_t>{10, 9, 12, 11, 14}));
+  EXPECT_DOUBLE_EQ(all[0].score, 1.0);
+  EXPECT_EQ(all[0].common_words, 4);
+  EXPECT_DOUBLE_EQ(all[1].score, 0.75);
+  EXPECT_EQ(all[1].common_words, 3);
+  EXPECT_DOUBLE_EQ(all[3].score, 0.5);
+  EXPECT_EQ(all[3].common_words, 2);
+  EXPECT_NEAR(all[4].score, 0.3, 1e-12);
+}
+
+TEST(Database, MinCommonRatioKeepsThoseSharingEnoughWords) {
+  Database db;
+  fill(db);
+  // Largest count 4: 0.8 x 4 = 3.2 keeps only kf 10; 0.75 x 4 = 3 adds the
+  // three-word ones; 0.5 x 4 = 2 adds kf 11.
+  EXPECT_EQ(ids(db.query(kQuery, 0.0)), (std::vector<std::uint64_t>{10}));
+  EXPECT_EQ(ids(db.query(kQuery, 0.0, 0.75)), (std::vector<std::uint64_t>{10, 9, 12, 14}));
+  EXPECT_EQ(ids(db.query(kQuery, 0.0, 0.5)), (std::vector<std::uint64_t>{10, 9, 12, 11, 14}));
+}
+
+TEST(Database, MinScoreFilters) {
+  Database db;
+  fill(db);
+  EXPECT_EQ(ids(db.query(kQuery, 0.75, 0.0)), (std::vector<std::uint64_t>{10, 9, 12}));
+  EXPECT_EQ(ids(db.query(kQuery, 0.76, 0.0)), (std::vector<std::uint64_t>{10}));
+  EXPECT_TRUE(db.query(kQuery, 1.01, 0.0).empty());
+}
+
+TEST(Database, SkippedKeyframesAreNeitherCandidatesNorCounted) {
+  Database db;
+  fill(db);
+  int calls = 0;
+  const auto skip = [&](std::uint64_t id) {
+    ++calls;
+    return id == 10;
+  };
+  // Without kf 10 the largest count is 3: at 0.8 the three-word keyframes.
+  EXPECT_EQ(ids(db.query(kQuery, 0.0, 0.8, skip)), (std::vector<std::uint64_t>{9, 12, 14}));
+  EXPECT_EQ(calls, 5);  // once per keyframe sharing a word: 9, 10, 11, 12, 14
+}
+
+TEST(Database, EraseAndReplaceUpdateTheIndex) {
+  Database db;
+  fill(db);
+  EXPECT_EQ(db.keyframes_with(1), (std::vector<std::uint64_t>{9, 10, 11, 12, 14}));
+  EXPECT_EQ(db.keyframes_with(5), (std::vector<std::uint64_t>{13}));
+  EXPECT_TRUE(db.keyframes_with(7).empty());
+  db.erase(10);
+  db.erase(10);   // absent: no-op
+  db.erase(100);  // never added
+  EXPECT_EQ(db.size(), 5U);
+  EXPECT_EQ(db.keyframes_with(1), (std::vector<std::uint64_t>{9, 11, 12, 14}));
+  EXPECT_TRUE(db.keyframes_with(4).empty());
+  EXPECT_EQ(ids(db.query(kQuery, 0.0, 0.0)), (std::vector<std::uint64_t>{9, 12, 11, 14}));
+  // kf 13 replaced by words 4 and 6: it leaves word 5's list and joins 4's and 6's.
+  db.add(13, {{4, .5}, {6, .5}});
+  EXPECT_EQ(db.size(), 5U);
+  EXPECT_TRUE(db.keyframes_with(5).empty());
+  EXPECT_EQ(db.keyframes_with(4), (std::vector<std::uint64_t>{13}));
+  EXPECT_EQ(db.keyframes_with(6), (std::vector<std::uint64_t>{13}));
+  const std::vector<Candidate> c = db.query(kQuery, 0.0, 0.0);
+  EXPECT_EQ(ids(c), (std::vector<std::uint64_t>{9, 12, 11, 14, 13}));
+  EXPECT_DOUBLE_EQ(c.back().score, 0.25);
+}
+
+TEST(Database, IdsStayAscendingWhateverTheAddOrder) {
+  Database db;
+  for (const std::uint64_t id : {5, 1, 9, 3, 7}) db.add(id, {{2, 1.0}});
+  EXPECT_EQ(db.keyframes_with(2), (std::vector<std::uint64_t>{1, 3, 5, 7, 9}));
+  // Equal scores: ascending ids.
+  EXPECT_EQ(ids(db.query({{2, 1.0}}, 0.0)), (std::vector<std::uint64_t>{1, 3, 5, 7, 9}));
+  EXPECT_TRUE(db.query({{3, 1.0}}, 0.0).empty());
+  EXPECT_TRUE(db.query({}, 0.0).empty());
+}
+
+}  // namespace
