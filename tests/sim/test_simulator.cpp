@@ -178,7 +178,7 @@ TEST(Simulator, PhysicsIsDeterministic) {
 TEST(Simulator, ShippedScenariosAreDrivenToTheEndOfTheirRoutes) {
   // Physics only: every shipped route is followed closely and finished
   // within the scenario's duration (turns and U-turns included).
-  for (const char* name : {"pv_station", "along_row", "lawnmower", "loop"}) {
+  for (const char* name : {"pv_station", "along_row", "lawnmower", "loop", "aliasing", "lawnmower_return"}) {
     sim::Simulator sim(scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + name + ".yaml"));
     double worst = 0;
     int finished_at = -1;
