@@ -35,6 +35,42 @@ double aisle_v(const PvArray& a, int k, double offset) {
   return k * a.row_pitch_m - std::min(offset, 0.5 * width);
 }
 
+/// Radius of the turns of a lawnmower's return to its start.
+constexpr double kReturnTurnRadiusM = 1.5;
+
+// Appends the segment unless it is shorter than one spacing (no repeated points).
+void append_segment_if_long(std::vector<Eigen::Vector2d>* out, const Eigen::Vector2d& a,
+                            const Eigen::Vector2d& b, double spacing) {
+  if ((b - a).norm() >= spacing) append_segment(out, a, b, spacing);
+}
+
+// A lawnmower's way back to its start, in the array frame, from the end of
+// its last aisle (at v_last; at u0 after an even number of aisles, at u1
+// after an odd one) to the start (u0, v0) heading +u, then on along the
+// first aisle for `overlap_m`.  Every part lies outside the rows: beyond
+// the row ends at u0 - r, and after an odd number of aisles also in front
+// of the first aisle at v0 - 2r.
+void append_return(std::vector<Eigen::Vector2d>* uv, double u0, double u1, double v0, double v_last,
+                   bool ends_at_u1, double overlap_m, double spacing) {
+  if (!ends_at_u1) {
+    // heading -u at (u0, v_last): left turn down the run-out, left turn into the first aisle
+    const double r = std::min(kReturnTurnRadiusM, 0.5 * (v_last - v0));
+    append_arc(uv, {u0, v_last - r}, r, M_PI / 2, M_PI, spacing);
+    append_segment_if_long(uv, {u0 - r, v_last - r}, {u0 - r, v0 + r}, spacing);
+    append_arc(uv, {u0, v0 + r}, r, M_PI, 1.5 * M_PI, spacing);
+  } else {
+    // heading +u at (u1, v_last): right turn down beyond u1, right turn into a
+    // lane in front of the first aisle, back along it, half turn up into the first aisle
+    const double r = kReturnTurnRadiusM;
+    append_arc(uv, {u1, v_last - r}, r, M_PI / 2, 0, spacing);
+    append_segment_if_long(uv, {u1 + r, v_last - r}, {u1 + r, v0 - r}, spacing);
+    append_arc(uv, {u1, v0 - r}, r, 0, -M_PI / 2, spacing);
+    append_segment(uv, {u1, v0 - 2 * r}, {u0, v0 - 2 * r}, spacing);
+    append_arc(uv, {u0, v0 - r}, r, -M_PI / 2, -1.5 * M_PI, spacing);
+  }
+  append_segment(uv, {u0, v0}, {u0 + overlap_m, v0}, spacing);
+}
+
 }  // namespace
 
 Eigen::Vector2d array_to_world(const PvArray& a, double u, double v) {
@@ -91,6 +127,9 @@ std::vector<Eigen::Vector2d> route_polyline(const Scenario& s, double spacing_m)
             append_arc(&uv, centre, radius, -M_PI / 2, -3 * M_PI / 2, spacing_m);
         }
       }
+      if (rt.return_to_start)
+        append_return(&uv, u0, u1, aisle_v(a, 0, rt.offset_m), aisle_v(a, rt.aisles - 1, rt.offset_m),
+                      rt.aisles % 2 == 1, rt.return_overlap_m, spacing_m);
       break;
     }
     case RoutePattern::kLoop: {

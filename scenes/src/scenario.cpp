@@ -10,6 +10,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/scenes/route.hpp"
 
 namespace pvb::scenes {
 namespace {
@@ -196,6 +197,7 @@ PvArray read_array(MapReader& r) {
   a.posts = r.boolean("posts", a.posts);
   a.rails = r.boolean("rails", a.rails);
   a.dirt = r.number("dirt", a.dirt, 0, 1);
+  a.identical_tables = r.boolean("identical_tables", a.identical_tables);
   const double min_pitch = a.table_depth_m() * std::cos(a.tilt_deg * M_PI / 180.0) + 0.5;
   a.row_pitch_m = r.number("row_pitch_m", std::max(a.row_pitch_m, min_pitch), min_pitch, 100);
   return a;
@@ -348,6 +350,11 @@ void read_route(MapReader& r, Route& rt) {
   rt.array = r.integer("array", rt.array, 0, 1000);
   rt.aisle = r.integer("aisle", rt.aisle, 0, 1000);
   rt.aisles = r.integer("aisles", rt.aisles, 1, 100);
+  rt.return_to_start = r.boolean("return_to_start", rt.return_to_start);
+  if (rt.return_to_start && rt.pattern != RoutePattern::kLawnmower)
+    r.fail(r.full("return_to_start"), r.child("return_to_start"), "false unless route.pattern is lawnmower",
+           "true");
+  rt.return_overlap_m = r.number("return_overlap_m", rt.return_overlap_m, 0.5, 100);
   rt.offset_m = r.number("offset_m", rt.offset_m, 0.3, 20);
   rt.margin_m = r.number("margin_m", rt.margin_m, 0, 50);
   rt.speed_mps = r.number("speed_mps", rt.speed_mps, 0.05, 3);
@@ -430,6 +437,41 @@ void read_expect(MapReader& r, Expectations& e) {
   });
 }
 
+/// Where `key` of the map `n` is in the file (the map itself when the key is absent).
+YAML::Node node_of(const YAML::Node& n, const char* key) {
+  const YAML::Node& cn = n;  // const: operator[] must not insert the key
+  const YAML::Node v = cn[key];
+  return v.IsDefined() ? v : n;
+}
+
+/// The kidnap: section.  Read after duration_s and camera, which bound it.
+void read_kidnap(MapReader& top, const std::string& origin, Scenario& s) {
+  const YAML::Node n = top.child("kidnap");
+  if (!n) return;
+  MapReader r(n, origin, "kidnap");
+  for (const char* key : {"at_s", "to_route_s"})
+    if (!r.has(key)) r.fail(r.full(key), n, "a time in seconds (required in kidnap)");
+  Kidnap k;
+  k.at_s = r.number("at_s", k.at_s, 0, 3600);
+  k.covered_s = r.number("covered_s", k.covered_s, 1e-3, 3600);
+  k.to_route_s = r.number("to_route_s", k.to_route_s, 0, 3600);
+  r.finish();
+  const KidnapFrames f = kidnap_frames(k, s.camera.fps);
+  if (!(k.to_route_s < k.at_s) || f.target >= f.cover_begin)
+    r.fail(r.full("to_route_s"), node_of(n, "to_route_s"),
+           "a time at least one frame before kidnap.at_s (" + format_number("%g", k.at_s) + " s)",
+           format_number("%g", k.to_route_s));
+  if (!(k.at_s + k.covered_s < s.duration_s))
+    r.fail(r.full("covered_s"), node_of(n, "covered_s"),
+           "at_s + covered_s before duration_s (" + format_number("%g", s.duration_s) + " s)",
+           format_number("%g", k.at_s + k.covered_s) + " s");
+  if (f.cover_end <= f.cover_begin)
+    r.fail(r.full("covered_s"), node_of(n, "covered_s"),
+           "at least one frame period (1 / camera.fps = " + format_number("%g", 1.0 / s.camera.fps) + " s)",
+           format_number("%g", k.covered_s));
+  s.kidnap = k;
+}
+
 /// Checks between fields: the route against the arrays it names.
 void check_route(const Scenario& s, const std::string& origin) {
   // Cross-field checks.
@@ -450,6 +492,11 @@ void check_route(const Scenario& s, const std::string& origin) {
     if (rt.pattern == RoutePattern::kLawnmower && rt.aisles > a.rows + 1)
       throw ConfigError(origin, "route.aisles", "at most rows + 1 = " + std::to_string(a.rows + 1),
                         std::to_string(rt.aisles));
+    const double first_aisle_m = row_length_m(a) + 2 * rt.margin_m;
+    if (rt.pattern == RoutePattern::kLawnmower && rt.return_to_start && rt.return_overlap_m > first_aisle_m)
+      throw ConfigError(origin, "route.return_overlap_m",
+                        "at most the first aisle's length, " + format_number("%.2f m", first_aisle_m),
+                        format_number("%g", rt.return_overlap_m));
   }
 }
 
@@ -486,6 +533,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
   with_map(top, "robot", [&](MapReader& r) { read_robot(r, s.robot); });
   with_map(top, "camera", [&](MapReader& r) { read_camera(r, s.camera); });
   with_map(top, "slam", [&](MapReader& r) { read_slam(r, s.slam); });
+  read_kidnap(top, origin, s);
   with_map(top, "expect", [&](MapReader& r) { read_expect(r, s.expect); });
   top.finish();
   check_scene_size(s, origin);
@@ -499,6 +547,18 @@ Scenario load_scenario(const std::string& path) { return parse_scenario(read_fil
 int frame_count(const Scenario& s, int max_frames) {
   const int n = static_cast<int>(std::floor(s.duration_s * s.camera.fps + 1e-9)) + 1;
   return max_frames > 0 ? std::min(n, max_frames) : n;
+}
+
+KidnapFrames kidnap_frames(const Kidnap& k, double fps) {
+  // Frame i is at i / fps; the small tolerance keeps a time that is a whole
+  // number of frames (40 s at 30 fps) on that frame.
+  const auto at_or_after = [fps](double t_s) { return static_cast<int>(std::ceil(t_s * fps - 1e-6)); };
+  KidnapFrames f;
+  f.cover_begin = at_or_after(k.at_s);
+  f.cover_end = at_or_after(k.at_s + k.covered_s);
+  f.teleport = f.cover_begin + (f.cover_end - f.cover_begin) / 2;
+  f.target = static_cast<int>(std::floor(k.to_route_s * fps + 1e-6));
+  return f;
 }
 
 const char* to_string(RoutePattern p) {

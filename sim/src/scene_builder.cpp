@@ -80,8 +80,10 @@ void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t 
   const double tl = a.table_length_m(), td = a.table_depth_m();
   Placer rng(seed ^ (0xA11A + static_cast<std::uint64_t>(index)));
   const std::string pre = "a" + std::to_string(index);
+  const Placer first_table_rng = rng;  // identical_tables: every table draws the first one's variants
   for (int row = 0; row < a.rows; ++row) {
     for (int t = 0; t < a.tables_per_row; ++t) {
+      if (a.identical_tables) rng = first_table_rng;
       const double u_start = t * (tl + a.table_gap_m);
       const double v0 = row * a.row_pitch_m;
       // table centre on the slope: s = td/2

@@ -104,6 +104,8 @@ Simulator::Simulator(scenes::Scenario scenario) : scenario_(std::move(scenario))
   // Settle: the robot starts 2 mm above the ground.
   step_physics(static_cast<int>(kSettleS / m->opt.timestep));
   mj_forward(m, data_.get());
+  if (scenario_.kidnap) kidnap_ = scenes::kidnap_frames(*scenario_.kidnap, scenario_.camera.fps);
+  kidnap_step();
 }
 
 std::int64_t Simulator::t_ns() const { return geom::frame_time_ns(0, frame_, scenario_.camera.fps); }
@@ -125,6 +127,23 @@ void Simulator::advance() {
   step_physics(assets_.substeps);
   mj_forward(model_.get(), data_.get());  // camera poses for the new state
   ++frame_;
+  kidnap_step();
+}
+
+void Simulator::kidnap_step() {
+  if (!kidnap_) return;
+  if (frame_ == kidnap_->target) {
+    kidnap_data_.reset(mj_makeData(model_.get()));
+    mj_copyData(kidnap_data_.get(), model_.get(), data_.get());
+    kidnap_follower_ = *follower_;
+  } else if (frame_ == kidnap_->teleport && kidnap_data_) {
+    // The whole physical state (positions, velocities, contacts, the
+    // solver's warm start) and the follower as they were; only time goes on.
+    const mjtNum time_s = data_->time;
+    mj_copyData(data_.get(), model_.get(), kidnap_data_.get());
+    data_->time = time_s;
+    *follower_ = *kidnap_follower_;
+  }
 }
 
 geom::SE3d Simulator::T_w_c() const {
@@ -180,15 +199,25 @@ RenderedFrame RgbdCamera::render(Simulator& sim) {
 Capture RgbdCamera::capture(Simulator& sim) { return sensor_.apply(render(sim)); }
 
 SensorModel::SensorModel(const Simulator& sim)
-    : camera_(sim.scenario().camera), K_(sim.intrinsics()), seed_(sim.scenario().seed) {}
+    : camera_(sim.scenario().camera),
+      K_(sim.intrinsics()),
+      seed_(sim.scenario().seed),
+      kidnap_(sim.kidnap_frames()) {}
 
 Capture SensorModel::apply(RenderedFrame rendered) const {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   Capture out;
   out.depth_gt_m = std::move(rendered.depth_gt_m);
-  out.frame.depth_m = apply_depth_model(out.depth_gt_m, K_, camera_, seed_, rendered.index);
-  apply_rgb_model(&rendered.rgb, camera_.rgb, rendered.sun_px, seed_, rendered.index);
+  const bool covered = kidnap_ && kidnap_->covered(static_cast<std::int64_t>(rendered.index));
+  if (covered) {  // no light reaches the colour sensor, no infrared pattern comes back
+    rendered.rgb.setTo(cv::Scalar::all(0));
+    out.frame.depth_m = cv::Mat::zeros(out.depth_gt_m.size(), CV_32FC1);
+  } else {
+    out.frame.depth_m = apply_depth_model(out.depth_gt_m, K_, camera_, seed_, rendered.index);
+  }
+  apply_rgb_model(&rendered.rgb, camera_.rgb, covered ? std::nullopt : rendered.sun_px, seed_,
+                  rendered.index);
   out.frame.rgb = std::move(rendered.rgb);
   out.frame.t_ns = rendered.t_ns;
   out.frame.index = rendered.index;

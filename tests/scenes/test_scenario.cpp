@@ -23,7 +23,8 @@ const char* kMinimal = "route: {waypoints_m: [[0, 0], [5, 0]]}\n";
 
 TEST(Scenario, ShippedScenariosLoad) {
   for (const char* name : {"pv_station", "along_row", "lawnmower", "loop", "wall_pass", "dusty_panels",
-                           "low_sun_glare", "high_noise", "fast_turns", "tracking_failure"}) {
+                           "low_sun_glare", "high_noise", "fast_turns", "tracking_failure", "kidnapped",
+                           "kidnapped_short", "aliasing", "lawnmower_return"}) {
     const Scenario s = load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + name + ".yaml");
     EXPECT_EQ(s.name, name);
     EXPECT_GE(s.duration_s, 20.0) << name;
@@ -202,7 +203,7 @@ TEST(Scenario, WallFinish) {
 }
 
 // The suite: every shipped scenario states its bounds, and the fast CI
-// subset (expect.ci_frames > 0) stays at two scenarios at most.
+// subset (expect.ci_frames > 0) stays at three scenarios at most.
 TEST(Scenario, EveryShippedScenarioHasBoundsAndTheCiSubsetIsSmall) {
   int in_ci = 0, files = 0;
   for (const auto& e : std::filesystem::directory_iterator(std::string(PVB_SOURCE_DIR) + "/scenes")) {
@@ -215,7 +216,7 @@ TEST(Scenario, EveryShippedScenarioHasBoundsAndTheCiSubsetIsSmall) {
   }
   EXPECT_GE(files, 10);
   EXPECT_GE(in_ci, 1);
-  EXPECT_LE(in_ci, 2);
+  EXPECT_LE(in_ci, 3);
 }
 
 // A scene larger than MuJoCo's renderer draws (4000 geoms) is refused with
@@ -255,4 +256,101 @@ TEST(Scenario, SceneSizeLimitCountsEveryPart) {
   EXPECT_EQ(error_of(with_shrubs(199)), "");  // 1850 + 1550 + 2 + 398 = 3800
   const std::string e = error_of(with_shrubs(200));
   EXPECT_NE(e.find("got 3802 (pv_arrays[0]: 5 rows x 10 tables x 37 geoms)"), std::string::npos) << e;
+}
+
+TEST(Scenario, KidnapIsReadAndOptional) {
+  EXPECT_FALSE(parse_scenario(kMinimal, "min.yaml").kidnap);
+  const Scenario s =
+      parse_scenario(std::string(kMinimal) + "duration_s: 60\nkidnap: {at_s: 40, to_route_s: 8}\n", "k.yaml");
+  ASSERT_TRUE(s.kidnap);
+  EXPECT_DOUBLE_EQ(s.kidnap->at_s, 40.0);
+  EXPECT_DOUBLE_EQ(s.kidnap->covered_s, 2.0);  // the default
+  EXPECT_DOUBLE_EQ(s.kidnap->to_route_s, 8.0);
+  // At 30 fps: frames 1200 to 1259 are covered, 1230 is the first in the
+  // new place, which is where the robot was at frame 240.
+  const KidnapFrames f = kidnap_frames(*s.kidnap, 30.0);
+  EXPECT_EQ(f.cover_begin, 1200);
+  EXPECT_EQ(f.cover_end, 1260);
+  EXPECT_EQ(f.teleport, 1230);
+  EXPECT_EQ(f.target, 240);
+  EXPECT_FALSE(f.covered(1199));
+  EXPECT_TRUE(f.covered(1200));
+  EXPECT_TRUE(f.covered(1259));
+  EXPECT_FALSE(f.covered(1260));
+  // Times between frames: covered from the first frame at or after at_s,
+  // carried to the frame at or just before to_route_s.
+  const KidnapFrames g = kidnap_frames(Kidnap{10.01, 0.5, 3.02}, 30.0);
+  EXPECT_EQ(g.cover_begin, 301);
+  EXPECT_EQ(g.cover_end, 316);
+  EXPECT_EQ(g.teleport, 308);
+  EXPECT_EQ(g.target, 90);
+}
+
+TEST(Scenario, KidnapIsValidatedWithFileAndLine) {
+  const std::string base = std::string(kMinimal) + "duration_s: 20\nkidnap:\n";
+  const auto err = [&](const std::string& body) { return error_of(base + body); };
+  std::string e = err("  at_s: 10\n  to_route_s: 3\n  covered: 2\n");
+  EXPECT_NE(e.find("bad.yaml:6: kidnap.covered: expected a known key"), std::string::npos) << e;
+  e = err("  at_s: 10\n  to_route_s: 12\n");
+  EXPECT_NE(e.find("bad.yaml:5: kidnap.to_route_s: expected a time at least one frame before kidnap.at_s (10 "
+                   "s), got 12"),
+            std::string::npos)
+      << e;
+  e = err("  at_s: 10\n  to_route_s: 10\n");  // the same time is not before it
+  EXPECT_NE(e.find("kidnap.to_route_s: expected a time at least one frame before"), std::string::npos) << e;
+  e = err("  at_s: 10\n  to_route_s: 9.99999999\n");  // on the frame of at_s
+  EXPECT_NE(e.find("kidnap.to_route_s: expected a time at least one frame before"), std::string::npos) << e;
+  e = err("  at_s: 17\n  covered_s: 3\n  to_route_s: 2\n");  // the cover would end with the run
+  EXPECT_NE(
+      e.find("bad.yaml:5: kidnap.covered_s: expected at_s + covered_s before duration_s (20 s), got 20 s"),
+      std::string::npos)
+      << e;
+  e = err("  at_s: 19\n  to_route_s: 2\n");  // the default cover of 2 s
+  EXPECT_NE(e.find("kidnap.covered_s: expected at_s + covered_s before duration_s"), std::string::npos) << e;
+  e = err("  at_s: -1\n  to_route_s: 0\n");
+  EXPECT_NE(e.find("bad.yaml:4: kidnap.at_s: expected a value in [0, 3600], got -1"), std::string::npos) << e;
+  e = err("  at_s: 10\n  to_route_s: -2\n");
+  EXPECT_NE(e.find("kidnap.to_route_s: expected a value in [0, 3600], got -2"), std::string::npos) << e;
+  e = err("  at_s: 10\n  covered_s: 0\n  to_route_s: 2\n");
+  EXPECT_NE(e.find("kidnap.covered_s: expected a value in"), std::string::npos) << e;
+  e = err("  at_s: 10.001\n  covered_s: 0.02\n  to_route_s: 2\n");  // no frame between 10.001 and 10.021 s
+  EXPECT_NE(e.find("kidnap.covered_s: expected at least one frame period"), std::string::npos) << e;
+  e = err("  covered_s: 2\n  to_route_s: 2\n");
+  EXPECT_NE(e.find("bad.yaml:4: kidnap.at_s: expected a time in seconds (required in kidnap)"),
+            std::string::npos)
+      << e;
+  e = err("  at_s: 10\n");
+  EXPECT_NE(e.find("kidnap.to_route_s: expected a time in seconds (required"), std::string::npos) << e;
+  e = error_of(std::string(kMinimal) + "kidnap: 40\n");
+  EXPECT_NE(e.find("kidnap: expected a mapping of keys"), std::string::npos) << e;
+  for (const std::string& body : {err("  at_s: 10\n  to_route_s: 3\n  covered: 2\n"), err("  at_s: 10\n")})
+    EXPECT_EQ(body.find('\n'), std::string::npos) << body;
+}
+
+TEST(Scenario, IdenticalTablesAndLawnmowerReturnAreRead) {
+  const std::string arrays = "pv_arrays:\n  - {rows: 2, tables_per_row: 2, panels_per_table: 4}\n";
+  const Scenario none = parse_scenario(std::string(kMinimal) + arrays, "a.yaml");
+  EXPECT_FALSE(none.pv_arrays[0].identical_tables);
+  EXPECT_FALSE(none.route.return_to_start);
+  const Scenario s = parse_scenario(
+      "pv_arrays:\n  - {rows: 2, tables_per_row: 2, panels_per_table: 4, identical_tables: true}\n"
+      "route: {pattern: lawnmower, aisles: 2, return_to_start: true, return_overlap_m: 3}\n",
+      "r.yaml");
+  EXPECT_TRUE(s.pv_arrays[0].identical_tables);
+  EXPECT_TRUE(s.route.return_to_start);
+  EXPECT_DOUBLE_EQ(s.route.return_overlap_m, 3.0);
+
+  std::string e = error_of("route:\n  waypoints_m: [[0, 0], [5, 0]]\n  return_to_start: true\n");
+  EXPECT_NE(e.find("bad.yaml:3"), std::string::npos) << e;
+  EXPECT_NE(e.find("route.return_to_start: expected false unless route.pattern is lawnmower, got true"),
+            std::string::npos)
+      << e;
+  // 2 tables of 4 panels of 0.99 m with 2 cm gaps, 1 m apart, 2 m run-out at each end: an aisle of 13.04 m
+  e = error_of(arrays + "route: {pattern: lawnmower, return_to_start: true, return_overlap_m: 14}\n");
+  EXPECT_NE(e.find("route.return_overlap_m: expected at most the first aisle's length, 13.04 m, got 14"),
+            std::string::npos)
+      << e;
+  e = error_of(arrays + "route: {pattern: lawnmower, return_to_start: true, return_overlap_m: 0.1}\n");
+  EXPECT_NE(e.find("route.return_overlap_m: expected a value in [0.5, 100], got 0.1"), std::string::npos)
+      << e;
 }

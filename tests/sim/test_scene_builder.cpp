@@ -96,3 +96,36 @@ TEST(SceneBuilder, SunShadowMapIsFixedOverTheRouteUnlessItFollowsTheRobot) {
   s.light.shadow_map_px = 512;  // an explicit size wins
   EXPECT_EQ(sim::compile_scene(sim::build_scene(s))->vis.quality.shadowsize, 512);
 }
+
+// identical_tables: every table of the array gets the same panel materials
+// in the same places, so rows and tables look alike; without it each
+// panel's dust variant is drawn on its own and the tables differ.
+TEST(SceneBuilder, IdenticalTablesGiveEveryTableTheSamePanels) {
+  scenes::Scenario s = station();
+  const scenes::PvArray& arr = s.pv_arrays[0];
+  ASSERT_GE(arr.rows * arr.tables_per_row, 4);
+  // Tables whose panel materials differ from table a0r0t0's, panel by panel.
+  const auto tables_unlike_the_first = [&](const scenes::Scenario& sc) {
+    const sim::ModelPtr m = sim::compile_scene(sim::build_scene(sc));
+    const auto material = [&](int row, int t, int line, int c) {
+      const std::string name = "a0r" + std::to_string(row) + "t" + std::to_string(t) + "p" +
+                               std::to_string(line) + "_" + std::to_string(c);
+      const int id = mj_name2id(m.get(), mjOBJ_GEOM, name.c_str());
+      EXPECT_GE(id, 0) << name;
+      return id < 0 ? -1 : m->geom_matid[id];
+    };
+    int unlike = 0;
+    for (int row = 0; row < arr.rows; ++row)
+      for (int t = 0; t < arr.tables_per_row; ++t) {
+        bool same = true;
+        for (int line = 0; line < arr.panel_lines; ++line)
+          for (int c = 0; c < arr.panels_per_table; ++c)
+            same = same && material(row, t, line, c) == material(0, 0, line, c);
+        if (!same) ++unlike;
+      }
+    return unlike;
+  };
+  EXPECT_EQ(tables_unlike_the_first(s), arr.rows * arr.tables_per_row - 1);
+  s.pv_arrays[0].identical_tables = true;
+  EXPECT_EQ(tables_unlike_the_first(s), 0);
+}

@@ -31,6 +31,28 @@ camera: {pitch_deg: -5, yaw_deg: 8, depth_noise: {model: none}, rgb: {sigma: 0}}
 
 double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
+// A straight drive towards a wall; the camera is covered from 1.5 s for
+// 0.4 s (frames 45 to 56), and at frame 51 the robot is carried back to its
+// state at 0.5 s (frame 15).
+scenes::Scenario kidnap_scenario() {
+  return scenes::parse_scenario(R"(
+name: kidnap_test
+seed: 5
+duration_s: 3
+ground: {size_m: [20, 20]}
+walls: [{start_m: [5, -3], end_m: [5, 3], height_m: 3}]
+route: {waypoints_m: [[0, 0], [3, 0]], speed_mps: 0.5}
+camera: {width: 160, height: 120, fx: 131.25, fy: 131.25}
+kidnap: {at_s: 1.5, covered_s: 0.4, to_route_s: 0.5}
+)",
+                                "kidnap_test.yaml");
+}
+
+/// Rotation angle between two poses, radians.
+double angle_between(const geom::SE3d& a, const geom::SE3d& b) {
+  return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
+}
+
 }  // namespace
 
 TEST(Simulator, OpticalFramePoseAndDepthAgreeWithTheWallPlane) {
@@ -156,7 +178,7 @@ TEST(Simulator, PhysicsIsDeterministic) {
 TEST(Simulator, ShippedScenariosAreDrivenToTheEndOfTheirRoutes) {
   // Physics only: every shipped route is followed closely and finished
   // within the scenario's duration (turns and U-turns included).
-  for (const char* name : {"pv_station", "along_row", "lawnmower", "loop"}) {
+  for (const char* name : {"pv_station", "along_row", "lawnmower", "loop", "aliasing", "lawnmower_return"}) {
     sim::Simulator sim(scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + name + ".yaml"));
     double worst = 0;
     int finished_at = -1;
@@ -235,4 +257,89 @@ TEST(SimFrameSource, SensorModelOnAnotherThreadGivesTheFramesOfNext) {
   }
   // The noise differs from frame to frame (seeded by the frame index).
   EXPECT_GT(cv::norm(split[1].depth_m, split[2].depth_m, cv::NORM_INF), 0.0);
+}
+
+// The kidnap happens in the simulator: at the teleport frame the robot is in
+// its exact state of the target frame (pose, velocities, the follower's
+// progress) and drives the route on from there, as it did then.
+TEST(Simulator, KidnapCarriesTheRobotBackToItsEarlierStateAndItDrivesOn) {
+  sim::Simulator sim(kidnap_scenario());
+  ASSERT_TRUE(sim.kidnap_frames());
+  const scenes::KidnapFrames k = *sim.kidnap_frames();
+  ASSERT_EQ(k.target, 15);
+  ASSERT_EQ(k.teleport, 51);
+  std::vector<geom::SE3d> T_w_c{sim.T_w_c()};
+  std::vector<sim::Pose2d> base{sim.base_pose()};
+  std::vector<std::size_t> progress{sim.follower().progress_index()};
+  for (int i = 1; i < sim.frame_count(); ++i) {
+    sim.advance();
+    EXPECT_EQ(sim.t_ns(), geom::frame_time_ns(0, i, 30.0)) << "time goes on at the frame rate";
+    T_w_c.push_back(sim.T_w_c());
+    base.push_back(sim.base_pose());
+    progress.push_back(sim.follower().progress_index());
+  }
+  const auto t = [&](int i) { return T_w_c[static_cast<std::size_t>(i)].translation(); };
+  // a jump back of about 0.5 m/s x 1.2 s
+  EXPECT_GT((t(k.teleport - 1) - t(k.teleport)).norm(), 0.4);
+  EXPECT_LT((t(k.teleport - 1) - t(k.teleport - 2)).norm(), 0.03);  // the frames before: an ordinary drive
+  // just after the teleport: the ground truth of the target frame
+  EXPECT_LT((t(k.teleport) - t(k.target)).norm(), 1e-3);
+  EXPECT_LT(angle_between(T_w_c[k.teleport], T_w_c[k.target]), 1e-6);
+  EXPECT_NEAR(wrap(base[k.teleport].yaw - base[k.target].yaw), 0.0, 1e-9);
+  EXPECT_EQ(progress[k.teleport], progress[k.target]);
+  EXPECT_LT(progress[k.teleport], progress[k.teleport - 1]);
+  // and on from there as it drove then (velocities kept): frame teleport + j is frame target + j
+  for (int j = 1; j <= 15; ++j) {
+    EXPECT_LT((t(k.teleport + j) - t(k.target + j)).norm(), 1e-3) << j;
+    EXPECT_LT(angle_between(T_w_c[k.teleport + j], T_w_c[k.target + j]), 1e-5) << j;
+  }
+  // the route goes on: the robot moves on past where it was taken from
+  const std::size_t last = T_w_c.size() - 1;
+  EXPECT_GT(base[last].x - base[k.teleport].x, 0.5);  // 1.3 s at 0.5 m/s
+  EXPECT_GT(progress[last], progress[k.teleport - 1]);
+}
+
+TEST(Simulator, KidnapIsDeterministic) {
+  sim::Simulator a(kidnap_scenario()), b(kidnap_scenario());
+  for (int i = 1; i < a.frame_count(); ++i) {
+    a.advance();
+    b.advance();
+    ASSERT_TRUE(a.T_w_c().matrix() == b.T_w_c().matrix()) << "frame " << i;
+  }
+}
+
+// The covered frames are what a covered lens gives, on the pipeline's path
+// (render, then a copy of the sensor model on the frame): black colour with
+// the sensor's noise and no depth; the frames around them are ordinary, and
+// the ground truth jumps with the robot.
+TEST(SimFrameSource, KidnapCoversTheCameraAndTheGroundTruthJumps) {
+  std::vector<geom::StampedPose> gt;
+  sim::SimFrameSource src(kidnap_scenario(), sim::GlBackend::kAuto, 0,
+                          [&gt](const geom::StampedPose& p) { gt.push_back(p); });
+  const sim::SensorModel model = src.sensor_model();
+  const scenes::KidnapFrames k = *src.simulator().kidnap_frames();
+  std::vector<sensor::RgbdFrame> frames;
+  while (auto r = src.next_rendered()) frames.push_back(model.apply(std::move(*r)).frame);
+  ASSERT_EQ(frames.size(), 91u);
+  ASSERT_EQ(gt.size(), frames.size());
+  int covered = 0;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const sensor::RgbdFrame& f = frames[i];
+    EXPECT_EQ(f.index, i);
+    EXPECT_EQ(f.t_ns, geom::frame_time_ns(0, static_cast<std::int64_t>(i), 30.0));
+    const double mean_rgb = cv::mean(f.rgb.reshape(1))[0];
+    const int valid_depth = cv::countNonZero(f.depth_m);
+    if (k.covered(static_cast<std::int64_t>(i))) {
+      ++covered;
+      EXPECT_EQ(valid_depth, 0) << "frame " << i;
+      EXPECT_LT(mean_rgb, 2.0) << "frame " << i;
+      EXPECT_GT(mean_rgb, 0.0) << "frame " << i << ": the sensor noise stays";
+    } else {
+      EXPECT_GT(valid_depth, f.depth_m.total() / 2) << "frame " << i;
+      EXPECT_GT(mean_rgb, 40.0) << "frame " << i;
+    }
+  }
+  EXPECT_EQ(covered, 12);  // 1.5 s to 1.9 s at 30 Hz
+  EXPECT_LT((gt[k.teleport].T_w_c.translation() - gt[k.target].T_w_c.translation()).norm(), 1e-3);
+  EXPECT_GT((gt[k.teleport - 1].T_w_c.translation() - gt[k.teleport].T_w_c.translation()).norm(), 0.4);
 }

@@ -42,6 +42,10 @@ struct PvArray {
   bool posts = true;
   bool rails = true;
   double dirt = 0.2;         ///< 0 clean .. 1 very dusty
+  /// Every table of the array gets the same panels (the same dust variants
+  /// in the same places), so its tables and rows look alike.  False: each
+  /// panel's variant is drawn on its own.
+  bool identical_tables = false;
 
   // Derived panel size (m) from cells and orientation.
   double panel_width_m() const;   ///< along the row
@@ -96,6 +100,11 @@ struct Route {
   int array = 0;                             ///< pattern routes: which array
   int aisle = 0;                             ///< along_row: aisle in front of this row
   int aisles = 2;                            ///< lawnmower: number of aisles driven
+  /// lawnmower: after the last aisle, drive back to the start beyond the row
+  /// ends and re-drive the first aisle's first return_overlap_m metres in
+  /// the direction of the start.
+  bool return_to_start = false;
+  double return_overlap_m = 4.0;             ///< lawnmower with return_to_start
   double offset_m = 1.5;                     ///< distance from the table edges
   double margin_m = 2.0;                     ///< run-out beyond the row ends
   double speed_mps = 0.5;
@@ -201,6 +210,27 @@ struct Expectations {
   bool any() const { return any_run_bound() || sweep.any(); }
 };
 
+/// The camera is covered for a while and meanwhile the robot is carried to
+/// where it was earlier (the `kidnap:` section).  While covered, the sensor
+/// delivers black colour (plus its noise) and no depth; in the middle of the
+/// covered frames the simulator puts the robot back into its exact state at
+/// to_route_s (pose, velocities and the route follower's progress), and it
+/// drives the route on from there.
+struct Kidnap {
+  double at_s = 0;        ///< the lens is covered from this time
+  double covered_s = 2;   ///< for this long
+  double to_route_s = 0;  ///< the robot is carried to its state at this earlier time
+};
+
+/// A kidnap in frame indices (frame i is at i / fps).
+struct KidnapFrames {
+  int cover_begin = 0;  ///< first covered frame: the first at or after at_s
+  int cover_end = 0;    ///< first frame after the cover: the first at or after at_s + covered_s
+  int teleport = 0;     ///< the first frame in the new place: the middle of the covered frames
+  int target = 0;       ///< the frame whose state the robot is carried to: at or just before to_route_s
+  bool covered(std::int64_t frame) const { return frame >= cover_begin && frame < cover_end; }
+};
+
 struct Scenario {
   std::string source_file;  ///< where it was loaded from ("" if built in code)
   std::string name = "unnamed";
@@ -216,6 +246,7 @@ struct Scenario {
   Robot robot;
   Camera camera;
   SlamTuning slam;
+  std::optional<Kidnap> kidnap;  ///< none unless the file has a kidnap: section
   Expectations expect;
 };
 
@@ -226,6 +257,9 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
 
 /// Frames the scenario yields: floor(duration_s * fps) + 1, capped by max_frames if > 0.
 int frame_count(const Scenario& s, int max_frames = 0);
+
+/// The kidnap's frames at the scenario's frame rate.
+KidnapFrames kidnap_frames(const Kidnap& k, double fps);
 
 const char* to_string(RoutePattern p);
 

@@ -30,7 +30,13 @@ class Simulator {
   /// Time of the current frame: exactly frame_index / fps.
   std::int64_t t_ns() const;
   /// Advances the physics by one camera period, steering at camera rate.
+  /// With a kidnap (scenario `kidnap:`), the frame kidnap_frames()->teleport
+  /// is the state kept at frame kidnap_frames()->target: the robot is
+  /// carried back there (pose, velocities, the route follower's progress)
+  /// and drives on from it; time goes on.
   void advance();
+  /// The scenario's kidnap in frames, if it has one.
+  const std::optional<scenes::KidnapFrames>& kidnap_frames() const { return kidnap_; }
 
   /// Ground truth: camera optical frame (x right, y down, z forward) in the world.
   geom::SE3d T_w_c() const;
@@ -60,6 +66,8 @@ class Simulator {
 
  private:
   void step_physics(int steps);
+  /// Kidnap: keeps the state of the target frame, restores it at the teleport frame.
+  void kidnap_step();
   scenes::Scenario scenario_;
   SceneAssets assets_;
   ModelPtr model_;
@@ -73,6 +81,9 @@ class Simulator {
   int camera_id_ = -1;
   int free_qpos_ = 0;
   int act_left_ = -1, act_right_ = -1;
+  std::optional<scenes::KidnapFrames> kidnap_;
+  DataPtr kidnap_data_;                           ///< the state at kidnap_->target
+  std::optional<RouteFollower> kidnap_follower_;  ///< the follower at kidnap_->target
 };
 
 /// One captured frame with its ground truth.
@@ -104,13 +115,16 @@ class SensorModel {
  public:
   explicit SensorModel(const Simulator& sim);
   /// Applies the sensor model; the result does not depend on the thread
-  /// or on which frames were processed before.
+  /// or on which frames were processed before.  A frame the scenario's
+  /// kidnap covers is what a covered lens gives: black colour with the
+  /// sensor's noise, and no depth (0 everywhere).
   Capture apply(RenderedFrame rendered) const;
 
  private:
   scenes::Camera camera_;
   geom::PinholeIntrinsics K_;
   std::uint64_t seed_;
+  std::optional<scenes::KidnapFrames> kidnap_;
 };
 
 /// Renders the simulator's camera and applies the sensor model.
