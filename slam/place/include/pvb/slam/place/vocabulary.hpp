@@ -106,6 +106,16 @@ class Vocabulary {
   int k_ = 0, levels_ = 0;
   std::vector<Node> nodes_;
   std::vector<NodeId> words_;  ///< word -> node
+  /// One child in the tree's layout for descending: the children of a node
+  /// side by side, each with where its own children are, so that a step
+  /// down reads one run of memory (built by VocabularyBuilder::lay_out).
+  struct Branch {
+    std::array<std::uint64_t, 4> bits{};  ///< the child's descriptor
+    std::uint32_t first = 0, last = 0;    ///< its children: branches_[first, last) (none for a leaf)
+    NodeId node = 0;                      ///< the child
+  };
+  std::vector<Branch> branches_;  ///< the root's children first, at [0, root_children_)
+  std::uint32_t root_children_ = 0;
 };
 
 }  // namespace pvb::slam::place
