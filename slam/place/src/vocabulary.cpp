@@ -15,6 +15,8 @@ void VocabularyBuilder::start(Vocabulary& voc, int k, int levels, std::size_t ex
   voc.levels_ = levels;
   voc.nodes_.clear();
   voc.words_.clear();
+  voc.branches_.clear();
+  voc.root_children_ = 0;
   voc.nodes_.reserve(expected_nodes);
   voc.nodes_.emplace_back();
   voc.nodes_.back().children.reserve(static_cast<std::size_t>(k));
@@ -66,6 +68,26 @@ void VocabularyBuilder::mark_leaves_as_words(Vocabulary& voc) {
   }
 }
 
+void VocabularyBuilder::lay_out(Vocabulary& voc) {
+  const std::vector<Node>& nodes = voc.nodes_;
+  std::vector<std::uint32_t> first(nodes.size() + 1, 0);  // where each node's children go
+  for (std::size_t id = 0; id < nodes.size(); ++id) {
+    first[id + 1] = first[id] + static_cast<std::uint32_t>(nodes[id].children.size());
+  }
+  voc.branches_.assign(first.back(), {});
+  for (std::size_t id = 0; id < nodes.size(); ++id) {
+    std::uint32_t i = first[id];
+    for (const NodeId c : nodes[id].children) {
+      Vocabulary::Branch& b = voc.branches_[i++];
+      b.bits = pack_descriptor(nodes[c].descriptor.data());
+      b.first = first[c];
+      b.last = first[c + 1];
+      b.node = c;
+    }
+  }
+  voc.root_children_ = first[1];
+}
+
 NodeId VocabularyBuilder::first_childless_inner_node(const Vocabulary& voc) {
   for (NodeId id = 0; id < voc.nodes_.size(); ++id) {
     if (!voc.nodes_[id].leaf && voc.nodes_[id].children.empty()) return id;
@@ -94,20 +116,23 @@ WordId Vocabulary::word_of(const unsigned char* descriptor, double* weight, Node
   NodeId at_level = 0;                           // the root, when level_wanted <= 0
   NodeId id = 0;
   int depth = 0;
-  do {
-    const std::vector<NodeId>& ch = nodes_[id].children;
-    NodeId best = ch[0];
-    int best_dist = hamming(d, pack_descriptor(nodes_[best].descriptor.data()));
-    for (std::size_t i = 1; i < ch.size(); ++i) {
-      const int dist = hamming(d, pack_descriptor(nodes_[ch[i]].descriptor.data()));
+  // Leaves, and only they, have no children (the loaders check it).
+  for (std::uint32_t first = 0, last = root_children_; first != last;) {
+    std::uint32_t best = first;
+    int best_dist = hamming(d, branches_[first].bits);
+    for (std::uint32_t i = first + 1; i < last; ++i) {
+      const int dist = hamming(d, branches_[i].bits);
       if (dist < best_dist) {  // ties keep the first child
         best_dist = dist;
-        best = ch[i];
+        best = i;
       }
     }
-    id = best;
+    const Branch& b = branches_[best];
+    id = b.node;
+    first = b.first;
+    last = b.last;
     if (++depth == level_wanted) at_level = id;
-  } while (!nodes_[id].leaf);
+  }
   if (depth < level_wanted) at_level = id;  // the path ended above the wanted depth
   if (weight != nullptr) *weight = nodes_[id].weight;
   if (node_at_level != nullptr) *node_at_level = at_level;

@@ -57,6 +57,8 @@ struct VocabularyBuilder {
   /// marks the nodes without children as leaves and numbers them as words in
   /// node order.
   static void mark_leaves_as_words(Vocabulary& voc);
+  /// Lays the complete tree out for word_of (Vocabulary::branches_).
+  static void lay_out(Vocabulary& voc);
   /// The first node that is not a leaf but has no children, or 0 when none.
   static NodeId first_childless_inner_node(const Vocabulary& voc);
   static std::vector<Node>& nodes(Vocabulary& voc) { return voc.nodes_; }

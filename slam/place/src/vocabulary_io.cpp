@@ -46,16 +46,25 @@ std::uint64_t fnv1a64(const unsigned char* p, std::size_t n) {
   return h;
 }
 
-/// The whole file in one read.
-std::string read_whole(const std::string& path) {
+/// A file's bytes, read whole in one call into a buffer that is not
+/// cleared first (a vocabulary file can be tens of megabytes).
+struct FileBytes {
+  std::unique_ptr<char[]> data;
+  std::size_t size = 0;
+  std::string_view view() const { return {data.get(), size}; }
+};
+
+FileBytes read_whole(const std::string& path) {
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!f) throw IoError(path, std::string("cannot open for reading: ") + std::strerror(errno));
   struct stat st {};
   if (fstat(fileno(f.get()), &st) != 0 || !S_ISREG(st.st_mode)) {
     throw IoError(path, "cannot read: not a regular file");
   }
-  std::string bytes(static_cast<std::size_t>(st.st_size), '\0');
-  if (!bytes.empty() && std::fread(bytes.data(), 1, bytes.size(), f.get()) != bytes.size()) {
+  FileBytes bytes;
+  bytes.size = static_cast<std::size_t>(st.st_size);
+  bytes.data.reset(new char[bytes.size + 1]);
+  if (bytes.size > 0 && std::fread(bytes.data.get(), 1, bytes.size, f.get()) != bytes.size) {
     throw IoError(path, std::string("cannot read: ") + std::strerror(errno));
   }
   return bytes;
@@ -136,7 +145,7 @@ std::uint32_t check_binary_frame(const std::string& path, const unsigned char* p
 
 /// The file formats, with access to the nodes.
 struct VocabularyFiles {
-  static Vocabulary load_binary(const std::string& path, const std::string& bytes) {
+  static Vocabulary load_binary(const std::string& path, std::string_view bytes) {
     const auto* p = reinterpret_cast<const unsigned char*>(bytes.data());
     const std::uint32_t n = check_binary_frame(path, p, bytes.size());
     Vocabulary voc;
@@ -163,6 +172,7 @@ struct VocabularyFiles {
       throw at_byte(path, kHeaderBytes + kNodeBytes * (bad - 1),
                     "node " + std::to_string(bad) + " is not a leaf but has no children");
     }
+    VocabularyBuilder::lay_out(voc);
     return voc;
   }
 
@@ -187,7 +197,7 @@ struct VocabularyFiles {
     return bytes;
   }
 
-  static Vocabulary load_text(const std::string& path, const std::string& bytes);
+  static Vocabulary load_text(const std::string& path, std::string_view bytes);
   static std::string text(const Vocabulary& voc);
 };
 
@@ -199,7 +209,7 @@ namespace {
 /// before it.  A file ending with '\n' has no empty last line.
 class Lines {
  public:
-  explicit Lines(const std::string& bytes) : text_(bytes) {}
+  explicit Lines(std::string_view bytes) : text_(bytes) {}
   bool next(std::string_view& line) {
     if (pos_ >= text_.size()) return false;
     std::size_t end = text_.find('\n', pos_);
@@ -315,7 +325,7 @@ void append_uint(std::string& out, unsigned v) {
 
 }  // namespace
 
-Vocabulary VocabularyFiles::load_text(const std::string& path, const std::string& bytes) {
+Vocabulary VocabularyFiles::load_text(const std::string& path, std::string_view bytes) {
   Lines lines(bytes);
   const auto [k, levels] = parse_text_header(path, lines);
   Vocabulary voc;
@@ -336,6 +346,7 @@ Vocabulary VocabularyFiles::load_text(const std::string& path, const std::string
     throw IoError(path, "node " + std::to_string(bad) + " is not a leaf (is_leaf 0) but has no children",
                   static_cast<int>(bad) + 1);
   }
+  VocabularyBuilder::lay_out(voc);
   return voc;
 }
 
@@ -360,7 +371,8 @@ std::string VocabularyFiles::text(const Vocabulary& voc) {
 }
 
 Vocabulary Vocabulary::load(const std::string& path) {
-  const std::string bytes = read_whole(path);
+  const FileBytes file = read_whole(path);
+  const std::string_view bytes = file.view();
   // Binary when the file starts like the magic ("PVBVOC"; a text file
   // starts with a digit), so that a cut binary file is reported as one.
   const std::size_t n = std::min<std::size_t>(bytes.size(), 6);

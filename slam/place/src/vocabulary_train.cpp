@@ -275,9 +275,10 @@ Vocabulary Vocabulary::train(const std::vector<cv::Mat>& descriptors_per_image, 
   Vocabulary voc;
   VocabularyBuilder::start(voc, params.k, params.levels, 0);
   TreeTrainer::build(voc, t.all, params);
-  VocabularyBuilder::mark_leaves_as_words(voc);
-  TreeTrainer::set_idf(voc, t);
   voc.nodes_.shrink_to_fit();
+  VocabularyBuilder::mark_leaves_as_words(voc);
+  VocabularyBuilder::lay_out(voc);
+  TreeTrainer::set_idf(voc, t);
   if (report != nullptr) {
     report->images = t.image_begin.size() - 1;
     report->descriptors = t.all.size();

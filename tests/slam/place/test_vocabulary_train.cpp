@@ -123,6 +123,29 @@ TEST(VocabularyTrain, TwoLevelsRecoverNineClustersInThreeGroups) {
   }
 }
 
+TEST(VocabularyTrain, ABitSetInHalfTheMembersIsSetInTheCentre) {
+  // Two pairs far apart; in each pair the two descriptors differ in one
+  // bit.  DBoW2's binary median sets a bit held by at least half of the
+  // members, so each centre is the member with the bit set.
+  std::mt19937_64 rng(6);
+  const std::vector<Desc> c = far_centres(2, 100, rng);
+  std::vector<Desc> with_bit(c), without_bit(c);
+  with_bit[0][0] |= 0x01;
+  without_bit[0][0] &= 0xFE;
+  with_bit[1][31] |= 0x80;
+  without_bit[1][31] &= 0x7F;
+  TrainParams p;
+  p.k = 2;
+  p.levels = 1;
+  const Vocabulary voc =
+      Vocabulary::train({to_mat({without_bit[0], with_bit[0], without_bit[1], with_bit[1]})}, p);
+  ASSERT_EQ(voc.size(), 2U);
+  for (int i = 0; i < 2; ++i) {
+    const WordId w = voc.word_of(c[i].data());
+    EXPECT_EQ(from_ptr(voc.centre(voc.word_node(w))), with_bit[i]) << "pair " << i;
+  }
+}
+
 TEST(VocabularyTrain, AtMostKDescriptorsEachMakeAChild) {
   std::mt19937_64 rng(3);
   const std::vector<Desc> three = far_centres(3, 60, rng);

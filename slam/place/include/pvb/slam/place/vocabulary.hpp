@@ -53,8 +53,16 @@ class Vocabulary {
 
   /// Trains from the descriptors of each image (CV_8U, N x 32 each; empty
   /// images are skipped).  The IDF weight of a word is ln(N / N_i), N the
-  /// images and N_i the images with at least one descriptor in the word.
+  /// non-empty images (DBoW2 counts empty ones too) and N_i the images with
+  /// at least one descriptor in the word.
   /// Throws pvb::ConfigError on bad params, no descriptors or a wrong type.
+  /// As DBoW2: a node with at most k descriptors gets one child per
+  /// descriptor; centres are binary medians (a bit is set when at least
+  /// half of the members have it); N_i counts the images whose descriptors
+  /// transform() puts in the word.  Unlike DBoW2, k-means++ draws with
+  /// probability proportional to the squared Hamming distance (DBoW2 uses
+  /// the distance), a centre left without members makes no child, and the
+  /// k-medians loop stops after params.max_iterations.
   static Vocabulary train(const std::vector<cv::Mat>& descriptors_per_image, const TrainParams& params,
                           TrainReport* report = nullptr);
 
@@ -78,9 +86,14 @@ class Vocabulary {
 
   /// Bag of words of an image's descriptors (CV_8U, N x 32), L1-normalised
   /// TF-IDF, and its direct index at `levels_up` above the leaves (fv may be null).
+  /// A descriptor whose word weighs 0 (in every training image) is in
+  /// neither, as in DBoW2.  Throws pvb::ConfigError on a wrong type.
   void transform(const cv::Mat& descriptors, BowVector* bow, FeatureVector* fv = nullptr,
                  int levels_up = 4) const;
-  /// The word of one descriptor (32 bytes), and its weight.
+  /// The word of one descriptor (32 bytes), and its weight: down from the
+  /// root to the nearest child (Hamming; ties to the first) until a leaf.
+  /// `node_at_level`: the node at depth L - levels_up on the way (see
+  /// above).  The vocabulary must not be empty (std::logic_error).
   WordId word_of(const unsigned char* descriptor, double* weight = nullptr, NodeId* node_at_level = nullptr,
                  int levels_up = 0) const;
   /// DBoW2's L1 score of two normalised vectors: 1 - 0.5 * |a - b|_1, in [0, 1].
@@ -106,6 +119,16 @@ class Vocabulary {
   int k_ = 0, levels_ = 0;
   std::vector<Node> nodes_;
   std::vector<NodeId> words_;  ///< word -> node
+  /// One child in the tree's layout for descending: the children of a node
+  /// side by side, each with where its own children are, so that a step
+  /// down reads one run of memory (built by VocabularyBuilder::lay_out).
+  struct Branch {
+    std::array<std::uint64_t, 4> bits{};  ///< the child's descriptor
+    std::uint32_t first = 0, last = 0;    ///< its children: branches_[first, last) (none for a leaf)
+    NodeId node = 0;                      ///< the child
+  };
+  std::vector<Branch> branches_;  ///< the root's children first, at [0, root_children_)
+  std::uint32_t root_children_ = 0;
 };
 
 }  // namespace pvb::slam::place
