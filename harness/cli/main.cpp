@@ -19,6 +19,7 @@ Command add_run_command(CLI::App& app);
 Command add_check_command(CLI::App& app);
 Command add_sweep_command(CLI::App& app);
 Command add_map_check_command(CLI::App& app);
+Command add_vocab_command(CLI::App& app);
 
 // Sub-commands register here (one line each).
 std::vector<Command> add_all_commands(CLI::App& app) {
@@ -34,6 +35,7 @@ std::vector<Command> add_all_commands(CLI::App& app) {
   cmds.push_back(add_check_command(app));
   cmds.push_back(add_sweep_command(app));
   cmds.push_back(add_map_check_command(app));
+  cmds.push_back(add_vocab_command(app));
   return cmds;
 }
 }  // namespace pvb::cli

@@ -42,6 +42,10 @@ RunReport new_report(const scenes::Scenario& scenario, const RunOptions& opt) {
   report.seed = scenario.seed;
   report.sync = opt.sync;
   report.fps = scenario.camera.fps;
+  if (scenario.kidnap) {
+    const scenes::KidnapFrames k = scenes::kidnap_frames(*scenario.kidnap, scenario.camera.fps);
+    report.camera_covered_frames = std::make_pair(k.cover_begin, k.cover_end - 1);
+  }
   return report;
 }
 

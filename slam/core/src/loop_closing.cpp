@@ -120,25 +120,38 @@ std::string to_json(const LoopClosingStats& stats) {
   }
   out += "], \"keyframes\": " + std::to_string(stats.keyframes) + ", \"candidates\": " +
          std::to_string(stats.candidates) + ", \"consistent\": " + std::to_string(stats.consistent) +
-         ", \"rejected\": " + std::to_string(stats.rejected) + ", \"detect_ms_total\": " +
+         ", \"rejected\": " + std::to_string(stats.rejected) +
+         ", \"refused_drift\": " + std::to_string(stats.refused_drift) +
+         ", \"refused_ambiguous\": " + std::to_string(stats.refused_ambiguous) + ", \"detect_ms_total\": " +
          num(stats.detect_ms_total) + "}";
   return out;
 }
 
-LoopClosing::LoopClosing(Map& map, const LoopClosingOptions& options) : map_(map), options_(options) {}
+LoopClosing::LoopClosing(Map& map, const LoopClosingOptions& options, PlaceRecognizer* place)
+    : map_(map), options_(options), place_(place) {}
 
 LoopClosingStats LoopClosing::stats() const {
   std::lock_guard<std::mutex> lock(stats_mutex_);
   return stats_;
 }
 
-std::vector<std::shared_ptr<KeyFrame>> LoopClosing::detect(const std::shared_ptr<KeyFrame>& kf) {
+std::vector<std::shared_ptr<KeyFrame>> LoopClosing::propose(const std::shared_ptr<KeyFrame>& kf) {
   std::vector<std::shared_ptr<KeyFrame>> candidates;
+  if (place_ && !options_.pose_proximity) {
+    candidates = place_->loop_candidates(map_, *kf, options_.min_keyframe_gap);
+    if (static_cast<int>(candidates.size()) > options_.max_candidates) candidates.resize(options_.max_candidates);
+    return candidates;
+  }
   for (const auto& cand : pose_candidates(map_, *kf, options_)) {
     Frame probe = kf->frame();
     std::fill(probe.map_points.begin(), probe.map_points.end(), nullptr);
     if (search_keyframe_bruteforce(*cand, probe, kThLow, 0.75) >= options_.min_matches) candidates.push_back(cand);
   }
+  return candidates;
+}
+
+std::vector<std::shared_ptr<KeyFrame>> LoopClosing::detect(const std::shared_ptr<KeyFrame>& kf) {
+  const std::vector<std::shared_ptr<KeyFrame>> candidates = propose(kf);
   {
     std::lock_guard<std::mutex> lock(stats_mutex_);
     stats_.candidates += static_cast<int>(candidates.size());
@@ -177,6 +190,54 @@ std::vector<std::shared_ptr<KeyFrame>> LoopClosing::detect(const std::shared_ptr
   return enough;
 }
 
+double LoopClosing::path_length_m(std::uint64_t from, std::uint64_t to) const {
+  double length = 0;
+  const KeyFrame* prev = nullptr;
+  for (auto it = map_.keyframes().lower_bound(from); it != map_.keyframes().end() && it->first <= to; ++it) {
+    if (it->second->bad()) continue;
+    if (prev) length += (it->second->camera_center_w() - prev->camera_center_w()).norm();
+    prev = it->second.get();
+  }
+  return length;
+}
+
+std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& kf,
+                                              const std::vector<std::shared_ptr<KeyFrame>>& consistent,
+                                              LoopMatch* best) {
+  std::shared_ptr<KeyFrame> loop_kf;
+  std::vector<Eigen::Vector3d> verified_centres_w;
+  int drift = 0;
+  for (const auto& cand : consistent) {
+    LoopMatch m = verify_loop(*kf, cand, options_);
+    if (!m.accepted) continue;
+    double dist_m = 0, angle_deg = 0;
+    pose_difference(m.T_c_w, kf->T_c_w(), &dist_m, &angle_deg);
+    if (dist_m > options_.max_correction_m || angle_deg > options_.max_correction_deg) continue;
+    verified_centres_w.push_back(m.T_c_w.inverse().translation());
+    const double bound_m = options_.drift_floor_m + options_.max_drift_rate * path_length_m(cand->id(), kf->id());
+    if (options_.max_drift_rate > 0 && dist_m > bound_m) {
+      ++drift;
+      continue;
+    }
+    if (!loop_kf || m.inliers > best->inliers) {
+      *best = std::move(m);
+      loop_kf = cand;
+    }
+    if (!options_.ambiguity_check) break;  // ORB-SLAM2: the first verified candidate
+  }
+  bool ambiguous = false;
+  for (std::size_t i = 0; i < verified_centres_w.size() && options_.ambiguity_check; ++i)
+    for (std::size_t j = i + 1; j < verified_centres_w.size(); ++j)
+      ambiguous = ambiguous || (verified_centres_w[i] - verified_centres_w[j]).norm() > options_.ambiguity_distance_m;
+  std::lock_guard<std::mutex> s(stats_mutex_);
+  if (ambiguous) {
+    ++stats_.refused_ambiguous;
+    return nullptr;
+  }
+  if (!loop_kf && drift > 0) ++stats_.refused_drift;
+  return loop_kf;
+}
+
 bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
   if (!options_.enabled) return false;
   const auto t0 = std::chrono::steady_clock::now();
@@ -192,30 +253,13 @@ bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
   }
   const std::vector<std::shared_ptr<KeyFrame>> consistent = detect(kf);
   LoopMatch best;
-  std::shared_ptr<KeyFrame> loop_kf;
-  bool rejected = false;
-  for (const auto& cand : consistent) {
-    LoopMatch m = verify_loop(*kf, cand, options_);
-    if (!m.accepted) {
-      rejected = true;
-      continue;
-    }
-    double dist_m = 0, angle_deg = 0;
-    pose_difference(m.T_c_w, kf->T_c_w(), &dist_m, &angle_deg);
-    if (dist_m > options_.max_correction_m || angle_deg > options_.max_correction_deg) {
-      rejected = true;
-      continue;
-    }
-    best = std::move(m);
-    loop_kf = cand;
-    break;
-  }
+  const std::shared_ptr<KeyFrame> loop_kf = consistent.empty() ? nullptr : verify(kf, consistent, &best);
   const double detect_ms = ms_since(t0);
   {
     std::lock_guard<std::mutex> s(stats_mutex_);
     stats_.detect_ms_total += detect_ms;
     if (!consistent.empty()) ++stats_.consistent;
-    if (rejected && !loop_kf) ++stats_.rejected;
+    if (!consistent.empty() && !loop_kf) ++stats_.rejected;
   }
   if (!loop_kf) return false;
 

@@ -190,6 +190,48 @@ int search_keyframe_bruteforce(const KeyFrame& kf, Frame& cur, int max_distance,
   return n;
 }
 
+int search_keyframe_by_bow(const KeyFrame& kf, Frame& cur, const place::FeatureVector& cur_features,
+                           int max_distance, double ratio) {
+  const Frame& kff = kf.frame();
+  std::vector<IndexMatch> matches;
+  std::vector<float> diffs;
+  std::vector<int> taken_dist(cur.size(), INT_MAX);
+  std::vector<long> taken_by(cur.size(), -1);
+  const place::FeatureVector& kf_features = kf.features_by_node();
+  auto a = kf_features.begin();
+  auto b = cur_features.begin();
+  while (a != kf_features.end() && b != cur_features.end()) {
+    if (a->first < b->first) { ++a; continue; }
+    if (b->first < a->first) { ++b; continue; }
+    for (std::uint32_t i : a->second) {
+      const auto& mp = kff.map_points[i];
+      if (!mp || mp->bad()) continue;
+      const unsigned char* d_mp = desc_row(kff.descriptors, i);
+      BestTwo best2;
+      for (std::uint32_t j : b->second)
+        if (!cur.map_points[j]) best2.offer(descriptor_distance(d_mp, desc_row(cur.descriptors, j)), j);
+      const std::size_t j = best2.best_idx;
+      if (best2.best > max_distance || (best2.second != INT_MAX && best2.best >= ratio * best2.second)) continue;
+      if (best2.best >= taken_dist[j]) continue;
+      if (taken_by[j] >= 0) matches[static_cast<std::size_t>(taken_by[j])].i1 = SIZE_MAX;
+      taken_dist[j] = best2.best;
+      taken_by[j] = static_cast<long>(matches.size());
+      matches.push_back({i, j});
+      diffs.push_back(kff.keys_un[i].angle - cur.keys_un[j].angle);
+    }
+    ++a;
+    ++b;
+  }
+  const std::vector<std::uint8_t> ok = orientation_consistent(diffs);
+  int n = 0;
+  for (std::size_t k = 0; k < matches.size(); ++k) {
+    if (!ok[k] || matches[k].i1 == SIZE_MAX) continue;
+    cur.map_points[matches[k].i2] = kff.map_points[matches[k].i1];
+    ++n;
+  }
+  return n;
+}
+
 int fuse(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::vector<std::shared_ptr<MapPoint>>& points, double th,
          FusePolicy policy) {
   const Frame& f = kf->frame();

@@ -79,6 +79,14 @@ class Reader {
   bool flag(const std::string& key, bool required, bool fallback) {
     return integral(key, required, fallback ? 1 : 0, 0, 1, "0 or 1") == 1;
   }
+  /// A string; `fallback` when the key is absent.
+  std::string text(const std::string& key, const std::string& fallback) {
+    seen_.insert(key);
+    const cv::FileNode n = fs_[key];
+    if (n.empty()) return fallback;
+    if (!n.isString()) throw ConfigError(path_, key, "a string (a file path, or none)");
+    return static_cast<std::string>(n);
+  }
   /// Checks a value read before against a range known only later.
   void check(const std::string& key, double v, const Range& range, const std::string& what) const {
     if (!range.contains(v)) throw ConfigError(path_, key, what + " in " + range.text(), number_text(v));
@@ -211,6 +219,12 @@ void read_loop_closing(Reader& r, LoopClosingOptions* lc) {
   lc->essential_weight = r.integer("LoopClosing.essentialWeight", false, lc->essential_weight, 1, 1000000);
   lc->global_ba = r.flag("LoopClosing.globalBA", false, lc->global_ba);
   lc->rotation_weight = r.real("LoopClosing.rotationWeight", false, lc->rotation_weight, above(0, 1e6));
+  lc->pose_proximity = r.flag("LoopClosing.poseProximity", false, lc->pose_proximity);
+  lc->max_drift_rate = r.real("LoopClosing.maxDriftRate", false, lc->max_drift_rate, Range{0, 1}, "a share of the path");
+  lc->drift_floor_m = r.real("LoopClosing.driftFloor", false, lc->drift_floor_m, Range{0, 1e4}, "metres");
+  lc->ambiguity_check = r.flag("LoopClosing.ambiguityCheck", false, lc->ambiguity_check);
+  lc->ambiguity_distance_m =
+      r.real("LoopClosing.ambiguityDistance", false, lc->ambiguity_distance_m, above(0, 1e4), "metres");
 }
 
 /// "FILE(LINE): REASON" from a cv::FileStorage parse error.  OpenCV 4.6
@@ -227,6 +241,15 @@ IoError parse_error(const std::string& path, const cv::Exception& e) {
 }
 
 }  // namespace
+
+/// Vocabulary.path: "" the default vocabulary, "none" none, else the file,
+/// a relative path taken from the settings file's folder.
+std::string vocabulary_path(const std::string& settings_path, const std::string& value) {
+  if (value.empty()) return kDefaultVocabularyPath;
+  if (value == "none" || value.front() == '/') return value;
+  const std::size_t slash = settings_path.rfind('/');
+  return slash == std::string::npos ? value : settings_path.substr(0, slash + 1) + value;
+}
 
 /// Lines OpenCV's YAML parser cannot read: it loops for ever on a line that
 /// starts with "----" and goes on (found by fuzz_settings), so a line that
@@ -265,6 +288,7 @@ Settings read_settings(const std::string& path) {
   read_keyframe(r, &s.keyframe);
   read_point_cloud(r, &s.dense);
   read_loop_closing(r, &s.loop);
+  s.vocabulary_path = vocabulary_path(path, r.text("Vocabulary.path", ""));
   const cv::FileNode root = fs.root();
   for (auto it = root.begin(); it != root.end(); ++it) {
     const std::string key = (*it).name();

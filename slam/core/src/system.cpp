@@ -39,15 +39,26 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.kf_ref_overlap = settings.keyframe.ref_overlap;
   topt.align_patches = settings.align_patches;
   topt.patch_align.scale_factor = settings.orb.scale_factor;
-  tracking_ = std::make_unique<Tracking>(map_, cam_, topt);
+  topt.reloc_ambiguity_check = settings.loop.ambiguity_check;
+  topt.reloc_ambiguity_distance_m = settings.loop.ambiguity_distance_m;
+  if (settings.vocabulary_path != "none")
+    place_ = std::make_unique<PlaceRecognizer>(
+        std::make_shared<const place::Vocabulary>(place::Vocabulary::load(settings.vocabulary_path)));
+  tracking_ = std::make_unique<Tracking>(map_, cam_, topt, place_.get());
   LocalMappingOptions mopt;
   mopt.align_patches = settings.align_patches;
   mopt.patch_align = topt.patch_align;
   mapping_ = std::make_unique<LocalMapping>(map_, cam_, mopt);
-  if (settings.loop.enabled) {
-    loop_ = std::make_unique<LoopClosing>(map_, settings.loop);
-    mapping_->set_after_keyframe([this](const std::shared_ptr<KeyFrame>& kf) { loop_->process(kf); });
-  }
+  if (settings.loop.enabled) loop_ = std::make_unique<LoopClosing>(map_, settings.loop, place_.get());
+  // After local mapping: the keyframe's bag of words, loop detection
+  // against the older keyframes, then the keyframe joins the database.
+  mapping_->set_after_keyframe([this](const std::shared_ptr<KeyFrame>& kf) {
+    // Descriptors never change; the bag is read by others only once the
+    // keyframe is in the database (whose mutex publishes it).
+    if (place_) place_->compute_bow(*kf);
+    if (loop_) loop_->process(kf);
+    if (place_ && !kf->bad()) place_->add(*kf);
+  });
   if (!options.synchronous) mapping_->start();
   if (settings.dense.enabled) {
     dense::DenseMapperOptions dopt;

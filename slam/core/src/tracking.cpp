@@ -1,5 +1,7 @@
 #include "pvb/slam/core/tracking.hpp"
 
+#include "pvb/common/text.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -40,8 +42,9 @@ bool IdMarks::marked(std::uint64_t id) const {
   return id < stamp_.size() && stamp_[id] == pass_;
 }
 
-Tracking::Tracking(Map& map, std::shared_ptr<const CameraModel> cam, const TrackingOptions& options)
-    : map_(map), cam_(std::move(cam)), options_(options), pe_matcher_(options.pe_match) {}
+Tracking::Tracking(Map& map, std::shared_ptr<const CameraModel> cam, const TrackingOptions& options,
+                   const PlaceRecognizer* place)
+    : map_(map), cam_(std::move(cam)), options_(options), pe_matcher_(options.pe_match), place_(place) {}
 
 std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_t mapping_queue) {
   std::lock_guard<std::mutex> lock(map_.mutex());
@@ -284,9 +287,9 @@ bool Tracking::track_reference_keyframe(Frame& f) {
   return true;
 }
 
-bool Tracking::relocalize(Frame& f) {
-  // Candidates: the most recent keyframes and the covisibility neighbours of
-  // the last reference keyframe (no bag of words yet).
+std::vector<std::shared_ptr<KeyFrame>> Tracking::recent_keyframes() const {
+  // The most recent keyframes and the covisibility neighbours of the last
+  // reference keyframe (without a vocabulary).
   std::vector<std::shared_ptr<KeyFrame>> cands;
   std::set<std::uint64_t> seen;
   const auto& kfs = map_.keyframes();
@@ -298,44 +301,84 @@ bool Tracking::relocalize(Frame& f) {
   if (ref_kf_ && !ref_kf_->bad())
     for (const auto& c : ref_kf_->best_covisibles(10))
       if (seen.insert(c->id()).second) cands.push_back(c);
+  return cands;
+}
 
+int Tracking::relocalize_against(Frame& f, const KeyFrame& kf, const place::FeatureVector* f_features,
+                                 int* matches) {
+  std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
+  *matches = f_features ? search_keyframe_by_bow(kf, f, *f_features, kThLow, 0.75)
+                        : search_keyframe_bruteforce(kf, f, kThLow, 0.75);
+  if (*matches < 15) return 0;
+  if (pnp_ransac_on_matches(f, 10) < 10) return 0;
+  int good = optimize_frame_pose(f);
+  if (good < 10) return 0;
+  int map_matches = 0;
+  discard_outliers(f, &map_matches);
+  if (good < 50) {
+    // more matches by projection of the candidate's points with a wide window
+    std::vector<ProjectedPoint> proj;
+    for (const auto& mp : kf.map_points()) {
+      if (!mp || mp->bad()) continue;
+      if (std::find(f.map_points.begin(), f.map_points.end(), mp) != f.map_points.end()) continue;
+      ProjectedPoint p;
+      if (project_in_frustum(f, mp, &p)) proj.push_back(p);
+    }
+    search_local_points(f, proj, 10.0 / 4.0);
+    good = optimize_frame_pose(f);
+    discard_outliers(f, &map_matches);
+  }
+  return good;
+}
+
+bool Tracking::relocalize(Frame& f) {
+  // Candidates from the bag of words anywhere in the map (ORB-SLAM2
+  // DetectRelocalizationCandidates), or the recent keyframes without one.
+  place::FeatureVector f_features;
+  std::vector<std::shared_ptr<KeyFrame>> cands;
+  if (place_) {
+    place::BowVector bow;
+    place_->vocabulary().transform(f.descriptors, &bow, &f_features, PlaceRecognizer::kDirectIndexLevelsUp);
+    cands = place_->relocalisation_candidates(map_, bow);
+    if (cands.size() > kMaxRelocCandidates) cands.resize(kMaxRelocCandidates);
+  } else {
+    cands = recent_keyframes();
+  }
   int best_matches = 0, best_inliers = 0;  // over the candidates, for the failure reason
+  std::vector<std::pair<Frame, std::shared_ptr<KeyFrame>>> found;
+  std::vector<int> found_inliers;
   for (const auto& kf : cands) {
     if (kf->bad()) continue;
-    std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
-    const int n = search_keyframe_bruteforce(*kf, f, kThLow, 0.75);
-    best_matches = std::max(best_matches, n);
-    if (n < 15) continue;
-    if (pnp_ransac_on_matches(f, 10) < 10) continue;
-    int good = optimize_frame_pose(f);
-    if (good < 10) continue;
-    int map_matches = 0;
-    discard_outliers(f, &map_matches);
-    if (good < 50) {
-      // more matches by projection of the candidate's points with a wide window
-      std::vector<ProjectedPoint> proj;
-      for (const auto& mp : kf->map_points()) {
-        if (!mp || mp->bad()) continue;
-        if (std::find(f.map_points.begin(), f.map_points.end(), mp) != f.map_points.end()) continue;
-        ProjectedPoint p;
-        if (project_in_frustum(f, mp, &p)) proj.push_back(p);
-      }
-      search_local_points(f, proj, 10.0 / 4.0);
-      good = optimize_frame_pose(f);
-      discard_outliers(f, &map_matches);
-    }
+    Frame trial = f;
+    int matches = 0;
+    const int good = relocalize_against(trial, *kf, place_ ? &f_features : nullptr, &matches);
+    best_matches = std::max(best_matches, matches);
     best_inliers = std::max(best_inliers, good);
-    if (good >= 50) {
-      last_reloc_frame_id_ = f.id;
-      reloc_kf_ = kf;
-      reloc_candidates_ = static_cast<int>(cands.size());
-      return true;
-    }
+    if (good < 50) continue;
+    found.emplace_back(std::move(trial), kf);
+    found_inliers.push_back(good);
+    if (!options_.reloc_ambiguity_check) break;
   }
   std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
-  return fail("relocalisation: no candidate keyframe matched (" + std::to_string(cands.size()) +
-              " candidates, best " + std::to_string(best_matches) + " descriptor matches (need 15), best " +
-              std::to_string(best_inliers) + " pose inliers (need 50))");
+  if (found.empty())
+    return fail("relocalisation: no candidate keyframe matched (" + std::to_string(cands.size()) +
+                " candidates, best " + std::to_string(best_matches) + " descriptor matches (need 15), best " +
+                std::to_string(best_inliers) + " pose inliers (need 50))");
+  for (std::size_t i = 0; i < found.size(); ++i)
+    for (std::size_t j = i + 1; j < found.size(); ++j)
+      if ((found[i].first.camera_center_w() - found[j].first.camera_center_w()).norm() >
+          options_.reloc_ambiguity_distance_m)
+        return fail("relocalisation: ambiguous (keyframes " + std::to_string(found[i].second->id()) + " and " +
+                    std::to_string(found[j].second->id()) + " both matched, at places " +
+                    format_fixed((found[i].first.camera_center_w() - found[j].first.camera_center_w()).norm(), 2) +
+                    " m apart)");
+  const std::size_t best = static_cast<std::size_t>(
+      std::max_element(found_inliers.begin(), found_inliers.end()) - found_inliers.begin());
+  f = std::move(found[best].first);
+  last_reloc_frame_id_ = f.id;
+  reloc_kf_ = found[best].second;
+  reloc_candidates_ = static_cast<int>(cands.size());
+  return true;
 }
 
 void Tracking::update_local_map(const Frame& f) {

@@ -10,6 +10,7 @@
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/slam/core/settings.hpp"
+#include "pvb/slam/core/system.hpp"
 
 namespace pvb::slam {
 namespace {
@@ -375,6 +376,49 @@ TEST(Settings, DocumentMarkerMustStandAlone) {
 }
 
 TEST(Settings, MissingFileIsAnIoError) { EXPECT_THROW(read_settings("/nonexistent/settings.yaml"), IoError); }
+
+TEST(Settings, ReadsPlaceRecognitionKeys) {
+  const Settings d = read_settings(kTum1);  // absent: the shipped vocabulary, BoW loops, both checks on
+  EXPECT_EQ(d.vocabulary_path, kDefaultVocabularyPath);
+  EXPECT_FALSE(d.loop.pose_proximity);
+  EXPECT_TRUE(d.loop.ambiguity_check);
+  EXPECT_DOUBLE_EQ(d.loop.max_drift_rate, 0.01);
+  const std::string path = temp_copy("place", read_file(kTum1) +
+                                                  "\nVocabulary.path: \"voc/ORBvoc.txt\"\n"
+                                                  "LoopClosing.poseProximity: 1\nLoopClosing.maxDriftRate: 0\n"
+                                                  "LoopClosing.driftFloor: 0.1\nLoopClosing.ambiguityCheck: 0\n"
+                                                  "LoopClosing.ambiguityDistance: 0.5\n");
+  const Settings s = read_settings(path);
+  EXPECT_TRUE(s.warnings.empty());
+  // relative to the settings file's folder
+  EXPECT_EQ(s.vocabulary_path, path.substr(0, path.rfind('/') + 1) + "voc/ORBvoc.txt");
+  EXPECT_TRUE(s.loop.pose_proximity);
+  EXPECT_DOUBLE_EQ(s.loop.max_drift_rate, 0);
+  EXPECT_DOUBLE_EQ(s.loop.drift_floor_m, 0.1);
+  EXPECT_FALSE(s.loop.ambiguity_check);
+  EXPECT_DOUBLE_EQ(s.loop.ambiguity_distance_m, 0.5);
+  EXPECT_EQ(read_settings(temp_copy("none", read_file(kTum1) + "\nVocabulary.path: none\n")).vocabulary_path, "none");
+  for (const std::string bad : {"Vocabulary.path: 3", "LoopClosing.maxDriftRate: 2", "LoopClosing.ambiguityDistance: 0"}) {
+    const std::string key = bad.substr(0, bad.find(':'));
+    try {
+      read_settings(temp_copy("bad_place", read_file(kTum1) + "\n" + bad + "\n"));
+      ADD_FAILURE() << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), key) << e.what();
+    }
+  }
+}
+
+TEST(Settings, MissingVocabularyIsOneIoErrorNamingIt) {
+  Settings s = read_settings(kTum1);
+  s.vocabulary_path = "/nonexistent/voc.pvbvoc";
+  try {
+    System system(s, {});
+    ADD_FAILURE() << "no error";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/voc.pvbvoc"), std::string::npos) << e.what();
+  }
+}
 
 }  // namespace
 }  // namespace pvb::slam

@@ -26,9 +26,12 @@
 //   5. optionally (`global_ba`, off by default) a bundle adjustment of the
 //      whole map, inline, with the map locked (tracking waits).
 //
-// Pose proximity only works while the drift is small compared with the
-// search radius (centimetres here): it cannot close a loop after the
-// estimate has drifted by metres; that would need place recognition.
+// Step 1 by default asks the bag-of-words database (PlaceRecognizer:
+// ORB-SLAM2's DetectLoopCandidates) instead of pose proximity, and step 3
+// verifies every consistent candidate, refusing the loop when the
+// correction is implausible for the path driven or when two candidates
+// verify at different places (docs/place_recognition.md).  Pose proximity
+// only works while the drift is small compared with the search radius.
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -37,6 +40,7 @@
 #include <vector>
 
 #include "pvb/slam/core/map.hpp"
+#include "pvb/slam/core/place_recognition.hpp"
 
 namespace pvb::slam {
 
@@ -56,6 +60,21 @@ struct LoopClosingOptions {
   int keyframes_between_loops = 10;  ///< no detection for this many keyframes after a loop (ORB-SLAM2: 10)
   double rotation_weight = 1.0;    ///< LoopClosing.rotationWeight: pose-graph rotation rows (rad) against translation (m)
   bool global_ba = false;          ///< LoopClosing.globalBA (0/1): bundle adjustment of the whole map after a loop
+  /// LoopClosing.poseProximity (0/1): candidates by pose proximity (step 1
+  /// above) instead of the bag of words.  Off by default: it cannot find a
+  /// loop after a drift larger than searchRadius.
+  bool pose_proximity = false;
+  /// Beyond ORB-SLAM2, against look-alike places (docs/place_recognition.md):
+  /// LoopClosing.maxDriftRate / driftFloor: a correction larger than
+  /// driftFloor + maxDriftRate x the path driven between the two keyframes
+  /// (as estimated) is implausible and refused; 0 turns the check off.
+  double max_drift_rate = 0.01;
+  double drift_floor_m = 0.05;
+  /// LoopClosing.ambiguityCheck (0/1) / ambiguityDistance: when two
+  /// candidates verify at camera positions more than ambiguityDistance
+  /// apart, the place is ambiguous (a repeated structure) and the loop is refused.
+  bool ambiguity_check = true;
+  double ambiguity_distance_m = 0.3;
 };
 
 /// One closed loop.
@@ -86,6 +105,8 @@ struct LoopClosingStats {
   int candidates = 0;             ///< pose candidates that passed the appearance check
   int consistent = 0;             ///< keyframes with a consistent candidate
   int rejected = 0;               ///< consistent detections refused by geometry or the correction bound
+  int refused_drift = 0;          ///< of those, verified but implausible against the drift bound
+  int refused_ambiguous = 0;      ///< of those, verified at two places apart
   double detect_ms_total = 0;     ///< all detection work
 };
 
@@ -119,7 +140,8 @@ LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand,
 
 class LoopClosing {
  public:
-  LoopClosing(Map& map, const LoopClosingOptions& options);
+  /// `place` (may be null: pose proximity only) finds BoW candidates.
+  LoopClosing(Map& map, const LoopClosingOptions& options, PlaceRecognizer* place = nullptr);
 
   /// Detects and, when verified, closes a loop for a keyframe local mapping
   /// has just processed.  Takes the map mutex.  Returns true when a loop
@@ -137,6 +159,14 @@ class LoopClosing {
   };
   /// Steps 1-2; returns the candidates consistent enough for verification.
   std::vector<std::shared_ptr<KeyFrame>> detect(const std::shared_ptr<KeyFrame>& kf);
+  /// Step 1: pose-proximity candidates with the appearance check, or BoW candidates.
+  std::vector<std::shared_ptr<KeyFrame>> propose(const std::shared_ptr<KeyFrame>& kf);
+  /// Step 3 over every consistent candidate, with the drift and ambiguity
+  /// checks; the accepted candidate (most inliers) or null.
+  std::shared_ptr<KeyFrame> verify(const std::shared_ptr<KeyFrame>& kf,
+                                   const std::vector<std::shared_ptr<KeyFrame>>& consistent, LoopMatch* best);
+  /// Camera path length (current estimates) over the keyframes from `from` to `to` by id.
+  double path_length_m(std::uint64_t from, std::uint64_t to) const;
   /// Step 5 (optional): bundle adjustment of every keyframe and point,
   /// keyframe 0 fixed, map locked throughout.
   void global_bundle_adjustment(LoopEvent* event);
@@ -146,6 +176,7 @@ class LoopClosing {
 
   Map& map_;
   LoopClosingOptions options_;
+  PlaceRecognizer* place_ = nullptr;
   std::vector<Group> groups_;  ///< consistency groups of the previous keyframe
   std::uint64_t last_loop_kf_id_ = 0;
   bool any_loop_ = false;

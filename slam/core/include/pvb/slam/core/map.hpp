@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "pvb/slam/core/frame.hpp"
+#include "pvb/slam/place/vocabulary.hpp"
 
 namespace pvb::slam {
 
@@ -125,6 +126,17 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   std::vector<std::shared_ptr<KeyFrame>> best_covisibles(int n) const;
   int weight(std::uint64_t kf_id) const;
 
+  // Bag of words (place recognition) -----------------------------------------
+  /// Set once, by the thread that processes the keyframe, before the
+  /// keyframe enters the place database (which publishes it).
+  void set_bow(place::BowVector bow, place::FeatureVector features) {
+    bow_ = std::move(bow);
+    features_by_node_ = std::move(features);
+  }
+  const place::BowVector& bow() const { return bow_; }
+  /// The direct index: keypoint indices by vocabulary node.
+  const place::FeatureVector& features_by_node() const { return features_by_node_; }
+
   // Loop edges (loop closing) ---------------------------------------------------
   /// Records a closed loop between this keyframe and kf; a keyframe with a
   /// loop edge is never removed (it anchors the essential graph).
@@ -159,6 +171,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   std::weak_ptr<KeyFrame> parent_;
   std::map<std::uint64_t, std::weak_ptr<KeyFrame>> children_;
   std::map<std::uint64_t, std::weak_ptr<KeyFrame>> loop_edges_;
+  place::BowVector bow_;
+  place::FeatureVector features_by_node_;
   bool bad_ = false;
   std::shared_ptr<KeyFrame> removed_parent_;          ///< parent at removal (kept alive for trajectories)
   geom::SE3d T_c_parent_ = geom::SE3d::Identity();  ///< pose relative to it at removal

@@ -53,6 +53,11 @@ int search_local_points(Frame& cur, const std::vector<ProjectedPoint>& points, d
 /// (replaces ORB-SLAM2's bag-of-words search): best <= max_distance and
 /// < ratio x second best, orientation check.  Sets cur.map_points.
 int search_keyframe_bruteforce(const KeyFrame& kf, Frame& cur, int max_distance, double ratio);
+/// The same through the direct index (ORB-SLAM2 SearchByBoW): only
+/// descriptors under the same vocabulary node are compared (kf's by
+/// kf.features_by_node(), cur's by `cur_features`).
+int search_keyframe_by_bow(const KeyFrame& kf, Frame& cur, const place::FeatureVector& cur_features,
+                           int max_distance, double ratio);
 
 /// EPnP RANSAC (OpenCV, 300 iterations, 4 px, fixed seed) of cur's matched
 /// map points against their undistorted keypoints, as relocalisation and

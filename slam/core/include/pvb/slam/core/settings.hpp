@@ -67,6 +67,9 @@ struct PointCloudMappingSettings {
   double max_depth_m = 4.0;    ///< PointCloudMapping.MaxDepth, metres
 };
 
+/// The vocabulary shipped with the project (docs/place_recognition.md).
+inline constexpr const char* kDefaultVocabularyPath = PVB_DEFAULT_VOCABULARY;
+
 /// Everything the SLAM system reads from its settings file.
 struct Settings {
   std::string source;               ///< file it came from
@@ -86,6 +89,12 @@ struct Settings {
   KeyFrameSettings keyframe;        ///< KeyFrame.* (optional section)
   PointCloudMappingSettings dense;  ///< PointCloudMapping.* (optional section)
   LoopClosingOptions loop;          ///< LoopClosing.* (optional section)
+  /// Vocabulary.path (ours, optional): the place-recognition vocabulary
+  /// (our binary format or ORB-SLAM2's ORBvoc.txt); relative to the
+  /// settings file's folder; "none" for none (pose-proximity loops and
+  /// relocalisation against recent keyframes only).  Absent: the default,
+  /// kDefaultVocabularyPath.
+  std::string vocabulary_path = kDefaultVocabularyPath;
   std::vector<std::string> warnings;  ///< unknown keys and similar, one line each
 
   /// Close/far depth threshold in metres (ORB-SLAM2: bf * ThDepth / fx).

@@ -90,6 +90,7 @@ class System {
   std::shared_ptr<const CameraModel> cam_;
   OrbExtractor extractor_;
   Map map_;
+  std::unique_ptr<PlaceRecognizer> place_;  ///< null with Vocabulary.path none
   std::unique_ptr<Tracking> tracking_;
   std::unique_ptr<LoopClosing> loop_;  ///< null when loop closing is disabled; runs on the mapping thread
   std::unique_ptr<LocalMapping> mapping_;

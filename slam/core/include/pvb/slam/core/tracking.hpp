@@ -12,6 +12,7 @@
 
 #include "pvb/slam/core/map.hpp"
 #include "pvb/slam/core/matcher.hpp"
+#include "pvb/slam/core/place_recognition.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/pematch/pe_match.hpp"
 
@@ -109,6 +110,11 @@ struct TrackingOptions {
   /// without one are not aligned).  docs/slam.md, "Patch alignment".
   bool align_patches = true;
   PatchAlignParams patch_align;
+  /// Relocalisation against look-alike places: every candidate is tried,
+  /// and when two match at camera positions more than this apart the frame
+  /// stays lost (LoopClosing.ambiguityCheck / ambiguityDistance).
+  bool reloc_ambiguity_check = true;
+  double reloc_ambiguity_distance_m = 0.3;
 };
 
 /// "Already seen in this pass" marks for map-point ids: a pass stamp per
@@ -133,7 +139,9 @@ class IdMarks {
 
 class Tracking {
  public:
-  Tracking(Map& map, std::shared_ptr<const CameraModel> cam, const TrackingOptions& options);
+  /// `place` (may be null) gives relocalisation candidates anywhere in the map.
+  Tracking(Map& map, std::shared_ptr<const CameraModel> cam, const TrackingOptions& options,
+           const PlaceRecognizer* place = nullptr);
 
   /// Tracks one frame (features extracted).  `mapping_idle` and
   /// `mapping_queue` describe the local mapper for the keyframe decision.
@@ -158,6 +166,13 @@ class Tracking {
   double translation_parallax_px(const std::vector<IndexMatch>& m, const geom::SE3d& T_cur_last) const;
   bool track_reference_keyframe(Frame& f);
   bool relocalize(Frame& f);
+  /// Relocalisation candidates without a vocabulary.
+  std::vector<std::shared_ptr<KeyFrame>> recent_keyframes() const;
+  /// Matches f against kf (through the direct index when f_features is
+  /// given), PnP RANSAC and pose optimisation; returns the pose inliers
+  /// (0 when a step failed) and the descriptor matches in *matches.
+  int relocalize_against(Frame& f, const KeyFrame& kf, const place::FeatureVector* f_features, int* matches);
+  static constexpr std::size_t kMaxRelocCandidates = 20;
   /// Appends the RelocEvent of f, just relocalised and tracked.
   void record_relocalisation(const Frame& f);
   bool track_local_map(Frame& f);
@@ -179,6 +194,7 @@ class Tracking {
   std::shared_ptr<const CameraModel> cam_;
   TrackingOptions options_;
   PeMatcher pe_matcher_;
+  const PlaceRecognizer* place_ = nullptr;
   TrackingState state_ = TrackingState::kNotInitialized;
   TrackingStats stats_;
 

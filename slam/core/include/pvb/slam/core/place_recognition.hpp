@@ -1,0 +1,51 @@
+#pragma once
+// Place recognition for tracking and loop closing: the keyframes' bags of
+// words in a database, and the candidate selection of ORB-SLAM2's
+// KeyFrameDatabase (DetectLoopCandidates, DetectRelocalizationCandidates):
+// keyframes sharing words with the query, those sharing at least 80 % of
+// the most shared words and scoring at least a minimum, then scores
+// accumulated over each candidate's 10 best covisibles that are candidates
+// too; the best keyframe of every group whose accumulated score exceeds
+// 75 % of the best group's.  docs/place_recognition.md.
+#include <memory>
+#include <vector>
+
+#include "pvb/slam/core/map.hpp"
+#include "pvb/slam/place/database.hpp"
+#include "pvb/slam/place/vocabulary.hpp"
+
+namespace pvb::slam {
+
+class PlaceRecognizer {
+ public:
+  /// Groups features by the node this many levels above the words (ORB-SLAM2: 4).
+  static constexpr int kDirectIndexLevelsUp = 4;
+
+  explicit PlaceRecognizer(std::shared_ptr<const place::Vocabulary> vocabulary);
+
+  const place::Vocabulary& vocabulary() const { return *vocabulary_; }
+  /// The bag of words and direct index of a keyframe's descriptors.
+  void compute_bow(KeyFrame& kf) const;
+  /// The bag of words of a frame's descriptors (no direct index).
+  place::BowVector bow_of(const Frame& f) const;
+  /// Adds a keyframe (its bag computed) to the database.
+  void add(const KeyFrame& kf);
+  /// Forgets a keyframe (culled).
+  void erase(std::uint64_t kf_id);
+
+  /// Loop candidates for `kf` (ORB-SLAM2 DetectLoopCandidates): older by at
+  /// least min_keyframe_gap ids, not kf's covisibles, scoring at least the
+  /// lowest score of kf against its covisibles.  Call with the map mutex held.
+  std::vector<std::shared_ptr<KeyFrame>> loop_candidates(const Map& map, const KeyFrame& kf,
+                                                         int min_keyframe_gap) const;
+  /// Relocalisation candidates for a frame's bag (DetectRelocalizationCandidates).
+  /// Call with the map mutex held.
+  std::vector<std::shared_ptr<KeyFrame>> relocalisation_candidates(const Map& map,
+                                                                   const place::BowVector& bow) const;
+
+ private:
+  std::shared_ptr<const place::Vocabulary> vocabulary_;
+  place::Database database_;
+};
+
+}  // namespace pvb::slam

@@ -1,0 +1,98 @@
+#include "pvb/slam/core/place_recognition.hpp"
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+namespace pvb::slam {
+namespace {
+
+using KeyFramePtr = std::shared_ptr<KeyFrame>;
+
+/// ORB-SLAM2's accumulation of candidate scores over covisibility groups:
+/// each candidate's score plus those of its 10 best covisibles that are
+/// candidates too; the best-scoring keyframe of every group whose sum is
+/// above 75 % of the best sum, each keyframe once, best group first.
+std::vector<KeyFramePtr> accumulate_groups(const Map& map, const std::vector<place::Candidate>& found) {
+  std::map<std::uint64_t, double> score;
+  for (const auto& c : found) score[c.id] = c.score;
+  struct Group {
+    double acc;
+    KeyFramePtr best;
+  };
+  std::vector<Group> groups;
+  double best_acc = 0;
+  for (const auto& c : found) {
+    auto it = map.keyframes().find(c.id);
+    if (it == map.keyframes().end() || it->second->bad()) continue;
+    Group g{c.score, it->second};
+    double best_score = c.score;
+    for (const auto& n : it->second->best_covisibles(10)) {
+      auto s = score.find(n->id());
+      if (s == score.end() || n->bad()) continue;
+      g.acc += s->second;
+      if (s->second > best_score) {
+        best_score = s->second;
+        g.best = n;
+      }
+    }
+    best_acc = std::max(best_acc, g.acc);
+    groups.push_back(g);
+  }
+  std::stable_sort(groups.begin(), groups.end(), [](const Group& a, const Group& b) { return a.acc > b.acc; });
+  std::vector<KeyFramePtr> out;
+  std::set<std::uint64_t> taken;
+  for (const Group& g : groups)
+    if (g.acc > 0.75 * best_acc && taken.insert(g.best->id()).second) out.push_back(g.best);
+  return out;
+}
+
+}  // namespace
+
+PlaceRecognizer::PlaceRecognizer(std::shared_ptr<const place::Vocabulary> vocabulary)
+    : vocabulary_(std::move(vocabulary)) {}
+
+void PlaceRecognizer::compute_bow(KeyFrame& kf) const {
+  place::BowVector bow;
+  place::FeatureVector features;
+  vocabulary_->transform(kf.frame().descriptors, &bow, &features, kDirectIndexLevelsUp);
+  kf.set_bow(std::move(bow), std::move(features));
+}
+
+place::BowVector PlaceRecognizer::bow_of(const Frame& f) const {
+  place::BowVector bow;
+  vocabulary_->transform(f.descriptors, &bow, nullptr, kDirectIndexLevelsUp);
+  return bow;
+}
+
+void PlaceRecognizer::add(const KeyFrame& kf) { database_.add(kf.id(), kf.bow()); }
+
+void PlaceRecognizer::erase(std::uint64_t kf_id) { database_.erase(kf_id); }
+
+std::vector<KeyFramePtr> PlaceRecognizer::loop_candidates(const Map& map, const KeyFrame& kf,
+                                                          int min_keyframe_gap) const {
+  std::set<std::uint64_t> connected = {kf.id()};
+  double min_score = 1.0;
+  for (const auto& n : kf.best_covisibles(-1)) {
+    connected.insert(n->id());
+    if (!n->bad()) min_score = std::min(min_score, place::Vocabulary::score(kf.bow(), n->bow()));
+  }
+  if (connected.size() == 1) min_score = 0;
+  const auto skip = [&](std::uint64_t id) {
+    if (connected.count(id) || id + static_cast<std::uint64_t>(min_keyframe_gap) > kf.id()) return true;
+    auto it = map.keyframes().find(id);
+    return it == map.keyframes().end() || it->second->bad();
+  };
+  return accumulate_groups(map, database_.query(kf.bow(), min_score, 0.8, skip));
+}
+
+std::vector<KeyFramePtr> PlaceRecognizer::relocalisation_candidates(const Map& map,
+                                                                    const place::BowVector& bow) const {
+  const auto skip = [&](std::uint64_t id) {
+    auto it = map.keyframes().find(id);
+    return it == map.keyframes().end() || it->second->bad();
+  };
+  return accumulate_groups(map, database_.query(bow, 0.0, 0.8, skip));
+}
+
+}  // namespace pvb::slam
