@@ -95,11 +95,15 @@ PlaceLabels label_place_events(const Trajectory& gt, const std::vector<PlaceEven
   judge(relocalisations, &out.relocalisations, &out.relocalisations_true, &out.relocalisations_false);
   out.revisits = find_revisits(gt, keyframe_t_ns, options);
   for (RevisitEpisode& ep : out.revisits) {
-    const auto inside = [&](const LabelledPlaceEvent& l) {
-      return l.correct && l.event.t_ns >= ep.first_t_ns && l.event.t_ns <= ep.last_t_ns;
+    // A loop closes the episode it is found in; a relocalisation also the
+    // one it leads into (the keyframes after it are made on the old map).
+    const auto lead_ns = static_cast<std::int64_t>(options.relocalisation_lead_s * 1e9);
+    const auto inside = [&](const LabelledPlaceEvent& l, std::int64_t lead) {
+      return l.correct && l.event.t_ns >= ep.first_t_ns - lead && l.event.t_ns <= ep.last_t_ns;
     };
-    ep.closed = std::any_of(out.loops.begin(), out.loops.end(), inside) ||
-                std::any_of(out.relocalisations.begin(), out.relocalisations.end(), inside);
+    ep.closed = std::any_of(out.loops.begin(), out.loops.end(), [&](const auto& l) { return inside(l, 0); }) ||
+                std::any_of(out.relocalisations.begin(), out.relocalisations.end(),
+                            [&](const auto& l) { return inside(l, lead_ns); });
     if (!ep.closed) ++out.loops_missed;
   }
   return out;

@@ -21,6 +21,14 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+/// Nearest-rank quantile q of the values (0 for none).
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
 /// Optical axis (z) of a keyframe in the world frame.
 Eigen::Vector3d optical_axis_w(const KeyFrame& kf) { return kf.T_c_w().linear().row(2).transpose(); }
 
@@ -122,7 +130,9 @@ std::string to_json(const LoopClosingStats& stats) {
          std::to_string(stats.candidates) + ", \"consistent\": " + std::to_string(stats.consistent) +
          ", \"rejected\": " + std::to_string(stats.rejected) +
          ", \"refused_drift\": " + std::to_string(stats.refused_drift) +
-         ", \"refused_ambiguous\": " + std::to_string(stats.refused_ambiguous) + ", \"detect_ms_total\": " +
+         ", \"refused_ambiguous\": " + std::to_string(stats.refused_ambiguous) +
+         ", \"detect_ms_median\": " + num(quantile(stats.detect_ms, 0.5)) +
+         ", \"detect_ms_p95\": " + num(quantile(stats.detect_ms, 0.95)) + ", \"detect_ms_total\": " +
          num(stats.detect_ms_total) + "}";
   return out;
 }
@@ -258,6 +268,7 @@ bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
   {
     std::lock_guard<std::mutex> s(stats_mutex_);
     stats_.detect_ms_total += detect_ms;
+    stats_.detect_ms.push_back(detect_ms);
     if (!consistent.empty()) ++stats_.consistent;
     if (!consistent.empty() && !loop_kf) ++stats_.rejected;
   }

@@ -102,6 +102,11 @@ TEST(PlaceLabels, RevisitEpisodesAndMissedLoops) {
   EXPECT_EQ(reloc.loops_missed, 0);
   EXPECT_EQ(reloc.relocalisations_true, 1);
   EXPECT_TRUE(reloc.revisits[0].closed);
+  // A relocalisation just before the episode leads into it; a loop does not.
+  EXPECT_EQ(label_place_events(gt, {}, {event_between(gt, 39.5, 0)}, kfs, o).loops_missed, 0);
+  EXPECT_EQ(label_place_events(gt, {event_between(gt, 39.5, 0)}, {}, kfs, o).loops_missed, 1);
+  o.relocalisation_lead_s = 0;
+  EXPECT_EQ(label_place_events(gt, {}, {event_between(gt, 39.5, 0)}, kfs, o).loops_missed, 1);
 }
 
 TEST(PlaceLabels, TooRecentOrLookingElsewhereIsNoRevisit) {

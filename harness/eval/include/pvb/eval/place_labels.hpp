@@ -34,6 +34,9 @@ struct PlaceLabelOptions {
   double revisit_radius_m = 1.0;
   double revisit_angle_deg = 30.0;
   double revisit_min_gap_s = 20.0;
+  /// A true relocalisation closes the revisit episode that starts within
+  /// this long after it (tracking goes on in the old map from there).
+  double relocalisation_lead_s = 5.0;
   double max_dt_s = 0.02;  ///< ground truth is looked up this close in time
 };
 
@@ -49,7 +52,7 @@ struct LabelledPlaceEvent {
 struct RevisitEpisode {
   std::int64_t first_t_ns = 0, last_t_ns = 0;
   int keyframes = 0;
-  bool closed = false;  ///< a true loop or a true relocalisation has its query inside it
+  bool closed = false;  ///< a true loop inside it, or a true relocalisation inside it or just before it
 };
 
 struct PlaceLabels {

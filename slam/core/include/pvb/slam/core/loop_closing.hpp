@@ -108,6 +108,7 @@ struct LoopClosingStats {
   int refused_drift = 0;          ///< of those, verified but implausible against the drift bound
   int refused_ambiguous = 0;      ///< of those, verified at two places apart
   double detect_ms_total = 0;     ///< all detection work
+  std::vector<double> detect_ms;  ///< detection and verification per keyframe examined
 };
 
 /// The stats as one JSON object for stats.json / metrics.json:
