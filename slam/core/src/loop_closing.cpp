@@ -81,7 +81,11 @@ LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand,
   LoopMatch out;
   Frame probe = kf.frame();  // a copy: its map_points become the loop-side matches
   std::fill(probe.map_points.begin(), probe.map_points.end(), nullptr);
-  out.initial_matches = search_keyframe_bruteforce(*cand, probe, kThLow, 0.75);
+  // Through the direct index when both have one (ORB-SLAM2 SearchByBoW):
+  // only descriptors under the same vocabulary node are compared.
+  const bool by_bow = !cand->features_by_node().empty() && !kf.features_by_node().empty();
+  out.initial_matches = by_bow ? search_keyframe_by_bow(*cand, probe, kf.features_by_node(), kThLow, 0.75)
+                               : search_keyframe_bruteforce(*cand, probe, kThLow, 0.75);
   if (out.initial_matches < options.min_matches) return out;
 
   // EPnP RANSAC on the loop-side points against the new keyframe's keypoints.
