@@ -155,81 +155,99 @@ int search_local_points(Frame& cur, const std::vector<ProjectedPoint>& points, d
   return n;
 }
 
+namespace {
+
+/// Keyframe-to-frame matches as ORB-SLAM2 keeps them: one per frame
+/// keypoint (the nearest wins), then the orientation check.
+class KeyFrameMatches {
+ public:
+  KeyFrameMatches(const Frame& kff, Frame& cur, int max_distance, double ratio)
+      : kff_(kff), cur_(cur), max_distance_(max_distance), ratio_(ratio),
+        taken_dist_(cur.size(), INT_MAX), taken_by_(cur.size(), -1) {}
+
+  /// Keyframe keypoint i (with a good map point) against the frame keypoints `js` without one.
+  template <typename Indices>
+  void offer(std::size_t i, const Indices& js) {
+    const unsigned char* d_mp = desc_row(kff_.descriptors, i);
+    BestTwo b;
+    for (std::size_t j : js)
+      if (!cur_.map_points[j]) b.offer(descriptor_distance(d_mp, desc_row(cur_.descriptors, j)), j);
+    const std::size_t j = b.best_idx;
+    if (b.best > max_distance_ || (b.second != INT_MAX && b.best >= ratio_ * b.second)) return;
+    if (b.best >= taken_dist_[j]) return;
+    if (taken_by_[j] >= 0) matches_[static_cast<std::size_t>(taken_by_[j])].i1 = SIZE_MAX;
+    taken_dist_[j] = b.best;
+    taken_by_[j] = static_cast<long>(matches_.size());
+    matches_.push_back({i, j});
+    diffs_.push_back(kff_.keys_un[i].angle - cur_.keys_un[j].angle);
+  }
+
+  /// Sets cur's map points of the kept matches; returns how many.
+  int apply() {
+    const std::vector<std::uint8_t> ok = orientation_consistent(diffs_);
+    int n = 0;
+    for (std::size_t k = 0; k < matches_.size(); ++k) {
+      if (!ok[k] || matches_[k].i1 == SIZE_MAX) continue;
+      cur_.map_points[matches_[k].i2] = kff_.map_points[matches_[k].i1];
+      ++n;
+    }
+    return n;
+  }
+
+ private:
+  const Frame& kff_;
+  Frame& cur_;
+  int max_distance_;
+  double ratio_;
+  std::vector<IndexMatch> matches_;
+  std::vector<float> diffs_;
+  std::vector<int> taken_dist_;
+  std::vector<long> taken_by_;
+};
+
+/// 0, 1, ..., n - 1 without storing them.
+struct AllIndices {
+  std::size_t n;
+  struct It {
+    std::size_t v;
+    std::size_t operator*() const { return v; }
+    It& operator++() { return ++v, *this; }
+    bool operator!=(const It& o) const { return v != o.v; }
+  };
+  It begin() const { return {0}; }
+  It end() const { return {n}; }
+};
+
+}  // namespace
+
 int search_keyframe_bruteforce(const KeyFrame& kf, Frame& cur, int max_distance, double ratio) {
   const Frame& kff = kf.frame();
-  std::vector<IndexMatch> matches;
-  std::vector<float> diffs;
-  std::vector<int> taken_dist(cur.size(), INT_MAX);
-  std::vector<long> taken_by(cur.size(), -1);
-  for (std::size_t i = 0; i < kff.size(); ++i) {
-    const auto& mp = kff.map_points[i];
-    if (!mp || mp->bad()) continue;
-    const unsigned char* d_mp = desc_row(kff.descriptors, i);
-    BestTwo b;
-    for (std::size_t j = 0; j < cur.size(); ++j) {
-      if (cur.map_points[j]) continue;
-      b.offer(descriptor_distance(d_mp, desc_row(cur.descriptors, j)), j);
-    }
-    const int best = b.best, second = b.second;
-    const std::size_t best_idx = b.best_idx;
-    if (best > max_distance || (second != INT_MAX && best >= ratio * second)) continue;
-    if (best >= taken_dist[best_idx]) continue;
-    if (taken_by[best_idx] >= 0) matches[static_cast<std::size_t>(taken_by[best_idx])].i1 = SIZE_MAX;
-    taken_dist[best_idx] = best;
-    taken_by[best_idx] = static_cast<long>(matches.size());
-    matches.push_back({i, best_idx});
-    diffs.push_back(kff.keys_un[i].angle - cur.keys_un[best_idx].angle);
-  }
-  const std::vector<std::uint8_t> ok = orientation_consistent(diffs);
-  int n = 0;
-  for (std::size_t k = 0; k < matches.size(); ++k) {
-    if (!ok[k] || matches[k].i1 == SIZE_MAX) continue;
-    cur.map_points[matches[k].i2] = kff.map_points[matches[k].i1];
-    ++n;
-  }
-  return n;
+  KeyFrameMatches m(kff, cur, max_distance, ratio);
+  for (std::size_t i = 0; i < kff.size(); ++i)
+    if (kff.map_points[i] && !kff.map_points[i]->bad()) m.offer(i, AllIndices{cur.size()});
+  return m.apply();
 }
 
 int search_keyframe_by_bow(const KeyFrame& kf, Frame& cur, const place::FeatureVector& cur_features,
                            int max_distance, double ratio) {
   const Frame& kff = kf.frame();
-  std::vector<IndexMatch> matches;
-  std::vector<float> diffs;
-  std::vector<int> taken_dist(cur.size(), INT_MAX);
-  std::vector<long> taken_by(cur.size(), -1);
+  KeyFrameMatches m(kff, cur, max_distance, ratio);
   const place::FeatureVector& kf_features = kf.features_by_node();
   auto a = kf_features.begin();
   auto b = cur_features.begin();
   while (a != kf_features.end() && b != cur_features.end()) {
-    if (a->first < b->first) { ++a; continue; }
-    if (b->first < a->first) { ++b; continue; }
-    for (std::uint32_t i : a->second) {
-      const auto& mp = kff.map_points[i];
-      if (!mp || mp->bad()) continue;
-      const unsigned char* d_mp = desc_row(kff.descriptors, i);
-      BestTwo best2;
-      for (std::uint32_t j : b->second)
-        if (!cur.map_points[j]) best2.offer(descriptor_distance(d_mp, desc_row(cur.descriptors, j)), j);
-      const std::size_t j = best2.best_idx;
-      if (best2.best > max_distance || (best2.second != INT_MAX && best2.best >= ratio * best2.second)) continue;
-      if (best2.best >= taken_dist[j]) continue;
-      if (taken_by[j] >= 0) matches[static_cast<std::size_t>(taken_by[j])].i1 = SIZE_MAX;
-      taken_dist[j] = best2.best;
-      taken_by[j] = static_cast<long>(matches.size());
-      matches.push_back({i, j});
-      diffs.push_back(kff.keys_un[i].angle - cur.keys_un[j].angle);
+    if (a->first < b->first) {
+      ++a;
+    } else if (b->first < a->first) {
+      ++b;
+    } else {
+      for (std::uint32_t i : a->second)
+        if (kff.map_points[i] && !kff.map_points[i]->bad()) m.offer(i, b->second);
+      ++a;
+      ++b;
     }
-    ++a;
-    ++b;
   }
-  const std::vector<std::uint8_t> ok = orientation_consistent(diffs);
-  int n = 0;
-  for (std::size_t k = 0; k < matches.size(); ++k) {
-    if (!ok[k] || matches[k].i1 == SIZE_MAX) continue;
-    cur.map_points[matches[k].i2] = kff.map_points[matches[k].i1];
-    ++n;
-  }
-  return n;
+  return m.apply();
 }
 
 int fuse(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::vector<std::shared_ptr<MapPoint>>& points, double th,
