@@ -439,11 +439,10 @@ std::string SlamRun::stats_json(StopReason stop, const std::string& dense_json) 
   if (system_->loop_closing_enabled()) {
     const slam::LoopClosingStats loops = system_->loop_stats();
     js << ",\n  \"loop_closing\": " << slam::to_json(loops);
-    std::vector<double> detect_ms = loops.detect_ms;
     std::printf("loop closing: %zu loops closed (%d consistent detections, %d refused: %d by the drift bound, "
                 "%d as ambiguous); detection %.2f ms median per keyframe\n",
                 loops.loops.size(), loops.consistent, loops.rejected, loops.refused_drift, loops.refused_ambiguous,
-                percentile(detect_ms, 0.5));
+                percentile(loops.detect_ms, 0.5));
     for (const slam::LoopEvent& e : loops.loops)
       std::printf(
           "  frame %llu (keyframe %llu) -> frame %llu (keyframe %llu): %d inliers, moved %.3f m / %.2f deg, "

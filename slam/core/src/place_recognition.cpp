@@ -52,22 +52,18 @@ std::vector<KeyFramePtr> accumulate_groups(const Map& map, const std::vector<pla
 PlaceRecognizer::PlaceRecognizer(std::shared_ptr<const place::Vocabulary> vocabulary)
     : vocabulary_(std::move(vocabulary)) {}
 
+void PlaceRecognizer::transform(const Frame& f, place::BowVector* bow, place::FeatureVector* features) const {
+  vocabulary_->transform(f.descriptors, bow, features, kDirectIndexLevelsUp);
+}
+
 void PlaceRecognizer::compute_bow(KeyFrame& kf) const {
   place::BowVector bow;
   place::FeatureVector features;
-  vocabulary_->transform(kf.frame().descriptors, &bow, &features, kDirectIndexLevelsUp);
+  transform(kf.frame(), &bow, &features);
   kf.set_bow(std::move(bow), std::move(features));
 }
 
-place::BowVector PlaceRecognizer::bow_of(const Frame& f) const {
-  place::BowVector bow;
-  vocabulary_->transform(f.descriptors, &bow, nullptr, kDirectIndexLevelsUp);
-  return bow;
-}
-
 void PlaceRecognizer::add(const KeyFrame& kf) { database_.add(kf.id(), kf.bow()); }
-
-void PlaceRecognizer::erase(std::uint64_t kf_id) { database_.erase(kf_id); }
 
 std::vector<KeyFramePtr> PlaceRecognizer::loop_candidates(const Map& map, const KeyFrame& kf,
                                                           int min_keyframe_gap) const {

@@ -338,7 +338,7 @@ bool Tracking::relocalize(Frame& f) {
   std::vector<std::shared_ptr<KeyFrame>> cands;
   if (place_) {
     place::BowVector bow;
-    place_->vocabulary().transform(f.descriptors, &bow, &f_features, PlaceRecognizer::kDirectIndexLevelsUp);
+    place_->transform(f, &bow, &f_features);
     cands = place_->relocalisation_candidates(map_, bow);
     if (cands.size() > kMaxRelocCandidates) cands.resize(kMaxRelocCandidates);
   } else {

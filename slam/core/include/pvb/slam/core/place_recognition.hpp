@@ -23,15 +23,13 @@ class PlaceRecognizer {
 
   explicit PlaceRecognizer(std::shared_ptr<const place::Vocabulary> vocabulary);
 
-  const place::Vocabulary& vocabulary() const { return *vocabulary_; }
-  /// The bag of words and direct index of a keyframe's descriptors.
+  /// The bag of words and direct index of a frame's descriptors.
+  void transform(const Frame& f, place::BowVector* bow, place::FeatureVector* features) const;
+  /// The same, stored in the keyframe.
   void compute_bow(KeyFrame& kf) const;
-  /// The bag of words of a frame's descriptors (no direct index).
-  place::BowVector bow_of(const Frame& f) const;
-  /// Adds a keyframe (its bag computed) to the database.
+  /// Adds a keyframe (its bag computed) to the database.  Culled keyframes
+  /// stay in it; queries skip keyframes no longer in the map or bad.
   void add(const KeyFrame& kf);
-  /// Forgets a keyframe (culled).
-  void erase(std::uint64_t kf_id);
 
   /// Loop candidates for `kf` (ORB-SLAM2 DetectLoopCandidates): older by at
   /// least min_keyframe_gap ids, not kf's covisibles, scoring at least the
