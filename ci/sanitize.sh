@@ -10,8 +10,12 @@ cd "$(dirname "$0")/.."
 JOBS="${PVB_JOBS:-$(nproc)}"
 B=build-asan
 
+# The main build's vocabulary, when there is one, instead of training it
+# again with the sanitized pvbench.
+VOCAB="$PWD/build/vocabulary/pvbench_orb.pvbvoc"
+[ -f "$VOCAB" ] && VOCAB_ARG="-DPVB_PREBUILT_VOCABULARY=$VOCAB" || VOCAB_ARG=""
 cmake -S . -B "$B" -DCMAKE_BUILD_TYPE=Release -DPVB_SANITIZE=address,undefined -DPVB_BUILD_BENCHMARKS=OFF \
-  -DCMAKE_CXX_FLAGS_RELEASE="-O1 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELEASE="-O1 -g1 -DNDEBUG" ${PVB_CMAKE_ARGS:-}
+  -DCMAKE_CXX_FLAGS_RELEASE="-O1 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELEASE="-O1 -g1 -DNDEBUG" $VOCAB_ARG ${PVB_CMAKE_ARGS:-}
 cmake --build "$B" -j "$JOBS"
 
 S="$PWD/ci/sanitizers"

@@ -93,10 +93,16 @@ void add_scenario(const std::string& file, const std::vector<std::uint64_t>& see
     s.seed = seed;
     sim::SimFrameSource source(s, sim::parse_gl_backend(o.gl), o.frames);
     ProgressBar bar("vocab " + s.name + " seed " + std::to_string(seed), source.size_hint());
-    int i = 0;
-    while (auto frame = source.next()) {
-      if (i % o.every == 0) c->add(frame->rgb);
-      bar.update(static_cast<std::size_t>(++i));
+    // Only the frames used are rendered; the others advance the physics.
+    for (int i = 0;; ++i) {
+      if (i % o.every != 0) {
+        if (!source.skip()) break;
+      } else if (auto frame = source.next()) {
+        c->add(frame->rgb);
+      } else {
+        break;
+      }
+      bar.update(static_cast<std::size_t>(i + 1));
     }
     bar.finish();
   }

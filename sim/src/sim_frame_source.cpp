@@ -23,6 +23,13 @@ std::optional<RenderedFrame> SimFrameSource::next_rendered() {
   return rendered;
 }
 
+bool SimFrameSource::skip() {
+  if (next_index_ >= frames_) return false;
+  if (next_index_ > 0) sim_.advance();
+  ++next_index_;
+  return true;
+}
+
 std::optional<sensor::RgbdFrame> SimFrameSource::next() {
   std::optional<RenderedFrame> rendered = next_rendered();
   if (!rendered) return std::nullopt;

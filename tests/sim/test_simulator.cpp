@@ -219,6 +219,39 @@ TEST(SimFrameSource, StreamsFramesWithGroundTruthThroughItsOwnSink) {
 
 // The run's pipeline renders on one thread and applies the sensor model on
 // another: that must give exactly the frames next() gives, noise included.
+TEST(SimFrameSource, SkippedFramesLeaveTheOthersAsNextGivesThem) {
+  scenes::Scenario s = wall_scenario();
+  s.camera.depth_noise.model = scenes::DepthNoiseModel::kKinect;
+  s.camera.rgb.sigma = 2.0;
+  constexpr int kFrames = 5;
+  std::vector<sensor::RgbdFrame> all;
+  {
+    sim::SimFrameSource src(s, sim::GlBackend::kAuto, kFrames);
+    while (auto f = src.next()) all.push_back(*f);
+  }
+  ASSERT_EQ(all.size(), static_cast<std::size_t>(kFrames));
+  std::vector<sensor::RgbdFrame> every_other;
+  {
+    sim::SimFrameSource src(s, sim::GlBackend::kAuto, kFrames);
+    for (int i = 0; i < kFrames; ++i) {
+      if (i % 2 == 1) {
+        EXPECT_TRUE(src.skip());
+      } else if (auto f = src.next()) {
+        every_other.push_back(*f);
+      }
+    }
+    EXPECT_FALSE(src.skip());  // past the last frame
+  }
+  ASSERT_EQ(every_other.size(), 3u);
+  for (std::size_t k = 0; k < every_other.size(); ++k) {
+    const sensor::RgbdFrame& want = all[2 * k];
+    EXPECT_EQ(every_other[k].index, want.index);
+    EXPECT_EQ(every_other[k].t_ns, want.t_ns);
+    EXPECT_EQ(cv::norm(every_other[k].rgb, want.rgb, cv::NORM_INF), 0.0) << "frame " << 2 * k;
+    EXPECT_EQ(cv::norm(every_other[k].depth_m, want.depth_m, cv::NORM_INF), 0.0) << "frame " << 2 * k;
+  }
+}
+
 TEST(SimFrameSource, SensorModelOnAnotherThreadGivesTheFramesOfNext) {
   scenes::Scenario s = wall_scenario();
   s.camera.depth_noise.model = scenes::DepthNoiseModel::kKinect;

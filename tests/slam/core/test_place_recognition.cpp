@@ -1,5 +1,4 @@
-// Place recognition with the shipped vocabulary on real Kinect images and on
-// the direct-index matcher.
+// The default vocabulary on real Kinect images.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>

@@ -378,7 +378,7 @@ TEST(Settings, DocumentMarkerMustStandAlone) {
 TEST(Settings, MissingFileIsAnIoError) { EXPECT_THROW(read_settings("/nonexistent/settings.yaml"), IoError); }
 
 TEST(Settings, ReadsPlaceRecognitionKeys) {
-  const Settings d = read_settings(kTum1);  // absent: the shipped vocabulary, BoW loops, both checks on
+  const Settings d = read_settings(kTum1);  // absent: the default vocabulary, BoW loops, both checks on
   EXPECT_EQ(d.vocabulary_path, kDefaultVocabularyPath);
   EXPECT_FALSE(d.loop.pose_proximity);
   EXPECT_TRUE(d.loop.ambiguity_check);

@@ -27,6 +27,11 @@ class SimFrameSource : public sensor::FrameSource {
   /// truth to the sink, without the sensor model.  For pipelines that run
   /// sensor_model().apply() on another thread; next() is both halves.
   std::optional<RenderedFrame> next_rendered();
+  /// Advances the physics by one camera period without rendering, for
+  /// frames a consumer does not use (no ground truth goes to the sink).
+  /// The frames after it are those next() would have given: the sensor
+  /// noise is seeded per frame.  False after the last frame.
+  bool skip();
   const SensorModel& sensor_model() const { return camera_.sensor_model(); }
   std::size_t size_hint() const override { return static_cast<std::size_t>(frames_); }
   std::string describe() const override;

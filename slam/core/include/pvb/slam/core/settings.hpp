@@ -67,7 +67,7 @@ struct PointCloudMappingSettings {
   double max_depth_m = 4.0;    ///< PointCloudMapping.MaxDepth, metres
 };
 
-/// The vocabulary shipped with the project (docs/place_recognition.md).
+/// The default vocabulary, trained by the build (docs/place_recognition.md).
 inline constexpr const char* kDefaultVocabularyPath = PVB_DEFAULT_VOCABULARY;
 
 /// Everything the SLAM system reads from its settings file.
