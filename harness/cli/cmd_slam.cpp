@@ -443,6 +443,10 @@ std::string SlamRun::stats_json(StopReason stop, const std::string& dense_json) 
                 "%d as ambiguous); detection %.2f ms median per keyframe\n",
                 loops.loops.size(), loops.consistent, loops.rejected, loops.refused_drift, loops.refused_ambiguous,
                 percentile(loops.detect_ms, 0.5));
+    std::printf("  %d candidates verified: refused %d at the descriptor matches, %d at RANSAC, %d after the guided "
+                "search, %d by the correction bound; verification %.0f of %.0f ms\n",
+                loops.verified, loops.refused_matches, loops.refused_ransac, loops.refused_inliers,
+                loops.refused_correction, loops.verify_ms_total, loops.detect_ms_total);
     for (const slam::LoopEvent& e : loops.loops)
       std::printf(
           "  frame %llu (keyframe %llu) -> frame %llu (keyframe %llu): %d inliers, moved %.3f m / %.2f deg, "

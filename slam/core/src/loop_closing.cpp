@@ -1,6 +1,7 @@
 #include "pvb/slam/core/loop_closing.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -87,11 +88,13 @@ LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand,
   out.initial_matches = by_bow ? search_keyframe_by_bow(*cand, probe, kf.features_by_node(), kThLow, 0.75)
                                : search_keyframe_bruteforce(*cand, probe, kThLow, 0.75);
   if (out.initial_matches < options.min_matches) return out;
+  out.stage = LoopMatch::Stage::kRansac;
 
   // EPnP RANSAC on the loop-side points against the new keyframe's keypoints.
   out.ransac_inliers = pnp_ransac_on_matches(probe, options.min_matches / 2);
   if (out.ransac_inliers < options.min_matches / 2) return out;
   if (optimize_and_prune(probe) < options.min_matches / 2) return out;
+  out.stage = LoopMatch::Stage::kInliers;
 
   // Guided search: the points of the candidate and its covisibles, projected
   // with the verified pose (ORB-SLAM2 SearchByProjection of mvpLoopMapPoints).
@@ -112,6 +115,7 @@ LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand,
   out.T_c_w = probe.T_c_w;
   out.points = probe.map_points;
   out.accepted = out.inliers >= options.min_inliers;
+  if (out.accepted) out.stage = LoopMatch::Stage::kAccepted;
   return out;
 }
 
@@ -135,6 +139,12 @@ std::string to_json(const LoopClosingStats& stats) {
          ", \"rejected\": " + std::to_string(stats.rejected) +
          ", \"refused_drift\": " + std::to_string(stats.refused_drift) +
          ", \"refused_ambiguous\": " + std::to_string(stats.refused_ambiguous) +
+         ", \"verified\": " + std::to_string(stats.verified) +
+         ", \"refused_matches\": " + std::to_string(stats.refused_matches) +
+         ", \"refused_ransac\": " + std::to_string(stats.refused_ransac) +
+         ", \"refused_inliers\": " + std::to_string(stats.refused_inliers) +
+         ", \"refused_correction\": " + std::to_string(stats.refused_correction) +
+         ", \"verify_ms_total\": " + num(stats.verify_ms_total) +
          ", \"detect_ms_median\": " + num(quantile(stats.detect_ms, 0.5)) +
          ", \"detect_ms_p95\": " + num(quantile(stats.detect_ms, 0.95)) + ", \"detect_ms_total\": " +
          num(stats.detect_ms_total) + "}";
@@ -221,12 +231,22 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
   std::shared_ptr<KeyFrame> loop_kf;
   std::vector<Eigen::Vector3d> verified_centres_w;
   int drift = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::array<int, 5> refused{};  // by LoopMatch::Stage, then the correction bound
+  int verified = 0;
   for (const auto& cand : consistent) {
+    ++verified;
     LoopMatch m = verify_loop(*kf, cand, options_);
-    if (!m.accepted) continue;
+    if (!m.accepted) {
+      ++refused[static_cast<std::size_t>(m.stage)];
+      continue;
+    }
     double dist_m = 0, angle_deg = 0;
     pose_difference(m.T_c_w, kf->T_c_w(), &dist_m, &angle_deg);
-    if (dist_m > options_.max_correction_m || angle_deg > options_.max_correction_deg) continue;
+    if (dist_m > options_.max_correction_m || angle_deg > options_.max_correction_deg) {
+      ++refused[4];
+      continue;
+    }
     verified_centres_w.push_back(m.T_c_w.inverse().translation());
     const double bound_m = options_.drift_floor_m + options_.max_drift_rate * path_length_m(cand->id(), kf->id());
     if (options_.max_drift_rate > 0 && dist_m > bound_m) {
@@ -244,6 +264,12 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
     for (std::size_t j = i + 1; j < verified_centres_w.size(); ++j)
       ambiguous = ambiguous || (verified_centres_w[i] - verified_centres_w[j]).norm() > options_.ambiguity_distance_m;
   std::lock_guard<std::mutex> s(stats_mutex_);
+  stats_.verified += verified;
+  stats_.refused_matches += refused[0];
+  stats_.refused_ransac += refused[1];
+  stats_.refused_inliers += refused[2];
+  stats_.refused_correction += refused[4];
+  stats_.verify_ms_total += ms_since(t0);
   if (ambiguous) {
     ++stats_.refused_ambiguous;
     return nullptr;

@@ -151,6 +151,7 @@ TEST(LoopVerification, AcceptsTrueRevisitAndFindsTheTruePose) {
   ASSERT_GT(centre_error_m(kf1->T_c_w(), T_true), 0.03);
   const LoopMatch m = verify_loop(*kf1, kf0, test_options());
   EXPECT_TRUE(m.accepted);
+  EXPECT_EQ(m.stage, LoopMatch::Stage::kAccepted);
   EXPECT_GE(m.inliers, 100);
   EXPECT_LT(centre_error_m(m.T_c_w, T_true), 0.005);
   EXPECT_LT(geom::rotation_angle_rad(m.T_c_w.linear() * T_true.linear().transpose()) * 180 / M_PI, 0.3);
@@ -165,6 +166,7 @@ TEST(LoopVerification, RejectsAWrongPlaceAtTheSameEstimatedPose) {
   ASSERT_EQ(pose_candidates(map, *kf1, test_options()).size(), 1u);  // close enough to be a candidate
   const LoopMatch m = verify_loop(*kf1, kf0, test_options());
   EXPECT_FALSE(m.accepted);
+  EXPECT_NE(m.stage, LoopMatch::Stage::kAccepted);
   EXPECT_LT(m.inliers, 40);
 
   LoopClosingOptions o = test_options();
@@ -172,6 +174,27 @@ TEST(LoopVerification, RejectsAWrongPlaceAtTheSameEstimatedPose) {
   LoopClosing lc(map, o);
   EXPECT_FALSE(lc.process(kf1));
   EXPECT_TRUE(lc.stats().loops.empty());
+}
+
+TEST(LoopClosing, CountsAVerifiedPlaceBeyondTheCorrectionBound) {
+  Map map;
+  const cv::Mat tex = make_texture(1);
+  add_keyframe(map, tex, pose(0, 0, 0), pose(0, 0, 0));
+  const geom::SE3d T = pose(3, 0.10, 0);
+  auto kf1 = add_keyframe(map, tex, T, drifted(T));
+  LoopClosingOptions o = test_options();
+  o.consistency = 1;
+  o.max_correction_m = 0.001;  // smaller than the drift the verification corrects
+  LoopClosing lc(map, o);
+  EXPECT_FALSE(lc.process(kf1));  // a first detection: not consistent yet
+  EXPECT_EQ(lc.stats().verified, 0);
+  EXPECT_FALSE(lc.process(kf1));  // detected again: verified, then refused by the bound
+  const LoopClosingStats s = lc.stats();
+  EXPECT_TRUE(s.loops.empty());
+  EXPECT_EQ(s.verified, 1);
+  EXPECT_EQ(s.refused_correction, 1);
+  EXPECT_EQ(s.refused_matches + s.refused_ransac + s.refused_inliers, 0);
+  EXPECT_EQ(s.rejected, 1);
 }
 
 TEST(LoopClosing, ClosesOnlyAfterConsistentDetectionsAndRemovesTheDrift) {

@@ -1,6 +1,6 @@
 #pragma once
 // Loop closing for RGB-D (ORB-SLAM2 LoopClosing with the scale known: SE(3)
-// instead of Sim(3), and no bag of words).  Runs after local mapping has
+// instead of Sim(3)).  Runs after local mapping has
 // processed a keyframe, on the same thread (the local-mapping worker, or
 // inline in synchronous mode), holding the map mutex:
 //
@@ -107,6 +107,13 @@ struct LoopClosingStats {
   int rejected = 0;               ///< consistent detections refused by geometry or the correction bound
   int refused_drift = 0;          ///< of those, verified but implausible against the drift bound
   int refused_ambiguous = 0;      ///< of those, verified at two places apart
+  /// Per candidate verified (step 3), the stage that refused it.
+  int verified = 0;               ///< candidates verified
+  int refused_matches = 0;        ///< fewer than min_matches descriptor matches
+  int refused_ransac = 0;         ///< too few EPnP RANSAC / pose-optimisation inliers
+  int refused_inliers = 0;        ///< fewer than min_inliers after the guided search
+  int refused_correction = 0;     ///< a correction over max_correction_m / max_correction_deg
+  double verify_ms_total = 0;     ///< the part of detect_ms_total spent in step 3
   double detect_ms_total = 0;     ///< all detection work
   std::vector<double> detect_ms;  ///< detection and verification per keyframe examined
 };
@@ -120,6 +127,9 @@ std::string to_json(const LoopClosingStats& stats);
 
 /// Result of the geometric verification of one candidate.
 struct LoopMatch {
+  /// How far the verification got: the stage that refused the candidate, or kAccepted.
+  enum class Stage { kMatches, kRansac, kInliers, kAccepted };
+  Stage stage = Stage::kMatches;
   bool accepted = false;
   geom::SE3d T_c_w;  ///< the new keyframe's pose in the candidate's map frame
   /// Per keypoint of the new keyframe: the matched loop-side point (inliers only), or null.
