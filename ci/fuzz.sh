@@ -12,7 +12,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH="${1:-60}"
 shift || true
-ALL=(fuzz_settings fuzz_scenario fuzz_tum_trajectory fuzz_tum_lists fuzz_oni fuzz_metrics)
+ALL=(fuzz_settings fuzz_scenario fuzz_tum_trajectory fuzz_tum_lists fuzz_oni fuzz_metrics fuzz_vocabulary)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -gt 0 ] || TARGETS=("${ALL[@]}")
 JOBS="${PVB_JOBS:-$(nproc)}"
@@ -34,6 +34,7 @@ seeds_of() {
     fuzz_tum_lists) echo tests/fuzz/corpus/tum_lists ;;
     fuzz_oni) echo tests/fuzz/corpus/oni ;;
     fuzz_metrics) echo tests/harness/suite/fixtures ;;
+    fuzz_vocabulary) echo tests/fuzz/corpus/vocabulary ;;
   esac
 }
 
