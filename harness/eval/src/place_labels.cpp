@@ -94,16 +94,20 @@ PlaceLabels label_place_events(const Trajectory& gt, const std::vector<PlaceEven
   judge(loops, &out.loops, &out.loops_true, &out.loops_false);
   judge(relocalisations, &out.relocalisations, &out.relocalisations_true, &out.relocalisations_false);
   out.revisits = find_revisits(gt, keyframe_t_ns, options);
+  const auto lead_ns = static_cast<std::int64_t>(options.relocalisation_lead_s * 1e9);
   for (RevisitEpisode& ep : out.revisits) {
     // A loop closes the episode it is found in; a relocalisation also the
-    // one it leads into (the keyframes after it are made on the old map).
-    const auto lead_ns = static_cast<std::int64_t>(options.relocalisation_lead_s * 1e9);
+    // one it leads into: the keyframes after it are made on the old map.
     const auto inside = [&](const LabelledPlaceEvent& l, std::int64_t lead) {
       return l.correct && l.event.t_ns >= ep.first_t_ns - lead && l.event.t_ns <= ep.last_t_ns;
     };
+    const auto leads_into = [&](const LabelledPlaceEvent& l) {
+      if (inside(l, lead_ns)) return true;
+      const auto next = std::upper_bound(keyframe_t_ns.begin(), keyframe_t_ns.end(), l.event.t_ns);
+      return l.correct && next != keyframe_t_ns.end() && *next == ep.first_t_ns;
+    };
     ep.closed = std::any_of(out.loops.begin(), out.loops.end(), [&](const auto& l) { return inside(l, 0); }) ||
-                std::any_of(out.relocalisations.begin(), out.relocalisations.end(),
-                            [&](const auto& l) { return inside(l, lead_ns); });
+                std::any_of(out.relocalisations.begin(), out.relocalisations.end(), leads_into);
     if (!ep.closed) ++out.loops_missed;
   }
   return out;

@@ -105,8 +105,29 @@ TEST(PlaceLabels, RevisitEpisodesAndMissedLoops) {
   // A relocalisation just before the episode leads into it; a loop does not.
   EXPECT_EQ(label_place_events(gt, {}, {event_between(gt, 39.5, 0)}, kfs, o).loops_missed, 0);
   EXPECT_EQ(label_place_events(gt, {event_between(gt, 39.5, 0)}, {}, kfs, o).loops_missed, 1);
+  // Without the lead, only when the next keyframe starts the episode
+  // (39.5 s: the next is 40 s; 38.5 s: the next, 39 s, is no revisit).
   o.relocalisation_lead_s = 0;
-  EXPECT_EQ(label_place_events(gt, {}, {event_between(gt, 39.5, 0)}, kfs, o).loops_missed, 1);
+  EXPECT_EQ(label_place_events(gt, {}, {event_between(gt, 39.5, 0)}, kfs, o).loops_missed, 0);
+  EXPECT_EQ(label_place_events(gt, {}, {event_between(gt, 38.5, 0)}, kfs, o).loops_missed, 1);
+}
+
+TEST(PlaceLabels, ARelocalisationClosesTheEpisodeOfItsNextKeyframeHoweverLate) {
+  const Trajectory gt = out_and_back();
+  // Relocalised at 30 s; tracking then made no keyframe until the
+  // episode's first, 10 s later (beyond the 5 s lead).
+  std::vector<std::int64_t> kfs;
+  for (int s = 0; s < 60; ++s)
+    if (s < 30 || s >= 40) kfs.push_back(s * kSecond);
+  PlaceLabelOptions o;
+  ASSERT_EQ(find_revisits(gt, kfs, o).at(0).first_t_ns, 40 * kSecond);
+  EXPECT_EQ(label_place_events(gt, {}, {event_between(gt, 30, 0)}, kfs, o).loops_missed, 0);
+  // A keyframe made in between (elsewhere): the episode is not its to close.
+  kfs.insert(kfs.begin() + 30, 35 * kSecond);
+  EXPECT_EQ(label_place_events(gt, {}, {event_between(gt, 30, 0)}, kfs, o).loops_missed, 1);
+  // A false relocalisation closes nothing.
+  kfs.erase(kfs.begin() + 30);
+  EXPECT_EQ(label_place_events(gt, {}, {event_between(gt, 30, 0, 1.0)}, kfs, o).loops_missed, 1);
 }
 
 TEST(PlaceLabels, TooRecentOrLookingElsewhereIsNoRevisit) {

@@ -35,7 +35,9 @@ struct PlaceLabelOptions {
   double revisit_angle_deg = 30.0;
   double revisit_min_gap_s = 20.0;
   /// A true relocalisation closes the revisit episode that starts within
-  /// this long after it (tracking goes on in the old map from there).
+  /// this long after it, or at the first keyframe after it however late
+  /// (tracking goes on in the old map from there, and made no keyframe
+  /// elsewhere in between).
   double relocalisation_lead_s = 5.0;
   double max_dt_s = 0.02;  ///< ground truth is looked up this close in time
 };
