@@ -1,25 +1,28 @@
 #include "pvb/slam/place/database.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace pvb::slam::place {
 namespace {
 
-/// Removes `id` from an ascending list (no-op when absent).
-void remove_sorted(std::vector<std::uint64_t>& ids, std::uint64_t id) {
-  const auto it = std::lower_bound(ids.begin(), ids.end(), id);
-  if (it != ids.end() && *it == id) ids.erase(it);
+bool by_id(const Database::Posting& p, std::uint64_t id) { return p.id < id; }
+
+/// Removes `id` from a list in ascending ids (no-op when absent).
+void remove_sorted(std::vector<Database::Posting>& list, std::uint64_t id) {
+  const auto it = std::lower_bound(list.begin(), list.end(), id, by_id);
+  if (it != list.end() && it->id == id) list.erase(it);
 }
 
-/// Inserts `id` into an ascending list; keyframes come with growing ids, so
-/// this is mostly an append.
-void insert_sorted(std::vector<std::uint64_t>& ids, std::uint64_t id) {
-  if (ids.empty() || ids.back() < id) {
-    ids.push_back(id);
+/// Inserts a posting into a list in ascending ids; keyframes come with
+/// growing ids, so this is mostly an append.
+void insert_sorted(std::vector<Database::Posting>& list, Database::Posting p) {
+  if (list.empty() || list.back().id < p.id) {
+    list.push_back(p);
     return;
   }
-  const auto it = std::lower_bound(ids.begin(), ids.end(), id);
-  if (it == ids.end() || *it != id) ids.insert(it, id);
+  const auto it = std::lower_bound(list.begin(), list.end(), p.id, by_id);
+  if (it == list.end() || it->id != p.id) list.insert(it, p);
 }
 
 }  // namespace
@@ -33,7 +36,7 @@ void Database::add(std::uint64_t id, const BowVector& bow) {
       if (ids.empty()) inverted_.erase(word);
     }
   }
-  for (const auto& [word, w] : bow) insert_sorted(inverted_[word], id);
+  for (const auto& [word, w] : bow) insert_sorted(inverted_[word], {id, w});
   bows_[id] = bow;
 }
 
@@ -58,27 +61,34 @@ std::size_t Database::size() const {
 std::vector<Candidate> Database::query(const BowVector& query, double min_score, double min_common_ratio,
                                        const std::function<bool(std::uint64_t)>& skip) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  // Words in common per keyframe; -1 marks a skipped one, so that skip() is
-  // asked once per keyframe.
-  std::unordered_map<std::uint64_t, int> common;
-  for (const auto& [word, w] : query) {
+  // Per keyframe: words in common (-1: skipped, so that skip() is asked
+  // once per keyframe) and Vocabulary::score's sum, term by term in the
+  // same ascending word order, so the score is the same double.
+  struct Tally {
+    int common = 0;
+    double sum = 0;
+  };
+  std::unordered_map<std::uint64_t, Tally> tally;
+  for (const auto& [word, x] : query) {
     const auto list = inverted_.find(word);
     if (list == inverted_.end()) continue;
-    for (const std::uint64_t id : list->second) {
-      auto [it, inserted] = common.try_emplace(id, 0);
-      if (inserted && skip && skip(id)) it->second = -1;
-      if (it->second >= 0) ++it->second;
+    for (const Posting& p : list->second) {
+      auto [it, inserted] = tally.try_emplace(p.id);
+      if (inserted && skip && skip(p.id)) it->second.common = -1;
+      if (it->second.common < 0) continue;
+      ++it->second.common;
+      it->second.sum += std::fabs(x - p.weight) - std::fabs(x) - std::fabs(p.weight);
     }
   }
   int max_common = 0;
-  for (const auto& [id, n] : common) max_common = std::max(max_common, n);
+  for (const auto& [id, t] : tally) max_common = std::max(max_common, t.common);
   std::vector<Candidate> out;
   if (max_common == 0) return out;
   const double min_common = min_common_ratio * max_common;
-  for (const auto& [id, n] : common) {
-    if (n <= 0 || n < min_common) continue;
-    const double s = Vocabulary::score(query, bows_.at(id));
-    if (s >= min_score) out.push_back({id, n, s});
+  for (const auto& [id, t] : tally) {
+    if (t.common <= 0 || t.common < min_common) continue;
+    const double s = 0.0 - 0.5 * t.sum;  // as Vocabulary::score
+    if (s >= min_score) out.push_back({id, t.common, s});
   }
   std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) {
     return a.score != b.score ? a.score > b.score : a.id < b.id;
@@ -88,8 +98,10 @@ std::vector<Candidate> Database::query(const BowVector& query, double min_score,
 
 std::vector<std::uint64_t> Database::keyframes_with(WordId word) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  const auto it = inverted_.find(word);
-  return it == inverted_.end() ? std::vector<std::uint64_t>{} : it->second;
+  std::vector<std::uint64_t> ids;
+  if (const auto it = inverted_.find(word); it != inverted_.end())
+    for (const Posting& p : it->second) ids.push_back(p.id);
+  return ids;
 }
 
 }  // namespace pvb::slam::place

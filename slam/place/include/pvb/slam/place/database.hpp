@@ -1,7 +1,8 @@
 #pragma once
 // The keyframe database: an inverted index from words to the keyframes
-// (by id) whose bag of words holds them, with each keyframe's bag kept for
-// scoring.  The first two steps of ORB-SLAM2's DetectLoopCandidates /
+// (by id) whose bag of words holds them, with the word's weight in each
+// (the score is summed while the lists are walked), and each keyframe's
+// bag kept for replacing or erasing it.  The first two steps of ORB-SLAM2's DetectLoopCandidates /
 // DetectRelocalizationCandidates: keyframes sharing words with a query,
 // those sharing at least `min_common_ratio` of the most shared words,
 // scored; covisibility accumulation is the caller's (it owns the graph).
@@ -24,6 +25,13 @@ struct Candidate {
 
 class Database {
  public:
+  /// One keyframe under a word, with the word's weight in its bag: query()
+  /// scores while it walks the lists, as DBoW2's database does, instead of
+  /// merging two bags per keyframe.
+  struct Posting {
+    std::uint64_t id;
+    double weight;
+  };
   /// Adds (or replaces) a keyframe's bag.
   void add(std::uint64_t id, const BowVector& bow);
   /// Removes a keyframe (no-op when absent).
@@ -42,8 +50,8 @@ class Database {
 
  private:
   mutable std::mutex mutex_;
-  std::unordered_map<WordId, std::vector<std::uint64_t>> inverted_;  ///< word -> keyframe ids
-  std::unordered_map<std::uint64_t, BowVector> bows_;                ///< keyframe id -> bag
+  std::unordered_map<WordId, std::vector<Posting>> inverted_;  ///< word -> keyframes, ascending ids
+  std::unordered_map<std::uint64_t, BowVector> bows_;          ///< keyframe id -> bag
 };
 
 }  // namespace pvb::slam::place
