@@ -189,8 +189,8 @@ const std::string& saved(int which) {
   return big.path;
 }
 
-void BM_LoadBinary(benchmark::State& state) {
-  const std::string& path = saved(static_cast<int>(state.range(0)));
+/// Loads `path` once per iteration; the node count as a counter.
+void load_repeatedly(benchmark::State& state, const std::string& path) {
   std::size_t nodes = 0;
   for (auto _ : state) {
     const pl::Vocabulary v = pl::Vocabulary::load(path);
@@ -199,18 +199,12 @@ void BM_LoadBinary(benchmark::State& state) {
   }
   state.counters["nodes"] = static_cast<double>(nodes);
 }
+
+void BM_LoadBinary(benchmark::State& state) { load_repeatedly(state, saved(static_cast<int>(state.range(0)))); }
 BENCHMARK(BM_LoadBinary)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 /// The default vocabulary (trained at build time), as every run loads it.
-void BM_LoadDefault(benchmark::State& state) {
-  std::size_t nodes = 0;
-  for (auto _ : state) {
-    const pl::Vocabulary v = pl::Vocabulary::load(PVB_DEFAULT_VOCABULARY_FILE);
-    nodes = v.node_count();
-    benchmark::DoNotOptimize(nodes);
-  }
-  state.counters["nodes"] = static_cast<double>(nodes);
-}
+void BM_LoadDefault(benchmark::State& state) { load_repeatedly(state, PVB_DEFAULT_VOCABULARY_FILE); }
 BENCHMARK(BM_LoadDefault)->Unit(benchmark::kMillisecond);
 
 /// Training from scratch: range(0) = 0 on the corpus, 1 on the corpus with

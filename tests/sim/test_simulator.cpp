@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <thread>
+#include <vector>
 
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sensor/depth_encoding.hpp"
@@ -51,6 +52,31 @@ kidnap: {at_s: 1.5, covered_s: 0.4, to_route_s: 0.5}
 /// Rotation angle between two poses, radians.
 double angle_between(const geom::SE3d& a, const geom::SE3d& b) {
   return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
+}
+
+/// The wall scenario with Kinect depth noise and colour noise on.
+scenes::Scenario noisy_wall_scenario() {
+  scenes::Scenario s = wall_scenario();
+  s.camera.depth_noise.model = scenes::DepthNoiseModel::kKinect;
+  s.camera.rgb.sigma = 2.0;
+  return s;
+}
+
+/// Every frame next() gives, from a source of its own (one at a time: a
+/// renderer draws in the context made current last).
+std::vector<sensor::RgbdFrame> all_frames(const scenes::Scenario& s, int frames) {
+  std::vector<sensor::RgbdFrame> out;
+  sim::SimFrameSource src(s, sim::GlBackend::kAuto, frames);
+  while (auto f = src.next()) out.push_back(*f);
+  return out;
+}
+
+/// The same frame: index, time and every pixel of colour and depth.
+void expect_same_frame(const sensor::RgbdFrame& got, const sensor::RgbdFrame& want) {
+  EXPECT_EQ(got.index, want.index);
+  EXPECT_EQ(got.t_ns, want.t_ns);
+  EXPECT_EQ(cv::norm(got.rgb, want.rgb, cv::NORM_INF), 0.0) << "frame " << want.index;
+  EXPECT_EQ(cv::norm(got.depth_m, want.depth_m, cv::NORM_INF), 0.0) << "frame " << want.index;
 }
 
 }  // namespace
@@ -217,18 +243,12 @@ TEST(SimFrameSource, StreamsFramesWithGroundTruthThroughItsOwnSink) {
   EXPECT_NE(src.describe().find("sim:wall_test"), std::string::npos);
 }
 
-// The run's pipeline renders on one thread and applies the sensor model on
-// another: that must give exactly the frames next() gives, noise included.
+// pvbench vocab renders only the frames it uses: skip() advances the
+// physics without rendering, and the frames rendered are those next() gives.
 TEST(SimFrameSource, SkippedFramesLeaveTheOthersAsNextGivesThem) {
-  scenes::Scenario s = wall_scenario();
-  s.camera.depth_noise.model = scenes::DepthNoiseModel::kKinect;
-  s.camera.rgb.sigma = 2.0;
+  const scenes::Scenario s = noisy_wall_scenario();
   constexpr int kFrames = 5;
-  std::vector<sensor::RgbdFrame> all;
-  {
-    sim::SimFrameSource src(s, sim::GlBackend::kAuto, kFrames);
-    while (auto f = src.next()) all.push_back(*f);
-  }
+  const std::vector<sensor::RgbdFrame> all = all_frames(s, kFrames);
   ASSERT_EQ(all.size(), static_cast<std::size_t>(kFrames));
   std::vector<sensor::RgbdFrame> every_other;
   {
@@ -243,26 +263,15 @@ TEST(SimFrameSource, SkippedFramesLeaveTheOthersAsNextGivesThem) {
     EXPECT_FALSE(src.skip());  // past the last frame
   }
   ASSERT_EQ(every_other.size(), 3u);
-  for (std::size_t k = 0; k < every_other.size(); ++k) {
-    const sensor::RgbdFrame& want = all[2 * k];
-    EXPECT_EQ(every_other[k].index, want.index);
-    EXPECT_EQ(every_other[k].t_ns, want.t_ns);
-    EXPECT_EQ(cv::norm(every_other[k].rgb, want.rgb, cv::NORM_INF), 0.0) << "frame " << 2 * k;
-    EXPECT_EQ(cv::norm(every_other[k].depth_m, want.depth_m, cv::NORM_INF), 0.0) << "frame " << 2 * k;
-  }
+  for (std::size_t k = 0; k < every_other.size(); ++k) expect_same_frame(every_other[k], all[2 * k]);
 }
 
+// The run's pipeline renders on one thread and applies the sensor model on
+// another: that must give exactly the frames next() gives, noise included.
 TEST(SimFrameSource, SensorModelOnAnotherThreadGivesTheFramesOfNext) {
-  scenes::Scenario s = wall_scenario();
-  s.camera.depth_noise.model = scenes::DepthNoiseModel::kKinect;
-  s.camera.rgb.sigma = 2.0;
+  const scenes::Scenario s = noisy_wall_scenario();
   constexpr int kFrames = 4;
-  std::vector<sensor::RgbdFrame> direct;
-  {
-    // One source at a time: a renderer draws in the context made current last.
-    sim::SimFrameSource src(s, sim::GlBackend::kAuto, kFrames);
-    while (auto f = src.next()) direct.push_back(*f);
-  }
+  const std::vector<sensor::RgbdFrame> direct = all_frames(s, kFrames);
   std::vector<geom::StampedPose> gt;
   std::vector<sim::RenderedFrame> rendered;
   std::optional<sim::SensorModel> model;
@@ -281,11 +290,8 @@ TEST(SimFrameSource, SensorModelOnAnotherThreadGivesTheFramesOfNext) {
   worker.join();
   ASSERT_EQ(split.size(), direct.size());
   for (std::size_t i = 0; i < split.size(); ++i) {
-    EXPECT_EQ(split[i].index, direct[i].index);
-    EXPECT_EQ(split[i].t_ns, direct[i].t_ns);
+    expect_same_frame(split[i], direct[i]);
     EXPECT_EQ(split[i].t_ns, gt[i].t_ns);
-    EXPECT_EQ(cv::norm(split[i].rgb, direct[i].rgb, cv::NORM_INF), 0.0) << "frame " << i;
-    EXPECT_EQ(cv::norm(split[i].depth_m, direct[i].depth_m, cv::NORM_INF), 0.0) << "frame " << i;
     EXPECT_GT(cv::countNonZero(split[i].depth_m), 1000) << "frame " << i;
   }
   // The noise differs from frame to frame (seeded by the frame index).

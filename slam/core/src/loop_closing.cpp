@@ -232,19 +232,19 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
   std::vector<Eigen::Vector3d> verified_centres_w;
   int drift = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  std::array<int, 5> refused{};  // by LoopMatch::Stage, then the correction bound
-  int verified = 0;
+  std::array<int, 3> refused_at{};  // by LoopMatch::Stage: matches, RANSAC, inliers
+  int verified = 0, refused_correction = 0;
   for (const auto& cand : consistent) {
     ++verified;
     LoopMatch m = verify_loop(*kf, cand, options_);
     if (!m.accepted) {
-      ++refused[static_cast<std::size_t>(m.stage)];
+      ++refused_at[static_cast<std::size_t>(m.stage)];
       continue;
     }
     double dist_m = 0, angle_deg = 0;
     pose_difference(m.T_c_w, kf->T_c_w(), &dist_m, &angle_deg);
     if (dist_m > options_.max_correction_m || angle_deg > options_.max_correction_deg) {
-      ++refused[4];
+      ++refused_correction;
       continue;
     }
     verified_centres_w.push_back(m.T_c_w.inverse().translation());
@@ -265,10 +265,10 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
       ambiguous = ambiguous || (verified_centres_w[i] - verified_centres_w[j]).norm() > options_.ambiguity_distance_m;
   std::lock_guard<std::mutex> s(stats_mutex_);
   stats_.verified += verified;
-  stats_.refused_matches += refused[0];
-  stats_.refused_ransac += refused[1];
-  stats_.refused_inliers += refused[2];
-  stats_.refused_correction += refused[4];
+  stats_.refused_matches += refused_at[0];
+  stats_.refused_ransac += refused_at[1];
+  stats_.refused_inliers += refused_at[2];
+  stats_.refused_correction += refused_correction;
   stats_.verify_ms_total += ms_since(t0);
   if (ambiguous) {
     ++stats_.refused_ambiguous;
