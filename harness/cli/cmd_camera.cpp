@@ -10,6 +10,7 @@
 // files, and the checks that fail the run after everything was written
 // (stream error, recording short of frames, SLAM never initialised).
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -97,8 +98,21 @@ std::optional<scenes::Scenario> check_inputs(const CameraArgs& a) {
   return scenario;
 }
 
+/// The fakenect dump a freenect:// device plays when FAKENECT_PATH names one
+/// (docs/openni.md); empty otherwise.  Its camera.yaml and groundtruth.txt,
+/// written by `pvbench record --format fakenect`, stand in for a sim://
+/// scenario's.
+std::string fakenect_dump_dir(const CameraArgs& a) {
+  const char* dir = std::getenv("FAKENECT_PATH");
+  if (!a.oni.empty() || a.uri.rfind("freenect://", 0) != 0 || !dir || !*dir) return {};
+  return dir;
+}
+
+bool readable(const std::string& path) { return static_cast<bool>(std::ifstream(path)); }
+
 /// The SLAM settings and the file they came from (the one named in errors):
-/// the user's --settings, or the scenario's camera for sim:// sources.  The
+/// the user's --settings, the scenario's camera for sim:// sources, or a
+/// fakenect dump's camera.yaml.  The
 /// file used is saved as camera.yaml; intrinsics never come from the driver.
 struct CameraSettings {
   slam::Settings slam;
@@ -119,10 +133,14 @@ CameraSettings prepare_settings(const CameraArgs& a, const std::optional<scenes:
     o.depth_map_factor = 1000.0;  // OpenNI2 depth is in millimetres
     dataset::write_orbslam_settings(saved, o);
     s.file = saved;
+  } else if (const std::string dump = fakenect_dump_dir(a); !dump.empty() && readable(dump + "/camera.yaml")) {
+    s.file = dump + "/camera.yaml";
+    write_file(saved, read_file(s.file));
   } else {
     throw ConfigError(
         "pvbench camera", "--settings",
-        "a settings file with the camera's calibrated intrinsics (only sim:// devices have their own)");
+        "a settings file with the camera's calibrated intrinsics (only sim:// devices and fakenect dumps "
+        "have their own)");
   }
   s.slam = slam::read_settings(s.file);
   for (const std::string& w : s.slam.warnings)
@@ -154,10 +172,15 @@ struct LiveOutputs {
   OutputFile cam_traj;
   std::unique_ptr<sim::Simulator> gt_sim;
   OutputFile gt_file;
+  std::string dump_gt;  ///< a fakenect dump's groundtruth.txt, copied at the end
+  bool has_gt() const { return gt_sim || !dump_gt.empty(); }
 };
 
-LiveOutputs open_live_outputs(const std::string& out, const std::optional<scenes::Scenario>& scenario) {
+LiveOutputs open_live_outputs(const CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
+  const std::string& out = a.out;
   LiveOutputs o;
+  if (const std::string dump = fakenect_dump_dir(a); !dump.empty() && readable(dump + "/groundtruth.txt"))
+    o.dump_gt = dump + "/groundtruth.txt";
   o.cam_traj = OutputFile(out + "/CameraTrajectory.txt");
   o.cam_traj.append("# timestamp tx ty tz qx qy qz qw (T_w_c)\n");
   if (scenario) {
@@ -284,14 +307,15 @@ void report_run(const CameraArgs& a, const slam::Settings& settings, openni::Ope
     js << ",\n  \"recorded\": {\"depth_frames\": " << rec->depth_frames
        << ", \"colour_frames\": " << rec->colour_frames << "}";
   }
-  if (live.gt_sim && c.frames > 0 && !never_initialized(c)) {
-    live.gt_file.close();
+  if (live.has_gt() && c.frames > 0 && !never_initialized(c)) {
+    if (live.gt_sim) live.gt_file.close();
+    if (!live.dump_gt.empty()) write_file(a.out + "/groundtruth.txt", read_file(live.dump_gt));
     evaluate_against_ground_truth(a.out, js);
   }
   js << "\n}\n";
   write_file(a.out + "/stats.json", js.str());
   std::printf("wrote %s/{camera.yaml,CameraTrajectory.txt,KeyFrameTrajectory.txt,map.ply,stats.json%s}\n",
-              a.out.c_str(), live.gt_sim ? ",groundtruth.txt" : "");
+              a.out.c_str(), live.has_gt() ? ",groundtruth.txt" : "");
 }
 
 /// After every output is written: the problems that fail the run.
@@ -323,7 +347,7 @@ int run_camera(const CameraArgs& a) {
   options.synchronous = a.sync;
   options.seed = a.seed;
   slam::System system(settings.slam, options);
-  LiveOutputs live = open_live_outputs(a.out, scenario);
+  LiveOutputs live = open_live_outputs(a, scenario);
 
   const TrackCounts counts = track_frames(source, max_frames, settings, system, live);
   const std::optional<openni::RecordingSummary> rec = stop_source(source, counts.stream_error.has_value());
@@ -344,8 +368,8 @@ Command add_camera_command(CLI::App& app) {
       app.add_subcommand("camera", "run PE-SLAM live on an OpenNI2 camera, an .oni file or sim://scenario");
   auto* uri =
       sub->add_option("--uri", args->uri,
-                      "OpenNI2 device URI: sim://<scenario.yaml>[?seed=S&frames=N&gl=egl], a camera's URI, "
-                      "or 'any' for the first device");
+                      "OpenNI2 device URI: sim://<scenario.yaml>[?seed=S&frames=N&gl=egl], freenect://<index> "
+                      "(a Kinect v1, or a fakenect dump), a camera's URI, or 'any' for the first device");
   auto* oni = sub->add_option("--oni", args->oni, "play back an .oni recording (in lockstep)");
   uri->excludes(oni);
   sub->add_option("--settings", args->settings,

@@ -1,4 +1,5 @@
-// pvbench record: render a scenario into a TUM RGB-D sequence folder.
+// pvbench record: render a scenario into a TUM RGB-D sequence folder, or
+// (--format fakenect) into a Kinect v1 dump that libfreenect's fakenect plays.
 //
 // Ctrl-C (SIGINT) or SIGTERM stops at the next frame: the lists (rgb.txt,
 // depth.txt, groundtruth.txt, associations.txt) hold the frames written,
@@ -10,6 +11,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <functional>
 #include <optional>
 
 #include "command.hpp"
@@ -17,7 +19,9 @@
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/dataset/fakenect_dump.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
+#include "pvb/sensor/kinect_v1.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/plot/contact_sheet.hpp"
 #include "pvb/run/run.hpp"
@@ -34,6 +38,39 @@ struct RecordOptions {
   std::string frames;  ///< empty: the scenario's duration; else checked by parse_count
   std::optional<std::uint64_t> seed;
   std::string gl = "auto";
+  std::string format = "tum";
+};
+
+/// A scenario recorded as a Kinect v1 would have seen it: the rendered
+/// (noise-free) depth, cut to the camera's range, as raw IR-view disparity
+/// (sensor::kinect), the colour as the sensor model made it, and the
+/// accelerometer's reading of gravity (docs/openni.md, "fakenect dumps").
+class FakenectDump {
+ public:
+  FakenectDump(const std::string& dir, const scenes::Scenario& s, sim::SimFrameSource& source)
+      : source_(source),
+        min_m_(s.camera.depth_range_m[0]),
+        max_m_(s.camera.depth_range_m[1]),
+        registration_(sensor::kinect::Calibration{}),
+        writer_(dir, registration_.calibration()) {
+    if (s.camera.width != sensor::kinect::kWidth || s.camera.height != sensor::kinect::kHeight)
+      throw ConfigError(s.name, "camera.width/height", "640x480 for a fakenect dump (a Kinect v1's frames)",
+                        std::to_string(s.camera.width) + "x" + std::to_string(s.camera.height));
+  }
+
+  void write(const sensor::RgbdFrame& frame, const geom::StampedPose& gt) {
+    cv::Mat depth_m = source_.last_depth_gt_m().clone();
+    depth_m.setTo(0.0f, (depth_m < min_m_) | (depth_m > max_m_));
+    const Eigen::Vector3d up_w(0.0, 0.0, 9.80665);  // the specific force of a body at rest
+    writer_.write(frame.t_ns, frame.rgb, registration_.encode_ir_raw(depth_m),
+                  gt.T_w_c.linear().transpose() * up_w, gt.T_w_c);
+  }
+
+ private:
+  sim::SimFrameSource& source_;
+  double min_m_, max_m_;
+  sensor::kinect::DepthRegistration registration_;
+  dataset::FakenectWriter writer_;
 };
 
 using Clock = std::chrono::steady_clock;
@@ -51,8 +88,11 @@ struct RecordLoop {
 
 /// Renders and writes up to n frames; stops early at the end of the source
 /// or, before the next frame, on Ctrl-C / SIGTERM.
-RecordLoop record_frames(sim::SimFrameSource& source, const geom::StampedPose& gt,
-                         dataset::TumSequenceWriter& writer, const std::string& name, int n) {
+/// Writes one frame with its ground-truth pose (TUM folder or fakenect dump).
+using FrameWriter = std::function<void(const sensor::RgbdFrame&, const geom::StampedPose&)>;
+
+RecordLoop record_frames(sim::SimFrameSource& source, const geom::StampedPose& gt, const FrameWriter& write,
+                         const std::string& name, int n) {
   RecordLoop loop;
   const std::vector<int> sheet_frames = plot::spread_indices(n, 12);
   const auto t_loop = Clock::now();
@@ -67,14 +107,14 @@ RecordLoop record_frames(sim::SimFrameSource& source, const geom::StampedPose& g
     loop.capture_ms += ms_since(t0);
     if (!frame) break;
     t0 = Clock::now();
-    writer.write(*frame, gt.T_w_c);
+    write(*frame, gt);
     loop.write_ms += ms_since(t0);
     if (std::find(sheet_frames.begin(), sheet_frames.end(), i) != sheet_frames.end()) {
       char label[64];
       std::snprintf(label, sizeof label, "frame %d  t=%.2f s", i, geom::ns_to_seconds(frame->t_ns));
       loop.thumbs.push_back({frame->rgb.clone(), label});
     }
-    loop.frames = writer.frames_written();
+    loop.frames = i + 1;
     bar.update(static_cast<std::size_t>(i + 1));
   }
   bar.finish();
@@ -127,10 +167,21 @@ int run_record(const RecordOptions& opt, bool frames_given) {
   const double setup_ms = ms_since(t_start);
 
   sim::write_scene(source.simulator().assets(), opt.out);
-  dataset::write_orbslam_settings(opt.out + "/camera.yaml", run::orbslam_settings_for(scenario));
-  dataset::TumSequenceWriter writer(opt.out, sensor::kTumDepthFactor,
-                                    std::string("pvbench ") + pvb::version());
-  const RecordLoop loop = record_frames(source, gt, writer, scenario.name, n);
+  dataset::OrbSlamSettings settings = run::orbslam_settings_for(scenario);
+  std::unique_ptr<dataset::TumSequenceWriter> tum;
+  std::unique_ptr<FakenectDump> dump;
+  FrameWriter write;
+  if (opt.format == "fakenect") {
+    settings.depth_map_factor = 1000.0;  // OpenNI2 serves depth in mm
+    dump = std::make_unique<FakenectDump>(opt.out, scenario, source);
+    write = [&dump](const sensor::RgbdFrame& f, const geom::StampedPose& p) { dump->write(f, p); };
+  } else {
+    tum = std::make_unique<dataset::TumSequenceWriter>(opt.out, sensor::kTumDepthFactor,
+                                                       std::string("pvbench ") + pvb::version());
+    write = [&tum](const sensor::RgbdFrame& f, const geom::StampedPose& p) { tum->write(f, p.T_w_c); };
+  }
+  dataset::write_orbslam_settings(opt.out + "/camera.yaml", settings);
+  const RecordLoop loop = record_frames(source, gt, write, scenario.name, n);
   if (loop.interrupted)
     std::printf("record: stopped by a signal after %d of %d frames; writing meta.json for them\n",
                 loop.frames, n);
@@ -156,6 +207,11 @@ Command add_record_command(CLI::App& app) {
   sub->add_option("--seed", opt->seed, "override the scenario's seed")
       ->check(seed_check("record", "--seed", std::numeric_limits<std::uint64_t>::max()));
   sub->add_option("--gl", opt->gl, "rendering backend")->check(CLI::IsMember({"auto", "egl", "osmesa"}));
+  sub->add_option("--format", opt->format,
+                  "tum: a TUM RGB-D folder; fakenect: a Kinect v1 dump for libfreenect's fakenect "
+                  "(docs/openni.md)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"tum", "fakenect"}));
   return {sub, [opt, frames] { return run_record(*opt, frames->count() > 0); }};
 }
 

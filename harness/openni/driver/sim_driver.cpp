@@ -26,10 +26,7 @@
 #include <memory>
 #include <string>
 
-#define XN_NEW(type, ...) new type(__VA_ARGS__)
-#define XN_DELETE(p) delete (p)
-#include <Driver/OniDriverAPI.h>
-
+#include "frame_stream.hpp"
 #include "pvb/openni/sim_uri.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/sim_frame_source.hpp"
@@ -39,141 +36,9 @@ namespace {
 using oni::driver::DeviceBase;
 using oni::driver::DriverBase;
 using oni::driver::StreamBase;
+using pvb::openni::FrameStream;
 
 class SimDriver;
-
-/// One stream (depth or colour) of the simulated camera.
-class SimStream : public StreamBase {
- public:
-  SimStream(OniSensorType type, OniVideoMode mode, double fx_px, double fy_px, int max_depth_mm)
-      : type_(type), mode_(mode), fx_px_(fx_px), fy_px_(fy_px), max_depth_mm_(max_depth_mm) {}
-
-  OniStatus start() override {
-    started_ = true;
-    return ONI_STATUS_OK;
-  }
-  void stop() override { started_ = false; }
-  bool started() const { return started_; }
-  OniSensorType type() const { return type_; }
-
-  int getRequiredFrameSize() override {
-    return mode_.resolutionX * mode_.resolutionY * (type_ == ONI_SENSOR_DEPTH ? 2 : 3);
-  }
-
-  OniBool isPropertySupported(int id) override {
-    switch (id) {
-      case ONI_STREAM_PROPERTY_VIDEO_MODE:
-      case ONI_STREAM_PROPERTY_MIRRORING:
-      case ONI_STREAM_PROPERTY_CROPPING:
-      case ONI_STREAM_PROPERTY_HORIZONTAL_FOV:
-      case ONI_STREAM_PROPERTY_VERTICAL_FOV:
-        return TRUE;
-      case ONI_STREAM_PROPERTY_MAX_VALUE:
-      case ONI_STREAM_PROPERTY_MIN_VALUE:
-        return type_ == ONI_SENSOR_DEPTH;
-      default:
-        return FALSE;
-    }
-  }
-
-  OniStatus getProperty(int id, void* data, int* size) override {
-    switch (id) {
-      case ONI_STREAM_PROPERTY_VIDEO_MODE:
-        return put(data, size, mode_);
-      case ONI_STREAM_PROPERTY_MIRRORING:
-        return put(data, size, OniBool(FALSE));
-      case ONI_STREAM_PROPERTY_CROPPING: {
-        // The player drops every frame of a stream without this property.
-        OniCropping c{};
-        c.enabled = FALSE;
-        c.originX = c.originY = 0;
-        c.width = mode_.resolutionX;
-        c.height = mode_.resolutionY;
-        return put(data, size, c);
-      }
-      case ONI_STREAM_PROPERTY_HORIZONTAL_FOV:
-        return put(data, size, static_cast<float>(2.0 * std::atan(0.5 * mode_.resolutionX / fx_px_)));
-      case ONI_STREAM_PROPERTY_VERTICAL_FOV:
-        return put(data, size, static_cast<float>(2.0 * std::atan(0.5 * mode_.resolutionY / fy_px_)));
-      case ONI_STREAM_PROPERTY_MAX_VALUE:
-        // The recorder's 16z codec only encodes values up to this one
-        // exactly: report the largest value a frame can hold, not the
-        // sensor's nominal range (noisy depth goes beyond it).
-        if (type_ != ONI_SENSOR_DEPTH) return ONI_STATUS_NOT_SUPPORTED;
-        return put(data, size, max_depth_mm_);
-      case ONI_STREAM_PROPERTY_MIN_VALUE:
-        if (type_ != ONI_SENSOR_DEPTH) return ONI_STATUS_NOT_SUPPORTED;
-        return put(data, size, 0);
-      default:
-        return ONI_STATUS_NOT_SUPPORTED;
-    }
-  }
-
-  OniStatus setProperty(int id, const void* data, int size) override {
-    switch (id) {
-      case ONI_STREAM_PROPERTY_VIDEO_MODE: {
-        if (size != static_cast<int>(sizeof(OniVideoMode))) return ONI_STATUS_BAD_PARAMETER;
-        OniVideoMode m;
-        std::memcpy(&m, data, sizeof m);
-        const bool same = m.pixelFormat == mode_.pixelFormat && m.resolutionX == mode_.resolutionX &&
-                          m.resolutionY == mode_.resolutionY && m.fps == mode_.fps;
-        return same ? ONI_STATUS_OK : ONI_STATUS_NOT_SUPPORTED;
-      }
-      case ONI_STREAM_PROPERTY_MIRRORING: {
-        if (size != static_cast<int>(sizeof(OniBool))) return ONI_STATUS_BAD_PARAMETER;
-        OniBool on;
-        std::memcpy(&on, data, sizeof on);
-        return on ? ONI_STATUS_NOT_SUPPORTED : ONI_STATUS_OK;
-      }
-      case ONI_STREAM_PROPERTY_CROPPING: {
-        if (size != static_cast<int>(sizeof(OniCropping))) return ONI_STATUS_BAD_PARAMETER;
-        OniCropping c;
-        std::memcpy(&c, data, sizeof c);
-        return c.enabled ? ONI_STATUS_NOT_SUPPORTED : ONI_STATUS_OK;
-      }
-      default:
-        return ONI_STATUS_NOT_SUPPORTED;
-    }
-  }
-
-  /// Raises one frame holding `image` (CV_16UC1 depth in mm or CV_8UC3 RGB).
-  void deliver(const cv::Mat& image, std::uint64_t t_us, int index) {
-    OniFrame* frame = getServices().acquireFrame();
-    if (!frame) return;
-    const int bpp = type_ == ONI_SENSOR_DEPTH ? 2 : 3;
-    const int row_bytes = mode_.resolutionX * bpp;
-    auto* dst = static_cast<unsigned char*>(frame->data);
-    for (int y = 0; y < mode_.resolutionY; ++y)
-      std::memcpy(dst + static_cast<std::size_t>(y) * row_bytes, image.ptr(y),
-                  static_cast<std::size_t>(row_bytes));
-    frame->dataSize = row_bytes * mode_.resolutionY;
-    frame->sensorType = type_;
-    frame->timestamp = t_us;
-    frame->frameIndex = index;
-    frame->videoMode = mode_;
-    frame->width = mode_.resolutionX;
-    frame->height = mode_.resolutionY;
-    frame->croppingEnabled = FALSE;
-    frame->cropOriginX = frame->cropOriginY = 0;
-    frame->stride = row_bytes;
-    raiseNewFrame(frame);
-    getServices().releaseFrame(frame);
-  }
-
- private:
-  template <typename T>
-  static OniStatus put(void* data, int* size, const T& value) {
-    if (*size != static_cast<int>(sizeof(T))) return ONI_STATUS_BAD_PARAMETER;
-    std::memcpy(data, &value, sizeof(T));
-    return ONI_STATUS_OK;
-  }
-
-  OniSensorType type_;
-  OniVideoMode mode_;
-  double fx_px_, fy_px_;
-  int max_depth_mm_;
-  bool started_ = false;
-};
 
 /// The simulated camera: the simulator, its renderer and the two streams.
 class SimDevice : public DeviceBase {
@@ -191,7 +56,7 @@ class SimDevice : public DeviceBase {
     if (type == ONI_SENSOR_COLOR) return &colour_;
     return nullptr;
   }
-  void destroyStream(StreamBase* stream) override { static_cast<SimStream*>(stream)->stop(); }
+  void destroyStream(StreamBase* stream) override { static_cast<FrameStream*>(stream)->stop(); }
 
   OniBool isImageRegistrationModeSupported(OniImageRegistrationMode mode) override {
     return mode == ONI_IMAGE_REGISTRATION_OFF || mode == ONI_IMAGE_REGISTRATION_DEPTH_TO_COLOR;
@@ -223,7 +88,7 @@ class SimDevice : public DeviceBase {
   pvb::sim::SimFrameSource source_;
   OniVideoMode depth_mode_, colour_mode_;
   OniSensorInfo sensors_[2];
-  SimStream depth_, colour_;
+  FrameStream depth_, colour_;
   OniImageRegistrationMode registration_ = ONI_IMAGE_REGISTRATION_DEPTH_TO_COLOR;
   int served_ = 0;
   bool finished_ = false;
@@ -273,7 +138,7 @@ class SimDriver : public DriverBase {
   void report(const char* format, ...) {
     va_list args;
     va_start(args, format);
-    getServices().errorLoggerAppend(format, args);
+    pvb::openni::append_error(getServices(), format, args);
     va_end(args);
   }
   void state_changed(const OniDeviceInfo& info, OniDeviceState state) { deviceStateChanged(&info, state); }

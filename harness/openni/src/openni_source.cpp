@@ -101,13 +101,27 @@ struct OpenniSource::Impl : ::openni::OpenNI::DeviceDisconnectedListener,
   std::atomic<bool> end_of_stream{false};
   std::unique_ptr<FramePairer> pairer;
 
+  std::mutex reason_mutex;
+  std::string device_reason;  ///< what the driver said when it gave up (its thread's extended error)
+
+  /// Listeners run on the thread that raised the event, where the driver's
+  /// report is still OpenNI2's (thread-local) extended error.
+  void keep_reason() {
+    std::lock_guard<std::mutex> lock(reason_mutex);
+    if (device_reason.empty()) device_reason = oni_error();
+  }
   void onDeviceDisconnected(const ::openni::DeviceInfo* info) override {
-    if (info && uri == info->getUri()) unplugged = true;
+    if (!info || uri != info->getUri()) return;
+    keep_reason();
+    unplugged = true;
   }
   void onDeviceStateChanged(const ::openni::DeviceInfo* info, ::openni::DeviceState state) override {
     if (!info || uri != info->getUri()) return;
     if (state == ::openni::DEVICE_STATE_EOF) end_of_stream = true;
-    if (state == ::openni::DEVICE_STATE_ERROR || state == ::openni::DEVICE_STATE_NOT_READY) unplugged = true;
+    if (state == ::openni::DEVICE_STATE_ERROR || state == ::openni::DEVICE_STATE_NOT_READY) {
+      keep_reason();
+      unplugged = true;
+    }
   }
 
   void open();
@@ -251,9 +265,11 @@ std::optional<sensor::RgbdFrame> OpenniSource::Impl::next() {
       return f;
     }
     if (file_done() || end_of_stream) return std::nullopt;
-    if (unplugged)
-      throw IoError(source_name,
-                    "the camera was disconnected after " + std::to_string(next_index) + " frames");
+    if (unplugged) {
+      std::lock_guard<std::mutex> lock(reason_mutex);
+      throw IoError(source_name, "the camera was disconnected after " + std::to_string(next_index) + " frames" +
+                                     (device_reason.empty() ? "" : ": " + device_reason));
+    }
 
     if (options.stop_requested && options.stop_requested()) return std::nullopt;  // e.g. Ctrl-C while waiting
     std::vector<::openni::VideoStream*> wait;

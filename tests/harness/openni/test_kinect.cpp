@@ -1,0 +1,170 @@
+// A Kinect v1 end to end without a Kinect: a fakenect dump of pv_station
+// from the simulator, played by Debian's fakenect library through our
+// OpenNI2 plug-in (freenect://0), libOpenNI2 and `pvbench camera --sync`.
+// The same command through the real libfreenect ends with "no Kinect found";
+// broken dumps end with one error line and keep the trajectory so far.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "pvb/common/text.hpp"
+
+namespace {
+
+const std::string kBin = std::string(PVB_BINARY_DIR) + "/bin/pvbench";
+constexpr int kFrames = 150;
+
+struct Result {
+  int code = -1;
+  std::string output;
+};
+
+/// Runs pvbench from the source folder; `env` goes before the command.
+Result run(const std::string& env, const std::string& args) {
+  const std::string log = ::testing::TempDir() + "pvb_kinect_" + std::to_string(::getpid()) + ".txt";
+  const std::string cmd = "cd " + std::string(PVB_SOURCE_DIR) + " && " + env + " timeout 300 " + kBin + " " +
+                          args + " > " + log + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, pvb::read_file(log)};
+}
+
+std::string fakenect_env(const std::string& dump) {
+  return "LD_LIBRARY_PATH=" + std::string(PVB_FAKENECT_LIBRARY_DIR) + " FAKENECT_PATH=" + dump;
+}
+
+std::string fresh(const std::string& name) {
+  const std::string d = ::testing::TempDir() + "pvb_kinect_" + name + "_" + std::to_string(::getpid());
+  std::system(("rm -rf " + d + " && mkdir -p " + d).c_str());
+  return d;
+}
+
+std::vector<std::string> data_lines(const std::string& path) {
+  std::vector<std::string> out;
+  std::ifstream in(path);
+  for (std::string l; std::getline(in, l);)
+    if (!l.empty() && l[0] != '#') out.push_back(l);
+  return out;
+}
+
+double json_number(const std::string& json, const std::string& key) {
+  const std::regex re("\"" + key + "\": ([-0-9.eE+]+)");
+  std::smatch m;
+  if (!std::regex_search(json, m, re)) return -1;
+  return std::stod(m[1]);
+}
+
+std::vector<std::string> error_lines(const std::string& output) {
+  std::vector<std::string> out;
+  std::istringstream in(output);
+  for (std::string l; std::getline(in, l);)
+    if (l.find("error") != std::string::npos) out.push_back(l);
+  return out;
+}
+
+void expect_one_error_line(const Result& r, const std::string& must_contain) {
+  EXPECT_NE(r.code, 0) << r.output;
+  const std::vector<std::string> errors = error_lines(r.output);
+  ASSERT_EQ(errors.size(), 1u) << r.output;
+  EXPECT_NE(errors[0].find(must_contain), std::string::npos) << errors[0];
+}
+
+std::string record_dump(const std::string& dir, int frames) {
+  const std::string dump = dir + "/dump";
+  const Result rec = run("", "record --scenario scenes/pv_station.yaml --format fakenect --frames " +
+                                 std::to_string(frames) + " --out " + dump);
+  EXPECT_EQ(rec.code, 0) << rec.output;
+  return dump;
+}
+
+/// Replaces the file on line `line` of the dump's INDEX.txt (1-based) with
+/// `content`, or removes it when `content` is null.
+std::string break_entry(const std::string& dump, int line, const std::string* content) {
+  std::ifstream in(dump + "/INDEX.txt");
+  std::string name;
+  for (int i = 0; i < line; ++i) std::getline(in, name);
+  const std::string path = dump + "/" + name;
+  std::remove(path.c_str());
+  if (content) std::ofstream(path, std::ios::binary) << *content;
+  return name;
+}
+
+}  // namespace
+
+TEST(KinectCli, FakenectDumpTracksDeterministicallyAndItsOniReplaysTheSame) {
+  const std::string dir = fresh("accept");
+  const std::string dump = record_dump(dir, kFrames);
+  const std::string oni = dir + "/run.oni";
+  const Result first =
+      run(fakenect_env(dump), "camera --uri freenect://0 --sync --record " + oni + " --out " + dir + "/a");
+  ASSERT_EQ(first.code, 0) << first.output;
+  const std::string stats = pvb::read_file(dir + "/a/stats.json");
+  EXPECT_EQ(json_number(stats, "frames"), kFrames) << stats;
+  EXPECT_EQ(json_number(stats, "lost_frames"), 0) << stats;
+  EXPECT_EQ(json_number(stats, "dropped_colour") + json_number(stats, "dropped_depth"), 0) << stats;
+  const std::vector<std::string> a = data_lines(dir + "/a/CameraTrajectory.txt");
+  EXPECT_EQ(a.size(), static_cast<std::size_t>(kFrames));  // every frame tracked
+  const double ate = json_number(stats, "ate_rmse_m");
+  ASSERT_GE(ate, 0.0) << stats;
+  EXPECT_LE(ate, 0.02) << stats;
+
+  const Result second = run(fakenect_env(dump), "camera --uri freenect://0 --sync --out " + dir + "/b");
+  ASSERT_EQ(second.code, 0) << second.output;
+  EXPECT_EQ(data_lines(dir + "/b/CameraTrajectory.txt"), a);
+
+  const Result replay =
+      run("", "camera --oni " + oni + " --settings " + dir + "/a/camera.yaml --sync --out " + dir + "/c");
+  ASSERT_EQ(replay.code, 0) << replay.output;
+  EXPECT_EQ(data_lines(dir + "/c/CameraTrajectory.txt"), a);
+  std::system(("rm -rf " + dir).c_str());  // 230 MB
+}
+
+TEST(KinectCli, RealLibfreenectWithoutAKinectSaysSo) {
+  const std::string dir = fresh("nodevice");
+  const Result r = run("FAKENECT_PATH=", "camera --uri freenect://0 --sync --settings " + std::string(PVB_SOURCE_DIR) +
+                                             "/configs/kinect/kinect_v1.yaml --out " + dir + "/out");
+  expect_one_error_line(r, "no Kinect found");
+}
+
+TEST(KinectCli, BrokenDumpsEndWithOneErrorAndKeepTheTrajectory) {
+  const std::string dir = fresh("broken");
+  const std::string dump = record_dump(dir, 40);
+  const int frame = 20, line_of_depth = 3 * frame + 2;  // a, d, r per frame
+  struct Case {
+    const char* what;
+    int line;
+    std::string content;
+    bool remove;
+    const char* expect;
+  };
+  const std::string full_depth = pvb::read_file(dump + "/" + [&] {
+    std::ifstream in(dump + "/INDEX.txt");
+    std::string n;
+    for (int i = 0; i < line_of_depth; ++i) std::getline(in, n);
+    return n;
+  }());
+  const Case cases[] = {
+      {"truncated", line_of_depth, full_depth.substr(0, full_depth.size() / 3), false, "truncated"},
+      {"missing", line_of_depth + 1, "", true, "missing"},
+      {"resolution", line_of_depth + 1, "P6 320 240 255\n" + std::string(320 * 240 * 3, 'x'), false, "320x240"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    const std::string copy = dir + "/" + c.what;
+    std::system(("cp -r " + dump + " " + copy).c_str());
+    const std::string name = break_entry(copy, c.line, c.remove ? nullptr : &c.content);
+    const Result r = run(fakenect_env(copy), "camera --uri freenect://0 --sync --out " + copy + "/out");
+    expect_one_error_line(r, c.expect);
+    EXPECT_NE(r.output.find(name), std::string::npos) << r.output;
+    EXPECT_EQ(data_lines(copy + "/out/CameraTrajectory.txt").size(), static_cast<std::size_t>(frame))
+        << r.output;
+  }
+  std::system(("rm -rf " + dir).c_str());
+}
