@@ -11,6 +11,7 @@
 // (stream error, recording short of frames, SLAM never initialised).
 #include <chrono>
 #include <cstdlib>
+#include <limits>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -26,6 +27,7 @@
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/evaluate.hpp"
+#include "pvb/geometry/time.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/openni/oni_file.hpp"
 #include "pvb/openni/openni_source.hpp"
@@ -197,7 +199,36 @@ struct TrackCounts {
   std::size_t not_initialized = 0;
   double elapsed_s = 0;
   std::optional<IoError> stream_error;  ///< unplugged camera or broken file
+  /// Per frame: its stream time stamp, and the run's clock (s) when the
+  /// source handed it over and when its pose was written.
+  std::vector<std::int64_t> t_ns;
+  std::vector<double> arrived_s, posed_s;
 };
+
+/// Latency from a frame's time stamp to its pose, in ms: the stream's clock
+/// is put on the run's by the smallest (arrival - time stamp) of the run,
+/// so the fastest-delivered frame counts as arriving at its time stamp and
+/// the figure is what the camera path and SLAM add on top of that frame's
+/// delivery (queueing included).  With `from_arrival`, from the frame's
+/// hand-over instead: the processing alone.  Median and 95th percentile.
+std::pair<double, double> latency_ms(const TrackCounts& c, bool from_arrival) {
+  if (c.t_ns.empty()) return {0, 0};
+  double offset_s = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < c.t_ns.size(); ++i)
+    offset_s = std::min(offset_s, c.arrived_s[i] - geom::ns_to_seconds(c.t_ns[i]));
+  std::vector<double> ms(c.t_ns.size());
+  for (std::size_t i = 0; i < ms.size(); ++i) {
+    const double start_s = from_arrival ? c.arrived_s[i] : geom::ns_to_seconds(c.t_ns[i]) + offset_s;
+    ms[i] = 1000.0 * (c.posed_s[i] - start_s);
+  }
+  auto at = [&ms](double q) {
+    const auto k = static_cast<std::size_t>(q * static_cast<double>(ms.size() - 1) + 0.5);
+    std::nth_element(ms.begin(), ms.begin() + static_cast<long>(k), ms.end());
+    return ms[k];
+  };
+  const double median = at(0.5);
+  return {median, at(0.95)};
+}
 
 /// Tracks one frame and appends its poses (ground truth first).
 slam::TrackingState track_frame(const sensor::RgbdFrame& frame, const CameraSettings& settings,
@@ -241,7 +272,10 @@ TrackCounts track_frames(openni::OpenniSource& source, std::size_t max_frames, c
         break;
       }
       if (!frame) break;
+      counts.t_ns.push_back(frame->t_ns);
+      counts.arrived_s.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
       const slam::TrackingState state = track_frame(*frame, settings, system, live, counts);
+      counts.posed_s.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
       const double elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
       char status[128];
       std::snprintf(status, sizeof status, "%.1f fps, %s, %zu keyframes",
@@ -298,9 +332,17 @@ void report_run(const CameraArgs& a, const slam::Settings& settings, openni::Ope
      << ",\n  \"dropped_depth\": " << source.dropped_depth()
      << ",\n  \"keyframes\": " << system.num_keyframes() << ",\n  \"map_points\": " << system.num_map_points()
      << ",\n  \"fps\": " << format_g(fps);
+  const auto [latency_median_ms, latency_p95_ms] = latency_ms(c, false);
+  const auto [processing_median_ms, processing_p95_ms] = latency_ms(c, true);
+  js << ",\n  \"latency_ms\": {\"median\": " << format_g(latency_median_ms)
+     << ", \"p95\": " << format_g(latency_p95_ms) << "}"
+     << ",\n  \"processing_ms\": {\"median\": " << format_g(processing_median_ms)
+     << ", \"p95\": " << format_g(processing_p95_ms) << "}";
   std::printf("camera: %zu frames (%.1f fps), lost %zu, keyframes %zu, map points %zu%s\n", c.frames, fps,
               c.lost, system.num_keyframes(), system.num_map_points(),
               StopSignals::requested() ? " (stopped by a signal)" : "");
+  std::printf("latency from frame time stamp to pose: median %.1f ms, p95 %.1f ms (hand-over to pose: %.1f, %.1f)\n",
+              latency_median_ms, latency_p95_ms, processing_median_ms, processing_p95_ms);
   if (rec) {
     std::printf("recorded %u depth and %u colour frames to %s\n", rec->depth_frames, rec->colour_frames,
                 rec->path.c_str());
