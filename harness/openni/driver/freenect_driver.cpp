@@ -22,10 +22,8 @@
 #include <libfreenect.h>
 
 #include <atomic>
-#include <cstdarg>
 #include <cstdlib>
 #include <exception>
-#include <list>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -33,14 +31,13 @@
 #include <thread>
 #include <vector>
 
-#include "frame_stream.hpp"
+#include "plugin.hpp"
 #include "pvb/dataset/fakenect_dump.hpp"
 #include "pvb/sensor/kinect_v1.hpp"
 
 namespace {
 
 using oni::driver::DeviceBase;
-using oni::driver::DriverBase;
 using pvb::openni::FrameStream;
 namespace kinect = pvb::sensor::kinect;
 
@@ -130,9 +127,9 @@ class FreenectDevice : public DeviceBase {
   std::thread thread_;
 };
 
-class FreenectDriver : public DriverBase {
+class FreenectDriver : public pvb::openni::PluginDriver {
  public:
-  explicit FreenectDriver(OniDriverServices* services) : DriverBase(services) {}
+  explicit FreenectDriver(OniDriverServices* services) : PluginDriver(services) {}
 
   OniStatus tryDevice(const char* uri) override;
   DeviceBase* deviceOpen(const char* uri, const char* mode) override;
@@ -142,15 +139,6 @@ class FreenectDriver : public DriverBase {
     ctx_ = nullptr;
   }
 
-  void report(const char* format, ...) {
-    va_list args;
-    va_start(args, format);
-    pvb::openni::append_error(getServices(), format, args);
-    va_end(args);
-  }
-  void state_changed(const OniDeviceInfo& info, OniDeviceState state) { deviceStateChanged(&info, state); }
-  void disconnected(const OniDeviceInfo& info) { deviceDisconnected(&info); }
-
  private:
   /// libfreenect's context, made on the first freenect:// URI; an error line otherwise.
   std::optional<std::string> open_context();
@@ -158,7 +146,6 @@ class FreenectDriver : public DriverBase {
 
   freenect_context* ctx_ = nullptr;
   bool playback_ = false;
-  std::list<OniDeviceInfo> infos_;  // stable addresses: OpenNI2 keeps pointers
 };
 
 // ---- the driver ------------------------------------------------------------
@@ -215,37 +202,28 @@ OniStatus FreenectDriver::tryDevice(const char* uri) {
     report("freenect device: no Kinect %d (libfreenect sees %d)", *index, count);
     return ONI_STATUS_ERROR;
   }
-  for (const OniDeviceInfo& known : infos_)
-    if (std::strcmp(known.uri, uri) == 0) return ONI_STATUS_OK;
-  OniDeviceInfo info{};
-  std::snprintf(info.uri, sizeof info.uri, "%s", uri);
-  std::snprintf(info.vendor, sizeof info.vendor, "Microsoft");
-  std::snprintf(info.name, sizeof info.name, playback_ ? "Kinect v1 (fakenect playback)" : "Kinect v1");
-  info.usbVendorId = 0x045e;
-  info.usbProductId = 0x02ae;
-  infos_.push_back(info);
-  deviceConnected(&infos_.back());
+  announce(uri, "Microsoft", playback_ ? "Kinect v1 (fakenect playback)" : "Kinect v1", 0x045e, 0x02ae);
   return ONI_STATUS_OK;
 }
 
 DeviceBase* FreenectDriver::deviceOpen(const char* uri, const char* /*mode*/) {
-  for (const OniDeviceInfo& info : infos_) {
-    if (std::strcmp(info.uri, uri) != 0) continue;
-    freenect_device* dev = nullptr;
-    if (freenect_open_device(ctx_, &dev, *parse_index(uri)) < 0 || !dev) {
-      report("freenect device: Kinect %s is busy or cannot be opened (does another program hold it?)", uri);
-      return nullptr;
-    }
-    try {
-      return new FreenectDevice(*this, info, ctx_, dev, playback_);
-    } catch (const std::exception& e) {
-      freenect_close_device(dev);
-      report("freenect device: %s", e.what());
-      return nullptr;
-    }
+  const OniDeviceInfo* info = announced(uri);
+  if (!info) {
+    report("freenect device: unknown URI %s", uri);
+    return nullptr;
   }
-  report("freenect device: unknown URI %s", uri);
-  return nullptr;
+  freenect_device* dev = nullptr;
+  if (freenect_open_device(ctx_, &dev, *parse_index(uri)) < 0 || !dev) {
+    report("freenect device: Kinect %s is busy or cannot be opened (does another program hold it?)", uri);
+    return nullptr;
+  }
+  try {
+    return new FreenectDevice(*this, *info, ctx_, dev, playback_);
+  } catch (const std::exception& e) {
+    freenect_close_device(dev);
+    report("freenect device: %s", e.what());
+    return nullptr;
+  }
 }
 
 // ---- the device ------------------------------------------------------------

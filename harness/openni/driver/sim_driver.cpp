@@ -19,14 +19,12 @@
 // Loaded by OpenNI2 from <folder of libOpenNI2.so.0>/OpenNI2/Drivers, which
 // the build stages under build/lib/openni2 (harness/openni/CMakeLists.txt).
 #include <cmath>
-#include <cstdarg>
 #include <cstring>
 #include <exception>
-#include <list>
 #include <memory>
 #include <string>
 
-#include "frame_stream.hpp"
+#include "plugin.hpp"
 #include "pvb/openni/sim_uri.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/sim_frame_source.hpp"
@@ -34,7 +32,6 @@
 namespace {
 
 using oni::driver::DeviceBase;
-using oni::driver::DriverBase;
 using oni::driver::StreamBase;
 using pvb::openni::FrameStream;
 
@@ -94,9 +91,9 @@ class SimDevice : public DeviceBase {
   bool finished_ = false;
 };
 
-class SimDriver : public DriverBase {
+class SimDriver : public pvb::openni::PluginDriver {
  public:
-  explicit SimDriver(OniDriverServices* services) : DriverBase(services) {}
+  explicit SimDriver(OniDriverServices* services) : PluginDriver(services) {}
 
   OniStatus tryDevice(const char* uri) override {
     if (!uri || !pvb::openni::is_sim_uri(uri)) return ONI_STATUS_ERROR;
@@ -107,45 +104,26 @@ class SimDriver : public DriverBase {
       report("sim device: %s", e.what());
       return ONI_STATUS_ERROR;
     }
-    for (const OniDeviceInfo& known : infos_)
-      if (std::strcmp(known.uri, uri) == 0) return ONI_STATUS_OK;
-    OniDeviceInfo info{};
-    std::snprintf(info.uri, sizeof info.uri, "%s", uri);
-    std::snprintf(info.vendor, sizeof info.vendor, "PE-SLAM Bench");
-    std::snprintf(info.name, sizeof info.name, "simulated RGB-D camera");
-    infos_.push_back(info);
-    deviceConnected(&infos_.back());
+    announce(uri, "PE-SLAM Bench", "simulated RGB-D camera");
     return ONI_STATUS_OK;
   }
 
   DeviceBase* deviceOpen(const char* uri, const char* /*mode*/) override {
-    for (const OniDeviceInfo& info : infos_) {
-      if (std::strcmp(info.uri, uri) != 0) continue;
-      try {
-        return new SimDevice(*this, info, pvb::openni::parse_sim_uri(uri));
-      } catch (const std::exception& e) {
-        report("sim device: %s", e.what());
-        return nullptr;
-      }
+    const OniDeviceInfo* info = announced(uri);
+    if (!info) {
+      report("sim device: unknown URI %s", uri);
+      return nullptr;
     }
-    report("sim device: unknown URI %s", uri);
-    return nullptr;
+    try {
+      return new SimDevice(*this, *info, pvb::openni::parse_sim_uri(uri));
+    } catch (const std::exception& e) {
+      report("sim device: %s", e.what());
+      return nullptr;
+    }
   }
 
   void deviceClose(DeviceBase* device) override { delete static_cast<SimDevice*>(device); }
   void shutdown() override {}
-
-  void report(const char* format, ...) {
-    va_list args;
-    va_start(args, format);
-    pvb::openni::append_error(getServices(), format, args);
-    va_end(args);
-  }
-  void state_changed(const OniDeviceInfo& info, OniDeviceState state) { deviceStateChanged(&info, state); }
-  void disconnected(const OniDeviceInfo& info) { deviceDisconnected(&info); }
-
- private:
-  std::list<OniDeviceInfo> infos_;  // stable addresses: OpenNI2 keeps pointers
 };
 
 pvb::scenes::Scenario scenario_for(const pvb::openni::SimUri& uri) {

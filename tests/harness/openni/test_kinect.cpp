@@ -15,25 +15,20 @@
 #include <string>
 #include <vector>
 
+#include "cli_helpers.hpp"
 #include "pvb/common/text.hpp"
 
 namespace {
 
-const std::string kBin = std::string(PVB_BINARY_DIR) + "/bin/pvbench";
 constexpr int kFrames = 150;
 
-struct Result {
-  int code = -1;
-  std::string output;
-};
+using Result = pvb::test::CliResult;
+using pvb::test::data_lines;
+using pvb::test::expect_one_error_line;
+using pvb::test::json_number;
 
-/// Runs pvbench from the source folder; `env` goes before the command.
 Result run(const std::string& env, const std::string& args) {
-  const std::string log = ::testing::TempDir() + "pvb_kinect_" + std::to_string(::getpid()) + ".txt";
-  const std::string cmd = "cd " + std::string(PVB_SOURCE_DIR) + " && " + env + " timeout 300 " + kBin + " " +
-                          args + " > " + log + " 2>&1";
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, pvb::read_file(log)};
+  return pvb::test::run_pvbench(env + " timeout 300", args);
 }
 
 std::string fakenect_env(const std::string& dump) {
@@ -44,36 +39,6 @@ std::string fresh(const std::string& name) {
   const std::string d = ::testing::TempDir() + "pvb_kinect_" + name + "_" + std::to_string(::getpid());
   std::system(("rm -rf " + d + " && mkdir -p " + d).c_str());
   return d;
-}
-
-std::vector<std::string> data_lines(const std::string& path) {
-  std::vector<std::string> out;
-  std::ifstream in(path);
-  for (std::string l; std::getline(in, l);)
-    if (!l.empty() && l[0] != '#') out.push_back(l);
-  return out;
-}
-
-double json_number(const std::string& json, const std::string& key) {
-  const std::regex re("\"" + key + "\": ([-0-9.eE+]+)");
-  std::smatch m;
-  if (!std::regex_search(json, m, re)) return -1;
-  return std::stod(m[1]);
-}
-
-std::vector<std::string> error_lines(const std::string& output) {
-  std::vector<std::string> out;
-  std::istringstream in(output);
-  for (std::string l; std::getline(in, l);)
-    if (l.find("error") != std::string::npos) out.push_back(l);
-  return out;
-}
-
-void expect_one_error_line(const Result& r, const std::string& must_contain) {
-  EXPECT_NE(r.code, 0) << r.output;
-  const std::vector<std::string> errors = error_lines(r.output);
-  ASSERT_EQ(errors.size(), 1u) << r.output;
-  EXPECT_NE(errors[0].find(must_contain), std::string::npos) << errors[0];
 }
 
 std::string record_dump(const std::string& dir, int frames) {

@@ -1,12 +1,15 @@
 #pragma once
-// The stream half of this project's OpenNI2 driver plug-ins (sim://,
-// freenect://): one fixed video mode, no mirroring or cropping, frames
-// raised from cv::Mat images.  Header-only: each plug-in compiles its own.
+// What this project's OpenNI2 driver plug-ins (sim://, freenect://) share:
+// the stream (one fixed video mode, no mirroring or cropping, frames raised
+// from cv::Mat images) and the driver's error reports, device events and
+// list of announced devices.  Header-only: each plug-in compiles its own.
+#include <atomic>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdint>
 #include <cstring>
+#include <list>
 
 #define XN_NEW(type, ...) new type(__VA_ARGS__)
 #define XN_DELETE(p) delete (p)
@@ -156,7 +159,48 @@ class FrameStream : public StreamBase {
   OniVideoMode mode_;
   double fx_px_, fy_px_;
   int max_depth_mm_;
-  bool started_ = false;
+  std::atomic<bool> started_{false};  // read by a live driver's event thread
+};
+
+/// The driver half: reports go to OpenNI2's extended error, device events
+/// to its listeners; announced devices keep stable addresses (OpenNI2 keeps
+/// pointers to their info).
+class PluginDriver : public oni::driver::DriverBase {
+ public:
+  using DriverBase::DriverBase;
+
+  void report(const char* format, ...) {
+    va_list args;
+    va_start(args, format);
+    append_error(getServices(), format, args);
+    va_end(args);
+  }
+  void state_changed(const OniDeviceInfo& info, OniDeviceState state) { deviceStateChanged(&info, state); }
+  void disconnected(const OniDeviceInfo& info) { deviceDisconnected(&info); }
+
+ protected:
+  /// The announced device with this URI, or null.
+  const OniDeviceInfo* announced(const char* uri) const {
+    for (const OniDeviceInfo& info : infos_)
+      if (std::strcmp(info.uri, uri) == 0) return &info;
+    return nullptr;
+  }
+  /// Tells OpenNI2 of a device (once per URI).
+  void announce(const char* uri, const char* vendor, const char* name, std::uint16_t usb_vendor = 0,
+                std::uint16_t usb_product = 0) {
+    if (announced(uri)) return;
+    OniDeviceInfo info{};
+    std::snprintf(info.uri, sizeof info.uri, "%s", uri);
+    std::snprintf(info.vendor, sizeof info.vendor, "%s", vendor);
+    std::snprintf(info.name, sizeof info.name, "%s", name);
+    info.usbVendorId = usb_vendor;
+    info.usbProductId = usb_product;
+    infos_.push_back(info);
+    deviceConnected(&infos_.back());
+  }
+
+ private:
+  std::list<OniDeviceInfo> infos_;
 };
 
 }  // namespace pvb::openni
