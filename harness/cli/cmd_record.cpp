@@ -61,6 +61,7 @@ class FakenectDump {
   void write(const sensor::RgbdFrame& frame, const geom::StampedPose& gt) {
     cv::Mat depth_m = source_.last_depth_gt_m().clone();
     depth_m.setTo(0.0f, (depth_m < min_m_) | (depth_m > max_m_));
+    if (cv::countNonZero(frame.depth_m) == 0) depth_m = 0.0f;  // a covered lens (kidnap) sees nothing
     const Eigen::Vector3d up_w(0.0, 0.0, 9.80665);  // the specific force of a body at rest
     writer_.write(frame.t_ns, frame.rgb, registration_.encode_ir_raw(depth_m),
                   gt.T_w_c.linear().transpose() * up_w, gt.T_w_c);
