@@ -133,3 +133,17 @@ TEST(KinectCli, BrokenDumpsEndWithOneErrorAndKeepTheTrajectory) {
   }
   std::system(("rm -rf " + dir).c_str());
 }
+
+TEST(KinectCli, IndexPastTheDevicesAndBadUrisSaySo) {
+  const std::string dir = fresh("index");
+  const std::string dump = record_dump(dir, 2);
+  const std::string settings = " --settings " + std::string(PVB_SOURCE_DIR) + "/configs/kinect/kinect_v1.yaml";
+  expect_one_error_line(run(fakenect_env(dump), "camera --uri freenect://1" + settings + " --out " + dir + "/a"),
+                        "no Kinect 1 (libfreenect sees 1)");
+  expect_one_error_line(run(fakenect_env(dump), "camera --uri freenect://x" + settings + " --out " + dir + "/b"),
+                        "is not freenect://<index>");
+  expect_one_error_line(run(fakenect_env(dir + "/nothing"), "camera --uri freenect://0" + settings + " --out " +
+                                                                 dir + "/c"),
+                        "INDEX.txt");
+  std::system(("rm -rf " + dir).c_str());
+}
