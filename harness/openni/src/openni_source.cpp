@@ -344,13 +344,19 @@ std::optional<RecordingSummary> OpenniSource::Impl::stop() {
     }
     summary = RecordingSummary{options.record_path, s.frames_of(kOniNodeDepth), s.frames_of(kOniNodeImage)};
   }
-  if (depth.isValid()) {
-    depth.stop();
-    depth.destroy();
-  }
+  // Colour (created last) goes first, while depth still runs.  Debian's
+  // OniFile player thread walks its stream list without a lock until it
+  // finds a started stream, and destroying a stream unlinks and deletes it
+  // without one: with the first stream still started the walk never reaches
+  // the one being deleted.  (Destroying depth first crashed about one .oni
+  // replay in ten, at this point, in the player thread.)
   if (colour.isValid()) {
     colour.stop();
     colour.destroy();
+  }
+  if (depth.isValid()) {
+    depth.stop();
+    depth.destroy();
   }
   if (device.isValid()) device.close();
   if (listening) {
