@@ -1,0 +1,175 @@
+#include "pvb/eval/map_accuracy.hpp"
+
+#include <nanoflann.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+namespace pvb::eval {
+namespace {
+
+/// nanoflann's view of a point list.
+struct Cloud {
+  const std::vector<Eigen::Vector3d>& pts;
+  std::size_t kdtree_get_point_count() const { return pts.size(); }
+  double kdtree_get_pt(std::size_t i, std::size_t d) const { return pts[i][static_cast<int>(d)]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3, std::size_t>;
+
+/// For each of `from`: the index of and distance to its nearest of `to`.
+struct Nearest {
+  std::vector<std::size_t> index;
+  std::vector<double> dist_m;
+};
+
+Nearest nearest(const std::vector<Eigen::Vector3d>& from, const Tree* to) {
+  Nearest n;
+  n.index.assign(from.size(), 0);
+  n.dist_m.assign(from.size(), std::numeric_limits<double>::infinity());
+  if (!to) return n;
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    double d2 = 0;
+    if (to->knnSearch(from[i].data(), 1, &n.index[i], &d2) == 1) n.dist_m[i] = std::sqrt(d2);
+  }
+  return n;
+}
+
+DistanceSummary summarise(std::vector<double> d) {
+  DistanceSummary s;
+  s.count = d.size();
+  if (d.empty()) return s;
+  double sum = 0, sum2 = 0;
+  for (double x : d) {
+    sum += x;
+    sum2 += x * x;
+  }
+  s.mean = sum / static_cast<double>(d.size());
+  s.rmse = std::sqrt(sum2 / static_cast<double>(d.size()));
+  std::sort(d.begin(), d.end());
+  const std::size_t n = d.size();
+  s.median = n % 2 ? d[n / 2] : 0.5 * (d[n / 2 - 1] + d[n / 2]);
+  s.p95 = d[static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(n))) - 1];
+  return s;
+}
+
+double share_within(const std::vector<double>& d, double tau) {
+  if (d.empty()) return 0;
+  return static_cast<double>(std::count_if(d.begin(), d.end(), [tau](double x) { return x <= tau; })) /
+         static_cast<double>(d.size());
+}
+
+/// Ghosting of one surface point from the map points whose nearest surface
+/// point lies within the lateral radius: their offsets along this point's
+/// normal, split by a gap wider than 2 tau with enough points on each side.
+/// 0 no, 1 yes, -1 not judged (too few map points).
+int ghosted(std::size_t at, const std::vector<SurfacePoint>& surface, const Tree& surface_tree,
+            const std::vector<std::vector<std::size_t>>& map_by_surface, const std::vector<Eigen::Vector3d>& map,
+            const MapAccuracyOptions& o) {
+  const SurfacePoint& s = surface[at];
+  std::vector<std::pair<std::size_t, double>> near;
+  surface_tree.radiusSearch(s.p_w.data(), o.ghost_radius_m * o.ghost_radius_m, near, nanoflann::SearchParams());
+  std::vector<double> offsets;
+  for (const auto& [j, d2] : near)
+    for (std::size_t m : map_by_surface[j]) offsets.push_back((map[m] - s.p_w).dot(s.n_w));
+  const auto k = static_cast<std::size_t>(o.ghost_min_points);
+  if (offsets.size() < k) return -1;
+  std::sort(offsets.begin(), offsets.end());
+  for (std::size_t i = k; i + k <= offsets.size(); ++i)  // a gap with k points on each side
+    if (offsets[i] - offsets[i - 1] > 2.0 * o.ghost_tau_m) return 1;
+  return 0;
+}
+
+/// The scores of a subset: accuracy distances of its map points,
+/// completeness distances and ghost flags of its surface points.
+MapScores score(const std::vector<double>& acc, const std::vector<double>& comp, const std::vector<int>& ghosts,
+                const MapAccuracyOptions& o) {
+  MapScores s;
+  s.accuracy = summarise(acc);
+  s.completeness = summarise(comp);
+  for (double tau : o.tau_m) {
+    const double p = share_within(acc, tau), r = share_within(comp, tau);
+    s.precision_at.push_back(p);
+    s.completeness_at.push_back(r);
+    s.fscore_at.push_back(p + r > 0 ? 2 * p * r / (p + r) : 0.0);
+  }
+  s.chamfer_m = 0.5 * (s.accuracy.mean + s.completeness.mean);
+  std::size_t yes = 0;
+  for (int g : ghosts) {
+    if (g < 0) continue;
+    ++s.ghosting_judged;
+    yes += static_cast<std::size_t>(g);
+  }
+  s.ghosting = s.ghosting_judged ? static_cast<double>(yes) / static_cast<double>(s.ghosting_judged) : 0.0;
+  return s;
+}
+
+int range_bin(double range_m, const std::vector<double>& edges) {
+  if (range_m < 0) return -1;
+  for (std::size_t i = 0; i + 1 < edges.size(); ++i)
+    if (range_m >= edges[i] && range_m < edges[i + 1]) return static_cast<int>(i);
+  return -1;
+}
+
+/// Keeps the values whose key equals `key`.
+template <class T>
+std::vector<T> select(const std::vector<T>& v, const std::vector<int>& keys, int key) {
+  std::vector<T> out;
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (keys[i] == key) out.push_back(v[i]);
+  return out;
+}
+
+}  // namespace
+
+MapAccuracy evaluate_map(const std::vector<MapPoint>& map, const std::vector<SurfacePoint>& surface,
+                         const MapAccuracyOptions& options) {
+  if (surface.empty()) throw std::invalid_argument("evaluate_map: the ground-truth surface is empty");
+  std::vector<Eigen::Vector3d> map_p, surf_p;
+  for (const MapPoint& m : map) map_p.push_back(m.p_w);
+  for (const SurfacePoint& s : surface) surf_p.push_back(s.p_w);
+  const Cloud map_cloud{map_p}, surf_cloud{surf_p};
+  Tree surf_tree(3, surf_cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  surf_tree.buildIndex();
+  std::unique_ptr<Tree> map_tree;
+  if (!map_p.empty()) {
+    map_tree = std::make_unique<Tree>(3, map_cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+    map_tree->buildIndex();
+  }
+  const Nearest acc = nearest(map_p, &surf_tree);
+  const Nearest comp = nearest(surf_p, map_tree.get());
+  std::vector<std::vector<std::size_t>> map_by_surface(surface.size());
+  for (std::size_t i = 0; i < map.size(); ++i) map_by_surface[acc.index[i]].push_back(i);
+  std::vector<int> ghosts(surface.size(), -1);
+  for (std::size_t i = 0; i < surface.size(); ++i)
+    ghosts[i] = ghosted(i, surface, surf_tree, map_by_surface, map_p, options);
+
+  MapAccuracy out;
+  out.options = options;
+  out.all = score(acc.dist_m, comp.dist_m, ghosts, options);
+  std::vector<int> map_class(map.size()), surf_class(surface.size()), map_bin(map.size()), surf_bin(surface.size());
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    map_class[i] = surface[acc.index[i]].class_id;
+    map_bin[i] = range_bin(map[i].range_m, options.range_edges_m);
+  }
+  for (std::size_t i = 0; i < surface.size(); ++i) {
+    surf_class[i] = surface[i].class_id;
+    surf_bin[i] = range_bin(surface[i].range_m, options.range_edges_m);
+  }
+  for (int c : surf_class)
+    if (!out.per_class.count(c))
+      out.per_class[c] = score(select(acc.dist_m, map_class, c), select(comp.dist_m, surf_class, c),
+                               select(ghosts, surf_class, c), options);
+  for (int b = 0; b + 1 < static_cast<int>(options.range_edges_m.size()); ++b)
+    out.per_range.push_back(score(select(acc.dist_m, map_bin, b), select(comp.dist_m, surf_bin, b),
+                                  select(ghosts, surf_bin, b), options));
+  return out;
+}
+
+}  // namespace pvb::eval
