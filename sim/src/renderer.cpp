@@ -132,4 +132,32 @@ void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat
   }
 }
 
+void Renderer::render_geom_ids(const mjModel* model, mjData* data, int camera_id, cv::Mat* geom_id) {
+  gl_->make_current();
+  camera_.type = mjCAMERA_FIXED;
+  camera_.fixedcamid = camera_id;
+  mjv_updateScene(model, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
+  const unsigned char shadow = scene_.flags[mjRND_SHADOW];
+  scene_.flags[mjRND_SEGMENT] = 1;
+  scene_.flags[mjRND_IDCOLOR] = 1;
+  scene_.flags[mjRND_SHADOW] = 0;
+  const mjrRect viewport{0, 0, width_, height_};
+  mjr_render(viewport, &scene_, &con_);
+  mjr_readPixels(rgb_buf_.data(), nullptr, viewport, &con_);
+  scene_.flags[mjRND_SEGMENT] = 0;
+  scene_.flags[mjRND_IDCOLOR] = 0;
+  scene_.flags[mjRND_SHADOW] = shadow;
+  // IDCOLOR paints scene geom s as the 24-bit number s + 1 (0: background).
+  geom_id->create(height_, width_, CV_32SC1);
+  for (int r = 0; r < height_; ++r) {
+    const unsigned char* src = rgb_buf_.data() + static_cast<std::size_t>(height_ - 1 - r) * width_ * 3;
+    int* dst = geom_id->ptr<int>(r);
+    for (int c = 0; c < width_; ++c, src += 3) {
+      const int seg = (src[0] | (src[1] << 8) | (src[2] << 16)) - 1;
+      const bool is_geom = seg >= 0 && seg < scene_.ngeom && scene_.geoms[seg].objtype == mjOBJ_GEOM;
+      dst[c] = is_geom ? scene_.geoms[seg].objid : -1;
+    }
+  }
+}
+
 }  // namespace pvb::sim

@@ -34,6 +34,10 @@ class Renderer {
   /// (R, G, B order), depth_m CV_32FC1 metres (0 = nothing within zfar).
   void render(const mjModel* model, mjData* data, int camera_id, cv::Mat* rgb, cv::Mat* depth_m);
 
+  /// Renders which model geom each pixel shows (CV_32SC1, -1 = none), with
+  /// MuJoCo's segmentation mode (mjRND_SEGMENT + mjRND_IDCOLOR).
+  void render_geom_ids(const mjModel* model, mjData* data, int camera_id, cv::Mat* geom_id);
+
   /// Turns shadows on or off for the following renders.
   void set_shadows(bool on);
   /// Keeps the shadow-map texel grid of each directional shadow-casting

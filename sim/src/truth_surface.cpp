@@ -1,0 +1,144 @@
+#include "pvb/sim/truth_surface.hpp"
+
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <unordered_map>
+
+#include "pvb/sim/renderer.hpp"
+#include "pvb/sim/scene_builder.hpp"
+#include "pvb/sim/simulator.hpp"
+
+namespace pvb::sim {
+
+const char* to_string(SurfaceClass c) {
+  switch (c) {
+    case SurfaceClass::kGround: return "ground";
+    case SurfaceClass::kPanel: return "panel";
+    case SurfaceClass::kFrame: return "frame";
+    case SurfaceClass::kPost: return "post";
+    case SurfaceClass::kWall: return "wall";
+    case SurfaceClass::kShrub: return "shrub";
+    case SurfaceClass::kOther: break;
+  }
+  return "other";
+}
+
+SurfaceClass classify_geom(const mjModel* m, int g) {
+  const int mat = m->geom_matid[g];
+  if (mat < 0) return SurfaceClass::kOther;
+  const std::string name = mj_id2name(m, mjOBJ_MATERIAL, mat) ? mj_id2name(m, mjOBJ_MATERIAL, mat) : "";
+  if (name == "ground") return SurfaceClass::kGround;
+  if (name.find("panel") != std::string::npos) return SurfaceClass::kPanel;
+  if (name == "backsheet") return SurfaceClass::kFrame;
+  if (name == "steel") return m->geom_size[3 * g + 2] > 0.2 ? SurfaceClass::kPost : SurfaceClass::kFrame;
+  if (name == "brick" || name == "plaster") return SurfaceClass::kWall;
+  if (name == "foliage" || name == "bark") return SurfaceClass::kShrub;
+  return SurfaceClass::kOther;
+}
+
+Eigen::Vector3d geom_normal(const mjModel* m, const mjData* d, int g, const Eigen::Vector3d& p_w,
+                            const Eigen::Vector3d& eye_w) {
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> R(d->geom_xmat + 9 * g);
+  const Eigen::Map<const Eigen::Vector3d> x(d->geom_xpos + 3 * g);
+  const Eigen::Map<const Eigen::Vector3d> size(m->geom_size + 3 * g);
+  const Eigen::Vector3d p = R.transpose() * (p_w - x);
+  Eigen::Vector3d n;
+  switch (m->geom_type[g]) {
+    case mjGEOM_PLANE: n = Eigen::Vector3d::UnitZ(); break;
+    case mjGEOM_BOX: {  // the face the point is nearest to, relative to the half sizes
+      Eigen::Index axis = 0;
+      (p.cwiseAbs().cwiseQuotient(size)).maxCoeff(&axis);
+      n = Eigen::Vector3d::Unit(axis) * (p[axis] < 0 ? -1.0 : 1.0);
+      break;
+    }
+    case mjGEOM_SPHERE: n = p; break;
+    case mjGEOM_ELLIPSOID: n = p.cwiseQuotient(size.cwiseProduct(size)); break;
+    case mjGEOM_CYLINDER:
+      n = std::abs(p.z()) >= size[1] - 1e-4 ? Eigen::Vector3d(0, 0, p.z() < 0 ? -1 : 1)
+                                           : Eigen::Vector3d(p.x(), p.y(), 0);
+      break;
+    default: return (eye_w - p_w).normalized();
+  }
+  return (R * n).normalized();
+}
+
+namespace {
+
+struct VoxelKey {
+  std::int64_t k;
+  bool operator==(const VoxelKey& o) const { return k == o.k; }
+};
+struct VoxelHash {
+  std::size_t operator()(const VoxelKey& v) const { return std::hash<std::int64_t>()(v.k); }
+};
+
+VoxelKey voxel_of(const Eigen::Vector3d& p, double size) {
+  const auto q = [size](double v) { return static_cast<std::int64_t>(std::floor(v / size)) & 0x1FFFFF; };
+  return {(q(p.x()) << 42) | (q(p.y()) << 21) | q(p.z())};
+}
+
+bool is_robot_geom(const mjModel* m, int g, int robot_body) {
+  return robot_body >= 0 && m->body_rootid[m->geom_bodyid[g]] == robot_body;
+}
+
+/// Adds the pixels of one rendered frame to the voxel map.
+void add_frame(Simulator& sim, const cv::Mat& depth_m, const cv::Mat& geom_id, const scenes::Camera& cam,
+               int robot_body, double voxel_m, std::unordered_map<VoxelKey, TruthSample, VoxelHash>* voxels) {
+  const geom::PinholeIntrinsics K = sim.intrinsics();
+  const geom::SE3d T_w_c = sim.T_w_c();
+  const Eigen::Vector3d eye = T_w_c.translation();
+  for (int v = 0; v < depth_m.rows; ++v)
+    for (int u = 0; u < depth_m.cols; ++u) {
+      const double z = depth_m.at<float>(v, u);
+      const int g = geom_id.at<int>(v, u);
+      if (g < 0 || z < cam.depth_range_m[0] || z > cam.depth_range_m[1] || is_robot_geom(sim.model(), g, robot_body))
+        continue;
+      const Eigen::Vector3d p_c((u - K.cx) / K.fx * z, (v - K.cy) / K.fy * z, z);
+      const Eigen::Vector3d p_w = T_w_c * p_c;
+      const double range = p_c.norm();
+      auto [it, added] = voxels->try_emplace(voxel_of(p_w, voxel_m));
+      TruthSample& s = it->second;
+      if (added) {
+        s.p_w = p_w;
+        s.cls = classify_geom(sim.model(), g);
+        s.n_w = geom_normal(sim.model(), sim.data(), g, p_w, eye);
+        s.range_m = range;
+      } else if (range < s.range_m) {
+        s.range_m = range;
+      }
+    }
+}
+
+}  // namespace
+
+std::vector<TruthSample> sample_truth_surface(const scenes::Scenario& scenario, GlBackend backend,
+                                              const TruthSurfaceOptions& options) {
+  Simulator sim(scenario);
+  Renderer renderer(sim.model(), backend, scenario.camera.width, scenario.camera.height);
+  const int robot_body = mj_name2id(sim.model(), mjOBJ_BODY, kRobotBody);
+  const int n = scenes::frame_count(scenario, options.frames);
+  std::unordered_map<VoxelKey, TruthSample, VoxelHash> voxels;
+  cv::Mat depth, ids;
+  for (int i = 0; i < n; ++i) {
+    if (i > 0) sim.advance();
+    if (i % std::max(1, options.every) != 0) continue;
+    renderer.render(sim.model(), sim.data(), sim.camera_id(), nullptr, &depth);
+    renderer.render_geom_ids(sim.model(), sim.data(), sim.camera_id(), &ids);
+    add_frame(sim, depth, ids, scenario.camera, robot_body, options.voxel_m, &voxels);
+  }
+  // Sort by voxel key: the output does not depend on hash-table order.
+  std::vector<std::pair<std::int64_t, TruthSample>> sorted;
+  sorted.reserve(voxels.size());
+  for (const auto& [k, s] : voxels) sorted.emplace_back(k.k, s);
+  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<TruthSample> out;
+  out.reserve(sorted.size());
+  for (const auto& [k, s] : sorted) out.push_back(s);
+  return out;
+}
+
+}  // namespace pvb::sim
