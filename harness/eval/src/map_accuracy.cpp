@@ -129,7 +129,7 @@ std::vector<T> select(const std::vector<T>& v, const std::vector<int>& keys, int
 }  // namespace
 
 MapAccuracy evaluate_map(const std::vector<MapPoint>& map, const std::vector<SurfacePoint>& surface,
-                         const MapAccuracyOptions& options) {
+                         const MapAccuracyOptions& options, std::vector<MapPointScore>* per_point) {
   if (surface.empty()) throw std::invalid_argument("evaluate_map: the ground-truth surface is empty");
   std::vector<Eigen::Vector3d> map_p, surf_p;
   for (const MapPoint& m : map) map_p.push_back(m.p_w);
@@ -155,8 +155,13 @@ MapAccuracy evaluate_map(const std::vector<MapPoint>& map, const std::vector<Sur
   out.all = score(acc.dist_m, comp.dist_m, ghosts, options);
   std::vector<int> map_class(map.size()), surf_class(surface.size()), map_bin(map.size()), surf_bin(surface.size());
   for (std::size_t i = 0; i < map.size(); ++i) {
-    map_class[i] = surface[acc.index[i]].class_id;
-    map_bin[i] = range_bin(map[i].range_m, options.range_edges_m);
+    const SurfacePoint& nearest_surface = surface[acc.index[i]];
+    map_class[i] = nearest_surface.class_id;
+    map_bin[i] = range_bin(map[i].range_m >= 0 ? map[i].range_m : nearest_surface.range_m, options.range_edges_m);
+  }
+  if (per_point) {
+    per_point->resize(map.size());
+    for (std::size_t i = 0; i < map.size(); ++i) (*per_point)[i] = {map_class[i], acc.dist_m[i]};
   }
   for (std::size_t i = 0; i < surface.size(); ++i) {
     surf_class[i] = surface[i].class_id;

@@ -70,9 +70,18 @@ struct MapAccuracy {
   MapAccuracyOptions options;
 };
 
-/// Scores `map` against `surface`.  Throws std::invalid_argument when the
-/// surface is empty.
+/// What one map point scored: the class of its nearest surface point and
+/// its distance to it.
+struct MapPointScore {
+  int class_id = 0;
+  double error_m = 0;
+};
+
+/// Scores `map` against `surface`.  A map point of unknown range takes the
+/// range of its nearest surface point.  `per_point`, when given, receives
+/// one score per map point.  Throws std::invalid_argument when the surface
+/// is empty.
 MapAccuracy evaluate_map(const std::vector<MapPoint>& map, const std::vector<SurfacePoint>& surface,
-                         const MapAccuracyOptions& options = {});
+                         const MapAccuracyOptions& options = {}, std::vector<MapPointScore>* per_point = nullptr);
 
 }  // namespace pvb::eval
