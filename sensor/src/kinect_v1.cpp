@@ -119,8 +119,8 @@ cv::Mat DepthRegistration::register_to_colour_mm(const cv::Mat& raw_ir) const {
   // Pass 2, libfreenect's dense registration: a target also covers the
   // pixels left, up and up-left of it.  Here only pixels that pass 1 left
   // empty are filled (libfreenect overwrites them), from the nearest of the
-  // right, lower and lower-right targets.
-  cv::Mat dense = out.clone();
+  // right, lower and lower-right targets.  In place: a pixel reads only
+  // pixels after it in raster order, which still hold pass 1's values.
   for (int y = 0; y < out.rows; ++y) {
     for (int x = 0; x < out.cols; ++x) {
       if (out.at<std::uint16_t>(y, x) != 0) continue;
@@ -132,10 +132,10 @@ cv::Mat DepthRegistration::register_to_colour_mm(const cv::Mat& raw_ir) const {
         const std::uint16_t z = out.at<std::uint16_t>(sy, sx);
         if (z != 0 && (best == 0 || z < best)) best = z;
       }
-      dense.at<std::uint16_t>(y, x) = best;
+      out.at<std::uint16_t>(y, x) = best;
     }
   }
-  return dense;
+  return out;
 }
 
 }  // namespace pvb::sensor::kinect

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <unordered_map>
 
@@ -81,13 +82,20 @@ VoxelKey voxel_of(const Eigen::Vector3d& p, double size) {
   return {(q(p.x()) << 42) | (q(p.y()) << 21) | q(p.z())};
 }
 
-bool is_robot_geom(const mjModel* m, int g, int robot_body) {
-  return robot_body >= 0 && m->body_rootid[m->geom_bodyid[g]] == robot_body;
+/// The class of every geom of the model, nullopt for the robot's own.
+std::vector<std::optional<SurfaceClass>> geom_classes(const mjModel* m) {
+  const int robot_body = mj_name2id(m, mjOBJ_BODY, kRobotBody);
+  std::vector<std::optional<SurfaceClass>> classes(static_cast<std::size_t>(m->ngeom));
+  for (int g = 0; g < m->ngeom; ++g)
+    if (robot_body < 0 || m->body_rootid[m->geom_bodyid[g]] != robot_body)
+      classes[static_cast<std::size_t>(g)] = classify_geom(m, g);
+  return classes;
 }
 
 /// Adds the pixels of one rendered frame to the voxel map.
 void add_frame(Simulator& sim, const cv::Mat& depth_m, const cv::Mat& geom_id, const scenes::Camera& cam,
-               int robot_body, double voxel_m, std::unordered_map<VoxelKey, TruthSample, VoxelHash>* voxels) {
+               const std::vector<std::optional<SurfaceClass>>& classes, double voxel_m,
+               std::unordered_map<VoxelKey, TruthSample, VoxelHash>* voxels) {
   const geom::PinholeIntrinsics K = sim.intrinsics();
   const geom::SE3d T_w_c = sim.T_w_c();
   const Eigen::Vector3d eye = T_w_c.translation();
@@ -95,7 +103,7 @@ void add_frame(Simulator& sim, const cv::Mat& depth_m, const cv::Mat& geom_id, c
     for (int u = 0; u < depth_m.cols; ++u) {
       const double z = depth_m.at<float>(v, u);
       const int g = geom_id.at<int>(v, u);
-      if (g < 0 || z < cam.depth_range_m[0] || z > cam.depth_range_m[1] || is_robot_geom(sim.model(), g, robot_body))
+      if (g < 0 || z < cam.depth_range_m[0] || z > cam.depth_range_m[1] || !classes[static_cast<std::size_t>(g)])
         continue;
       const Eigen::Vector3d p_c((u - K.cx) / K.fx * z, (v - K.cy) / K.fy * z, z);
       const Eigen::Vector3d p_w = T_w_c * p_c;
@@ -104,7 +112,7 @@ void add_frame(Simulator& sim, const cv::Mat& depth_m, const cv::Mat& geom_id, c
       TruthSample& s = it->second;
       if (added) {
         s.p_w = p_w;
-        s.cls = classify_geom(sim.model(), g);
+        s.cls = *classes[static_cast<std::size_t>(g)];
         s.n_w = geom_normal(sim.model(), sim.data(), g, p_w, eye);
         s.range_m = range;
       } else if (range < s.range_m) {
@@ -119,7 +127,7 @@ std::vector<TruthSample> sample_truth_surface(const scenes::Scenario& scenario, 
                                               const TruthSurfaceOptions& options) {
   Simulator sim(scenario);
   Renderer renderer(sim.model(), backend, scenario.camera.width, scenario.camera.height);
-  const int robot_body = mj_name2id(sim.model(), mjOBJ_BODY, kRobotBody);
+  const std::vector<std::optional<SurfaceClass>> classes = geom_classes(sim.model());
   const int n = scenes::frame_count(scenario, options.frames);
   std::unordered_map<VoxelKey, TruthSample, VoxelHash> voxels;
   cv::Mat depth, ids;
@@ -128,7 +136,7 @@ std::vector<TruthSample> sample_truth_surface(const scenes::Scenario& scenario, 
     if (i % std::max(1, options.every) != 0) continue;
     renderer.render(sim.model(), sim.data(), sim.camera_id(), nullptr, &depth);
     renderer.render_geom_ids(sim.model(), sim.data(), sim.camera_id(), &ids);
-    add_frame(sim, depth, ids, scenario.camera, robot_body, options.voxel_m, &voxels);
+    add_frame(sim, depth, ids, scenario.camera, classes, options.voxel_m, &voxels);
   }
   // Sort by voxel key: the output does not depend on hash-table order.
   std::vector<std::pair<std::int64_t, TruthSample>> sorted;

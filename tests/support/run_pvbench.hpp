@@ -37,6 +37,17 @@ inline RunResult run_pvbench(const std::string& args) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(log)};
 }
 
+/// Runs `ENV pvbench ARGS` from the source folder, so that relative paths
+/// such as sim://scenes/... resolve as in the README; ENV goes before the
+/// program (variable assignments, or a wrapper such as `timeout 300`).
+inline RunResult run_pvbench_from_source(const std::string& env, const std::string& args) {
+  const std::string log = ::testing::TempDir() + "pvb_run_" + std::to_string(::getpid()) + ".txt";
+  const std::string cmd =
+      "cd " + std::string(PVB_SOURCE_DIR) + " && " + env + " " + pvbench_path() + " " + args + " > " + log + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(log)};
+}
+
 /// Runs `pvbench ARGS` with every file it writes capped at `max_kib` KiB
 /// (a disk that fills up): SIGXFSZ ignored, so a write past the cap fails
 /// with EFBIG instead of killing the program.

@@ -118,7 +118,6 @@ class FreenectDevice : public DeviceBase {
   bool streaming_ = false;
   bool finished_ = false;
   // playback
-  std::string dump_dir_;
   std::vector<pvb::dataset::FakenectEntry> entries_;
   std::size_t next_entry_ = 0;
   std::optional<kinect::DepthRegistration> registration_;
@@ -239,9 +238,9 @@ FreenectDevice::FreenectDevice(FreenectDriver& driver, const OniDeviceInfo& info
                                freenect_device* dev, bool playback)
     : driver_(driver), info_(info), ctx_(ctx), dev_(dev), playback_(playback) {
   if (playback_) {
-    dump_dir_ = std::getenv("FAKENECT_PATH");
-    entries_ = pvb::dataset::read_fakenect_index(dump_dir_);
-    registration_.emplace(pvb::dataset::read_fakenect_calibration(dump_dir_));
+    const std::string dump = std::getenv("FAKENECT_PATH");  // checked by the driver's open_context()
+    entries_ = pvb::dataset::read_fakenect_index(dump);
+    registration_.emplace(pvb::dataset::read_fakenect_calibration(dump));
   }
   freenect_set_user(dev_, this);
   freenect_set_depth_callback(dev_, depth_callback);

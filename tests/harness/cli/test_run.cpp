@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "pvb/common/text.hpp"
+#include "cli_output.hpp"
 #include "run_pvbench.hpp"
 
 using namespace pvb;
@@ -30,14 +31,7 @@ std::string fresh(const std::string& name) {
 
 bool exists(const std::string& path) { return std::ifstream(path).good(); }
 
-/// Data lines (not '#' comments) of a text file.
-std::vector<std::string> data_lines(const std::string& path) {
-  std::vector<std::string> out;
-  std::ifstream in(path);
-  for (std::string l; std::getline(in, l);)
-    if (!l.empty() && l[0] != '#') out.push_back(l);
-  return out;
-}
+using pvb::test::data_lines;
 
 YAML::Node metrics(const std::string& dir) { return YAML::Load(read_file(dir + "/metrics.json")); }
 

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "cli_helpers.hpp"
+#include "cli_output.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/openni/oni_file.hpp"
 
@@ -26,12 +26,12 @@ namespace {
 const std::string kBin = std::string(PVB_BINARY_DIR) + "/bin/pvbench";
 constexpr int kFrames = PVB_CAMERA_FRAMES;
 
-using Result = pvb::test::CliResult;
+using Result = pvb::test::RunResult;
 using pvb::test::data_lines;
 using pvb::test::expect_one_error_line;
 using pvb::test::json_number;
 
-Result run(const std::string& args) { return pvb::test::run_pvbench("", args); }
+Result run(const std::string& args) { return pvb::test::run_pvbench_from_source("", args); }
 
 std::string fresh(const std::string& name) {
   const std::string d = ::testing::TempDir() + "pvb_cam_" + name + "_" + std::to_string(kFrames) + "_" +

@@ -15,20 +15,20 @@
 #include <string>
 #include <vector>
 
-#include "cli_helpers.hpp"
+#include "cli_output.hpp"
 #include "pvb/common/text.hpp"
 
 namespace {
 
 constexpr int kFrames = 150;
 
-using Result = pvb::test::CliResult;
+using Result = pvb::test::RunResult;
 using pvb::test::data_lines;
 using pvb::test::expect_one_error_line;
 using pvb::test::json_number;
 
 Result run(const std::string& env, const std::string& args) {
-  return pvb::test::run_pvbench(env + " timeout 300", args);
+  return pvb::test::run_pvbench_from_source(env + " timeout 300", args);
 }
 
 std::string fakenect_env(const std::string& dump) {
@@ -49,12 +49,18 @@ std::string record_dump(const std::string& dir, int frames) {
   return dump;
 }
 
-/// Replaces the file on line `line` of the dump's INDEX.txt (1-based) with
-/// `content`, or removes it when `content` is null.
-std::string break_entry(const std::string& dump, int line, const std::string* content) {
+/// The file named on line `line` (1-based) of the dump's INDEX.txt.
+std::string index_entry(const std::string& dump, int line) {
   std::ifstream in(dump + "/INDEX.txt");
   std::string name;
   for (int i = 0; i < line; ++i) std::getline(in, name);
+  return name;
+}
+
+/// Replaces the file on line `line` of the dump's INDEX.txt with `content`,
+/// or removes it when `content` is null.
+std::string break_entry(const std::string& dump, int line, const std::string* content) {
+  const std::string name = index_entry(dump, line);
   const std::string path = dump + "/" + name;
   std::remove(path.c_str());
   if (content) std::ofstream(path, std::ios::binary) << *content;
@@ -109,12 +115,7 @@ TEST(KinectCli, BrokenDumpsEndWithOneErrorAndKeepTheTrajectory) {
     bool remove;
     const char* expect;
   };
-  const std::string full_depth = pvb::read_file(dump + "/" + [&] {
-    std::ifstream in(dump + "/INDEX.txt");
-    std::string n;
-    for (int i = 0; i < line_of_depth; ++i) std::getline(in, n);
-    return n;
-  }());
+  const std::string full_depth = pvb::read_file(dump + "/" + index_entry(dump, line_of_depth));
   const Case cases[] = {
       {"truncated", line_of_depth, full_depth.substr(0, full_depth.size() / 3), false, "truncated"},
       {"missing", line_of_depth + 1, "", true, "missing"},

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "pvb/common/text.hpp"
+#include "cli_output.hpp"
 #include "run_pvbench.hpp"
 #include "station_sequence.hpp"
 
@@ -36,11 +37,7 @@ std::string dir(const std::string& name) {
 
 using pvb::test::station_sequence;
 
-double json_number(const std::string& json, const std::string& key) {
-  std::smatch m;
-  if (!std::regex_search(json, m, std::regex("\"" + key + "\": *([-0-9.eE+]+)"))) return -1;
-  return std::stod(m[1]);
-}
+using pvb::test::json_number;
 
 /// The "local_mapping": {...} object of stats.json (empty when missing).
 std::string local_mapping_json(const std::string& stats) {
