@@ -61,6 +61,32 @@ void BM_GlobalRebuild(benchmark::State& state) {
 }
 BENCHMARK(BM_GlobalRebuild)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 
+/// A loop correction: n keyframes in the map, every one moved by 1 cm and
+/// re-binned (update_poses), as after the loop scenario's correction.
+void BM_LoopUpdate(benchmark::State& state) {
+  const Images im = make_images();
+  dn::DenseMapperOptions o;
+  dn::DenseMapper mapper(o);
+  const int n = static_cast<int>(state.range(0));
+  dn::PoseUpdate a, b;
+  for (int i = 0; i < n; ++i) {
+    const auto T = pvb::geom::make_se3(pvb::geom::Mat3d::Identity(), Eigen::Vector3d(0.05 * i, 0.01 * (i % 7), 0));
+    mapper.insert({static_cast<std::uint64_t>(i), i, im.rgb, im.depth_m, T});
+    a.T_w_c_by_id[i] = T;
+    b.T_w_c_by_id[i] = pvb::geom::make_se3(pvb::geom::Mat3d::Identity(), Eigen::Vector3d(0, 0, 0.01)) * T;
+  }
+  bool flip = false;
+  for (auto _ : state) {
+    mapper.update_poses(flip ? a : b);
+    flip = !flip;
+  }
+  state.counters["points_per_keyframe"] =
+      static_cast<double>(mapper.stats().points) / static_cast<double>(mapper.stats().keyframes);
+  state.counters["keyframes_moved_per_update"] =
+      static_cast<double>(mapper.stats().keyframes_moved) / static_cast<double>(mapper.stats().pose_updates);
+}
+BENCHMARK(BM_LoopUpdate)->Arg(250)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 
 BENCHMARK_MAIN();

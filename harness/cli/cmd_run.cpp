@@ -23,6 +23,7 @@ struct RunArgs {
   std::optional<std::uint64_t> seed;
   bool baseline = false;
   bool no_loop_closing = false;
+  bool no_map_eval = false;
   bool compare = false;
   bool check = false;
   bool no_pace = false;
@@ -37,6 +38,7 @@ int run_run(RunArgs& a) {
   o.seed = a.seed;
   o.pace = !a.no_pace;
   o.loop_closing = !a.no_loop_closing;
+  o.map_eval = !a.no_map_eval;
   o.mode = a.compare    ? run::SlamMode::kCompare
            : a.baseline ? run::SlamMode::kBaseline
                         : run::SlamMode::kPeSlam;
@@ -75,6 +77,8 @@ Command add_run_command(CLI::App& app) {
   sub->add_flag("--sync", args->options.sync, "synchronous: no threads, bit-identical runs");
   sub->add_flag("--no-loop-closing", args->no_loop_closing,
                 "switch loop closing off (LoopClosing.enabled: 0)");
+  sub->add_flag("--no-map-eval", args->no_map_eval,
+                "write the dense maps without scoring them against the true surface");
   sub->add_flag("--baseline", args->baseline,
                 "run the baseline (PE-match off: ORB-SLAM2's motion model) instead of PE-SLAM");
   sub->add_flag("--compare", args->compare, "run PE-SLAM and the baseline on the same rendered frames");

@@ -57,6 +57,7 @@ struct SweepArgs {
   bool compare = false;
   bool baseline = false;
   bool sync = false;
+  bool no_map_eval = false;
   std::string gl;
   bool print_commands = false;
   bool aggregate_only = false;
@@ -81,6 +82,7 @@ std::vector<std::string> run_args(const SweepArgs& a, std::uint64_t seed) {
   if (a.compare) v.push_back("--compare");
   if (a.baseline) v.push_back("--baseline");
   if (a.sync) v.push_back("--sync");
+  if (a.no_map_eval) v.push_back("--no-map-eval");
   if (!a.gl.empty()) {
     v.push_back("--gl");
     v.push_back(a.gl);
@@ -352,6 +354,7 @@ Command add_sweep_command(CLI::App& app) {
   sub->add_flag("--compare", args->compare, "passed to pvbench run: PE-SLAM and the baseline (PE-match off)");
   sub->add_flag("--baseline", args->baseline, "passed to pvbench run: the baseline alone (PE-match off)");
   sub->add_flag("--sync", args->sync, "passed to pvbench run: synchronous, bit-reproducible SLAM");
+  sub->add_flag("--no-map-eval", args->no_map_eval, "passed to pvbench run: dense maps written, not scored");
   sub->add_option("--gl", args->gl, "passed to pvbench run: rendering backend")
       ->check(CLI::IsMember({"auto", "egl", "osmesa"}));
   sub->add_flag("--print-commands", args->print_commands,

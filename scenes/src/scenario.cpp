@@ -419,6 +419,8 @@ void read_expect(MapReader& r, Expectations& e) {
   if (r.has("relocalised_within_frames"))
     e.relocalised_within_frames = r.integer("relocalised_within_frames", 0, 1, 1000000);
   if (r.has("loops_min")) e.loops_min = r.integer("loops_min", 0, 1, 1000000);
+  if (r.has("map_accuracy_m_max")) e.map_accuracy_m_max = r.number("map_accuracy_m_max", 0.0, 1e-6, 100);
+  if (r.has("map_completeness_min")) e.map_completeness_min = r.number("map_completeness_min", 0.0, 0.0, 1.0);
   if (r.has("pe_not_worse_than_baseline"))
     r.fail(r.full("pe_not_worse_than_baseline"), r.child("pe_not_worse_than_baseline"),
            "expect.sweep.pe_not_significantly_worse instead (PE-SLAM against the baseline is judged over "

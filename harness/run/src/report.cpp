@@ -55,6 +55,7 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
   if (run.local_mapping) out += in + "\"local_mapping\": " + slam::to_json(*run.local_mapping) + ",\n";
   if (!run.loop_closing_json.empty()) out += in + "\"loop_closing\": " + run.loop_closing_json + ",\n";
   if (run.place) out += in + "\"place_recognition\": " + place_json(*run.place) + ",\n";
+  if (run.dense_map) out += in + "\"dense_map\": " + dense_map_json(*run.dense_map, in) + ",\n";
   out += in + "\"tracking_ms\": {\"median\": " + num(percentile(ms, 0.5)) +
          ", \"mean\": " + num(mean_of(ms)) + ", \"p95\": " + num(percentile(ms, 0.95)) + "},\n";
   out += in + "\"loss_events\": [";
@@ -90,6 +91,35 @@ std::string run_fields(const RunReport& r, const std::string& in) {
 }
 
 }  // namespace
+
+const MapResult* DenseMapReport::find(const std::string& name) const {
+  for (const MapResult& m : maps)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+std::string dense_map_json(const DenseMapReport& d, const std::string& in) {
+  std::string out = "{\"keyframes\": " + std::to_string(d.keyframes) + ", \"points\": " + std::to_string(d.points) +
+                    ", \"live_points\": " + std::to_string(d.live_points) +
+                    ", \"pose_updates\": " + std::to_string(d.pose_updates) +
+                    ", \"keyframes_moved\": " + std::to_string(d.keyframes_moved) +
+                    ", \"update_ms\": {\"median\": " + num(d.update_ms_median) + ", \"max\": " + num(d.update_ms_max) +
+                    "}, \"loop_update_ms\": [";
+  for (std::size_t i = 0; i < d.loop_update_ms.size(); ++i) out += (i ? ", " : "") + num(d.loop_update_ms[i]);
+  out += "], \"files\": [\"PointCloud.ply\", \"PointCloud_live.ply\"";
+  if (d.loop_snapshot) out += ", \"PointCloud_before_loop.ply\", \"PointCloud_after_loop.ply\"";
+  out += "]";
+  if (!d.note.empty()) out += ", \"note\": " + str(d.note);
+  if (!d.maps.empty()) {
+    out += ",\n" + in + "  \"alignment\": " + str(d.alignment) + ", \"surface_samples\": " +
+           std::to_string(d.surface_samples) + ", \"truth_s\": " + num(d.truth_s) + ",\n" + in + "  \"maps\": {";
+    for (std::size_t i = 0; i < d.maps.size(); ++i)
+      out += std::string(i ? "," : "") + "\n" + in + "    " + str(d.maps[i].name) + ": " +
+             map_accuracy_json(d.maps[i].accuracy, static_cast<int>(in.size()) + 4);
+    out += "\n" + in + "  }";
+  }
+  return out + "}";
+}
 
 std::string place_json(const PlaceRecognition& p) {
   std::string out = "{\"loops_proposed\": " + std::to_string(p.loops_proposed) +
@@ -442,6 +472,55 @@ std::string figures_section(const std::vector<std::string>& figures) {
   return h;
 }
 
+/// One row of a map-scores table.
+std::string map_scores_row(const std::string& name, const eval::MapScores& m) {
+  auto pct = [](const std::vector<double>& v, std::size_t i) { return i < v.size() ? fixed(100 * v[i], 1) : "-"; };
+  return "<tr><td>" + html_escape(name) + "</td><td>" + std::to_string(m.accuracy.count) + "</td><td>" +
+         fixed(1000 * m.accuracy.median, 1) + " / " + fixed(1000 * m.accuracy.mean, 1) + " / " +
+         fixed(1000 * m.accuracy.p95, 1) + "</td><td>" + pct(m.completeness_at, 1) + " / " +
+         pct(m.completeness_at, 2) + "</td><td>" + (m.fscore_at.size() > 1 ? fixed(m.fscore_at[1], 3) : "-") +
+         "</td><td>" + fixed(100 * m.ghosting, 2) + "</td></tr>\n";
+}
+
+const char* const kMapTableHead =
+    "<table><tr><th></th><th>points</th><th>accuracy median / mean / p95 [mm]</th>"
+    "<th>complete within 2 / 5 cm [%]</th><th>F at 2 cm</th><th>ghosting [%]</th></tr>\n";
+
+/// One system's dense map: its versions, the corrected map per class, the figure.
+std::string dense_map_part(const SlamRun& run) {
+  const DenseMapReport& d = *run.dense_map;
+  std::string h = "<h3>" + html_escape(eval::mode_label(run.mode)) + "</h3>\n<p>" + std::to_string(d.keyframes) +
+                  " keyframes; corrected map " + std::to_string(d.points) + " points, live map " +
+                  std::to_string(d.live_points) + "; " + std::to_string(d.pose_updates) + " pose updates re-binned " +
+                  std::to_string(d.keyframes_moved) + " keyframes (median " + fixed(d.update_ms_median, 1) +
+                  " ms, max " + fixed(d.update_ms_max, 1) + " ms)";
+  for (double ms : d.loop_update_ms) h += "; a loop correction reached the map in " + fixed(ms, 1) + " ms";
+  h += ".</p>\n";
+  if (d.maps.empty()) return h + "<p>Not scored: " + html_escape(d.note) + "</p>\n";
+  h += "<p>Against the true surface (" + std::to_string(d.surface_samples) + " samples; maps put into the world by " +
+       (d.alignment == "first" ? std::string("the first frame's pose") : "the ATE's alignment") + "):</p>\n" +
+       kMapTableHead;
+  for (const MapResult& m : d.maps) h += map_scores_row(m.name, m.accuracy.all);
+  h += "</table>\n";
+  if (const MapResult* c = d.find("corrected")) {
+    h += "<p>The corrected map per surface class:</p>\n" + std::string(kMapTableHead);
+    for (const auto& [cls, scores] : c->accuracy.per_class)
+      h += map_scores_row(sim::to_string(static_cast<sim::SurfaceClass>(cls)), scores);
+    h += "</table>\n";
+  }
+  if (!d.top_view.empty())
+    h += "<p><img src=\"" + html_escape(d.top_view) + "\" alt=\"map error, top view\"></p>\n";
+  return h;
+}
+
+/// "Dense map": every system's maps and scores (nothing without dense mapping).
+std::string dense_map_section(const RunReport& r) {
+  std::string h;
+  for (const SlamRun* run : {&r.primary, r.baseline ? &*r.baseline : nullptr})
+    if (run && run->dense_map) h += dense_map_part(*run);
+  return h.empty() ? h : "<h2>Dense map</h2>\n" + h;
+}
+
 /// "Where the time went": the profile (nothing when there is none).
 std::string profile_section(const RunReport& r) {
   if (r.profile.empty()) return {};
@@ -462,6 +541,12 @@ std::string files_and_log(const RunReport& r) {
   for (const char* f : {"metrics.json", "groundtruth.txt", "CameraTrajectory.txt", "KeyFrameTrajectory.txt",
                         "timing.csv", "camera.yaml", "run.log"})
     h += std::string("<li><a href=\"") + f + "\">" + f + "</a></li>\n";
+  if (r.primary.dense_map) {
+    std::vector<std::string> maps = {"PointCloud.ply", "PointCloud_live.ply"};
+    if (r.primary.dense_map->loop_snapshot) maps.insert(maps.end(), {"PointCloud_before_loop.ply", "PointCloud_after_loop.ply"});
+    if (!r.primary.dense_map->maps.empty()) maps.push_back("map_errors.ply");
+    for (const std::string& f : maps) h += "<li><a href=\"" + f + "\">" + f + "</a></li>\n";
+  }
   if (r.baseline)
     for (const char* f :
          {"baseline/CameraTrajectory.txt", "baseline/KeyFrameTrajectory.txt", "baseline/timing.csv"})
@@ -483,6 +568,7 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
     h += "<h2>PE-SLAM against the " + std::string(eval::kBaselineLabel) + "</h2>\n<pre>" +
          html_escape(table) + "</pre>\n";
   h += figures_section(figures);
+  h += dense_map_section(r);
   h += profile_section(r);
   h += files_and_log(r);
   return h;

@@ -13,6 +13,7 @@
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/slam/core/settings.hpp"
+#include "map_scoring.hpp"
 #include "run_log.hpp"
 #include "system_sink.hpp"
 
@@ -198,6 +199,18 @@ double evaluate_systems(SystemSinks& sinks, const eval::Trajectory& gt) {
   return ms_since(t_eval);
 }
 
+/// The dense maps scored against the true surface, unless the options say
+/// not to; returns the time it took (ms).
+double score_or_skip_maps(const RunOptions& opt, const scenes::Scenario& scenario, sim::GlBackend backend,
+                          const eval::Trajectory& gt, SystemSinks& sinks, RunLog& log) {
+  if (opt.map_eval && !gt.empty()) return score_dense_maps(scenario, backend, gt, sinks, log);
+  for (auto& sink : sinks) {
+    if (sink->run.dense_map) sink->run.dense_map->note = opt.map_eval ? "no frames" : "not scored (--no-map-eval)";
+    sink->clouds.clear();
+  }
+  return 0.0;
+}
+
 /// Pipelined: the queue waits, the latency from due to tracked, and the CPU
 /// time of each thread (group) over the loop: pvb-render (physics, GL
 /// calls), llvmpipe (its rasteriser workers), pvb-sensor, pvbench (this
@@ -345,10 +358,12 @@ RunReport run_scenario(const RunOptions& opt) {
   finish_loop(opt, loop, consumer.aborted(), n, sinks, report, log);
   gt.close();
   const double eval_ms = evaluate_systems(sinks, gt.trajectory());
+  const double map_ms = score_or_skip_maps(opt, scenario, backend, gt.trajectory(), sinks, log);
   if (closed_loop) report.closed_loop = closed_loop->metrics();
   report.primary = sinks.front()->run;
   if (sinks.size() > 1) report.baseline = sinks[1]->run;
   report.profile = profile_entries(opt, loop, consumer.costs(), sinks, report.primary.frames, eval_ms);
+  report.profile.push_back({"map_eval", map_ms, 1, "main"});
   log_summary(report, log);
 
   write_run_report(report, log, opt.out_dir);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pvb/common/output_file.hpp"
@@ -28,6 +29,9 @@ struct SystemSink {
   slam::TrackingState prev_state = slam::TrackingState::kNotInitialized;
   double tracking_ms = 0, orb_ms = 0, inline_mapping_ms = 0;
   std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made, for the revisit labels
+  /// The dense maps written by finish(), by name (corrected, live, and
+  /// before_loop / after_loop when a loop was closed); kept for scoring.
+  std::vector<std::pair<std::string, slam::dense::PointCloud>> clouds;
 
   SystemSink(const std::string& mode, const slam::Settings& settings, bool sync, std::uint32_t seed,
              const std::string& out_dir);
@@ -35,13 +39,16 @@ struct SystemSink {
   /// Tracks one frame, writes its lines and records loss and recovery.
   slam::FrameResult track(const sensor::RgbdFrame& frame, RunLog& log);
 
-  /// Stops mapping, rewrites the keyframe trajectory with refined poses.
+  /// Stops mapping, rewrites the keyframe trajectory with refined poses,
+  /// writes the dense maps.
   void finish();
 
   /// ATE/RPE of the trajectory (and of the refined one) against `gt`.
   void evaluate(const eval::Trajectory& gt);
 
  private:
+  /// The dense maps into `clouds` and their PLY files; run.dense_map.
+  void write_dense_maps();
   /// The counters and the per-frame record.
   void count(const slam::FrameResult& r, int index, double t_s);
   /// The frame's lines in CameraTrajectory, KeyFrameTrajectory and timing.csv.
@@ -49,6 +56,10 @@ struct SystemSink {
 };
 
 using SystemSinks = std::vector<std::unique_ptr<SystemSink>>;
+
+/// The PLY file of a dense map by name: PointCloud.ply for the corrected
+/// map, PointCloud_<name>.ply for the others.
+std::string dense_map_file(const std::string& name);
 
 /// The systems that see the frames (options.mode): PE-SLAM or the baseline
 /// in out_dir, and with kCompare the baseline beside PE-SLAM in

@@ -18,15 +18,23 @@ std::string json_num(double v) { return json_number(v, 9); }
 std::string json_opt(const std::optional<double>& v) { return v ? json_num(*v) : "null"; }
 
 RunSummary summarize_runs(const std::vector<const RunMetrics*>& runs) {
-  std::vector<double> ate, lost, ms, rtf, refined;
+  std::vector<double> ate, lost, ms, rtf, refined, map_acc, map_comp, ghost, ghost_live;
   for (const RunMetrics* r : runs) {
+    if (const MapMetrics* m = r->map("corrected")) {
+      map_acc.push_back(m->accuracy_median_m);
+      map_comp.push_back(m->completeness_5cm);
+      ghost.push_back(m->ghosting);
+    }
+    if (const MapMetrics* m = r->map("live")) ghost_live.push_back(m->ghosting);
     if (r->ate_rmse_m) ate.push_back(*r->ate_rmse_m);
     if (r->refined_ate_rmse_m) refined.push_back(*r->refined_ate_rmse_m);
     lost.push_back(r->lost_frames);
     if (r->tracking_ms_median) ms.push_back(*r->tracking_ms_median);
     if (r->realtime_factor) rtf.push_back(*r->realtime_factor);
   }
-  return {summarize(ate), summarize(lost), summarize(ms), summarize(rtf), summarize(refined)};
+  return {summarize(ate),     summarize(lost),     summarize(ms),    summarize(rtf),
+          summarize(refined), summarize(map_acc), summarize(map_comp), summarize(ghost),
+          summarize(ghost_live)};
 }
 
 std::string place_totals_json(const PlaceTotals& p) {
@@ -55,6 +63,15 @@ std::string pm(const Summary& s, const char* f, double scale = 1.0) {
   return format_number(f, s.mean * scale) + " ± " + format_number(f, s.sd * scale);
 }
 
+/// The dense-map line of one run kind (empty when no seed scored its map).
+std::string map_line(const std::string& name, const RunSummary& s) {
+  if (s.map_accuracy_median_m.count == 0) return {};
+  return "\n" + name + " dense map over " + std::to_string(s.map_accuracy_median_m.count) +
+         " seeds: median accuracy " + pm(s.map_accuracy_median_m, "%.1f", 1000.0) + " mm, complete within 5 cm " +
+         pm(s.map_completeness_5cm, "%.1f", 100.0) + " %, ghosting " + pm(s.map_ghosting, "%.2f", 100.0) +
+         " % (live map " + pm(s.map_ghosting_live, "%.2f", 100.0) + " %).\n";
+}
+
 std::string summary_json(const Summary& s) {
   if (s.count == 0) return "{\"count\": 0}";
   return "{\"count\": " + std::to_string(s.count) + ", \"mean\": " + json_num(s.mean) +
@@ -67,7 +84,11 @@ std::string run_summary_json(const RunSummary& r) {
          ", \"refined_ate_rmse_m\": " + summary_json(r.refined_ate_rmse_m) +
          ", \"lost_frames\": " + summary_json(r.lost_frames) +
          ", \"tracking_ms_median\": " + summary_json(r.tracking_ms_median) +
-         ", \"realtime_factor\": " + summary_json(r.realtime_factor) + "}";
+         ", \"realtime_factor\": " + summary_json(r.realtime_factor) +
+         ", \"map_accuracy_median_m\": " + summary_json(r.map_accuracy_median_m) +
+         ", \"map_completeness_5cm\": " + summary_json(r.map_completeness_5cm) +
+         ", \"map_ghosting\": " + summary_json(r.map_ghosting) +
+         ", \"map_ghosting_live\": " + summary_json(r.map_ghosting_live) + "}";
 }
 
 std::string paired_json(const PairedComparison& p) {
@@ -324,8 +345,10 @@ std::string format_markdown(const SweepAggregate& a) {
            pm(a.primary.refined_ate_rmse_m, "%.2f", 1000.0) + " mm, max " +
            format_number("%.2f", a.primary.refined_ate_rmse_m.max * 1000.0) + " mm.\n";
   if (a.primary_place.seeds > 0) out += "\n" + place_totals_line(a.primary_place);
+  out += map_line(primary_name, a.primary);
   if (a.has_baseline) {
     row(eval::kBaselineLabel, a.baseline);
+    out += map_line(eval::kBaselineLabel, a.baseline);
     // The paired figure (docs/sweeps.md): per seed d = PE − baseline on the same frames.
     out += "\n" + format_paired_line(a.paired) + "\n";
     if (a.paired.count > 0)

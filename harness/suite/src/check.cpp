@@ -64,6 +64,24 @@ void check_relocalisation(const scenes::Expectations& expect, const RunMetrics& 
   }
 }
 
+/// The dense-map bounds, on the corrected map's scores.
+void check_map(const scenes::Expectations& expect, const RunMetrics& run, std::vector<Violation>* out) {
+  if (!expect.map_accuracy_m_max && !expect.map_completeness_min) return;
+  const MapMetrics* m = run.map("corrected");
+  const std::string key = expect.map_accuracy_m_max ? "map_accuracy_m_max" : "map_completeness_min";
+  if (m == nullptr) {
+    out->push_back({key, "no scores of the corrected dense map in the metrics (dense_map.maps.corrected)"});
+    return;
+  }
+  if (expect.map_accuracy_m_max && !(m->accuracy_median_m <= *expect.map_accuracy_m_max))
+    out->push_back({"map_accuracy_m_max", "dense map median accuracy " + metres(m->accuracy_median_m) + " > " +
+                                              metres(*expect.map_accuracy_m_max)});
+  if (expect.map_completeness_min && !(m->completeness_5cm >= *expect.map_completeness_min))
+    out->push_back({"map_completeness_min", "dense map complete within 5 cm " +
+                                                format_number("%.1f %%", 100 * m->completeness_5cm) + " < " +
+                                                format_number("%.1f %%", 100 * *expect.map_completeness_min)});
+}
+
 }  // namespace
 
 std::vector<Violation> check_expectations(const scenes::Expectations& expect, const MetricsFile& metrics,
@@ -117,6 +135,7 @@ std::vector<Violation> check_expectations(const scenes::Expectations& expect, co
   }
   check_place(expect, run, &out);
   check_relocalisation(expect, run, &out);
+  check_map(expect, run, &out);
 
   if (notes != nullptr && metrics.baseline && metrics.baseline->ate_rmse_m && run.ate_rmse_m)
     notes->push_back(pe_against_baseline_note(*run.ate_rmse_m, *metrics.baseline->ate_rmse_m));

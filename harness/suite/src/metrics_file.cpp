@@ -108,12 +108,47 @@ class Reader {
     }
     r.refined_ate_rmse_m = optional_number(obj, "refined", "ate_rmse");
     r.place = place(obj);
+    r.maps = maps(obj);
     const YAML::Node cover = obj["camera_covered_frames"];
     if (cover.IsDefined() && !cover.IsNull()) {
       if (!cover.IsSequence() || cover.size() != 2) fail(cover, "camera_covered_frames", "expected [first, last]");
       r.camera_covered_frames = {cover[0].as<int>(-1), cover[1].as<int>(-1)};
     }
     return r;
+  }
+
+  /// "dense_map.maps": each map's whole-map scores (tau 1, 2, 5, 10 cm).
+  std::vector<MapMetrics> maps(const YAML::Node& obj) const {
+    const YAML::Node d = obj["dense_map"];
+    if (!d.IsDefined() || d.IsNull()) return {};
+    if (!d.IsMap()) fail(d, "dense_map", "expected an object or null");
+    const YAML::Node maps = d["maps"];
+    if (!maps.IsDefined()) return {};
+    if (!maps.IsMap()) fail(maps, "dense_map.maps", "expected an object");
+    std::vector<MapMetrics> out;
+    for (const auto& kv : maps) {
+      const std::string name = kv.first.Scalar();
+      const Reader in(path_, prefix_ + "dense_map.maps." + name + ".");
+      const YAML::Node all = in.required(kv.second, "all");
+      const Reader all_in(path_, prefix_ + "dense_map.maps." + name + ".all.");
+      const YAML::Node comp = all_in.required(all, "completeness_at");
+      if (!comp.IsSequence() || comp.size() < 3) all_in.fail(comp, "completeness_at", "expected 4 shares (1, 2, 5, 10 cm)");
+      MapMetrics m;
+      m.name = name;
+      m.accuracy_median_m = Reader(path_, prefix_ + "dense_map.maps." + name + ".all.accuracy_m.")
+                                .number(all_in.required(all, "accuracy_m"), "median");
+      const auto share = [&](std::size_t i) {
+        double v = 0;
+        if (!comp[i].IsScalar() || !YAML::convert<double>::decode(comp[i], v) || !std::isfinite(v))
+          all_in.fail(comp[i], "completeness_at[" + std::to_string(i) + "]", "expected a number");
+        return v;
+      };
+      m.completeness_2cm = share(1);
+      m.completeness_5cm = share(2);
+      m.ghosting = all_in.number(all, "ghosting");
+      out.push_back(m);
+    }
+    return out;
   }
 
   /// "place_recognition": counts always, labels when judged against ground truth.
@@ -144,6 +179,12 @@ class Reader {
 };
 
 }  // namespace
+
+const MapMetrics* RunMetrics::map(const std::string& name) const {
+  for (const MapMetrics& m : maps)
+    if (m.name == name) return &m;
+  return nullptr;
+}
 
 MetricsFile read_metrics_file(const std::string& path) {
   const std::string text = read_file(path);

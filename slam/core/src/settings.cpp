@@ -200,6 +200,7 @@ void read_point_cloud(Reader& r, PointCloudMappingSettings* pc) {
   pc->min_depth_m = r.real("PointCloudMapping.MinDepth", false, pc->min_depth_m, closed(0, 1000), "metres");
   pc->max_depth_m = r.real("PointCloudMapping.MaxDepth", false, pc->max_depth_m, above(pc->min_depth_m, 1000),
                            "metres beyond PointCloudMapping.MinDepth");
+  pc->reassemble = r.flag("PointCloudMapping.Reassemble", false, pc->reassemble);
 }
 
 void read_loop_closing(Reader& r, LoopClosingOptions* lc) {

@@ -56,8 +56,10 @@ System::System(const Settings& settings, const SystemOptions& options)
     // Descriptors never change; the bag is read by others only once the
     // keyframe is in the database (whose mutex publishes it).
     if (place_) place_->compute_bow(*kf);
-    if (loop_) loop_->process(kf);
+    const bool closed = loop_ && loop_->process(kf);
     if (place_ && !kf->bad()) place_->add(*kf);
+    // Local BA (and a loop's correction) moved keyframes: the dense map follows.
+    if (dense_ && settings_.dense.reassemble) post_dense_poses(closed, false);
   });
   if (!options.synchronous) mapping_->start();
   if (settings.dense.enabled) {
@@ -114,7 +116,10 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
       std::lock_guard<std::mutex> lock(map_.mutex());
       dkf.T_w_c = kf->T_c_w().inverse();
     }
-    dense_keyframes_[kf->id()] = kf;
+    {
+      std::lock_guard<std::mutex> lock(dense_keyframes_mutex_);
+      dense_keyframes_[kf->id()] = kf;
+    }
     dense_->insert(std::move(dkf));
   }
   if (kf) {
@@ -146,14 +151,28 @@ std::vector<geom::StampedPose> System::refined_trajectory() {
   return out;
 }
 
+void System::post_dense_poses(bool loop_correction, bool exact) {
+  dense::PoseUpdate update;
+  update.loop_correction = loop_correction;
+  update.exact = exact;
+  {
+    std::lock_guard<std::mutex> kf_lock(dense_keyframes_mutex_);
+    std::lock_guard<std::mutex> lock(map_.mutex());
+    for (const auto& [id, kf] : dense_keyframes_) update.T_w_c_by_id[id] = kf->T_c_w_via_tree().inverse();
+  }
+  dense_->update_poses(std::move(update));
+}
+
 dense::PointCloud System::point_cloud() {
   if (!dense_) return {};
-  std::map<std::uint64_t, geom::SE3d> T_w_c_by_id;
-  {
-    std::lock_guard<std::mutex> lock(map_.mutex());
-    for (const auto& [id, kf] : dense_keyframes_) T_w_c_by_id[id] = kf->T_c_w_via_tree().inverse();
-  }
-  return dense_->global_cloud(T_w_c_by_id);
+  post_dense_poses(false, true);
+  return dense_->corrected_cloud();
+}
+
+dense::PointCloud System::live_point_cloud() const { return dense_ ? dense_->live_cloud() : dense::PointCloud{}; }
+
+std::optional<dense::LoopSnapshot> System::dense_first_loop() const {
+  return dense_ ? dense_->first_loop() : std::nullopt;
 }
 
 std::size_t System::write_point_cloud(const std::string& path) {

@@ -67,6 +67,35 @@ void check_metrics_and_accuracy(const std::string& d) {
   EXPECT_FALSE(m["baseline"]);
 }
 
+// The dense maps: written, scored against the true surface, in the report.
+void check_dense_map(const std::string& d) {
+  const YAML::Node dm = metrics(d)["dense_map"];
+  ASSERT_TRUE(dm);
+  EXPECT_GT(dm["keyframes"].as<int>(), 1);
+  EXPECT_GT(dm["points"].as<int>(), 10000);
+  EXPECT_GT(dm["pose_updates"].as<int>(), 0);  // local BA moved keyframes and the map followed
+  EXPECT_EQ(dm["alignment"].as<std::string>(), "first");
+  EXPECT_GT(dm["surface_samples"].as<int>(), 10000);
+  for (const char* name : {"corrected", "live"}) {
+    const YAML::Node all = dm["maps"][name]["all"];
+    ASSERT_TRUE(all) << name;
+    // 150 frames, a few millimetres of drift: the Kinect model's noise (about
+    // 1 cm at 3 m) dominates; a frame mix-up or a wrong alignment is metres off.
+    EXPECT_LT(all["accuracy_m"]["median"].as<double>(), 0.02) << name;
+    EXPECT_GT(all["accuracy_m"]["median"].as<double>(), 0.0) << name;
+    EXPECT_GT(all["completeness_at"][2].as<double>(), 0.8) << name;
+    EXPECT_LT(all["ghosting"].as<double>(), 0.01) << name;
+  }
+  EXPECT_TRUE(dm["maps"]["corrected"]["per_class"]["panel"]);
+  EXPECT_TRUE(metrics(d)["profile"]["map_eval"]);
+  for (const char* f : {"PointCloud.ply", "PointCloud_live.ply", "map_errors.ply", "map_error_top.png"})
+    EXPECT_TRUE(exists(d + "/" + f)) << f;
+  EXPECT_FALSE(exists(d + "/PointCloud_before_loop.ply"));  // no loop in 150 frames
+  const std::string html = read_file(d + "/index.html");
+  EXPECT_NE(html.find("<h2>Dense map</h2>"), std::string::npos);
+  EXPECT_NE(html.find("map_error_top.png"), std::string::npos);
+}
+
 void check_report_files(const std::string& d) {
   EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 150u);
   EXPECT_EQ(data_lines(d + "/CameraTrajectory.txt").size(), 150u);
@@ -129,6 +158,10 @@ TEST(RunCli, DefaultStationSync) {
   {
     SCOPED_TRACE("report files");
     check_report_files(d);
+  }
+  {
+    SCOPED_TRACE("dense map");
+    check_dense_map(d);
   }
   {
     SCOPED_TRACE("bit-identical prefix");

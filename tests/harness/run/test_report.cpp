@@ -253,6 +253,54 @@ TEST(RunReport, LocalMappingLoopsAndRefinedAteInTheReport) {
   EXPECT_NE(index_html(r, {}).find("<th>loops closed</th><td>2</td>"), std::string::npos);
 }
 
+TEST(RunReport, DenseMapInMetricsAndReport) {
+  RunReport r = hand_report();
+  EXPECT_FALSE(YAML::Load(metrics_json(r))["dense_map"]);  // dense mapping off
+  EXPECT_EQ(index_html(r, {}).find("Dense map"), std::string::npos);
+
+  DenseMapReport d;
+  d.keyframes = 30;
+  d.points = 1000;
+  d.live_points = 1100;
+  d.pose_updates = 30;
+  d.keyframes_moved = 120;
+  d.update_ms_median = 4.5;
+  d.update_ms_max = 250;
+  d.loop_update_ms = {250};
+  d.loop_snapshot = true;
+  d.note = "not scored (--no-map-eval)";
+  r.primary.dense_map = d;
+  YAML::Node m = YAML::Load(metrics_json(r));
+  ASSERT_TRUE(m["dense_map"]);
+  EXPECT_EQ(m["dense_map"]["keyframes_moved"].as<int>(), 120);
+  EXPECT_NEAR(m["dense_map"]["loop_update_ms"][0].as<double>(), 250.0, 1e-9);
+  EXPECT_EQ(m["dense_map"]["files"].size(), 4u);
+  EXPECT_FALSE(m["dense_map"]["maps"]);
+  EXPECT_NE(index_html(r, {}).find("Not scored: not scored (--no-map-eval)"), std::string::npos);
+
+  // Scored: one map with two classes (ids as sim::SurfaceClass: 2 panel, 5 wall).
+  eval::MapScores s;
+  s.accuracy.median = 0.012;
+  s.accuracy.count = 1000;
+  s.completeness_at = {0.5, 0.8, 0.9, 0.95};
+  s.fscore_at = {0.5, 0.8, 0.9, 0.95};
+  s.ghosting = 0.001;
+  MapResult corrected{"corrected", "PointCloud.ply", {}, 1.0};
+  corrected.accuracy.all = s;
+  corrected.accuracy.per_class = {{2, s}, {5, s}};
+  r.primary.dense_map->maps = {corrected};
+  r.primary.dense_map->note.clear();
+  r.primary.dense_map->alignment = "first";
+  r.primary.dense_map->top_view = "map_error_top.png";
+  m = YAML::Load(metrics_json(r));
+  EXPECT_NEAR(m["dense_map"]["maps"]["corrected"]["all"]["accuracy_m"]["median"].as<double>(), 0.012, 1e-12);
+  EXPECT_TRUE(m["dense_map"]["maps"]["corrected"]["per_class"]["wall"]);
+  const std::string html = index_html(r, {});
+  EXPECT_NE(html.find("<tr><td>panel</td><td>1000</td><td>12.0 / "), std::string::npos) << html;
+  EXPECT_NE(html.find("<img src=\"map_error_top.png\""), std::string::npos);
+  EXPECT_NE(html.find("a loop correction reached the map in 250.0 ms"), std::string::npos);
+}
+
 TEST(RunReport, WriteReportWritesEveryFile) {
   const std::string dir = ::testing::TempDir() + "pvb_run_report_" + std::to_string(::getpid());
   std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());

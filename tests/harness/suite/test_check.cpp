@@ -5,6 +5,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/scenes/scenario.hpp"
+#include "pvb/suite/aggregate.hpp"
 #include "pvb/suite/check.hpp"
 
 using namespace pvb;
@@ -291,4 +292,47 @@ TEST(SuiteCheckPlace, SweepTotals) {
   EXPECT_EQ(a.primary_place.seeds_with_false_match, 1);
   EXPECT_EQ(a.primary.refined_ate_rmse_m.count, 3);
   EXPECT_NE(suite::format_markdown(a).find("2 false"), std::string::npos);
+}
+
+TEST(SuiteCheckMap, ReadsTheScoredMaps) {
+  const suite::MetricsFile m = suite::read_metrics_file(fixture("dense_map.json"));
+  ASSERT_EQ(m.primary.maps.size(), 2u);
+  const suite::MapMetrics* c = m.primary.map("corrected");
+  ASSERT_NE(c, nullptr);
+  EXPECT_DOUBLE_EQ(c->accuracy_median_m, 0.012);
+  EXPECT_DOUBLE_EQ(c->completeness_2cm, 0.8);
+  EXPECT_DOUBLE_EQ(c->completeness_5cm, 0.9);
+  EXPECT_DOUBLE_EQ(c->ghosting, 0.001);
+  EXPECT_DOUBLE_EQ(m.primary.map("live")->ghosting, 0.012);
+  EXPECT_EQ(m.primary.map("before_loop"), nullptr);
+  EXPECT_TRUE(suite::read_metrics_file(fixture("kidnapped.json")).primary.maps.empty());
+}
+
+TEST(SuiteCheckMap, AccuracyAndCompletenessBoundsOnTheCorrectedMap) {
+  scenes::Expectations e;
+  e.map_accuracy_m_max = 0.012;  // inclusive
+  e.map_completeness_min = 0.9;
+  suite::MetricsFile m = suite::read_metrics_file(fixture("dense_map.json"));
+  EXPECT_TRUE(suite::check_expectations(e, m).empty());
+  e.map_accuracy_m_max = 0.011;
+  EXPECT_TRUE(has_key(suite::check_expectations(e, m), "map_accuracy_m_max"));
+  EXPECT_FALSE(has_key(suite::check_expectations(e, m), "map_completeness_min"));
+  e.map_completeness_min = 0.95;
+  EXPECT_TRUE(has_key(suite::check_expectations(e, m), "map_completeness_min"));
+  m.primary.maps.clear();  // not scored (--no-map-eval, or no dense map): cannot be judged
+  e.map_accuracy_m_max.reset();
+  EXPECT_TRUE(has_key(suite::check_expectations(e, m), "map_completeness_min"));
+}
+
+TEST(SuiteCheckMap, SweepsAggregateTheMaps) {
+  std::vector<suite::SeedRun> runs = {suite::read_seed_run(1, fixture("dense_map.json")),
+                                      suite::read_seed_run(2, fixture("dense_map.json")),
+                                      suite::read_seed_run(3, fixture("kidnapped.json"))};
+  runs[1].metrics->primary.maps[0].accuracy_median_m = 0.016;
+  const suite::SweepAggregate a = suite::aggregate("kidnapped", runs);
+  EXPECT_EQ(a.primary.map_accuracy_median_m.count, 2);
+  EXPECT_NEAR(a.primary.map_accuracy_median_m.mean, 0.014, 1e-12);
+  EXPECT_NEAR(a.primary.map_ghosting_live.mean, 0.012, 1e-12);
+  const std::string md = suite::format_markdown(a);
+  EXPECT_NE(md.find("dense map over 2 seeds: median accuracy 14.0 ± 2.8 mm"), std::string::npos) << md;
 }

@@ -1,9 +1,11 @@
 // The DenseMapper: several views of a plane at known poses give a cloud on
 // the plane; the worker thread gives the same cloud as synchronous mode;
-// re-posing a keyframe moves its points.
+// re-posing a keyframe moves its points; pose updates carry the corrected
+// map to the map built from scratch, and leave the live map alone.
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <memory>
 #include <vector>
 
 #include "pvb/slam/dense/dense_mapper.hpp"
@@ -19,6 +21,7 @@ using pvb::slam::dense::DenseKeyFrame;
 using pvb::slam::dense::DenseMapper;
 using pvb::slam::dense::DenseMapperOptions;
 using pvb::slam::dense::PointCloud;
+using pvb::slam::dense::PoseUpdate;
 
 // The plane z_w = 2.5 m, seen by cameras looking roughly along +z_w.
 const Eigen::Vector3d kNormal(0, 0, 1);
@@ -158,6 +161,77 @@ TEST(DenseMapper, RePosingAKeyframeMovesItsPoints) {
     ASSERT_TRUE(uv);
     EXPECT_TRUE(options().K.in_image(*uv, -3.0));
   }
+}
+
+double worst_off_plane(const PointCloud& cloud) {
+  double worst = 0;
+  for (const CloudPoint& p : cloud)
+    worst = std::max(worst, std::abs(kNormal.dot(Eigen::Vector3d(p.x, p.y, p.z)) - kPlaneD));
+  return worst;
+}
+
+// Keyframes inserted at poses off by a few centimetres (drift), then the
+// true poses posted as a loop correction would.
+std::unique_ptr<DenseMapper> drifted_mapper(bool worker) {
+  auto owner = std::make_unique<DenseMapper>(options());
+  DenseMapper& mapper = *owner;
+  if (worker) mapper.start();
+  const std::vector<SE3d> poses = view_poses();
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    DenseKeyFrame kf = keyframe(i, poses[i]);
+    kf.T_w_c = make_se3(so3_exp(Eigen::Vector3d(0.01 * i, 0, 0)), Eigen::Vector3d(0, 0, 0.02 * i)) * poses[i];
+    mapper.insert(std::move(kf));
+  }
+  PoseUpdate update;
+  for (std::size_t i = 0; i < poses.size(); ++i) update.T_w_c_by_id[i] = poses[i];
+  update.loop_correction = true;
+  mapper.update_poses(update);
+  mapper.stop();
+  return owner;
+}
+
+TEST(DenseMapper, PoseUpdatesBringTheCorrectedMapToTheMapFromScratch) {
+  const auto owner = drifted_mapper(false);
+  const DenseMapper& mapper = *owner;
+  std::map<std::uint64_t, SE3d> truth;
+  const std::vector<SE3d> poses = view_poses();
+  for (std::size_t i = 0; i < poses.size(); ++i) truth[i] = poses[i];
+  const PointCloud corrected = mapper.corrected_cloud(), scratch = mapper.global_cloud(truth);
+  ASSERT_EQ(corrected.size(), scratch.size());
+  for (std::size_t i = 0; i < corrected.size(); ++i) ASSERT_NEAR(corrected[i].z, scratch[i].z, 2e-6);
+  EXPECT_LT(worst_off_plane(corrected), 1e-4);
+  EXPECT_GT(worst_off_plane(mapper.live_cloud()), 0.05);  // the live map keeps the drift
+  // keyframe 0 had no drift: 5 of 6 moved
+  EXPECT_EQ(mapper.stats().keyframes_moved, poses.size() - 1);
+  ASSERT_EQ(mapper.stats().loop_update_ms.size(), 1u);
+  const auto loop = mapper.first_loop();
+  ASSERT_TRUE(loop);
+  EXPECT_EQ(loop->keyframes_moved, poses.size() - 1);
+  EXPECT_GT(worst_off_plane(loop->before), 0.05);
+  EXPECT_TRUE(loop->after == corrected);
+}
+
+TEST(DenseMapper, WorkerAppliesTheSameUpdatesAsSynchronousMode) {
+  const auto sync = drifted_mapper(false), worker = drifted_mapper(true);
+  EXPECT_TRUE(sync->corrected_cloud() == worker->corrected_cloud());
+  EXPECT_TRUE(sync->live_cloud() == worker->live_cloud());
+}
+
+TEST(DenseMapper, SmallMovesWaitUnlessExact) {
+  DenseMapper mapper(options());
+  const SE3d T = view_poses()[2];
+  mapper.insert(keyframe(0, T));
+  const PointCloud before = mapper.corrected_cloud();
+  const SE3d nudged = make_se3(SE3d::Identity().linear(), Eigen::Vector3d(0.0004, 0, 0)) * T;  // 0.4 mm
+  mapper.update_poses({{{0, nudged}}, false, false});
+  EXPECT_TRUE(mapper.corrected_cloud() == before);
+  EXPECT_EQ(mapper.stats().keyframes_moved, 0u);
+  mapper.update_poses({{{0, nudged}}, false, true});
+  EXPECT_FALSE(mapper.corrected_cloud() == before);
+  EXPECT_EQ(mapper.stats().keyframes_moved, 1u);
+  mapper.update_poses({{{0, T}, {7, T}}, false, true});  // back again; an unknown id is ignored
+  EXPECT_TRUE(mapper.corrected_cloud() == before);        // exactly: the sums are integers
+  EXPECT_FALSE(mapper.first_loop());
 }
 
 }  // namespace

@@ -198,13 +198,19 @@ struct Expectations {
   std::optional<int> relocalised_within_frames;
   /// At least this many true loops (found by the place recognition).
   std::optional<int> loops_min;
+  /// The corrected dense map against the true surface (docs/map_accuracy.md):
+  /// median distance of its points to the surface, metres, at most this;
+  /// and at least this share (0-1) of the surface within 5 cm of the map.
+  std::optional<double> map_accuracy_m_max;
+  std::optional<double> map_completeness_min;
   bool tracking_loss_expected = false;         ///< the run must report a loss with a reason
   int ci_frames = 0;                           ///< frames of the fast CI run; 0 = not in the fast subset
   SweepExpectations sweep;                     ///< judged over a seed sweep only
   /// True when a bound on a single run is set.
   bool any_run_bound() const {
     return ate_rmse_m_max || rpe_trans_rmse_m_max || lost_frames_max || tracking_loss_expected ||
-           refined_ate_rmse_m_max || false_loops_max || relocalised_within_frames || loops_min;
+           refined_ate_rmse_m_max || false_loops_max || relocalised_within_frames || loops_min ||
+           map_accuracy_m_max || map_completeness_min;
   }
   /// True when any bound or flag is set.
   bool any() const { return any_run_bound() || sweep.any(); }

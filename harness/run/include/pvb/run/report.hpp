@@ -12,6 +12,7 @@
 #include "pvb/eval/evaluate.hpp"
 #include "pvb/eval/place_labels.hpp"
 #include "pvb/plot/contact_sheet.hpp"
+#include "pvb/run/map_eval.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 
 namespace pvb::run {
@@ -61,6 +62,30 @@ struct PlaceRecognition {
 /// The place-recognition object of metrics.json.
 std::string place_json(const PlaceRecognition& p);
 
+/// One SLAM system's dense map: how it was built and, with ground truth,
+/// how each of its versions scored against the true surface.
+struct DenseMapReport {
+  std::size_t keyframes = 0;
+  std::size_t points = 0;       ///< the corrected map, PointCloud.ply
+  std::size_t live_points = 0;  ///< the live map, PointCloud_live.ply
+  std::size_t pose_updates = 0;     ///< local BA and loop corrections posted to the map
+  std::size_t keyframes_moved = 0;  ///< keyframes re-binned over those updates
+  double update_ms_median = 0, update_ms_max = 0;
+  std::vector<double> loop_update_ms;  ///< per loop correction: its re-binning time
+  bool loop_snapshot = false;          ///< PointCloud_{before,after}_loop.ply written
+  std::string alignment;               ///< how the maps went into the world (scored only)
+  std::size_t surface_samples = 0;
+  double truth_s = 0;            ///< sampling the true surface
+  std::vector<MapResult> maps;   ///< scored maps: corrected, live, before_loop, after_loop
+  std::string note;              ///< why the maps were not scored
+  std::string top_view;          ///< the error figure's file name (PNG), if written
+  /// The scores of map `name`, or null.
+  const MapResult* find(const std::string& name) const;
+};
+
+/// The dense_map object of metrics.json.
+std::string dense_map_json(const DenseMapReport& d, const std::string& in);
+
 /// One SLAM system's run (PE-SLAM, or the baseline: PE-match off, ORB-SLAM2's motion model).
 struct SlamRun {
   std::string mode;  ///< eval::kPeSlamMode or eval::kBaselineMode ("pe-slam", "baseline")
@@ -80,6 +105,7 @@ struct SlamRun {
   std::optional<slam::LocalMappingStats> local_mapping;  ///< nullopt when not known
   std::size_t loops_closed = 0;
   std::optional<PlaceRecognition> place;  ///< nullopt when loop closing is off
+  std::optional<DenseMapReport> dense_map;  ///< nullopt when dense mapping is off
 };
 
 /// Closed loop: distance of the ground-truth robot (axle centre) from the

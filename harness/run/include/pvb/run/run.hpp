@@ -40,6 +40,9 @@ struct RunOptions {
   SlamMode mode = SlamMode::kPeSlam;
   bool closed_loop = false;        ///< steer from the SLAM pose instead of ground truth
   bool loop_closing = true;        ///< false: LoopClosing.enabled = 0 for every system (--no-loop-closing)
+  /// Score the dense maps against the scenario's true surface
+  /// (docs/map_accuracy.md); false: write them only (--no-map-eval).
+  bool map_eval = true;
   std::string gl = "auto";         ///< auto, egl or osmesa
   std::size_t queue_capacity = 3;  ///< frames the producer may run ahead (open loop)
   /// Pipelined: release frame i no earlier than i / fps after the first,

@@ -103,6 +103,11 @@ struct RunSummary {
   Summary tracking_ms_median;
   Summary realtime_factor;
   Summary refined_ate_rmse_m;  ///< seeds with a refined evaluation
+  // The dense maps, over the seeds where they were scored (docs/map_accuracy.md).
+  Summary map_accuracy_median_m;  ///< corrected map
+  Summary map_completeness_5cm;   ///< corrected map
+  Summary map_ghosting;           ///< corrected map
+  Summary map_ghosting_live;      ///< the live map (keyframes at the poses they were made with)
 };
 
 /// Place recognition summed over the seeds whose metrics carry

@@ -24,6 +24,16 @@ struct PlaceMetrics {
   std::optional<int> relocalisations_true, relocalisations_false;
 };
 
+/// One scored dense map of metrics.json's "dense_map.maps" (corrected,
+/// live, before_loop, after_loop), over the whole map.
+struct MapMetrics {
+  std::string name;
+  double accuracy_median_m = 0;
+  double completeness_2cm = 0;  ///< share of the true surface within 2 cm
+  double completeness_5cm = 0;  ///< within 5 cm
+  double ghosting = 0;          ///< share of the judged surface mapped twice
+};
+
 /// One SLAM run's figures (the top level, or the "baseline" object).
 struct RunMetrics {
   std::string mode;    ///< "pe-slam" or "baseline" ("orb-slam2" in version 1 files is read as "baseline")
@@ -39,6 +49,9 @@ struct RunMetrics {
   std::optional<double> tracking_ms_median;
   std::optional<double> realtime_factor;
   std::vector<LossEvent> loss_events;
+  std::vector<MapMetrics> maps;  ///< empty when the dense maps were not scored
+  /// The scores of map `name` (e.g. "corrected"), or null.
+  const MapMetrics* map(const std::string& name) const;
 };
 
 struct MetricsFile {

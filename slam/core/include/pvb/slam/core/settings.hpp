@@ -65,6 +65,9 @@ struct PointCloudMappingSettings {
   int stride_px = 3;           ///< PointCloudMapping.Stride: every n-th pixel in rows and columns
   double min_depth_m = 0.1;    ///< PointCloudMapping.MinDepth, metres
   double max_depth_m = 4.0;    ///< PointCloudMapping.MaxDepth, metres
+  /// PointCloudMapping.Reassemble (0/1): the map follows local BA and loop
+  /// corrections as they happen (0: only when the final map is asked for).
+  bool reassemble = true;
 };
 
 /// The default vocabulary, trained by the build (docs/place_recognition.md).

@@ -3,8 +3,9 @@
 // thread, local mapping and dense point-cloud mapping inline (synchronous
 // mode) or on worker threads.
 #include <cstdint>
-#include <memory>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -73,11 +74,16 @@ class System {
   // Dense point-cloud mapping (Settings::dense; off: the functions below
   // return empty results) ----------------------------------------------------
   bool dense_enabled() const { return dense_ != nullptr; }
-  /// The global coloured cloud, rebuilt from every keyframe the dense
-  /// mapper has processed, each at its current (bundle-adjusted) pose;
-  /// culled keyframes at their pose through the spanning tree.  Call after
-  /// shutdown() for the complete map.
+  /// The corrected map: every keyframe the dense mapper has processed at
+  /// its current (bundle-adjusted, loop-corrected) pose, culled keyframes at
+  /// their pose through the spanning tree.  Posts the current poses first
+  /// (every change re-binned); call after shutdown() for the complete map.
   dense::PointCloud point_cloud();
+  /// The live map: each keyframe at the pose it was made with.
+  dense::PointCloud live_point_cloud() const;
+  /// The corrected map just before and after the first loop correction
+  /// (PointCloudMapping.Reassemble 1 and a loop closed).
+  std::optional<dense::LoopSnapshot> dense_first_loop() const;
   /// Writes point_cloud() as binary PLY; returns the number of points.
   /// Throws pvb::IoError when the file cannot be written.
   std::size_t write_point_cloud(const std::string& path);
@@ -95,8 +101,12 @@ class System {
   std::unique_ptr<LoopClosing> loop_;  ///< null when loop closing is disabled; runs on the mapping thread
   std::unique_ptr<LocalMapping> mapping_;
   std::unique_ptr<dense::DenseMapper> dense_;  ///< null when dense mapping is disabled
-  /// Keyframes handed to the dense mapper, by id (for their current poses).
+  /// Keyframes handed to the dense mapper, by id (for their current poses);
+  /// written by track(), read by the mapping thread.
   std::map<std::uint64_t, std::shared_ptr<KeyFrame>> dense_keyframes_;
+  std::mutex dense_keyframes_mutex_;
+  /// Hands every dense keyframe's current pose to the dense mapper.
+  void post_dense_poses(bool loop_correction, bool exact);
   std::uint64_t next_frame_id_ = 0;
   /// Per tracked frame: time, reference keyframe and T_c_r (for refined_trajectory()).
   struct FrameRecord {

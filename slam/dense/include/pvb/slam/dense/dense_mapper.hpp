@@ -1,28 +1,38 @@
 #pragma once
 // PE-SLAM's dense point-cloud mapping thread (paper sec. 3, "DENSE POINT
 // CLOUD MAPPING"): every new keyframe's RGB-D image is back-projected,
-// voxel-filtered and kept in its own camera frame.  The global coloured
-// cloud is built on request from the keyframe clouds and the keyframe poses
-// the caller passes in (the latest, bundle-adjusted ones), then voxel-
-// filtered again.  Knows nothing of the tracker: keyframes come in as
-// images plus a pose.
+// voxel-filtered and kept in its own camera frame.  Two maps are kept:
 //
-// Threads: start() runs a worker that takes keyframes from a closable
-// blocking queue; stop() closes the queue, lets the worker finish what is
+//   live       each keyframe cloud at the pose it was made with, never moved
+//              (the paper's map: "not corrected after back-end optimisation")
+//   corrected  a VoxelMap that follows the poses: after each local BA and
+//              loop correction the caller posts the keyframes' current poses
+//              (update_poses()); every keyframe that moved by more than a
+//              threshold leaves the map at its old pose and re-enters at its
+//              new one, so an update costs in proportion to what moved.
+//
+// Knows nothing of the tracker: keyframes come in as images plus a pose.
+//
+// Threads: start() runs a worker that takes keyframes and pose updates, in
+// the order posted, from a closable blocking queue; stop() closes the queue, lets the worker finish what is
 // queued and joins it.  Without start() (synchronous mode) insert()
-// processes the keyframe inline, so runs are bit-identical.  Either way the
-// per-keyframe clouds are computed by the same code from the same input, so
-// the cloud after stop() is the same in both modes.
+// processes the keyframe (update_poses() the update) inline, so runs are
+// bit-identical.  Either way the same messages are applied in the same order
+// by the same code, so the maps after stop() are the same in both modes.
 #include <cstdint>
 #include <map>
 #include <mutex>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <thread>
+#include <variant>
+#include <vector>
 
 #include "pvb/common/closable_queue.hpp"
 #include "pvb/geometry/pinhole.hpp"
 #include "pvb/geometry/se3.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"
+#include "pvb/slam/dense/voxel_map.hpp"
 
 namespace pvb::slam::dense {
 
@@ -40,6 +50,25 @@ struct DenseMapperOptions {
   geom::PinholeIntrinsics K;  ///< camera of the depth (registered) images
   BackProjectionParams back_projection;
   double leaf_m = 0.02;  ///< voxel size of the keyframe and global clouds
+  /// A keyframe is re-binned when its pose moved by more than either bound
+  /// since it was last binned (1 mm; 0.25 mrad is 1 mm at 4 m range).
+  double update_min_translation_m = 0.001;
+  double update_min_rotation_rad = 0.00025;
+};
+
+/// The keyframes' current poses, posted after bundle adjustment or a loop
+/// correction.  Ids the mapper does not know are ignored.
+struct PoseUpdate {
+  std::map<std::uint64_t, geom::SE3d> T_w_c_by_id;
+  bool loop_correction = false;  ///< the first one keeps the map before and after it
+  bool exact = false;            ///< re-bin every keyframe whose pose changed at all
+};
+
+/// The corrected map just before and just after the first loop correction.
+struct LoopSnapshot {
+  PointCloud before, after;
+  std::size_t keyframes_moved = 0;
+  double update_ms = 0;  ///< the re-binning alone (not the two snapshots)
 };
 
 /// Figures for reports.
@@ -47,6 +76,10 @@ struct DenseMapperStats {
   std::size_t keyframes = 0;  ///< keyframes processed
   std::size_t points = 0;     ///< points over all keyframe clouds (before the global filter)
   double total_ms = 0;        ///< back-projection + voxel filter, summed over keyframes
+  std::size_t pose_updates = 0;    ///< update_poses() applied
+  std::size_t keyframes_moved = 0; ///< keyframes re-binned, over all updates
+  std::vector<double> update_ms;   ///< per update: the re-binning time
+  std::vector<double> loop_update_ms;  ///< the same for the loop corrections
 };
 
 class DenseMapper {
@@ -68,11 +101,20 @@ class DenseMapper {
   /// Hands a keyframe over: queued for the worker, or processed now when no
   /// worker runs.  A second keyframe with the same id replaces the first.
   void insert(DenseKeyFrame kf);
+  /// Hands new keyframe poses over (queued behind the keyframes already
+  /// handed over, or applied now when no worker runs).
+  void update_poses(PoseUpdate update);
 
-  /// The global cloud in the world frame: each keyframe cloud moved by
-  /// T_w_c_by_id[id] when present, else by the pose it was inserted with;
-  /// concatenated in id order and voxel-filtered.  Keyframes still queued
-  /// are not included (call stop() first for the complete cloud).
+  /// The corrected map (world frame) as the updates so far left it.
+  PointCloud corrected_cloud() const;
+  /// Every keyframe cloud at the pose it was inserted with, voxel-filtered.
+  PointCloud live_cloud() const;
+  /// The corrected map around the first loop correction, if there was one.
+  std::optional<LoopSnapshot> first_loop() const;
+
+  /// Built from scratch: each keyframe cloud moved by T_w_c_by_id[id] when
+  /// present, else by the pose it was inserted with; concatenated in id
+  /// order and voxel-filtered.  Keyframes still queued are not included.
   PointCloud global_cloud(const std::map<std::uint64_t, geom::SE3d>& T_w_c_by_id = {}) const;
 
   /// The cloud of keyframe `id` in its camera frame (empty when unknown).
@@ -83,17 +125,25 @@ class DenseMapper {
  private:
   struct Entry {
     std::int64_t t_ns = 0;
-    geom::SE3d T_w_c = geom::SE3d::Identity();
+    geom::SE3d T_w_c = geom::SE3d::Identity();   ///< pose at insertion (the live map's)
+    geom::SE3d T_w_c_binned = geom::SE3d::Identity();  ///< pose it has in the corrected map
     PointCloud cloud_c;  ///< voxel-filtered, camera frame
+    VoxelMap::Handle handle;  ///< its voxels in the corrected map
   };
+  using Message = std::variant<DenseKeyFrame, PoseUpdate>;
   void run();
   void process(const DenseKeyFrame& kf);
+  void apply(const PoseUpdate& update);
+  bool moved(const geom::SE3d& from, const geom::SE3d& to, bool exact) const;
 
   DenseMapperOptions options_;
-  mutable std::mutex mutex_;  ///< guards entries_ and stats_
+  mutable std::mutex mutex_;  ///< guards entries_, the maps, first_loop_ and stats_
   std::map<std::uint64_t, Entry> entries_;
+  VoxelMap live_;
+  VoxelMap corrected_;
+  std::optional<LoopSnapshot> first_loop_;
   DenseMapperStats stats_;
-  ClosableQueue<DenseKeyFrame> queue_;
+  ClosableQueue<Message> queue_;
   std::thread worker_;
   bool stopped_ = false;  ///< stop() has closed the queue
 };

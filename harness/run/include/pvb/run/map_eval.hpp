@@ -1,0 +1,66 @@
+#pragma once
+// A SLAM run's dense maps scored against the scenario's true surface
+// (docs/map_accuracy.md): the pieces `pvbench eval-map` and `pvbench run`
+// share.  The true surface is sampled once per run and every map (the
+// corrected one, the live one, the corrected one around the first loop
+// correction) is scored against it.
+#include <string>
+#include <vector>
+
+#include "pvb/eval/align.hpp"
+#include "pvb/eval/evaluate.hpp"
+#include "pvb/eval/map_accuracy.hpp"
+#include "pvb/eval/trajectory.hpp"
+#include "pvb/scenes/scenario.hpp"
+#include "pvb/sim/gl_context.hpp"
+#include "pvb/sim/truth_surface.hpp"
+#include "pvb/slam/dense/point_cloud.hpp"
+
+namespace pvb::run {
+
+/// How a map goes from SLAM's world (its first camera) into the ground
+/// truth's world.
+enum class MapAlignment {
+  kFirstFrame,  ///< the first estimated pose put on its ground truth (default)
+  kAte,         ///< the trajectory's SE(3) alignment, as for the ATE
+};
+const char* to_string(MapAlignment a);
+
+/// The transform for `alignment`; `ate` is the trajectory's evaluation
+/// against `gt` (its pairs and alignment).
+eval::Sim3Transform map_to_world(MapAlignment alignment, const eval::EvalResult& ate, const eval::Trajectory& gt,
+                                 const eval::Trajectory& est);
+
+/// The map's points in the world, of unknown range.
+std::vector<eval::MapPoint> map_in_world(const slam::dense::PointCloud& cloud, const eval::Sim3Transform& T);
+
+/// The true surface seen along the scenario's route, as evaluation points.
+std::vector<eval::SurfacePoint> true_surface(const scenes::Scenario& scenario, sim::GlBackend backend,
+                                             const sim::TruthSurfaceOptions& options);
+
+/// One scored map.
+struct MapResult {
+  std::string name;  ///< corrected, live, before_loop, after_loop
+  std::string ply;   ///< file name of the map in the run's folder
+  eval::MapAccuracy accuracy;
+  double score_s = 0;
+};
+
+/// The scores as JSON: {"map_points", "surface_points", "accuracy_m":
+/// {mean, median, rmse, p95}, "completeness_at", "precision_at",
+/// "fscore_at", "chamfer_m", "ghosting", "ghosting_judged"}.
+std::string scores_json(const eval::MapScores& s);
+/// The whole result: {"tau_m", "all", "per_class": {...}, "per_range": [...]},
+/// indented by `indent` spaces after each newline.
+std::string map_accuracy_json(const eval::MapAccuracy& r, int indent = 0);
+/// A fixed-width table, one row for the whole map and one per class
+/// (accuracy in mm, completeness in % within each tau, F at 2 cm, ghosting).
+std::string map_accuracy_table(const eval::MapAccuracy& r);
+
+/// The map's points with their class and error as PLY properties
+/// (binary, float x y z, uchar class, float error), for CloudCompare or
+/// MeshLab.  Throws pvb::IoError when the file cannot be written.
+void write_map_errors_ply(const std::string& path, const std::vector<eval::MapPoint>& map,
+                          const std::vector<eval::MapPointScore>& scores);
+
+}  // namespace pvb::run

@@ -1,0 +1,122 @@
+#include "pvb/run/map_eval.hpp"
+
+#include <cstdio>
+#include <sstream>
+
+#include "pvb/common/output_file.hpp"
+#include "pvb/common/text.hpp"
+
+namespace pvb::run {
+
+const char* to_string(MapAlignment a) { return a == MapAlignment::kAte ? "ate" : "first"; }
+
+eval::Sim3Transform map_to_world(MapAlignment alignment, const eval::EvalResult& ate, const eval::Trajectory& gt,
+                                 const eval::Trajectory& est) {
+  if (alignment == MapAlignment::kAte) return ate.alignment;
+  const eval::IndexPair first = ate.pairs.front();
+  const geom::SE3d T = gt.poses[first.gt].T_w_c * est.poses[first.est].T_w_c.inverse();
+  eval::Sim3Transform out;
+  out.R = T.linear();
+  out.t = T.translation();
+  return out;
+}
+
+std::vector<eval::MapPoint> map_in_world(const slam::dense::PointCloud& cloud, const eval::Sim3Transform& T) {
+  std::vector<eval::MapPoint> map;
+  map.reserve(cloud.size());
+  for (const slam::dense::CloudPoint& p : cloud) map.push_back({T.apply(geom::Vec3d(p.x, p.y, p.z)), -1.0});
+  return map;
+}
+
+std::vector<eval::SurfacePoint> true_surface(const scenes::Scenario& scenario, sim::GlBackend backend,
+                                             const sim::TruthSurfaceOptions& options) {
+  const std::vector<sim::TruthSample> truth = sim::sample_truth_surface(scenario, backend, options);
+  std::vector<eval::SurfacePoint> s;
+  s.reserve(truth.size());
+  for (const sim::TruthSample& t : truth) s.push_back({t.p_w, t.n_w, static_cast<int>(t.cls), t.range_m});
+  return s;
+}
+
+std::string scores_json(const eval::MapScores& s) {
+  std::ostringstream js;
+  auto list = [&js](const std::vector<double>& v) {
+    js << "[";
+    for (std::size_t i = 0; i < v.size(); ++i) js << (i ? ", " : "") << format_g(v[i]);
+    js << "]";
+  };
+  js << "{\"map_points\": " << s.accuracy.count << ", \"surface_points\": " << s.completeness.count
+     << ", \"accuracy_m\": {\"mean\": " << format_g(s.accuracy.mean) << ", \"median\": " << format_g(s.accuracy.median)
+     << ", \"rmse\": " << format_g(s.accuracy.rmse) << ", \"p95\": " << format_g(s.accuracy.p95) << "}"
+     << ", \"completeness_at\": ";
+  list(s.completeness_at);
+  js << ", \"precision_at\": ";
+  list(s.precision_at);
+  js << ", \"fscore_at\": ";
+  list(s.fscore_at);
+  js << ", \"chamfer_m\": " << format_g(s.chamfer_m) << ", \"ghosting\": " << format_g(s.ghosting)
+     << ", \"ghosting_judged\": " << s.ghosting_judged << "}";
+  return js.str();
+}
+
+std::string map_accuracy_json(const eval::MapAccuracy& r, int indent) {
+  const std::string nl = "\n" + std::string(static_cast<std::size_t>(indent), ' ');
+  std::ostringstream js;
+  js << "{" << nl << "  \"tau_m\": [";
+  for (std::size_t i = 0; i < r.options.tau_m.size(); ++i) js << (i ? ", " : "") << format_g(r.options.tau_m[i]);
+  js << "]," << nl << "  \"all\": " << scores_json(r.all) << "," << nl << "  \"per_class\": {";
+  bool first = true;
+  for (const auto& [c, s] : r.per_class) {
+    js << (first ? "" : ",") << nl << "    \"" << sim::to_string(static_cast<sim::SurfaceClass>(c))
+       << "\": " << scores_json(s);
+    first = false;
+  }
+  js << nl << "  }," << nl << "  \"per_range\": [";
+  for (std::size_t b = 0; b < r.per_range.size(); ++b)
+    js << (b ? "," : "") << nl << "    {\"from_m\": " << format_g(r.options.range_edges_m[b])
+       << ", \"to_m\": " << format_g(r.options.range_edges_m[b + 1]) << ", \"scores\": " << scores_json(r.per_range[b])
+       << "}";
+  js << nl << "  ]" << nl << "}";
+  return js.str();
+}
+
+namespace {
+std::string scores_row(const std::string& name, const eval::MapScores& s) {
+  char line[256];
+  auto pct = [&s](std::size_t i) { return i < s.completeness_at.size() ? 100.0 * s.completeness_at[i] : 0.0; };
+  std::snprintf(line, sizeof line, "%-7s %9zu %9zu %8.1f %8.1f %8.1f %6.1f %6.1f %6.1f %6.1f %7.3f %7.1f\n",
+                name.c_str(), s.accuracy.count, s.completeness.count, 1000 * s.accuracy.median,
+                1000 * s.accuracy.mean, 1000 * s.accuracy.p95, pct(0), pct(1), pct(2), pct(3),
+                s.fscore_at.size() > 1 ? s.fscore_at[1] : 0.0, 100.0 * s.ghosting);
+  return line;
+}
+}  // namespace
+
+std::string map_accuracy_table(const eval::MapAccuracy& r) {
+  std::string t =
+      "class     map pts  surf pts  acc med  acc mean  acc p95  comp1  comp2  comp5 comp10  F@2cm  ghost%\n";
+  t += scores_row("all", r.all);
+  for (const auto& [c, s] : r.per_class) t += scores_row(sim::to_string(static_cast<sim::SurfaceClass>(c)), s);
+  return t;
+}
+
+void write_map_errors_ply(const std::string& path, const std::vector<eval::MapPoint>& map,
+                          const std::vector<eval::MapPointScore>& scores) {
+  std::ostringstream h;
+  h << "ply\nformat binary_little_endian 1.0\ncomment PE-SLAM dense map in the world frame, with class "
+       "(0 other, 1 ground, 2 panel, 3 frame, 4 post, 5 wall, 6 shrub) and error (m) to the true surface\n"
+    << "element vertex " << map.size()
+    << "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar class\nproperty float error\n"
+       "end_header\n";
+  std::string body = h.str();
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    const float v[3] = {static_cast<float>(map[i].p_w.x()), static_cast<float>(map[i].p_w.y()),
+                        static_cast<float>(map[i].p_w.z())};
+    body.append(reinterpret_cast<const char*>(v), sizeof v);
+    body.push_back(static_cast<char>(scores[i].class_id));
+    const float e = static_cast<float>(scores[i].error_m);
+    body.append(reinterpret_cast<const char*>(&e), sizeof e);
+  }
+  write_file(path, body);
+}
+
+}  // namespace pvb::run
