@@ -26,6 +26,7 @@
 #include "pvb/harness/matching/ground_truth.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
+#include "pvb/slam/dense/ply.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"
 #include "stop_signals.hpp"
 
@@ -345,6 +346,13 @@ std::string SlamRun::write_final_outputs() {
   cam_traj_.close();
   if (!system_->dense_enabled()) return {};
   const std::size_t cloud_points = system_->write_point_cloud(a_.out + "/PointCloud.ply");
+  // The map as built (each keyframe at the pose it was made with), and the
+  // corrected map around the first loop correction.
+  slam::dense::write_ply(a_.out + "/PointCloud_live.ply", system_->live_point_cloud());
+  if (const auto loop = system_->dense_first_loop()) {
+    slam::dense::write_ply(a_.out + "/PointCloud_before_loop.ply", loop->before);
+    slam::dense::write_ply(a_.out + "/PointCloud_after_loop.ply", loop->after);
+  }
   const slam::dense::DenseMapperStats dense = system_->dense_stats();
   const double per_kf_ms = dense.keyframes ? dense.total_ms / static_cast<double>(dense.keyframes) : 0.0;
   std::printf("dense map: %zu points from %zu keyframes (%.1f ms per keyframe) -> %s/PointCloud.ply\n",
@@ -352,7 +360,11 @@ std::string SlamRun::write_final_outputs() {
   std::ostringstream js;
   js << ",\n  \"dense\": {\"keyframes\": " << dense.keyframes << ", \"points\": " << cloud_points
      << ", \"keyframe_points\": " << dense.points << ", \"ms_per_keyframe\": " << format_g(per_kf_ms)
-     << ", \"resolution_m\": " << format_g(settings_.dense.resolution_m) << "}";
+     << ", \"resolution_m\": " << format_g(settings_.dense.resolution_m)
+     << ", \"pose_updates\": " << dense.pose_updates << ", \"keyframes_moved\": " << dense.keyframes_moved
+     << ", \"loop_update_ms\": [";
+  for (std::size_t i = 0; i < dense.loop_update_ms.size(); ++i) js << (i ? ", " : "") << format_g(dense.loop_update_ms[i]);
+  js << "]}";
   return js.str();
 }
 

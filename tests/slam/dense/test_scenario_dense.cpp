@@ -112,6 +112,11 @@ TEST(DenseScenario, CloudLiesOnTheRenderedGeometry) {
   ASSERT_EQ(ev.pairs.size(), static_cast<std::size_t>(kFrames));
   const pvb::slam::dense::PointCloud cloud = pvb::slam::dense::read_ply(out + "/PointCloud.ply");
   ASSERT_GT(cloud.size(), 1000u);
+  // The map as built is there too; local BA moved keyframes, so it differs.
+  const pvb::slam::dense::PointCloud live = pvb::slam::dense::read_ply(out + "/PointCloud_live.ply");
+  EXPECT_GT(live.size(), 1000u);
+  EXPECT_FALSE(live == cloud);
+  EXPECT_NE(stats.find("\"pose_updates\": "), std::string::npos) << stats;
 
   // Reference surface: the same scenario and seed, rendered without the
   // sensor model at the ground-truth poses.
