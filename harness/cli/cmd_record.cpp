@@ -16,6 +16,7 @@
 
 #include "command.hpp"
 #include "count_option.hpp"
+#include "pvb/common/clock.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
@@ -75,9 +76,6 @@ class FakenectDump {
 };
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 /// What the frame loop did.
 struct RecordLoop {

@@ -21,12 +21,12 @@
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/evaluate.hpp"
+#include "pvb/run/map_eval.hpp"
 #include "pvb/run/place_recognition.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/harness/matching/ground_truth.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
-#include "pvb/slam/dense/ply.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"
 #include "stop_signals.hpp"
 
@@ -345,14 +345,10 @@ std::string SlamRun::write_final_outputs() {
   }
   cam_traj_.close();
   if (!system_->dense_enabled()) return {};
-  const std::size_t cloud_points = system_->write_point_cloud(a_.out + "/PointCloud.ply");
-  // The map as built (each keyframe at the pose it was made with), and the
-  // corrected map around the first loop correction.
-  slam::dense::write_ply(a_.out + "/PointCloud_live.ply", system_->live_point_cloud());
-  if (const auto loop = system_->dense_first_loop()) {
-    slam::dense::write_ply(a_.out + "/PointCloud_before_loop.ply", loop->before);
-    slam::dense::write_ply(a_.out + "/PointCloud_after_loop.ply", loop->after);
-  }
+  // The corrected map, the map as built and, after a loop, the corrected map around it.
+  const run::NamedClouds maps = run::dense_maps(*system_);
+  run::write_dense_maps(maps, a_.out);
+  const std::size_t cloud_points = maps.front().second.size();
   const slam::dense::DenseMapperStats dense = system_->dense_stats();
   const double per_kf_ms = dense.keyframes ? dense.total_ms / static_cast<double>(dense.keyframes) : 0.0;
   std::printf("dense map: %zu points from %zu keyframes (%.1f ms per keyframe) -> %s/PointCloud.ply\n",

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "pvb/common/clock.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 
@@ -15,9 +16,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 /// Keeps the matches within `threshold_px` (eq. 8) of F's epipolar lines.
 std::vector<std::uint8_t> filter_by_F(const cv::Mat& Fcv, const std::vector<slam::PointMatch>& pts,

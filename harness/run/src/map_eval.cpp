@@ -5,8 +5,33 @@
 
 #include "pvb/common/output_file.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/slam/dense/ply.hpp"
 
 namespace pvb::run {
+
+NamedClouds dense_maps(slam::System& system) {
+  NamedClouds maps;
+  maps.emplace_back("corrected", system.point_cloud());
+  maps.emplace_back("live", system.live_point_cloud());
+  if (std::optional<slam::dense::LoopSnapshot> loop = system.dense_first_loop()) {
+    maps.emplace_back("before_loop", std::move(loop->before));
+    maps.emplace_back("after_loop", std::move(loop->after));
+  }
+  return maps;
+}
+
+std::string dense_map_file(const std::string& name) {
+  return name == "corrected" ? "PointCloud.ply" : "PointCloud_" + name + ".ply";
+}
+
+std::vector<std::string> write_dense_maps(const NamedClouds& maps, const std::string& dir) {
+  std::vector<std::string> files;
+  for (const auto& [name, cloud] : maps) {
+    files.push_back(dense_map_file(name));
+    slam::dense::write_ply(dir + "/" + files.back(), cloud);
+  }
+  return files;
+}
 
 const char* to_string(MapAlignment a) { return a == MapAlignment::kAte ? "ate" : "first"; }
 
@@ -37,6 +62,7 @@ std::vector<eval::SurfacePoint> true_surface(const scenes::Scenario& scenario, s
   return s;
 }
 
+namespace {
 std::string scores_json(const eval::MapScores& s) {
   std::ostringstream js;
   auto list = [&js](const std::vector<double>& v) {
@@ -58,6 +84,17 @@ std::string scores_json(const eval::MapScores& s) {
   return js.str();
 }
 
+std::string scores_row(const std::string& name, const eval::MapScores& s) {
+  char line[256];
+  auto pct = [&s](std::size_t i) { return i < s.completeness_at.size() ? 100.0 * s.completeness_at[i] : 0.0; };
+  std::snprintf(line, sizeof line, "%-7s %9zu %9zu %8.1f %8.1f %8.1f %6.1f %6.1f %6.1f %6.1f %7.3f %7.1f\n",
+                name.c_str(), s.accuracy.count, s.completeness.count, 1000 * s.accuracy.median,
+                1000 * s.accuracy.mean, 1000 * s.accuracy.p95, pct(0), pct(1), pct(2), pct(3),
+                s.fscore_at.size() > 1 ? s.fscore_at[1] : 0.0, 100.0 * s.ghosting);
+  return line;
+}
+}  // namespace
+
 std::string map_accuracy_json(const eval::MapAccuracy& r, int indent) {
   const std::string nl = "\n" + std::string(static_cast<std::size_t>(indent), ' ');
   std::ostringstream js;
@@ -78,18 +115,6 @@ std::string map_accuracy_json(const eval::MapAccuracy& r, int indent) {
   js << nl << "  ]" << nl << "}";
   return js.str();
 }
-
-namespace {
-std::string scores_row(const std::string& name, const eval::MapScores& s) {
-  char line[256];
-  auto pct = [&s](std::size_t i) { return i < s.completeness_at.size() ? 100.0 * s.completeness_at[i] : 0.0; };
-  std::snprintf(line, sizeof line, "%-7s %9zu %9zu %8.1f %8.1f %8.1f %6.1f %6.1f %6.1f %6.1f %7.3f %7.1f\n",
-                name.c_str(), s.accuracy.count, s.completeness.count, 1000 * s.accuracy.median,
-                1000 * s.accuracy.mean, 1000 * s.accuracy.p95, pct(0), pct(1), pct(2), pct(3),
-                s.fscore_at.size() > 1 ? s.fscore_at[1] : 0.0, 100.0 * s.ghosting);
-  return line;
-}
-}  // namespace
 
 std::string map_accuracy_table(const eval::MapAccuracy& r) {
   std::string t =

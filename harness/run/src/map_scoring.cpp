@@ -1,7 +1,6 @@
 #include "map_scoring.hpp"
 
-#include <chrono>
-
+#include "pvb/common/clock.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/eval/slam_mode.hpp"
@@ -10,10 +9,6 @@
 
 namespace pvb::run {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 /// The corrected map's per-point output: map_errors.ply and the top view.
 void write_error_outputs(const SystemSink& sink, const std::string& scenario, const std::vector<eval::MapPoint>& map,
@@ -38,10 +33,10 @@ void score_sink(SystemSink& sink, const std::string& scenario, const eval::Traje
   d.alignment = to_string(MapAlignment::kFirstFrame);
   d.surface_samples = surface.size();
   for (const auto& [name, cloud] : sink.clouds) {
-    const auto t0 = Clock::now();
+    const auto t0 = SteadyClock::now();
     const std::vector<eval::MapPoint> map = map_in_world(cloud, T);
     std::vector<eval::MapPointScore> scores;
-    MapResult r{name, dense_map_file(name), eval::evaluate_map(map, surface, {}, &scores), 0.0};
+    MapResult r{name, eval::evaluate_map(map, surface, {}, &scores), 0.0};
     r.score_s = seconds_since(t0);
     if (name == "corrected") write_error_outputs(sink, scenario, map, scores, &d);
     log.line(eval::mode_label(sink.run.mode) + ": " + name + " map: accuracy median " +
@@ -57,7 +52,7 @@ void score_sink(SystemSink& sink, const std::string& scenario, const eval::Traje
 
 double score_dense_maps(const scenes::Scenario& scenario, sim::GlBackend backend, const eval::Trajectory& gt,
                         SystemSinks& sinks, RunLog& log) {
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   bool wanted = false;
   for (auto& sink : sinks) {
     if (!sink->run.dense_map) continue;

@@ -106,8 +106,8 @@ std::string dense_map_json(const DenseMapReport& d, const std::string& in) {
                     ", \"update_ms\": {\"median\": " + num(d.update_ms_median) + ", \"max\": " + num(d.update_ms_max) +
                     "}, \"loop_update_ms\": [";
   for (std::size_t i = 0; i < d.loop_update_ms.size(); ++i) out += (i ? ", " : "") + num(d.loop_update_ms[i]);
-  out += "], \"files\": [\"PointCloud.ply\", \"PointCloud_live.ply\"";
-  if (d.loop_snapshot) out += ", \"PointCloud_before_loop.ply\", \"PointCloud_after_loop.ply\"";
+  out += "], \"files\": [";
+  for (std::size_t i = 0; i < d.files.size(); ++i) out += (i ? ", " : "") + str(d.files[i]);
   out += "]";
   if (!d.note.empty()) out += ", \"note\": " + str(d.note);
   if (!d.maps.empty()) {
@@ -542,8 +542,7 @@ std::string files_and_log(const RunReport& r) {
                         "timing.csv", "camera.yaml", "run.log"})
     h += std::string("<li><a href=\"") + f + "\">" + f + "</a></li>\n";
   if (r.primary.dense_map) {
-    std::vector<std::string> maps = {"PointCloud.ply", "PointCloud_live.ply"};
-    if (r.primary.dense_map->loop_snapshot) maps.insert(maps.end(), {"PointCloud_before_loop.ply", "PointCloud_after_loop.ply"});
+    std::vector<std::string> maps = r.primary.dense_map->files;
     if (!r.primary.dense_map->maps.empty()) maps.push_back("map_errors.ply");
     for (const std::string& f : maps) h += "<li><a href=\"" + f + "\">" + f + "</a></li>\n";
   }

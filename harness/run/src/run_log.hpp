@@ -6,14 +6,12 @@
 #include <string>
 #include <vector>
 
+#include "pvb/common/clock.hpp"
 #include "pvb/common/output_file.hpp"
 
 namespace pvb::run {
 
 using Clock = std::chrono::steady_clock;
-
-/// Milliseconds from t0 to now.
-double ms_since(Clock::time_point t0);
 
 /// CPU time of the whole process (every thread, GL workers included), seconds.
 double process_cpu_s();

@@ -9,7 +9,6 @@
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/run/place_recognition.hpp"
-#include "pvb/slam/dense/ply.hpp"
 
 namespace pvb::run {
 namespace {
@@ -125,17 +124,11 @@ void SystemSink::finish() {
   run.keyframes = system->num_keyframes();
   run.map_points = system->num_map_points();
   run.local_mapping = system->mapping_stats();
-  if (system->dense_enabled()) write_dense_maps();
+  if (system->dense_enabled()) save_dense_maps();
 }
 
-void SystemSink::write_dense_maps() {
-  clouds.clear();
-  clouds.emplace_back("corrected", system->point_cloud());
-  clouds.emplace_back("live", system->live_point_cloud());
-  if (const std::optional<slam::dense::LoopSnapshot> loop = system->dense_first_loop()) {
-    clouds.emplace_back("before_loop", loop->before);
-    clouds.emplace_back("after_loop", loop->after);
-  }
+void SystemSink::save_dense_maps() {
+  clouds = dense_maps(*system);
   const slam::dense::DenseMapperStats st = system->dense_stats();
   DenseMapReport d;
   d.keyframes = st.keyframes;
@@ -146,13 +139,8 @@ void SystemSink::write_dense_maps() {
   d.update_ms_median = percentile(st.update_ms, 0.5);
   d.update_ms_max = st.update_ms.empty() ? 0.0 : *std::max_element(st.update_ms.begin(), st.update_ms.end());
   d.loop_update_ms = st.loop_update_ms;
-  d.loop_snapshot = clouds.size() > 2;
-  for (const auto& [name, cloud] : clouds) slam::dense::write_ply(dir + "/" + dense_map_file(name), cloud);
+  d.files = write_dense_maps(clouds, dir);
   run.dense_map = std::move(d);
-}
-
-std::string dense_map_file(const std::string& name) {
-  return name == "corrected" ? "PointCloud.ply" : "PointCloud_" + name + ".ply";
 }
 
 void SystemSink::evaluate(const eval::Trajectory& gt) {

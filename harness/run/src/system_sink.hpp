@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <memory>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "pvb/common/output_file.hpp"
@@ -31,7 +30,7 @@ struct SystemSink {
   std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made, for the revisit labels
   /// The dense maps written by finish(), by name (corrected, live, and
   /// before_loop / after_loop when a loop was closed); kept for scoring.
-  std::vector<std::pair<std::string, slam::dense::PointCloud>> clouds;
+  NamedClouds clouds;
 
   SystemSink(const std::string& mode, const slam::Settings& settings, bool sync, std::uint32_t seed,
              const std::string& out_dir);
@@ -48,7 +47,7 @@ struct SystemSink {
 
  private:
   /// The dense maps into `clouds` and their PLY files; run.dense_map.
-  void write_dense_maps();
+  void save_dense_maps();
   /// The counters and the per-frame record.
   void count(const slam::FrameResult& r, int index, double t_s);
   /// The frame's lines in CameraTrajectory, KeyFrameTrajectory and timing.csv.
@@ -56,10 +55,6 @@ struct SystemSink {
 };
 
 using SystemSinks = std::vector<std::unique_ptr<SystemSink>>;
-
-/// The PLY file of a dense map by name: PointCloud.ply for the corrected
-/// map, PointCloud_<name>.ply for the others.
-std::string dense_map_file(const std::string& name);
 
 /// The systems that see the frames (options.mode): PE-SLAM or the baseline
 /// in out_dir, and with kCompare the baseline beside PE-SLAM in

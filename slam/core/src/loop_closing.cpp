@@ -8,6 +8,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
+#include "pvb/common/clock.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/matcher.hpp"
@@ -17,10 +18,6 @@ namespace pvb::slam {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// Nearest-rank quantile q of the values (0 for none).
 double quantile(std::vector<double> v, double q) {

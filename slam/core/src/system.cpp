@@ -1,16 +1,10 @@
 #include "pvb/slam/core/system.hpp"
 
-#include <chrono>
 #include <opencv2/imgproc.hpp>
 
-#include "pvb/slam/dense/ply.hpp"
+#include "pvb/common/clock.hpp"
 
 namespace pvb::slam {
-namespace {
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-}  // namespace
 
 System::System(const Settings& settings, const SystemOptions& options)
     : settings_(settings), options_(options), extractor_(settings.orb) {
@@ -173,12 +167,6 @@ dense::PointCloud System::live_point_cloud() const { return dense_ ? dense_->liv
 
 std::optional<dense::LoopSnapshot> System::dense_first_loop() const {
   return dense_ ? dense_->first_loop() : std::nullopt;
-}
-
-std::size_t System::write_point_cloud(const std::string& path) {
-  const dense::PointCloud cloud = point_cloud();
-  dense::write_ply(path, cloud);
-  return cloud.size();
 }
 
 dense::DenseMapperStats System::dense_stats() const { return dense_ ? dense_->stats() : dense::DenseMapperStats{}; }

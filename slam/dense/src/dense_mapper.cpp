@@ -1,16 +1,11 @@
 #include "pvb/slam/dense/dense_mapper.hpp"
 
 #include <Eigen/Geometry>
-#include <chrono>
 
+#include "pvb/common/clock.hpp"
 #include "pvb/common/threads.hpp"
 
 namespace pvb::slam::dense {
-namespace {
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-}  // namespace
 
 DenseMapper::DenseMapper(const DenseMapperOptions& options)
     : options_(options), live_(options.leaf_m), corrected_(options.leaf_m) {}
@@ -87,11 +82,10 @@ void DenseMapper::process(const DenseKeyFrame& kf) {
 }
 
 bool DenseMapper::moved(const geom::SE3d& from, const geom::SE3d& to, bool exact) const {
+  if (exact) return from.matrix() != to.matrix();
   const geom::SE3d d = from.inverse() * to;
-  const double dt_m = d.translation().norm();
-  const double dr_rad = Eigen::AngleAxisd(d.linear()).angle();
-  if (exact) return dt_m > 0 || dr_rad > 0 || !from.isApprox(to, 0);
-  return dt_m > options_.update_min_translation_m || dr_rad > options_.update_min_rotation_rad;
+  return d.translation().norm() > options_.update_min_translation_m ||
+         Eigen::AngleAxisd(d.linear()).angle() > options_.update_min_rotation_rad;
 }
 
 void DenseMapper::apply(const PoseUpdate& update) {
@@ -118,7 +112,6 @@ void DenseMapper::apply(const PoseUpdate& update) {
   if (snapshot) {
     snap.after = corrected_.cloud();
     snap.keyframes_moved = n_moved;
-    snap.update_ms = ms;
     first_loop_ = std::move(snap);
   }
 }

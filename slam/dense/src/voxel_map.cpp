@@ -45,10 +45,11 @@ VoxelMap::VoxelMap(double leaf_m) : leaf_m_(leaf_m), slots_(1024) {
 void VoxelMap::grow() {
   std::vector<Slot> slots(slots_.size() * 2);
   const std::size_t mask = slots.size() - 1;
-  for (std::uint32_t c = 0; c < cells_.size(); ++c) {
-    std::size_t i = mix(cell_keys_[c]) & mask;
+  for (const Slot& s : slots_) {
+    if (s.cell == kNoCell) continue;
+    std::size_t i = mix(s.key) & mask;
     while (slots[i].cell != kNoCell) i = (i + 1) & mask;
-    slots[i] = {cell_keys_[c], c};
+    slots[i] = s;
   }
   slots_.swap(slots);
 }
@@ -61,7 +62,6 @@ std::uint32_t VoxelMap::find_or_make(std::uint64_t key) {
   const auto c = static_cast<std::uint32_t>(cells_.size());
   if (c == kNoCell) throw Error("VoxelMap: more than 2^32 - 1 voxels");
   cells_.emplace_back();
-  cell_keys_.push_back(key);
   slots_[i] = {key, c};
   if (2 * cells_.size() > slots_.size()) grow();  // load factor <= 1/2
   return c;
@@ -98,16 +98,16 @@ void VoxelMap::remove(const PointCloud& cloud_w, const Handle& handle) {
 }
 
 PointCloud VoxelMap::cloud() const {
-  std::vector<std::uint32_t> order;
-  order.reserve(occupied_);
-  for (std::uint32_t c = 0; c < cells_.size(); ++c)
-    if (cells_[c].n > 0) order.push_back(c);
+  std::vector<Slot> occupied;
+  occupied.reserve(occupied_);
+  for (const Slot& s : slots_)
+    if (s.cell != kNoCell && cells_[s.cell].n > 0) occupied.push_back(s);
   // Packed keys sort as (x, y, z): each axis is biased to non-negative.
-  std::sort(order.begin(), order.end(), [this](std::uint32_t a, std::uint32_t b) { return cell_keys_[a] < cell_keys_[b]; });
+  std::sort(occupied.begin(), occupied.end(), [](const Slot& a, const Slot& b) { return a.key < b.key; });
   PointCloud out;
-  out.reserve(order.size());
-  for (std::uint32_t ci : order) {
-    const Cell& c = cells_[ci];
+  out.reserve(occupied.size());
+  for (const Slot& s : occupied) {
+    const Cell& c = cells_[s.cell];
     const double n = static_cast<double>(c.n);
     const double to_m = 1.0 / (kUnitsPerMetre * n);
     out.push_back({static_cast<float>(c.sx * to_m), static_cast<float>(c.sy * to_m), static_cast<float>(c.sz * to_m),

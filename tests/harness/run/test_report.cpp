@@ -267,7 +267,7 @@ TEST(RunReport, DenseMapInMetricsAndReport) {
   d.update_ms_median = 4.5;
   d.update_ms_max = 250;
   d.loop_update_ms = {250};
-  d.loop_snapshot = true;
+  d.files = {"PointCloud.ply", "PointCloud_live.ply", "PointCloud_before_loop.ply", "PointCloud_after_loop.ply"};
   d.note = "not scored (--no-map-eval)";
   r.primary.dense_map = d;
   YAML::Node m = YAML::Load(metrics_json(r));
@@ -285,7 +285,7 @@ TEST(RunReport, DenseMapInMetricsAndReport) {
   s.completeness_at = {0.5, 0.8, 0.9, 0.95};
   s.fscore_at = {0.5, 0.8, 0.9, 0.95};
   s.ghosting = 0.001;
-  MapResult corrected{"corrected", "PointCloud.ply", {}, 1.0};
+  MapResult corrected{"corrected", {}, 1.0};
   corrected.accuracy.all = s;
   corrected.accuracy.per_class = {{2, s}, {5, s}};
   r.primary.dense_map->maps = {corrected};

@@ -5,6 +5,7 @@
 // corrected one, the live one, the corrected one around the first loop
 // correction) is scored against it.
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pvb/eval/align.hpp"
@@ -14,9 +15,27 @@
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/gl_context.hpp"
 #include "pvb/sim/truth_surface.hpp"
+#include "pvb/slam/core/system.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"
 
 namespace pvb::run {
+
+/// A run's dense maps by name: "corrected" (every keyframe at its final
+/// pose), "live" (each at the pose it was made with) and, when a loop was
+/// closed, "before_loop" and "after_loop" (the corrected map around it).
+using NamedClouds = std::vector<std::pair<std::string, slam::dense::PointCloud>>;
+
+/// The maps of a stopped System with dense mapping on, corrected first
+/// (System::point_cloud() re-bins the final poses).
+NamedClouds dense_maps(slam::System& system);
+
+/// The file of map `name`: PointCloud.ply for the corrected map,
+/// PointCloud_<name>.ply for the others.
+std::string dense_map_file(const std::string& name);
+
+/// Writes every map as PLY into `dir`; returns the file names.  Throws
+/// pvb::IoError when a file cannot be written.
+std::vector<std::string> write_dense_maps(const NamedClouds& maps, const std::string& dir);
 
 /// How a map goes from SLAM's world (its first camera) into the ground
 /// truth's world.
@@ -41,16 +60,14 @@ std::vector<eval::SurfacePoint> true_surface(const scenes::Scenario& scenario, s
 /// One scored map.
 struct MapResult {
   std::string name;  ///< corrected, live, before_loop, after_loop
-  std::string ply;   ///< file name of the map in the run's folder
   eval::MapAccuracy accuracy;
   double score_s = 0;
 };
 
-/// The scores as JSON: {"map_points", "surface_points", "accuracy_m":
-/// {mean, median, rmse, p95}, "completeness_at", "precision_at",
-/// "fscore_at", "chamfer_m", "ghosting", "ghosting_judged"}.
-std::string scores_json(const eval::MapScores& s);
-/// The whole result: {"tau_m", "all", "per_class": {...}, "per_range": [...]},
+/// The result as JSON: {"tau_m", "all", "per_class": {...}, "per_range":
+/// [...]}, each scores object {"map_points", "surface_points",
+/// "accuracy_m": {mean, median, rmse, p95}, "completeness_at",
+/// "precision_at", "fscore_at", "chamfer_m", "ghosting", "ghosting_judged"};
 /// indented by `indent` spaces after each newline.
 std::string map_accuracy_json(const eval::MapAccuracy& r, int indent = 0);
 /// A fixed-width table, one row for the whole map and one per class

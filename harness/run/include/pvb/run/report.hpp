@@ -72,7 +72,7 @@ struct DenseMapReport {
   std::size_t keyframes_moved = 0;  ///< keyframes re-binned over those updates
   double update_ms_median = 0, update_ms_max = 0;
   std::vector<double> loop_update_ms;  ///< per loop correction: its re-binning time
-  bool loop_snapshot = false;          ///< PointCloud_{before,after}_loop.ply written
+  std::vector<std::string> files;      ///< the maps' PLY files, corrected first
   std::string alignment;               ///< how the maps went into the world (scored only)
   std::size_t surface_samples = 0;
   double truth_s = 0;            ///< sampling the true surface

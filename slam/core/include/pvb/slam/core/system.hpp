@@ -84,9 +84,6 @@ class System {
   /// The corrected map just before and after the first loop correction
   /// (PointCloudMapping.Reassemble 1 and a loop closed).
   std::optional<dense::LoopSnapshot> dense_first_loop() const;
-  /// Writes point_cloud() as binary PLY; returns the number of points.
-  /// Throws pvb::IoError when the file cannot be written.
-  std::size_t write_point_cloud(const std::string& path);
   /// Keyframes processed, points and time spent (empty when disabled).
   dense::DenseMapperStats dense_stats() const;
 

@@ -68,7 +68,6 @@ struct PoseUpdate {
 struct LoopSnapshot {
   PointCloud before, after;
   std::size_t keyframes_moved = 0;
-  double update_ms = 0;  ///< the re-binning alone (not the two snapshots)
 };
 
 /// Figures for reports.

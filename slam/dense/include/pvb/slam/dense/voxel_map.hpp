@@ -59,7 +59,6 @@ class VoxelMap {
   double leaf_m_;
   std::size_t occupied_ = 0;
   std::vector<Cell> cells_;
-  std::vector<std::uint64_t> cell_keys_;  ///< packed key of each cell
   struct Slot {
     std::uint64_t key = 0;
     std::uint32_t cell = kNoCell;  ///< kNoCell: free
