@@ -6,6 +6,7 @@
 
 #include "command.hpp"
 #include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
 
 namespace pvb::cli {
 Command add_record_command(CLI::App& app);
@@ -56,17 +57,17 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const pvb::Error& e) {  // an option's own check (count_option.hpp)
-    std::fprintf(stderr, "pvbench: error: %s\n", e.what());
+    std::fprintf(stderr, "pvbench: error: %s\n", pvb::printable(e.what()).c_str());
     return 1;
   }
   try {
     for (auto& c : cmds)
       if (c.app->parsed()) return c.run();
   } catch (const pvb::Error& e) {
-    std::fprintf(stderr, "pvbench: error: %s\n", e.what());
+    std::fprintf(stderr, "pvbench: error: %s\n", pvb::printable(e.what()).c_str());
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "pvbench: internal error: %s\n", e.what());
+    std::fprintf(stderr, "pvbench: internal error: %s\n", pvb::printable(e.what()).c_str());
     return 2;
   }
   return 0;

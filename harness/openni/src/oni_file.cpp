@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
 
 namespace pvb::openni {
 namespace {
@@ -33,6 +34,7 @@ std::size_t OniFileSummary::nodes_begun() const {
 }
 
 OniFileSummary scan_oni_file(const std::string& path) {
+  require_regular_file(path);  // a FIFO would block the open, a folder reads as garbage
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path, "cannot open the file");
   in.seekg(0, std::ios::end);

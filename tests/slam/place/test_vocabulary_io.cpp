@@ -1,6 +1,8 @@
 // Vocabulary files: text and binary round trips, and bad files, each error
 // naming the file and the line (text) or byte (binary).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
@@ -159,6 +161,30 @@ TEST(VocabularyFiles, MissingFileNamesIt) {
     EXPECT_EQ(e.file(), path);
     EXPECT_NE(e.message().find("cannot open"), std::string::npos) << e.what();
   }
+}
+
+// A vocabulary path that is not a regular file is refused before it is
+// opened: a FIFO used to block the load for ever.
+TEST(VocabularyFiles, OnlyRegularFilesAreOpened) {
+  const std::string fifo = temp_path("voc_fifo");
+  std::remove(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    Vocabulary::load(fifo);
+    ADD_FAILURE() << "loaded";
+  } catch (const pvb::IoError& e) {
+    EXPECT_EQ(std::string(e.what()), fifo + ": is a FIFO; expected a regular file");
+  }
+  std::remove(fifo.c_str());
+  const std::string dir = temp_path("voc_dir");
+  ::mkdir(dir.c_str(), 0700);
+  try {
+    Vocabulary::load(dir);
+    ADD_FAILURE() << "loaded";
+  } catch (const pvb::IoError& e) {
+    EXPECT_EQ(std::string(e.what()), dir + ": is a folder; expected a regular file");
+  }
+  ::rmdir(dir.c_str());
 }
 
 TEST(VocabularyFiles, BadTextFilesNameTheLine) {

@@ -5,8 +5,15 @@
 
 namespace pvb {
 
-/// Reads a whole file; throws IoError when it cannot.
+/// Throws IoError naming `path` unless it is a regular file (or a link to
+/// one).  Checked with stat before anything opens it: a FIFO would block an
+/// open for reading, and a folder opens but reads as garbage.
+void require_regular_file(const std::string& path);
+/// Reads a whole regular file; throws IoError when it cannot.
 std::string read_file(const std::string& path);
+/// `s` made safe for one line of a message: control characters, DEL and
+/// bytes that are not UTF-8 become \xNN (a tab \t, a newline \n).
+std::string printable(const std::string& s);
 /// Writes a whole file through `path`.tmp, renamed over `path` once whole
 /// (write_file_via_temp); throws IoError naming `path` when it cannot, and
 /// leaves neither a half-written file nor the temporary one behind.

@@ -2,6 +2,7 @@
 // PLY files for coloured clouds: binary little endian, one `vertex` element
 // with properties x y z (float) and red green blue (uchar), which
 // CloudCompare, MeshLab and Open3D read.
+#include <cstddef>
 #include <string>
 
 #include "pvb/slam/dense/point_cloud.hpp"
@@ -11,11 +12,19 @@ namespace pvb::slam::dense {
 /// Writes the cloud; throws pvb::IoError when the file cannot be written.
 void write_ply(const std::string& path, const PointCloud& cloud);
 
+/// What read_ply() left out.
+struct PlyReadStats {
+  std::size_t non_finite_dropped = 0;  ///< vertices with a NaN or infinite coordinate
+};
+
 /// Reads a PLY file as write_ply() writes it (binary_little_endian 1.0, a
 /// vertex element whose properties are float x y z and uchar red green blue
-/// in that order; comments allowed, no other elements).  Throws
-/// pvb::IoError naming the file and the header line that is not understood,
-/// or a truncated body.
-PointCloud read_ply(const std::string& path);
+/// in that order; comments allowed, no other elements).  The body must hold
+/// exactly the vertices the header announces (checked against the file's
+/// size before anything is allocated).  Vertices with a NaN or infinite
+/// coordinate are left out and counted in `stats`.  Throws pvb::IoError
+/// naming the file and the header line that is not understood, or a body
+/// of the wrong size.
+PointCloud read_ply(const std::string& path, PlyReadStats* stats = nullptr);
 
 }  // namespace pvb::slam::dense
