@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "command.hpp"
+#include "pvb/common/output_file.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/eval/evaluate.hpp"
 #include "pvb/eval/plot.hpp"
@@ -101,9 +102,16 @@ int run_eval(const EvalArgs& a) {
 
   if (!a.json.empty()) write_file(a.json, eval::format_json_document(a.gt, results));
   if (!a.plot.empty()) {
+    // A stream (--plot /dev/stdout, a FIFO) gets every figure's SVG, one
+    // after the other, and nothing is created beside it.
+    const bool stream = resolve_output_target(a.plot).kind == OutputTarget::Kind::kStream;
     for (std::size_t k = 0; k < results.size(); ++k) {
       const eval::Figure fig =
           eval::make_error_figure(results[k], "Trajectory error: " + base_name(results[k].est_source));
+      if (stream) {
+        write_file(a.plot, eval::format_svg(fig));
+        continue;
+      }
       const std::string svg = numbered(a.plot, k);
       write_file(svg, eval::format_svg(fig));
       plot::write_png(fig, png_beside(svg));

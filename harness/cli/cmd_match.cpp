@@ -11,6 +11,7 @@
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/harness/matching/experiment.hpp"
+#include "pvb/plot/png.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -152,13 +153,7 @@ int run_match(const MatchOptions& o) {
     slam::PeMatcher pe;
     const auto keep = run_method(methods.back(), cs, o.seed, slam::PeMatchParams{}, pe);
     const cv::Mat canvas = draw_matches(img1, img2, cs, keep);
-    bool ok = false;
-    try {
-      ok = cv::imwrite(o.draw, canvas);
-    } catch (const cv::Exception& e) {
-      throw IoError(o.draw, std::string("cannot write image: ") + e.what());
-    }
-    if (!ok) throw IoError(o.draw, "cannot write image (is the extension .png/.jpg?)");
+    plot::write_image(canvas, o.draw);
   }
   return 0;
 }

@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pvb/common/error.hpp"
+#include "pvb/plot/png.hpp"
 
 namespace pvb::plot {
 
@@ -35,7 +36,7 @@ cv::Mat make_contact_sheet(const std::vector<Thumbnail>& thumbs, int cols, int t
 void write_rgb_png(const cv::Mat& rgb, const std::string& path) {
   cv::Mat bgr;
   cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
-  if (!cv::imwrite(path, bgr)) throw IoError(path, "cannot write image");
+  write_image(bgr, path);
 }
 
 std::vector<int> spread_indices(int n, int count) {

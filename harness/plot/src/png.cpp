@@ -1,10 +1,12 @@
 #include "pvb/plot/png.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_file.hpp"
 
 namespace pvb::plot {
 namespace {
@@ -55,13 +57,33 @@ void write_png(const eval::Figure& figure, const std::string& path) {
     cv::polylines(img, pts, false, bgr(p.color), std::max(1, static_cast<int>(std::lround(p.width_px))), cv::LINE_AA);
   }
   for (const eval::FigText& t : figure.texts) draw_text(img, t);
+  write_image(img, path);
+}
+
+void write_image(const cv::Mat& image, const std::string& path) {
+  static const char* const kExtensions[] = {".png", ".jpg", ".jpeg", ".bmp", ".ppm", ".pgm", ".tif", ".tiff"};
+  const std::size_t dot = path.find_last_of('.');
+  const std::size_t slash = path.find_last_of('/');
+  std::string ext = dot != std::string::npos && (slash == std::string::npos || dot > slash) ? path.substr(dot) : "";
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  bool known = false;
+  for (const char* k : kExtensions) known = known || ext == k;
+  if (!known) {
+    if (resolve_output_target(path).kind != OutputTarget::Kind::kStream)
+      throw IoError(path, "cannot write an image without an image extension (.png, .jpg, .bmp, .ppm, .tif)");
+    ext = ".png";
+  }
+  std::vector<unsigned char> bytes;
   bool ok = false;
   try {
-    ok = cv::imwrite(path, img);
+    ok = cv::imencode(ext, image, bytes);
   } catch (const cv::Exception& e) {
-    throw IoError(path, std::string("cannot write PNG: ") + e.what());
+    throw IoError(path, std::string("cannot encode the image: ") + e.what());
   }
-  if (!ok) throw IoError(path, "cannot write PNG");
+  if (!ok) throw IoError(path, "cannot encode the image as " + ext);
+  write_file_via_temp(path, [&](OutputFile& out) {
+    out.append(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  });
 }
 
 }  // namespace pvb::plot
