@@ -29,5 +29,6 @@ cd "${SLURM_SUBMIT_DIR:-.}"
 pvbench="${PVBENCH:-build/bin/pvbench}"
 dir="$out/seed_$seed"
 mkdir -p "$dir"
-# One process per task; OpenCV and Ceres may use the task's CPUs.
-exec "$pvbench" run --scenario "$scenario" --seed "$seed" --out "$dir" "$@" > "$dir/stdout.log" 2>&1
+# One process per task; OpenCV and Ceres may use the task's CPUs.  A task
+# run again replaces its seed's earlier output (--overwrite).
+exec "$pvbench" run --scenario "$scenario" --seed "$seed" --out "$dir" --overwrite "$@" > "$dir/stdout.log" 2>&1

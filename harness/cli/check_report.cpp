@@ -5,6 +5,7 @@
 
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/suite/check.hpp"
+#include "pvb/suite/metrics_file.hpp"
 
 namespace pvb::cli {
 
@@ -14,8 +15,12 @@ int check_and_print(const std::string& scenario_file, const std::string& metrics
     std::printf("%s: no expect: section, nothing to check\n", scenario_file.c_str());
     return no_expect_code;
   }
+  // The run must be one of this scenario: another's metrics would be
+  // judged by the wrong bounds.
+  const suite::MetricsFile metrics = suite::read_metrics_file(metrics_path);
+  suite::expect_run_identity(metrics, s.name, scenario_file, std::nullopt);
   std::vector<std::string> notes;
-  const std::vector<suite::Violation> violations = suite::check_expectations(s.expect, metrics_path, &notes);
+  const std::vector<suite::Violation> violations = suite::check_expectations(s.expect, metrics, &notes);
   if (s.expect.sweep.any())
     notes.push_back("expect.sweep is judged over seeds: pvbench sweep --scenario " + scenario_file +
                     " --compare --check");

@@ -22,6 +22,8 @@
 #include "command.hpp"
 #include "count_option.hpp"
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_folder.hpp"
+#include "pvb/dataset/fakenect_dump.hpp"
 #include "pvb/common/output_file.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
@@ -48,6 +50,7 @@ struct CameraArgs {
   std::string oni;
   std::string settings;
   std::string out;
+  bool overwrite = false;
   std::string record;
   std::string frames = "0";  ///< checked by parse_count: 0 = until the stream ends
   bool sync = false;
@@ -121,12 +124,30 @@ struct CameraSettings {
   std::string file;
 };
 
+/// Where the settings will come from, checked before anything is written:
+/// the user's file, a sim:// scenario, or a fakenect dump's camera.yaml.
+void check_settings_source(const CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
+  if (!a.settings.empty()) {
+    require_regular_file(a.settings);
+    return;
+  }
+  if (scenario) return;
+  if (const std::string dump = fakenect_dump_dir(a); !dump.empty()) {
+    dataset::read_fakenect_index(dump);  // a folder that is no dump says so, not that settings are missing
+    if (readable(dump + "/camera.yaml")) return;
+    throw ConfigError("pvbench camera", "--settings",
+                      "a settings file with the camera's calibrated intrinsics (the fakenect dump " + dump +
+                          " has no camera.yaml of its own)");
+  }
+  throw ConfigError("pvbench camera", "--settings",
+                    "a settings file with the camera's calibrated intrinsics (only sim:// devices and fakenect dumps "
+                    "have their own)");
+}
+
 CameraSettings prepare_settings(const CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
   const std::string saved = a.out + "/camera.yaml";
   CameraSettings s;
   if (!a.settings.empty()) {
-    std::ifstream probe(a.settings);
-    if (!probe) throw IoError(a.settings, "cannot read the settings file");
     const std::string text = read_file(a.settings);
     if (!openni::same_file(a.settings, saved)) write_file(saved, text);
     s.file = a.settings;
@@ -135,14 +156,9 @@ CameraSettings prepare_settings(const CameraArgs& a, const std::optional<scenes:
     o.depth_map_factor = 1000.0;  // OpenNI2 depth is in millimetres
     dataset::write_orbslam_settings(saved, o);
     s.file = saved;
-  } else if (const std::string dump = fakenect_dump_dir(a); !dump.empty() && readable(dump + "/camera.yaml")) {
-    s.file = dump + "/camera.yaml";
+  } else {  // a fakenect dump's own (check_settings_source)
+    s.file = fakenect_dump_dir(a) + "/camera.yaml";
     write_file(saved, read_file(s.file));
-  } else {
-    throw ConfigError(
-        "pvbench camera", "--settings",
-        "a settings file with the camera's calibrated intrinsics (only sim:// devices and fakenect dumps "
-        "have their own)");
   }
   s.slam = slam::read_settings(s.file);
   for (const std::string& w : s.slam.warnings)
@@ -381,7 +397,8 @@ int run_camera(const CameraArgs& a) {
   // which OpenNI2 unloads at shutdown.
   sim::install_mujoco_handlers();
   const std::optional<scenes::Scenario> scenario = check_inputs(a);
-  dataset::make_dirs(a.out);
+  check_settings_source(a, scenario);
+  prepare_output_folder(a.out, a.overwrite, "camera");
   const CameraSettings settings = prepare_settings(a, scenario);
   openni::OpenniSource source(source_options(a, settings.slam, timeout_ms));
 
@@ -417,7 +434,8 @@ Command add_camera_command(CLI::App& app) {
   sub->add_option("--settings", args->settings,
                   "ORB-SLAM2 RGB-D settings YAML with the calibrated intrinsics (default for sim://: the "
                   "scenario's camera)");
-  sub->add_option("--out", args->out, "output folder")->required();
+  sub->add_option("--out", args->out, "output folder (created; refused when not empty)")->required();
+  sub->add_flag("--overwrite", args->overwrite, "empty an earlier pvbench output in --out first");
   sub->add_option(
       "--record", args->record,
       "record the depth and colour streams to this new .oni file while tracking (an existing file "

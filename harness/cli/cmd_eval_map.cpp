@@ -22,6 +22,7 @@
 #include "command.hpp"
 #include "pvb/common/clock.hpp"
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_folder.hpp"
 #include "pvb/common/output_file.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
@@ -32,6 +33,7 @@
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/truth_surface.hpp"
 #include "pvb/slam/dense/ply.hpp"
+#include "pvb/suite/metrics_file.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -43,6 +45,7 @@ struct EvalMapArgs {
   int every = 5;
   std::string gl = "auto";
   std::string align = "first";
+  bool overwrite = false;
 };
 
 run::MapAlignment alignment_of(const std::string& name) {
@@ -61,15 +64,56 @@ void print_alignment_gap(run::MapAlignment used, const eval::Sim3Transform& to_w
               1000 * (to_world.apply(c) - b.apply(c)).norm());
 }
 
+/// The scenario and seed that the map's and the ground truth's folders say
+/// they were made from (a run's metrics.json, a recording's meta.json), if
+/// any, must be the ones given: a map is never scored against another world.
+void check_inputs_match(const scenes::Scenario& scenario, const EvalMapArgs& a) {
+  const auto folder = [](const std::string& file) {
+    const std::size_t slash = file.rfind('/');
+    return slash == std::string::npos ? std::string(".") : file.substr(0, slash);
+  };
+  for (const std::string& dir : {folder(a.map), folder(a.gt)}) {
+    const std::optional<suite::FolderIdentity> id = suite::read_folder_identity(dir);
+    if (!id) continue;
+    if (!id->scenario.empty() && id->scenario != scenario.name)
+      throw ConfigError(id->file, "scenario", "a run of " + scenario.name + " (--scenario " + a.scenario + ")",
+                        id->scenario);
+    if (id->seed && *id->seed != scenario.seed)
+      throw ConfigError(id->file, "seed",
+                        std::to_string(scenario.seed) + " (the scenario's seed" + (a.seed ? ", --seed" : "") +
+                            "; give --seed " + std::to_string(*id->seed) + " for this run)",
+                        std::to_string(*id->seed));
+  }
+}
+
+/// The map's points, refusing a map with none: an empty map scores nothing,
+/// never a perfect accuracy.
+slam::dense::PointCloud read_map(const std::string& path, std::size_t* dropped) {
+  slam::dense::PlyReadStats stats;
+  slam::dense::PointCloud cloud = slam::dense::read_ply(path, &stats);
+  *dropped = stats.non_finite_dropped;
+  if (cloud.empty())
+    throw IoError(path, "the map has no points to score" +
+                            (*dropped ? " (" + std::to_string(*dropped) + " vertices with a NaN or infinite coordinate)"
+                                      : std::string()));
+  if (*dropped)
+    std::printf("map %s: %zu vertices with a NaN or infinite coordinate left out\n", path.c_str(), *dropped);
+  return cloud;
+}
+
 int run_eval_map(const EvalMapArgs& a) {
   scenes::Scenario scenario = scenes::load_scenario(a.scenario);
   if (a.seed) scenario.seed = *a.seed;
+  if (!a.out.empty()) check_output_folder(a.out, a.overwrite);  // before the work
+  check_inputs_match(scenario, a);
   const eval::Trajectory gt = eval::read_tum(a.gt);
   const eval::Trajectory est = eval::read_tum(a.trajectory);
   const eval::EvalResult ate = eval::evaluate(gt, est, eval::EvalOptions{});
   const run::MapAlignment alignment = alignment_of(a.align);
   const eval::Sim3Transform to_world = run::map_to_world(alignment, ate, gt, est);
-  const std::vector<eval::MapPoint> map = run::map_in_world(slam::dense::read_ply(a.map), to_world);
+  std::size_t dropped = 0;
+  const std::vector<eval::MapPoint> map = run::map_in_world(read_map(a.map, &dropped), to_world);
+  if (!a.out.empty()) prepare_output_folder(a.out, a.overwrite, "eval-map");
   sim::TruthSurfaceOptions to;
   to.voxel_m = a.voxel_m;
   to.every = a.every;
@@ -88,11 +132,11 @@ int run_eval_map(const EvalMapArgs& a) {
   std::printf("%s", run::map_accuracy_table(r).c_str());
   std::printf("(accuracy in mm; completeness in %% of the surface within 1, 2, 5, 10 cm)\n");
   if (!a.out.empty()) {
-    dataset::make_dirs(a.out);
     const std::string body = run::map_accuracy_json(r);
-    write_file(a.out + "/map_accuracy.json", "{\n  \"ate_rmse_m\": " + format_g(ate.ate.rmse) +
+    write_file(a.out + "/map_accuracy.json", "{\n  \"ate_rmse_m\": " + json_number(ate.ate.rmse, 6) +
                                                  ",\n  \"alignment\": \"" + run::to_string(alignment) + "\"," +
-                                                 body.substr(1) + "\n");
+                                                 "\n  \"non_finite_vertices_dropped\": " + std::to_string(dropped) +
+                                                 "," + body.substr(1) + "\n");
     run::write_map_errors_ply(a.out + "/map_errors.ply", map, point_scores);
     std::printf("wrote %s/{map_accuracy.json,map_errors.ply}\n", a.out.c_str());
   }
@@ -109,7 +153,8 @@ Command add_eval_map_command(CLI::App& app) {
   sub->add_option("--seed", a->seed, "the scenario's seed, when the run overrode it");
   sub->add_option("--trajectory", a->trajectory, "the estimated trajectory (TUM), for the alignment")->required();
   sub->add_option("--gt", a->gt, "the ground truth (TUM) of the same run")->required();
-  sub->add_option("--out", a->out, "folder for map_accuracy.json and map_errors.ply");
+  sub->add_option("--out", a->out, "folder for map_accuracy.json and map_errors.ply (refused when not empty)");
+  sub->add_flag("--overwrite", a->overwrite, "empty an earlier pvbench output in --out first");
   sub->add_option("--voxel", a->voxel_m, "true-surface sampling, metres")->capture_default_str()->check(CLI::Range(0.002, 0.5));
   sub->add_option("--every", a->every, "render every k-th frame of the route")->capture_default_str()->check(CLI::Range(1, 1000));
   sub->add_option("--gl", a->gl, "rendering backend")->check(CLI::IsMember({"auto", "egl", "osmesa"}));

@@ -18,6 +18,7 @@
 #include "count_option.hpp"
 #include "pvb/common/clock.hpp"
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_folder.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/fakenect_dump.hpp"
@@ -40,6 +41,7 @@ struct RecordOptions {
   std::optional<std::uint64_t> seed;
   std::string gl = "auto";
   std::string format = "tum";
+  bool overwrite = false;
 };
 
 /// A scenario recorded as a Kinect v1 would have seen it: the rendered
@@ -156,7 +158,7 @@ int run_record(const RecordOptions& opt, bool frames_given) {
   const sim::GlBackend backend = sim::parse_gl_backend(opt.gl);
   scenes::Scenario scenario = scenes::load_scenario(opt.scenario);
   if (opt.seed) scenario.seed = *opt.seed;
-  dataset::make_dirs(opt.out);     // fail early on an unwritable folder
+  prepare_output_folder(opt.out, opt.overwrite, "record");  // before the work: never into another recording
   const StopSignals stop_signals;  // Ctrl-C during the set-up stops before the first frame
 
   const auto t_start = Clock::now();
@@ -200,7 +202,8 @@ Command add_record_command(CLI::App& app) {
   auto opt = std::make_shared<RecordOptions>();
   CLI::App* sub = app.add_subcommand("record", "Render a scenario into a TUM RGB-D sequence folder");
   sub->add_option("--scenario", opt->scenario, "scenario YAML file")->required();
-  sub->add_option("--out", opt->out, "output folder (created)")->required();
+  sub->add_option("--out", opt->out, "output folder (created; refused when not empty)")->required();
+  sub->add_flag("--overwrite", opt->overwrite, "empty an earlier pvbench output in --out first");
   CLI::Option* frames =
       sub->add_option("--frames", opt->frames, "record at most N frames (default: the scenario's duration)");
   sub->add_option("--seed", opt->seed, "override the scenario's seed")

@@ -70,7 +70,8 @@ Command add_run_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "run", "simulate a scenario and run PE-SLAM on it in memory; write a report folder (index.html)");
   sub->add_option("--scenario", args->options.scenario_file, "scenario YAML file")->required();
-  sub->add_option("--out", args->options.out_dir, "report folder (created)")->required();
+  sub->add_option("--out", args->options.out_dir, "report folder (created; refused when not empty)")->required();
+  sub->add_flag("--overwrite", args->options.overwrite, "empty an earlier pvbench output in --out first");
   sub->add_option("--seed", args->seed, "override the scenario's seed (also seeds PE-match)")
       ->check(seed_check("run", "--seed", std::numeric_limits<std::uint64_t>::max()));
   sub->add_option("--frames", args->frames, "stop after N frames (default: the scenario's duration)");

@@ -16,6 +16,7 @@
 #include "command.hpp"
 #include "count_option.hpp"
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_folder.hpp"
 #include "pvb/common/output_file.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
@@ -37,6 +38,7 @@ struct SlamArgs {
   std::string sequence;
   std::string settings;
   std::string out;
+  bool overwrite = false;
   bool no_pe_match = false;
   bool sync = false;
   bool no_dense = false;
@@ -235,7 +237,7 @@ SlamRun::SlamRun(const SlamArgs& a)
   reader_.set_max_skipped(std::max<std::size_t>(
       kMinMissingAllowed,
       static_cast<std::size_t>(std::floor(a.max_missing * static_cast<double>(reader_.size_hint())))));
-  dataset::make_dirs(a.out);
+  prepare_output_folder(a.out, a.overwrite, "slam");
   slam::SystemOptions options;
   options.synchronous = a.sync;
   options.seed = a.seed;
@@ -523,7 +525,8 @@ Command add_slam_command(CLI::App& app) {
   sub->add_option("--sequence", args->sequence, "TUM RGB-D sequence folder")->required();
   sub->add_option("--settings", args->settings, "ORB-SLAM2 RGB-D settings YAML (plus optional PEMatch.*)")
       ->required();
-  sub->add_option("--out", args->out, "output folder")->required();
+  sub->add_option("--out", args->out, "output folder (created; refused when not empty)")->required();
+  sub->add_flag("--overwrite", args->overwrite, "empty an earlier pvbench output in --out first");
   sub->add_flag("--no-pe-match", args->no_pe_match, "baseline: ORB-SLAM2 motion model without PE-match");
   sub->add_flag("--no-dense", args->no_dense, "skip the dense point-cloud map (PointCloud.ply)");
   sub->add_flag("--sync", args->sync, "synchronous mode: no worker threads, bit-identical runs");

@@ -27,12 +27,14 @@
 #include "command.hpp"
 #include "count_option.hpp"
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_folder.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/eval/plot.hpp"
 #include "pvb/plot/png.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/suite/aggregate.hpp"
 #include "pvb/suite/check.hpp"
+#include "pvb/suite/metrics_file.hpp"
 #include "pvb/suite/seeds.hpp"
 
 namespace pvb::cli {
@@ -62,6 +64,7 @@ struct SweepArgs {
   bool print_commands = false;
   bool aggregate_only = false;
   bool check = false;
+  bool overwrite = false;
 };
 
 volatile std::sig_atomic_t g_stop_signal = 0;
@@ -73,8 +76,11 @@ std::string seed_dir(const std::string& out, std::uint64_t seed) {
 
 /// The arguments after the program name for one seed's `pvbench run`.
 std::vector<std::string> run_args(const SweepArgs& a, std::uint64_t seed) {
+  // --overwrite: a seed's command replaces that seed's earlier output, so
+  // that a failed seed can be run again (the sweep folder itself is
+  // checked once, by the sweep).
   std::vector<std::string> v = {"run",   "--scenario",         a.scenario, "--seed", std::to_string(seed),
-                                "--out", seed_dir(a.out, seed)};
+                                "--out", seed_dir(a.out, seed), "--overwrite"};
   if (a.frames > 0) {
     v.push_back("--frames");
     v.push_back(std::to_string(a.frames));
@@ -250,11 +256,23 @@ suite::SweepAggregate write_aggregate(const SweepArgs& a, const std::string& sce
                                       const std::vector<std::uint64_t>& seeds,
                                       const std::map<std::uint64_t, int>& exit_codes) {
   std::vector<suite::SeedRun> runs;
+  // Without --scenario, the first seed with metrics names the sweep's scenario.
+  std::string expected = scenario_name;
+  std::string expected_source = a.scenario;
   for (std::uint64_t s : seeds) {
     const auto it = exit_codes.find(s);
     const int code = it == exit_codes.end() ? 0 : it->second;
     suite::SeedRun r = suite::read_seed_run(s, seed_dir(a.out, s) + "/metrics.json", code);
     if (code == -1 && !r.metrics) r.error = "not run (the sweep was stopped)";
+    // A seed folder holds that seed's run of this scenario, or the sweep
+    // would report another run as this seed, judged by the wrong bounds.
+    if (r.metrics) {
+      suite::expect_run_identity(*r.metrics, expected, expected_source, s, "the folder seed_" + std::to_string(s));
+      if (expected.empty()) {
+        expected = r.metrics->scenario;
+        expected_source = "the sweep's other seeds";
+      }
+    }
     runs.push_back(std::move(r));
   }
   std::string name = scenario_name;
@@ -323,9 +341,7 @@ int run_sweep(SweepArgs a) {
     for (std::uint64_t s : seeds) std::printf("%s\n", seed_command(a, exe, s).c_str());
     return 0;
   }
-  std::error_code ec;
-  fs::create_directories(a.out, ec);
-  if (ec) throw IoError(a.out, "cannot create the sweep folder: " + ec.message());
+  prepare_output_folder(a.out, a.overwrite, "sweep");
   std::printf("sweep: %s, %zu seed(s), %d at once, into %s\n", scenario_name.c_str(), seeds.size(), a.jobs,
               a.out.c_str());
   const std::map<std::uint64_t, int> exit_codes = run_seeds(a, seeds);
@@ -349,7 +365,9 @@ Command add_sweep_command(CLI::App& app) {
   sub->add_option("--scenario", args->scenario, "scenario YAML file");
   sub->add_option("--seeds", args->seeds, "seed list: 1-20, 1,3,5 or 1-5,9");
   sub->add_option("--jobs,-j", args->jobs_text, "seeds run at once")->capture_default_str();
-  sub->add_option("--out", args->out, "sweep folder (DIR/seed_S per seed, DIR/aggregate.*)")->required();
+  sub->add_option("--out", args->out, "sweep folder (DIR/seed_S per seed, DIR/aggregate.*; refused when not empty)")
+      ->required();
+  sub->add_flag("--overwrite", args->overwrite, "empty an earlier pvbench output in --out first");
   sub->add_option("--frames", args->frames_text, "passed to pvbench run: at most N frames");
   sub->add_flag("--compare", args->compare, "passed to pvbench run: PE-SLAM and the baseline (PE-match off)");
   sub->add_flag("--baseline", args->baseline, "passed to pvbench run: the baseline alone (PE-match off)");

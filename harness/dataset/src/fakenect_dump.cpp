@@ -1,5 +1,6 @@
 #include "pvb/dataset/fakenect_dump.hpp"
 
+#include <sys/stat.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -93,8 +94,12 @@ void FakenectWriter::write(std::int64_t t_ns, const cv::Mat& rgb, const cv::Mat&
 
 std::vector<FakenectEntry> read_fakenect_index(const std::string& dir) {
   const std::string index = dir + "/INDEX.txt";
+  struct stat st {};
+  if (::stat(index.c_str(), &st) != 0)
+    throw IoError(dir, "not a fakenect dump: it has no INDEX.txt (pvbench record --format fakenect writes one)");
+  require_regular_file(index);
   std::ifstream in(index);
-  if (!in) throw IoError(index, "cannot read the dump's index (is FAKENECT_PATH a fakenect dump folder?)");
+  if (!in) throw IoError(index, "cannot read the dump's index");
   std::vector<FakenectEntry> entries;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {

@@ -63,34 +63,53 @@ std::vector<eval::SurfacePoint> true_surface(const scenes::Scenario& scenario, s
 }
 
 namespace {
+/// One subset's scores.  What a subset without map points (or without
+/// surface points) cannot have is null, and "null_reason" says why: an
+/// empty map is never scored as a perfect one.
 std::string scores_json(const eval::MapScores& s) {
+  const bool has_map = s.accuracy.count > 0, has_surface = s.completeness.count > 0;
   std::ostringstream js;
-  auto list = [&js](const std::vector<double>& v) {
+  auto list = [&js](bool known, const std::vector<double>& v) {
+    if (!known) {
+      js << "null";
+      return;
+    }
     js << "[";
-    for (std::size_t i = 0; i < v.size(); ++i) js << (i ? ", " : "") << format_g(v[i]);
+    for (std::size_t i = 0; i < v.size(); ++i) js << (i ? ", " : "") << json_number(v[i], 6);
     js << "]";
   };
   js << "{\"map_points\": " << s.accuracy.count << ", \"surface_points\": " << s.completeness.count
-     << ", \"accuracy_m\": {\"mean\": " << format_g(s.accuracy.mean) << ", \"median\": " << format_g(s.accuracy.median)
-     << ", \"rmse\": " << format_g(s.accuracy.rmse) << ", \"p95\": " << format_g(s.accuracy.p95) << "}"
-     << ", \"completeness_at\": ";
-  list(s.completeness_at);
+     << ", \"accuracy_m\": ";
+  if (has_map)
+    js << "{\"mean\": " << json_number(s.accuracy.mean, 6) << ", \"median\": " << json_number(s.accuracy.median, 6)
+       << ", \"rmse\": " << json_number(s.accuracy.rmse, 6) << ", \"p95\": " << json_number(s.accuracy.p95, 6) << "}";
+  else
+    js << "null";
+  js << ", \"completeness_at\": ";
+  list(has_surface, s.completeness_at);
   js << ", \"precision_at\": ";
-  list(s.precision_at);
+  list(has_map, s.precision_at);
   js << ", \"fscore_at\": ";
-  list(s.fscore_at);
-  js << ", \"chamfer_m\": " << format_g(s.chamfer_m) << ", \"ghosting\": " << format_g(s.ghosting)
-     << ", \"ghosting_judged\": " << s.ghosting_judged << "}";
+  list(has_map && has_surface, s.fscore_at);
+  js << ", \"chamfer_m\": " << (has_map && has_surface ? json_number(s.chamfer_m, 6) : "null")
+     << ", \"ghosting\": " << json_number(s.ghosting, 6) << ", \"ghosting_judged\": " << s.ghosting_judged;
+  if (!has_map || !has_surface)
+    js << ", \"null_reason\": \"" << (has_map ? "no surface points" : "no map points") << " in this subset\"";
+  js << "}";
   return js.str();
 }
 
+/// One row of the table; a subset without map points shows "-" for what it cannot have.
 std::string scores_row(const std::string& name, const eval::MapScores& s) {
-  char line[256];
+  const bool has_map = s.accuracy.count > 0;
+  auto mm = [has_map](double v_m) { return has_map ? format_number("%8.1f", 1000 * v_m) : std::string("       -"); };
   auto pct = [&s](std::size_t i) { return i < s.completeness_at.size() ? 100.0 * s.completeness_at[i] : 0.0; };
-  std::snprintf(line, sizeof line, "%-7s %9zu %9zu %8.1f %8.1f %8.1f %6.1f %6.1f %6.1f %6.1f %7.3f %7.1f\n",
-                name.c_str(), s.accuracy.count, s.completeness.count, 1000 * s.accuracy.median,
-                1000 * s.accuracy.mean, 1000 * s.accuracy.p95, pct(0), pct(1), pct(2), pct(3),
-                s.fscore_at.size() > 1 ? s.fscore_at[1] : 0.0, 100.0 * s.ghosting);
+  char line[256];
+  std::snprintf(line, sizeof line, "%-7s %9zu %9zu %s %s %s %6.1f %6.1f %6.1f %6.1f %7s %7.1f\n", name.c_str(),
+                s.accuracy.count, s.completeness.count, mm(s.accuracy.median).c_str(), mm(s.accuracy.mean).c_str(),
+                mm(s.accuracy.p95).c_str(), pct(0), pct(1), pct(2), pct(3),
+                has_map && s.fscore_at.size() > 1 ? format_number("%.3f", s.fscore_at[1]).c_str() : "-",
+                100.0 * s.ghosting);
   return line;
 }
 }  // namespace
@@ -99,7 +118,7 @@ std::string map_accuracy_json(const eval::MapAccuracy& r, int indent) {
   const std::string nl = "\n" + std::string(static_cast<std::size_t>(indent), ' ');
   std::ostringstream js;
   js << "{" << nl << "  \"tau_m\": [";
-  for (std::size_t i = 0; i < r.options.tau_m.size(); ++i) js << (i ? ", " : "") << format_g(r.options.tau_m[i]);
+  for (std::size_t i = 0; i < r.options.tau_m.size(); ++i) js << (i ? ", " : "") << json_number(r.options.tau_m[i], 6);
   js << "]," << nl << "  \"all\": " << scores_json(r.all) << "," << nl << "  \"per_class\": {";
   bool first = true;
   for (const auto& [c, s] : r.per_class) {
@@ -109,8 +128,8 @@ std::string map_accuracy_json(const eval::MapAccuracy& r, int indent) {
   }
   js << nl << "  }," << nl << "  \"per_range\": [";
   for (std::size_t b = 0; b < r.per_range.size(); ++b)
-    js << (b ? "," : "") << nl << "    {\"from_m\": " << format_g(r.options.range_edges_m[b])
-       << ", \"to_m\": " << format_g(r.options.range_edges_m[b + 1]) << ", \"scores\": " << scores_json(r.per_range[b])
+    js << (b ? "," : "") << nl << "    {\"from_m\": " << json_number(r.options.range_edges_m[b], 6)
+       << ", \"to_m\": " << json_number(r.options.range_edges_m[b + 1], 6) << ", \"scores\": " << scores_json(r.per_range[b])
        << "}";
   js << nl << "  ]" << nl << "}";
   return js.str();

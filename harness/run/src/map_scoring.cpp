@@ -33,6 +33,11 @@ void score_sink(SystemSink& sink, const std::string& scenario, const eval::Traje
   d.alignment = to_string(MapAlignment::kFirstFrame);
   d.surface_samples = surface.size();
   for (const auto& [name, cloud] : sink.clouds) {
+    if (cloud.empty()) {  // nothing to score: never a perfect score
+      log.line(eval::mode_label(sink.run.mode) + ": " + name + " map: not scored, it has no points");
+      d.note += (d.note.empty() ? "" : "; ") + name + " map not scored: it has no points";
+      continue;
+    }
     const auto t0 = SteadyClock::now();
     const std::vector<eval::MapPoint> map = map_in_world(cloud, T);
     std::vector<eval::MapPointScore> scores;

@@ -7,6 +7,7 @@
 
 #include "closed_loop.hpp"
 #include "frame_pipeline.hpp"
+#include "pvb/common/output_folder.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/slam_mode.hpp"
@@ -338,7 +339,7 @@ RunReport run_scenario(const RunOptions& opt) {
   const sim::GlBackend backend = sim::parse_gl_backend(opt.gl);
   const scenes::Scenario scenario = load_run_scenario(opt);
   const int n = scenes::frame_count(scenario, opt.max_frames);
-  dataset::make_dirs(opt.out_dir);
+  prepare_output_folder(opt.out_dir, opt.overwrite, "run");
   if (opt.mode == SlamMode::kCompare) dataset::make_dirs(opt.out_dir + "/baseline");
   RunLog log(opt.out_dir + "/run.log", opt.on_log);
   SystemSinks sinks =

@@ -21,7 +21,7 @@ RunSummary summarize_runs(const std::vector<const RunMetrics*>& runs) {
   std::vector<double> ate, lost, ms, rtf, refined, map_acc, map_comp, ghost, ghost_live;
   for (const RunMetrics* r : runs) {
     if (const MapMetrics* m = r->map("corrected")) {
-      map_acc.push_back(m->accuracy_median_m);
+      if (m->accuracy_median_m) map_acc.push_back(*m->accuracy_median_m);
       map_comp.push_back(m->completeness_5cm);
       ghost.push_back(m->ghosting);
     }
@@ -339,7 +339,10 @@ std::string format_markdown(const SweepAggregate& a) {
       if (r.metrics->primary.mode == eval::kBaselineMode) primary_name = eval::kBaselineLabel;
       break;
     }
+  // The table's rows first, together, then the lines about them: a line
+  // between two rows would end the table in a Markdown viewer.
   row(primary_name.c_str(), a.primary);
+  if (a.has_baseline) row(eval::kBaselineLabel, a.baseline);
   if (a.primary.refined_ate_rmse_m.count > 0)
     out += "\nRefined trajectory (frames re-anchored on the final keyframe poses, after loop closing): ATE RMSE " +
            pm(a.primary.refined_ate_rmse_m, "%.2f", 1000.0) + " mm, max " +
@@ -347,7 +350,6 @@ std::string format_markdown(const SweepAggregate& a) {
   if (a.primary_place.seeds > 0) out += "\n" + place_totals_line(a.primary_place);
   out += map_line(primary_name, a.primary);
   if (a.has_baseline) {
-    row(eval::kBaselineLabel, a.baseline);
     out += map_line(eval::kBaselineLabel, a.baseline);
     // The paired figure (docs/sweeps.md): per seed d = PE − baseline on the same frames.
     out += "\n" + format_paired_line(a.paired) + "\n";

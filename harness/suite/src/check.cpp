@@ -46,6 +46,13 @@ void check_place(const scenes::Expectations& expect, const RunMetrics& run, std:
 void check_relocalisation(const scenes::Expectations& expect, const RunMetrics& run, std::vector<Violation>* out) {
   if (!expect.relocalised_within_frames) return;
   const int bound = *expect.relocalised_within_frames;
+  // Lost frames without their loss events cannot be judged: a violation,
+  // never a silent pass.
+  if (run.lost_frames > 0 && run.loss_events.empty()) {
+    out->push_back({"relocalised_within_frames", "not judged: " + std::to_string(run.lost_frames) +
+                                                     " lost frames but no loss_events in the metrics"});
+    return;
+  }
   for (const LossEvent& e : run.loss_events) {
     int from = e.frame;
     if (run.camera_covered_frames && run.camera_covered_frames->first <= e.frame + bound &&
@@ -73,8 +80,10 @@ void check_map(const scenes::Expectations& expect, const RunMetrics& run, std::v
     out->push_back({key, "no scores of the corrected dense map in the metrics (dense_map.maps.corrected)"});
     return;
   }
-  if (expect.map_accuracy_m_max && !(m->accuracy_median_m <= *expect.map_accuracy_m_max))
-    out->push_back({"map_accuracy_m_max", "dense map median accuracy " + metres(m->accuracy_median_m) + " > " +
+  if (expect.map_accuracy_m_max && !m->accuracy_median_m)
+    out->push_back({"map_accuracy_m_max", "not judged: the corrected dense map has no points"});
+  else if (expect.map_accuracy_m_max && !(*m->accuracy_median_m <= *expect.map_accuracy_m_max))
+    out->push_back({"map_accuracy_m_max", "dense map median accuracy " + metres(*m->accuracy_median_m) + " > " +
                                               metres(*expect.map_accuracy_m_max)});
   if (expect.map_completeness_min && !(m->completeness_5cm >= *expect.map_completeness_min))
     out->push_back({"map_completeness_min", "dense map complete within 5 cm " +

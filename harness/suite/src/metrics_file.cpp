@@ -1,7 +1,11 @@
 #include "pvb/suite/metrics_file.hpp"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
+#include <sys/stat.h>
+
+#include <climits>
 #include <cmath>
 
 #include "pvb/common/error.hpp"
@@ -27,19 +31,30 @@ class Reader {
     return n;
   }
 
+  /// yaml-cpp reads JSON, and would decode the string "0.003" as a number:
+  /// a quoted scalar (tag "!") is a string, never a number.
+  static bool is_plain_scalar(const YAML::Node& n) { return n.IsScalar() && n.Tag() != "!"; }
+
   double number(const YAML::Node& obj, const std::string& key) const {
     const YAML::Node n = required(obj, key);
     double v = 0;
-    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
-      fail(n, key, "expected a number");
+    if (!is_plain_scalar(n) || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
+      fail(n, key, "expected a number, got " + shown(n));
     return v;
   }
 
   int integer(const YAML::Node& obj, const std::string& key) const {
     const YAML::Node n = required(obj, key);
     long long v = 0;
-    if (!n.IsScalar() || !YAML::convert<long long>::decode(n, v)) fail(n, key, "expected an integer");
+    if (!is_plain_scalar(n) || !YAML::convert<long long>::decode(n, v) || v < INT_MIN || v > INT_MAX)
+      fail(n, key, "expected an integer, got " + shown(n));
     return static_cast<int>(v);
+  }
+
+  /// A value as the message shows it: a string in quotes.
+  static std::string shown(const YAML::Node& n) {
+    if (!n.IsScalar()) return n.IsNull() ? "null" : "a list or an object";
+    return n.Tag() == "!" ? "the string \"" + n.Scalar() + "\"" : n.Scalar();
   }
 
   std::string text(const YAML::Node& obj, const std::string& key) const {
@@ -135,11 +150,13 @@ class Reader {
       if (!comp.IsSequence() || comp.size() < 3) all_in.fail(comp, "completeness_at", "expected 4 shares (1, 2, 5, 10 cm)");
       MapMetrics m;
       m.name = name;
-      m.accuracy_median_m = Reader(path_, prefix_ + "dense_map.maps." + name + ".all.accuracy_m.")
-                                .number(all_in.required(all, "accuracy_m"), "median");
+      const YAML::Node acc = all_in.required(all, "accuracy_m");
+      if (!acc.IsNull())
+        m.accuracy_median_m =
+            Reader(path_, prefix_ + "dense_map.maps." + name + ".all.accuracy_m.").number(acc, "median");
       const auto share = [&](std::size_t i) {
         double v = 0;
-        if (!comp[i].IsScalar() || !YAML::convert<double>::decode(comp[i], v) || !std::isfinite(v))
+        if (!is_plain_scalar(comp[i]) || !YAML::convert<double>::decode(comp[i], v) || !std::isfinite(v))
           all_in.fail(comp[i], "completeness_at[" + std::to_string(i) + "]", "expected a number");
         return v;
       };
@@ -191,6 +208,8 @@ MetricsFile read_metrics_file(const std::string& path) {
   YAML::Node root;
   try {
     root = YAML::Load(text);
+  } catch (const YAML::DeepRecursion& e) {
+    throw IoError(path, "not valid JSON: nested too deeply for the parser", e.mark.line + 1);
   } catch (const YAML::Exception& e) {
     throw IoError(path, "not valid JSON: " + e.msg, e.mark.line + 1);
   }
@@ -198,12 +217,24 @@ MetricsFile read_metrics_file(const std::string& path) {
   MetricsFile m;
   m.path = path;
   const Reader top(path, "");
+  // Version 1 files have no metrics_version; a newer version than this
+  // program knows is refused rather than read as if it were this one.
+  const YAML::Node version = root["metrics_version"];
+  if (version.IsDefined()) {
+    const int v = top.integer(root, "metrics_version");
+    if (v < 1 || v > eval::kMetricsVersion)
+      top.fail(version, "metrics_version",
+               "expected 1 to " + std::to_string(eval::kMetricsVersion) + " (this pvbench reads up to version " +
+                   std::to_string(eval::kMetricsVersion) + "), got " + std::to_string(v));
+    m.version = v;
+  }
   if (root["scenario"].IsDefined()) m.scenario = top.text(root, "scenario");
   const YAML::Node seed = root["seed"];
   if (seed.IsDefined() && !seed.IsNull()) {
     unsigned long long v = 0;
-    if (!seed.IsScalar() || !YAML::convert<unsigned long long>::decode(seed, v))
-      top.fail(seed, "seed", "expected a non-negative integer");
+    if (!Reader::is_plain_scalar(seed) || seed.Scalar().empty() || seed.Scalar()[0] == '-' ||
+        !YAML::convert<unsigned long long>::decode(seed, v))
+      top.fail(seed, "seed", "expected a non-negative integer, got " + Reader::shown(seed));
     m.seed = v;
   }
   m.primary = top.run(root);
@@ -213,6 +244,42 @@ MetricsFile read_metrics_file(const std::string& path) {
     m.baseline = Reader(path, "baseline.").run(base);
   }
   return m;
+}
+
+void expect_run_identity(const MetricsFile& m, const std::string& scenario, const std::string& scenario_source,
+                         std::optional<unsigned long long> seed, const std::string& seed_source) {
+  if (!scenario.empty() && m.scenario != scenario)
+    throw ConfigError(m.path, "scenario",
+                      "a run of " + scenario + (scenario_source.empty() ? "" : " (" + scenario_source + ")"),
+                      m.scenario.empty() ? std::string("no scenario name") : m.scenario);
+  if (seed && m.seed != seed)
+    throw ConfigError(m.path, "seed",
+                      std::to_string(*seed) + (seed_source.empty() ? "" : " (" + seed_source + ")"),
+                      m.seed ? std::to_string(*m.seed) : std::string("no seed"));
+}
+
+std::optional<FolderIdentity> read_folder_identity(const std::string& dir) {
+  const std::string metrics = dir + "/metrics.json", meta = dir + "/meta.json";
+  struct stat st {};
+  if (::stat(metrics.c_str(), &st) == 0) {
+    const MetricsFile m = read_metrics_file(metrics);
+    return FolderIdentity{metrics, m.scenario, m.seed};
+  }
+  if (::stat(meta.c_str(), &st) != 0) return std::nullopt;
+  YAML::Node root;
+  try {
+    root = YAML::Load(read_file(meta));
+  } catch (const YAML::Exception& e) {
+    throw IoError(meta, "not valid JSON: " + e.msg, e.mark.line + 1);
+  }
+  FolderIdentity id{meta, "", std::nullopt};
+  const YAML::Node name = root.IsMap() && root["scenario"].IsMap() ? root["scenario"]["name"] : YAML::Node();
+  if (name.IsDefined() && name.IsScalar()) id.scenario = name.Scalar();
+  const YAML::Node seed = root.IsMap() ? root["seed"] : YAML::Node();
+  unsigned long long v = 0;
+  if (seed.IsDefined() && Reader::is_plain_scalar(seed) && YAML::convert<unsigned long long>::decode(seed, v))
+    id.seed = v;
+  return id;
 }
 
 }  // namespace pvb::suite

@@ -5,11 +5,15 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "pvb/common/text.hpp"
 #include "run_pvbench.hpp"
@@ -67,4 +71,80 @@ TEST(EvalMapCli, AMissingMapIsOneErrorLine) {
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("error"), std::string::npos) << r.output;
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+}
+
+namespace {
+
+/// A binary PLY of `n` vertices, each (x, y, z) as given, coloured grey.
+void write_points_ply(const std::string& path, const std::vector<std::array<float, 3>>& points) {
+  std::string body = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(points.size()) +
+                     "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\n"
+                     "property uchar green\nproperty uchar blue\nend_header\n";
+  for (const auto& p : points) {
+    body.append(reinterpret_cast<const char*>(p.data()), 12);
+    body.append(3, static_cast<char>(128));
+  }
+  pvb::write_file(path, body);
+}
+
+}  // namespace
+
+// An empty map is never a perfect one, non-finite vertices are left out and
+// counted, a map is never scored against another scenario's world, and the
+// output folder is checked before the work.
+TEST(EvalMapCli, BadMapsAndMismatchedInputsAreRefused) {
+  const std::string dir = fresh("bad");
+  const std::string station = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
+  auto r = pvb::test::run_pvbench("record --scenario " + station + " --frames 30 --out " + dir + "/seq");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string inputs = " --trajectory " + dir + "/seq/groundtruth.txt --gt " + dir + "/seq/groundtruth.txt";
+  const auto eval_map = [&](const std::string& map, const std::string& scenario, const std::string& extra) {
+    return pvb::test::run_pvbench("eval-map --map " + map + " --scenario " + scenario + inputs + " " + extra);
+  };
+  const auto one_line = [](const pvb::test::RunResult& res) {
+    return std::count(res.output.begin(), res.output.end(), '\n') == 1;
+  };
+  write_points_ply(dir + "/empty.ply", {});
+  r = eval_map(dir + "/empty.ply", station, "--out " + dir + "/e1");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_TRUE(one_line(r)) << r.output;
+  EXPECT_NE(r.output.find(dir + "/empty.ply: the map has no points to score"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/e1/map_accuracy.json"));
+
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  write_points_ply(dir + "/nan.ply", {{nan, 0, 0}, {0, inf, 0}});
+  r = eval_map(dir + "/nan.ply", station, "");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("the map has no points to score (2 vertices with a NaN or infinite coordinate)"),
+            std::string::npos)
+      << r.output;
+
+  write_points_ply(dir + "/some.ply", {{0.0f, 0.0f, 1.0f}, {nan, 0, 0}, {0.2f, 0.1f, 2.0f}});
+  r = eval_map(dir + "/some.ply", station, "--out " + dir + "/e2");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("1 vertices with a NaN or infinite coordinate left out"), std::string::npos) << r.output;
+  const std::string js = pvb::read_file(dir + "/e2/map_accuracy.json");
+  EXPECT_NE(js.find("\"non_finite_vertices_dropped\": 1"), std::string::npos) << js;
+  for (const char* bad : {"inf", "nan", "NaN", "Infinity"}) EXPECT_EQ(js.find(bad), std::string::npos) << bad;
+  // Two points cannot cover every class: a class without map points has no
+  // accuracy (null, with the reason), never a perfect 0 mm.
+  EXPECT_NE(js.find("\"accuracy_m\": null"), std::string::npos) << js;
+  EXPECT_NE(js.find("\"null_reason\": \"no map points in this subset\""), std::string::npos) << js;
+
+  // The recording's meta.json names pv_station and seed 7.
+  r = eval_map(dir + "/some.ply", std::string(PVB_SOURCE_DIR) + "/scenes/lawnmower.yaml", "");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_TRUE(one_line(r)) << r.output;
+  EXPECT_NE(r.output.find(dir + "/seq/meta.json: scenario: expected a run of lawnmower"), std::string::npos)
+      << r.output;
+  r = eval_map(dir + "/some.ply", station, "--seed 3");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("seq/meta.json: seed: expected 3"), std::string::npos) << r.output;
+
+  pvb::write_file(dir + "/a_file", "x");
+  r = eval_map(dir + "/some.ply", station, "--out " + dir + "/a_file");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_TRUE(one_line(r)) << r.output;  // refused before the surface is sampled
+  EXPECT_NE(r.output.find(dir + "/a_file: is not a folder"), std::string::npos) << r.output;
+  std::filesystem::remove_all(dir);
 }

@@ -278,3 +278,36 @@ TEST(RecordCli, SeedMustBeAWholeNumberInRange) {
                             ": --seed: expected a whole number in [0, 18446744073709551615], got -1\n");
   }
 }
+
+// A recording is never written into another one: the second run used to
+// shrink rgb.txt and leave the first run's images orphaned.  --overwrite
+// empties an earlier pvbench output first; a folder of anything else is
+// never emptied.
+TEST(RecordCli, ExistingOutputIsRefusedUnlessOverwriteEmptiesAnEarlierRecording) {
+  const std::string& full = station_run();
+  Result r = run("record --scenario " + kStation + " --out " + full + " --frames 5 --seed 7");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  EXPECT_NE(r.output.find("pvbench: error: " + full + ": the output folder is not empty"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(dataset::read_tum_list(full + "/rgb.txt").size(), 120u);
+
+  const std::string d = fresh("overwrite");
+  ASSERT_EQ(run("record --scenario " + kStation + " --out " + d + " --frames 6").code, 0);
+  r = run("record --scenario " + kStation + " --out " + d + " --frames 3 --overwrite");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(dataset::read_tum_list(d + "/rgb.txt").size(), 3u);
+  std::size_t images = 0;
+  for (const std::string& f : list_files(d)) images += f.rfind("./rgb/", 0) == 0 ? 1 : 0;
+  EXPECT_EQ(images, 3u) << "images of the earlier recording are left behind";
+
+  const std::string mine = fresh("not_ours");
+  std::system(("mkdir -p " + mine).c_str());
+  write_file(mine + "/notes.txt", "the user's\n");
+  r = run("record --scenario " + kStation + " --out " + mine + " --frames 3 --overwrite");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("holds files pvbench did not write (1 entry: notes.txt, no .pvbench marker)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(read_file(mine + "/notes.txt"), "the user's\n");
+}

@@ -188,7 +188,7 @@ TEST(PVB_CAMERA_SUITE, BadUriIsOneErrorLine) {
                         "no_such_scenario.yaml");
   expect_one_error_line(run("camera --uri 'sim://scenes/pv_station.yaml?fps=3' --out " + d), "fps");
   expect_one_error_line(
-      run("camera --uri 'nonsense://device' --settings " + settings_file(d) + " --out " + d),
+      run("camera --uri 'nonsense://device' --settings " + settings_file(d) + " --out " + d + "/out"),
       "nonsense://device");
   // a real camera needs calibrated intrinsics
   expect_one_error_line(run("camera --uri 'nonsense://device' --out " + d), "--settings");
@@ -196,7 +196,7 @@ TEST(PVB_CAMERA_SUITE, BadUriIsOneErrorLine) {
 
 TEST(PVB_CAMERA_SUITE, MissingOniIsOneErrorLine) {
   const std::string d = fresh("missing");
-  expect_one_error_line(run("camera --oni " + d + "/none.oni --settings " + settings_file(d) + " --out " + d),
+  expect_one_error_line(run("camera --oni " + d + "/none.oni --settings " + settings_file(d) + " --out " + d + "/out"),
                         "none.oni");
 }
 

@@ -1,12 +1,17 @@
 // The scenario checker against hand-written metrics.json fixtures.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <cstdio>
 #include <string>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/suite/aggregate.hpp"
 #include "pvb/suite/check.hpp"
+#include "pvb/suite/metrics_file.hpp"
 
 using namespace pvb;
 
@@ -143,6 +148,59 @@ TEST(SuiteCheck, MalformedMetricsAreIoErrorsNamingFileAndKey) {
   EXPECT_THROW(suite::read_metrics_file(fixture("does_not_exist.json")), IoError);
 }
 
+// metrics.json is read as JSON is meant: a quoted number is a string, and a
+// version newer than this program's is refused, not read as its own.
+TEST(SuiteCheck, StringsAreNotNumbersAndUnknownVersionsAreRefused) {
+  const std::string good = read_file(fixture("good_compare.json"));
+  const std::string path = ::testing::TempDir() + "pvb_metrics_strict_" + std::to_string(::getpid()) + ".json";
+  auto message = [&path](const std::string& text) -> std::string {
+    write_file(path, text);
+    try {
+      suite::read_metrics_file(path);
+    } catch (const IoError& e) {
+      return e.what();
+    }
+    return "(no error)";
+  };
+  EXPECT_EQ(message(good), "(no error)");
+  std::string quoted = good;
+  const std::string lost = "\"lost_frames\": 0";
+  quoted.replace(quoted.find(lost), lost.size(), "\"lost_frames\": \"0\"");
+  EXPECT_NE(message(quoted).find("lost_frames: expected an integer, got the string \"0\""), std::string::npos)
+      << message(quoted);
+  std::string version = good;
+  version.replace(version.find('{'), 1, "{\"metrics_version\": 2,");
+  EXPECT_EQ(message(version), "(no error)");
+  const std::string v2 = "\"metrics_version\": 2";
+  version.replace(version.find(v2), v2.size(), "\"metrics_version\": 99");
+  EXPECT_NE(message(version).find("metrics_version: expected 1 to 2 (this pvbench reads up to version 2), got 99"),
+            std::string::npos)
+      << message(version);
+  std::remove(path.c_str());
+}
+
+// A run of another scenario or seed is refused, not judged by the wrong bounds.
+TEST(SuiteCheck, MetricsOfAnotherRunAreRefused) {
+  const suite::MetricsFile m = suite::read_metrics_file(fixture("good_compare.json"));
+  ASSERT_TRUE(m.seed.has_value());
+  EXPECT_NO_THROW(suite::expect_run_identity(m, m.scenario, "x.yaml", m.seed));
+  try {
+    suite::expect_run_identity(m, "lawnmower_return", "scenes/lawnmower_return.yaml", std::nullopt);
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), m.path + ": scenario: expected a run of lawnmower_return "
+                                              "(scenes/lawnmower_return.yaml), got " + m.scenario);
+  }
+  try {
+    suite::expect_run_identity(m, "", "", *m.seed + 1, "the folder seed_" + std::to_string(*m.seed + 1));
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(": seed: expected " + std::to_string(*m.seed + 1) + " (the folder seed_"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(SuiteCheck, PeAgainstBaselineIsANoteNeverAViolationOfOneRun) {
   // PE-SLAM 23.5 mm against the baseline's 15 mm: one run says nothing
   // about the distribution, so it is a note with both values.
@@ -270,6 +328,21 @@ TEST(SuiteCheckPlace, RelocalisationIsCountedFromTheCamerasReturn) {
   EXPECT_TRUE(has_key(suite::check_expectations(e, m), "relocalised_within_frames"));
 }
 
+// A bound whose data is missing is never passed: 40 lost frames without
+// their loss events cannot show a relocalisation within 30 frames.
+TEST(SuiteCheckPlace, RelocalisationBoundWithoutLossEventsIsNotJudged) {
+  scenes::Expectations e;
+  e.relocalised_within_frames = 30;
+  suite::MetricsFile m = kidnapped();
+  m.primary.lost_frames = 40;
+  m.primary.loss_events.clear();
+  const auto v = suite::check_expectations(e, m);
+  ASSERT_EQ(v.size(), 1u);
+  EXPECT_EQ(v[0].line(), "relocalised_within_frames: not judged: 40 lost frames but no loss_events in the metrics");
+  m.primary.lost_frames = 0;  // nothing lost: nothing to relocalise from
+  EXPECT_TRUE(suite::check_expectations(e, m).empty());
+}
+
 TEST(SuiteCheckPlace, RefinedAteBound) {
   scenes::Expectations e;
   suite::MetricsFile m = kidnapped();
@@ -294,12 +367,33 @@ TEST(SuiteCheckPlace, SweepTotals) {
   EXPECT_NE(suite::format_markdown(a).find("2 false"), std::string::npos);
 }
 
+// With --compare, the summary table's PE-SLAM and baseline rows stay
+// together: the dense-map and place-recognition lines come after the table.
+TEST(SuiteCheckMap, SummaryTableStaysWholeWithMapAndPlaceLines) {
+  std::vector<suite::SeedRun> runs;
+  for (int s = 1; s <= 2; ++s) {
+    suite::SeedRun r = suite::read_seed_run(s, fixture("kidnapped.json"));
+    const suite::MetricsFile maps = suite::read_metrics_file(fixture("dense_map.json"));
+    r.metrics->primary.maps = maps.primary.maps;
+    r.metrics->baseline = r.metrics->primary;
+    r.metrics->baseline->mode = "baseline";
+    runs.push_back(r);
+  }
+  const std::string md = suite::format_markdown(suite::aggregate("kidnapped", runs));
+  const std::size_t pe = md.find("\n| PE-SLAM |");
+  ASSERT_NE(pe, std::string::npos) << md;
+  const std::size_t next_line = md.find('\n', pe + 1) + 1;
+  EXPECT_EQ(md.compare(next_line, 9, "| baselin"), 0) << md;
+  EXPECT_LT(next_line, md.find("dense map over")) << md;
+  EXPECT_LT(next_line, md.find("Place recognition over")) << md;
+}
+
 TEST(SuiteCheckMap, ReadsTheScoredMaps) {
   const suite::MetricsFile m = suite::read_metrics_file(fixture("dense_map.json"));
   ASSERT_EQ(m.primary.maps.size(), 2u);
   const suite::MapMetrics* c = m.primary.map("corrected");
   ASSERT_NE(c, nullptr);
-  EXPECT_DOUBLE_EQ(c->accuracy_median_m, 0.012);
+  EXPECT_DOUBLE_EQ(c->accuracy_median_m.value_or(-1), 0.012);
   EXPECT_DOUBLE_EQ(c->completeness_2cm, 0.8);
   EXPECT_DOUBLE_EQ(c->completeness_5cm, 0.9);
   EXPECT_DOUBLE_EQ(c->ghosting, 0.001);

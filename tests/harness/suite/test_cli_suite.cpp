@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <regex>
 #include <string>
 
 #include "pvb/common/text.hpp"
@@ -20,7 +21,7 @@ std::string fixture(const std::string& name) {
 }
 
 std::string scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("pvb_cli_suite_" + std::to_string(::getpid())) / name;
+  const fs::path dir = fs::path(::testing::TempDir()) / ("pvb_cli_suite_" + std::to_string(::getpid())) / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir.string();
@@ -30,10 +31,21 @@ std::string scratch(const std::string& name) {
 std::string scenario_file() {
   const std::string path = scratch("scenario") + "/s.yaml";
   pvb::write_file(path,
-                  "name: s\nroute: {waypoints_m: [[0, 0], [5, 0]]}\n"
+                  "name: pv_station\nroute: {waypoints_m: [[0, 0], [5, 0]]}\n"
                   "expect:\n  ate_rmse_m_max: 0.01\n  rpe_trans_rmse_m_max: 0.005\n  lost_frames_max: 0\n"
                   "  sweep: {pe_not_significantly_worse: true}\n");
   return path;
+}
+
+/// A fixture as the run of `scenario` with `seed` would have written it:
+/// every "scenario" and "seed" value replaced (a sweep refuses a seed
+/// folder whose metrics name another seed or scenario).
+void write_metrics(const std::string& fixture_name, const std::string& path, const std::string& scenario,
+                   int seed) {
+  std::string text = pvb::read_file(fixture(fixture_name));
+  text = std::regex_replace(text, std::regex("\"scenario\": \"[^\"]*\""), "\"scenario\": \"" + scenario + "\"");
+  text = std::regex_replace(text, std::regex("\"seed\": [0-9]+"), "\"seed\": " + std::to_string(seed));
+  pvb::write_file(path, text);
 }
 
 int count_lines(const std::string& s) {
@@ -48,12 +60,13 @@ TEST(CliCheck, PassingRunExitsZero) {
   const auto r =
       run_pvbench("check --scenario " + scenario_file() + " --metrics " + fixture("good_compare.json"));
   EXPECT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("good_compare.json: ok (s)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("good_compare.json: ok (pv_station)"), std::string::npos) << r.output;
 }
 
 TEST(CliCheck, ViolationsExitThreeWithOneLineEach) {
-  const auto r = run_pvbench("check --scenario " + scenario_file() + " --metrics " +
-                             fixture("worse_than_baseline.json"));
+  const std::string metrics = scratch("violations") + "/worse_than_baseline.json";
+  write_metrics("worse_than_baseline.json", metrics, "pv_station", 3);
+  const auto r = run_pvbench("check --scenario " + scenario_file() + " --metrics " + metrics);
   EXPECT_EQ(r.code, 3) << r.output;
   // Three violations and two notes: PE against the baseline (never judged on
   // one run) and where the sweep expectation is judged.
@@ -85,10 +98,53 @@ TEST(CliCheck, ShippedFailureScenarioAcceptsAReportedLoss) {
                         fixture("lost_aborted.json"))
                 .code,
             0);
-  const auto r = run_pvbench("check --scenario " + scenes + "tracking_failure.yaml --metrics " +
-                             fixture("good_compare.json"));
+  const std::string completed = scratch("failure") + "/good_compare.json";
+  write_metrics("good_compare.json", completed, "tracking_failure", 7);
+  const auto r = run_pvbench("check --scenario " + scenes + "tracking_failure.yaml --metrics " + completed);
   EXPECT_EQ(r.code, 3) << r.output;
   EXPECT_NE(r.output.find("tracking_loss_expected: no tracking loss was reported"), std::string::npos)
+      << r.output;
+}
+
+// Another scenario's run is refused with one line, never judged by this
+// scenario's bounds.
+TEST(CliCheck, RunOfAnotherScenarioIsRefused) {
+  const std::string scenes = std::string(PVB_SOURCE_DIR) + "/scenes/";
+  const auto r = run_pvbench("check --scenario " + scenes + "lawnmower_return.yaml --metrics " +
+                             fixture("good_compare.json"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(count_lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("good_compare.json: scenario: expected a run of lawnmower_return ("), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("got pv_station"), std::string::npos) << r.output;
+}
+
+TEST(CliSweep, AggregateOnlyRefusesRunsOfAnotherScenarioOrSeed) {
+  const std::string scenes = std::string(PVB_SOURCE_DIR) + "/scenes/";
+  const std::string out = scratch("identity");
+  fs::create_directories(out + "/seed_1");
+  fs::create_directories(out + "/seed_2");
+  write_metrics("good_compare.json", out + "/seed_1/metrics.json", "pv_station", 1);
+  write_metrics("good_compare.json", out + "/seed_2/metrics.json", "pv_station", 2);
+  EXPECT_EQ(run_pvbench("sweep --out " + out + " --aggregate-only").code, 0);
+  // Judged by another scenario's bounds: refused.
+  auto r = run_pvbench("sweep --scenario " + scenes + "lawnmower_return.yaml --out " + out + " --aggregate-only --check");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(count_lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("seed_1/metrics.json: scenario: expected a run of lawnmower_return"), std::string::npos)
+      << r.output;
+  // A seed folder holding another seed's run.
+  write_metrics("good_compare.json", out + "/seed_2/metrics.json", "pv_station", 7);
+  r = run_pvbench("sweep --out " + out + " --aggregate-only");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("seed_2/metrics.json: seed: expected 2 (the folder seed_2), got 7"), std::string::npos)
+      << r.output;
+  // Two scenarios mixed in one sweep folder.
+  write_metrics("good_compare.json", out + "/seed_2/metrics.json", "along_row", 2);
+  r = run_pvbench("sweep --out " + out + " --aggregate-only");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("seed_2/metrics.json: scenario: expected a run of pv_station (the sweep's other seeds)"),
+            std::string::npos)
       << r.output;
 }
 
@@ -120,7 +176,7 @@ TEST(CliSweep, PrintCommandsGivesOneSelfContainedLinePerSeed) {
   EXPECT_EQ(count_lines(r.output), 3) << r.output;
   const std::string exe = fs::canonical(pvb::test::pvbench_path()).string();
   const std::string seed9 = "mkdir -p " + out + "/seed_9 && " + exe + " run --scenario " + scenario +
-                            " --seed 9 --out " + out + "/seed_9 --frames 30 --compare --sync > " + out +
+                            " --seed 9 --out " + out + "/seed_9 --overwrite --frames 30 --compare --sync > " + out +
                             "/seed_9/stdout.log 2>&1\n";
   EXPECT_NE(r.output.find(seed9), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out + "/seed_1"));  // printing runs nothing
@@ -132,8 +188,8 @@ TEST(CliSweep, AggregateOnlyCollectsSeedFolders) {
   fs::create_directories(out + "/seed_2");
   fs::create_directories(out + "/seed_10");  // a seed that left no metrics
   fs::create_directories(out + "/not_a_seed");
-  fs::copy_file(fixture("good_compare.json"), out + "/seed_1/metrics.json");
-  fs::copy_file(fixture("worse_than_baseline.json"), out + "/seed_2/metrics.json");
+  write_metrics("good_compare.json", out + "/seed_1/metrics.json", "pv_station", 1);
+  write_metrics("worse_than_baseline.json", out + "/seed_2/metrics.json", "pv_station", 2);
   const auto r = run_pvbench("sweep --out " + out + " --aggregate-only");
   EXPECT_EQ(r.code, 3) << r.output;  // one seed failed
   for (const char* f : {"aggregate.md", "aggregate.csv", "aggregate.json", "aggregate.svg", "aggregate.png"})
@@ -182,8 +238,8 @@ std::string sweep_folder(const std::string& name, int good, int worse) {
   for (int i = 1; i <= good + worse; ++i) {
     const std::string dir = out + "/seed_" + std::to_string(i);
     fs::create_directories(dir);
-    fs::copy_file(fixture(i <= good ? "good_compare.json" : "worse_than_baseline.json"),
-                  dir + "/metrics.json");
+    write_metrics(i <= good ? "good_compare.json" : "worse_than_baseline.json", dir + "/metrics.json",
+                  "pv_station", i);
   }
   return out;
 }
@@ -200,7 +256,7 @@ TEST(CliSweep, CheckJudgesEverySeedAndTheSweep) {
                      "PE-SLAM − baseline ATE reaches -0.90 mm <= margin 0.51 mm over 10 seeds\n"),
       std::string::npos)
       << ok.output;
-  EXPECT_NE(ok.output.find("check: ok (s, 10 seeds)\n"), std::string::npos) << ok.output;
+  EXPECT_NE(ok.output.find("check: ok (pv_station, 10 seeds)\n"), std::string::npos) << ok.output;
 
   // One seed breaks three run bounds and drags the paired interval's upper
   // end to 2.17 mm, past the margin of 10 % of the baseline's 6.09 mm.

@@ -19,7 +19,7 @@ constexpr int kFrames = 12;
 }  // namespace
 
 TEST(SweepRun, TwoSeedsThenASlurmTaskThenAggregateOnly) {
-  const fs::path out = fs::temp_directory_path() / ("pvb_sweep_run_" + std::to_string(::getpid()));
+  const fs::path out = fs::path(::testing::TempDir()) / ("pvb_sweep_run_" + std::to_string(::getpid()));
   fs::remove_all(out);
   const std::string scenario = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
   const std::string common = " --frames " + std::to_string(kFrames) + " --compare --sync";

@@ -34,6 +34,9 @@ enum class SlamMode {
 struct RunOptions {
   std::string scenario_file;
   std::string out_dir;
+  /// An earlier pvbench output in out_dir is emptied first (--overwrite);
+  /// false: a folder that holds anything is refused.
+  bool overwrite = false;
   std::optional<std::uint64_t> seed;  ///< overrides the scenario's seed (also seeds PE-match)
   int max_frames = 0;                 ///< cap (0: the scenario's duration)
   bool sync = false;                  ///< no threads: bit-identical runs

@@ -28,7 +28,7 @@ struct PlaceMetrics {
 /// live, before_loop, after_loop), over the whole map.
 struct MapMetrics {
   std::string name;
-  double accuracy_median_m = 0;
+  std::optional<double> accuracy_median_m;  ///< absent when the map had no points ("accuracy_m": null)
   double completeness_2cm = 0;  ///< share of the true surface within 2 cm
   double completeness_5cm = 0;  ///< within 5 cm
   double ghosting = 0;          ///< share of the judged surface mapped twice
@@ -56,11 +56,29 @@ struct RunMetrics {
 
 struct MetricsFile {
   std::string path;
+  int version = 1;  ///< "metrics_version" (absent in version 1 files)
   std::string scenario;
   std::optional<unsigned long long> seed;
   RunMetrics primary;                  ///< the top-level run (PE-SLAM with --compare)
   std::optional<RunMetrics> baseline;  ///< only with --compare
 };
+
+/// Refuses the metrics of another run: throws ConfigError naming the file
+/// and the key when its "scenario" is not `scenario` (unless that is empty;
+/// `scenario_source` says where the expected name comes from, e.g. the
+/// scenario file) or its "seed" is not `seed` (unless nullopt).
+void expect_run_identity(const MetricsFile& m, const std::string& scenario, const std::string& scenario_source,
+                         std::optional<unsigned long long> seed, const std::string& seed_source = "");
+
+/// The scenario name and seed a run or recording folder says it was made
+/// from: its metrics.json ("scenario", "seed") or else its meta.json
+/// ("scenario": {"name"}, "seed").  nullopt when the folder holds neither.
+struct FolderIdentity {
+  std::string file;      ///< the file read
+  std::string scenario;  ///< "" when the file names none
+  std::optional<unsigned long long> seed;
+};
+std::optional<FolderIdentity> read_folder_identity(const std::string& dir);
 
 /// Reads and checks the shape of a metrics.json.  Throws IoError naming the
 /// file and the key when the file is missing, is not JSON, or a required key
