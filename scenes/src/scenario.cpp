@@ -1,10 +1,13 @@
 #include "pvb/scenes/scenario.hpp"
 
+#include <sys/stat.h>
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -219,6 +222,8 @@ long long table_geoms(const PvArray& a) {
 /// also take minutes in MuJoCo's compiler: 50 x 50 tables of 240 panels
 /// (617 500 geoms) were not compiled after 5 minutes.
 constexpr long long kMaxSceneGeoms = 3800;
+/// A scenario file's largest size: 3800 walls of 100 bytes each fit in 400 KiB.
+constexpr std::size_t kMaxScenarioBytes = 1024 * 1024;
 
 /// Refuses a scenario whose scene would not fit the renderer: one line naming
 /// the limit, the total and the largest array.
@@ -277,6 +282,9 @@ namespace {
 void read_arrays(MapReader& top, const std::string& origin, std::vector<PvArray>& out) {
   if (const YAML::Node arrays = top.child("pv_arrays")) {
     if (!arrays.IsSequence()) top.fail("pv_arrays", arrays, "a list of arrays");
+    if (arrays.size() > static_cast<std::size_t>(kMaxSceneGeoms))
+      top.fail("pv_arrays", arrays, "at most " + std::to_string(kMaxSceneGeoms) + " arrays (the renderer's geom limit)",
+               std::to_string(arrays.size()));
     for (std::size_t i = 0; i < arrays.size(); ++i) {
       MapReader r(arrays[i], origin, "pv_arrays[" + std::to_string(i) + "]");
       out.push_back(read_array(r));
@@ -288,6 +296,9 @@ void read_arrays(MapReader& top, const std::string& origin, std::vector<PvArray>
 void read_walls(MapReader& top, const std::string& origin, std::vector<Wall>& out) {
   if (const YAML::Node walls = top.child("walls")) {
     if (!walls.IsSequence()) top.fail("walls", walls, "a list of walls");
+    if (walls.size() > static_cast<std::size_t>(kMaxSceneGeoms))  // one geom each: refused before reading them
+      top.fail("walls", walls, "at most " + std::to_string(kMaxSceneGeoms) + " walls (the renderer's geom limit)",
+               std::to_string(walls.size()));
     for (std::size_t i = 0; i < walls.size(); ++i) {
       MapReader r(walls[i], origin, "walls[" + std::to_string(i) + "]");
       Wall w;
@@ -354,6 +365,10 @@ void read_route(MapReader& r, Route& rt) {
   if (rt.return_to_start && rt.pattern != RoutePattern::kLawnmower)
     r.fail(r.full("return_to_start"), r.child("return_to_start"), "false unless route.pattern is lawnmower",
            "true");
+  if (!rt.return_to_start && r.has("return_overlap_m"))
+    r.fail(r.full("return_overlap_m"), r.child("return_overlap_m"),
+           "no return_overlap_m unless route.return_to_start is true (it would be ignored)",
+           r.child("return_overlap_m").Scalar());
   rt.return_overlap_m = r.number("return_overlap_m", rt.return_overlap_m, 0.5, 100);
   rt.offset_m = r.number("offset_m", rt.offset_m, 0.3, 20);
   rt.margin_m = r.number("margin_m", rt.margin_m, 0, 50);
@@ -458,6 +473,15 @@ void read_kidnap(MapReader& top, const std::string& origin, Scenario& s) {
   k.covered_s = r.number("covered_s", k.covered_s, 1e-3, 3600);
   k.to_route_s = r.number("to_route_s", k.to_route_s, 0, 3600);
   r.finish();
+  const double frame_s = 1.0 / s.camera.fps;
+  if (!(k.at_s < s.duration_s))
+    r.fail(r.full("at_s"), node_of(n, "at_s"),
+           "a time before duration_s (" + format_number("%g", s.duration_s) + " s)", format_number("%g", k.at_s));
+  // At least one frame period (1e-9 s: a period written in decimals).
+  if (k.covered_s < frame_s - 1e-9)
+    r.fail(r.full("covered_s"), node_of(n, "covered_s"),
+           "at least one frame period (1 / camera.fps = " + format_number("%g", frame_s) + " s)",
+           format_number("%g", k.covered_s));
   const KidnapFrames f = kidnap_frames(k, s.camera.fps);
   if (!(k.to_route_s < k.at_s) || f.target >= f.cover_begin)
     r.fail(r.full("to_route_s"), node_of(n, "to_route_s"),
@@ -474,43 +498,89 @@ void read_kidnap(MapReader& top, const std::string& origin, Scenario& s) {
   s.kidnap = k;
 }
 
+/// "FILE:LINE" of `section`.`key` in the document (FILE when not there).
+std::string where(const YAML::Node& root, const std::string& origin, const char* section, const char* key) {
+  const YAML::Node& croot = root;  // const: operator[] must not insert keys
+  const YAML::Node sec = croot[section];
+  if (!sec.IsDefined() || !sec.IsMap()) return origin;
+  const YAML::Node& csec = sec;
+  const YAML::Node v = csec[key];
+  return v.IsDefined() && v.Mark().line >= 0 ? origin + ":" + std::to_string(v.Mark().line + 1) : origin;
+}
+
 /// Checks between fields: the route against the arrays it names.
-void check_route(const Scenario& s, const std::string& origin) {
-  // Cross-field checks.
+void check_route(const Scenario& s, const std::string& origin, const YAML::Node& root) {
   const Route& rt = s.route;
+  const auto at = [&](const char* key) { return where(root, origin, "route", key); };
   if (rt.pattern == RoutePattern::kWaypoints && rt.waypoints_m.size() < 2)
-    throw ConfigError(origin, "route.waypoints_m", "at least 2 points when route.pattern is waypoints");
+    throw ConfigError(at("pattern"), "route.waypoints_m", "at least 2 points when route.pattern is waypoints");
   if (rt.pattern != RoutePattern::kWaypoints) {
     if (s.pv_arrays.empty())
-      throw ConfigError(origin, "route.pattern", "a waypoints route when the scenario has no pv_arrays",
+      throw ConfigError(at("pattern"), "route.pattern", "a waypoints route when the scenario has no pv_arrays",
                         to_string(rt.pattern));
     if (rt.array >= static_cast<int>(s.pv_arrays.size()))
-      throw ConfigError(origin, "route.array", "an index below " + std::to_string(s.pv_arrays.size()),
+      throw ConfigError(at("array"), "route.array", "an index below " + std::to_string(s.pv_arrays.size()),
                         std::to_string(rt.array));
     const PvArray& a = s.pv_arrays[static_cast<std::size_t>(rt.array)];
     if (rt.pattern == RoutePattern::kAlongRow && rt.aisle > a.rows)
-      throw ConfigError(origin, "route.aisle", "an aisle in [0, " + std::to_string(a.rows) + "]",
+      throw ConfigError(at("aisle"), "route.aisle", "an aisle in [0, " + std::to_string(a.rows) + "]",
                         std::to_string(rt.aisle));
     if (rt.pattern == RoutePattern::kLawnmower && rt.aisles > a.rows + 1)
-      throw ConfigError(origin, "route.aisles", "at most rows + 1 = " + std::to_string(a.rows + 1),
+      throw ConfigError(at("aisles"), "route.aisles", "at most rows + 1 = " + std::to_string(a.rows + 1),
                         std::to_string(rt.aisles));
     const double first_aisle_m = row_length_m(a) + 2 * rt.margin_m;
     if (rt.pattern == RoutePattern::kLawnmower && rt.return_to_start && rt.return_overlap_m > first_aisle_m)
-      throw ConfigError(origin, "route.return_overlap_m",
+      throw ConfigError(at("return_overlap_m"), "route.return_overlap_m",
                         "at most the first aisle's length, " + format_number("%.2f m", first_aisle_m),
                         format_number("%g", rt.return_overlap_m));
+  }
+}
+
+/// yaml-cpp keeps both of two equal keys in a map and finds the first, so
+/// a second value would go unread and unchecked: a key given twice is an
+/// error naming both lines.
+void check_no_duplicate_keys(const YAML::Node& n, const std::string& origin, const std::string& path) {
+  if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i)
+      check_no_duplicate_keys(n[i], origin, path + "[" + std::to_string(i) + "]");
+    return;
+  }
+  if (!n.IsMap()) return;
+  std::map<std::string, int> first_line;
+  for (const auto& kv : n) {
+    if (!kv.first.IsScalar()) continue;  // MapReader::finish() names a non-scalar key
+    const std::string key = kv.first.Scalar();
+    const std::string full = path.empty() ? key : path + "." + key;
+    const int line = kv.first.Mark().line + 1;
+    const auto [at, fresh] = first_line.emplace(key, line);
+    if (!fresh)
+      throw ConfigError(origin + ":" + std::to_string(line), full,
+                        "each key once in its section (first given at line " + std::to_string(at->second) + ")",
+                        "a second " + key);
+    check_no_duplicate_keys(kv.second, origin, full);
   }
 }
 
 }  // namespace
 
 Scenario parse_scenario(const std::string& yaml_text, const std::string& origin) {
+  // The parser takes about 100 bytes of memory per byte of text: a file far
+  // larger than any scene the renderer draws is refused before it is parsed.
+  if (yaml_text.size() > kMaxScenarioBytes)
+    throw ConfigError(origin, "(file)",
+                      "a scenario file of at most " + std::to_string(kMaxScenarioBytes / 1024) +
+                          " KiB (the largest scene the renderer draws takes far less)",
+                      std::to_string(yaml_text.size() / 1024) + " KiB");
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
+  } catch (const YAML::DeepRecursion& e) {
+    throw ConfigError(origin + ":" + std::to_string(e.mark.line + 1), "(syntax)",
+                      "YAML nested at most a few hundred levels deep", "nesting too deep for the parser");
   } catch (const YAML::Exception& e) {
     throw ConfigError(origin + ":" + std::to_string(e.mark.line + 1), "(syntax)", "valid YAML", e.msg);
   }
+  check_no_duplicate_keys(root, origin, "");
   if (!root.IsDefined() || root.IsNull())
     throw ConfigError(origin, "(top level)", "a scenario mapping", "an empty file");
   Scenario s;
@@ -540,11 +610,18 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
   top.finish();
   check_scene_size(s, origin);
 
-  check_route(s, origin);
+  check_route(s, origin, root);
   return s;
 }
 
-Scenario load_scenario(const std::string& path) { return parse_scenario(read_file(path), path); }
+Scenario load_scenario(const std::string& path) {
+  require_regular_file(path);
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && static_cast<std::size_t>(st.st_size) > kMaxScenarioBytes)
+    throw ConfigError(path, "(file)", "a scenario file of at most " + std::to_string(kMaxScenarioBytes / 1024) + " KiB",
+                      std::to_string(st.st_size / 1024) + " KiB");
+  return parse_scenario(read_file(path), path);
+}
 
 int frame_count(const Scenario& s, int max_frames) {
   const int n = static_cast<int>(std::floor(s.duration_s * s.camera.fps + 1e-9)) + 1;

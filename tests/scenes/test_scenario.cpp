@@ -354,3 +354,73 @@ TEST(Scenario, IdenticalTablesAndLawnmowerReturnAreRead) {
   EXPECT_NE(e.find("route.return_overlap_m: expected a value in [0.5, 100], got 0.1"), std::string::npos)
       << e;
 }
+
+// yaml-cpp finds the first of two equal keys and never reads the second: a
+// key given twice is an error naming both lines, at any depth.
+TEST(Scenario, DuplicateKeysAreRefusedWithBothLines) {
+  std::string e = error_of(std::string(kMinimal) + "seed: 43\nseed: -1\n");
+  EXPECT_NE(e.find("bad.yaml:3: seed: expected each key once in its section (first given at line 2), got a second seed"),
+            std::string::npos)
+      << e;
+  e = error_of(std::string(kMinimal) + "duration_s: 20\nkidnap: {at_s: 10, to_route_s: 3}\nkidnap: {at_s: 12, to_route_s: 3}\n");
+  EXPECT_NE(e.find("bad.yaml:4: kidnap: expected each key once in its section (first given at line 3)"),
+            std::string::npos)
+      << e;
+  e = error_of(std::string(kMinimal) + "camera:\n  width: 320\n  fps: 15\n  width: 640\n");
+  EXPECT_NE(e.find("bad.yaml:5: camera.width: expected each key once in its section (first given at line 3)"),
+            std::string::npos)
+      << e;
+  e = error_of("pv_arrays:\n  - {rows: 2, rows: 3}\n" + std::string(kMinimal));
+  EXPECT_NE(e.find("pv_arrays[0].rows: expected each key once"), std::string::npos) << e;
+  // The same key in two sections is not a duplicate.
+  EXPECT_EQ(error_of(std::string(kMinimal) + "camera: {fps: 15}\nlight: {ambient: 0.3}\nrobot: {track_m: 0.4}\n"), "");
+}
+
+TEST(Scenario, KidnapTimesAreJudgedByTheKeyThatIsWrong) {
+  const std::string base = std::string(kMinimal) + "duration_s: 20\nkidnap:\n";
+  // A cover shorter than one frame period is refused even where it happens
+  // to straddle a frame boundary (10.0 s is on a frame at 30 fps).
+  std::string e = error_of(base + "  at_s: 10\n  covered_s: 0.01\n  to_route_s: 2\n");
+  EXPECT_NE(e.find("bad.yaml:5: kidnap.covered_s: expected at least one frame period (1 / camera.fps = 0.0333333 s), "
+                   "got 0.01"),
+            std::string::npos)
+      << e;
+  EXPECT_EQ(error_of(base + "  at_s: 10\n  covered_s: 0.0333333333\n  to_route_s: 2\n"), "");
+  // A cover that starts after the run is at_s's fault, not covered_s's.
+  e = error_of(base + "  at_s: 25\n  to_route_s: 2\n");
+  EXPECT_NE(e.find("bad.yaml:4: kidnap.at_s: expected a time before duration_s (20 s), got 25"), std::string::npos) << e;
+}
+
+TEST(Scenario, ReturnOverlapOnlyWithReturnToStart) {
+  const std::string arrays = "pv_arrays:\n  - {rows: 2, tables_per_row: 2, panels_per_table: 4}\n";
+  std::string e = error_of(arrays + "route:\n  pattern: lawnmower\n  return_overlap_m: 40\n");
+  EXPECT_NE(e.find("bad.yaml:5: route.return_overlap_m: expected no return_overlap_m unless route.return_to_start "
+                   "is true (it would be ignored), got 40"),
+            std::string::npos)
+      << e;
+  // Too long for the aisle: the error names the line it was written on.
+  e = error_of(arrays + "route:\n  pattern: lawnmower\n  return_to_start: true\n  return_overlap_m: 14\n");
+  EXPECT_NE(e.find("bad.yaml:6: route.return_overlap_m: expected at most the first aisle's length"), std::string::npos)
+      << e;
+}
+
+TEST(Scenario, TooDeepNestingSaysSo) {
+  const std::string e = error_of(std::string(kMinimal) + "ground: " + std::string(2000, '[') + std::string(2000, ']') + "\n");
+  EXPECT_NE(e.find("(syntax): expected YAML nested at most a few hundred levels deep, got nesting too deep"),
+            std::string::npos)
+      << e;
+}
+
+// A huge file is refused before it is parsed (an 11 MB file of 200 000
+// walls took 20 s and 1.1 GB before its geom count was checked).
+TEST(Scenario, HugeFilesAndWallListsAreRefusedBeforeTheyAreBuilt) {
+  std::string walls = "walls:\n";
+  for (int i = 0; i < 4000; ++i) walls += "  - {start_m: [0, " + std::to_string(i) + "], end_m: [1, " + std::to_string(i) + "]}\n";
+  std::string e = error_of(std::string(kMinimal) + walls);
+  EXPECT_NE(e.find("bad.yaml:3: walls: expected at most 3800 walls (the renderer's geom limit), got 4000"),
+            std::string::npos)
+      << e;
+  std::string huge = std::string(kMinimal) + "description: \"" + std::string(2 * 1024 * 1024, 'x') + "\"\n";
+  e = error_of(huge);
+  EXPECT_NE(e.find("bad.yaml: (file): expected a scenario file of at most 1024 KiB"), std::string::npos) << e;
+}

@@ -13,6 +13,7 @@
 #include <set>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
 
 namespace pvb::slam {
 namespace {
@@ -266,9 +267,32 @@ void check_document_markers(const std::string& path) {
   }
 }
 
+/// OpenCV's parser keeps the first of two equal keys in one map and never
+/// looks at the second; a key given twice is an error naming both lines.
+/// Keys are compared within their map: a nested map (an !!opencv-matrix)
+/// opens a new scope at a deeper indentation.
+void check_duplicate_keys(const std::string& path) {
+  static const std::regex key_line(R"(^( *)([A-Za-z_][\w.\-]*)\s*:(\s|$))");
+  std::vector<std::pair<std::size_t, std::map<std::string, int>>> scopes{{0, {}}};  // (indent, key -> line)
+  std::ifstream in(path);
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    std::smatch m;
+    if (!std::regex_search(line, m, key_line)) continue;
+    const std::size_t indent = m[1].length();
+    while (scopes.size() > 1 && indent < scopes.back().first) scopes.pop_back();
+    if (indent > scopes.back().first) scopes.push_back({indent, {}});
+    const auto [at, fresh] = scopes.back().second.emplace(m[2].str(), n);
+    if (!fresh)
+      throw IoError(path, "key '" + m[2].str() + "' given twice (first at line " + std::to_string(at->second) +
+                              "); OpenCV would read the first and ignore this one", n);
+  }
+}
+
 Settings read_settings(const std::string& path) {
-  if (!std::ifstream(path)) throw IoError(path, "cannot open settings file");
+  require_regular_file(path);  // before any open: a FIFO would block
   check_document_markers(path);
+  check_duplicate_keys(path);
   cv::FileStorage fs;
   try {
     if (!fs.open(path, cv::FileStorage::READ)) throw IoError(path, "cannot open settings file");

@@ -1,6 +1,9 @@
 // The settings reader on ORB-SLAM2's own TUM1.yaml and on broken copies.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#include <algorithm>
 
 #include <fstream>
 #include <regex>
@@ -407,6 +410,41 @@ TEST(Settings, ReadsPlaceRecognitionKeys) {
       EXPECT_EQ(e.key(), key) << e.what();
     }
   }
+}
+
+// OpenCV's parser reads the first of two equal keys and ignores the second:
+// a key given twice is an error naming both lines.
+TEST(Settings, DuplicateKeyNamesBothLines) {
+  const std::string text = read_file(kTum1);
+  const int lines = static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+  const std::string path = temp_copy("dup", text + "Vocabulary.path: none\nVocabulary.path: other.txt\n");
+  try {
+    read_settings(path);
+    ADD_FAILURE() << "accepted";
+  } catch (const IoError& e) {
+    EXPECT_EQ(e.line(), lines + 2) << e.what();
+    EXPECT_NE(e.message().find("key 'Vocabulary.path' given twice (first at line " + std::to_string(lines + 1) + ")"),
+              std::string::npos)
+        << e.what();
+  }
+  // The same key name in two nested maps is not a duplicate.
+  const std::string nested = temp_copy(
+      "nested", text + "M1: !!opencv-matrix\n   rows: 1\n   cols: 1\n   dt: d\n   data: [ 1.0 ]\n"
+                       "M2: !!opencv-matrix\n   rows: 1\n   cols: 1\n   dt: d\n   data: [ 2.0 ]\n");
+  EXPECT_NO_THROW(read_settings(nested));
+}
+
+TEST(Settings, FifoIsRefusedBeforeItIsOpened) {
+  const std::string fifo = ::testing::TempDir() + "pvb_settings_fifo_" + std::to_string(::getpid());
+  std::remove(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    read_settings(fifo);
+    ADD_FAILURE() << "accepted";
+  } catch (const IoError& e) {
+    EXPECT_EQ(std::string(e.what()), fifo + ": is a FIFO; expected a regular file");
+  }
+  std::remove(fifo.c_str());
 }
 
 TEST(Settings, MissingVocabularyIsOneIoErrorNamingIt) {
