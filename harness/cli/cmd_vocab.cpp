@@ -13,6 +13,7 @@
 #include "count_option.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
+#include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/sim_frame_source.hpp"
@@ -77,6 +78,15 @@ void add_image_folder(const std::string& dir, Collector* c) {
   }
 }
 
+/// Which of the source-specific options the command line gave.
+struct VocabGiven {
+  CLI::Option* seeds_opt = nullptr;
+  CLI::Option* every_opt = nullptr;
+  CLI::Option* frames_opt = nullptr;
+  CLI::Option* gl_opt = nullptr;
+  bool seeds = false, every = false, frames = false, gl = false;
+};
+
 void add_sequence(const std::string& dir, int every, Collector* c) {
   dataset::TumSequenceReader reader(dir);
   int i = 0;
@@ -108,9 +118,22 @@ void add_scenario(const std::string& file, const std::vector<std::uint64_t>& see
   }
 }
 
-int run_vocab(const VocabOptions& o) {
+/// Options that apply to some sources only are refused where none of those
+/// is given, rather than ignored without a word.
+void check_option_sources(const VocabOptions& o, const VocabGiven& given) {
+  if (o.scenarios.empty()) {
+    if (given.seeds) throw ConfigError("command line", "--seeds", "a --scenario to take the seeds of (images and sequences have none)");
+    if (given.frames) throw ConfigError("command line", "--frames", "a --scenario whose run it limits");
+    if (given.gl) throw ConfigError("command line", "--gl", "a --scenario to render");
+  }
+  if (given.every && o.scenarios.empty() && o.sequences.empty())
+    throw ConfigError("command line", "--every", "a --sequence or --scenario (every image of --images is used)");
+}
+
+int run_vocab(const VocabOptions& o, const VocabGiven& given) {
   if (o.images.empty() && o.sequences.empty() && o.scenarios.empty())
     throw ConfigError("command line", "--images/--sequence/--scenario", "at least one source of images");
+  check_option_sources(o, given);
   const auto t0 = std::chrono::steady_clock::now();
   Collector c(o.features);
   const std::vector<std::uint64_t> seeds = o.seeds.empty() ? std::vector<std::uint64_t>{}
@@ -127,11 +150,13 @@ int run_vocab(const VocabOptions& o) {
   const auto vocab = slam::place::Vocabulary::train(c.descriptors, p, &report);
   if (o.format == "text") vocab.save_text(o.out);
   else vocab.save_binary(o.out);
+  std::error_code ec;  // a device or a FIFO (--out /dev/null) has no size
+  const std::uintmax_t bytes = fs::is_regular_file(o.out, ec) ? fs::file_size(o.out, ec) : 0;
   std::printf("vocab: %zu images, %zu descriptors -> %zu words (%zu nodes, k %d, L %d, seed %llu); "
-              "extraction %.1f s, training %.1f s; wrote %s (%.1f MB)\n",
+              "extraction %.1f s, training %.1f s; wrote %s%s\n",
               report.images, report.descriptors, report.words, report.nodes, o.k, o.levels,
               static_cast<unsigned long long>(o.seed), extract_s, report.seconds, o.out.c_str(),
-              static_cast<double>(fs::file_size(o.out)) / 1e6);
+              bytes > 0 ? format_number(" (%.1f MB)", static_cast<double>(bytes) / 1e6).c_str() : "");
   return 0;
 }
 
@@ -144,9 +169,10 @@ Command add_vocab_command(CLI::App& app) {
   sub->add_option("--images", opt->images, "a folder of images (.png .jpg .ppm .pgm), every one used");
   sub->add_option("--sequence", opt->sequences, "a TUM RGB-D folder (rgb.txt), every --every-th frame");
   sub->add_option("--scenario", opt->scenarios, "a scenario rendered in memory, every --every-th frame");
-  sub->add_option("--seeds", opt->seeds, "scenario seeds, e.g. 101-103 or 101,105 (default: each scenario's own)");
-  sub->add_option("--every", opt->every, "use every n-th frame of sequences and scenarios")->check(CLI::Range(1, 100000));
-  sub->add_option("--frames", opt->frames, "frames of each scenario run (0: its duration)")->check(CLI::Range(0, 10000000));
+  auto given = std::make_shared<VocabGiven>();
+  given->seeds_opt = sub->add_option("--seeds", opt->seeds, "scenario seeds, e.g. 101-103 or 101,105 (default: each scenario's own)");
+  given->every_opt = sub->add_option("--every", opt->every, "use every n-th frame of sequences and scenarios")->check(CLI::Range(1, 100000));
+  given->frames_opt = sub->add_option("--frames", opt->frames, "frames of each scenario run (0: its duration)")->check(CLI::Range(0, 10000000));
   sub->add_option("--features", opt->features, "ORB features per image")->check(CLI::Range(100, 20000));
   sub->add_option("--k", opt->k, "branching factor")->check(CLI::Range(2, 64));
   sub->add_option("--levels", opt->levels, "tree depth L")->check(CLI::Range(1, 8));
@@ -154,8 +180,14 @@ Command add_vocab_command(CLI::App& app) {
       ->check(seed_check("vocab", "--seed", std::numeric_limits<std::uint64_t>::max()));
   sub->add_option("--format", opt->format, "binary (ours, fast to load) or text (DBoW2, ORBvoc.txt)")
       ->check(CLI::IsMember({"binary", "text"}));
-  sub->add_option("--gl", opt->gl, "rendering backend")->check(CLI::IsMember({"auto", "egl", "osmesa"}));
-  return {sub, [opt] { return run_vocab(*opt); }};
+  given->gl_opt = sub->add_option("--gl", opt->gl, "rendering backend")->check(CLI::IsMember({"auto", "egl", "osmesa"}));
+  return {sub, [opt, given] {
+            given->seeds = given->seeds_opt->count() > 0;
+            given->every = given->every_opt->count() > 0;
+            given->frames = given->frames_opt->count() > 0;
+            given->gl = given->gl_opt->count() > 0;
+            return run_vocab(*opt, *given);
+          }};
 }
 
 }  // namespace pvb::cli
