@@ -9,6 +9,7 @@ PKGS=(
   libegl-dev libegl-mesa0 libgl-dev libgles-dev libosmesa6-dev libgl1-mesa-dri
   libopenni2-dev
   libnanoflann-dev   # k-d trees for map accuracy
+  nlohmann-json3-dev # the tests parse every JSON file pvbench writes with a strict parser
   libfreenect-dev libfreenect0.5 libfreenect-bin   # Kinect v1 plug-in and fakenect playback
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev   # the libFuzzer targets (ci/fuzz.sh)

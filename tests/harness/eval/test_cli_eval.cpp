@@ -15,7 +15,7 @@ namespace {
 const std::string kBin = std::string(PVB_BINARY_DIR) + "/bin/pvbench";
 
 std::string temp_dir() {
-  const auto dir = std::filesystem::temp_directory_path() / ("pvb_cli_eval_" + std::to_string(::getpid()));
+  const auto dir = std::filesystem::path(::testing::TempDir()) / ("pvb_cli_eval_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   return dir.string();
 }

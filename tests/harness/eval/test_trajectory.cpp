@@ -11,7 +11,7 @@ using namespace pvb::eval;
 
 namespace {
 std::string temp_path(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("pvb_eval_test_" + std::to_string(::getpid()));
+  const auto dir = std::filesystem::path(::testing::TempDir()) / ("pvb_eval_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   return (dir / name).string();
 }
