@@ -27,6 +27,7 @@
 #include "pvb/geometry/time.hpp"
 #include "pvb/plot/contact_sheet.hpp"
 #include "pvb/run/run.hpp"
+#include "pvb/run/world_json.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/sim_frame_source.hpp"
 #include "stop_signals.hpp"
@@ -127,11 +128,12 @@ void write_meta(const std::string& path, const RecordOptions& opt, const scenes:
                 sim::SimFrameSource& source, const RecordLoop& loop, double total_s, double setup_ms) {
   const sim::Simulator& sim = source.simulator();
   const double per_frame = loop.frames > 0 ? 1.0 / loop.frames : 0.0;
-  char meta[4096];
-  std::snprintf(meta, sizeof meta,
-                "{\n"
-                "  \"scenario\": {\"name\": \"%s\", \"file\": \"%s\"},\n"
-                "  \"seed\": %llu,\n"
+  // The world first, whatever its size; the rest fits a line each.
+  std::string meta = "{\n  \"scenario\": {\"name\": \"" + json_escape(scenario.name) + "\", \"file\": \"" +
+                     json_escape(opt.scenario) + "\"},\n  \"seed\": " + std::to_string(scenario.seed) +
+                     ",\n  \"world\": " + run::world_json(scenario) + ",\n";
+  char rest[2048];
+  std::snprintf(rest, sizeof rest,
                 "  \"frames\": %d,\n"
                 "  \"interrupted\": %s,\n"
                 "  \"fps\": %.6g,\n"
@@ -142,13 +144,13 @@ void write_meta(const std::string& path, const RecordOptions& opt, const scenes:
                 "  \"timings\": {\"total_s\": %.3f, \"setup_ms\": %.1f, \"capture_ms_per_frame\": %.3f, "
                 "\"write_ms_per_frame\": %.3f, \"frames_per_s\": %.2f}\n"
                 "}\n",
-                json_escape(scenario.name).c_str(), json_escape(opt.scenario).c_str(),
-                static_cast<unsigned long long>(scenario.seed), loop.frames,
-                loop.interrupted ? "true" : "false", scenario.camera.fps, pvb::version(), mj_versionString(),
-                sim::to_string(source.camera().backend()), json_escape(source.camera().description()).c_str(),
-                sim.assets().timestep_s, sim.assets().substeps, sim.kinematics().wheel_radius_m,
-                sim.kinematics().track_m, total_s, setup_ms, loop.capture_ms * per_frame,
-                loop.write_ms * per_frame, loop.loop_s > 0 ? loop.frames / loop.loop_s : 0.0);
+                loop.frames, loop.interrupted ? "true" : "false", scenario.camera.fps, pvb::version(),
+                mj_versionString(), sim::to_string(source.camera().backend()),
+                json_escape(source.camera().description()).c_str(), sim.assets().timestep_s, sim.assets().substeps,
+                sim.kinematics().wheel_radius_m, sim.kinematics().track_m, total_s, setup_ms,
+                loop.capture_ms * per_frame, loop.write_ms * per_frame,
+                loop.loop_s > 0 ? loop.frames / loop.loop_s : 0.0);
+  meta += rest;
   write_file(path, meta);
 }
 

@@ -22,6 +22,7 @@ Command add_sweep_command(CLI::App& app);
 Command add_map_check_command(CLI::App& app);
 Command add_vocab_command(CLI::App& app);
 Command add_eval_map_command(CLI::App& app);
+Command add_sheet_command(CLI::App& app);
 
 // Sub-commands register here (one line each).
 std::vector<Command> add_all_commands(CLI::App& app) {
@@ -39,6 +40,7 @@ std::vector<Command> add_all_commands(CLI::App& app) {
   cmds.push_back(add_map_check_command(app));
   cmds.push_back(add_vocab_command(app));
   cmds.push_back(add_eval_map_command(app));
+  cmds.push_back(add_sheet_command(app));
   return cmds;
 }
 }  // namespace pvb::cli

@@ -84,7 +84,11 @@ double row_length_m(const PvArray& a) {
   return a.tables_per_row * a.table_length_m() + (a.tables_per_row - 1) * a.table_gap_m;
 }
 
-double row_footprint_m(const PvArray& a) { return a.table_depth_m() * std::cos(a.tilt_deg * kDegToRad); }
+double row_footprint_m(const PvArray& a) {
+  // A tracker's row is widest flat: routes keep their clearance at every angle.
+  if (a.mount == Mount::kSingleAxis) return a.table_depth_m();
+  return a.table_depth_m() * std::cos(a.tilt_deg * kDegToRad);
+}
 
 double polyline_length(const std::vector<Eigen::Vector2d>& pts) {
   double len = 0;

@@ -70,7 +70,19 @@ class XmlWriter {
   }
 };
 
-void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t seed) {
+/// The panels' dust variants: one drawn per panel from the day's seed.
+Placer dust_placer(std::uint64_t day_seed, int index) {
+  return Placer(day_seed ^ (0xA11A + static_cast<std::uint64_t>(index)));
+}
+
+std::string panel_geom(const std::string& name, double pw, double ph, const Eigen::Vector3d& pos,
+                       const std::string& axes, const std::string& material) {
+  return "<geom name=\"" + name + "\" class=\"scenery\" type=\"box\" size=\"" + v3(pw / 2, ph / 2, kPanelHalfThicknessM) +
+         "\" pos=\"" + v3(pos) + "\" xyaxes=\"" + axes + "\" material=\"" + material + "\"/>";
+}
+
+/// Fixed tables: each tilted by tilt_deg, facing -v, on rails and four posts.
+void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed) {
   const double az = a.azimuth_deg * kDeg, tilt = a.tilt_deg * kDeg;
   const Eigen::Vector3d eu(std::cos(az), std::sin(az), 0), ev(-std::sin(az), std::cos(az), 0);
   const Eigen::Vector3d up_slope = std::cos(tilt) * ev + std::sin(tilt) * Eigen::Vector3d::UnitZ();
@@ -78,7 +90,7 @@ void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t 
   const std::string axes = v3(eu) + " " + v3(up_slope);
   const double pw = a.panel_width_m(), ph = a.panel_height_m(), gap = 0.02;
   const double tl = a.table_length_m(), td = a.table_depth_m();
-  Placer rng(seed ^ (0xA11A + static_cast<std::uint64_t>(index)));
+  Placer rng = dust_placer(day_seed, index);
   const std::string pre = "a" + std::to_string(index);
   const Placer first_table_rng = rng;  // identical_tables: every table draws the first one's variants
   for (int row = 0; row < a.rows; ++row) {
@@ -97,10 +109,8 @@ void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t 
           const double u = u_start + c * (pw + gap) + pw / 2;
           const double s = line * (ph + gap) + ph / 2;
           const int variant = static_cast<int>(rng.uniform(0, kDirtVariants)) % kDirtVariants;
-          x.line("<geom name=\"" + tname + "p" + std::to_string(line) + "_" + std::to_string(c) +
-                 "\" class=\"scenery\" type=\"box\" size=\"" + v3(pw / 2, ph / 2, kPanelHalfThicknessM) + "\" pos=\"" +
-                 v3(slope_point(u, s)) + "\" xyaxes=\"" + axes + "\" material=\"" + pre + "panel" +
-                 std::to_string(variant) + "\"/>");
+          x.line(panel_geom(tname + "p" + std::to_string(line) + "_" + std::to_string(c), pw, ph, slope_point(u, s), axes,
+                            pre + "panel" + std::to_string(variant)));
         }
       }
       // backsheet and frame structure under the panels, one box per table
@@ -128,6 +138,64 @@ void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t 
       }
     }
   }
+}
+
+/// Single-axis trackers: each row's tables on a torque tube along u at the
+/// row's middle, turned by rotation_deg (right-handed about +u, 0 flat), on
+/// two posts per table.  The panels sit kTrackerPanelAboveAxisM above the
+/// tube's axis along their normal.
+void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed) {
+  const double az = a.azimuth_deg * kDeg, rot = a.rotation_deg * kDeg;
+  const Eigen::Vector3d eu(std::cos(az), std::sin(az), 0), ev(-std::sin(az), std::cos(az), 0);
+  const Eigen::Vector3d across = std::cos(rot) * ev + std::sin(rot) * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d normal = std::cos(rot) * Eigen::Vector3d::UnitZ() - std::sin(rot) * ev;
+  const std::string axes = v3(eu) + " " + v3(across);
+  const double pw = a.panel_width_m(), ph = a.panel_height_m(), gap = 0.02;
+  const double tl = a.table_length_m(), td = a.table_depth_m(), h = a.axis_height_m();
+  Placer rng = dust_placer(day_seed, index);
+  const Placer first_table_rng = rng;
+  const std::string pre = "a" + std::to_string(index);
+  for (int row = 0; row < a.rows; ++row) {
+    for (int t = 0; t < a.tables_per_row; ++t) {
+      if (a.identical_tables) rng = first_table_rng;
+      const double u_start = t * (tl + a.table_gap_m);
+      const auto axis_point = [&](double u) {
+        const Eigen::Vector2d g = scenes::array_to_world(a, u, row * a.row_pitch_m + td / 2);
+        return Eigen::Vector3d(g.x(), g.y(), h);
+      };
+      // s from the table's lower (-across) edge, as for fixed tables.
+      const auto plane_point = [&](double u, double s) {
+        return axis_point(u) + (s - td / 2) * across + scenes::kTrackerPanelAboveAxisM * normal;
+      };
+      const std::string tname = pre + "r" + std::to_string(row) + "t" + std::to_string(t);
+      for (int line = 0; line < a.panel_lines; ++line)
+        for (int c = 0; c < a.panels_per_table; ++c) {
+          const int variant = static_cast<int>(rng.uniform(0, kDirtVariants)) % kDirtVariants;
+          x.line(panel_geom(tname + "p" + std::to_string(line) + "_" + std::to_string(c), pw, ph,
+                            plane_point(u_start + c * (pw + gap) + pw / 2, line * (ph + gap) + ph / 2), axes,
+                            pre + "panel" + std::to_string(variant)));
+        }
+      const Eigen::Vector3d mid = axis_point(u_start + tl / 2);
+      x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2, td / 2, 0.015) + "\" pos=\"" +
+             v3(plane_point(u_start + tl / 2, td / 2) - normal * (kPanelHalfThicknessM + 0.016)) + "\" xyaxes=\"" +
+             axes + "\" material=\"backsheet\"/>");
+      x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2 + 0.1, 0.06, 0.06) + "\" pos=\"" + v3(mid) +
+             "\" xyaxes=\"" + axes + "\" material=\"steel\"/>");
+      if (a.posts)
+        for (double uf : {0.15, 0.85}) {
+          const Eigen::Vector3d top = axis_point(u_start + tl * uf) - Eigen::Vector3d(0, 0, 0.06);
+          x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(0.05, 0.05, top.z() / 2) + "\" pos=\"" +
+                 v3(top.x(), top.y(), top.z() / 2) + "\" euler=\"0 0 " + f(a.azimuth_deg) + "\" material=\"steel\"/>");
+        }
+    }
+  }
+}
+
+void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed) {
+  if (a.mount == scenes::Mount::kSingleAxis)
+    add_tracker_array(x, a, index, day_seed);
+  else
+    add_fixed_array(x, a, index, day_seed);
 }
 
 }  // namespace
@@ -178,25 +246,27 @@ SceneAssets build_scene(const scenes::Scenario& s) {
     out.route_xy.push_back(p.y());
   }
 
-  // ---- textures
-  const std::uint64_t seed = s.seed;
-  out.files.emplace_back("textures/ground.png", png(make_ground_texture(s.ground.type, seed)));
-  out.files.emplace_back("textures/brick.png", png(make_brick_texture(seed)));
-  out.files.emplace_back("textures/foliage.png", png(make_foliage_texture(seed)));
-  out.files.emplace_back("textures/bark.png", png(make_bark_texture(seed)));
+  // ---- textures: the station's, but for the day's dust on the panels
+  const std::uint64_t station_seed = s.station_seed_or_seed(), day_seed = s.seed;
+  out.files.emplace_back("textures/ground.png", png(make_ground_texture(s.ground.type, station_seed)));
+  out.files.emplace_back("textures/brick.png", png(make_brick_texture(station_seed)));
+  out.files.emplace_back("textures/foliage.png", png(make_foliage_texture(station_seed)));
+  out.files.emplace_back("textures/bark.png", png(make_bark_texture(station_seed)));
   for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) {
     for (int k = 0; k < kDirtVariants; ++k) {
       // variant 0 is the cleanest; dirt grows with k up to the array's level
       const double dirt = s.pv_arrays[i].dirt * (0.55 + 0.15 * k);
       out.files.emplace_back("textures/a" + std::to_string(i) + "panel" + std::to_string(k) + ".png",
-                             png(make_panel_texture(s.pv_arrays[i], dirt, seed * 131 + i * 17 + k)));
+                             png(make_panel_texture(s.pv_arrays[i], dirt, station_seed * 131 + i * 17 + k,
+                                                    day_seed * 131 + i * 17 + k)));
     }
   }
 
   XmlWriter x;
   x.open("<mujoco model=\"" + s.name + "\">");
   x.line("<!-- generated by pvbench from " + (s.source_file.empty() ? std::string("code") : s.source_file) +
-         ", seed " + std::to_string(s.seed) + " -->");
+         (s.station_seed ? ", station seed " + std::to_string(*s.station_seed) : std::string()) + ", seed " +
+         std::to_string(s.seed) + " -->");
   x.line("<compiler angle=\"degree\" autolimits=\"true\"/>");
   char step[40];
   std::snprintf(step, sizeof step, "%.17g", out.timestep_s);  // exact: a frame is `substeps` steps
@@ -255,7 +325,7 @@ SceneAssets build_scene(const scenes::Scenario& s) {
   x.open("<worldbody>");
   x.line("<geom name=\"ground\" type=\"plane\" size=\"" + v3(s.ground.size_m.x() / 2, s.ground.size_m.y() / 2, 1) +
          "\" material=\"ground\" condim=\"3\" friction=\"1 0.005 0.0001\"/>");
-  for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) add_array(x, s.pv_arrays[i], static_cast<int>(i), seed);
+  for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) add_array(x, s.pv_arrays[i], static_cast<int>(i), day_seed);
   for (std::size_t i = 0; i < s.walls.size(); ++i) {
     const scenes::Wall& w = s.walls[i];
     const Eigen::Vector2d d = (w.end_m - w.start_m).normalized();
@@ -270,7 +340,7 @@ SceneAssets build_scene(const scenes::Scenario& s) {
   // Vegetation: rejection sampling away from the route, walls and arrays.
   {
     const scenes::Vegetation& veg = s.vegetation;
-    Placer rng(seed ^ 0x5EED5EED);
+    Placer rng(station_seed ^ 0x5EED5EED);  // where the plants stand is the station's
     auto clear_of_everything = [&](const Eigen::Vector2d& p, double radius) {
       const double keep = veg.keep_out_m + radius;
       for (std::size_t i = 1; i < route.size(); i += 4)
@@ -299,16 +369,19 @@ SceneAssets build_scene(const scenes::Scenario& s) {
       const double radius = tree ? 0.3 * size : 0.5 * size;
       if (!clear_of_everything(p, radius)) continue;
       const std::string n = (tree ? "tree" : "shrub") + std::to_string(placed);
+      // The day's growth scales the plant where it stands (placed at its
+      // station size, so that it stands in the same place every day).
+      const double grown = size * veg.growth;
       if (tree) {
-        const double trunk_h = 0.45 * size, crown = 0.3 * size;
-        x.line("<geom name=\"" + n + "_trunk\" class=\"scenery\" type=\"cylinder\" size=\"" + v3(0.06 + 0.02 * size, trunk_h / 2, 0) +
+        const double trunk_h = 0.45 * grown, crown = 0.3 * grown;
+        x.line("<geom name=\"" + n + "_trunk\" class=\"scenery\" type=\"cylinder\" size=\"" + v3(0.06 + 0.02 * grown, trunk_h / 2, 0) +
                "\" pos=\"" + v3(p.x(), p.y(), trunk_h / 2) + "\" material=\"bark\"/>");
         x.line("<geom name=\"" + n + "_crown\" class=\"scenery\" type=\"ellipsoid\" size=\"" +
-               v3(crown, crown * rng.uniform(0.8, 1.1), 0.55 * size * 0.6) + "\" pos=\"" +
-               v3(p.x(), p.y(), trunk_h + 0.25 * size) + "\" euler=\"0 0 " + f(rng.uniform(0, 180)) +
+               v3(crown, crown * rng.uniform(0.8, 1.1), 0.55 * grown * 0.6) + "\" pos=\"" +
+               v3(p.x(), p.y(), trunk_h + 0.25 * grown) + "\" euler=\"0 0 " + f(rng.uniform(0, 180)) +
                "\" material=\"foliage\"/>");
       } else {
-        const double r = size / 2;
+        const double r = grown / 2;
         x.line("<geom name=\"" + n + "\" class=\"scenery\" type=\"ellipsoid\" size=\"" +
                v3(r, r * rng.uniform(0.7, 1.0), r * rng.uniform(0.6, 0.9)) + "\" pos=\"" + v3(p.x(), p.y(), r * 0.55) +
                "\" euler=\"0 0 " + f(rng.uniform(0, 180)) + "\" material=\"foliage\"/>");

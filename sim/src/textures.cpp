@@ -62,8 +62,9 @@ cv::Mat value_noise(int size, int cells, Rng* rng) {
 
 }  // namespace
 
-cv::Mat make_panel_texture(const scenes::PvArray& array, double dirt, std::uint64_t seed) {
-  Rng rng(seed);
+cv::Mat make_panel_texture(const scenes::PvArray& array, double dirt, std::uint64_t station_seed,
+                           std::uint64_t day_seed) {
+  Rng rng(station_seed);
   // Cell grid: 60 -> 6x10, 72 -> 6x12, 144 half-cut -> 6x24 (cells are half height).
   const int cols = 6;
   const int rows = array.cells == 60 ? 10 : array.cells == 72 ? 12 : 24;
@@ -95,6 +96,11 @@ cv::Mat make_panel_texture(const scenes::PvArray& array, double dirt, std::uint6
     }
   }
   add_noise(&img, &rng, 3.0);
+  // The dust is the day's: drawn from the day's seed, on its stream where
+  // the cells above leave off (one number per cell, two per pixel of noise),
+  // so that with the station's seed it is the one stream it always was.
+  rng = Rng(day_seed);
+  rng.gen.discard(static_cast<unsigned long long>(rows) * cols + 2ULL * static_cast<unsigned long long>(w) * h);
   // Dust: low-frequency mask, stronger towards the lower edge where rain
   // leaves it; then a few stains (bird droppings, water marks).
   if (dirt > 0) {

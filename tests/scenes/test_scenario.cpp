@@ -226,7 +226,7 @@ TEST(Scenario, EveryShippedScenarioHasBoundsAndTheCiSubsetIsSmall) {
 TEST(Scenario, SceneLargerThanTheRendererDrawsIsRefused) {
   const std::string big = std::string(kMinimal) + "pv_arrays:\n  - {rows: 50, tables_per_row: 50}\n";
   const std::string e = error_of(big);
-  EXPECT_EQ(e.rfind("bad.yaml: pv_arrays: expected at most 3800 geoms in the scene", 0), 0u) << e;
+  EXPECT_EQ(e.rfind("bad.yaml:2: pv_arrays: expected at most 3800 geoms in the scene", 0), 0u) << e;
   // 2500 tables x (16 panels + backsheet + 2 rails + 4 posts)
   EXPECT_NE(e.find("got 57500 (pv_arrays[0]: 50 rows x 50 tables x 23 geoms)"), std::string::npos) << e;
   EXPECT_EQ(e.find('\n'), std::string::npos) << e;
@@ -316,7 +316,7 @@ TEST(Scenario, KidnapIsValidatedWithFileAndLine) {
   e = err("  at_s: 10.001\n  covered_s: 0.02\n  to_route_s: 2\n");  // no frame between 10.001 and 10.021 s
   EXPECT_NE(e.find("kidnap.covered_s: expected at least one frame period"), std::string::npos) << e;
   e = err("  covered_s: 2\n  to_route_s: 2\n");
-  EXPECT_NE(e.find("bad.yaml:4: kidnap.at_s: expected a time in seconds (required in kidnap)"),
+  EXPECT_NE(e.find("bad.yaml:3: kidnap.at_s: expected a time in seconds (required in kidnap)"),
             std::string::npos)
       << e;
   e = err("  at_s: 10\n");
@@ -417,7 +417,7 @@ TEST(Scenario, HugeFilesAndWallListsAreRefusedBeforeTheyAreBuilt) {
   std::string walls = "walls:\n";
   for (int i = 0; i < 4000; ++i) walls += "  - {start_m: [0, " + std::to_string(i) + "], end_m: [1, " + std::to_string(i) + "]}\n";
   std::string e = error_of(std::string(kMinimal) + walls);
-  EXPECT_NE(e.find("bad.yaml:3: walls: expected at most 3800 walls (the renderer's geom limit), got 4000"),
+  EXPECT_NE(e.find("bad.yaml:2: walls: expected at most 3800 walls (the renderer's geom limit), got 4000"),
             std::string::npos)
       << e;
   std::string huge = std::string(kMinimal) + "description: \"" + std::string(2 * 1024 * 1024, 'x') + "\"\n";

@@ -75,6 +75,7 @@ std::string run_fields(const RunReport& r, const std::string& in) {
   out += in + "\"scenario\": " + str(r.scenario) + ",\n";
   out += in + "\"scenario_file\": " + str(r.scenario_file) + ",\n";
   out += in + "\"seed\": " + std::to_string(r.seed) + ",\n";
+  if (!r.world.empty()) out += in + "\"world\": " + r.world + ",\n";
   out += in + "\"status\": " + str(to_string(r.status)) + ",\n";
   if (!r.status_detail.empty()) out += in + "\"status_detail\": " + str(r.status_detail) + ",\n";
   out += in + "\"sync\": " + (r.sync ? "true" : "false") + ",\n";

@@ -9,6 +9,7 @@
 #include "frame_pipeline.hpp"
 #include "pvb/common/output_folder.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/run/world_json.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
@@ -42,6 +43,7 @@ RunReport new_report(const scenes::Scenario& scenario, const RunOptions& opt) {
   report.scenario = scenario.name;
   report.scenario_file = opt.scenario_file;
   report.seed = scenario.seed;
+  report.world = world_json(scenario);
   report.sync = opt.sync;
   report.fps = scenario.camera.fps;
   if (scenario.kidnap) {

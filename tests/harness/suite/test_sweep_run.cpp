@@ -59,7 +59,17 @@ TEST(SweepRun, TwoSeedsThenASlurmTaskThenAggregateOnly) {
   ASSERT_EQ(std::system(slurm.c_str()), 0) << slurm;
   EXPECT_EQ(pvb::read_file((slurm_out / "seed_2" / "CameraTrajectory.txt").string()),
             pvb::read_file((out / "seed_2" / "CameraTrajectory.txt").string()));
-  fs::copy(slurm_out / "seed_2", out / "seed_3", fs::copy_options::recursive);  // stands in for a third task
+  // A copy of seed 2 standing in for seed 3 is another seed's run: refused.
+  fs::copy(slurm_out / "seed_2", out / "seed_3", fs::copy_options::recursive);
+  const auto copied = run_pvbench("sweep --out " + out.string() + " --aggregate-only");
+  EXPECT_EQ(copied.code, 1) << copied.output;
+  EXPECT_NE(copied.output.find("seed_3/metrics.json: seed: expected 3 (the folder seed_3), got 2"), std::string::npos)
+      << copied.output;
+  // The third task for real, run again over the copy (its command carries --overwrite).
+  const std::string task3 = "cd " + std::string(PVB_SOURCE_DIR) + " && SLURM_ARRAY_TASK_ID=3 PVBENCH=" +
+                            pvb::test::pvbench_path() + " bash scripts/slurm_sweep.sh " + scenario + " " +
+                            out.string() + common;
+  ASSERT_EQ(std::system(task3.c_str()), 0) << task3;
 
   const auto agg = run_pvbench("sweep --out " + out.string() + " --aggregate-only");
   EXPECT_EQ(agg.code, 0) << agg.output;

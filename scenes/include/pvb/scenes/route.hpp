@@ -12,7 +12,8 @@ namespace pvb::scenes {
 Eigen::Vector2d array_to_world(const PvArray& a, double u, double v);
 /// Length of one row along u: tables and the gaps between them.
 double row_length_m(const PvArray& a);
-/// Ground footprint depth of one row along v (the tilted table's projection).
+/// Ground footprint depth of one row along v (the tilted table's projection;
+/// a tracker row's full width, which it has flat).
 double row_footprint_m(const PvArray& a);
 
 /// The route as a polyline sampled every `spacing_m` (first point = start).

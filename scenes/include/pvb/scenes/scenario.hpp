@@ -17,15 +17,35 @@ enum class RoutePattern { kWaypoints, kAlongRow, kLawnmower, kLoop };
 enum class DepthNoiseModel { kNone, kKinect };
 enum class OnLoss { kWait, kAbort };
 enum class WallFinish { kBrick, kPlaster };
+/// How an array's panels are held: fixed tilted tables, or rows of modules
+/// on a horizontal torque tube that turns with the sun.
+enum class Mount { kFixed, kSingleAxis };
+
+/// A single-axis tracker row's mechanics and its angle on the day.  The
+/// torque tube runs along the row (the array's u axis, azimuth_deg); its
+/// rotation is right-handed about +u, 0 with the panels flat.
+struct TrackerMount {
+  double max_angle_deg = 55.0;  ///< the rotation stays in [-max, max] (45-60 are usual)
+  bool backtrack = true;        ///< turn back from the sun so that rows do not shade each other
+  /// A fixed angle (stow, or parked for cleaning); unset: true tracking
+  /// with backtracking from the day's sun (pvlib's singleaxis).
+  std::optional<double> fixed_rotation_deg;
+};
 
 struct Ground {
   GroundType type = GroundType::kSoil;
   Eigen::Vector2d size_m{60.0, 60.0};  ///< extent along x and y, centred at origin
 };
 
-/// Rows of tilted PV tables.  Array frame: u along the rows (azimuth_deg,
-/// counter-clockwise from world x), v across them; rows stack towards +v and
-/// panels face -v (tilted up by tilt_deg).
+/// Trackers: the panels sit this far above the torque tube's axis, along
+/// their normal (the tube and the purlins between them).
+inline constexpr double kTrackerPanelAboveAxisM = 0.10;
+
+/// Rows of PV tables.  Array frame: u along the rows (azimuth_deg,
+/// counter-clockwise from world x), v across them; rows stack towards +v.
+/// Fixed mount: tilted tables whose panels face -v (up by tilt_deg).
+/// Single-axis mount: each row's tables turn on a torque tube along u, the
+/// row's middle (v = row pitch x row + table depth / 2), by rotation_deg.
 struct PvArray {
   Eigen::Vector2d origin_m{0.0, 0.0};  ///< front-left corner of the first row
   double azimuth_deg = 0.0;
@@ -46,12 +66,25 @@ struct PvArray {
   /// in the same places), so its tables and rows look alike.  False: each
   /// panel's variant is drawn on its own.
   bool identical_tables = false;
+  Mount mount = Mount::kFixed;
+  TrackerMount tracker;  ///< mount single_axis only
+  /// The tracker's rotation on the day (degrees; 0 for a fixed mount),
+  /// resolved by the loader from the sun or tracker.rotation_deg.
+  double rotation_deg = 0.0;
+  /// The true-tracking angle before backtracking and clipping (trackers
+  /// following the sun only; equal to rotation_deg otherwise).
+  double ideal_rotation_deg = 0.0;
 
   // Derived panel size (m) from cells and orientation.
   double panel_width_m() const;   ///< along the row
   double panel_height_m() const;  ///< up the slope
   double table_length_m() const;  ///< along the row
   double table_depth_m() const;   ///< slope length of a table
+  /// Trackers: module width across the tube over the row pitch.
+  double ground_coverage_ratio() const { return table_depth_m() / row_pitch_m; }
+  /// Trackers: height of the torque tube's axis, so that the lowest panel
+  /// edge is clearance_m above the ground at the largest rotation.
+  double axis_height_m() const;
 };
 
 struct Wall {
@@ -71,6 +104,9 @@ struct Vegetation {
   Eigen::Vector2d tree_height_m{2.0, 4.0};
   Eigen::Vector4d area_m{-10, -10, 10, 10};  ///< xmin, ymin, xmax, ymax
   double keep_out_m = 1.0;                   ///< clearance from route, walls and arrays
+  /// How much the plants have grown (or been cut back) on the day: their
+  /// sizes scale by this, where they stand does not.
+  double growth = 1.0;
 };
 
 struct Light {
@@ -92,6 +128,26 @@ struct Light {
   /// Quads along each edge of a box face (MuJoCo vis.quality.numquads);
   /// only per-vertex lighting uses them.  1 renders faster (docs/run.md).
   int box_quads = 1;
+};
+
+/// Where the station is and when the day's run happens: the sun's position
+/// follows from them (NOAA's solar position algorithm).
+struct Site {
+  double latitude_deg = 0.0;   ///< north positive
+  double longitude_deg = 0.0;  ///< east positive
+  std::string date;            ///< YYYY-MM-DD, local
+  std::string time;            ///< HH:MM[:SS], local
+  double utc_offset_h = 0.0;   ///< local = UTC + offset (daylight saving included)
+  double pressure_hpa = 1010.0;
+  double temperature_c = 10.0;
+};
+
+/// The sun of the run, as resolved by the loader (for reports).
+struct SunPosition {
+  enum class Source { kDefault, kLight, kSite };
+  Source source = Source::kDefault;  ///< light.* keys (or their defaults), or the site and time
+  double solar_azimuth_deg = 0.0;    ///< clockwise from north (world +y), [0, 360)
+  double elevation_deg = 0.0;        ///< apparent, above the horizon
 };
 
 struct Route {
@@ -239,15 +295,26 @@ struct KidnapFrames {
 
 struct Scenario {
   std::string source_file;  ///< where it was loaded from ("" if built in code)
+  /// The files it derives from (base:), nearest first; empty for a file
+  /// that stands alone.
+  std::vector<std::string> base_files;
   std::string name = "unnamed";
   std::string description;
+  /// The day's seed: dust on the panels, sensor noise, PE-match's particles
+  /// (and, without station_seed, the station too).
   std::uint64_t seed = 0;
+  /// The station's seed: what stays from day to day (textures of soil,
+  /// bricks, cells and plants, where the plants stand).  Unset: `seed`.
+  std::optional<std::uint64_t> station_seed;
+  std::uint64_t station_seed_or_seed() const { return station_seed.value_or(seed); }
   double duration_s = 20.0;
   Ground ground;
   std::vector<PvArray> pv_arrays;
   std::vector<Wall> walls;
   Vegetation vegetation;
   Light light;
+  std::optional<Site> site;  ///< none unless the file has a site: section
+  SunPosition sun;           ///< resolved from site: or light:
   Route route;
   Robot robot;
   Camera camera;
@@ -255,6 +322,16 @@ struct Scenario {
   std::optional<Kidnap> kidnap;  ///< none unless the file has a kidnap: section
   Expectations expect;
 };
+
+/// The sun's diffuse light (light.intensity) for a sun at this apparent
+/// elevation, when the site gives the sun and the file does not set it: the
+/// default 0.8 at 45 degrees, scaled by the clear-sky beam that reaches the
+/// ground, 0.7^(AM^0.678) (Meinel and Meinel 1976) with the air mass of
+/// Kasten and Young (1989); in [0.05, 1].
+double sun_intensity_for(double elevation_deg);
+/// The sky's light (light.ambient) likewise: the default 0.35 at 45
+/// degrees, 0.45 + 0.55 sin(elevation) / sin(45) of it; in [0.1, 0.6].
+double sky_ambient_for(double elevation_deg);
 
 /// Loads and validates a scenario file.  Throws ConfigError or IoError.
 Scenario load_scenario(const std::string& path);

@@ -9,9 +9,11 @@
 namespace pvb::sim {
 
 /// One PV module seen from the front: an aluminium frame, cells with
-/// busbars on dark glass, and seeded dust (denser towards the lower edge)
-/// and stains.  The image's top row is the panel's upper edge.
-cv::Mat make_panel_texture(const scenes::PvArray& array, double dirt, std::uint64_t seed);
+/// busbars on dark glass (drawn from the station's seed), and the day's dust
+/// (from the day's seed: denser towards the lower edge) and stains.  The
+/// image's top row is the panel's upper edge.
+cv::Mat make_panel_texture(const scenes::PvArray& array, double dirt, std::uint64_t station_seed,
+                           std::uint64_t day_seed);
 /// Grey bricks of high similarity in running bond; the image covers
 /// kBrickTileWidthM x kBrickTileHeightM of wall.
 cv::Mat make_brick_texture(std::uint64_t seed);

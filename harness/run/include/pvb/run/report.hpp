@@ -130,6 +130,7 @@ struct RunReport {
   std::string scenario;  ///< scenario name
   std::string scenario_file;
   std::uint64_t seed = 0;
+  std::string world;  ///< the station and the day (world_json.hpp), a JSON object
   RunStatus status = RunStatus::kCompleted;
   std::string status_detail;  ///< one line: why interrupted or aborted
   bool sync = false;

@@ -1,0 +1,41 @@
+#pragma once
+// The readers of a scenario's sections and the checks between them, used by
+// the loader (scenario.cpp).
+#include <vector>
+
+#include "map_reader.hpp"
+#include "pvb/scenes/scenario.hpp"
+
+namespace pvb::scenes::detail {
+
+/// MuJoCo's renderer draws at most 4000 geoms a frame (sim/src/renderer.cpp)
+/// and leaves the rest out of the image, with one warning.  Far larger scenes
+/// also take minutes in MuJoCo's compiler: 50 x 50 tables of 240 panels
+/// (617 500 geoms) were not compiled after 5 minutes.
+inline constexpr long long kMaxSceneGeoms = 3800;
+
+void read_arrays(MapReader& top, std::vector<PvArray>& out);
+void read_walls(MapReader& top, std::vector<Wall>& out);
+void read_vegetation(MapReader& r, Vegetation& v);
+void read_light(MapReader& r, Light& l);
+void read_route(MapReader& r, Route& rt);
+void read_robot(MapReader& r, Robot& rb);
+void read_camera(MapReader& r, Camera& c);
+void read_slam(MapReader& r, SlamTuning& t);
+void read_expect(MapReader& r, Expectations& e);
+/// The kidnap: section.  Read after duration_s and camera, which bound it.
+void read_kidnap(MapReader& top, Scenario& s);
+/// The site: section (the station's place and the run's local time).
+void read_site(MapReader& top, Scenario& s);
+
+/// The sun of the day (from site: and light:), its light, and every
+/// tracker's rotation.  After every section is read.
+void resolve_day(Scenario& s, const ReadContext& ctx);
+
+/// Refuses a scenario whose scene would not fit the renderer: one line naming
+/// the limit, the total and the largest array.
+void check_scene_size(const Scenario& s, const ReadContext& ctx);
+/// Checks between fields: the route against the arrays it names.
+void check_route(const Scenario& s, const ReadContext& ctx);
+
+}  // namespace pvb::scenes::detail
