@@ -90,6 +90,21 @@ double row_footprint_m(const PvArray& a) {
   return a.table_depth_m() * std::cos(a.tilt_deg * kDegToRad);
 }
 
+std::vector<Eigen::Vector2d> polyline_from(const std::vector<Eigen::Vector2d>& route, double start_m) {
+  if (start_m <= 0.0 || route.size() < 2) return route;
+  double along = 0.0;
+  for (std::size_t i = 1; i < route.size(); ++i) {
+    const double seg = (route[i] - route[i - 1]).norm();
+    if (along + seg > start_m) {
+      std::vector<Eigen::Vector2d> out{route[i - 1] + (route[i] - route[i - 1]) * ((start_m - along) / seg)};
+      out.insert(out.end(), route.begin() + static_cast<std::ptrdiff_t>(i), route.end());
+      return out;
+    }
+    along += seg;
+  }
+  return {route.back()};
+}
+
 double polyline_length(const std::vector<Eigen::Vector2d>& pts) {
   double len = 0;
   for (std::size_t i = 1; i < pts.size(); ++i) len += (pts[i] - pts[i - 1]).norm();

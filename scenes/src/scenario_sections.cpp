@@ -215,6 +215,7 @@ void read_route(MapReader& r, Route& rt) {
   rt.speed_mps = r.number("speed_mps", rt.speed_mps, 0.05, 3);
   rt.lookahead_m = r.number("lookahead_m", rt.lookahead_m, 0.1, 5);
   rt.on_loss = r.choice<OnLoss>("on_loss", rt.on_loss, {{"wait", OnLoss::kWait}, {"abort", OnLoss::kAbort}});
+  rt.start_m = r.number("start_m", rt.start_m, 0, 1e5);
 }
 
 void read_robot(MapReader& r, Robot& rb) {
@@ -363,6 +364,14 @@ void check_route(const Scenario& s, const ReadContext& ctx) {
       throw ConfigError(at("return_overlap_m"), "route.return_overlap_m",
                         "at most the first aisle's length, " + format_number("%.2f m", first_aisle_m),
                         format_number("%g", rt.return_overlap_m));
+  }
+  if (rt.start_m > 0) {
+    // A start part-way must leave a route to drive.
+    const double length = polyline_length(route_polyline(s));
+    if (!(rt.start_m < length - 1.0))
+      throw ConfigError(at("start_m"), "route.start_m",
+                        "a distance at least 1 m before the route's end (" + format_number("%.2f m", length) + " long)",
+                        format_number("%g", rt.start_m));
   }
 }
 

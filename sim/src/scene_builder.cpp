@@ -239,9 +239,12 @@ SceneAssets build_scene(const scenes::Scenario& s) {
   const double extent = diag / 2;
   const double znear_m = 0.05, zfar_m = 2.5 * diag;
 
+  // The whole route bounds the shadow map and where plants may grow; the
+  // robot drives it from route.start_m.
   const std::vector<Eigen::Vector2d> route = scenes::route_polyline(s);
+  const std::vector<Eigen::Vector2d> driven = scenes::polyline_from(route, s.route.start_m);
   const ShadowMap shadow = shadow_map_for(s.light, route);
-  for (const auto& p : route) {
+  for (const auto& p : driven) {
     out.route_xy.push_back(p.x());
     out.route_xy.push_back(p.y());
   }
@@ -396,10 +399,10 @@ SceneAssets build_scene(const scenes::Scenario& s) {
   // ---- robot: differential drive, two driven wheels and a caster
   const scenes::Robot& rb = s.robot;
   const double r = rb.wheel_radius_m;
-  const Eigen::Vector2d start = route.empty() ? Eigen::Vector2d::Zero() : route.front();
+  const Eigen::Vector2d start = driven.empty() ? Eigen::Vector2d::Zero() : driven.front();
   double yaw0 = 0;
-  if (route.size() >= 2) {
-    const Eigen::Vector2d d = route[std::min<std::size_t>(10, route.size() - 1)] - route.front();
+  if (driven.size() >= 2) {
+    const Eigen::Vector2d d = driven[std::min<std::size_t>(10, driven.size() - 1)] - driven.front();
     yaw0 = std::atan2(d.y(), d.x());
   }
   x.open("<body name=\"" + std::string(kRobotBody) + "\" pos=\"" + v3(start.x(), start.y(), r + 0.002) +

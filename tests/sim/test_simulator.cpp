@@ -2,10 +2,12 @@
 // following and determinism, on scenes built by the generator.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <optional>
 #include <thread>
 #include <vector>
 
+#include "pvb/common/error.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sensor/depth_encoding.hpp"
 #include "pvb/geometry/time.hpp"
@@ -181,6 +183,36 @@ TEST(Simulator, RouteFollowerReachesItsWaypoints) {
   EXPECT_TRUE(sim.follower().finished());
   for (std::size_t w = 0; w < closest.size(); ++w) EXPECT_LT(closest[w], 0.15) << "waypoint " << w;
   EXPECT_LT(worst_cross_track, 0.25);
+}
+
+// A session may start part-way along its route (route.start_m): the robot
+// stands there, heading along the route, and drives the rest of it.
+TEST(Simulator, RouteStartPartWayPutsTheRobotThereAndDrivesOn) {
+  const std::string route =
+      "duration_s: 12\nground: {size_m: [30, 30]}\n"
+      "route: {waypoints_m: [[0, 0], [4, 0], [4, 4]], speed_mps: 0.5, lookahead_m: 0.6";
+  const scenes::Scenario whole = scenes::parse_scenario(route + "}\n", "whole.yaml");
+  const scenes::Scenario later = scenes::parse_scenario(route + ", start_m: 5}\n", "later.yaml");
+  sim::Simulator a(whole), b(later);
+  const sim::Pose2d p0 = a.base_pose(), p1 = b.base_pose();
+  EXPECT_NEAR(p0.x, 0.0, 0.05);
+  EXPECT_NEAR(p0.y, 0.0, 0.05);
+  EXPECT_NEAR(p1.x, 4.0, 0.05);  // 5 m along: 4 m east, then 1 m north
+  EXPECT_NEAR(p1.y, 1.0, 0.05);
+  EXPECT_NEAR(p1.yaw, M_PI / 2, 0.05);  // heading north
+  for (int i = 1; i < b.frame_count() && !b.follower().finished(); ++i) b.advance();
+  EXPECT_TRUE(b.follower().finished());
+  EXPECT_NEAR(b.base_pose().y, 4.0, 0.2);
+  // Beyond the route's end, less 1 m, is refused where it is written.
+  try {
+    scenes::parse_scenario(route + ", start_m: 7.5}\n", "far.yaml");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("far.yaml:3: route.start_m: expected a distance at least 1 m before the "
+                                         "route's end (8.00 m long), got 7.5"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Simulator, FrameTimesAreExactMultiplesOfThePeriod) {

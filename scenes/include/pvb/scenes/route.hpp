@@ -26,6 +26,10 @@ double row_footprint_m(const PvArray& a);
 ///   it started.
 std::vector<Eigen::Vector2d> route_polyline(const Scenario& s, double spacing_m = 0.05);
 
+/// The rest of `route` from `start_m` metres along it: the point there
+/// (interpolated) first, then the route's points beyond it.
+std::vector<Eigen::Vector2d> polyline_from(const std::vector<Eigen::Vector2d>& route, double start_m);
+
 /// Total length of a polyline.
 double polyline_length(const std::vector<Eigen::Vector2d>& pts);
 

@@ -165,6 +165,9 @@ struct Route {
   double margin_m = 2.0;                     ///< run-out beyond the row ends
   double speed_mps = 0.5;
   double lookahead_m = 0.6;                  ///< pure pursuit lookahead
+  /// The robot starts this far along the route and drives the rest of it
+  /// (a session that begins part-way; the route itself is unchanged).
+  double start_m = 0.0;
   OnLoss on_loss = OnLoss::kWait;            ///< closed loop: what to do when tracking is lost
 };
 
