@@ -253,6 +253,7 @@ void read_camera(MapReader& r, Camera& c) {
     g.sigma = n.number("sigma", g.sigma, 0, 100);
     g.exposure = n.number("exposure", g.exposure, 0.05, 10);
     g.glare = n.number("glare", g.glare, 0, 1);
+    g.auto_exposure = n.boolean("auto_exposure", g.auto_exposure);
   });
 }
 

@@ -1,5 +1,6 @@
 #include "pvb/sim/sensor_model.hpp"
 
+#include <algorithm>
 #include <array>
 #include <vector>
 #include <Eigen/Geometry>
@@ -117,9 +118,23 @@ cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, c
   return sensor::snap_depth_to_u16_grid(out, sensor::kTumDepthFactor);
 }
 
-void apply_rgb_model(cv::Mat* rgb, const scenes::RgbNoise& params, const std::optional<cv::Point2d>& sun_px,
+double auto_exposure_gain(const cv::Mat& rgb) {
+  CV_Assert(rgb.type() == CV_8UC3);
+  const cv::Rect centre(rgb.cols / 5, rgb.rows / 5, rgb.cols - 2 * (rgb.cols / 5), rgb.rows - 2 * (rgb.rows / 5));
+  const cv::Scalar m = cv::mean(rgb(centre));  // R, G, B
+  const double grey = 0.299 * m[0] + 0.587 * m[1] + 0.114 * m[2];
+  return std::clamp(kAutoExposureTargetGrey / std::max(grey, 1.0), 0.25, 8.0);
+}
+
+void apply_rgb_model(cv::Mat* rgb, const scenes::RgbNoise& given, const std::optional<cv::Point2d>& sun_px,
                      std::uint64_t seed, std::uint64_t frame) {
   CV_Assert(rgb->type() == CV_8UC3);
+  scenes::RgbNoise params = given;
+  if (params.auto_exposure) {  // the gain amplifies the sensor's noise with the signal
+    const double gain = auto_exposure_gain(*rgb);
+    params.exposure *= gain;
+    params.sigma *= gain;
+  }
   const bool glare = params.glare > 0 && sun_px.has_value();
   if (params.sigma <= 0 && params.exposure == 1.0 && !glare) return;
   const auto& nt = normal_table();

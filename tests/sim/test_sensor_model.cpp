@@ -116,3 +116,26 @@ TEST(SensorModel, RgbExposureAndNoise) {
   EXPECT_NEAR(sd[0], 4.0, 0.3);
   EXPECT_NEAR(mean[0], 100.0, 0.2);
 }
+
+// Automatic exposure brings a dark view to middle grey and amplifies the
+// noise with it; a bright one is turned down; the meter reads the centre.
+TEST(SensorModel, AutoExposureMetersTheCentreAndScalesTheNoise) {
+  scenes::RgbNoise p;
+  p.sigma = 2.0;
+  p.auto_exposure = true;
+  cv::Mat dark(200, 200, CV_8UC3, cv::Scalar(30, 30, 30));
+  EXPECT_NEAR(sim::auto_exposure_gain(dark), sim::kAutoExposureTargetGrey / 30.0, 1e-9);
+  sim::apply_rgb_model(&dark, p, std::nullopt, 1, 0);
+  cv::Scalar mean, sd;
+  cv::meanStdDev(dark.reshape(1), mean, sd);
+  EXPECT_NEAR(mean[0], sim::kAutoExposureTargetGrey, 1.0);
+  EXPECT_NEAR(sd[0], 2.0 * sim::kAutoExposureTargetGrey / 30.0, 0.6);  // noise x gain
+  cv::Mat bright(200, 200, CV_8UC3, cv::Scalar(236, 236, 236));
+  EXPECT_NEAR(sim::auto_exposure_gain(bright), 0.5, 1e-9);
+  // A bright border (the sky) around a dark centre does not dim the centre.
+  cv::Mat framed(200, 200, CV_8UC3, cv::Scalar(250, 250, 250));
+  framed(cv::Rect(40, 40, 120, 120)).setTo(cv::Scalar(59, 59, 59));
+  EXPECT_NEAR(sim::auto_exposure_gain(framed), 2.0, 1e-9);
+  // The gain stays within [1/4, 8].
+  EXPECT_DOUBLE_EQ(sim::auto_exposure_gain(cv::Mat(100, 100, CV_8UC3, cv::Scalar(1, 1, 1))), 8.0);
+}

@@ -184,6 +184,11 @@ struct RgbNoise {
   double sigma = 1.5;     ///< additive Gaussian noise, 8-bit levels
   double exposure = 1.0;  ///< gain applied before noise
   double glare = 0.0;     ///< strength of sun glare when the sun is in view, 0..1
+  /// Automatic exposure, as a Kinect's colour camera has it: each frame's
+  /// gain brings the mean grey of the image's central region to middle
+  /// grey (within [1/4, 8] times `exposure`), and the noise grows with it.
+  /// false: the fixed `exposure`.
+  bool auto_exposure = false;
 };
 
 struct Camera {

@@ -26,7 +26,16 @@ cv::Mat apply_depth_model(const cv::Mat& depth_gt_m, const geom::PinholeIntrinsi
 
 /// Exposure gain, sun glare (when `sun_px` is given: the sun's projection,
 /// possibly outside the image) and additive Gaussian noise on an RGB image.
+/// With params.auto_exposure the gain is metered on the frame itself
+/// (auto_exposure_gain) and multiplies the exposure and the noise.
 void apply_rgb_model(cv::Mat* rgb, const scenes::RgbNoise& params, const std::optional<cv::Point2d>& sun_px,
                      std::uint64_t seed, std::uint64_t frame);
+
+/// Middle grey in 8-bit sRGB (18 % reflectance), the target of automatic exposure.
+inline constexpr double kAutoExposureTargetGrey = 118.0;
+/// The automatic-exposure gain for a rendered RGB image: middle grey over
+/// the mean grey (Rec. 601 luma) of its central region (the middle 60 % of
+/// its width and height, a centre-weighted meter), clamped to [1/4, 8].
+double auto_exposure_gain(const cv::Mat& rgb);
 
 }  // namespace pvb::sim
