@@ -4,6 +4,7 @@
 #include <yaml-cpp/depthguard.h>
 
 #include <filesystem>
+#include <optional>
 #include <regex>
 
 #include "pvb/common/error.hpp"
@@ -157,13 +158,17 @@ void merge_map(YAML::Node into, const YAML::Node& over, const std::string& path,
 }
 
 /// The station seed a base fixes: its station_seed, else its seed, else 0.
-std::pair<std::string, const KeyOrigin*> station_seed_of(const ScenarioDocument& base) {
+/// The base's station seed and where it was written (a copy: the base's
+/// origins change when the derived file is merged over them).
+std::pair<std::string, std::optional<KeyOrigin>> station_seed_of(const ScenarioDocument& base) {
   for (const char* key : {"station_seed", "seed"}) {
     const YAML::Node& root = base.root;
     const YAML::Node v = root[key];
-    if (v.IsDefined() && v.IsScalar()) return {v.Scalar(), base.origins.find(key)};
+    if (!v.IsDefined() || !v.IsScalar()) continue;
+    const KeyOrigin* origin = base.origins.find(key);
+    return {v.Scalar(), origin ? std::optional<KeyOrigin>(*origin) : std::nullopt};
   }
-  return {"0", nullptr};
+  return {"0", std::nullopt};
 }
 
 ScenarioDocument read_document(const std::string& text, const std::string& origin, int depth,

@@ -311,3 +311,28 @@ TEST(RecordCli, ExistingOutputIsRefusedUnlessOverwriteEmptiesAnEarlierRecording)
       << r.output;
   EXPECT_EQ(read_file(mine + "/notes.txt"), "the user's\n");
 }
+
+// The same station at two hours, side by side; the recording's meta.json
+// says which world it was: both seeds, the sun, the trackers' angle.
+TEST(RecordCli, DaysOfAStationAreRecordedWithTheirWorldAndShownSideBySide) {
+  const std::string days = std::string(PVB_SOURCE_DIR) + "/scenes/days/";
+  const std::string d = fresh("days");
+  Result r = run("record --scenario " + days + "tracker_station_0800.yaml --out " + d + " --frames 2");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string meta = read_file(d + "/meta.json");
+  EXPECT_NE(meta.find("\"station_seed\": 11, \"day_seed\": 10800"), std::string::npos) << meta;
+  EXPECT_NE(meta.find("\"sun\": {\"source\": \"site\""), std::string::npos) << meta;
+  EXPECT_NE(meta.find("\"mount\": \"single_axis\", \"rotation_deg\": 25.97"), std::string::npos) << meta;
+  const std::string sheet = ::testing::TempDir() + "pvb_sheet_" + std::to_string(::getpid()) + ".png";
+  r = run("sheet --scenario " + days + "tracker_station_0800.yaml --scenario " + days +
+          "tracker_station_1600.yaml --frame 3 --columns 2 --out " + sheet);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const cv::Mat img = cv::imread(sheet);
+  ASSERT_FALSE(img.empty());
+  EXPECT_GT(img.cols, img.rows);  // two tiles in a row
+  EXPECT_NE(r.output.find("tracker_station_1600: sun 247/63, trackers -25"), std::string::npos) << r.output;
+  r = run("sheet --scenario " + days + "tracker_station_0800.yaml --frame 100000 --out " + sheet);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("--frame: expected a frame below the scenario's 751, got 100000"), std::string::npos)
+      << r.output;
+}
