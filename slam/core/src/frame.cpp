@@ -99,6 +99,29 @@ Frame::Frame(std::uint64_t frame_id, std::int64_t time_ns, OrbFeatures features,
       u_right[i] = right_coordinate(keys_un[i].pt.x, d);
     }
   }
+  build_index();
+}
+
+Frame Frame::from_saved(std::uint64_t frame_id, std::int64_t time_ns, std::vector<cv::KeyPoint> keys_detected,
+                        std::vector<cv::KeyPoint> keys_undistorted, cv::Mat descriptors, std::vector<float> depth,
+                        std::shared_ptr<const CameraModel> camera) {
+  Frame f;
+  f.id = frame_id;
+  f.t_ns = time_ns;
+  f.cam = std::move(camera);
+  f.keys = std::move(keys_detected);
+  f.keys_un = std::move(keys_undistorted);
+  f.descriptors = std::move(descriptors);
+  f.depth_m = std::move(depth);
+  f.u_right.assign(f.keys_un.size(), -1.0f);
+  for (std::size_t i = 0; i < f.keys_un.size(); ++i)
+    if (f.depth_m[i] > 0) f.u_right[i] = f.right_coordinate(f.keys_un[i].pt.x, f.depth_m[i]);
+  f.build_index();
+  return f;
+}
+
+void Frame::build_index() {
+  const std::size_t n = keys_un.size();
   map_points.assign(n, nullptr);
   outlier.assign(n, 0);
   aligned_for.assign(n, kNotAligned);

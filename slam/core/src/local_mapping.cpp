@@ -301,7 +301,7 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
     std::map<std::uint64_t, std::size_t> kf_index, pt_index;
     auto add_kf = [&](const std::shared_ptr<KeyFrame>& k, bool fixed) {
       kf_index[k->id()] = problem.keyframes.size();
-      problem.keyframes.push_back({k->id(), k->T_c_w(), fixed || k->id() == 0});
+      problem.keyframes.push_back({k->id(), k->T_c_w(), fixed || k->id() == 0 || k->fixed()});
       kfs.push_back(k);
     };
     add_kf(kf, false);

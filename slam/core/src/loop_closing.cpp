@@ -347,7 +347,8 @@ struct MovedGroup {
 MovedGroup move_neighbourhood(const KeyFramePtr& kf, const geom::SE3d& T_cur_w) {
   MovedGroup g;
   g.keyframes = {kf};
-  for (const auto& n : kf->best_covisibles(-1)) g.keyframes.push_back(n);
+  for (const auto& n : kf->best_covisibles(-1))
+    if (!n->fixed()) g.keyframes.push_back(n);  // a loaded map being extended stays where it is
   const geom::SE3d T_w_cur = kf->T_c_w().inverse();
   std::map<std::uint64_t, geom::SE3d> corrected;  // T_c_w by keyframe id
   for (const auto& k : g.keyframes) {
@@ -358,6 +359,7 @@ MovedGroup move_neighbourhood(const KeyFramePtr& kf, const geom::SE3d& T_cur_w) 
     const geom::SE3d move = corrected.at(k->id()).inverse() * g.uncorrected.at(k->id());
     for (const auto& mp : k->map_points()) {
       if (!mp || mp->bad() || g.corrected_by.count(mp->id())) continue;
+      if (const auto ref = mp->reference_keyframe(); ref && ref->fixed()) continue;
       mp->set_p_w(move * mp->p_w());
       g.corrected_by[mp->id()] = k->id();
     }
@@ -449,7 +451,7 @@ class EssentialGraph {
       initial[id] = k->T_c_w();
       if (!in_tree) continue;  // queued, not yet processed by local mapping: moved in step 4.5
       node[id] = problem.nodes.size();
-      problem.nodes.push_back({id, k->T_c_w(), k == loop_kf});
+      problem.nodes.push_back({id, k->T_c_w(), k == loop_kf || k->fixed()});
       node_kf.push_back(k);
     }
   }
@@ -581,7 +583,8 @@ void LoopClosing::global_bundle_adjustment(LoopEvent* event) {
   for (const auto& [id, k] : map_.keyframes()) {
     if (k->bad()) continue;
     kf_index[id] = kfs.size();
-    problem.keyframes.push_back({id, k->T_c_w(), id == 0});  // keyframe 0 fixes the gauge (the world frame)
+    // keyframe 0 fixes the gauge (the world frame), a loaded map its own
+    problem.keyframes.push_back({id, k->T_c_w(), id == 0 || k->fixed()});
     kfs.push_back(k);
   }
   if (kfs.size() < 2) return;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <stdexcept>
 
 namespace pvb::slam {
 
@@ -217,6 +218,23 @@ int KeyFrame::weight(std::uint64_t kf_id) const {
   return it == connections_.end() ? 0 : it->second.second;
 }
 
+std::map<std::uint64_t, int> KeyFrame::connection_weights() const {
+  std::map<std::uint64_t, int> out;
+  for (const auto& [kid, c] : connections_) out[kid] = c.second;
+  return out;
+}
+
+void KeyFrame::restore_graph(const std::shared_ptr<KeyFrame>& parent,
+                             const std::vector<std::pair<std::shared_ptr<KeyFrame>, int>>& connections,
+                             const std::vector<std::shared_ptr<KeyFrame>>& loop_edges) {
+  first_connection_ = false;
+  if (parent) change_parent(parent);
+  connections_.clear();
+  for (const auto& [kf, w] : connections) connections_[kf->id()] = {kf, w};
+  update_order();
+  for (const auto& kf : loop_edges) loop_edges_[kf->id()] = kf;
+}
+
 std::vector<std::shared_ptr<KeyFrame>> KeyFrame::children() const {
   std::vector<std::shared_ptr<KeyFrame>> out;
   for (const auto& [id, w] : children_)
@@ -239,7 +257,7 @@ void KeyFrame::change_parent(const std::shared_ptr<KeyFrame>& kf) {
 }
 
 bool KeyFrame::set_bad() {
-  if (id_ == 0 || bad_ || !loop_edges_.empty()) return false;
+  if (id_ == 0 || bad_ || fixed_ || !loop_edges_.empty()) return false;
   for (const auto& [kid, c] : connections_)
     if (auto k = c.first.lock()) k->erase_connection(id_);
   for (std::size_t i = 0; i < frame_.map_points.size(); ++i)
@@ -297,8 +315,24 @@ geom::SE3d KeyFrame::T_c_w_via_tree() const {
 
 std::shared_ptr<KeyFrame> Map::create_keyframe(const Frame& frame) {
   auto kf = std::make_shared<KeyFrame>(next_kf_id_++, frame);
+  kf->set_session(session_);
   keyframes_[kf->id()] = kf;
   return kf;
+}
+
+std::shared_ptr<KeyFrame> Map::add_loaded_keyframe(std::uint64_t id, const Frame& frame) {
+  auto kf = std::make_shared<KeyFrame>(id, frame);
+  if (!keyframes_.emplace(id, kf).second) throw std::logic_error("Map: keyframe id given twice");
+  next_kf_id_ = std::max(next_kf_id_, id + 1);
+  return kf;
+}
+
+std::shared_ptr<MapPoint> Map::add_loaded_point(std::uint64_t id, const Eigen::Vector3d& p_w,
+                                                const std::shared_ptr<KeyFrame>& ref_kf) {
+  auto mp = std::make_shared<MapPoint>(id, p_w, ref_kf);
+  if (!points_.emplace(id, mp).second) throw std::logic_error("Map: point id given twice");
+  next_point_id_ = std::max(next_point_id_, id + 1);
+  return mp;
 }
 
 std::shared_ptr<MapPoint> Map::create_point(const Eigen::Vector3d& p_w, const std::shared_ptr<KeyFrame>& ref_kf) {

@@ -3,6 +3,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pvb/common/clock.hpp"
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
 
 namespace pvb::slam {
 
@@ -35,9 +37,11 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.patch_align.scale_factor = settings.orb.scale_factor;
   topt.reloc_ambiguity_check = settings.loop.ambiguity_check;
   topt.reloc_ambiguity_distance_m = settings.loop.ambiguity_distance_m;
-  if (settings.vocabulary_path != "none")
-    place_ = std::make_unique<PlaceRecognizer>(
-        std::make_shared<const place::Vocabulary>(place::Vocabulary::load(settings.vocabulary_path)));
+  if (settings.vocabulary_path != "none") {
+    auto vocabulary = std::make_shared<const place::Vocabulary>(place::Vocabulary::load(settings.vocabulary_path));
+    vocabulary_fingerprint_ = vocabulary->fingerprint();
+    place_ = std::make_unique<PlaceRecognizer>(std::move(vocabulary));
+  }
   tracking_ = std::make_unique<Tracking>(map_, cam_, topt, place_.get());
   LocalMappingOptions mopt;
   mopt.align_patches = settings.align_patches;
@@ -122,6 +126,78 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
     out.mapping_ms = ms_since(t1);
   }
   return out;
+}
+
+MapSettings System::map_settings() const {
+  MapSettings m;
+  m.fx = settings_.K.fx;
+  m.fy = settings_.K.fy;
+  m.cx = settings_.K.cx;
+  m.cy = settings_.K.cy;
+  m.bf = settings_.bf;
+  m.width = static_cast<std::uint32_t>(settings_.K.width);
+  m.height = static_cast<std::uint32_t>(settings_.K.height);
+  m.distortion = {settings_.k1, settings_.k2, settings_.p1, settings_.p2, settings_.k3};
+  m.th_depth_m = settings_.th_depth_m();
+  m.depth_factor = settings_.depth_map_factor;
+  m.scale_factor = settings_.orb.scale_factor;
+  m.num_levels = static_cast<std::uint32_t>(settings_.orb.num_levels);
+  m.num_features = static_cast<std::uint32_t>(settings_.orb.num_features);
+  m.vocabulary = vocabulary_fingerprint_;
+  return m;
+}
+
+MapLoadInfo System::load_map(const std::string& path, MapStart start) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!place_) throw ConfigError(settings_.source, "Vocabulary.path", "a vocabulary to relocalise in a saved map");
+  if (next_frame_id_ > 0 || map_start_) throw std::logic_error("System::load_map: after the first frame");
+  const std::string bytes = read_file(path);
+  const MapFileHeader head = read_map_header(bytes, path);
+  const std::string diff = head.settings.difference(map_settings());
+  if (!diff.empty()) throw ConfigError(path, "settings", "a map made with this run's settings", diff);
+  MapLoadInfo info;
+  {
+    std::lock_guard<std::mutex> lock(map_.mutex());
+    decode_map(bytes, path, cam_, &map_);
+    for (const auto& [id, kf] : map_.keyframes()) {
+      kf->set_fixed(start == MapStart::kExtend);
+      place_->compute_bow(*kf);
+      place_->add(*kf);
+    }
+    map_.set_session(head.sessions);
+    info.keyframes = map_.num_keyframes();
+    info.points = map_.num_points();
+  }
+  tracking_->start_in_map(start == MapStart::kLocalise);
+  map_start_ = start;
+  loaded_sessions_ = head.sessions;
+  info.sessions = head.sessions;
+  info.bytes = bytes.size();
+  info.app_json = head.app_json;
+  info.load_ms = ms_since(t0);
+  return info;
+}
+
+MapSaveInfo System::save_map(const std::string& path, const std::string& app_json) {
+  if (map_start_ == MapStart::kLocalise)
+    throw ConfigError(path, "map", "a map made or extended by this run (it only localised in a saved one)");
+  const auto t0 = std::chrono::steady_clock::now();
+  MapSaveInfo info;
+  std::string bytes;
+  {
+    std::lock_guard<std::mutex> lock(map_.mutex());
+    // The sessions loaded, and this one when it made a keyframe.
+    info.sessions = loaded_sessions_;
+    for (const auto& [id, kf] : map_.keyframes())
+      if (kf->session() == map_.session()) info.sessions = map_.session() + 1;
+    bytes = encode_map(map_, map_settings(), info.sessions, app_json);
+    info.keyframes = map_.num_keyframes();
+    info.points = map_.num_points();
+  }
+  write_file(path, bytes);
+  info.bytes = bytes.size();
+  info.save_ms = ms_since(t0);
+  return info;
 }
 
 std::vector<geom::StampedPose> System::keyframe_trajectory() {

@@ -110,6 +110,11 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
   return new_kf;
 }
 
+void Tracking::start_in_map(bool localise_only) {
+  state_ = TrackingState::kLost;
+  localise_only_ = localise_only;
+}
+
 void Tracking::record_relocalisation(const Frame& f) {
   RelocEvent e;
   e.frame_id = f.id;
@@ -485,6 +490,7 @@ void Tracking::align_matches(Frame& f) {
 }
 
 bool Tracking::need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue) {
+  if (localise_only_) return false;
   const std::size_t num_kfs = map_.num_keyframes();
   const auto max_frames = static_cast<std::uint64_t>(options_.max_frames);
   const int min_obs = num_kfs <= 2 ? 2 : 3;

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/fnv.hpp"
 #include "vocabulary_builder.hpp"
 
 namespace pvb::slam::place {
@@ -160,6 +161,19 @@ void Vocabulary::transform(const cv::Mat& descriptors, BowVector* bow, FeatureVe
   if (norm > 0) {
     for (auto& [word, w] : v) w /= norm;
   }
+}
+
+std::uint64_t Vocabulary::fingerprint() const {
+  const std::int32_t shape[2] = {k_, levels_};
+  std::uint64_t h = fnv1a64(shape, sizeof shape);
+  for (const Node& n : nodes_) {
+    const std::uint8_t leaf = n.leaf ? 1 : 0;
+    h = fnv1a64(&n.parent, sizeof n.parent, h);
+    h = fnv1a64(&leaf, 1, h);
+    h = fnv1a64(n.descriptor.data(), n.descriptor.size(), h);
+    h = fnv1a64(&n.weight, sizeof n.weight, h);
+  }
+  return h;
 }
 
 double Vocabulary::score(const BowVector& a, const BowVector& b) {

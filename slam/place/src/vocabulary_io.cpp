@@ -23,6 +23,7 @@
 #include <string_view>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/fnv.hpp"
 #include "pvb/common/output_file.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/slam/place/vocabulary.hpp"
@@ -37,15 +38,6 @@ constexpr std::size_t kHeaderBytes = 24;
 constexpr std::size_t kNodeBytes = 45;
 constexpr std::size_t kChecksumBytes = 8;
 constexpr std::size_t kTextFields = 35;  // parent, is_leaf, 32 bytes, weight
-
-std::uint64_t fnv1a64(const unsigned char* p, std::size_t n) {
-  std::uint64_t h = 14695981039346656037ULL;
-  for (std::size_t i = 0; i < n; ++i) {
-    h ^= p[i];
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
 
 /// A file's bytes, read whole in one call into a buffer that is not
 /// cleared first (a vocabulary file can be tens of megabytes).

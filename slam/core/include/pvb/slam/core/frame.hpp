@@ -67,6 +67,12 @@ class Frame {
   /// (metres, 0 = invalid).
   Frame(std::uint64_t id, std::int64_t t_ns, OrbFeatures features, const cv::Mat& depth_m,
         std::shared_ptr<const CameraModel> cam);
+  /// A frame from what a map file keeps of a keyframe: keypoints as
+  /// detected and undistorted, descriptors (N x 32 CV_8U) and depth per
+  /// keypoint (<= 0: none); sizes must agree.  No map points yet, no pose.
+  static Frame from_saved(std::uint64_t id, std::int64_t t_ns, std::vector<cv::KeyPoint> keys,
+                          std::vector<cv::KeyPoint> keys_un, cv::Mat descriptors, std::vector<float> depth_m,
+                          std::shared_ptr<const CameraModel> cam);
 
   std::size_t size() const { return keys_un.size(); }
   /// Indices of keypoints within radius_px of (u, v) with octave in
@@ -116,6 +122,9 @@ class Frame {
  private:
   /// The virtual right-camera coordinate u - bf / depth (ORB-SLAM2's RGB-D uR).
   float right_coordinate(float u_un, float depth) const { return static_cast<float>(u_un - cam->K.bf / depth); }
+  /// Map-point slots, outlier and alignment marks, and the area grid, for
+  /// the keypoints in keys_un.
+  void build_index();
 
   std::vector<std::vector<std::uint32_t>> grid_;  ///< keypoint indices per cell, row-major
 };

@@ -75,6 +75,12 @@ class MapPoint {
   double found_ratio() const { return visible_ > 0 ? static_cast<double>(found_) / visible_ : 0.0; }
   int visible() const { return visible_; }
   int found() const { return found_; }
+  /// A point read from a map file: its first keyframe and statistics.
+  void restore(std::uint64_t first_kf_id, int visible, int found) {
+    first_kf_id_ = first_kf_id;
+    visible_ = visible;
+    found_ = found;
+  }
 
  private:
   std::uint64_t id_;
@@ -108,6 +114,13 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   void set_T_c_w(const geom::SE3d& T) { frame_.T_c_w = T; }
   Eigen::Vector3d camera_center_w() const { return frame_.camera_center_w(); }
   bool bad() const { return bad_; }
+  /// The mapping session the keyframe was made in (0: the map's first).
+  std::uint32_t session() const { return session_; }
+  void set_session(std::uint32_t s) { session_ = s; }
+  /// Held where it is: local BA does not move it and culling keeps it
+  /// (the keyframes of a loaded map that a session extends).
+  bool fixed() const { return fixed_; }
+  void set_fixed(bool f) { fixed_ = f; }
 
   /// Map points per keypoint (null where none).
   const std::vector<std::shared_ptr<MapPoint>>& map_points() const { return frame_.map_points; }
@@ -125,6 +138,14 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   /// Neighbours sorted by weight (descending, then id ascending); at most n (n < 0: all).
   std::vector<std::shared_ptr<KeyFrame>> best_covisibles(int n) const;
   int weight(std::uint64_t kf_id) const;
+  /// Covisibility weights by neighbour id (for map files).
+  std::map<std::uint64_t, int> connection_weights() const;
+  /// A keyframe read from a map file: its parent in the spanning tree (may
+  /// be null) and its edges, as they were saved; the other ends are updated
+  /// by their own restore.  update_connections() will not re-parent it.
+  void restore_graph(const std::shared_ptr<KeyFrame>& parent,
+                     const std::vector<std::pair<std::shared_ptr<KeyFrame>, int>>& connections,
+                     const std::vector<std::shared_ptr<KeyFrame>>& loop_edges);
 
   // Bag of words (place recognition) -----------------------------------------
   /// Set once, by the thread that processes the keyframe, before the
@@ -174,6 +195,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   place::BowVector bow_;
   place::FeatureVector features_by_node_;
   bool bad_ = false;
+  std::uint32_t session_ = 0;
+  bool fixed_ = false;
   std::shared_ptr<KeyFrame> removed_parent_;          ///< parent at removal (kept alive for trajectories)
   geom::SE3d T_c_parent_ = geom::SE3d::Identity();  ///< pose relative to it at removal
 };
@@ -198,12 +221,25 @@ class Map {
   std::size_t num_points() const { return points_.size(); }
   void clear();
 
+  // Loading a saved map (map_file.hpp) ---------------------------------------
+  /// Adds a keyframe or point with its saved id; ids created later follow
+  /// the largest.  An id already in the map is a logic error.
+  std::shared_ptr<KeyFrame> add_loaded_keyframe(std::uint64_t id, const Frame& frame);
+  std::shared_ptr<MapPoint> add_loaded_point(std::uint64_t id, const Eigen::Vector3d& p_w,
+                                             const std::shared_ptr<KeyFrame>& ref_kf);
+  /// The session that new keyframes belong to (set_session on creation).
+  std::uint32_t session() const { return session_; }
+  void set_session(std::uint32_t s) { session_ = s; }
+  std::uint64_t next_keyframe_id() const { return next_kf_id_; }
+  std::uint64_t next_point_id() const { return next_point_id_; }
+
  private:
   std::mutex mutex_;
   std::map<std::uint64_t, std::shared_ptr<KeyFrame>> keyframes_;
   std::map<std::uint64_t, std::shared_ptr<MapPoint>> points_;
   std::uint64_t next_kf_id_ = 0;
   std::uint64_t next_point_id_ = 0;
+  std::uint32_t session_ = 0;
 };
 
 }  // namespace pvb::slam

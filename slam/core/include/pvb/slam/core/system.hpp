@@ -14,12 +14,33 @@
 #include "pvb/sensor/rgbd_frame.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/loop_closing.hpp"
+#include "pvb/slam/core/map_file.hpp"
 #include "pvb/slam/core/map_snapshot.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/tracking.hpp"
 #include "pvb/slam/dense/dense_mapper.hpp"
 
 namespace pvb::slam {
+
+/// How a run starts from a saved map (System::load_map).
+enum class MapStart {
+  kLocalise,  ///< the map is fixed: tracked against, never changed
+  kExtend,    ///< new keyframes join it; its own keyframes stay where they are
+};
+
+/// A loaded map: what the file held, and how long it took.
+struct MapLoadInfo {
+  std::uint32_t sessions = 0;  ///< mapping sessions in the file
+  std::size_t keyframes = 0, points = 0, bytes = 0;
+  std::string app_json;        ///< the application's data saved with it
+  double load_ms = 0;          ///< reading, checking, linking and bags of words
+};
+
+struct MapSaveInfo {
+  std::uint32_t sessions = 0;
+  std::size_t keyframes = 0, points = 0, bytes = 0;
+  double save_ms = 0;          ///< encoding and the atomic write
+};
 
 struct SystemOptions {
   bool synchronous = false;    ///< no worker threads: bit-identical runs
@@ -44,6 +65,17 @@ class System {
   ~System();
   System(const System&) = delete;
   System& operator=(const System&) = delete;
+
+  /// Starts from the map saved at `path` (map_file.hpp), before the first
+  /// frame: tracking is lost until it relocalises in it, and poses are in
+  /// its frame.  A map made with other camera or ORB settings, or another
+  /// vocabulary, is refused (ConfigError); a bad file throws IoError.
+  MapLoadInfo load_map(const std::string& path, MapStart start);
+  /// Saves the map (after shutdown(): the final one) atomically, with the
+  /// caller's JSON; a map that was loaded to localise in is refused.
+  MapSaveInfo save_map(const std::string& path, const std::string& app_json);
+  /// The settings a map of this system records (and a loaded one must match).
+  MapSettings map_settings() const;
 
   FrameResult track(const sensor::RgbdFrame& frame);
   /// Lets local and dense mapping finish their queues and stops the workers.
@@ -94,6 +126,9 @@ class System {
   OrbExtractor extractor_;
   Map map_;
   std::unique_ptr<PlaceRecognizer> place_;  ///< null with Vocabulary.path none
+  std::uint64_t vocabulary_fingerprint_ = 0;
+  std::optional<MapStart> map_start_;       ///< set when the run started from a saved map
+  std::uint32_t loaded_sessions_ = 0;
   std::unique_ptr<Tracking> tracking_;
   std::unique_ptr<LoopClosing> loop_;  ///< null when loop closing is disabled; runs on the mapping thread
   std::unique_ptr<LocalMapping> mapping_;

@@ -148,6 +148,12 @@ class Tracking {
   /// Returns the new keyframe when one was created (for the local mapper).
   std::shared_ptr<KeyFrame> track(Frame frame, bool mapping_idle, std::size_t mapping_queue);
 
+  /// Starts in a loaded map: lost until a global relocalisation finds the
+  /// first pose in it.  `localise_only`: the map stays as it is, no
+  /// keyframe is ever made (localisation mode).  Before the first frame.
+  void start_in_map(bool localise_only);
+  bool localise_only() const { return localise_only_; }
+
   TrackingState state() const { return state_; }
   const TrackingStats& stats() const { return stats_; }
   /// Pose of the last frame tracked (valid when state() == kOk).
@@ -197,6 +203,7 @@ class Tracking {
   const PlaceRecognizer* place_ = nullptr;
   TrackingState state_ = TrackingState::kNotInitialized;
   TrackingStats stats_;
+  bool localise_only_ = false;
 
   Frame last_;
   bool last_is_keyframe_ = false;

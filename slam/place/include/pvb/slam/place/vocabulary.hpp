@@ -83,6 +83,11 @@ class Vocabulary {
   int levels() const { return levels_; }
   std::size_t size() const { return words_.size(); }        ///< words
   std::size_t node_count() const { return nodes_.size(); }  ///< including the root
+  /// FNV-1a of what decides words and weights (k, L, every node's parent,
+  /// leaf flag, centre and weight): the same for a vocabulary and its copy
+  /// in the other file format, different for any other vocabulary.  Maps
+  /// record it, so that a map is never searched with another vocabulary.
+  std::uint64_t fingerprint() const;
 
   /// Bag of words of an image's descriptors (CV_8U, N x 32), L1-normalised
   /// TF-IDF, and its direct index at `levels_up` above the leaves (fv may be null).

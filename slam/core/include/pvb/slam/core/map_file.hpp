@@ -1,0 +1,67 @@
+#pragma once
+// Map files: a sparse map saved to disk and read back (docs/map_file.md).
+// A versioned binary format: the magic "PVBMAP\r\n", a version, then
+// sections (HEAD settings, KEYF keyframes, POIN points, GRAP graph, META
+// the application's JSON), each with its length and an FNV-1a checksum.
+// What is saved is the map's own state (poses, keypoints, descriptors,
+// point positions and statistics, the graph); what follows from it (point
+// descriptors, normals, scale ranges, bags of words) is recomputed on
+// load, so save -> load -> save gives the same bytes.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "pvb/slam/core/map.hpp"
+
+namespace pvb::slam {
+
+/// What a map was made with.  A map is used only by a run whose settings
+/// match, and never with another vocabulary.
+struct MapSettings {
+  double fx = 0, fy = 0, cx = 0, cy = 0, bf = 0;
+  std::uint32_t width = 0, height = 0;
+  std::array<double, 5> distortion{};  ///< k1 k2 p1 p2 k3
+  double th_depth_m = 0;
+  double depth_factor = 0;  ///< raw depth units per metre (DepthMapFactor)
+  double scale_factor = 0;  ///< ORB pyramid
+  std::uint32_t num_levels = 0;
+  std::uint32_t num_features = 0;
+  std::uint64_t vocabulary = 0;  ///< place::Vocabulary::fingerprint()
+
+  /// The first setting that differs from `run`'s, as "NAME: VALUE in the
+  /// map, VALUE in this run"; empty when they agree.
+  std::string difference(const MapSettings& run) const;
+};
+
+/// The file's header and application data, without the map itself.
+struct MapFileHeader {
+  std::uint32_t version = 0;
+  MapSettings settings;
+  std::uint32_t sessions = 0;  ///< mapping sessions the map holds
+  std::string app_json;        ///< the META section (the caller's JSON, "" when none)
+};
+
+constexpr std::uint32_t kMapFileVersion = 1;
+
+/// The map file's bytes for every keyframe and point in `map` (bad ones
+/// are not in it).  Call with the map's mutex held.
+std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
+                       const std::string& app_json);
+
+/// Checks the whole file (magic, version, sections, checksums) and returns
+/// its header.  Throws IoError naming `file` and what is wrong (truncated,
+/// damaged, not a map file, a newer version).
+MapFileHeader read_map_header(const std::string& bytes, const std::string& file);
+
+/// The camera model of the map's settings (that read_map_header checked).
+std::shared_ptr<const CameraModel> camera_for(const MapSettings& settings);
+
+/// Reads the keyframes, points and graph into `map` (empty), with frames
+/// on camera `cam`.  Every reference is checked (ids, keypoint indices,
+/// octaves, rotations); a bad one throws IoError naming `file`, the section
+/// and the item.  Point descriptors, normals and scale ranges are computed.
+void decode_map(const std::string& bytes, const std::string& file, const std::shared_ptr<const CameraModel>& cam,
+                Map* map);
+
+}  // namespace pvb::slam

@@ -1,0 +1,164 @@
+#include "pvb/slam/core/map_file.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <set>
+#include <sstream>
+
+#include "map_file_bytes.hpp"
+#include "pvb/common/error.hpp"
+#include "pvb/common/fnv.hpp"
+
+namespace pvb::slam {
+namespace {
+
+using namespace mapfile;
+
+
+void put_settings(ByteWriter& w, const MapSettings& s, std::uint32_t sessions) {
+  for (double v : {s.fx, s.fy, s.cx, s.cy, s.bf}) w.f64(v);
+  w.u32(s.width);
+  w.u32(s.height);
+  for (double v : s.distortion) w.f64(v);
+  w.f64(s.th_depth_m);
+  w.f64(s.depth_factor);
+  w.f64(s.scale_factor);
+  w.u32(s.num_levels);
+  w.u32(s.num_features);
+  w.u64(s.vocabulary);
+  w.u32(sessions);
+}
+
+void put_pose(ByteWriter& w, const geom::SE3d& T) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) w.f64(T.linear()(r, c));
+  for (int r = 0; r < 3; ++r) w.f64(T.translation()(r));
+}
+
+void put_keyframe(ByteWriter& w, const KeyFrame& kf, const std::set<std::uint64_t>& point_ids) {
+  const Frame& f = kf.frame();
+  w.u64(kf.id());
+  w.u64(f.id);
+  w.i64(f.t_ns);
+  w.u32(kf.session());
+  put_pose(w, kf.T_c_w());
+  w.u32(static_cast<std::uint32_t>(f.size()));
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    const cv::KeyPoint& k = f.keys[i];
+    const cv::KeyPoint& u = f.keys_un[i];
+    for (float v : {k.pt.x, k.pt.y, u.pt.x, u.pt.y, u.angle, u.size, u.response}) w.f32(v);
+    w.u8(static_cast<std::uint8_t>(u.octave));
+    w.f32(f.depth_m[i]);
+    const auto& mp = f.map_points[i];
+    w.u64(mp && !mp->bad() && point_ids.count(mp->id()) ? mp->id() : kNone);
+    w.bytes(f.descriptors.ptr<unsigned char>(static_cast<int>(i)), 32);
+  }
+}
+
+void put_graph(ByteWriter& w, const KeyFrame& kf, const Map& map) {
+  w.u64(kf.id());
+  const auto parent = kf.parent();
+  w.u64(parent && map.keyframes().count(parent->id()) ? parent->id() : kNone);
+  std::vector<std::pair<std::uint64_t, int>> edges;
+  for (const auto& [id, weight] : kf.connection_weights())
+    if (map.keyframes().count(id)) edges.emplace_back(id, weight);
+  w.u64(edges.size());
+  for (const auto& [id, weight] : edges) {
+    w.u64(id);
+    w.i32(weight);
+  }
+  std::vector<std::uint64_t> loops;
+  for (const auto& k : kf.loop_edges())
+    if (map.keyframes().count(k->id())) loops.push_back(k->id());
+  w.u64(loops.size());
+  for (std::uint64_t id : loops) w.u64(id);
+}
+
+void put_section(ByteWriter& out, const char* tag, const std::string& payload) {
+  out.bytes(tag, 4);
+  out.u64(payload.size());
+  out.bytes(payload.data(), payload.size());
+  out.u64(fnv1a64(payload.data(), payload.size()));
+}
+
+}  // namespace
+
+std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
+                       const std::string& app_json) {
+  std::set<std::uint64_t> point_ids;
+  for (const auto& [id, mp] : map.points())
+    if (!mp->bad()) point_ids.insert(id);
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  for (const auto& [id, kf] : map.keyframes())
+    if (!kf->bad()) kfs.push_back(kf);
+
+  ByteWriter head, keyf, poin, grap;
+  put_settings(head, settings, sessions);
+  keyf.u64(kfs.size());
+  for (const auto& kf : kfs) put_keyframe(keyf, *kf, point_ids);
+  poin.u64(point_ids.size());
+  for (std::uint64_t id : point_ids) {
+    const MapPoint& mp = *map.points().at(id);
+    poin.u64(id);
+    for (int r = 0; r < 3; ++r) poin.f64(mp.p_w()(r));
+    const auto ref = mp.reference_keyframe();
+    poin.u64(ref && !ref->bad() ? ref->id() : kNone);
+    poin.u64(mp.first_kf_id());
+    poin.i32(mp.visible());
+    poin.i32(mp.found());
+  }
+  grap.u64(kfs.size());
+  for (const auto& kf : kfs) put_graph(grap, *kf, map);
+
+  ByteWriter out;
+  out.bytes(kMagic, kMagicBytes);
+  out.u32(kMapFileVersion);
+  out.u32(static_cast<std::uint32_t>(kSections.size()));
+  const std::string* payloads[] = {&head.data(), &keyf.data(), &poin.data(), &grap.data(), &app_json};
+  for (std::size_t s = 0; s < kSections.size(); ++s) put_section(out, kSections[s], *payloads[s]);
+  return out.data();
+}
+
+std::string MapSettings::difference(const MapSettings& run) const {
+  std::ostringstream o;
+  o.precision(17);
+  const auto differs = [&](const char* name, double in_map, double in_run) {
+    if (in_map == in_run) return false;
+    o << name << ": " << in_map << " in the map, " << in_run << " in this run";
+    return true;
+  };
+  const char* dist_names[] = {"k1", "k2", "p1", "p2", "k3"};
+  if (differs("fx", fx, run.fx) || differs("fy", fy, run.fy) || differs("cx", cx, run.cx) ||
+      differs("cy", cy, run.cy) || differs("bf", bf, run.bf) || differs("width", width, run.width) ||
+      differs("height", height, run.height))
+    return o.str();
+  for (int i = 0; i < 5; ++i)
+    if (differs(dist_names[i], distortion[i], run.distortion[i])) return o.str();
+  if (differs("ThDepth (m)", th_depth_m, run.th_depth_m) ||
+      differs("DepthMapFactor", depth_factor, run.depth_factor) ||
+      differs("ORBextractor.scaleFactor", scale_factor, run.scale_factor) ||
+      differs("ORBextractor.nLevels", num_levels, run.num_levels) ||
+      differs("ORBextractor.nFeatures", num_features, run.num_features))
+    return o.str();
+  if (vocabulary != run.vocabulary) {
+    o << "vocabulary: fingerprint " << std::hex << vocabulary << " in the map, " << run.vocabulary
+      << " in this run (another vocabulary)";
+    return o.str();
+  }
+  return {};
+}
+
+std::shared_ptr<const CameraModel> camera_for(const MapSettings& s) {
+  StereoIntrinsics K;
+  K.fx = s.fx;
+  K.fy = s.fy;
+  K.cx = s.cx;
+  K.cy = s.cy;
+  K.bf = s.bf;
+  const std::vector<double> dist(s.distortion.begin(), s.distortion.end());
+  return std::make_shared<const CameraModel>(CameraModel::make(K, static_cast<int>(s.width),
+                                                               static_cast<int>(s.height), dist, s.th_depth_m,
+                                                               s.scale_factor, static_cast<int>(s.num_levels)));
+}
+
+}  // namespace pvb::slam

@@ -1,0 +1,167 @@
+// Map files on a real Kinect pair (TUM fr3 long_office_household): a map
+// made on the pair is saved, loaded and saved again byte for byte; every
+// kind of bad file is one IoError or ConfigError naming the file; and a
+// run that loads the map to localise in it starts lost, relocalises on the
+// first frame at the map's own pose, never adds a keyframe, and tracks the
+// second frame where the mapping run put it.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+#include "pvb/dataset/tum_sequence.hpp"
+#include "pvb/slam/core/map_file.hpp"
+#include "pvb/slam/core/system.hpp"
+
+namespace pvb::slam {
+namespace {
+
+const std::string kPair = std::string(PVB_SHARED_DIR) + "/data/tum/fr3_long_office_household_pair";
+const std::string kTum3 = std::string(PVB_SOURCE_DIR) + "/configs/tum/TUM3.yaml";
+
+std::string tmp_path(const std::string& name) {
+  const char* dir = std::getenv("TEST_TMPDIR");
+  return std::string(dir ? dir : "/tmp") + "/map_file_" + name;
+}
+
+std::vector<sensor::RgbdFrame> pair_frames(const Settings& s) {
+  dataset::TumSequenceReader reader(kPair, s.depth_map_factor);
+  std::vector<sensor::RgbdFrame> out;
+  while (auto f = reader.next()) out.push_back(*f);
+  return out;
+}
+
+SystemOptions sync_options() {
+  SystemOptions o;
+  o.synchronous = true;
+  return o;
+}
+
+/// Maps the pair, saves the map; returns the second frame's pose.
+geom::SE3d map_pair(const std::string& path) {
+  const Settings s = read_settings(kTum3);
+  System system(s, sync_options());
+  geom::SE3d T_w_c2 = geom::SE3d::Identity();
+  for (const auto& f : pair_frames(s)) {
+    const FrameResult r = system.track(f);
+    EXPECT_EQ(r.state, TrackingState::kOk);
+    if (r.T_w_c) T_w_c2 = *r.T_w_c;
+  }
+  system.shutdown();
+  const MapSaveInfo info = system.save_map(path, R"({"station": "fr3"})");
+  EXPECT_EQ(info.sessions, 1u);
+  EXPECT_GE(info.keyframes, 1u);
+  EXPECT_GT(info.points, 100u);
+  return T_w_c2;
+}
+
+class MapFile : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    path_ = tmp_path("pair.pvbmap");
+    T_w_c2_ = map_pair(path_);
+    bytes_ = read_file(path_);
+  }
+  static std::string path_, bytes_;
+  static geom::SE3d T_w_c2_;
+
+  /// Loads `bytes` written to a file; returns what() of the error thrown ("" when none).
+  static std::string load_error(const std::string& bytes, const std::string& name) {
+    const std::string p = tmp_path(name);
+    write_file(p, bytes);
+    System system(read_settings(kTum3), sync_options());
+    try {
+      system.load_map(p, MapStart::kLocalise);
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(p), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+      return what;
+    }
+    return "";
+  }
+};
+std::string MapFile::path_, MapFile::bytes_;
+geom::SE3d MapFile::T_w_c2_;
+
+TEST_F(MapFile, SaveLoadSaveGivesTheSameBytes) {
+  System system(read_settings(kTum3), sync_options());
+  const MapLoadInfo info = system.load_map(path_, MapStart::kExtend);
+  EXPECT_EQ(info.app_json, R"({"station": "fr3"})");
+  EXPECT_EQ(info.bytes, bytes_.size());
+  EXPECT_EQ(info.sessions, 1u);
+  system.shutdown();
+  const std::string again = tmp_path("again.pvbmap");
+  const MapSaveInfo saved = system.save_map(again, info.app_json);
+  EXPECT_EQ(saved.sessions, 1u);  // a session that added nothing is not counted
+  EXPECT_TRUE(read_file(again) == bytes_);
+}
+
+TEST_F(MapFile, EncodeOfADecodedMapIsTheFileItCameFrom) {
+  const MapFileHeader h = read_map_header(bytes_, path_);
+  Map map;
+  decode_map(bytes_, path_, camera_for(h.settings), &map);
+  std::lock_guard<std::mutex> lock(map.mutex());
+  EXPECT_EQ(encode_map(map, h.settings, h.sessions, h.app_json), bytes_);
+}
+
+TEST_F(MapFile, EveryTruncationIsOneErrorNamingTheFile) {
+  for (std::size_t n : {std::size_t(0), std::size_t(5), std::size_t(8), std::size_t(12), std::size_t(20),
+                        bytes_.size() / 3, bytes_.size() / 2, bytes_.size() - 9, bytes_.size() - 1}) {
+    const std::string what = load_error(bytes_.substr(0, n), "cut.pvbmap");
+    EXPECT_FALSE(what.empty()) << n << " bytes";
+  }
+}
+
+TEST_F(MapFile, ADamagedByteInAnySectionFailsItsChecksum) {
+  for (std::size_t at : {std::size_t(40), bytes_.size() / 4, bytes_.size() / 2, bytes_.size() - 20}) {
+    std::string b = bytes_;
+    b[at] = static_cast<char>(b[at] ^ 0x10);
+    const std::string what = load_error(b, "damaged.pvbmap");
+    EXPECT_NE(what.find("damaged"), std::string::npos) << what;
+  }
+}
+
+TEST_F(MapFile, ForeignAndFutureFilesSaySo) {
+  EXPECT_NE(load_error("PVBVOC1\nnot a map", "foreign.pvbmap").find("not a map file"), std::string::npos);
+  std::string future = bytes_;
+  future[8] = 2;  // version, little-endian u32 after the magic
+  EXPECT_NE(load_error(future, "future.pvbmap").find("version 2 is newer"), std::string::npos);
+}
+
+TEST_F(MapFile, AMapOfOtherSettingsIsRefused) {
+  Settings s = read_settings(kTum3);
+  s.orb.num_features += 100;
+  System system(s, sync_options());
+  try {
+    system.load_map(path_, MapStart::kLocalise);
+    FAIL() << "loaded";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("ORBextractor.nFeatures"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(MapFile, LocaliseStartsLostRelocalisesAndNeverAddsKeyframes) {
+  const Settings s = read_settings(kTum3);
+  System system(s, sync_options());
+  const MapLoadInfo info = system.load_map(path_, MapStart::kLocalise);
+  EXPECT_EQ(system.state(), TrackingState::kLost);
+  const auto frames = pair_frames(s);
+  std::vector<FrameResult> results;
+  for (const auto& f : frames) results.push_back(system.track(f));
+  ASSERT_EQ(results.size(), 2u);
+  ASSERT_TRUE(results[0].T_w_c) << results[0].tracking.failure;
+  EXPECT_EQ(results[0].tracking.method, TrackingMethod::kRelocalization);
+  // The map's frame is the mapping run's first camera.
+  EXPECT_LT(results[0].T_w_c->translation().norm(), 0.01);
+  ASSERT_TRUE(results[1].T_w_c);
+  EXPECT_LT((results[1].T_w_c->translation() - T_w_c2_.translation()).norm(), 0.01);
+  EXPECT_EQ(system.num_keyframes(), info.keyframes);
+  EXPECT_EQ(system.relocalisations().size(), 1u);
+  EXPECT_THROW(system.save_map(tmp_path("localised.pvbmap"), "{}"), ConfigError);
+}
+
+}  // namespace
+}  // namespace pvb::slam
