@@ -9,6 +9,7 @@
 #include "check_report.hpp"
 #include "command.hpp"
 #include "count_option.hpp"
+#include "map_options.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/run/run.hpp"
@@ -27,6 +28,7 @@ struct RunArgs {
   bool compare = false;
   bool check = false;
   bool no_pace = false;
+  std::string map_mode;
 };
 
 int run_run(RunArgs& a) {
@@ -36,6 +38,7 @@ int run_run(RunArgs& a) {
   if (!a.frames.empty())
     o.max_frames = static_cast<int>(parse_count("run", "--frames", a.frames, 1, 10'000'000));
   o.seed = a.seed;
+  if (!a.map_mode.empty()) o.map.use = run::parse_map_use(a.map_mode, "--map-mode");
   o.pace = !a.no_pace;
   o.loop_closing = !a.no_loop_closing;
   o.map_eval = !a.no_map_eval;
@@ -92,6 +95,9 @@ Command add_run_command(CLI::App& app) {
   sub->add_option("--mapping-nice", args->options.mapping_nice,
                   "pipelined: nice value of the local/dense mapping workers (default 10 when paced, else 0)")
       ->check(CLI::Range(-20, 19));
+  add_map_options(sub, &args->options.map, &args->map_mode);
+  sub->add_option("--start-m", args->options.start_m,
+                  "start this many metres along the route (overrides the scenario's route.start_m)");
   sub->add_flag("--check", args->check, "check metrics.json against the scenario's expect: bounds (exit 3)");
   return {sub, [args] { return run_run(*args); }};
 }

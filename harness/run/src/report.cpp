@@ -56,6 +56,7 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
   if (!run.loop_closing_json.empty()) out += in + "\"loop_closing\": " + run.loop_closing_json + ",\n";
   if (run.place) out += in + "\"place_recognition\": " + place_json(*run.place) + ",\n";
   if (run.dense_map) out += in + "\"dense_map\": " + dense_map_json(*run.dense_map, in) + ",\n";
+  if (run.map) out += in + "\"map\": " + map_report_json(*run.map) + ",\n";
   out += in + "\"tracking_ms\": {\"median\": " + num(percentile(ms, 0.5)) +
          ", \"mean\": " + num(mean_of(ms)) + ", \"p95\": " + num(percentile(ms, 0.95)) + "},\n";
   out += in + "\"loss_events\": [";
@@ -303,6 +304,19 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
       write_figure(
           eval::make_line_chart("absolute trajectory error over time", "time [s]", "ATE [m]", series), dir,
           "ate_over_time", &written);
+  }
+  // Localisation in a loaded map: the error of every frame in the map's frame.
+  if (r.primary.map && r.primary.map->localisation) {
+    const eval::LocalisationScores& l = *r.primary.map->localisation;
+    eval::Series t{"translation error [m]", {}, {}, eval::series_color(0)};
+    for (std::size_t i = 0; i < l.translation_error_m.size(); ++i) {
+      t.x.push_back(static_cast<double>(i));
+      t.y.push_back(l.translation_error_m[i] >= 0 ? l.translation_error_m[i]
+                                                   : std::numeric_limits<double>::quiet_NaN());
+    }
+    write_figure(eval::make_line_chart("localisation in the map's frame (no alignment; gaps: no pose)", "frame",
+                                       "translation error [m]", {t}),
+                 dir, "localisation_error", &written);
   }
   // Tracking time histogram, one per run.
   for (const SlamRun* run : runs) {

@@ -43,13 +43,15 @@ void write_tum(const std::string& path, const std::string& header,
 }  // namespace
 
 SystemSink::SystemSink(const std::string& mode, const slam::Settings& settings, bool sync, std::uint32_t seed,
-                       const std::string& out_dir)
-    : dir(out_dir) {
+                       const std::string& out_dir, const MapOptions& map)
+    : map_options(map), dir(out_dir) {
   run.mode = mode;
   slam::SystemOptions options;
   options.synchronous = sync;
   options.seed = seed;
   system = std::make_unique<slam::System>(settings, options);
+  if (!map.load_path.empty() || !map.save_path.empty()) run.map = start_map(*system, map);
+  prev_state = system->state();  // lost in a loaded map until it relocalises
   cam_traj = OutputFile(dir + "/CameraTrajectory.txt");
   kf_traj = OutputFile(dir + "/KeyFrameTrajectory.txt");
   timing = OutputFile(dir + "/timing.csv");
@@ -121,6 +123,7 @@ void SystemSink::finish() {
   run.place = collect_place_recognition(*system, keyframe_t_ns);
   cam_traj.close();
   timing.close();
+  if (run.map) run.map->relocalisations = system->relocalisations().size();
   run.keyframes = system->num_keyframes();
   run.map_points = system->num_map_points();
   run.local_mapping = system->mapping_stats();
@@ -143,8 +146,15 @@ void SystemSink::save_dense_maps() {
   run.dense_map = std::move(d);
 }
 
+void SystemSink::save_map(const eval::Trajectory& gt, const std::string& scenario, std::uint64_t station_seed) {
+  if (!run.map || map_options.save_path.empty()) return;
+  if (!run.map->load) run.map->T_world_map = T_world_new_map(gt, est);
+  run::save_map(*system, map_options, scenario, station_seed, &*run.map);
+}
+
 void SystemSink::evaluate(const eval::Trajectory& gt) {
   if (run.place) label_place_recognition(&*run.place, gt);
+  if (run.map) score_map_localisation(&*run.map, gt, est);
   if (est.poses.size() < 3) {
     run.eval_note = "only " + std::to_string(est.poses.size()) + " tracked frames (need 3)";
     return;
@@ -178,11 +188,13 @@ SystemSinks make_systems(const slam::Settings& settings, const RunOptions& opt, 
   s.loop.enabled = s.loop.enabled && opt.loop_closing;
   s.pe_match.enabled = opt.mode != SlamMode::kBaseline;
   sinks.push_back(std::make_unique<SystemSink>(s.pe_match.enabled ? eval::kPeSlamMode : eval::kBaselineMode,
-                                               s, opt.sync, seed, opt.out_dir));
+                                               s, opt.sync, seed, opt.out_dir, opt.map));
   if (opt.mode == SlamMode::kCompare) {
     s.pe_match.enabled = false;
-    sinks.push_back(
-        std::make_unique<SystemSink>(eval::kBaselineMode, s, opt.sync, seed, opt.out_dir + "/baseline"));
+    MapOptions baseline_map = opt.map;  // starts from the same map; only the primary run saves
+    baseline_map.save_path.clear();
+    sinks.push_back(std::make_unique<SystemSink>(eval::kBaselineMode, s, opt.sync, seed,
+                                                 opt.out_dir + "/baseline", baseline_map));
   }
   return sinks;
 }

@@ -33,7 +33,8 @@ struct SystemSink {
   NamedClouds clouds;
 
   SystemSink(const std::string& mode, const slam::Settings& settings, bool sync, std::uint32_t seed,
-             const std::string& out_dir);
+             const std::string& out_dir, const MapOptions& map = {});
+  MapOptions map_options;
 
   /// Tracks one frame, writes its lines and records loss and recovery.
   slam::FrameResult track(const sensor::RgbdFrame& frame, RunLog& log);
@@ -42,8 +43,12 @@ struct SystemSink {
   /// writes the dense maps.
   void finish();
 
-  /// ATE/RPE of the trajectory (and of the refined one) against `gt`.
+  /// ATE/RPE of the trajectory (and of the refined one) against `gt`,
+  /// and the localisation in a loaded map.
   void evaluate(const eval::Trajectory& gt);
+  /// Saves the final map when the options say so, with its frame in the
+  /// world (a loaded map's, or the ground truth at the first pose).
+  void save_map(const eval::Trajectory& gt, const std::string& scenario, std::uint64_t station_seed);
 
  private:
   /// The dense maps into `clouds` and their PLY files; run.dense_map.

@@ -50,7 +50,11 @@ void put_keyframe(ByteWriter& w, const KeyFrame& kf, const std::set<std::uint64_
     w.u8(static_cast<std::uint8_t>(u.octave));
     w.f32(f.depth_m[i]);
     const auto& mp = f.map_points[i];
-    w.u64(mp && !mp->bad() && point_ids.count(mp->id()) ? mp->id() : kNone);
+    // A keyframe can hold a point at a second keypoint after fusion; the
+    // point's own observation says which one counts.
+    const bool observed = mp && !mp->bad() && point_ids.count(mp->id()) &&
+                          mp->index_in(kf.id()) == static_cast<long>(i);
+    w.u64(observed ? mp->id() : kNone);
     w.bytes(f.descriptors.ptr<unsigned char>(static_cast<int>(i)), 32);
   }
 }

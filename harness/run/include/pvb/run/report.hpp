@@ -12,6 +12,7 @@
 #include "pvb/eval/evaluate.hpp"
 #include "pvb/eval/place_labels.hpp"
 #include "pvb/plot/contact_sheet.hpp"
+#include "pvb/run/map_session.hpp"
 #include "pvb/run/map_eval.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 
@@ -106,6 +107,8 @@ struct SlamRun {
   std::size_t loops_closed = 0;
   std::optional<PlaceRecognition> place;  ///< nullopt when loop closing is off
   std::optional<DenseMapReport> dense_map;  ///< nullopt when dense mapping is off
+  /// A saved map loaded or the final map saved (nullopt: neither).
+  std::optional<MapReport> map;
 };
 
 /// Closed loop: distance of the ground-truth robot (axle centre) from the

@@ -18,6 +18,7 @@
 
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/se3.hpp"
+#include "pvb/run/map_session.hpp"
 #include "pvb/run/report.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/robot.hpp"
@@ -39,6 +40,9 @@ struct RunOptions {
   bool overwrite = false;
   std::optional<std::uint64_t> seed;  ///< overrides the scenario's seed (also seeds PE-match)
   int max_frames = 0;                 ///< cap (0: the scenario's duration)
+  /// Overrides the scenario's route.start_m: the robot starts this far
+  /// along its route (--start-m); at least 1 m before its end.
+  std::optional<double> start_m;
   bool sync = false;                  ///< no threads: bit-identical runs
   SlamMode mode = SlamMode::kPeSlam;
   bool closed_loop = false;        ///< steer from the SLAM pose instead of ground truth
@@ -46,6 +50,9 @@ struct RunOptions {
   /// Score the dense maps against the scenario's true surface
   /// (docs/map_accuracy.md); false: write them only (--no-map-eval).
   bool map_eval = true;
+  /// Start from a saved map (localise in it or extend it) and/or save the
+  /// final map (--map, --map-mode, --save-map).
+  MapOptions map;
   std::string gl = "auto";         ///< auto, egl or osmesa
   std::size_t queue_capacity = 3;  ///< frames the producer may run ahead (open loop)
   /// Pipelined: release frame i no earlier than i / fps after the first,

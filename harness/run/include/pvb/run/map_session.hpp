@@ -1,0 +1,68 @@
+#pragma once
+// A run that starts from a saved map or leaves one (docs/map_reuse.md):
+// which map, how it is used (localise in it, extend it), where the result
+// is saved, and the map's frame in the world, kept in the map file's
+// application data so that a later session can be judged against ground
+// truth in that frame without any alignment.
+#include <optional>
+#include <string>
+
+#include "pvb/eval/localisation.hpp"
+#include "pvb/eval/trajectory.hpp"
+#include "pvb/geometry/se3.hpp"
+#include "pvb/slam/core/system.hpp"
+
+namespace pvb::run {
+
+/// How a run uses a saved map.
+enum class MapUse { kFresh, kLocalise, kExtend };
+const char* to_string(MapUse u);
+/// "localise" or "extend"; anything else throws ConfigError naming `option`.
+MapUse parse_map_use(const std::string& text, const std::string& option);
+
+struct MapOptions {
+  std::string load_path;           ///< the saved map to start from (empty: a fresh map)
+  MapUse use = MapUse::kFresh;     ///< kLocalise or kExtend with load_path
+  std::string save_path;           ///< where to save the final map (empty: not saved)
+  /// Checks the combination: a use needs a map and a map a use, and a map
+  /// only localised in is not saved again.  Throws ConfigError.
+  void check() const;
+};
+
+/// What a run did with maps, for metrics.json and the report.
+struct MapReport {
+  std::string loaded_from;
+  MapUse use = MapUse::kFresh;
+  std::optional<slam::MapLoadInfo> load;
+  /// The map's frame in the world (its first session's first camera), from
+  /// the loaded map's data or, for a new map, the ground truth.
+  std::optional<geom::SE3d> T_world_map;
+  std::string saved_to;
+  std::optional<slam::MapSaveInfo> save;
+  std::size_t relocalisations = 0;                        ///< tracking found again (the first pose included)
+  std::optional<eval::LocalisationScores> localisation;  ///< with a loaded map and ground truth
+  std::string localisation_note;                          ///< why there is none
+};
+
+/// The application data of a map file: the station it shows and T_world_map.
+std::string map_app_json(const std::string& scenario, std::uint64_t station_seed,
+                         const std::optional<geom::SE3d>& T_world_map);
+/// T_world_map from a map file's application data, when it has one.
+std::optional<geom::SE3d> T_world_map_of(const std::string& app_json);
+
+/// The pose of a new map's frame in the world: the ground truth at the
+/// first pose of the run's trajectory (SLAM's frame is its first camera).
+std::optional<geom::SE3d> T_world_new_map(const eval::Trajectory& gt, const eval::Trajectory& est);
+
+/// Loads the map into `system` when the options name one.
+MapReport start_map(slam::System& system, const MapOptions& options);
+/// Scores localisation in the loaded map against ground truth.
+void score_map_localisation(MapReport* report, const eval::Trajectory& gt, const eval::Trajectory& est);
+/// Saves the final map when the options say so (after System::shutdown()).
+void save_map(slam::System& system, const MapOptions& options, const std::string& scenario,
+              std::uint64_t station_seed, MapReport* report);
+
+/// The "map" object of metrics.json (one line).
+std::string map_report_json(const MapReport& r);
+
+}  // namespace pvb::run

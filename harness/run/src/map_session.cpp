@@ -1,0 +1,145 @@
+#include "pvb/run/map_session.hpp"
+
+#include <cmath>
+#include <cstdlib>
+
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+
+namespace pvb::run {
+namespace {
+
+std::string num(double v) { return json_number(v); }
+
+/// The ground-truth pose within 1 ms of t_ns, if any.
+std::optional<geom::SE3d> pose_at(const eval::Trajectory& t, std::int64_t t_ns) {
+  for (const auto& p : t.poses)
+    if (std::llabs(p.t_ns - t_ns) <= 1'000'000) return p.T_w_c;
+  return std::nullopt;
+}
+
+std::string pose_json(const geom::SE3d& T) {
+  std::string out = "[";
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) out += (r || c ? ", " : "") + num(T.matrix()(r, c));
+  return out + "]";
+}
+
+}  // namespace
+
+const char* to_string(MapUse u) {
+  switch (u) {
+    case MapUse::kFresh:
+      return "fresh";
+    case MapUse::kLocalise:
+      return "localise";
+    case MapUse::kExtend:
+      return "extend";
+  }
+  return "?";
+}
+
+MapUse parse_map_use(const std::string& text, const std::string& option) {
+  if (text == "localise") return MapUse::kLocalise;
+  if (text == "extend") return MapUse::kExtend;
+  throw ConfigError(option, "", "localise or extend", text);
+}
+
+void MapOptions::check() const {
+  if (!load_path.empty() && use == MapUse::kFresh)
+    throw ConfigError("--map-mode", "", "localise or extend with --map");
+  if (load_path.empty() && use != MapUse::kFresh)
+    throw ConfigError("--map", "", "the saved map to " + std::string(to_string(use)) + " (--map-mode needs it)");
+  if (use == MapUse::kLocalise && !save_path.empty())
+    throw ConfigError("--save-map", "", "a map made or extended by the run, not with --map-mode localise");
+}
+
+std::string map_app_json(const std::string& scenario, std::uint64_t station_seed,
+                         const std::optional<geom::SE3d>& T_world_map) {
+  return "{\"scenario\": " + std::string("\"") + json_escape(scenario) + "\", \"station_seed\": " +
+         std::to_string(station_seed) +
+         ", \"T_world_map\": " + (T_world_map ? pose_json(*T_world_map) : std::string("null")) + "}";
+}
+
+std::optional<geom::SE3d> T_world_map_of(const std::string& app_json) {
+  const std::string key = "\"T_world_map\": [";
+  const std::size_t at = app_json.find(key);
+  if (at == std::string::npos) return std::nullopt;
+  const char* p = app_json.c_str() + at + key.size();
+  Eigen::Matrix<double, 3, 4> m;
+  for (int k = 0; k < 12; ++k) {
+    char* end = nullptr;
+    const double v = std::strtod(p, &end);
+    if (end == p || !std::isfinite(v)) return std::nullopt;
+    m(k / 4, k % 4) = v;
+    p = end;
+    while (*p == ',' || *p == ' ') ++p;
+  }
+  const Eigen::Matrix3d R = m.leftCols<3>();
+  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6) return std::nullopt;
+  return geom::make_se3(R, m.col(3));
+}
+
+std::optional<geom::SE3d> T_world_new_map(const eval::Trajectory& gt, const eval::Trajectory& est) {
+  if (est.empty()) return std::nullopt;
+  const auto T_world_c = pose_at(gt, est.poses.front().t_ns);
+  if (!T_world_c) return std::nullopt;
+  return *T_world_c * est.poses.front().T_w_c.inverse();
+}
+
+MapReport start_map(slam::System& system, const MapOptions& options) {
+  options.check();
+  MapReport r;
+  r.use = options.use;
+  if (options.load_path.empty()) return r;
+  r.loaded_from = options.load_path;
+  r.load = system.load_map(options.load_path, options.use == MapUse::kLocalise ? slam::MapStart::kLocalise
+                                                                               : slam::MapStart::kExtend);
+  r.T_world_map = T_world_map_of(r.load->app_json);
+  return r;
+}
+
+void score_map_localisation(MapReport* r, const eval::Trajectory& gt, const eval::Trajectory& est) {
+  if (!r->load) return;
+  if (gt.empty()) {
+    r->localisation_note = "no ground truth";
+  } else if (!r->T_world_map) {
+    r->localisation_note = "the map does not say where its frame lies in the world (no T_world_map)";
+  } else {
+    r->localisation = eval::score_localisation(gt, est, *r->T_world_map);
+  }
+}
+
+void save_map(slam::System& system, const MapOptions& options, const std::string& scenario,
+              std::uint64_t station_seed, MapReport* r) {
+  if (options.save_path.empty()) return;
+  r->saved_to = options.save_path;
+  r->save = system.save_map(options.save_path, map_app_json(scenario, station_seed, r->T_world_map));
+}
+
+std::string map_report_json(const MapReport& r) {
+  std::string out = "{\"use\": \"" + std::string(to_string(r.use)) + "\"";
+  if (r.load) {
+    const slam::MapLoadInfo& l = *r.load;
+    out += ", \"loaded\": {\"file\": \"" + json_escape(r.loaded_from) + "\", \"sessions\": " +
+           std::to_string(l.sessions) + ", \"keyframes\": " + std::to_string(l.keyframes) +
+           ", \"points\": " + std::to_string(l.points) + ", \"bytes\": " + std::to_string(l.bytes) +
+           ", \"load_ms\": " + num(l.load_ms) + "}, \"relocalisations\": " + std::to_string(r.relocalisations);
+  }
+  out += ", \"T_world_map\": " + (r.T_world_map ? pose_json(*r.T_world_map) : std::string("null"));
+  if (r.save) {
+    const slam::MapSaveInfo& s = *r.save;
+    out += ", \"saved\": {\"file\": \"" + json_escape(r.saved_to) + "\", \"sessions\": " +
+           std::to_string(s.sessions) + ", \"keyframes\": " + std::to_string(s.keyframes) +
+           ", \"points\": " + std::to_string(s.points) + ", \"bytes\": " + std::to_string(s.bytes) +
+           ", \"bytes_per_keyframe\": " + num(s.keyframes ? double(s.bytes) / double(s.keyframes) : 0.0) +
+           ", \"save_ms\": " + num(s.save_ms) + "}";
+  }
+  if (r.load)
+    out += ", \"localisation\": " +
+           (r.localisation ? eval::localisation_json(*r.localisation)
+                           : "null, \"localisation_note\": \"" + json_escape(r.localisation_note) + "\"");
+  return out + "}";
+}
+
+}  // namespace pvb::run
