@@ -1,5 +1,6 @@
-// pvbench sweep: runs one scenario over a list of seeds, each seed as an
-// independent child process `pvbench run ... --seed S --out DIR/seed_S`
+// pvbench sweep: runs one scenario (or campaign) over a list of seeds, each
+// seed as an independent child process `pvbench run ... --seed S --out
+// DIR/seed_S` (`pvbench campaign ...` with --campaign)
 // (this same binary, through /proc/self/exe), at most --jobs at once, then
 // aggregates DIR/seed_*/metrics.json into DIR/aggregate.{md,csv,json,svg,png}
 // and, with --compare, prints the paired PE-SLAM − baseline ATE line last.
@@ -30,9 +31,12 @@
 #include "pvb/common/output_folder.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/eval/plot.hpp"
+#include "pvb/plot/matrix.hpp"
 #include "pvb/plot/png.hpp"
+#include "pvb/run/campaign.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/suite/aggregate.hpp"
+#include "pvb/suite/campaign_aggregate.hpp"
 #include "pvb/suite/check.hpp"
 #include "pvb/suite/metrics_file.hpp"
 #include "pvb/suite/seeds.hpp"
@@ -50,6 +54,7 @@ constexpr int kInterruptedExit = 130;
 
 struct SweepArgs {
   std::string scenario;
+  std::string campaign;  ///< sweep a campaign instead of a scenario
   std::string seeds;
   std::string jobs_text = "1";  ///< --jobs, checked by parse_count
   int jobs = 1;
@@ -81,6 +86,8 @@ std::vector<std::string> run_args(const SweepArgs& a, std::uint64_t seed) {
   // checked once, by the sweep).
   std::vector<std::string> v = {"run",   "--scenario",         a.scenario, "--seed", std::to_string(seed),
                                 "--out", seed_dir(a.out, seed), "--overwrite"};
+  if (!a.campaign.empty()) v = {"campaign", "--campaign", a.campaign, "--seed", std::to_string(seed),
+                                "--out",    seed_dir(a.out, seed), "--overwrite"};
   if (a.frames > 0) {
     v.push_back("--frames");
     v.push_back(std::to_string(a.frames));
@@ -172,6 +179,18 @@ std::string seed_summary(const suite::SeedRun& r) {
   return s;
 }
 
+std::string campaign_seed_summary(const std::string& dir, std::uint64_t seed) {
+  const suite::CampaignSeed c = suite::read_campaign_seed(seed, dir + "/campaign.json");
+  if (!c.error.empty()) return "no campaign.json: " + c.error;
+  int completed = 0, wrong = 0;
+  for (const auto& s : c.sessions) {
+    completed += s.status == "completed";
+    wrong += s.wrong_place.value_or(0);
+  }
+  return std::to_string(completed) + " of " + std::to_string(c.sessions.size()) + " sessions completed, " +
+         std::to_string(wrong) + " wrong-place poses";
+}
+
 /// Runs every seed, at most a.jobs at once.  Returns each seed's exit code
 /// (-1 for a seed never started because the sweep was stopped).
 std::map<std::uint64_t, int> run_seeds(const SweepArgs& a, const std::vector<std::uint64_t>& seeds) {
@@ -221,9 +240,11 @@ std::map<std::uint64_t, int> run_seeds(const SweepArgs& a, const std::vector<std
     const int code =
         WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
     exit_codes[seed] = code;
-    const suite::SeedRun r = suite::read_seed_run(seed, seed_dir(a.out, seed) + "/metrics.json", code);
+    const std::string summary =
+        a.campaign.empty() ? seed_summary(suite::read_seed_run(seed, seed_dir(a.out, seed) + "/metrics.json", code))
+                           : campaign_seed_summary(seed_dir(a.out, seed), seed);
     std::printf("[%zu/%zu] seed %llu: %s; %s\n", done, seeds.size(), static_cast<unsigned long long>(seed),
-                describe_exit(status).c_str(), seed_summary(r).c_str());
+                describe_exit(status).c_str(), summary.c_str());
     if (code != 0) std::printf("  see %s/stdout.log\n", seed_dir(a.out, seed).c_str());
     std::fflush(stdout);
   }
@@ -298,6 +319,39 @@ suite::SweepAggregate write_aggregate(const SweepArgs& a, const std::string& sce
   return agg;
 }
 
+/// A campaign sweep: DIR/aggregate.{md,json} per session and the matrix of
+/// the mean shares within (0.25 m, 2 deg).  Returns the seeds that failed.
+int write_campaign_aggregate(const SweepArgs& a, const std::vector<std::uint64_t>& seeds) {
+  std::vector<suite::CampaignSeed> runs;
+  for (std::uint64_t s : seeds) runs.push_back(suite::read_campaign_seed(s, seed_dir(a.out, s) + "/campaign.json"));
+  const suite::CampaignAggregate agg = suite::aggregate_campaign(runs);
+  const fs::path out(a.out);
+  write_file((out / "aggregate.md").string(), suite::format_campaign_markdown(agg));
+  write_file((out / "aggregate.json").string(), suite::format_campaign_json(agg));
+  plot::MatrixFigure m;
+  m.title = "campaign " + agg.campaign + ", " + std::to_string(seeds.size()) + " seeds: mean share within 0.25 m, 2 deg";
+  m.row_label = "the session whose map is used";
+  m.col_label = "query session";
+  for (const auto& g : agg.sessions) {
+    if (g.mode != "localise") m.rows.push_back(g.name);
+    if (g.mode != "map") m.cols.push_back(g.name);
+  }
+  m.values.assign(m.rows.size(), std::vector<std::optional<double>>(m.cols.size()));
+  for (const auto& g : agg.sessions) {
+    const auto row = std::find(m.rows.begin(), m.rows.end(), g.map);
+    const auto col = std::find(m.cols.begin(), m.cols.end(), g.name);
+    if (row != m.rows.end() && col != m.cols.end() && g.high.count > 0)
+      m.values[row - m.rows.begin()][col - m.cols.begin()] = g.high.mean;
+  }
+  plot::write_matrix(m, (out / "matrix").string());
+  std::printf("\n%s\nwrote %s/aggregate.{md,json}, matrix.{svg,png}\n", suite::format_campaign_markdown(agg).c_str(),
+              a.out.c_str());
+  std::fflush(stdout);
+  int failed = static_cast<int>(agg.seed_errors.size());
+  for (const auto& g : agg.sessions) failed += g.failed;
+  return failed;
+}
+
 /// --check: every seed against the scenario's single-run bounds and the sweep
 /// against expect.sweep; one line per violation (or one "ok" line).  Returns
 /// true when everything holds.
@@ -312,17 +366,45 @@ bool check_sweep_and_print(const std::string& scenario_file, const suite::SweepA
   return violations.empty();
 }
 
+/// A sweep of a campaign: each seed a `pvbench campaign` child process.
+int run_campaign_sweep(const SweepArgs& a) {
+  if (!a.scenario.empty() || a.compare || a.baseline || a.check)
+    throw ConfigError("command line", "--campaign", "no --scenario, --compare, --baseline or --check with it");
+  const run::Campaign campaign = run::load_campaign(a.campaign);  // validates the file early
+  std::vector<std::uint64_t> seeds;
+  if (a.aggregate_only) {
+    seeds = a.seeds.empty() ? discover_seeds(a.out) : suite::parse_seed_list(a.seeds);
+    if (seeds.empty()) throw ConfigError(a.out, "seed_*/campaign.json", "at least one seed folder", "none");
+    return write_campaign_aggregate(a, seeds) > 0 ? kSeedFailedExit : 0;
+  }
+  if (a.seeds.empty()) throw ConfigError("command line", "--seeds", "a seed list like 1-20, 1,3,5 or 1-5,9");
+  seeds = suite::parse_seed_list(a.seeds);
+  if (a.print_commands) {
+    const std::string exe = self_path();
+    for (std::uint64_t s : seeds) std::printf("%s\n", seed_command(a, exe, s).c_str());
+    return 0;
+  }
+  prepare_output_folder(a.out, a.overwrite, "sweep");
+  std::printf("sweep: campaign %s, %zu seed(s), %d at once, into %s\n", campaign.name.c_str(), seeds.size(), a.jobs,
+              a.out.c_str());
+  run_seeds(a, seeds);
+  const int failed = write_campaign_aggregate(a, seeds);
+  if (g_stop_signal != 0) return kInterruptedExit;
+  return failed > 0 ? kSeedFailedExit : 0;
+}
+
 int run_sweep(SweepArgs a) {
   a.jobs = static_cast<int>(parse_count("sweep", "--jobs", a.jobs_text, 1, 1024));
   if (!a.frames_text.empty())
     a.frames = static_cast<int>(parse_count("sweep", "--frames", a.frames_text, 1, 10'000'000));
   if (a.compare && a.baseline)
     throw ConfigError("command line", "--baseline", "either --compare or --baseline, not both");
+  if (!a.campaign.empty()) return run_campaign_sweep(a);
   std::string scenario_name;
   if (!a.scenario.empty())
     scenario_name = scenes::load_scenario(a.scenario).name;  // validates the file early
   else if (!a.aggregate_only)
-    throw ConfigError("command line", "--scenario", "a scenario file");
+    throw ConfigError("command line", "--scenario", "a scenario file (or --campaign)");
 
   if (a.check && a.scenario.empty())
     throw ConfigError("command line", "--check", "a --scenario whose expect: section judges the sweep");
@@ -363,6 +445,7 @@ Command add_sweep_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "sweep", "Run a scenario over many seeds in parallel processes and aggregate the results");
   sub->add_option("--scenario", args->scenario, "scenario YAML file");
+  sub->add_option("--campaign", args->campaign, "campaign YAML file: sweep pvbench campaign instead of pvbench run");
   sub->add_option("--seeds", args->seeds, "seed list: 1-20, 1,3,5 or 1-5,9");
   sub->add_option("--jobs,-j", args->jobs_text, "seeds run at once")->capture_default_str();
   sub->add_option("--out", args->out, "sweep folder (DIR/seed_S per seed, DIR/aggregate.*; refused when not empty)")

@@ -23,6 +23,7 @@ Command add_map_check_command(CLI::App& app);
 Command add_vocab_command(CLI::App& app);
 Command add_eval_map_command(CLI::App& app);
 Command add_sheet_command(CLI::App& app);
+Command add_campaign_command(CLI::App& app);
 
 // Sub-commands register here (one line each).
 std::vector<Command> add_all_commands(CLI::App& app) {
@@ -35,6 +36,7 @@ std::vector<Command> add_all_commands(CLI::App& app) {
   cmds.push_back(add_camera_command(app));
 #endif
   cmds.push_back(add_run_command(app));
+  cmds.push_back(add_campaign_command(app));
   cmds.push_back(add_check_command(app));
   cmds.push_back(add_sweep_command(app));
   cmds.push_back(add_map_check_command(app));

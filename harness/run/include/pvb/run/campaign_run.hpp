@@ -1,0 +1,69 @@
+#pragma once
+// Running a campaign: its sessions in order, each a scenario run in its
+// folder (OUT/SESSION), the maps passed along in OUT/maps/SESSION.pvbmap,
+// then OUT/campaign.json, OUT/campaign.md, the matrix figure (map session
+// x query session, coloured by the share of frames within 0.25 m and 2 deg)
+// and OUT/index.html (docs/map_reuse.md).
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pvb/plot/matrix.hpp"
+#include "pvb/run/campaign.hpp"
+#include "pvb/run/map_session.hpp"
+#include "pvb/run/report.hpp"
+
+namespace pvb::run {
+
+struct CampaignOptions {
+  std::string campaign_file;
+  std::string out_dir;
+  bool overwrite = false;
+  /// Session i runs with seed * 1000 + i (the station seed stays the
+  /// scenario's); nullopt: each scenario's own seed.
+  std::optional<std::uint64_t> seed;
+  int max_frames = 0;  ///< per session (0: the scenario's duration)
+  bool sync = false;
+  bool map_eval = true;
+  std::string gl = "auto";
+  const std::atomic<bool>* stop = nullptr;
+  std::function<void(const std::string&)> on_log;
+};
+
+/// One session's outcome.
+struct SessionResult {
+  CampaignSession session;
+  std::uint64_t seed = 0;
+  std::string error;  ///< why it did not run or failed ("" when it ran)
+  std::optional<RunStatus> status;
+  std::size_t frames = 0, lost_frames = 0, keyframes = 0;
+  std::size_t keyframes_loaded = 0;  ///< in the map it started from (0 for a new map)
+  std::optional<double> ate_rmse_m;
+  double tracking_ms_median = 0;
+  std::optional<MapReport> map;
+};
+
+struct CampaignReport {
+  Campaign campaign;
+  std::optional<std::uint64_t> seed;
+  std::vector<SessionResult> sessions;
+  bool stopped = false;
+};
+
+/// Runs every session in order.  A session whose map is missing (its map
+/// session failed) is skipped with the reason.  Throws pvb::Error for a bad
+/// campaign file or output folder.
+CampaignReport run_campaign(const CampaignOptions& options);
+
+/// campaign.json: the campaign, its seed and each session's figures.
+std::string campaign_json(const CampaignReport& r);
+/// The matrix of a campaign: rows the sessions that leave a map, columns
+/// those that start from one, each cell the share within (0.25 m, 2 deg).
+plot::MatrixFigure campaign_matrix(const CampaignReport& r);
+/// 0 when every session completed, else non-zero.
+int campaign_exit_code(const CampaignReport& r);
+
+}  // namespace pvb::run

@@ -1,0 +1,193 @@
+#include "pvb/run/campaign_run.hpp"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <filesystem>
+
+#include "pvb/common/error.hpp"
+#include "pvb/common/output_folder.hpp"
+#include "pvb/common/text.hpp"
+#include "pvb/run/run.hpp"
+
+namespace pvb::run {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string map_file(const std::string& out, const std::string& session) {
+  return (fs::path(out) / "maps" / (session + ".pvbmap")).string();
+}
+
+bool exists(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+/// The map options of session `i`: where it loads from and saves to.
+MapOptions session_map(const CampaignOptions& opt, const CampaignSession& s) {
+  MapOptions m;
+  if (s.mode != SessionMode::kMap) {
+    m.load_path = map_file(opt.out_dir, s.map);
+    m.use = s.mode == SessionMode::kLocalise ? MapUse::kLocalise : MapUse::kExtend;
+  }
+  if (s.mode != SessionMode::kLocalise) m.save_path = map_file(opt.out_dir, s.name);
+  return m;
+}
+
+void fill_result(const RunReport& rep, SessionResult* r) {
+  const SlamRun& p = rep.primary;
+  r->seed = rep.seed;
+  r->status = rep.status;
+  r->frames = p.frames;
+  r->lost_frames = p.lost_frames;
+  r->keyframes = p.keyframes;
+  if (p.map && p.map->load) r->keyframes_loaded = p.map->load->keyframes;
+  if (p.eval) r->ate_rmse_m = p.eval->ate.rmse;
+  std::vector<double> ms;
+  for (const auto& f : p.per_frame) ms.push_back(f.tracking_ms);
+  r->tracking_ms_median = percentile(ms, 0.5);
+  r->map = p.map;
+}
+
+SessionResult run_session(const CampaignOptions& opt, const Campaign& c, std::size_t i) {
+  SessionResult r;
+  r.session = c.sessions[i];
+  const CampaignSession& s = r.session;
+  RunOptions o;
+  o.scenario_file = s.scenario_file;
+  o.out_dir = (fs::path(opt.out_dir) / s.name).string();
+  if (opt.seed) o.seed = *opt.seed * 1000 + i;
+  o.max_frames = opt.max_frames;
+  o.sync = opt.sync;
+  o.map_eval = opt.map_eval;
+  o.gl = opt.gl;
+  o.stop = opt.stop;
+  o.start_m = s.start_m;
+  o.map = session_map(opt, s);
+  if (opt.on_log) o.on_log = [&](const std::string& line) { opt.on_log("[" + s.name + "] " + line); };
+  if (!o.map.load_path.empty() && !exists(o.map.load_path)) {
+    r.error = "session " + s.map + " left no map (" + o.map.load_path + ")";
+    return r;
+  }
+  try {
+    fill_result(run_scenario(o), &r);
+  } catch (const Error& e) {
+    r.error = e.what();
+  }
+  return r;
+}
+
+std::string num_or_null(const std::optional<double>& v) { return v ? json_number(*v) : "null"; }
+
+std::string session_json(const SessionResult& r) {
+  const CampaignSession& s = r.session;
+  std::string out = "{\"name\": \"" + json_escape(s.name) + "\", \"mode\": \"" + to_string(s.mode) +
+                    "\", \"map\": " + (s.map.empty() ? "null" : "\"" + json_escape(s.map) + "\"") +
+                    ", \"scenario\": \"" + json_escape(s.scenario_file) + "\", \"start_m\": " +
+                    num_or_null(s.start_m) + ", \"seed\": " + std::to_string(r.seed) + ", \"status\": " +
+                    (r.status ? "\"" + std::string(to_string(*r.status)) + "\"" : "null") +
+                    ", \"error\": " + (r.error.empty() ? "null" : "\"" + json_escape(r.error) + "\"");
+  out += ", \"frames\": " + std::to_string(r.frames) + ", \"lost_frames\": " + std::to_string(r.lost_frames) +
+         ", \"keyframes\": " + std::to_string(r.keyframes) + ", \"keyframes_loaded\": " +
+         std::to_string(r.keyframes_loaded) + ", \"ate_rmse\": " + num_or_null(r.ate_rmse_m) +
+         ", \"tracking_ms_median\": " + json_number(r.tracking_ms_median);
+  out += ", \"map_report\": " + (r.map ? map_report_json(*r.map) : std::string("null"));
+  return out + "}";
+}
+
+/// campaign.md: one row per session.
+std::string campaign_markdown(const CampaignReport& r) {
+  std::string out = "# Campaign " + r.campaign.name + "\n\n" + r.campaign.description + "\n\n";
+  out += "| session | mode | map | frames | lost | keyframes (loaded) | within 0.05 m/1 deg | within 0.25 m/2 deg "
+         "| wrong place | first pose (frame) | tracking ms median |\n";
+  out += "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const SessionResult& s : r.sessions) {
+    const auto* l = s.map && s.map->localisation ? &*s.map->localisation : nullptr;
+    const auto pct = [&](std::size_t k) { return l ? format_fixed(100 * l->share_within[k], 1) + " %" : "-"; };
+    out += "| " + s.session.name + " | " + to_string(s.session.mode) + " | " +
+           (s.session.map.empty() ? "-" : s.session.map) + " | " +
+           (s.error.empty() ? std::to_string(s.frames) : "failed: " + s.error) + " | " +
+           std::to_string(s.lost_frames) + " | " + std::to_string(s.keyframes) + " (" +
+           std::to_string(s.keyframes_loaded) + ") | " + pct(0) + " | " + pct(1) + " | " +
+           (l ? std::to_string(l->wrong_place) : "-") + " | " +
+           (l && l->first_pose_frame ? std::to_string(*l->first_pose_frame) : "-") + " | " +
+           format_fixed(s.tracking_ms_median, 2) + " |\n";
+  }
+  return out;
+}
+
+std::string campaign_html(const CampaignReport& r, const std::string& markdown) {
+  std::string out = "<!doctype html><html><head><meta charset=\"utf-8\"><title>campaign " + r.campaign.name +
+                    "</title></head><body style=\"font-family:sans-serif\">\n<pre>" + markdown + "</pre>\n";
+  out += "<img src=\"matrix.png\" alt=\"map session x query session\">\n<ul>\n";
+  for (const SessionResult& s : r.sessions)
+    out += "<li><a href=\"" + s.session.name + "/index.html\">" + s.session.name + "</a></li>\n";
+  return out + "</ul></body></html>\n";
+}
+
+}  // namespace
+
+CampaignReport run_campaign(const CampaignOptions& opt) {
+  CampaignReport report;
+  report.campaign = load_campaign(opt.campaign_file);
+  report.seed = opt.seed;
+  prepare_output_folder(opt.out_dir, opt.overwrite, "campaign");
+  std::error_code ec;
+  fs::create_directories(fs::path(opt.out_dir) / "maps", ec);
+  if (ec) throw IoError(opt.out_dir + "/maps", "cannot create the maps folder: " + ec.message());
+  for (std::size_t i = 0; i < report.campaign.sessions.size(); ++i) {
+    if (opt.stop && opt.stop->load()) {
+      report.stopped = true;
+      break;
+    }
+    report.sessions.push_back(run_session(opt, report.campaign, i));
+    if (!report.sessions.back().error.empty() && opt.on_log)
+      opt.on_log("[" + report.sessions.back().session.name + "] failed: " + report.sessions.back().error);
+    // Written after every session: a stopped campaign keeps what it did.
+    write_file(opt.out_dir + "/campaign.json", campaign_json(report));
+  }
+  const std::string md = campaign_markdown(report);
+  write_file(opt.out_dir + "/campaign.md", md);
+  plot::write_matrix(campaign_matrix(report), opt.out_dir + "/matrix");
+  write_file(opt.out_dir + "/index.html", campaign_html(report, md));
+  if (opt.on_log) opt.on_log(md);
+  return report;
+}
+
+std::string campaign_json(const CampaignReport& r) {
+  std::string out = "{\n  \"campaign_version\": 1,\n  \"campaign\": \"" + json_escape(r.campaign.name) +
+                    "\",\n  \"file\": \"" + json_escape(r.campaign.file) + "\",\n  \"seed\": " +
+                    (r.seed ? std::to_string(*r.seed) : std::string("null")) + ",\n  \"sessions\": [";
+  for (std::size_t i = 0; i < r.sessions.size(); ++i) out += (i ? ",\n    " : "\n    ") + session_json(r.sessions[i]);
+  return out + "\n  ]\n}\n";
+}
+
+plot::MatrixFigure campaign_matrix(const CampaignReport& r) {
+  plot::MatrixFigure m;
+  m.title = "campaign " + r.campaign.name + ": share of frames within 0.25 m and 2 deg";
+  m.row_label = "the session whose map is used";
+  m.col_label = "query session";
+  for (const auto& s : r.campaign.sessions) {
+    if (s.mode != SessionMode::kLocalise) m.rows.push_back(s.name);
+    if (s.mode != SessionMode::kMap) m.cols.push_back(s.name);
+  }
+  m.values.assign(m.rows.size(), std::vector<std::optional<double>>(m.cols.size()));
+  for (const SessionResult& s : r.sessions) {
+    if (!s.map || !s.map->localisation) continue;
+    const auto row = std::find(m.rows.begin(), m.rows.end(), s.session.map);
+    const auto col = std::find(m.cols.begin(), m.cols.end(), s.session.name);
+    if (row == m.rows.end() || col == m.cols.end()) continue;
+    m.values[row - m.rows.begin()][col - m.cols.begin()] = s.map->localisation->share_within[1];
+  }
+  return m;
+}
+
+int campaign_exit_code(const CampaignReport& r) {
+  if (r.stopped) return 130;
+  for (const SessionResult& s : r.sessions)
+    if (!s.error.empty() || !s.status || *s.status != RunStatus::kCompleted) return 3;
+  return 0;
+}
+
+}  // namespace pvb::run
