@@ -21,6 +21,7 @@
 
 #include "command.hpp"
 #include "count_option.hpp"
+#include "map_options.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/output_folder.hpp"
 #include "pvb/dataset/fakenect_dump.hpp"
@@ -57,6 +58,8 @@ struct CameraArgs {
   std::uint32_t seed = 1;
   bool no_pe_match = false;
   std::string timeout_ms = "10000";  ///< checked by parse_count
+  run::MapOptions map;
+  std::string map_mode;
 };
 
 /// Files written into --out (a recording must not land on one of them).
@@ -333,10 +336,28 @@ void evaluate_against_ground_truth(const std::string& out, std::ostringstream& j
   }
 }
 
+/// With a map loaded or to save: the localisation scored against the run's
+/// ground truth (when it has one) and the map saved; stats.json's "map".
+void finish_camera_map(const CameraArgs& a, const std::string& source, slam::System& system,
+                       run::MapReport* map, std::ostringstream& js) {
+  const auto read = [](const std::string& path) {
+    try {
+      return eval::read_tum(path);
+    } catch (const Error&) {
+      return eval::Trajectory{};  // none, or nothing tracked
+    }
+  };
+  const eval::Trajectory gt = readable(a.out + "/groundtruth.txt") ? read(a.out + "/groundtruth.txt") : eval::Trajectory{};
+  run::finish_map(system, a.map, gt, read(a.out + "/CameraTrajectory.txt"), source, 0, map);
+  for (const std::string& line : run::map_log_lines(*map)) std::printf("%s\n", line.c_str());
+  js << ",\n  \"map\": " << run::map_report_json(*map);
+}
+
 /// Prints the summary and writes stats.json (and the ATE for sim:// runs).
 void report_run(const CameraArgs& a, const slam::Settings& settings, openni::OpenniSource& source,
                 slam::System& system, const TrackCounts& c,
-                const std::optional<openni::RecordingSummary>& rec, LiveOutputs& live) {
+                const std::optional<openni::RecordingSummary>& rec, LiveOutputs& live,
+                std::optional<run::MapReport>& map) {
   const double fps = c.elapsed_s > 0 ? static_cast<double>(c.frames) / c.elapsed_s : 0.0;
   std::ostringstream js;
   js << "{\n  \"source\": \"" << json_escape(source.describe())
@@ -370,6 +391,7 @@ void report_run(const CameraArgs& a, const slam::Settings& settings, openni::Ope
     if (!live.dump_gt.empty()) write_file(a.out + "/groundtruth.txt", read_file(live.dump_gt));
     evaluate_against_ground_truth(a.out, js);
   }
+  if (map) finish_camera_map(a, source.describe(), system, &*map, js);
   js << "\n}\n";
   write_file(a.out + "/stats.json", js.str());
   std::printf("wrote %s/{camera.yaml,CameraTrajectory.txt,KeyFrameTrajectory.txt,map.ply,stats.json%s}\n",
@@ -389,7 +411,8 @@ void fail_on_problems(const std::string& source, const TrackCounts& c,
                               " frames (too few points with valid depth: is the depth stream all zeros?)");
 }
 
-int run_camera(const CameraArgs& a) {
+int run_camera(CameraArgs a) {
+  if (!a.map_mode.empty()) a.map.use = run::parse_map_use(a.map_mode, "--map-mode");
   const std::size_t max_frames =
       parse_count("camera", "--frames", a.frames, 0, 1'000'000'000, " (0: until the stream ends)");
   const int timeout_ms = static_cast<int>(parse_count("camera", "--timeout-ms", a.timeout_ms, 1, 86'400'000));
@@ -398,6 +421,7 @@ int run_camera(const CameraArgs& a) {
   sim::install_mujoco_handlers();
   const std::optional<scenes::Scenario> scenario = check_inputs(a);
   check_settings_source(a, scenario);
+  a.map.check();
   prepare_output_folder(a.out, a.overwrite, "camera");
   const CameraSettings settings = prepare_settings(a, scenario);
   openni::OpenniSource source(source_options(a, settings.slam, timeout_ms));
@@ -406,6 +430,8 @@ int run_camera(const CameraArgs& a) {
   options.synchronous = a.sync;
   options.seed = a.seed;
   slam::System system(settings.slam, options);
+  std::optional<run::MapReport> map;
+  if (!a.map.load_path.empty() || !a.map.save_path.empty()) map = run::start_map(system, a.map);
   LiveOutputs live = open_live_outputs(a, scenario);
 
   const TrackCounts counts = track_frames(source, max_frames, settings, system, live);
@@ -414,7 +440,7 @@ int run_camera(const CameraArgs& a) {
   live.cam_traj.close();
   write_tum_file(a.out + "/KeyFrameTrajectory.txt", system.keyframe_trajectory());
   write_map_ply(a.out + "/map.ply", system.map_point_positions());
-  report_run(a, settings.slam, source, system, counts, rec, live);
+  report_run(a, settings.slam, source, system, counts, rec, live, map);
   fail_on_problems(source.describe(), counts, rec);
   return 0;
 }
@@ -449,6 +475,7 @@ Command add_camera_command(CLI::App& app) {
   sub->add_flag("--no-pe-match", args->no_pe_match, "baseline: ORB-SLAM2 motion model without PE-match");
   sub->add_option("--timeout-ms", args->timeout_ms, "no frame for this long is an error")
       ->capture_default_str();
+  add_map_options(sub, &args->map, &args->map_mode);
   return {sub, [args, uri, oni] {
             if (uri->count() == 0 && oni->count() == 0)
               throw ConfigError("pvbench camera", "--uri/--oni", "one of them");

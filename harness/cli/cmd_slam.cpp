@@ -15,6 +15,7 @@
 
 #include "command.hpp"
 #include "count_option.hpp"
+#include "map_options.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/output_folder.hpp"
 #include "pvb/common/output_file.hpp"
@@ -47,6 +48,8 @@ struct SlamArgs {
   double max_missing = 0.1;
   bool dump_matches = false;
   bool dump_map = false;
+  run::MapOptions map;
+  std::string map_mode;
 };
 
 /// Ground-truth scoring of the motion model's coarse matches (--dump-matches):
@@ -175,6 +178,7 @@ struct Tally {
   std::vector<double> cpu_ms;  ///< caller-thread CPU per frame: tracking, plus inline mapping in sync mode
   std::string init_failure;    ///< why the last frame failed to initialise
   std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made
+  std::vector<std::int64_t> frame_t_ns;     ///< every frame tracked
 };
 
 double mean_of(const std::vector<double>& v) {
@@ -200,6 +204,8 @@ class SlamRun {
   /// Labels the loops and relocalisations against `gt` and prints them.
   void label_places(const eval::Trajectory& gt);
   void fail_if_incomplete(StopReason stop) const;
+  /// Scores localisation in a loaded map and saves the final map; appends stats.json's "map".
+  void finish_map(std::ostringstream* js);
 
   const SlamArgs& a_;
   slam::Settings settings_;
@@ -210,6 +216,7 @@ class SlamRun {
   Tally tally_;
   run::PlaceRecognition place_;  ///< collected after the run, labelled when there is ground truth
   std::string image_size_error_;  ///< set when the loop stopped on an image of the wrong size
+  std::optional<run::MapReport> map_;  ///< with --map or --save-map
 };
 
 /// Missing frames always allowed, whatever --max-missing says.
@@ -237,11 +244,13 @@ SlamRun::SlamRun(const SlamArgs& a)
   reader_.set_max_skipped(std::max<std::size_t>(
       kMinMissingAllowed,
       static_cast<std::size_t>(std::floor(a.max_missing * static_cast<double>(reader_.size_hint())))));
+  a.map.check();
   prepare_output_folder(a.out, a.overwrite, "slam");
   slam::SystemOptions options;
   options.synchronous = a.sync;
   options.seed = a.seed;
   system_ = std::make_unique<slam::System>(settings_, options);
+  if (!a.map.load_path.empty() || !a.map.save_path.empty()) map_ = run::start_map(*system_, a.map);
   open_outputs();
 }
 
@@ -297,6 +306,7 @@ slam::TrackingState SlamRun::track_one(const sensor::RgbdFrame& frame) {
   const slam::FrameResult r = system_->track(frame);
   const double cpu_ms = thread_cpu_ms() - cpu0_ms;
   tally_.cpu_ms.push_back(cpu_ms);
+  tally_.frame_t_ns.push_back(frame.t_ns);
   ++tally_.frames;
   if (r.state == slam::TrackingState::kLost) ++tally_.lost;
   if (r.state == slam::TrackingState::kNotInitialized) {
@@ -410,6 +420,19 @@ void SlamRun::evaluate(std::ostringstream* js) {
   }
 }
 
+void SlamRun::finish_map(std::ostringstream* js) {
+  if (!map_) return;
+  const std::string gt_path = a_.sequence + "/groundtruth.txt";
+  // The ground truth at the frames' times: every frame counts once.
+  const eval::Trajectory gt =
+      std::ifstream(gt_path) ? run::ground_truth_at(eval::read_tum(gt_path), tally_.frame_t_ns) : eval::Trajectory{};
+  const eval::Trajectory est =
+      tally_.poses > 0 ? eval::read_tum(a_.out + "/CameraTrajectory.txt") : eval::Trajectory{};
+  run::finish_map(*system_, a_.map, gt, est, a_.sequence, 0, &*map_);
+  for (const std::string& line : run::map_log_lines(*map_)) std::printf("%s\n", line.c_str());
+  *js << ",\n  \"map\": " << run::map_report_json(*map_);
+}
+
 void SlamRun::label_places(const eval::Trajectory& gt) {
   run::label_place_recognition(&place_, gt);
   const eval::PlaceLabels& l = *place_.labels;
@@ -500,6 +523,7 @@ int SlamRun::run() {
   js << stats_json(stop, dense_json);
   place_ = run::collect_place_recognition(*system_, tally_.keyframe_t_ns);
   evaluate(&js);
+  finish_map(&js);
   js << ",\n  \"place_recognition\": " << run::place_json(place_);
   if (scorer_) js << ",\n  " << scorer_->json();
   js << "\n}\n";
@@ -512,7 +536,8 @@ int SlamRun::run() {
   return stop == StopReason::kSignal ? 130 : 0;
 }
 
-int run_slam(const SlamArgs& a) {
+int run_slam(SlamArgs a) {
+  if (!a.map_mode.empty()) a.map.use = run::parse_map_use(a.map_mode, "--map-mode");
   SlamRun run(a);
   return run.run();
 }
@@ -546,6 +571,7 @@ Command add_slam_command(CLI::App& app) {
          "stop (exit 1, outputs kept) when more than this share of the frames, 0 to 1, and more than 5 "
          "frames are missing or corrupt")
       ->capture_default_str();
+  add_map_options(sub, &args->map, &args->map_mode);
   return {sub, [args] { return run_slam(*args); }};
 }
 

@@ -1,5 +1,6 @@
 #include "pvb/run/map_session.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -11,11 +12,20 @@ namespace {
 
 std::string num(double v) { return json_number(v); }
 
-/// The ground-truth pose within 1 ms of t_ns, if any.
+/// The ground-truth pose at t_ns: one within 1 ms, or interpolated between
+/// two at most 50 ms apart around it (a motion-capture rate unlike the
+/// camera's); nullopt otherwise.
 std::optional<geom::SE3d> pose_at(const eval::Trajectory& t, std::int64_t t_ns) {
-  for (const auto& p : t.poses)
-    if (std::llabs(p.t_ns - t_ns) <= 1'000'000) return p.T_w_c;
-  return std::nullopt;
+  const auto& p = t.poses;
+  const auto it = std::lower_bound(p.begin(), p.end(), t_ns,
+                                   [](const geom::StampedPose& a, std::int64_t t) { return a.t_ns < t; });
+  if (it != p.end() && std::llabs(it->t_ns - t_ns) <= 1'000'000) return it->T_w_c;
+  if (it != p.begin() && std::llabs(std::prev(it)->t_ns - t_ns) <= 1'000'000) return std::prev(it)->T_w_c;
+  if (it == p.begin() || it == p.end() || it->t_ns - std::prev(it)->t_ns > 50'000'000) return std::nullopt;
+  const auto& a = *std::prev(it);
+  const double s = double(t_ns - a.t_ns) / double(it->t_ns - a.t_ns);
+  const geom::Quatd q0(a.T_w_c.linear()), q1(it->T_w_c.linear());
+  return geom::make_se3(q0.slerp(s, q1), (1 - s) * a.T_w_c.translation() + s * it->T_w_c.translation());
 }
 
 std::string pose_json(const geom::SE3d& T) {
@@ -80,11 +90,18 @@ std::optional<geom::SE3d> T_world_map_of(const std::string& app_json) {
   return geom::make_se3(R, m.col(3));
 }
 
+eval::Trajectory ground_truth_at(const eval::Trajectory& gt, const std::vector<std::int64_t>& t_ns) {
+  eval::Trajectory out;
+  out.source = gt.source;
+  for (std::int64_t t : t_ns)
+    if (const auto T = pose_at(gt, t); T && (out.poses.empty() || t > out.poses.back().t_ns)) out.poses.push_back({t, *T});
+  return out;
+}
+
 std::optional<geom::SE3d> T_world_new_map(const eval::Trajectory& gt, const eval::Trajectory& est) {
-  if (est.empty()) return std::nullopt;
-  const auto T_world_c = pose_at(gt, est.poses.front().t_ns);
-  if (!T_world_c) return std::nullopt;
-  return *T_world_c * est.poses.front().T_w_c.inverse();
+  for (const auto& p : est.poses)
+    if (const auto T_world_c = pose_at(gt, p.t_ns)) return *T_world_c * p.T_w_c.inverse();
+  return std::nullopt;
 }
 
 MapReport start_map(slam::System& system, const MapOptions& options) {
@@ -115,6 +132,40 @@ void save_map(slam::System& system, const MapOptions& options, const std::string
   if (options.save_path.empty()) return;
   r->saved_to = options.save_path;
   r->save = system.save_map(options.save_path, map_app_json(scenario, station_seed, r->T_world_map));
+}
+
+void finish_map(slam::System& system, const MapOptions& options, const eval::Trajectory& gt,
+                const eval::Trajectory& est, const std::string& name, std::uint64_t station_seed, MapReport* r) {
+  r->relocalisations = system.relocalisations().size();
+  score_map_localisation(r, gt, est);
+  if (!r->load && !gt.empty()) r->T_world_map = T_world_new_map(gt, est);
+  save_map(system, options, name, station_seed, r);
+}
+
+std::vector<std::string> map_log_lines(const MapReport& m) {
+  std::vector<std::string> lines;
+  if (m.load) {
+    std::string line = "map " + m.loaded_from + " (" + to_string(m.use) + ", " + std::to_string(m.load->keyframes) +
+                       " keyframes, loaded in " + format_fixed(m.load->load_ms, 0) + " ms): ";
+    if (m.localisation) {
+      const eval::LocalisationScores& l = *m.localisation;
+      const auto& classes = eval::precision_classes();
+      for (std::size_t k = 0; k < classes.size(); ++k)
+        line += format_fixed(100 * l.share_within[k], 1) + " % within " + format_g(classes[k].max_translation_m) +
+                " m/" + format_g(classes[k].max_rotation_deg) + " deg, ";
+      line += std::to_string(l.wrong_place) + " wrong-place poses, first pose at frame " +
+              (l.first_pose_frame ? std::to_string(*l.first_pose_frame) : std::string("-"));
+    } else {
+      line += "not scored: " + m.localisation_note;
+    }
+    lines.push_back(line);
+  }
+  if (m.save)
+    lines.push_back("map saved to " + m.saved_to + ": " + std::to_string(m.save->sessions) + " sessions, " +
+                    std::to_string(m.save->keyframes) + " keyframes, " + std::to_string(m.save->points) +
+                    " points, " + std::to_string(m.save->bytes) + " bytes in " + format_fixed(m.save->save_ms, 0) +
+                    " ms");
+  return lines;
 }
 
 std::string map_report_json(const MapReport& r) {

@@ -290,34 +290,11 @@ std::string summary_line(const RunReport& report) {
   return summary;
 }
 
-/// A loaded map's localisation and a saved map, in one line each.
-void log_map(const MapReport& m, RunLog& log) {
-  if (m.load) {
-    std::string line = "map " + m.loaded_from + " (" + to_string(m.use) + ", " + std::to_string(m.load->keyframes) +
-                       " keyframes, loaded in " + format_fixed(m.load->load_ms, 0) + " ms): ";
-    if (m.localisation) {
-      const eval::LocalisationScores& l = *m.localisation;
-      const auto& classes = eval::precision_classes();
-      for (std::size_t k = 0; k < classes.size(); ++k)
-        line += format_fixed(100 * l.share_within[k], 1) + " % within " + format_g(classes[k].max_translation_m) +
-                " m/" + format_g(classes[k].max_rotation_deg) + " deg, ";
-      line += std::to_string(l.wrong_place) + " wrong-place poses, first pose at frame " +
-              (l.first_pose_frame ? std::to_string(*l.first_pose_frame) : std::string("-"));
-    } else {
-      line += "not scored: " + m.localisation_note;
-    }
-    log.line(line);
-  }
-  if (m.save)
-    log.line("map saved to " + m.saved_to + ": " + std::to_string(m.save->sessions) + " sessions, " +
-             std::to_string(m.save->keyframes) + " keyframes, " + std::to_string(m.save->points) + " points, " +
-             std::to_string(m.save->bytes) + " bytes in " + format_fixed(m.save->save_ms, 0) + " ms");
-}
-
 /// The summary, the refined trajectories, the closed loop and the comparison table.
 void log_summary(const RunReport& report, RunLog& log) {
   log.line(summary_line(report));
-  if (report.primary.map) log_map(*report.primary.map, log);
+  if (report.primary.map)
+    for (const std::string& line : map_log_lines(*report.primary.map)) log.line(line);
   for (const SlamRun* r : {&report.primary, report.baseline ? &*report.baseline : nullptr}) {
     if (!r || (!r->refined_eval && r->loop_closing_json.empty())) continue;
     log.line(eval::mode_label(r->mode) + ": refined trajectory ATE rmse " +
@@ -396,7 +373,7 @@ RunReport run_scenario(const RunOptions& opt) {
   finish_loop(opt, loop, consumer.aborted(), n, sinks, report, log);
   gt.close();
   const double eval_ms = evaluate_systems(sinks, gt.trajectory());
-  for (auto& sink : sinks) sink->save_map(gt.trajectory(), scenario.name, scenario.station_seed_or_seed());
+  for (auto& sink : sinks) sink->finish_map(gt.trajectory(), scenario.name, scenario.station_seed_or_seed());
   const double map_ms = score_or_skip_maps(opt, scenario, backend, gt.trajectory(), sinks, log);
   if (closed_loop) report.closed_loop = closed_loop->metrics();
   report.primary = sinks.front()->run;

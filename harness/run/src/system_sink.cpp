@@ -123,7 +123,6 @@ void SystemSink::finish() {
   run.place = collect_place_recognition(*system, keyframe_t_ns);
   cam_traj.close();
   timing.close();
-  if (run.map) run.map->relocalisations = system->relocalisations().size();
   run.keyframes = system->num_keyframes();
   run.map_points = system->num_map_points();
   run.local_mapping = system->mapping_stats();
@@ -146,15 +145,12 @@ void SystemSink::save_dense_maps() {
   run.dense_map = std::move(d);
 }
 
-void SystemSink::save_map(const eval::Trajectory& gt, const std::string& scenario, std::uint64_t station_seed) {
-  if (!run.map || map_options.save_path.empty()) return;
-  if (!run.map->load) run.map->T_world_map = T_world_new_map(gt, est);
-  run::save_map(*system, map_options, scenario, station_seed, &*run.map);
+void SystemSink::finish_map(const eval::Trajectory& gt, const std::string& scenario, std::uint64_t station_seed) {
+  if (run.map) run::finish_map(*system, map_options, gt, est, scenario, station_seed, &*run.map);
 }
 
 void SystemSink::evaluate(const eval::Trajectory& gt) {
   if (run.place) label_place_recognition(&*run.place, gt);
-  if (run.map) score_map_localisation(&*run.map, gt, est);
   if (est.poses.size() < 3) {
     run.eval_note = "only " + std::to_string(est.poses.size()) + " tracked frames (need 3)";
     return;

@@ -43,12 +43,11 @@ struct SystemSink {
   /// writes the dense maps.
   void finish();
 
-  /// ATE/RPE of the trajectory (and of the refined one) against `gt`,
-  /// and the localisation in a loaded map.
+  /// ATE/RPE of the trajectory (and of the refined one) against `gt`.
   void evaluate(const eval::Trajectory& gt);
-  /// Saves the final map when the options say so, with its frame in the
-  /// world (a loaded map's, or the ground truth at the first pose).
-  void save_map(const eval::Trajectory& gt, const std::string& scenario, std::uint64_t station_seed);
+  /// The localisation in a loaded map against `gt`, and the final map
+  /// saved when the options say so (run::finish_map).
+  void finish_map(const eval::Trajectory& gt, const std::string& scenario, std::uint64_t station_seed);
 
  private:
   /// The dense maps into `clouds` and their PLY files; run.dense_map.

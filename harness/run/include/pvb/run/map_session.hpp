@@ -6,6 +6,7 @@
 // truth in that frame without any alignment.
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "pvb/eval/localisation.hpp"
 #include "pvb/eval/trajectory.hpp"
@@ -50,8 +51,14 @@ std::string map_app_json(const std::string& scenario, std::uint64_t station_seed
 /// T_world_map from a map file's application data, when it has one.
 std::optional<geom::SE3d> T_world_map_of(const std::string& app_json);
 
-/// The pose of a new map's frame in the world: the ground truth at the
-/// first pose of the run's trajectory (SLAM's frame is its first camera).
+/// Ground truth at the camera's frame times (within 1 ms, or interpolated
+/// between poses at most 50 ms apart), for sequences whose ground truth
+/// runs at its own rate (TUM's motion capture); frames without are left out.
+eval::Trajectory ground_truth_at(const eval::Trajectory& gt, const std::vector<std::int64_t>& t_ns);
+
+/// The pose of a new map's frame in the world: from the first pose of the
+/// run's trajectory that has ground truth (the map's frame is SLAM's first
+/// camera; in a simulated run that pose is the first one, at identity).
 std::optional<geom::SE3d> T_world_new_map(const eval::Trajectory& gt, const eval::Trajectory& est);
 
 /// Loads the map into `system` when the options name one.
@@ -61,6 +68,16 @@ void score_map_localisation(MapReport* report, const eval::Trajectory& gt, const
 /// Saves the final map when the options say so (after System::shutdown()).
 void save_map(slam::System& system, const MapOptions& options, const std::string& scenario,
               std::uint64_t station_seed, MapReport* report);
+
+/// After a run (System::shutdown() done): the localisation in a loaded map
+/// scored against `gt` (may be empty: no ground truth), then the map saved
+/// when the options say so, with its frame in the world (the loaded map's,
+/// or the ground truth at the first pose of `est`).
+void finish_map(slam::System& system, const MapOptions& options, const eval::Trajectory& gt,
+                const eval::Trajectory& est, const std::string& name, std::uint64_t station_seed, MapReport* report);
+
+/// What the run did with maps, one line per loaded or saved map.
+std::vector<std::string> map_log_lines(const MapReport& r);
 
 /// The "map" object of metrics.json (one line).
 std::string map_report_json(const MapReport& r);
