@@ -12,7 +12,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH="${1:-60}"
 shift || true
-ALL=(fuzz_settings fuzz_scenario fuzz_tum_trajectory fuzz_tum_lists fuzz_oni fuzz_metrics fuzz_vocabulary)
+ALL=(fuzz_settings fuzz_scenario fuzz_tum_trajectory fuzz_tum_lists fuzz_oni fuzz_metrics fuzz_vocabulary fuzz_map_file)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -gt 0 ] || TARGETS=("${ALL[@]}")
 JOBS="${PVB_JOBS:-$(nproc)}"
@@ -35,6 +35,7 @@ seeds_of() {
     fuzz_oni) echo tests/fuzz/corpus/oni ;;
     fuzz_metrics) echo tests/harness/suite/fixtures ;;
     fuzz_vocabulary) echo tests/fuzz/corpus/vocabulary ;;
+    fuzz_map_file) echo tests/fuzz/corpus/map_file ;;
   esac
 }
 
@@ -52,7 +53,9 @@ for t in "${TARGETS[@]}"; do
   log="$B/$t.log"
   echo "fuzz: $t for ${SECONDS_EACH} s (seeds: ${dirs[*]:-none})"
   set +e
-  "$B/fuzz/$t" -max_total_time="$SECONDS_EACH" -timeout=10 -rss_limit_mb=4096 -max_len=65536 \
+  max_len=65536
+  [ "$t" = fuzz_map_file ] && max_len=262144  # its seed, a two-keyframe map, is 129 KB
+  "$B/fuzz/$t" -max_total_time="$SECONDS_EACH" -timeout=10 -rss_limit_mb=4096 -max_len=$max_len \
     -print_final_stats=1 -artifact_prefix="$B/artifacts/$t-" "$corpus" "${dirs[@]}" > "$log" 2>&1
   rc=$?
   set -e

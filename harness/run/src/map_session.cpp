@@ -131,6 +131,10 @@ void save_map(slam::System& system, const MapOptions& options, const std::string
               std::uint64_t station_seed, MapReport* r) {
   if (options.save_path.empty()) return;
   r->saved_to = options.save_path;
+  if (system.num_keyframes() == 0) {
+    r->save_note = "not saved: the run made no keyframe";
+    return;
+  }
   r->save = system.save_map(options.save_path, map_app_json(scenario, station_seed, r->T_world_map));
 }
 
@@ -160,6 +164,7 @@ std::vector<std::string> map_log_lines(const MapReport& m) {
     }
     lines.push_back(line);
   }
+  if (!m.save_note.empty()) lines.push_back("map " + m.saved_to + " " + m.save_note);
   if (m.save)
     lines.push_back("map saved to " + m.saved_to + ": " + std::to_string(m.save->sessions) + " sessions, " +
                     std::to_string(m.save->keyframes) + " keyframes, " + std::to_string(m.save->points) +
@@ -186,6 +191,7 @@ std::string map_report_json(const MapReport& r) {
            ", \"bytes_per_keyframe\": " + num(s.keyframes ? double(s.bytes) / double(s.keyframes) : 0.0) +
            ", \"save_ms\": " + num(s.save_ms) + "}";
   }
+  if (!r.save_note.empty()) out += ", \"save_note\": \"" + json_escape(r.save_note) + "\"";
   if (r.load)
     out += ", \"localisation\": " +
            (r.localisation ? eval::localisation_json(*r.localisation)

@@ -187,6 +187,7 @@ MapSaveInfo System::save_map(const std::string& path, const std::string& app_jso
   {
     std::lock_guard<std::mutex> lock(map_.mutex());
     // The sessions loaded, and this one when it made a keyframe.
+    if (map_.num_keyframes() == 0) throw ConfigError(path, "map", "a map with keyframes (this run made none)");
     info.sessions = loaded_sessions_;
     for (const auto& [id, kf] : map_.keyframes())
       if (kf->session() == map_.session()) info.sessions = map_.session() + 1;

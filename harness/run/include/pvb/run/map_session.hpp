@@ -40,6 +40,7 @@ struct MapReport {
   std::optional<geom::SE3d> T_world_map;
   std::string saved_to;
   std::optional<slam::MapSaveInfo> save;
+  std::string save_note;  ///< why a map to save was not saved (none: the run made no keyframe)
   std::size_t relocalisations = 0;                        ///< tracking found again (the first pose included)
   std::optional<eval::LocalisationScores> localisation;  ///< with a loaded map and ground truth
   std::string localisation_note;                          ///< why there is none
