@@ -138,8 +138,10 @@ std::string MapSettings::difference(const MapSettings& run) const {
     return o.str();
   for (int i = 0; i < 5; ++i)
     if (differs(dist_names[i], distortion[i], run.distortion[i])) return o.str();
+  // DepthMapFactor is recorded but not compared: it says how a source's raw
+  // depth becomes metres (5000 for TUM PNGs, 1000 for a Kinect's
+  // millimetres), and the map holds metres.
   if (differs("ThDepth (m)", th_depth_m, run.th_depth_m) ||
-      differs("DepthMapFactor", depth_factor, run.depth_factor) ||
       differs("ORBextractor.scaleFactor", scale_factor, run.scale_factor) ||
       differs("ORBextractor.nLevels", num_levels, run.num_levels) ||
       differs("ORBextractor.nFeatures", num_features, run.num_features))

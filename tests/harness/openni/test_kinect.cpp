@@ -148,3 +148,31 @@ TEST(KinectCli, IndexPastTheDevicesAndBadUrisSaySo) {
                         "INDEX.txt");
   std::system(("rm -rf " + dir).c_str());
 }
+
+namespace {
+
+TEST(KinectCli, ADumpOfAnotherRunLocalisesInAMapSavedByRun) {
+  // The map from the simulator in memory (pvbench run), the query from a
+  // Kinect v1 dump of the same station with other noise and dust: the
+  // real-Kinect path must find itself in the map, judged in its frame.
+  const std::string d = fresh("map");
+  const std::string noon = "scenes/days/pv_station_1200.yaml";
+  const Result map = run("", "run --scenario " + noon + " --frames 90 --sync --no-map-eval --save-map " + d +
+                                 "/noon.pvbmap --out " + d + "/map");
+  ASSERT_EQ(map.code, 0) << map.output;
+  const Result rec = run("", "record --scenario " + noon + " --seed 2 --format fakenect --frames 60 --out " + d + "/dump");
+  ASSERT_EQ(rec.code, 0) << rec.output;
+  const Result cam = run(fakenect_env(d + "/dump"), "camera --uri freenect://0 --sync --map " + d +
+                                                        "/noon.pvbmap --map-mode localise --out " + d + "/cam");
+  ASSERT_EQ(cam.code, 0) << cam.output;
+  const std::string stats = pvb::read_file(d + "/cam/stats.json");
+  const std::size_t loc = stats.find("\"localisation\": {");
+  ASSERT_NE(loc, std::string::npos) << stats;
+  const std::string l = stats.substr(loc);
+  EXPECT_EQ(json_number(l, "wrong_place"), 0.0) << l;
+  EXPECT_GE(json_number(l, "first_pose_frame"), 0.0) << l;
+  EXPECT_LE(json_number(l, "first_pose_frame"), 30.0) << l;
+  EXPECT_GE(json_number(l.substr(l.find("\"fine\"")), "share"), 0.95) << l;
+}
+
+}  // namespace

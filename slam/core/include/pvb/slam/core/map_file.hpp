@@ -30,7 +30,8 @@ struct MapSettings {
   std::uint64_t vocabulary = 0;  ///< place::Vocabulary::fingerprint()
 
   /// The first setting that differs from `run`'s, as "NAME: VALUE in the
-  /// map, VALUE in this run"; empty when they agree.
+  /// map, VALUE in this run"; empty when they agree.  The depth factor is
+  /// not compared (a source's raw units; the map holds metres).
   std::string difference(const MapSettings& run) const;
 };
 
