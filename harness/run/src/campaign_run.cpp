@@ -96,12 +96,25 @@ std::string session_json(const SessionResult& r) {
   return out + "}";
 }
 
+/// "P, S, U": matched landmarks on panels, on what stays (ground, posts,
+/// walls, frames, shrubs), and unlabelled; "-" when not classified.
+std::string landmark_cell(const SessionResult& s) {
+  if (!s.map || s.map->matched_landmarks.empty()) return "-";
+  int panel = 0, unlabelled = 0, total = 0;
+  for (const auto& [name, n] : s.map->matched_landmarks) {
+    if (name == "total") total = n;
+    else if (name == "panel") panel = n;
+    else if (name == "unlabelled") unlabelled = n;
+  }
+  return std::to_string(panel) + ", " + std::to_string(total - panel - unlabelled) + ", " + std::to_string(unlabelled);
+}
+
 /// campaign.md: one row per session.
 std::string campaign_markdown(const CampaignReport& r) {
   std::string out = "# Campaign " + r.campaign.name + "\n\n" + r.campaign.description + "\n\n";
   out += "| session | mode | map | frames | lost | keyframes (loaded) | within 0.05 m/1 deg | within 0.25 m/2 deg "
-         "| wrong place | first pose (frame) | tracking ms median |\n";
-  out += "|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "| wrong place | first pose (frame) | tracking ms median | matched landmarks: panels, static, unlabelled |\n";
+  out += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const SessionResult& s : r.sessions) {
     const auto* l = s.map && s.map->localisation ? &*s.map->localisation : nullptr;
     const auto pct = [&](std::size_t k) { return l ? format_fixed(100 * l->share_within[k], 1) + " %" : "-"; };
@@ -112,7 +125,7 @@ std::string campaign_markdown(const CampaignReport& r) {
            std::to_string(s.keyframes_loaded) + ") | " + pct(0) + " | " + pct(1) + " | " +
            (l ? std::to_string(l->wrong_place) : "-") + " | " +
            (l && l->first_pose_frame ? std::to_string(*l->first_pose_frame) : "-") + " | " +
-           format_fixed(s.tracking_ms_median, 2) + " |\n";
+           format_fixed(s.tracking_ms_median, 2) + " | " + landmark_cell(s) + " |\n";
   }
   return out;
 }

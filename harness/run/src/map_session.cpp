@@ -65,10 +65,20 @@ void MapOptions::check() const {
 }
 
 std::string map_app_json(const std::string& scenario, std::uint64_t station_seed,
-                         const std::optional<geom::SE3d>& T_world_map) {
-  return "{\"scenario\": " + std::string("\"") + json_escape(scenario) + "\", \"station_seed\": " +
-         std::to_string(station_seed) +
+                         const std::optional<geom::SE3d>& T_world_map, const std::string& scenario_file) {
+  return "{\"scenario\": \"" + json_escape(scenario) + "\", \"scenario_file\": " +
+         (scenario_file.empty() ? std::string("null") : "\"" + json_escape(scenario_file) + "\"") +
+         ", \"station_seed\": " + std::to_string(station_seed) +
          ", \"T_world_map\": " + (T_world_map ? pose_json(*T_world_map) : std::string("null")) + "}";
+}
+
+std::string map_scenario_file(const std::string& app_json) {
+  const std::string key = "\"scenario_file\": \"";
+  const std::size_t at = app_json.find(key);
+  if (at == std::string::npos) return "";
+  const std::size_t end = app_json.find('"', at + key.size());
+  const std::string file = app_json.substr(at + key.size(), end == std::string::npos ? 0 : end - at - key.size());
+  return file.find('\\') == std::string::npos ? file : "";  // an escaped name is not read back
 }
 
 std::optional<geom::SE3d> T_world_map_of(const std::string& app_json) {
@@ -113,6 +123,7 @@ MapReport start_map(slam::System& system, const MapOptions& options) {
   r.load = system.load_map(options.load_path, options.use == MapUse::kLocalise ? slam::MapStart::kLocalise
                                                                                : slam::MapStart::kExtend);
   r.T_world_map = T_world_map_of(r.load->app_json);
+  for (const auto& l : system.landmark_uses()) r.found_at_load[l.id] = l.found;
   return r;
 }
 
@@ -128,22 +139,25 @@ void score_map_localisation(MapReport* r, const eval::Trajectory& gt, const eval
 }
 
 void save_map(slam::System& system, const MapOptions& options, const std::string& scenario,
-              std::uint64_t station_seed, MapReport* r) {
+              std::uint64_t station_seed, MapReport* r, const std::string& scenario_file) {
   if (options.save_path.empty()) return;
   r->saved_to = options.save_path;
   if (system.num_keyframes() == 0) {
     r->save_note = "not saved: the run made no keyframe";
     return;
   }
-  r->save = system.save_map(options.save_path, map_app_json(scenario, station_seed, r->T_world_map));
+  // An extended map keeps the scenario it was first made from.
+  const std::string made_from = r->load ? map_scenario_file(r->load->app_json) : scenario_file;
+  r->save = system.save_map(options.save_path, map_app_json(scenario, station_seed, r->T_world_map, made_from));
 }
 
 void finish_map(slam::System& system, const MapOptions& options, const eval::Trajectory& gt,
-                const eval::Trajectory& est, const std::string& name, std::uint64_t station_seed, MapReport* r) {
+                const eval::Trajectory& est, const std::string& name, std::uint64_t station_seed, MapReport* r,
+                const std::string& scenario_file) {
   r->relocalisations = system.relocalisations().size();
   score_map_localisation(r, gt, est);
   if (!r->load && !gt.empty()) r->T_world_map = T_world_new_map(gt, est);
-  save_map(system, options, name, station_seed, r);
+  save_map(system, options, name, station_seed, r, scenario_file);
 }
 
 std::vector<std::string> map_log_lines(const MapReport& m) {
@@ -192,6 +206,14 @@ std::string map_report_json(const MapReport& r) {
            ", \"save_ms\": " + num(s.save_ms) + "}";
   }
   if (!r.save_note.empty()) out += ", \"save_note\": \"" + json_escape(r.save_note) + "\"";
+  if (!r.matched_landmarks.empty()) {
+    out += ", \"matched_landmarks\": {";
+    for (std::size_t i = 0; i < r.matched_landmarks.size(); ++i)
+      out += (i ? ", \"" : "\"") + r.matched_landmarks[i].first + "\": " + std::to_string(r.matched_landmarks[i].second);
+    out += "}";
+  } else if (!r.matched_landmarks_note.empty()) {
+    out += ", \"matched_landmarks_note\": \"" + json_escape(r.matched_landmarks_note) + "\"";
+  }
   if (r.load)
     out += ", \"localisation\": " +
            (r.localisation ? eval::localisation_json(*r.localisation)

@@ -16,6 +16,7 @@
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/slam/core/settings.hpp"
+#include "landmark_classes.hpp"
 #include "map_scoring.hpp"
 #include "run_log.hpp"
 #include "system_sink.hpp"
@@ -373,7 +374,10 @@ RunReport run_scenario(const RunOptions& opt) {
   finish_loop(opt, loop, consumer.aborted(), n, sinks, report, log);
   gt.close();
   const double eval_ms = evaluate_systems(sinks, gt.trajectory());
-  for (auto& sink : sinks) sink->finish_map(gt.trajectory(), scenario.name, scenario.station_seed_or_seed());
+  for (auto& sink : sinks)
+    sink->finish_map(gt.trajectory(), scenario.name, scenario.station_seed_or_seed(), opt.scenario_file);
+  if (SlamRun& p = sinks.front()->run; p.map && p.map->localisation)
+    classify_matched_landmarks(*sinks.front()->system, backend, &*p.map);
   const double map_ms = score_or_skip_maps(opt, scenario, backend, gt.trajectory(), sinks, log);
   if (closed_loop) report.closed_loop = closed_loop->metrics();
   report.primary = sinks.front()->run;

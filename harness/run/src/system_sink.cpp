@@ -145,8 +145,9 @@ void SystemSink::save_dense_maps() {
   run.dense_map = std::move(d);
 }
 
-void SystemSink::finish_map(const eval::Trajectory& gt, const std::string& scenario, std::uint64_t station_seed) {
-  if (run.map) run::finish_map(*system, map_options, gt, est, scenario, station_seed, &*run.map);
+void SystemSink::finish_map(const eval::Trajectory& gt, const std::string& scenario, std::uint64_t station_seed,
+                            const std::string& scenario_file) {
+  if (run.map) run::finish_map(*system, map_options, gt, est, scenario, station_seed, &*run.map, scenario_file);
 }
 
 void SystemSink::evaluate(const eval::Trajectory& gt) {

@@ -47,7 +47,8 @@ struct SystemSink {
   void evaluate(const eval::Trajectory& gt);
   /// The localisation in a loaded map against `gt`, and the final map
   /// saved when the options say so (run::finish_map).
-  void finish_map(const eval::Trajectory& gt, const std::string& scenario, std::uint64_t station_seed);
+  void finish_map(const eval::Trajectory& gt, const std::string& scenario, std::uint64_t station_seed,
+                  const std::string& scenario_file);
 
  private:
   /// The dense maps into `clouds` and their PLY files; run.dense_map.

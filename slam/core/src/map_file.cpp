@@ -78,6 +78,22 @@ void put_graph(ByteWriter& w, const KeyFrame& kf, const Map& map) {
   for (std::uint64_t id : loops) w.u64(id);
 }
 
+/// The keyframe's bag of words and direct index (as the place database and
+/// relocalisation use them): recomputing them is most of a load's time.
+void put_bow(ByteWriter& w, const KeyFrame& kf) {
+  w.u64(kf.bow().size());
+  for (const auto& [word, weight] : kf.bow()) {
+    w.u32(word);
+    w.f64(weight);
+  }
+  w.u64(kf.features_by_node().size());
+  for (const auto& [node, indices] : kf.features_by_node()) {
+    w.u32(node);
+    w.u64(indices.size());
+    for (std::uint32_t i : indices) w.u32(i);
+  }
+}
+
 void put_section(ByteWriter& out, const char* tag, const std::string& payload) {
   out.bytes(tag, 4);
   out.u64(payload.size());
@@ -96,7 +112,7 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   for (const auto& [id, kf] : map.keyframes())
     if (!kf->bad()) kfs.push_back(kf);
 
-  ByteWriter head, keyf, poin, grap;
+  ByteWriter head, keyf, poin, grap, bowv;
   put_settings(head, settings, sessions);
   keyf.u64(kfs.size());
   for (const auto& kf : kfs) put_keyframe(keyf, *kf, point_ids);
@@ -113,12 +129,13 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   }
   grap.u64(kfs.size());
   for (const auto& kf : kfs) put_graph(grap, *kf, map);
+  for (const auto& kf : kfs) put_bow(bowv, *kf);
 
   ByteWriter out;
   out.bytes(kMagic, kMagicBytes);
   out.u32(kMapFileVersion);
   out.u32(static_cast<std::uint32_t>(kSections.size()));
-  const std::string* payloads[] = {&head.data(), &keyf.data(), &poin.data(), &grap.data(), &app_json};
+  const std::string* payloads[] = {&head.data(), &keyf.data(), &poin.data(), &grap.data(), &bowv.data(), &app_json};
   for (std::size_t s = 0; s < kSections.size(); ++s) put_section(out, kSections[s], *payloads[s]);
   return out.data();
 }

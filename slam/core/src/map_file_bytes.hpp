@@ -12,7 +12,7 @@ namespace pvb::slam::mapfile {
 constexpr char kMagic[] = "PVBMAP\r\n";  // 8 bytes, without the NUL
 constexpr std::size_t kMagicBytes = 8;
 constexpr std::uint64_t kNone = ~std::uint64_t(0);  ///< no keyframe, no point
-constexpr std::array<const char*, 5> kSections = {"HEAD", "KEYF", "POIN", "GRAP", "META"};
+constexpr std::array<const char*, 6> kSections = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "META"};
 /// Bytes of one keypoint in KEYF: 7 f32, the octave, depth, point id, descriptor.
 constexpr std::size_t kKeypointBytes = 7 * 4 + 1 + 4 + 8 + 32;
 constexpr std::uint32_t kMaxKeypoints = 100000;

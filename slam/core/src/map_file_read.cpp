@@ -247,12 +247,40 @@ void read_graph(ByteReader r, Map* map) {
   if (!r.at_end()) r.fail("longer than its graph");
 }
 
+/// The bags of words and direct indices, in keyframe order.
+void read_bows(ByteReader r, Map* map) {
+  for (const auto& [id, kf] : map->keyframes()) {
+    const std::string what = "keyframe " + std::to_string(id);
+    place::BowVector bow;
+    const std::uint64_t words = r.count(12, "words");
+    for (std::uint64_t k = 0; k < words; ++k) {
+      const std::uint32_t word = r.u32();
+      const double weight = r.f64();
+      if (!(std::isfinite(weight) && weight >= 0) || !bow.emplace(word, weight).second)
+        r.fail(what + ": word " + std::to_string(word) + " repeated or weighted " + std::to_string(weight));
+    }
+    place::FeatureVector features;
+    const std::uint64_t nodes = r.count(12, "nodes");
+    for (std::uint64_t k = 0; k < nodes; ++k) {
+      const std::uint32_t node = r.u32();
+      std::vector<std::uint32_t> indices(r.count(4, "keypoint indices"));
+      for (std::uint32_t& i : indices) {
+        i = r.u32();
+        if (i >= kf->frame().size()) r.fail(what + ": keypoint " + std::to_string(i) + " of node " + std::to_string(node));
+      }
+      if (!features.emplace(node, std::move(indices)).second) r.fail(what + ": node " + std::to_string(node) + " repeated");
+    }
+    kf->set_bow(std::move(bow), std::move(features));
+  }
+  if (!r.at_end()) r.fail("longer than its bags of words");
+}
+
 }  // namespace
 
 MapFileHeader read_map_header(const std::string& bytes, const std::string& file) {
   const Sections s = split_sections(bytes, file);
   MapFileHeader h = parse_head(reader_for(bytes, s, 0, file));
-  h.app_json.assign(bytes, s[4].offset, s[4].length);
+  h.app_json.assign(bytes, s[5].offset, s[5].length);
   return h;
 }
 
@@ -265,6 +293,7 @@ void decode_map(const std::string& bytes, const std::string& file, const std::sh
   const auto saved = read_points(reader_for(bytes, s, 2, file), *map);
   link_points(reader_for(bytes, s, 2, file), ids, saved, map);
   read_graph(reader_for(bytes, s, 3, file), map);
+  read_bows(reader_for(bytes, s, 4, file), map);
 }
 
 }  // namespace pvb::slam

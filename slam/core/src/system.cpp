@@ -161,7 +161,7 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
     decode_map(bytes, path, cam_, &map_);
     for (const auto& [id, kf] : map_.keyframes()) {
       kf->set_fixed(start == MapStart::kExtend);
-      place_->compute_bow(*kf);
+      if (kf->bow().empty()) place_->compute_bow(*kf);  // saved with the map (the same vocabulary)
       place_->add(*kf);
     }
     map_.set_session(head.sessions);
@@ -264,6 +264,15 @@ std::vector<Eigen::Vector3d> System::map_point_positions() {
   out.reserve(map_.num_points());
   for (const auto& [id, mp] : map_.points())
     if (!mp->bad()) out.push_back(mp->p_w());
+  return out;
+}
+
+std::vector<System::LandmarkUse> System::landmark_uses() {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::vector<LandmarkUse> out;
+  out.reserve(map_.num_points());
+  for (const auto& [id, mp] : map_.points())
+    if (!mp->bad()) out.push_back({id, mp->p_w(), mp->found()});
   return out;
 }
 

@@ -4,6 +4,7 @@
 // is saved, and the map's frame in the world, kept in the map file's
 // application data so that a later session can be judged against ground
 // truth in that frame without any alignment.
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,13 +43,24 @@ struct MapReport {
   std::optional<slam::MapSaveInfo> save;
   std::string save_note;  ///< why a map to save was not saved (none: the run made no keyframe)
   std::size_t relocalisations = 0;                        ///< tracking found again (the first pose included)
+  /// Times each loaded landmark had been matched when the map was loaded,
+  /// by id: what this session matched is the difference at its end.
+  std::map<std::uint64_t, int> found_at_load;
+  /// The landmarks this session matched, by the surface they lie on in
+  /// the map's own day (sim::SurfaceClass names, "unlabelled" beyond 5 cm
+  /// of any); empty when not classified.
+  std::vector<std::pair<std::string, int>> matched_landmarks;
+  std::string matched_landmarks_note;  ///< why they were not classified
   std::optional<eval::LocalisationScores> localisation;  ///< with a loaded map and ground truth
   std::string localisation_note;                          ///< why there is none
 };
 
-/// The application data of a map file: the station it shows and T_world_map.
+/// The application data of a map file: the station it shows (its scenario
+/// name and, when known, file) and T_world_map.
 std::string map_app_json(const std::string& scenario, std::uint64_t station_seed,
-                         const std::optional<geom::SE3d>& T_world_map);
+                         const std::optional<geom::SE3d>& T_world_map, const std::string& scenario_file = "");
+/// The scenario file a map was made from, when its data names one.
+std::string map_scenario_file(const std::string& app_json);
 /// T_world_map from a map file's application data, when it has one.
 std::optional<geom::SE3d> T_world_map_of(const std::string& app_json);
 
@@ -68,14 +80,15 @@ MapReport start_map(slam::System& system, const MapOptions& options);
 void score_map_localisation(MapReport* report, const eval::Trajectory& gt, const eval::Trajectory& est);
 /// Saves the final map when the options say so (after System::shutdown()).
 void save_map(slam::System& system, const MapOptions& options, const std::string& scenario,
-              std::uint64_t station_seed, MapReport* report);
+              std::uint64_t station_seed, MapReport* report, const std::string& scenario_file = "");
 
 /// After a run (System::shutdown() done): the localisation in a loaded map
 /// scored against `gt` (may be empty: no ground truth), then the map saved
 /// when the options say so, with its frame in the world (the loaded map's,
 /// or the ground truth at the first pose of `est`).
 void finish_map(slam::System& system, const MapOptions& options, const eval::Trajectory& gt,
-                const eval::Trajectory& est, const std::string& name, std::uint64_t station_seed, MapReport* report);
+                const eval::Trajectory& est, const std::string& name, std::uint64_t station_seed, MapReport* report,
+                const std::string& scenario_file = "");
 
 /// What the run did with maps, one line per loaded or saved map.
 std::vector<std::string> map_log_lines(const MapReport& r);

@@ -1,12 +1,13 @@
 #pragma once
 // Map files: a sparse map saved to disk and read back (docs/map_file.md).
 // A versioned binary format: the magic "PVBMAP\r\n", a version, then
-// sections (HEAD settings, KEYF keyframes, POIN points, GRAP graph, META
-// the application's JSON), each with its length and an FNV-1a checksum.
+// sections (HEAD settings, KEYF keyframes, POIN points, GRAP graph, BOWV
+// bags of words, META the application's JSON), each with its length and an
+// FNV-1a checksum.
 // What is saved is the map's own state (poses, keypoints, descriptors,
 // point positions and statistics, the graph); what follows from it (point
-// descriptors, normals, scale ranges, bags of words) is recomputed on
-// load, so save -> load -> save gives the same bytes.
+// descriptors, normals, scale ranges) is recomputed on load, so save ->
+// load -> save gives the same bytes.
 #include <array>
 #include <cstdint>
 #include <memory>

@@ -93,6 +93,15 @@ class System {
   MapSnapshot map_snapshot();
   /// Positions of the map points (world frame), by point id.
   std::vector<Eigen::Vector3d> map_point_positions();
+  /// Every map point with the number of frames that matched it so far
+  /// (ORB-SLAM2's mnFound): the difference over a session says which
+  /// landmarks that session used.
+  struct LandmarkUse {
+    std::uint64_t id = 0;
+    Eigen::Vector3d p_w = Eigen::Vector3d::Zero();
+    int found = 0;
+  };
+  std::vector<LandmarkUse> landmark_uses();
   /// Keyframes processed, local BAs started (and cut short) and the time
   /// spent so far (inline or on its worker).
   LocalMappingStats mapping_stats() const { return mapping_->stats(); }
