@@ -164,7 +164,9 @@ void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::u
         return Eigen::Vector3d(g.x(), g.y(), h);
       };
       // s from the table's lower (-across) edge, as for fixed tables.
-      const auto plane_point = [&](double u, double s) {
+      // Returns a vector, not an Eigen expression: that would refer to
+      // axis_point's temporary after the lambda returns.
+      const auto plane_point = [&](double u, double s) -> Eigen::Vector3d {
         return axis_point(u) + (s - td / 2) * across + scenes::kTrackerPanelAboveAxisM * normal;
       };
       const std::string tname = pre + "r" + std::to_string(row) + "t" + std::to_string(t);
