@@ -33,7 +33,7 @@
 #include "pvb/eval/plot.hpp"
 #include "pvb/plot/matrix.hpp"
 #include "pvb/plot/png.hpp"
-#include "pvb/run/campaign.hpp"
+#include "pvb/run/campaign_run.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/suite/aggregate.hpp"
 #include "pvb/suite/campaign_aggregate.hpp"
@@ -328,21 +328,16 @@ int write_campaign_aggregate(const SweepArgs& a, const std::vector<std::uint64_t
   const fs::path out(a.out);
   write_file((out / "aggregate.md").string(), suite::format_campaign_markdown(agg));
   write_file((out / "aggregate.json").string(), suite::format_campaign_json(agg));
-  plot::MatrixFigure m;
-  m.title = "campaign " + agg.campaign + ", " + std::to_string(seeds.size()) + " seeds: mean share within 0.25 m, 2 deg";
-  m.row_label = "the session whose map is used";
-  m.col_label = "query session";
+  std::vector<run::MatrixSession> sessions;
   for (const auto& g : agg.sessions) {
-    if (g.mode != "localise") m.rows.push_back(g.name);
-    if (g.mode != "map") m.cols.push_back(g.name);
+    const run::SessionMode mode = g.mode == "map"        ? run::SessionMode::kMap
+                                  : g.mode == "localise" ? run::SessionMode::kLocalise
+                                                         : run::SessionMode::kExtend;
+    sessions.push_back({g.name, mode, g.map, g.high.count > 0 ? std::optional<double>(g.high.mean) : std::nullopt});
   }
-  m.values.assign(m.rows.size(), std::vector<std::optional<double>>(m.cols.size()));
-  for (const auto& g : agg.sessions) {
-    const auto row = std::find(m.rows.begin(), m.rows.end(), g.map);
-    const auto col = std::find(m.cols.begin(), m.cols.end(), g.name);
-    if (row != m.rows.end() && col != m.cols.end() && g.high.count > 0)
-      m.values[row - m.rows.begin()][col - m.cols.begin()] = g.high.mean;
-  }
+  const plot::MatrixFigure m = run::campaign_matrix(
+      "campaign " + agg.campaign + ", " + std::to_string(seeds.size()) + " seeds: mean share within 0.25 m, 2 deg",
+      sessions);
   plot::write_matrix(m, (out / "matrix").string());
   std::printf("\n%s\nwrote %s/aggregate.{md,json}, matrix.{svg,png}\n", suite::format_campaign_markdown(agg).c_str(),
               a.out.c_str());

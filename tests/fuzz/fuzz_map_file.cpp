@@ -41,7 +41,7 @@ void read(const std::string& bytes) {
     pvb::slam::MapSettings s = h.settings;
     s.distortion = {};  // no per-pixel undistortion table: the reader is what is under test
     pvb::slam::Map map;
-    pvb::slam::decode_map(bytes, "input.pvbmap", pvb::slam::camera_for(s), &map);
+    pvb::slam::decode_map(bytes, "input.pvbmap", h, pvb::slam::camera_for(s), &map);
   } catch (const pvb::Error&) {
   }
 }

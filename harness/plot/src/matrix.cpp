@@ -29,8 +29,13 @@ std::string xml(const std::string& s) {
 
 std::string cell_text(const std::optional<double>& v) { return v ? format_fixed(100 * *v, 0) + " %" : "-"; }
 
+/// Wide enough for the cells and for the title (about 11 px a character).
+int width_of(const MatrixFigure& m) {
+  return std::max(kLeft + kCell * static_cast<int>(m.cols.size()) + kRight, 20 + 11 * static_cast<int>(m.title.size()));
+}
+
 std::string svg(const MatrixFigure& m) {
-  const int w = kLeft + kCell * static_cast<int>(m.cols.size()) + kRight;
+  const int w = width_of(m);
   const int h = kTop + kCell * static_cast<int>(m.rows.size()) + kBottom;
   std::string out = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(w) + "\" height=\"" +
                     std::to_string(h) + "\" font-family=\"sans-serif\" font-size=\"13\">\n";
@@ -59,7 +64,7 @@ std::string svg(const MatrixFigure& m) {
 }
 
 cv::Mat raster(const MatrixFigure& m) {
-  const int w = kLeft + kCell * static_cast<int>(m.cols.size()) + kRight;
+  const int w = width_of(m);
   const int h = kTop + kCell * static_cast<int>(m.rows.size()) + kBottom;
   cv::Mat img(h, w, CV_8UC3, cv::Scalar(255, 255, 255));
   const auto text = [&](const std::string& s, int x, int y, double scale) {

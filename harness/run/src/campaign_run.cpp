@@ -176,24 +176,34 @@ std::string campaign_json(const CampaignReport& r) {
   return out + "\n  ]\n}\n";
 }
 
-plot::MatrixFigure campaign_matrix(const CampaignReport& r) {
+plot::MatrixFigure campaign_matrix(const std::string& title, const std::vector<MatrixSession>& sessions) {
   plot::MatrixFigure m;
-  m.title = "campaign " + r.campaign.name + ": share of frames within 0.25 m and 2 deg";
+  m.title = title;
   m.row_label = "the session whose map is used";
   m.col_label = "query session";
-  for (const auto& s : r.campaign.sessions) {
+  for (const MatrixSession& s : sessions) {
     if (s.mode != SessionMode::kLocalise) m.rows.push_back(s.name);
     if (s.mode != SessionMode::kMap) m.cols.push_back(s.name);
   }
   m.values.assign(m.rows.size(), std::vector<std::optional<double>>(m.cols.size()));
-  for (const SessionResult& s : r.sessions) {
-    if (!s.map || !s.map->localisation) continue;
-    const auto row = std::find(m.rows.begin(), m.rows.end(), s.session.map);
-    const auto col = std::find(m.cols.begin(), m.cols.end(), s.session.name);
-    if (row == m.rows.end() || col == m.cols.end()) continue;
-    m.values[row - m.rows.begin()][col - m.cols.begin()] = s.map->localisation->share_within[1];
+  for (const MatrixSession& s : sessions) {
+    const auto row = std::find(m.rows.begin(), m.rows.end(), s.map);
+    const auto col = std::find(m.cols.begin(), m.cols.end(), s.name);
+    if (s.share && row != m.rows.end() && col != m.cols.end())
+      m.values[row - m.rows.begin()][col - m.cols.begin()] = s.share;
   }
   return m;
+}
+
+plot::MatrixFigure campaign_matrix(const CampaignReport& r) {
+  std::vector<MatrixSession> sessions;
+  for (const CampaignSession& c : r.campaign.sessions) {
+    MatrixSession m{c.name, c.mode, c.map, std::nullopt};
+    for (const SessionResult& s : r.sessions)
+      if (s.session.name == c.name && s.map && s.map->localisation) m.share = s.map->localisation->share_within[1];
+    sessions.push_back(m);
+  }
+  return campaign_matrix("campaign " + r.campaign.name + ": share of frames within 0.25 m and 2 deg", sessions);
 }
 
 int campaign_exit_code(const CampaignReport& r) {

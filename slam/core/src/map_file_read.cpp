@@ -6,6 +6,8 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "map_file_bytes.hpp"
@@ -19,11 +21,8 @@ namespace {
 using namespace mapfile;
 
 
-/// Where each section's payload lies in the file.
-struct Section {
-  std::size_t offset = 0, length = 0;
-};
-using Sections = std::array<Section, kSections.size()>;
+/// Where each section's payload lies in the file: (offset, length).
+using Sections = std::vector<std::pair<std::size_t, std::size_t>>;
 
 Sections split_sections(const std::string& b, const std::string& file) {
   if (b.size() < kMagicBytes || b.compare(0, kMagicBytes, kMagic, kMagicBytes) != 0)
@@ -37,14 +36,14 @@ Sections split_sections(const std::string& b, const std::string& file) {
   const std::uint32_t count = r.u32();
   if (count != kSections.size())
     r.fail(std::to_string(count) + " sections, expected " + std::to_string(kSections.size()));
-  Sections out;
+  Sections out(kSections.size());
   for (std::size_t s = 0; s < kSections.size(); ++s) {
     const std::string tag(r.bytes(4), 4);
     if (tag != kSections[s]) r.fail("section " + std::to_string(s) + " is not " + kSections[s]);
     const std::uint64_t length = r.u64();
     if (length > r.remaining()) r.fail(std::string(kSections[s]) + " is cut short (the file is truncated)");
-    out[s].offset = b.size() - r.remaining();
-    out[s].length = length;
+    out[s].first = b.size() - r.remaining();
+    out[s].second = length;
     const char* payload = r.bytes(length);
     if (r.u64() != fnv1a64(payload, length))
       r.fail(std::string(kSections[s]) + " checksum does not match (the file is damaged)");
@@ -54,7 +53,7 @@ Sections split_sections(const std::string& b, const std::string& file) {
 }
 
 ByteReader reader_for(const std::string& b, const Sections& s, std::size_t i, const std::string& file) {
-  return ByteReader(b.data() + s[i].offset, s[i].length, file, kSections[i], s[i].offset);
+  return ByteReader(b.data() + s[i].first, s[i].second, file, kSections[i], s[i].first);
 }
 
 void check_settings(ByteReader& r, const MapSettings& s) {
@@ -280,14 +279,15 @@ void read_bows(ByteReader r, Map* map) {
 MapFileHeader read_map_header(const std::string& bytes, const std::string& file) {
   const Sections s = split_sections(bytes, file);
   MapFileHeader h = parse_head(reader_for(bytes, s, 0, file));
-  h.app_json.assign(bytes, s[5].offset, s[5].length);
+  h.app_json.assign(bytes, s[5].first, s[5].second);
+  h.sections = s;
   return h;
 }
 
-void decode_map(const std::string& bytes, const std::string& file, const std::shared_ptr<const CameraModel>& cam,
-                Map* map) {
-  const Sections s = split_sections(bytes, file);
-  const MapFileHeader h = parse_head(reader_for(bytes, s, 0, file));
+void decode_map(const std::string& bytes, const std::string& file, const MapFileHeader& h,
+                const std::shared_ptr<const CameraModel>& cam, Map* map) {
+  const Sections& s = h.sections;
+  if (s.size() != kSections.size()) throw std::logic_error("decode_map: a header not from read_map_header");
   const PointIdsByKf ids = read_keyframes(reader_for(bytes, s, 1, file), cam, h.sessions, map);
   if (map->keyframes().empty()) throw IoError(file, "the map has no keyframes");
   const auto saved = read_points(reader_for(bytes, s, 2, file), *map);

@@ -158,7 +158,7 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
   MapLoadInfo info;
   {
     std::lock_guard<std::mutex> lock(map_.mutex());
-    decode_map(bytes, path, cam_, &map_);
+    decode_map(bytes, path, head, cam_, &map_);
     for (const auto& [id, kf] : map_.keyframes()) {
       kf->set_fixed(start == MapStart::kExtend);
       if (kf->bow().empty()) place_->compute_bow(*kf);  // saved with the map (the same vocabulary)

@@ -102,7 +102,7 @@ TEST_F(MapFile, SaveLoadSaveGivesTheSameBytes) {
 TEST_F(MapFile, EncodeOfADecodedMapIsTheFileItCameFrom) {
   const MapFileHeader h = read_map_header(bytes_, path_);
   Map map;
-  decode_map(bytes_, path_, camera_for(h.settings), &map);
+  decode_map(bytes_, path_, h, camera_for(h.settings), &map);
   std::lock_guard<std::mutex> lock(map.mutex());
   EXPECT_EQ(encode_map(map, h.settings, h.sessions, h.app_json), bytes_);
 }

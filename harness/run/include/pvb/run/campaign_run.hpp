@@ -60,8 +60,18 @@ CampaignReport run_campaign(const CampaignOptions& options);
 
 /// campaign.json: the campaign, its seed and each session's figures.
 std::string campaign_json(const CampaignReport& r);
-/// The matrix of a campaign: rows the sessions that leave a map, columns
-/// those that start from one, each cell the share within (0.25 m, 2 deg).
+/// One session's place in a campaign matrix: what it is, the session
+/// whose map it used, and its share within (0.25 m, 2 deg) when measured.
+struct MatrixSession {
+  std::string name;
+  SessionMode mode = SessionMode::kMap;
+  std::string map;
+  std::optional<double> share;
+};
+/// The matrix: rows the sessions that leave a map, columns those that start
+/// from one, each cell a query session's share in its map session's row.
+plot::MatrixFigure campaign_matrix(const std::string& title, const std::vector<MatrixSession>& sessions);
+/// The matrix of one run of a campaign.
 plot::MatrixFigure campaign_matrix(const CampaignReport& r);
 /// 0 when every session completed, else non-zero.
 int campaign_exit_code(const CampaignReport& r);

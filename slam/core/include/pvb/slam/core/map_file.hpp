@@ -12,6 +12,8 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "pvb/slam/core/map.hpp"
 
@@ -42,6 +44,9 @@ struct MapFileHeader {
   MapSettings settings;
   std::uint32_t sessions = 0;  ///< mapping sessions the map holds
   std::string app_json;        ///< the META section (the caller's JSON, "" when none)
+  /// Where each section's payload lies in the file (offset, length), in
+  /// file order; checked by read_map_header, used by decode_map.
+  std::vector<std::pair<std::size_t, std::size_t>> sections;
 };
 
 constexpr std::uint32_t kMapFileVersion = 1;
@@ -59,11 +64,12 @@ MapFileHeader read_map_header(const std::string& bytes, const std::string& file)
 /// The camera model of the map's settings (that read_map_header checked).
 std::shared_ptr<const CameraModel> camera_for(const MapSettings& settings);
 
-/// Reads the keyframes, points and graph into `map` (empty), with frames
-/// on camera `cam`.  Every reference is checked (ids, keypoint indices,
+/// Reads the keyframes, points and graph of the file whose header
+/// read_map_header gave into `map` (empty), with frames on camera `cam`
+/// (the checksums are not checked again).  Every reference is checked (ids, keypoint indices,
 /// octaves, rotations); a bad one throws IoError naming `file`, the section
 /// and the item.  Point descriptors, normals and scale ranges are computed.
-void decode_map(const std::string& bytes, const std::string& file, const std::shared_ptr<const CameraModel>& cam,
-                Map* map);
+void decode_map(const std::string& bytes, const std::string& file, const MapFileHeader& header,
+                const std::shared_ptr<const CameraModel>& cam, Map* map);
 
 }  // namespace pvb::slam
