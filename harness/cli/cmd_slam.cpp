@@ -9,6 +9,7 @@
 #include <fstream>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -17,23 +18,26 @@
 #include "count_option.hpp"
 #include "map_options.hpp"
 #include "pvb/common/error.hpp"
-#include "pvb/common/output_folder.hpp"
 #include "pvb/common/output_file.hpp"
+#include "pvb/common/output_folder.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/evaluate.hpp"
-#include "pvb/run/map_eval.hpp"
-#include "pvb/run/place_recognition.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/harness/matching/ground_truth.hpp"
+#include "pvb/run/map_eval.hpp"
+#include "pvb/run/place_recognition.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"
+#include "pvb/suite/metrics_file.hpp"
 #include "stop_signals.hpp"
 
 namespace pvb::cli {
 namespace {
+
+constexpr std::uint32_t kDefaultSeed = 1;  ///< a sequence that names no seed (a TUM download)
 
 struct SlamArgs {
   std::string sequence;
@@ -43,8 +47,9 @@ struct SlamArgs {
   bool no_pe_match = false;
   bool sync = false;
   bool no_dense = false;
-  std::uint32_t seed = 1;
-  long long max_frames = 0;  ///< frames to track, 0: all (a negative count is an error, not a wrap)
+  std::optional<std::uint32_t> seed;  ///< --seed; else the recording's own, else kDefaultSeed
+  std::string seed_source;            ///< where the seed used came from, for the log and stats.json
+  long long max_frames = 0;           ///< frames to track, 0: all (a negative count is an error, not a wrap)
   double max_missing = 0.1;
   bool dump_matches = false;
   bool dump_map = false;
@@ -214,8 +219,8 @@ class SlamRun {
   OutputFile cam_traj_, kf_traj_, timing_;
   std::unique_ptr<MotionMatchScorer> scorer_;
   Tally tally_;
-  run::PlaceRecognition place_;  ///< collected after the run, labelled when there is ground truth
-  std::string image_size_error_;  ///< set when the loop stopped on an image of the wrong size
+  run::PlaceRecognition place_;        ///< collected after the run, labelled when there is ground truth
+  std::string image_size_error_;       ///< set when the loop stopped on an image of the wrong size
   std::optional<run::MapReport> map_;  ///< with --map or --save-map
 };
 
@@ -248,7 +253,7 @@ SlamRun::SlamRun(const SlamArgs& a)
   prepare_output_folder(a.out, a.overwrite, "slam");
   slam::SystemOptions options;
   options.synchronous = a.sync;
-  options.seed = a.seed;
+  options.seed = *a.seed;
   system_ = std::make_unique<slam::System>(settings_, options);
   if (!a.map.load_path.empty() || !a.map.save_path.empty()) map_ = run::start_map(*system_, a.map);
   open_outputs();
@@ -371,7 +376,8 @@ std::string SlamRun::write_final_outputs() {
      << ", \"resolution_m\": " << format_g(settings_.dense.resolution_m)
      << ", \"pose_updates\": " << dense.pose_updates << ", \"keyframes_moved\": " << dense.keyframes_moved
      << ", \"loop_update_ms\": [";
-  for (std::size_t i = 0; i < dense.loop_update_ms.size(); ++i) js << (i ? ", " : "") << format_g(dense.loop_update_ms[i]);
+  for (std::size_t i = 0; i < dense.loop_update_ms.size(); ++i)
+    js << (i ? ", " : "") << format_g(dense.loop_update_ms[i]);
   js << "]}";
   return js.str();
 }
@@ -424,8 +430,9 @@ void SlamRun::finish_map(std::ostringstream* js) {
   if (!map_) return;
   const std::string gt_path = a_.sequence + "/groundtruth.txt";
   // The ground truth at the frames' times: every frame counts once.
-  const eval::Trajectory gt =
-      std::ifstream(gt_path) ? run::ground_truth_at(eval::read_tum(gt_path), tally_.frame_t_ns) : eval::Trajectory{};
+  const eval::Trajectory gt = std::ifstream(gt_path)
+                                  ? run::ground_truth_at(eval::read_tum(gt_path), tally_.frame_t_ns)
+                                  : eval::Trajectory{};
   const eval::Trajectory est =
       tally_.poses > 0 ? eval::read_tum(a_.out + "/CameraTrajectory.txt") : eval::Trajectory{};
   run::finish_map(*system_, a_.map, gt, est, a_.sequence, 0, &*map_);
@@ -436,10 +443,11 @@ void SlamRun::finish_map(std::ostringstream* js) {
 void SlamRun::label_places(const eval::Trajectory& gt) {
   run::label_place_recognition(&place_, gt);
   const eval::PlaceLabels& l = *place_.labels;
-  std::printf("place recognition: loops %d true, %d false, %d missed of %zu true revisits; "
-              "relocalisations %d true, %d false\n",
-              l.loops_true, l.loops_false, l.loops_missed, l.revisits.size(), l.relocalisations_true,
-              l.relocalisations_false);
+  std::printf(
+      "place recognition: loops %d true, %d false, %d missed of %zu true revisits; "
+      "relocalisations %d true, %d false\n",
+      l.loops_true, l.loops_false, l.loops_missed, l.revisits.size(), l.relocalisations_true,
+      l.relocalisations_false);
 }
 
 /// The run's counts, timings and mapping statistics for stats.json (without
@@ -449,7 +457,8 @@ std::string SlamRun::stats_json(StopReason stop, const std::string& dense_json) 
   std::ostringstream js;
   js << "{\n  \"sequence\": \"" << json_escape(a_.sequence)
      << "\",\n  \"pe_match\": " << (settings_.pe_match.enabled ? "true" : "false")
-     << ",\n  \"sync\": " << (a_.sync ? "true" : "false") << ",\n  \"seed\": " << a_.seed
+     << ",\n  \"sync\": " << (a_.sync ? "true" : "false") << ",\n  \"seed\": " << *a_.seed
+     << ",\n  \"seed_source\": \"" << json_escape(a_.seed_source) << "\""
      << ",\n  \"interrupted\": " << (stop == StopReason::kSignal ? "true" : "false") << ",\n  \"stop\": \""
      << stop_name(stop) << "\",\n  \"frames\": " << t.frames << ",\n  \"lost_frames\": " << t.lost
      << ",\n  \"not_initialized_frames\": " << t.not_init << ",\n  \"skipped_frames\": " << reader_.skipped()
@@ -472,14 +481,16 @@ std::string SlamRun::stats_json(StopReason stop, const std::string& dense_json) 
   if (system_->loop_closing_enabled()) {
     const slam::LoopClosingStats loops = system_->loop_stats();
     js << ",\n  \"loop_closing\": " << slam::to_json(loops);
-    std::printf("loop closing: %zu loops closed (%d consistent detections, %d refused: %d by the drift bound, "
-                "%d as ambiguous); detection %.2f ms median per keyframe\n",
-                loops.loops.size(), loops.consistent, loops.rejected, loops.refused_drift, loops.refused_ambiguous,
-                percentile(loops.detect_ms, 0.5));
-    std::printf("  %d candidates verified: refused %d at the descriptor matches, %d at RANSAC, %d after the guided "
-                "search, %d by the correction bound; verification %.0f of %.0f ms\n",
-                loops.verified, loops.refused_matches, loops.refused_ransac, loops.refused_inliers,
-                loops.refused_correction, loops.verify_ms_total, loops.detect_ms_total);
+    std::printf(
+        "loop closing: %zu loops closed (%d consistent detections, %d refused: %d by the drift bound, "
+        "%d as ambiguous); detection %.2f ms median per keyframe\n",
+        loops.loops.size(), loops.consistent, loops.rejected, loops.refused_drift, loops.refused_ambiguous,
+        percentile(loops.detect_ms, 0.5));
+    std::printf(
+        "  %d candidates verified: refused %d at the descriptor matches, %d at RANSAC, %d after the guided "
+        "search, %d by the correction bound; verification %.0f of %.0f ms\n",
+        loops.verified, loops.refused_matches, loops.refused_ransac, loops.refused_inliers,
+        loops.refused_correction, loops.verify_ms_total, loops.detect_ms_total);
     for (const slam::LoopEvent& e : loops.loops)
       std::printf(
           "  frame %llu (keyframe %llu) -> frame %llu (keyframe %llu): %d inliers, moved %.3f m / %.2f deg, "
@@ -528,6 +539,7 @@ int SlamRun::run() {
   if (scorer_) js << ",\n  " << scorer_->json();
   js << "\n}\n";
   write_file(a_.out + "/stats.json", js.str());
+  std::printf("PE-match seed %u (%s)\n", *a_.seed, a_.seed_source.c_str());
   std::printf(
       "wrote "
       "%s/{CameraTrajectory.txt,CameraTrajectoryRefined.txt,KeyFrameTrajectory.txt,timing.csv,stats.json}\n",
@@ -536,8 +548,24 @@ int SlamRun::run() {
   return stop == StopReason::kSignal ? 130 : 0;
 }
 
+/// PE-match's seed: --seed, else the seed the recording was made with (its
+/// meta.json, as pvbench record writes it, or a run folder's metrics.json),
+/// so that a replay is the run it recorded; else kDefaultSeed.
+void resolve_seed(SlamArgs* a) {
+  if (a->seed) {
+    a->seed_source = "--seed";
+  } else if (const auto id = suite::read_folder_identity(a->sequence); id && id->seed) {
+    a->seed = static_cast<std::uint32_t>(*id->seed);  // as pvbench run and record seed PE-match
+    a->seed_source = id->file;
+  } else {
+    a->seed = kDefaultSeed;
+    a->seed_source = "default";
+  }
+}
+
 int run_slam(SlamArgs a) {
   if (!a.map_mode.empty()) a.map.use = run::parse_map_use(a.map_mode, "--map-mode");
+  resolve_seed(&a);
   SlamRun run(a);
   return run.run();
 }
@@ -555,8 +583,8 @@ Command add_slam_command(CLI::App& app) {
   sub->add_flag("--no-pe-match", args->no_pe_match, "baseline: ORB-SLAM2 motion model without PE-match");
   sub->add_flag("--no-dense", args->no_dense, "skip the dense point-cloud map (PointCloud.ply)");
   sub->add_flag("--sync", args->sync, "synchronous mode: no worker threads, bit-identical runs");
-  sub->add_option("--seed", args->seed, "PE-match seed")
-      ->capture_default_str()
+  sub->add_option("--seed", args->seed,
+                  "PE-match seed (default: the recording's own seed from its meta.json, else 1)")
       ->check(seed_check("slam", "--seed"));
   sub->add_option("--max-frames", args->max_frames, "stop after this many frames (0: all)")
       ->capture_default_str();

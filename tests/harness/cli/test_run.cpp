@@ -131,13 +131,16 @@ void check_bit_identical_prefix(const std::string& d) {
 
 // A recording replays what the live run saw: `pvbench slam` on `pvbench
 // record`'s folder gives the live run's trajectory bit for bit (the sensor
-// model emits depth on the PNG grid; settings travel through camera.yaml).
+// model emits depth on the PNG grid; settings travel through camera.yaml),
+// with no --seed: PE-match takes the recording's own seed from its meta.json.
 void check_replay_of_recording(const std::string& d) {
   const std::string rec = fresh("replay_rec"), out = fresh("replay_slam");
   ASSERT_EQ(test::run_pvbench("record --scenario " + kStation + " --out " + rec + " --frames 40").code, 0);
   const test::RunResult r = test::run_pvbench("slam --sequence " + rec + " --settings " + rec +
-                                              "/camera.yaml --out " + out + " --sync --seed 7 --no-dense");
+                                              "/camera.yaml --out " + out + " --sync --no-dense");
   ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("PE-match seed 7 (" + rec + "/meta.json)\n"), std::string::npos) << r.output;
+  EXPECT_EQ(test::json_number(read_file(out + "/stats.json"), "seed"), 7.0);
   const std::vector<std::string> live = data_lines(d + "/CameraTrajectory.txt"),
                                  replay = data_lines(out + "/CameraTrajectory.txt");
   ASSERT_EQ(replay.size(), 40u);
