@@ -472,7 +472,8 @@ std::string SlamRun::stats_json(StopReason stop, const std::string& dense_json) 
      << ",\n  \"cpu_ms\": {\"median\": " << format_g(percentile(t.cpu_ms, 0.5))
      << ", \"mean\": " << format_g(mean_of(t.cpu_ms)) << ", \"p95\": " << format_g(percentile(t.cpu_ms, 0.95))
      << "}"
-     << ",\n  \"local_mapping\": " << slam::to_json(system_->mapping_stats()) << dense_json;
+     << ",\n  \"local_mapping\": " << slam::to_json(system_->mapping_stats()) << dense_json
+     << ",\n  \"memory\": " << slam::to_json(system_->memory());
   const slam::LocalMappingStats mapping = system_->mapping_stats();
   std::printf(
       "frames %zu, lost %zu, keyframes %zu, map points %zu; local BA %lld (%lld stopped by a keyframe)\n",

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <opencv2/calib3d.hpp>
 
+#include "pvb/common/memory.hpp"
 #include "pvb/slam/core/map.hpp"
 
 namespace pvb::slam {
@@ -200,6 +201,40 @@ int Frame::num_tracked() const {
   int n = 0;
   for (const auto& mp : map_points) n += (mp != nullptr);
   return n;
+}
+
+FrameMemory& FrameMemory::operator+=(const FrameMemory& o) {
+  pyramid += o.pyramid;
+  keypoints += o.keypoints;
+  descriptors += o.descriptors;
+  per_keypoint += o.per_keypoint;
+  grid += o.grid;
+  object += o.object;
+  return *this;
+}
+
+std::size_t mat_heap_bytes(const cv::Mat& m) {
+  if (m.u == nullptr) return 0;
+  // cv::fastMalloc asks for a pointer and 64 bytes more, to align the data to 64.
+  constexpr std::size_t kAlignSlack = sizeof(void*) + 64;
+  return heap_block_bytes(m.u->size + kAlignSlack) + heap_block_bytes(sizeof(cv::UMatData));
+}
+
+FrameMemory Frame::memory() const {
+  FrameMemory m;
+  if (pyramid) {
+    // make_shared: the vector and its control block in one block
+    m.pyramid = heap_block_bytes(sizeof(ImagePyramid) + 2 * sizeof(long)) + vector_heap_bytes(*pyramid);
+    for (const cv::Mat& level : *pyramid) m.pyramid += mat_heap_bytes(level);
+  }
+  m.keypoints = vector_heap_bytes(keys) + vector_heap_bytes(keys_un);
+  m.descriptors = mat_heap_bytes(descriptors);
+  m.per_keypoint = vector_heap_bytes(depth_m) + vector_heap_bytes(u_right) + vector_heap_bytes(map_points) +
+                   vector_heap_bytes(outlier) + vector_heap_bytes(aligned_for);
+  m.grid = vector_heap_bytes(grid_);
+  for (const auto& cell : grid_) m.grid += vector_heap_bytes(cell);
+  m.object = sizeof(Frame);
+  return m;
 }
 
 int descriptor_distance(const unsigned char* a, const unsigned char* b) {

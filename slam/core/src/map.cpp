@@ -4,6 +4,8 @@
 #include <climits>
 #include <stdexcept>
 
+#include "pvb/common/memory.hpp"
+
 namespace pvb::slam {
 
 // MapPoint ------------------------------------------------------------------
@@ -123,7 +125,31 @@ void MapPoint::update_normal_and_depth() {
   min_dist_m_ = max_dist_m_ / cam.scale[cam.num_levels - 1];
 }
 
+std::size_t MapPoint::memory_bytes() const {
+  // make_shared puts the object after a control block of two counts and a vtable pointer.
+  return heap_block_bytes(sizeof(MapPoint) + 2 * sizeof(long)) + map_node_bytes(obs_) + mat_heap_bytes(descriptor_);
+}
+
 // KeyFrame ------------------------------------------------------------------
+
+KeyFrameMemory& KeyFrameMemory::operator+=(const KeyFrameMemory& o) {
+  frame += o.frame;
+  bow += o.bow;
+  graph += o.graph;
+  object += o.object;
+  return *this;
+}
+
+KeyFrameMemory KeyFrame::memory() const {
+  KeyFrameMemory m;
+  m.frame = frame_.memory();
+  m.bow = map_node_bytes(bow_) + map_node_bytes(features_by_node_);
+  for (const auto& [node, indices] : features_by_node_) m.bow += vector_heap_bytes(indices);
+  m.graph = map_node_bytes(connections_) + vector_heap_bytes(ordered_) + map_node_bytes(children_) +
+            map_node_bytes(loop_edges_);
+  m.object = heap_block_bytes(sizeof(KeyFrame) + 2 * sizeof(long)) - sizeof(Frame);
+  return m;
+}
 
 KeyFrame::KeyFrame(std::uint64_t id, const Frame& frame) : id_(id), frame_(frame) {}
 
@@ -356,6 +382,15 @@ bool Map::erase_keyframe(const std::shared_ptr<KeyFrame>& kf) {
 void Map::remove_bad_points() {
   for (auto it = points_.begin(); it != points_.end();)
     it = it->second->bad() ? points_.erase(it) : std::next(it);
+}
+
+MapMemory Map::memory() const {
+  MapMemory m;
+  m.keyframes = keyframes_.size();
+  for (const auto& [id, kf] : keyframes_) m.keyframe_bytes += kf->memory();
+  m.points = points_.size();
+  for (const auto& [id, mp] : points_) m.point_bytes += mp->memory_bytes();
+  return m;
 }
 
 void Map::clear() {

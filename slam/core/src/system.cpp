@@ -2,6 +2,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <set>
+#include <sstream>
+
 #include "pvb/common/clock.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
@@ -247,6 +250,47 @@ std::optional<dense::LoopSnapshot> System::dense_first_loop() const {
 }
 
 dense::DenseMapperStats System::dense_stats() const { return dense_ ? dense_->stats() : dense::DenseMapperStats{}; }
+
+SystemMemory System::memory() {
+  SystemMemory m;
+  {
+    std::lock_guard<std::mutex> lock(map_.mutex());
+    m.map = map_.memory();
+    // Every keyframe was the reference keyframe of the frame that made it.
+    std::set<const KeyFrame*> culled;
+    for (const FrameRecord& r : records_)
+      if (r.ref->bad() && culled.insert(r.ref.get()).second) m.culled_bytes += r.ref->memory();
+    m.culled_keyframes = culled.size();
+  }
+  if (dense_) m.dense = dense_->memory();
+  return m;
+}
+
+namespace {
+std::string frame_memory_json(const FrameMemory& f) {
+  std::ostringstream js;
+  js << "\"pyramid\": " << f.pyramid << ", \"keypoints\": " << f.keypoints << ", \"descriptors\": " << f.descriptors
+     << ", \"per_keypoint\": " << f.per_keypoint << ", \"grid\": " << f.grid << ", \"frame_object\": " << f.object;
+  return js.str();
+}
+std::string keyframe_memory_json(const KeyFrameMemory& k) {
+  std::ostringstream js;
+  js << "{" << frame_memory_json(k.frame) << ", \"bow\": " << k.bow << ", \"graph\": " << k.graph
+     << ", \"object\": " << k.object << ", \"total\": " << k.total() << "}";
+  return js.str();
+}
+}  // namespace
+
+std::string to_json(const SystemMemory& m) {
+  std::ostringstream js;
+  js << "{\"keyframes\": " << m.map.keyframes << ", \"keyframe_bytes\": " << keyframe_memory_json(m.map.keyframe_bytes)
+     << ", \"points\": " << m.map.points << ", \"point_bytes\": " << m.map.point_bytes
+     << ", \"culled_keyframes\": " << m.culled_keyframes
+     << ", \"culled_keyframe_bytes\": " << keyframe_memory_json(m.culled_bytes)
+     << ", \"dense_keyframes\": " << m.dense.keyframes << ", \"dense_keyframe_bytes\": " << m.dense.keyframe_bytes
+     << ", \"dense_map_bytes\": " << m.dense.map_bytes << "}";
+  return js.str();
+}
 
 std::size_t System::num_keyframes() {
   std::lock_guard<std::mutex> lock(map_.mutex());

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 
 #include "pvb/common/clock.hpp"
+#include "pvb/common/memory.hpp"
 #include "pvb/common/threads.hpp"
 
 namespace pvb::slam::dense {
@@ -150,6 +151,16 @@ PointCloud DenseMapper::keyframe_cloud(std::uint64_t id) const {
   std::lock_guard<std::mutex> lock(mutex_);
   const auto it = entries_.find(id);
   return it == entries_.end() ? PointCloud{} : it->second.cloud_c;
+}
+
+DenseMemory DenseMapper::memory() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  DenseMemory m;
+  m.keyframes = entries_.size();
+  m.keyframe_bytes = map_node_bytes(entries_);
+  for (const auto& [id, e] : entries_) m.keyframe_bytes += vector_heap_bytes(e.cloud_c) + vector_heap_bytes(e.handle);
+  m.map_bytes = live_.memory_bytes() + corrected_.memory_bytes();
+  return m;
 }
 
 DenseMapperStats DenseMapper::stats() const {

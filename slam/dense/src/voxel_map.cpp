@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/memory.hpp"
 
 namespace pvb::slam::dense {
 namespace {
@@ -116,5 +117,7 @@ PointCloud VoxelMap::cloud() const {
   }
   return out;
 }
+
+std::size_t VoxelMap::memory_bytes() const { return vector_heap_bytes(cells_) + vector_heap_bytes(slots_); }
 
 }  // namespace pvb::slam::dense

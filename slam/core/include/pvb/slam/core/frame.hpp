@@ -60,6 +60,25 @@ struct CameraModel {
   int predict_scale(double dist_m, double max_dist_m) const;
 };
 
+/// Bytes a frame holds, by structure: heap blocks as malloc sizes them
+/// (pvb/common/memory.hpp) plus the object itself.  The pyramid is shared
+/// by the frame and the keyframe made from it; each counts it.
+struct FrameMemory {
+  std::size_t pyramid = 0;       ///< grey image pyramid (patch alignment)
+  std::size_t keypoints = 0;     ///< keys and keys_un
+  std::size_t descriptors = 0;
+  std::size_t per_keypoint = 0;  ///< depth, u_right, map-point links, outlier flags, aligned_for
+  std::size_t grid = 0;          ///< the area-search index
+  std::size_t object = 0;        ///< sizeof(Frame)
+  std::size_t total() const { return pyramid + keypoints + descriptors + per_keypoint + grid + object; }
+  FrameMemory& operator+=(const FrameMemory& o);
+};
+
+/// Heap bytes of the buffer a cv::Mat refers to (0 for a view of memory
+/// OpenCV did not allocate): the data with OpenCV's alignment slack and its
+/// reference-count block.
+std::size_t mat_heap_bytes(const cv::Mat& m);
+
 class Frame {
  public:
   Frame() = default;
@@ -97,6 +116,8 @@ class Frame {
   Eigen::Vector3d camera_center_w() const { return T_c_w.inverse().translation(); }
   /// Number of keypoints with a map point.
   int num_tracked() const;
+  /// What this frame holds, by structure.
+  FrameMemory memory() const;
 
   std::uint64_t id = 0;
   std::int64_t t_ns = 0;

@@ -23,6 +23,25 @@ namespace pvb::slam {
 
 class KeyFrame;
 
+/// Bytes a keyframe holds, by structure (heap blocks as malloc sizes them,
+/// plus the objects themselves); docs/slam.md, "Keyframe memory".
+struct KeyFrameMemory {
+  FrameMemory frame;       ///< its frame's data
+  std::size_t bow = 0;     ///< bag of words and the direct index
+  std::size_t graph = 0;   ///< covisibility, spanning tree, loop edges
+  std::size_t object = 0;  ///< the KeyFrame beyond its Frame, with make_shared's control block
+  std::size_t total() const { return frame.total() + bow + graph + object; }
+  KeyFrameMemory& operator+=(const KeyFrameMemory& o);
+};
+
+/// What the map holds: its keyframes (by structure, summed) and points.
+struct MapMemory {
+  std::size_t keyframes = 0;
+  KeyFrameMemory keyframe_bytes;
+  std::size_t points = 0;
+  std::size_t point_bytes = 0;
+};
+
 /// A 3-D landmark.
 class MapPoint {
  public:
@@ -81,6 +100,10 @@ class MapPoint {
     visible_ = visible;
     found_ = found;
   }
+
+  /// Bytes the point holds: the object (with make_shared's control block),
+  /// its observation nodes and its descriptor.
+  std::size_t memory_bytes() const;
 
  private:
   std::uint64_t id_;
@@ -181,6 +204,9 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   /// spanning tree from its pose relative to its parent at removal time.
   geom::SE3d T_c_w_via_tree() const;
 
+  /// What this keyframe holds, by structure.
+  KeyFrameMemory memory() const;
+
  private:
   void update_order();
 
@@ -219,6 +245,8 @@ class Map {
   const std::map<std::uint64_t, std::shared_ptr<MapPoint>>& points() const { return points_; }
   std::size_t num_keyframes() const { return keyframes_.size(); }
   std::size_t num_points() const { return points_.size(); }
+  /// What the keyframes and points in the map hold (callers hold mutex()).
+  MapMemory memory() const;
   void clear();
 
   // Loading a saved map (map_file.hpp) ---------------------------------------

@@ -59,6 +59,18 @@ struct FrameResult {
   int num_features = 0;
 };
 
+/// What the system holds, by part (docs/slam.md, "Keyframe memory").
+struct SystemMemory {
+  MapMemory map;                       ///< keyframes and points in the map
+  /// Keyframes culled from the map but kept for the trajectory (their
+  /// poses follow their spanning-tree parents), and what they hold.
+  std::size_t culled_keyframes = 0;
+  KeyFrameMemory culled_bytes;
+  dense::DenseMemory dense;            ///< empty when dense mapping is off
+};
+/// {"keyframes": .., "keyframe_bytes": {"pyramid": .., ...}, ...} for stats.json.
+std::string to_json(const SystemMemory& m);
+
 class System {
  public:
   System(const Settings& settings, const SystemOptions& options);
@@ -109,6 +121,9 @@ class System {
   /// Loops closed so far and detection totals (empty when LoopClosing.enabled is 0).
   LoopClosingStats loop_stats() const { return loop_ ? loop_->stats() : LoopClosingStats{}; }
   bool loop_closing_enabled() const { return loop_ != nullptr; }
+  /// What the map, the culled keyframes and the dense mapper hold now (call
+  /// from the thread that calls track(); after shutdown() for the final figures).
+  SystemMemory memory();
   /// Every relocalisation so far (call from the thread that calls track()).
   const std::vector<RelocEvent>& relocalisations() const { return tracking_->relocalisations(); }
 

@@ -81,6 +81,14 @@ struct DenseMapperStats {
   std::vector<double> loop_update_ms;  ///< the same for the loop corrections
 };
 
+/// Bytes the mapper holds (heap blocks as malloc sizes them).
+struct DenseMemory {
+  std::size_t keyframes = 0;        ///< keyframes kept
+  std::size_t keyframe_bytes = 0;   ///< their clouds (camera frame), voxel handles and entries
+  std::size_t map_bytes = 0;        ///< the live and the corrected voxel maps
+  std::size_t total() const { return keyframe_bytes + map_bytes; }
+};
+
 class DenseMapper {
  public:
   explicit DenseMapper(const DenseMapperOptions& options);
@@ -119,6 +127,8 @@ class DenseMapper {
   /// The cloud of keyframe `id` in its camera frame (empty when unknown).
   PointCloud keyframe_cloud(std::uint64_t id) const;
   DenseMapperStats stats() const;
+  /// What the mapper holds now (not counting keyframes still queued).
+  DenseMemory memory() const;
   const DenseMapperOptions& options() const { return options_; }
 
  private:

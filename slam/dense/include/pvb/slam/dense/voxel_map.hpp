@@ -45,6 +45,8 @@ class VoxelMap {
   /// Occupied voxels.
   std::size_t voxels() const { return occupied_; }
   double leaf_m() const { return leaf_m_; }
+  /// Heap bytes of the cells and the table.
+  std::size_t memory_bytes() const;
 
  private:
   struct Cell {
