@@ -3,8 +3,9 @@
 // (PVB_BENCH_MAP) with the settings of the run that made it
 // (PVB_BENCH_SETTINGS, e.g. the run's camera.yaml).  Without them it skips.
 // The file size per keyframe is reported as a counter.  Run pinned:
-//   PVB_BENCH_MAP=DIR/maps/noon.pvbmap PVB_BENCH_SETTINGS=DIR/noon/camera.yaml \
-//     taskset -c 1 build/bin/bench_map_file --benchmark_repetitions=5
+//   PVB_BENCH_MAP=DIR/maps/noon.pvbmap PVB_BENCH_SETTINGS=DIR/noon/camera.yaml
+//   taskset -c 1 build/bin/bench_map_file --benchmark_repetitions=5
+// (the two lines as one command).
 #include <benchmark/benchmark.h>
 
 #include <cstdio>

@@ -18,7 +18,7 @@ std::string num(double v) { return json_number(v); }
 std::optional<geom::SE3d> pose_at(const eval::Trajectory& t, std::int64_t t_ns) {
   const auto& p = t.poses;
   const auto it = std::lower_bound(p.begin(), p.end(), t_ns,
-                                   [](const geom::StampedPose& a, std::int64_t t) { return a.t_ns < t; });
+                                   [](const geom::StampedPose& a, std::int64_t b_ns) { return a.t_ns < b_ns; });
   if (it != p.end() && std::llabs(it->t_ns - t_ns) <= 1'000'000) return it->T_w_c;
   if (it != p.begin() && std::llabs(std::prev(it)->t_ns - t_ns) <= 1'000'000) return std::prev(it)->T_w_c;
   if (it == p.begin() || it == p.end() || it->t_ns - std::prev(it)->t_ns > 50'000'000) return std::nullopt;

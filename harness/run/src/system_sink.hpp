@@ -19,6 +19,7 @@ namespace pvb::run {
 
 /// One SLAM system with its output files and bookkeeping.
 struct SystemSink {
+  MapOptions map_options;
   SlamRun run;
   std::unique_ptr<slam::System> system;
   std::string dir;
@@ -34,7 +35,6 @@ struct SystemSink {
 
   SystemSink(const std::string& mode, const slam::Settings& settings, bool sync, std::uint32_t seed,
              const std::string& out_dir, const MapOptions& map = {});
-  MapOptions map_options;
 
   /// Tracks one frame, writes its lines and records loss and recovery.
   slam::FrameResult track(const sensor::RgbdFrame& frame, RunLog& log);
