@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <opencv2/calib3d.hpp>
 
 #include "pvb/common/memory.hpp"
@@ -74,6 +75,36 @@ int CameraModel::predict_scale(double dist_m, double max_dist_m) const {
   return std::clamp(level, 0, num_levels - 1);
 }
 
+namespace {
+
+/// Counting sort of the keypoints by cell: start[c] is where cell c's
+/// indices begin in `index`, each cell's in ascending order.
+template <typename T>
+void group_by_cell(const std::vector<int>& cell_of, int num_cells, std::vector<T>* start, std::vector<T>* index) {
+  start->assign(static_cast<std::size_t>(num_cells) + 1, 0);
+  for (int c : cell_of)
+    if (c >= 0) ++(*start)[static_cast<std::size_t>(c) + 1];
+  for (std::size_t c = 1; c < start->size(); ++c) (*start)[c] = static_cast<T>((*start)[c] + (*start)[c - 1]);
+  index->resize(start->back());
+  std::vector<T> next(start->begin(), start->end() - 1);
+  for (std::size_t i = 0; i < cell_of.size(); ++i)
+    if (cell_of[i] >= 0) (*index)[next[static_cast<std::size_t>(cell_of[i])]++] = static_cast<T>(i);
+}
+
+}  // namespace
+
+KeypointGrid::KeypointGrid(const std::vector<int>& cell_of, int num_cells) {
+  if (cell_of.size() <= std::numeric_limits<std::uint16_t>::max())
+    group_by_cell(cell_of, num_cells, &start16_, &index16_);
+  else
+    group_by_cell(cell_of, num_cells, &start32_, &index32_);
+}
+
+std::size_t KeypointGrid::memory_bytes() const {
+  return vector_heap_bytes(start16_) + vector_heap_bytes(index16_) + vector_heap_bytes(start32_) +
+         vector_heap_bytes(index32_);
+}
+
 Frame::Frame(std::uint64_t frame_id, std::int64_t time_ns, OrbFeatures features, const cv::Mat& depth,
              std::shared_ptr<const CameraModel> camera)
     : id(frame_id), t_ns(time_ns), cam(std::move(camera)) {
@@ -126,13 +157,14 @@ void Frame::build_index() {
   map_points.assign(n, nullptr);
   outlier.assign(n, 0);
   aligned_for.assign(n, kNotAligned);
-  grid_.assign(CameraModel::kGridCols * CameraModel::kGridRows, {});
+  std::vector<int> cell_of(n, -1);
   for (std::size_t i = 0; i < n; ++i) {
     const int cx = static_cast<int>(std::floor((keys_un[i].pt.x - cam->min_x) * cam->grid_inv_w));
     const int cy = static_cast<int>(std::floor((keys_un[i].pt.y - cam->min_y) * cam->grid_inv_h));
     if (cx < 0 || cy < 0 || cx >= CameraModel::kGridCols || cy >= CameraModel::kGridRows) continue;
-    grid_[cy * CameraModel::kGridCols + cx].push_back(static_cast<std::uint32_t>(i));
+    cell_of[i] = cy * CameraModel::kGridCols + cx;
   }
+  grid_ = KeypointGrid(cell_of, CameraModel::kGridCols * CameraModel::kGridRows);
 }
 
 std::vector<std::size_t> Frame::features_in_area(double u, double v, double r, int min_level, int max_level) const {
@@ -152,13 +184,13 @@ void Frame::features_in_area(double u, double v, double r, int min_level, int ma
   if (c0 > c1 || r0 > r1 || grid_.empty()) return;
   for (int gy = r0; gy <= r1; ++gy)
     for (int gx = c0; gx <= c1; ++gx)
-      for (std::uint32_t i : grid_[gy * CameraModel::kGridCols + gx]) {
+      grid_.for_each_in_cell(gy * CameraModel::kGridCols + gx, [&](std::size_t i) {
         const cv::KeyPoint& k = keys_un[i];
-        if (min_level >= 0 && k.octave < min_level) continue;
-        if (max_level >= 0 && k.octave > max_level) continue;
+        if (min_level >= 0 && k.octave < min_level) return;
+        if (max_level >= 0 && k.octave > max_level) return;
         const double dx = k.pt.x - u, dy = k.pt.y - v;
         if (std::abs(dx) < r && std::abs(dy) < r) out.push_back(i);
-      }
+      });
   std::sort(out.begin(), out.end());
 }
 
@@ -231,8 +263,7 @@ FrameMemory Frame::memory() const {
   m.descriptors = mat_heap_bytes(descriptors);
   m.per_keypoint = vector_heap_bytes(depth_m) + vector_heap_bytes(u_right) + vector_heap_bytes(map_points) +
                    vector_heap_bytes(outlier) + vector_heap_bytes(aligned_for);
-  m.grid = vector_heap_bytes(grid_);
-  for (const auto& cell : grid_) m.grid += vector_heap_bytes(cell);
+  m.grid = grid_.memory_bytes();
   m.object = sizeof(Frame);
   return m;
 }
