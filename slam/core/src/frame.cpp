@@ -108,22 +108,26 @@ std::size_t KeypointGrid::memory_bytes() const {
 Frame::Frame(std::uint64_t frame_id, std::int64_t time_ns, OrbFeatures features, const cv::Mat& depth,
              std::shared_ptr<const CameraModel> camera)
     : id(frame_id), t_ns(time_ns), cam(std::move(camera)) {
-  keys = std::move(features.keypoints);
   descriptors = features.descriptors;
-  const std::size_t n = keys.size();
-  keys_un = keys;
+  const std::size_t n = features.keypoints.size();
+  keys.resize(n);
+  keys_un.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const cv::KeyPoint& k = features.keypoints[i];
+    keys[i] = k.pt;
+    keys_un[i] = Keypoint{k.pt, k.angle, k.octave};
+  }
   if (!cam->dist_cv.empty() && n > 0) {
-    std::vector<cv::Point2f> pts(n), un;
-    for (std::size_t i = 0; i < n; ++i) pts[i] = keys[i].pt;
-    cv::undistortPoints(pts, un, cam->K_cv, cam->dist_cv, cv::noArray(), cam->K_cv);
+    std::vector<cv::Point2f> un;
+    cv::undistortPoints(keys, un, cam->K_cv, cam->dist_cv, cv::noArray(), cam->K_cv);
     for (std::size_t i = 0; i < n; ++i) keys_un[i].pt = un[i];
   }
   depth_m.assign(n, -1.0f);
   u_right.assign(n, -1.0f);
   for (std::size_t i = 0; i < n; ++i) {
     // depth is read at the distorted (image) position, as ORB-SLAM2 does
-    const int u = static_cast<int>(std::lround(keys[i].pt.x));
-    const int v = static_cast<int>(std::lround(keys[i].pt.y));
+    const int u = static_cast<int>(std::lround(keys[i].x));
+    const int v = static_cast<int>(std::lround(keys[i].y));
     if (u < 0 || v < 0 || u >= depth.cols || v >= depth.rows) continue;
     const float d = depth.at<float>(v, u);
     if (d > 0 && std::isfinite(d)) {
@@ -185,7 +189,7 @@ void Frame::features_in_area(double u, double v, double r, int min_level, int ma
   for (int gy = r0; gy <= r1; ++gy)
     for (int gx = c0; gx <= c1; ++gx)
       grid_.for_each_in_cell(gy * CameraModel::kGridCols + gx, [&](std::size_t i) {
-        const cv::KeyPoint& k = keys_un[i];
+        const Keypoint& k = keys_un[i];
         if (min_level >= 0 && k.octave < min_level) return;
         if (max_level >= 0 && k.octave > max_level) return;
         const double dx = k.pt.x - u, dy = k.pt.y - v;
@@ -207,9 +211,9 @@ Eigen::Vector3d Frame::unproject_world(std::size_t i) const {
 }
 
 void Frame::move_keypoint(std::size_t i, const Eigen::Vector2d& to_px) {
-  const Eigen::Vector2d shift = to_px - Eigen::Vector2d(keys[i].pt.x, keys[i].pt.y);
-  keys[i].pt.x = static_cast<float>(to_px.x());
-  keys[i].pt.y = static_cast<float>(to_px.y());
+  const Eigen::Vector2d shift = to_px - Eigen::Vector2d(keys[i].x, keys[i].y);
+  keys[i].x = static_cast<float>(to_px.x());
+  keys[i].y = static_cast<float>(to_px.y());
   if (cam->undistort_table.empty()) {
     keys_un[i].pt.x += static_cast<float>(shift.x());
     keys_un[i].pt.y += static_cast<float>(shift.y());

@@ -202,8 +202,8 @@ void LocalMapping::create_new_points(const std::shared_ptr<KeyFrame>& kf) {
     const std::vector<IndexMatch> matches = search_for_triangulation(*kf, *kf2);
     for (const IndexMatch& m : matches) {
       if (kf->map_points()[m.i1] || kf2->map_points()[m.i2]) continue;
-      const cv::KeyPoint& k1 = f1.keys_un[m.i1];
-      const cv::KeyPoint& k2 = f2.keys_un[m.i2];
+      const Keypoint& k1 = f1.keys_un[m.i1];
+      const Keypoint& k2 = f2.keys_un[m.i2];
       const Eigen::Vector3d ray1 = kf->T_c_w().linear().transpose() *
                                    Eigen::Vector3d((k1.pt.x - cam.K.cx) / cam.K.fx, (k1.pt.y - cam.K.cy) / cam.K.fy, 1);
       const Eigen::Vector3d ray2 = kf2->T_c_w().linear().transpose() *

@@ -274,7 +274,7 @@ int fuse(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::vector<std::s
     int best = INT_MAX;
     std::size_t best_idx = 0;
     for (std::size_t j : cands) {
-      const cv::KeyPoint& k = f.keys_un[j];
+      const Keypoint& k = f.keys_un[j];
       if (k.octave < level - 1 || k.octave > level) continue;
       const double ex = uv.x() - k.pt.x, ey = uv.y() - k.pt.y;
       const double inv_s2 = cam.inv_level_sigma2[k.octave];
@@ -326,7 +326,7 @@ std::vector<IndexMatch> search_for_triangulation(const KeyFrame& kf1, const KeyF
   std::vector<long> taken_by(f2.size(), -1);
   for (std::size_t i = 0; i < f1.size(); ++i) {
     if (f1.map_points[i]) continue;
-    const cv::KeyPoint& k1 = f1.keys_un[i];
+    const Keypoint& k1 = f1.keys_un[i];
     const Eigen::Vector3d x1(k1.pt.x, k1.pt.y, 1.0);
     const Eigen::RowVector3d l2 = x1.transpose() * F12;  // line in image 2
     const double den = l2(0) * l2(0) + l2(1) * l2(1);
@@ -335,7 +335,7 @@ std::vector<IndexMatch> search_for_triangulation(const KeyFrame& kf1, const KeyF
     std::size_t best_idx = SIZE_MAX;
     for (std::size_t j = 0; j < f2.size(); ++j) {
       if (f2.map_points[j]) continue;
-      const cv::KeyPoint& k2 = f2.keys_un[j];
+      const Keypoint& k2 = f2.keys_un[j];
       const double num = l2(0) * k2.pt.x + l2(1) * k2.pt.y + l2(2);
       if (num * num / den >= 3.84 * cam.level_sigma2[k2.octave]) continue;
       const int d = descriptor_distance(desc_row(f1.descriptors, i), desc_row(f2.descriptors, j));

@@ -25,10 +25,10 @@ bool align_to_reference(Frame& f, std::size_t i, const MapPoint& mp, const Patch
   Eigen::Matrix2d A;
   A.col(0) = 0.5 * (to_cur(1, 0) - to_cur(-1, 0));
   A.col(1) = 0.5 * (to_cur(0, 1) - to_cur(0, -1));
-  const cv::KeyPoint& key = f.keys[i];
+  const cv::Point2f& key = f.keys[i];
   Eigen::Vector2d aligned;
-  if (!align_patch(*rf.pyramid, Eigen::Vector2d(rf.keys[j].pt.x, rf.keys[j].pt.y), A, *f.pyramid, key.octave,
-                   Eigen::Vector2d(key.pt.x, key.pt.y), params, &aligned))
+  if (!align_patch(*rf.pyramid, Eigen::Vector2d(rf.keys[j].x, rf.keys[j].y), A, *f.pyramid, f.keys_un[i].octave,
+                   Eigen::Vector2d(key.x, key.y), params, &aligned))
     return false;
   f.move_keypoint(i, aligned);
   return true;

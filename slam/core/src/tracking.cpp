@@ -212,7 +212,7 @@ bool Tracking::track_with_motion_model(Frame& f) {
   for (std::size_t k = 0; k < m.size(); ++k) {
     const auto to_eigen = [](const cv::Point2f& p) { return Eigen::Vector2d(p.x, p.y); };
     rec.undistorted[k] = {to_eigen(last_.keys_un[m[k].i1].pt), to_eigen(f.keys_un[m[k].i2].pt)};
-    rec.raw[k] = {to_eigen(last_.keys[m[k].i1].pt), to_eigen(f.keys[m[k].i2].pt)};
+    rec.raw[k] = {to_eigen(last_.keys[m[k].i1]), to_eigen(f.keys[m[k].i2])};
     rec.octaves[k] = {last_.keys_un[m[k].i1].octave, f.keys_un[m[k].i2].octave};
   }
 

@@ -77,8 +77,8 @@ TEST(Frame, MovedKeypointIsUndistortedWhereItNowIs) {
   // The old rule (same shift as the raw keypoint) would miss by more than this.
   ASSERT_GT((un_from + (to - from) - exact).norm(), 0.02);
   f.move_keypoint(0, to);
-  EXPECT_FLOAT_EQ(f.keys[0].pt.x, 24.8f);
-  EXPECT_FLOAT_EQ(f.keys[0].pt.y, 29.4f);
+  EXPECT_FLOAT_EQ(f.keys[0].x, 24.8f);
+  EXPECT_FLOAT_EQ(f.keys[0].y, 29.4f);
   EXPECT_LT((Eigen::Vector2d(f.keys_un[0].pt.x, f.keys_un[0].pt.y) - exact).norm(), 2e-3);
   EXPECT_NEAR(f.u_right[0], f.keys_un[0].pt.x - cam->K.bf / 2.0, 1e-4);
 }
@@ -129,7 +129,7 @@ class VectorPerCellGrid {
     for (int gy = r0; gy <= r1; ++gy)
       for (int gx = c0; gx <= c1; ++gx)
         for (std::size_t i : cells_[static_cast<std::size_t>(gy * CameraModel::kGridCols + gx)]) {
-          const cv::KeyPoint& k = f.keys_un[i];
+          const Keypoint& k = f.keys_un[i];
           if (min_level >= 0 && k.octave < min_level) continue;
           if (max_level >= 0 && k.octave > max_level) continue;
           if (std::abs(k.pt.x - u) < r && std::abs(k.pt.y - v) < r) out.push_back(i);
@@ -154,7 +154,7 @@ TEST(Frame, AreaSearchFindsWhatAVectorPerCellFinds) {
     Frame f(0, 0, random_features(n, 3), depth, cam);
     const VectorPerCellGrid reference(f);
     for (std::size_t i = 0; i < f.size(); i += 3)
-      f.move_keypoint(i, Eigen::Vector2d(f.keys[i].pt.x + shift(rng), f.keys[i].pt.y + shift(rng)));
+      f.move_keypoint(i, Eigen::Vector2d(f.keys[i].x + shift(rng), f.keys[i].y + shift(rng)));
     std::size_t found = 0;
     for (int q = 0; q < 2000; ++q) {
       const double qu = u(rng), qv = v(rng), r = radius(rng);

@@ -70,7 +70,7 @@ TEST(PatchRefine, MovesObservationsToTheReferencePatch) {
     mp->add_observation(kf, j);
     kf->set_map_point(j, mp);
     const Eigen::Vector2d truth = cam->project(fb.T_c_w * mp->p_w());
-    const int level = fa.keys[j].octave;
+    const int level = fa.keys_un[j].octave;
     const double scale = cam->scale[static_cast<std::size_t>(level)];
     long best = -1;
     double best_d = 1.5 * scale;
@@ -90,7 +90,7 @@ TEST(PatchRefine, MovesObservationsToTheReferencePatch) {
     sum2_before += (before - truth).squaredNorm() / (scale * scale);
     sum2_after += (after - truth).squaredNorm() / (scale * scale);
     EXPECT_EQ(fb.aligned_for[i], mp->id());
-    EXPECT_FLOAT_EQ(fb.keys[i].pt.x, fb.keys_un[i].pt.x);  // no distortion
+    EXPECT_FLOAT_EQ(fb.keys[i].x, fb.keys_un[i].pt.x);  // no distortion
     EXPECT_NEAR(fb.u_right[i], fb.keys_un[i].pt.x - cam->K.bf / (kWallM - kStepM), 1e-3);
   }
   ASSERT_GT(matched, 300);
@@ -103,9 +103,9 @@ TEST(PatchRefine, MovesObservationsToTheReferencePatch) {
 
   // The keyframe's own observations are the anchors: nothing to align.
   auto& kf_frame = kf->frame_for_alignment();
-  const cv::Point2f p = kf_frame.keys[0].pt;
+  const cv::Point2f p = kf_frame.keys[0];
   EXPECT_FALSE(align_to_reference(kf_frame, 0, *kf->map_points()[0], PatchAlignParams{}));
-  EXPECT_EQ(kf_frame.keys[0].pt, p);
+  EXPECT_EQ(kf_frame.keys[0], p);
   // Already tried for its point: align_keyframe_observations skips it.
   const auto [tried, moved] = align_keyframe_observations(*kf, PatchAlignParams{});
   EXPECT_EQ(tried, static_cast<int>(fa.size()) - 1);

@@ -74,6 +74,15 @@ struct FrameMemory {
   FrameMemory& operator+=(const FrameMemory& o);
 };
 
+/// A keypoint as SLAM keeps it after extraction: cv::KeyPoint's position,
+/// orientation and level (16 bytes; cv::KeyPoint's size, response and
+/// class id, 12 bytes more, are not used after extraction).
+struct Keypoint {
+  cv::Point2f pt;   ///< px
+  float angle = 0;  ///< orientation, degrees (cv::KeyPoint::angle)
+  int octave = 0;   ///< pyramid level
+};
+
 /// The area-search index of a frame: keypoint indices grouped by grid cell
 /// in one array (cell c's in [start[c], start[c + 1]), in keypoint order),
 /// with 16-bit entries while the frame has fewer than 65536 keypoints.  A
@@ -150,8 +159,12 @@ class Frame {
   std::uint64_t id = 0;
   std::int64_t t_ns = 0;
   std::shared_ptr<const CameraModel> cam;
-  std::vector<cv::KeyPoint> keys;     ///< as detected (distorted)
-  std::vector<cv::KeyPoint> keys_un;  ///< undistorted
+  /// Positions as detected (distorted image px); level and orientation are
+  /// keys_un's.  Without distortion these are keys_un's positions, but a
+  /// keypoint moved by patch alignment may differ from its keys_un in the
+  /// last bit (move_keypoint), so both are kept.
+  std::vector<cv::Point2f> keys;
+  std::vector<Keypoint> keys_un;  ///< undistorted
   cv::Mat descriptors;                ///< N x 32 CV_8U
   std::vector<float> depth_m;         ///< per keypoint, <= 0 invalid
   std::vector<float> u_right;         ///< u - bf / depth, < 0 when no depth
