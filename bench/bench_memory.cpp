@@ -16,6 +16,7 @@
 //   kf_grid_MB, kf_bow_MB, kf_other_MB (graph, objects)
 //   culled_MB                     what the culled keyframes hold, per map keyframe
 //   points_MB                     map points per keyframe
+//   place_db_MB                   the place-recognition database (bags of words) per keyframe
 //   dense_kf_MB                   the dense mapper's per-keyframe clouds, per keyframe
 //   dense_map_MB                  its two voxel maps (grow with the area, not per keyframe)
 //   rss_MB                        growth of the resident set (after malloc_trim) from the
@@ -71,6 +72,7 @@ void report(benchmark::State& state, const pvb::slam::SystemMemory& m, double rs
   state.counters["kf_other_MB"] = static_cast<double>(k.graph + k.object + f.object) / kMB / n;
   state.counters["culled_MB"] = static_cast<double>(m.culled_bytes.total()) / kMB / n;
   state.counters["points_MB"] = static_cast<double>(m.map.point_bytes) / kMB / n;
+  state.counters["place_db_MB"] = static_cast<double>(m.place_database_bytes) / kMB / n;
   state.counters["dense_kf_MB"] = static_cast<double>(m.dense.keyframe_bytes) / kMB / n;
   state.counters["dense_map_MB"] = static_cast<double>(m.dense.map_bytes) / kMB;
   state.counters["rss_MB"] = rss_growth_mb / n;

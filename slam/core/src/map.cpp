@@ -143,7 +143,7 @@ KeyFrameMemory& KeyFrameMemory::operator+=(const KeyFrameMemory& o) {
 KeyFrameMemory KeyFrame::memory() const {
   KeyFrameMemory m;
   m.frame = frame_.memory();
-  m.bow = map_node_bytes(bow_) + map_node_bytes(features_by_node_);
+  m.bow = vector_heap_bytes(bow_) + vector_heap_bytes(features_by_node_);
   for (const auto& [node, indices] : features_by_node_) m.bow += vector_heap_bytes(indices);
   m.graph = map_node_bytes(connections_) + vector_heap_bytes(ordered_) + map_node_bytes(children_) +
             map_node_bytes(loop_edges_);

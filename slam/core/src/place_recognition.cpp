@@ -63,7 +63,14 @@ void PlaceRecognizer::compute_bow(KeyFrame& kf) const {
   kf.set_bow(std::move(bow), std::move(features));
 }
 
-void PlaceRecognizer::add(const KeyFrame& kf) { database_.add(kf.id(), kf.bow()); }
+void PlaceRecognizer::add(KeyFrame& kf) {
+  database_.add(kf.id(), kf.bow());
+  kf.drop_bow();
+}
+
+place::BowVector PlaceRecognizer::bag_of(const KeyFrame& kf) const {
+  return kf.bow().empty() ? database_.bag(kf.id()) : kf.bow();
+}
 
 std::vector<KeyFramePtr> PlaceRecognizer::loop_candidates(const Map& map, const KeyFrame& kf,
                                                           int min_keyframe_gap) const {
@@ -71,7 +78,7 @@ std::vector<KeyFramePtr> PlaceRecognizer::loop_candidates(const Map& map, const 
   double min_score = 1.0;
   for (const auto& n : kf.best_covisibles(-1)) {
     connected.insert(n->id());
-    if (!n->bad()) min_score = std::min(min_score, place::Vocabulary::score(kf.bow(), n->bow()));
+    if (!n->bad()) min_score = std::min(min_score, place::Vocabulary::score(kf.bow(), bag_of(*n)));
   }
   if (connected.size() == 1) min_score = 0;
   const auto skip = [&](std::uint64_t id) {

@@ -262,6 +262,7 @@ SystemMemory System::memory() {
       if (r.ref->bad() && culled.insert(r.ref.get()).second) m.culled_bytes += r.ref->memory();
     m.culled_keyframes = culled.size();
   }
+  if (place_) m.place_database_bytes = place_->database_bytes();
   if (dense_) m.dense = dense_->memory();
   return m;
 }
@@ -287,6 +288,7 @@ std::string to_json(const SystemMemory& m) {
      << ", \"points\": " << m.map.points << ", \"point_bytes\": " << m.map.point_bytes
      << ", \"culled_keyframes\": " << m.culled_keyframes
      << ", \"culled_keyframe_bytes\": " << keyframe_memory_json(m.culled_bytes)
+     << ", \"place_database_bytes\": " << m.place_database_bytes
      << ", \"dense_keyframes\": " << m.dense.keyframes << ", \"dense_keyframe_bytes\": " << m.dense.keyframe_bytes
      << ", \"dense_map_bytes\": " << m.dense.map_bytes << "}";
   return js.str();

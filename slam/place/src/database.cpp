@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "pvb/common/memory.hpp"
+
 namespace pvb::slam::place {
 namespace {
 
@@ -29,33 +31,60 @@ void insert_sorted(std::vector<Database::Posting>& list, Database::Posting p) {
 
 void Database::add(std::uint64_t id, const BowVector& bow) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (const auto old = bows_.find(id); old != bows_.end()) {
-    for (const auto& [word, w] : old->second) {
+  if (const auto old = words_.find(id); old != words_.end()) {
+    for (WordId word : old->second) {
       auto& ids = inverted_[word];
       remove_sorted(ids, id);
       if (ids.empty()) inverted_.erase(word);
     }
   }
-  for (const auto& [word, w] : bow) insert_sorted(inverted_[word], {id, w});
-  bows_[id] = bow;
+  std::vector<WordId> words;
+  words.reserve(bow.size());
+  for (const auto& [word, w] : bow) {
+    insert_sorted(inverted_[word], {id, w});
+    words.push_back(word);
+  }
+  words_[id] = std::move(words);
 }
 
 void Database::erase(std::uint64_t id) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const auto it = bows_.find(id);
-  if (it == bows_.end()) return;
-  for (const auto& [word, w] : it->second) {
+  const auto it = words_.find(id);
+  if (it == words_.end()) return;
+  for (WordId word : it->second) {
     const auto list = inverted_.find(word);
     if (list == inverted_.end()) continue;
     remove_sorted(list->second, id);
     if (list->second.empty()) inverted_.erase(list);
   }
-  bows_.erase(it);
+  words_.erase(it);
 }
 
 std::size_t Database::size() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return bows_.size();
+  return words_.size();
+}
+
+BowVector Database::bag(std::uint64_t id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  BowVector bow;
+  const auto it = words_.find(id);
+  if (it == words_.end()) return bow;
+  bow.reserve(it->second.size());
+  for (WordId word : it->second) {
+    const std::vector<Posting>& list = inverted_.at(word);
+    const auto p = std::lower_bound(list.begin(), list.end(), id, by_id);
+    bow.emplace_back(word, p->weight);  // present: add() listed it under every one of its words
+  }
+  return bow;
+}
+
+std::size_t Database::memory_bytes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::size_t bytes = unordered_map_bytes(inverted_) + unordered_map_bytes(words_);
+  for (const auto& [word, list] : inverted_) bytes += vector_heap_bytes(list);
+  for (const auto& [id, words] : words_) bytes += vector_heap_bytes(words);
+  return bytes;
 }
 
 std::vector<Candidate> Database::query(const BowVector& query, double min_score, double min_common_ratio,

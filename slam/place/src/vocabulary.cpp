@@ -2,6 +2,7 @@
 // the builder that training and the file readers fill the tree through.
 #include "pvb/slam/place/vocabulary.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -146,15 +147,38 @@ void Vocabulary::transform(const cv::Mat& descriptors, BowVector* bow, FeatureVe
   if (bow != nullptr) bow->clear();
   if (fv != nullptr) fv->clear();
   if (empty() || descriptors.empty()) return;
+  struct Hit {
+    WordId word;
+    NodeId node;
+    std::uint32_t row;
+    double weight;
+  };
+  std::vector<Hit> hits;
+  hits.reserve(static_cast<std::size_t>(descriptors.rows));
+  for (int i = 0; i < descriptors.rows; ++i) {
+    Hit h{0, 0, static_cast<std::uint32_t>(i), 0};
+    h.word = word_of(descriptors.ptr<unsigned char>(i), &h.weight, &h.node, levels_up);
+    if (h.weight <= 0) continue;  // a stop word (IDF 0: in every training image), as DBoW2 skips it
+    hits.push_back(h);
+  }
+  if (fv != nullptr) {
+    // By node, each node's rows in ascending order (stable).
+    std::stable_sort(hits.begin(), hits.end(), [](const Hit& a, const Hit& b) { return a.node < b.node; });
+    for (const Hit& h : hits) {
+      if (fv->empty() || fv->back().first != h.node) fv->emplace_back(h.node, std::vector<std::uint32_t>{});
+      fv->back().second.push_back(h.row);
+    }
+  }
+  // TF-IDF: the IDF once per occurrence, summed per word in row order, as a
+  // std::map's v[word] += weight would, so the sums are the same doubles.
+  std::sort(hits.begin(), hits.end(), [](const Hit& a, const Hit& b) {
+    return a.word != b.word ? a.word < b.word : a.row < b.row;
+  });
   BowVector local;
   BowVector& v = bow != nullptr ? *bow : local;
-  for (int i = 0; i < descriptors.rows; ++i) {
-    double weight = 0;
-    NodeId node = 0;
-    const WordId word = word_of(descriptors.ptr<unsigned char>(i), &weight, &node, levels_up);
-    if (weight <= 0) continue;  // a stop word (IDF 0: in every training image), as DBoW2 skips it
-    v[word] += weight;          // TF-IDF: the IDF once per occurrence, normalised below
-    if (fv != nullptr) (*fv)[node].push_back(static_cast<std::uint32_t>(i));
+  for (const Hit& h : hits) {
+    if (v.empty() || v.back().first != h.word) v.emplace_back(h.word, 0.0);
+    v.back().second += h.weight;
   }
   double norm = 0;
   for (const auto& [word, w] : v) norm += std::fabs(w);

@@ -113,4 +113,19 @@ TEST(Database, IdsStayAscendingWhateverTheAddOrder) {
   EXPECT_TRUE(db.query({}, 0.0).empty());
 }
 
+TEST(Database, BagIsWhatWasAddedFromTheListsWeights) {
+  Database db;
+  fill(db);
+  EXPECT_EQ(db.bag(10), kQuery);
+  EXPECT_EQ(db.bag(14), (BowVector{{1, .1}, {2, .1}, {3, .1}, {9, .7}}));
+  EXPECT_TRUE(db.bag(99).empty());
+  db.add(14, {{2, .6}, {7, .4}});  // replaced: the old words go
+  EXPECT_EQ(db.bag(14), (BowVector{{2, .6}, {7, .4}}));
+  EXPECT_EQ(db.keyframes_with(9), std::vector<std::uint64_t>{});
+  db.erase(12);
+  EXPECT_TRUE(db.bag(12).empty());
+  EXPECT_EQ(db.bag(9), (BowVector{{1, .25}, {2, .25}, {3, .5}}));
+  EXPECT_GT(db.memory_bytes(), 0U);
+}
+
 }  // namespace

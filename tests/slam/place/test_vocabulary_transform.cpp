@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
 
@@ -74,11 +75,15 @@ TEST(VocabularyTransform, ToyTfIdfAndL1Score) {
   voc.transform(to_mat({toy_a(), toy_a(), toy_a2(), toy_b2()}), &a);
   voc.transform(to_mat({toy_a(), toy_b(), toy_b()}), &b);
   ASSERT_EQ(a.size(), 2U);
-  EXPECT_DOUBLE_EQ(a.at(0), 0.5);
-  EXPECT_DOUBLE_EQ(a.at(1), 0.5);
+  EXPECT_EQ(a[0].first, 0U);
+  EXPECT_DOUBLE_EQ(a[0].second, 0.5);
+  EXPECT_EQ(a[1].first, 1U);
+  EXPECT_DOUBLE_EQ(a[1].second, 0.5);
   ASSERT_EQ(b.size(), 2U);
-  EXPECT_DOUBLE_EQ(b.at(0), 1.0 / 9.0);
-  EXPECT_DOUBLE_EQ(b.at(2), 8.0 / 9.0);
+  EXPECT_EQ(b[0].first, 0U);
+  EXPECT_DOUBLE_EQ(b[0].second, 1.0 / 9.0);
+  EXPECT_EQ(b[1].first, 2U);
+  EXPECT_DOUBLE_EQ(b[1].second, 8.0 / 9.0);
   EXPECT_DOUBLE_EQ(Vocabulary::score(a, b), 1.0 / 9.0);
   EXPECT_DOUBLE_EQ(Vocabulary::score(b, a), 1.0 / 9.0);
   EXPECT_DOUBLE_EQ(Vocabulary::score(a, a), 1.0);
@@ -166,6 +171,45 @@ TEST(VocabularyTransform, TrainedDirectIndexGroupsByTheNodeAboveTheWord) {
   double sum = 0;
   for (const auto& [w, v] : bow) sum += v;
   EXPECT_NEAR(sum, 1.0, 1e-12);
+}
+
+TEST(VocabularyTransform, SortedArraysHoldWhatMapsPerWordAndNodeHeld) {
+  // Many descriptors per word: the weights are summed per word in row
+  // order, as a std::map's v[word] += weight did, so the bags are the same
+  // doubles, not merely close.
+  std::mt19937_64 rng(21);
+  const std::vector<Desc> centres = far_centres(6, 90, rng);
+  std::vector<cv::Mat> images;
+  for (int i = 0; i < 12; ++i) {
+    std::vector<Desc> img;
+    for (int j = 0; j < 30; ++j) img.push_back(flip_bits(centres[(i + j) % 6], static_cast<int>(rng() % 20), rng));
+    images.push_back(to_mat(img));
+  }
+  TrainParams p;
+  p.k = 3;
+  p.levels = 3;
+  const Vocabulary voc = Vocabulary::train(images, p);
+  for (const cv::Mat& img : images) {
+    std::map<WordId, double> words;
+    std::map<NodeId, std::vector<std::uint32_t>> nodes;
+    for (int r = 0; r < img.rows; ++r) {
+      double weight = 0;
+      NodeId node = 0;
+      const WordId w = voc.word_of(img.ptr(r), &weight, &node, 1);
+      if (weight <= 0) continue;
+      words[w] += weight;
+      nodes[node].push_back(static_cast<std::uint32_t>(r));
+    }
+    double norm = 0;
+    for (const auto& [w, v] : words) norm += std::fabs(v);
+    for (auto& [w, v] : words) v /= norm;
+    BowVector bow;
+    FeatureVector fv;
+    voc.transform(img, &bow, &fv, 1);
+    EXPECT_EQ(bow, BowVector(words.begin(), words.end()));
+    EXPECT_EQ(fv, FeatureVector(nodes.begin(), nodes.end()));
+    EXPECT_LT(bow.size(), static_cast<std::size_t>(img.rows));  // words do repeat
+  }
 }
 
 TEST(VocabularyTransform, EmptyInputGivesEmptyVectorsAndWrongTypeThrows) {

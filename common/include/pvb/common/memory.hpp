@@ -5,6 +5,7 @@
 // process holds, which resident_bytes() confirms from outside.
 #include <cstddef>
 #include <map>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -27,6 +28,15 @@ std::size_t vector_heap_bytes(const std::vector<T>& v) {
 template <typename K, typename V>
 std::size_t map_node_bytes(const std::map<K, V>& m) {
   return m.size() * heap_block_bytes(4 * sizeof(void*) + sizeof(std::pair<const K, V>));
+}
+
+/// Heap bytes of a std::unordered_map's nodes and bucket array (libstdc++:
+/// a link word, then the value; hash codes not stored, as for integer keys),
+/// not counting what the values own.
+template <typename K, typename V, typename H, typename E, typename A>
+std::size_t unordered_map_bytes(const std::unordered_map<K, V, H, E, A>& m) {
+  const std::size_t buckets = m.bucket_count() > 1 ? heap_block_bytes(m.bucket_count() * sizeof(void*)) : 0;
+  return m.size() * heap_block_bytes(sizeof(void*) + sizeof(std::pair<const K, V>)) + buckets;
 }
 
 /// The process's resident set (VmRSS of /proc/self/status), bytes; 0 where

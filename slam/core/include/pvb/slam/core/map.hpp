@@ -177,7 +177,11 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
     bow_ = std::move(bow);
     features_by_node_ = std::move(features);
   }
+  /// Its bag of words until it enters the place database, which keeps the
+  /// weights from then on (PlaceRecognizer::bag_of); empty after that.
   const place::BowVector& bow() const { return bow_; }
+  /// Frees the bag (PlaceRecognizer::add, once the database holds it).
+  void drop_bow() { place::BowVector().swap(bow_); }
   /// The direct index: keypoint indices by vocabulary node.
   const place::FeatureVector& features_by_node() const { return features_by_node_; }
 

@@ -27,9 +27,15 @@ class PlaceRecognizer {
   void transform(const Frame& f, place::BowVector* bow, place::FeatureVector* features) const;
   /// The same, stored in the keyframe.
   void compute_bow(KeyFrame& kf) const;
-  /// Adds a keyframe (its bag computed) to the database.  Culled keyframes
-  /// stay in it; queries skip keyframes no longer in the map or bad.
-  void add(const KeyFrame& kf);
+  /// Adds a keyframe (its bag computed) to the database, which keeps its
+  /// weights from then on: the keyframe's own bag is dropped.  Culled
+  /// keyframes stay in it; queries skip keyframes no longer in the map or bad.
+  void add(KeyFrame& kf);
+  /// A keyframe's bag: its own until add(), then the database's (the same
+  /// words and weights).
+  place::BowVector bag_of(const KeyFrame& kf) const;
+  /// Heap bytes of the database.
+  std::size_t database_bytes() const { return database_.memory_bytes(); }
 
   /// Loop candidates for `kf` (ORB-SLAM2 DetectLoopCandidates): older by at
   /// least min_keyframe_gap ids, not kf's covisibles, scoring at least the

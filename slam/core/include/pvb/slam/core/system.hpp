@@ -66,6 +66,7 @@ struct SystemMemory {
   /// poses follow their spanning-tree parents), and what they hold.
   std::size_t culled_keyframes = 0;
   KeyFrameMemory culled_bytes;
+  std::size_t place_database_bytes = 0;  ///< the keyframes' bags of words (0 without a vocabulary)
   dense::DenseMemory dense;            ///< empty when dense mapping is off
 };
 /// {"keyframes": .., "keyframe_bytes": {"pyramid": .., ...}, ...} for stats.json.

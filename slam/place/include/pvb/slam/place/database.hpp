@@ -2,7 +2,8 @@
 // The keyframe database: an inverted index from words to the keyframes
 // (by id) whose bag of words holds them, with the word's weight in each
 // (the score is summed while the lists are walked), and each keyframe's
-// bag kept for replacing or erasing it.  The first two steps of ORB-SLAM2's DetectLoopCandidates /
+// words kept for replacing or erasing it.  The weights are kept once, in
+// the lists: bag() puts a keyframe's bag back together from them.  The first two steps of ORB-SLAM2's DetectLoopCandidates /
 // DetectRelocalizationCandidates: keyframes sharing words with a query,
 // those sharing at least `min_common_ratio` of the most shared words,
 // scored; covisibility accumulation is the caller's (it owns the graph).
@@ -47,11 +48,16 @@ class Database {
                                const std::function<bool(std::uint64_t)>& skip = {}) const;
   /// Keyframes (ids, ascending) listed under `word`.
   std::vector<std::uint64_t> keyframes_with(WordId word) const;
+  /// The bag added for keyframe `id`, the same words and weights (empty when
+  /// the keyframe is not in the database).
+  BowVector bag(std::uint64_t id) const;
+  /// Heap bytes of the lists and the word lists (as malloc sizes them).
+  std::size_t memory_bytes() const;
 
  private:
   mutable std::mutex mutex_;
   std::unordered_map<WordId, std::vector<Posting>> inverted_;  ///< word -> keyframes, ascending ids
-  std::unordered_map<std::uint64_t, BowVector> bows_;          ///< keyframe id -> bag
+  std::unordered_map<std::uint64_t, std::vector<WordId>> words_;  ///< keyframe id -> its words, ascending
 };
 
 }  // namespace pvb::slam::place

@@ -21,6 +21,7 @@
 #include <map>
 #include <opencv2/core.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pvb::slam::place {
@@ -28,11 +29,14 @@ namespace pvb::slam::place {
 using WordId = std::uint32_t;
 using NodeId = std::uint32_t;
 
-/// A normalised bag of words: word -> weight, the weights summing to 1 (L1).
-using BowVector = std::map<WordId, double>;
-/// The direct index of one image: node -> indices of its features (rows
-/// of the descriptor matrix), ascending.
-using FeatureVector = std::map<NodeId, std::vector<std::uint32_t>>;
+/// A normalised bag of words: (word, weight) in ascending words, each word
+/// once, the weights summing to 1 (L1).  A sorted array rather than a
+/// std::map: an image has about as many words as features, and a map node
+/// per word costs 64 bytes where the pair costs 16.
+using BowVector = std::vector<std::pair<WordId, double>>;
+/// The direct index of one image: (node, indices of its features (rows of
+/// the descriptor matrix), ascending) in ascending nodes.
+using FeatureVector = std::vector<std::pair<NodeId, std::vector<std::uint32_t>>>;
 
 struct TrainParams {
   int k = 10;               ///< branching factor, in [2, 64]
