@@ -138,8 +138,8 @@ Frame::Frame(std::uint64_t frame_id, std::int64_t time_ns, OrbFeatures features,
   build_index();
 }
 
-Frame Frame::from_saved(std::uint64_t frame_id, std::int64_t time_ns, std::vector<cv::KeyPoint> keys_detected,
-                        std::vector<cv::KeyPoint> keys_undistorted, cv::Mat descriptors, std::vector<float> depth,
+Frame Frame::from_saved(std::uint64_t frame_id, std::int64_t time_ns, std::vector<cv::Point2f> keys_detected,
+                        std::vector<Keypoint> keys_undistorted, cv::Mat descriptors, std::vector<float> depth,
                         std::shared_ptr<const CameraModel> camera) {
   Frame f;
   f.id = frame_id;

@@ -44,9 +44,11 @@ void put_keyframe(ByteWriter& w, const KeyFrame& kf, const std::set<std::uint64_
   put_pose(w, kf.T_c_w());
   w.u32(static_cast<std::uint32_t>(f.size()));
   for (std::size_t i = 0; i < f.size(); ++i) {
-    const cv::KeyPoint& k = f.keys[i];
-    const cv::KeyPoint& u = f.keys_un[i];
-    for (float v : {k.pt.x, k.pt.y, u.pt.x, u.pt.y, u.angle, u.size, u.response}) w.f32(v);
+    const cv::Point2f& k = f.keys[i];
+    const Keypoint& u = f.keys_un[i];
+    // Two reserved floats, written as 0 (ORB's size and response: never
+    // read after extraction, so a frame does not keep them).
+    for (float v : {k.x, k.y, u.pt.x, u.pt.y, u.angle, 0.0f, 0.0f}) w.f32(v);
     w.u8(static_cast<std::uint8_t>(u.octave));
     w.f32(f.depth_m[i]);
     const auto& mp = f.map_points[i];
@@ -80,9 +82,10 @@ void put_graph(ByteWriter& w, const KeyFrame& kf, const Map& map) {
 
 /// The keyframe's bag of words and direct index (as the place database and
 /// relocalisation use them): recomputing them is most of a load's time.
-void put_bow(ByteWriter& w, const KeyFrame& kf) {
-  w.u64(kf.bow().size());
-  for (const auto& [word, weight] : kf.bow()) {
+void put_bow(ByteWriter& w, const KeyFrame& kf, const BagOf& bag_of) {
+  const place::BowVector bow = bag_of ? bag_of(kf) : kf.bow();
+  w.u64(bow.size());
+  for (const auto& [word, weight] : bow) {
     w.u32(word);
     w.f64(weight);
   }
@@ -104,7 +107,7 @@ void put_section(ByteWriter& out, const char* tag, const std::string& payload) {
 }  // namespace
 
 std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
-                       const std::string& app_json) {
+                       const std::string& app_json, const BagOf& bag_of) {
   std::set<std::uint64_t> point_ids;
   for (const auto& [id, mp] : map.points())
     if (!mp->bad()) point_ids.insert(id);
@@ -129,7 +132,7 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   }
   grap.u64(kfs.size());
   for (const auto& kf : kfs) put_graph(grap, *kf, map);
-  for (const auto& kf : kfs) put_bow(bowv, *kf);
+  for (const auto& kf : kfs) put_bow(bowv, *kf, bag_of);
 
   ByteWriter out;
   out.bytes(kMagic, kMagicBytes);

@@ -109,12 +109,13 @@ Frame read_frame(ByteReader& r, std::uint64_t frame_id, std::int64_t t_ns,
                  const std::shared_ptr<const CameraModel>& cam, std::vector<std::uint64_t>* point_ids) {
   const std::uint32_t n = r.u32();
   if (n > kMaxKeypoints || n * kKeypointBytes > r.remaining()) r.fail(std::to_string(n) + " keypoints do not fit");
-  std::vector<cv::KeyPoint> keys(n), keys_un(n);
+  std::vector<cv::Point2f> keys(n);
+  std::vector<Keypoint> keys_un(n);
   std::vector<float> depth(n);
   cv::Mat desc(static_cast<int>(n), 32, CV_8U);
   point_ids->assign(n, kNone);
   for (std::uint32_t i = 0; i < n; ++i) {
-    float v[7];  // x, y, undistorted x, y, angle, size, response
+    float v[7];  // x, y, undistorted x, y, angle, two reserved
     for (float& x : v) x = r.f32();
     const std::uint8_t octave = r.u8();
     depth[i] = r.f32();
@@ -124,8 +125,8 @@ Frame read_frame(ByteReader& r, std::uint64_t frame_id, std::int64_t t_ns,
       if (!std::isfinite(x)) r.fail("keypoint " + std::to_string(i) + " has a value that is not finite");
     if (!std::isfinite(depth[i])) r.fail("keypoint " + std::to_string(i) + " has a depth that is not finite");
     if (octave >= cam->num_levels) r.fail("keypoint " + std::to_string(i) + " has octave " + std::to_string(octave));
-    keys[i] = cv::KeyPoint(v[0], v[1], v[5], v[4], v[6], octave);
-    keys_un[i] = cv::KeyPoint(v[2], v[3], v[5], v[4], v[6], octave);
+    keys[i] = cv::Point2f(v[0], v[1]);
+    keys_un[i] = Keypoint{cv::Point2f(v[2], v[3]), v[4], octave};
   }
   return Frame::from_saved(frame_id, t_ns, std::move(keys), std::move(keys_un), desc, std::move(depth), cam);
 }
@@ -255,8 +256,10 @@ void read_bows(ByteReader r, Map* map) {
     for (std::uint64_t k = 0; k < words; ++k) {
       const std::uint32_t word = r.u32();
       const double weight = r.f64();
-      if (!(std::isfinite(weight) && weight >= 0) || !bow.emplace(word, weight).second)
-        r.fail(what + ": word " + std::to_string(word) + " repeated or weighted " + std::to_string(weight));
+      if (!(std::isfinite(weight) && weight >= 0) || (!bow.empty() && bow.back().first >= word))
+        r.fail(what + ": word " + std::to_string(word) + " out of order, repeated or weighted " +
+               std::to_string(weight));
+      bow.emplace_back(word, weight);
     }
     place::FeatureVector features;
     const std::uint64_t nodes = r.count(12, "nodes");
@@ -267,7 +270,9 @@ void read_bows(ByteReader r, Map* map) {
         i = r.u32();
         if (i >= kf->frame().size()) r.fail(what + ": keypoint " + std::to_string(i) + " of node " + std::to_string(node));
       }
-      if (!features.emplace(node, std::move(indices)).second) r.fail(what + ": node " + std::to_string(node) + " repeated");
+      if (!features.empty() && features.back().first >= node)
+        r.fail(what + ": node " + std::to_string(node) + " out of order or repeated");
+      features.emplace_back(node, std::move(indices));
     }
     kf->set_bow(std::move(bow), std::move(features));
   }

@@ -194,7 +194,8 @@ MapSaveInfo System::save_map(const std::string& path, const std::string& app_jso
     info.sessions = loaded_sessions_;
     for (const auto& [id, kf] : map_.keyframes())
       if (kf->session() == map_.session()) info.sessions = map_.session() + 1;
-    bytes = encode_map(map_, map_settings(), info.sessions, app_json);
+    const BagOf bag_of = [this](const KeyFrame& kf) { return place_ ? place_->bag_of(kf) : kf.bow(); };
+    bytes = encode_map(map_, map_settings(), info.sessions, app_json, bag_of);
     info.keyframes = map_.num_keyframes();
     info.points = map_.num_points();
   }

@@ -126,8 +126,8 @@ class Frame {
   /// A frame from what a map file keeps of a keyframe: keypoints as
   /// detected and undistorted, descriptors (N x 32 CV_8U) and depth per
   /// keypoint (<= 0: none); sizes must agree.  No map points yet, no pose.
-  static Frame from_saved(std::uint64_t id, std::int64_t t_ns, std::vector<cv::KeyPoint> keys,
-                          std::vector<cv::KeyPoint> keys_un, cv::Mat descriptors, std::vector<float> depth_m,
+  static Frame from_saved(std::uint64_t id, std::int64_t t_ns, std::vector<cv::Point2f> keys,
+                          std::vector<Keypoint> keys_un, cv::Mat descriptors, std::vector<float> depth_m,
                           std::shared_ptr<const CameraModel> cam);
 
   std::size_t size() const { return keys_un.size(); }

@@ -10,6 +10,7 @@
 // load -> save gives the same bytes.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -51,10 +52,15 @@ struct MapFileHeader {
 
 constexpr std::uint32_t kMapFileVersion = 1;
 
+/// A keyframe's bag of words, wherever it is kept (a keyframe in the place
+/// database has handed its own to the database: PlaceRecognizer::bag_of).
+using BagOf = std::function<place::BowVector(const KeyFrame&)>;
+
 /// The map file's bytes for every keyframe and point in `map` (bad ones
-/// are not in it).  Call with the map's mutex held.
+/// are not in it); bags of words from `bag_of`, or each keyframe's own when
+/// it is empty.  Call with the map's mutex held.
 std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
-                       const std::string& app_json);
+                       const std::string& app_json, const BagOf& bag_of = nullptr);
 
 /// Checks the whole file (magic, version, sections, checksums) and returns
 /// its header.  Throws IoError naming `file` and what is wrong (truncated,
