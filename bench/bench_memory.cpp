@@ -12,6 +12,8 @@
 // the map at the end, as KeyFrameTrajectory.txt counts them):
 //   keyframes, culled_keyframes   keyframes in the map; culled ones kept for the trajectory
 //   kf_MB                         keyframe data per keyframe (System::memory(), by structure below)
+//   outside_keyframes, kf_outside_MB  keyframes outside the local map (pyramid released) and
+//                                 their data per keyframe: what an hour of driving adds
 //   kf_pyramid_MB, kf_features_MB (keypoints, descriptors, per-keypoint arrays),
 //   kf_grid_MB, kf_bow_MB, kf_other_MB (graph, objects)
 //   culled_MB                     what the culled keyframes hold, per map keyframe
@@ -70,6 +72,9 @@ void report(benchmark::State& state, const pvb::slam::SystemMemory& m, double rs
   state.counters["kf_grid_MB"] = static_cast<double>(f.grid) / kMB / n;
   state.counters["kf_bow_MB"] = static_cast<double>(k.bow) / kMB / n;
   state.counters["kf_other_MB"] = static_cast<double>(k.graph + k.object + f.object) / kMB / n;
+  const double outside = std::max<double>(1.0, static_cast<double>(m.map.keyframes_outside));
+  state.counters["outside_keyframes"] = static_cast<double>(m.map.keyframes_outside);
+  state.counters["kf_outside_MB"] = static_cast<double>(m.map.outside_bytes.total()) / kMB / outside;
   state.counters["culled_MB"] = static_cast<double>(m.culled_bytes.total()) / kMB / n;
   state.counters["points_MB"] = static_cast<double>(m.map.point_bytes) / kMB / n;
   state.counters["place_db_MB"] = static_cast<double>(m.place_database_bytes) / kMB / n;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <set>
+#include <set>
 
 #include "pvb/common/text.hpp"
 #include "pvb/common/threads.hpp"
@@ -147,9 +148,35 @@ void LocalMapping::process(const std::shared_ptr<KeyFrame>& kf) {
     std::lock_guard<std::mutex> lock(map_.mutex());
     cull_keyframes(kf);
   }
+  if (options_.align_patches) {
+    std::lock_guard<std::mutex> lock(map_.mutex());
+    release_pyramids(kf);
+  }
   if (after_keyframe_) after_keyframe_(kf);
   ++processed_;
   --pending_;
+}
+
+/// The pyramids of keyframes that have left the local map go: neither
+/// among the newest options_.pyramid_window keyframes nor covisible with
+/// kf.  A released pyramid is not rebuilt (the image is gone), so a point
+/// whose reference keyframe has lost it is matched without alignment.
+void LocalMapping::release_pyramids(const std::shared_ptr<KeyFrame>& kf) {
+  if (kf->frame().pyramid) with_pyramid_.push_back(kf);
+  std::set<std::uint64_t> covisible;
+  for (const auto& k : kf->best_covisibles(-1)) covisible.insert(k->id());
+  const std::size_t n = with_pyramid_.size();
+  const std::size_t window = static_cast<std::size_t>(std::max(0, options_.pyramid_window));
+  std::deque<std::weak_ptr<KeyFrame>> kept;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto k = with_pyramid_[i].lock();
+    if (!k || !k->frame().pyramid) continue;
+    if (i + window >= n || (!k->bad() && covisible.count(k->id())))
+      kept.push_back(k);
+    else
+      k->release_pyramid();
+  }
+  with_pyramid_.swap(kept);
 }
 
 void LocalMapping::process_new_keyframe(const std::shared_ptr<KeyFrame>& kf) {

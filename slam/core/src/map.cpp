@@ -387,7 +387,13 @@ void Map::remove_bad_points() {
 MapMemory Map::memory() const {
   MapMemory m;
   m.keyframes = keyframes_.size();
-  for (const auto& [id, kf] : keyframes_) m.keyframe_bytes += kf->memory();
+  for (const auto& [id, kf] : keyframes_) {
+    const KeyFrameMemory k = kf->memory();
+    m.keyframe_bytes += k;
+    if (kf->frame().pyramid) continue;
+    ++m.keyframes_outside;
+    m.outside_bytes += k;
+  }
   m.points = points_.size();
   for (const auto& [id, mp] : points_) m.point_bytes += mp->memory_bytes();
   return m;

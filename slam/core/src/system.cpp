@@ -286,6 +286,8 @@ std::string keyframe_memory_json(const KeyFrameMemory& k) {
 std::string to_json(const SystemMemory& m) {
   std::ostringstream js;
   js << "{\"keyframes\": " << m.map.keyframes << ", \"keyframe_bytes\": " << keyframe_memory_json(m.map.keyframe_bytes)
+     << ", \"keyframes_outside_local_map\": " << m.map.keyframes_outside
+     << ", \"outside_keyframe_bytes\": " << keyframe_memory_json(m.map.outside_bytes)
      << ", \"points\": " << m.map.points << ", \"point_bytes\": " << m.map.point_bytes
      << ", \"culled_keyframes\": " << m.culled_keyframes
      << ", \"culled_keyframe_bytes\": " << keyframe_memory_json(m.culled_bytes)

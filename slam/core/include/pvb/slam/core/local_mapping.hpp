@@ -35,6 +35,11 @@ struct LocalMappingOptions {
   /// (patch_refine.hpp); the tracker aligns the rest.
   bool align_patches = true;
   PatchAlignParams patch_align;
+  /// A keyframe's grey pyramid (about 1 MB at 640 x 480) is kept while it
+  /// is in the local map, that is among the newest `pyramid_window`
+  /// keyframes or covisible with the newest; then it is released, and its
+  /// points are no longer aligned to its patches (release_pyramids).
+  int pyramid_window = 10;
   /// Local BA iterations and gates; its abort_flag is local mapping's own
   /// (set on the worker thread only), whatever is given here.
   BaOptions ba;
@@ -115,11 +120,13 @@ class LocalMapping {
   void fuse_with_neighbors(const std::shared_ptr<KeyFrame>& kf);
   void local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf);
   void cull_keyframes(const std::shared_ptr<KeyFrame>& kf);
+  void release_pyramids(const std::shared_ptr<KeyFrame>& kf);
 
   Map& map_;
   std::shared_ptr<const CameraModel> cam_;
   LocalMappingOptions options_;
   std::list<std::shared_ptr<MapPoint>> recent_points_;  ///< points on trial
+  std::deque<std::weak_ptr<KeyFrame>> with_pyramid_;   ///< keyframes still holding one, oldest first
   ClosableQueue<std::shared_ptr<KeyFrame>> queue_;
   std::atomic<int> pending_{0};  ///< keyframes inserted and not yet processed
   std::atomic<std::int64_t> busy_us_{0};  ///< time in process(), microseconds

@@ -38,6 +38,10 @@ struct KeyFrameMemory {
 struct MapMemory {
   std::size_t keyframes = 0;
   KeyFrameMemory keyframe_bytes;
+  /// Keyframes outside the local map (their pyramid released) and what
+  /// they hold: the part of keyframe_bytes that grows with the route.
+  std::size_t keyframes_outside = 0;
+  KeyFrameMemory outside_bytes;
   std::size_t points = 0;
   std::size_t point_bytes = 0;
 };
@@ -133,6 +137,9 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   /// Write access for patch alignment of its keypoints only
   /// (align_keyframe_observations), under the map lock.
   Frame& frame_for_alignment() { return frame_; }
+  /// Drops the grey pyramid (the keyframe has left the local map): its
+  /// patches are no longer alignment references.
+  void release_pyramid() { frame_.pyramid.reset(); }
   const geom::SE3d& T_c_w() const { return frame_.T_c_w; }
   void set_T_c_w(const geom::SE3d& T) { frame_.T_c_w = T; }
   Eigen::Vector3d camera_center_w() const { return frame_.camera_center_w(); }
