@@ -45,31 +45,15 @@ ImagePyramid copy_pyramid(const std::vector<cv::Mat>& levels) {
   return out;
 }
 
-bool align_patch(const ImagePyramid& ref, const Eigen::Vector2d& p_ref, const Eigen::Matrix2d& A_cur_ref,
-                 const ImagePyramid& cur, int level_cur, const Eigen::Vector2d& p_cur_start,
-                 const PatchAlignParams& params, Eigen::Vector2d* p_cur) {
-  const int num_levels = static_cast<int>(std::min(ref.size(), cur.size()));
-  if (level_cur < 0 || level_cur >= num_levels) return false;
-  if (params.half_size < 1 || params.half_size > kMaxHalfSize) return false;
-  const double det = A_cur_ref.determinant();
-  if (!(std::abs(det) > 1e-6) || !A_cur_ref.allFinite()) return false;
-  const int R = params.half_size;
-  const int W = 2 * R + 1;       // patch width
-  const int WT = W + 2;          // template width: one more ring for its gradient
-  const Eigen::Vector2d rb = level_ratio(cur, level_cur);
-  // A current-level pixel spans |A^-1| * rb reference level-0 px: the
-  // reference level whose pixels are that size.
-  const double zoom = std::sqrt(std::abs(det));
-  const int la = std::clamp(
-      static_cast<int>(std::lround(level_cur - std::log(zoom) / std::log(params.scale_factor))), 0,
-      num_levels - 1);
-  const Eigen::Vector2d ra = level_ratio(ref, la);
-  const Eigen::Matrix2d A_inv = A_cur_ref.inverse();
-  const cv::Mat& ref_img = ref[static_cast<std::size_t>(la)];
+namespace {
 
-  // Template on the current level's pixel grid: T(dx, dy) for offsets in
-  // [-R-1, R+1]^2 current-level px, sampled from the reference level.
-  double tmpl[kMaxTemplate];
+/// The template on the current level's pixel grid: T(dx, dy) for offsets in
+/// [-R-1, R+1]^2 current-level px, sampled from reference level `ref_img`
+/// (level-0 px per its px: ra) around p_ref, along the current level's
+/// axes mapped back by A_inv.  False where it leaves the image.
+bool sample_template(const cv::Mat& ref_img, const Eigen::Vector2d& p_ref, const Eigen::Vector2d& ra,
+                     const Eigen::Matrix2d& A_inv, const Eigen::Vector2d& rb, int R, double* tmpl) {
+  const int WT = 2 * R + 3;
   // Reference-level position of offset (dx, dy): q0 + dx ex + dy ey.
   const Eigen::Vector2d q0 = to_level(p_ref, ra);
   const Eigen::Vector2d ex = (A_inv.col(0) * rb.x()).cwiseQuotient(ra);
@@ -81,9 +65,13 @@ bool align_patch(const ImagePyramid& ref, const Eigen::Vector2d& p_ref, const Ei
       if (!bilinear(ref_img, qx, qy, &tmpl[(dy + R + 1) * WT + (dx + R + 1)])) return false;
     }
   }
-  // Mean-subtracted template and its gradients on the inner W x W patch.
-  const int n = W * W;
-  double t[kMaxPatch], gx[kMaxPatch], gy[kMaxPatch];
+  return true;
+}
+
+/// The mean-subtracted template (t) and its mean-subtracted gradients (gx,
+/// gy) on the inner W x W patch, and their Gauss-Newton matrix H.
+Eigen::Matrix2d template_gradients(const double* tmpl, int W, double* t, double* gx, double* gy) {
+  const int WT = W + 2, n = W * W;
   double t_mean = 0, gx_mean = 0, gy_mean = 0;
   for (int y = 0; y < W; ++y)
     for (int x = 0; x < W; ++x) {
@@ -104,40 +92,84 @@ bool align_patch(const ImagePyramid& ref, const Eigen::Vector2d& p_ref, const Ei
     H(1, 1) += gy[k] * gy[k];
   }
   H(1, 0) = H(0, 1);
-  // Eigenvalues of the symmetric 2x2 H in closed form.
+  return H;
+}
+
+/// Whether H's smaller eigenvalue (closed form for a symmetric 2x2) is at
+/// least min_ratio of the larger: a patch textured in both directions.
+bool well_conditioned(const Eigen::Matrix2d& H, double min_ratio) {
   const double half_trace = 0.5 * (H(0, 0) + H(1, 1));
   const double root = std::sqrt(0.25 * (H(0, 0) - H(1, 1)) * (H(0, 0) - H(1, 1)) + H(0, 1) * H(0, 1));
   const double ev_min = half_trace - root, ev_max = half_trace + root;
-  if (!(ev_max > 0) || !(ev_min > params.min_eigen_ratio * ev_max)) return false;
+  return ev_max > 0 && ev_min > min_ratio * ev_max;
+}
+
+/// The steepest-descent vector b = sum g e of the W x W patch of `img` at
+/// level position c (bilinear, one set of weights for all samples) against
+/// the template t; false where the patch leaves the image.
+bool patch_residual(const cv::Mat& img, const Eigen::Vector2d& c, int R, const double* t, const double* gx,
+                    const double* gy, Eigen::Vector2d* b) {
+  const int W = 2 * R + 1, n = W * W;
+  double cur_px[kMaxPatch];
+  // Integer offsets: every sample shares the same bilinear weights.
+  const int x0 = static_cast<int>(std::floor(c.x())) - R, y0 = static_cast<int>(std::floor(c.y())) - R;
+  if (x0 < 0 || y0 < 0 || x0 + W >= img.cols || y0 + W >= img.rows) return false;
+  const double fx = c.x() - std::floor(c.x()), fy = c.y() - std::floor(c.y());
+  const double w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
+  double c_mean = 0;
+  for (int y = 0; y < W; ++y) {
+    const uchar* r0 = img.ptr<uchar>(y0 + y) + x0;
+    const uchar* r1 = r0 + img.step[0];
+    for (int x = 0; x < W; ++x) {
+      const double v = w00 * r0[x] + w01 * r0[x + 1] + w10 * r1[x] + w11 * r1[x + 1];
+      cur_px[y * W + x] = v;
+      c_mean += v;
+    }
+  }
+  c_mean /= n;
+  *b = Eigen::Vector2d::Zero();
+  for (int k = 0; k < n; ++k) {
+    const double e = (cur_px[k] - c_mean) - t[k];
+    b->x() += gx[k] * e;
+    b->y() += gy[k] * e;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool align_patch(const ImagePyramid& ref, const Eigen::Vector2d& p_ref, const Eigen::Matrix2d& A_cur_ref,
+                 const ImagePyramid& cur, int level_cur, const Eigen::Vector2d& p_cur_start,
+                 const PatchAlignParams& params, Eigen::Vector2d* p_cur) {
+  const int num_levels = static_cast<int>(std::min(ref.size(), cur.size()));
+  if (level_cur < 0 || level_cur >= num_levels) return false;
+  if (params.half_size < 1 || params.half_size > kMaxHalfSize) return false;
+  const double det = A_cur_ref.determinant();
+  if (!(std::abs(det) > 1e-6) || !A_cur_ref.allFinite()) return false;
+  const int R = params.half_size;
+  const int W = 2 * R + 1;  // patch width
+  const Eigen::Vector2d rb = level_ratio(cur, level_cur);
+  // A current-level pixel spans |A^-1| * rb reference level-0 px: the
+  // reference level whose pixels are that size.
+  const double zoom = std::sqrt(std::abs(det));
+  const int la = std::clamp(
+      static_cast<int>(std::lround(level_cur - std::log(zoom) / std::log(params.scale_factor))), 0,
+      num_levels - 1);
+  double tmpl[kMaxTemplate];
+  if (!sample_template(ref[static_cast<std::size_t>(la)], p_ref, level_ratio(ref, la), A_cur_ref.inverse(), rb,
+                       R, tmpl))
+    return false;
+  double t[kMaxPatch], gx[kMaxPatch], gy[kMaxPatch];
+  const Eigen::Matrix2d H = template_gradients(tmpl, W, t, gx, gy);
+  if (!well_conditioned(H, params.min_eigen_ratio)) return false;
   const Eigen::Matrix2d H_inv = H.inverse();
 
   const cv::Mat& img = cur[static_cast<std::size_t>(level_cur)];
   const Eigen::Vector2d start = to_level(p_cur_start, rb);
   Eigen::Vector2d c = start;
-  double cur_px[kMaxPatch];
   for (int it = 0; it < params.max_iterations; ++it) {
-    // Integer offsets: every sample shares the same bilinear weights.
-    const int x0 = static_cast<int>(std::floor(c.x())) - R, y0 = static_cast<int>(std::floor(c.y())) - R;
-    if (x0 < 0 || y0 < 0 || x0 + W >= img.cols || y0 + W >= img.rows) return false;
-    const double fx = c.x() - std::floor(c.x()), fy = c.y() - std::floor(c.y());
-    const double w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
-    double c_mean = 0;
-    for (int y = 0; y < W; ++y) {
-      const uchar* r0 = img.ptr<uchar>(y0 + y) + x0;
-      const uchar* r1 = r0 + img.step[0];
-      for (int x = 0; x < W; ++x) {
-        const double v = w00 * r0[x] + w01 * r0[x + 1] + w10 * r1[x] + w11 * r1[x + 1];
-        cur_px[y * W + x] = v;
-        c_mean += v;
-      }
-    }
-    c_mean /= n;
-    Eigen::Vector2d b = Eigen::Vector2d::Zero();
-    for (int k = 0; k < n; ++k) {
-      const double e = (cur_px[k] - c_mean) - t[k];
-      b.x() += gx[k] * e;
-      b.y() += gy[k] * e;
-    }
+    Eigen::Vector2d b;
+    if (!patch_residual(img, c, R, t, gx, gy, &b)) return false;
     // Inverse compositional: the template's step Δ = H^-1 b, composed
     // inversely with the current warp.
     const Eigen::Vector2d step = H_inv * b;

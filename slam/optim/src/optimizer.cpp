@@ -214,6 +214,138 @@ PoseOptimizerResult optimize_pose(const geom::SE3d& T_c_w_init, const std::vecto
 // ---------------------------------------------------------------------------
 // Local bundle adjustment
 // ---------------------------------------------------------------------------
+namespace {
+
+/// One local bundle adjustment: the blocks it moves (copies of the
+/// problem's poses and points), an owned cost per edge, and which edges,
+/// keyframes and points take part.
+class LocalBa {
+ public:
+  LocalBa(BaProblem& ba, const StereoIntrinsics& K, const BaOptions& options)
+      : ba_(ba),
+        K_(K),
+        options_(options),
+        huber_mono_(std::sqrt(options.chi2_mono)),
+        huber_stereo_(std::sqrt(options.chi2_stereo)),
+        abort_callback_(options.abort_flag, options.on_iteration) {
+    poses_.resize(ba.keyframes.size());
+    for (std::size_t k = 0; k < ba.keyframes.size(); ++k) poses_[k] = PoseBlock::from_se3(ba.keyframes[k].T_c_w);
+    points_.resize(ba.points.size());
+    for (std::size_t p = 0; p < ba.points.size(); ++p) points_[p] = ba.points[p].p_w;
+    costs_.resize(ba.edges.size());
+    for (std::size_t e = 0; e < ba.edges.size(); ++e) costs_[e].reset(optim_detail::make_ba_cost(K, ba.edges[e].obs));
+    // Edges whose point is behind the camera have no defined residual; they
+    // never enter the problem and are reported as outliers.
+    active_.assign(ba.edges.size(), 0);
+    for (std::size_t e = 0; e < ba.edges.size(); ++e) active_[e] = std::isfinite(edge_chi2(e)) ? 1 : 0;
+    keyframe_used_.assign(ba.keyframes.size(), 0);
+    point_used_.assign(ba.points.size(), 0);
+  }
+
+  /// Two passes as ORB-SLAM2 runs them: all edges with the Huber loss, then
+  /// without that pass's outliers and without a robust kernel.
+  void run(BaResult* result) {
+    solve_pass(options_.iterations_first, true, result);
+    const bool skip_second = aborted(options_.abort_flag);
+    if (!skip_second) {
+      for (std::size_t e = 0; e < active_.size(); ++e)
+        if (active_[e] && edge_bad(e)) active_[e] = 0;
+      solve_pass(options_.iterations_second, false, result);
+    }
+    result->stopped = abort_callback_.fired() || skip_second;
+    // Outliers: excluded from the last pass, or chi2 too big / behind the
+    // camera at the final estimate.
+    for (std::size_t e = 0; e < active_.size(); ++e)
+      if (!active_[e] || edge_bad(e)) result->outlier_edges.push_back(e);
+  }
+
+  /// Writes back only what was optimised, so untouched keyframes keep their
+  /// exact input pose (no quaternion round trip).
+  void write_back() const {
+    for (std::size_t k = 0; k < ba_.keyframes.size(); ++k)
+      if (keyframe_used_[k] && !ba_.keyframes[k].fixed) ba_.keyframes[k].T_c_w = poses_[k].to_se3();
+    for (std::size_t p = 0; p < ba_.points.size(); ++p)
+      if (point_used_[p]) ba_.points[p].p_w = points_[p];
+  }
+
+ private:
+  double edge_chi2(std::size_t e) const {
+    const BaEdge& edge = ba_.edges[e];
+    return observation_chi2(K_, poses_[edge.keyframe].to_se3(), points_[edge.point], edge.obs);
+  }
+  bool edge_bad(std::size_t e) const {
+    // chi2 is +inf for a point behind the camera (ORB-SLAM2's isDepthPositive).
+    return !(edge_chi2(e) <= chi2_threshold(ba_.edges[e].obs, options_.chi2_mono, options_.chi2_stereo));
+  }
+
+  /// The active edges as residual blocks; kf_in / pt_in mark the blocks added.
+  void add_residuals(ceres::Problem* prob, bool robust, std::vector<std::uint8_t>* kf_in,
+                     std::vector<std::uint8_t>* pt_in) {
+    for (std::size_t e = 0; e < active_.size(); ++e) {
+      if (!active_[e]) continue;
+      const BaEdge& edge = ba_.edges[e];
+      PoseBlock& pose = poses_[edge.keyframe];
+      if (!(*kf_in)[edge.keyframe]) {
+        prob->AddParameterBlock(pose.pose, optim_detail::kPoseSize, &se3_manifold_);
+        // Fixed keyframes (ORB-SLAM2: covisible keyframes outside the local
+        // window) anchor the gauge and the scale of the local map; they
+        // constrain the local points but must not move.
+        if (ba_.keyframes[edge.keyframe].fixed) prob->SetParameterBlockConstant(pose.pose);
+        (*kf_in)[edge.keyframe] = 1;
+      }
+      (*pt_in)[edge.point] = 1;
+      ceres::LossFunction* loss = nullptr;
+      if (robust) loss = is_stereo(edge.obs) ? &huber_stereo_ : &huber_mono_;
+      prob->AddResidualBlock(costs_[e].get(), loss, pose.pose, points_[edge.point].data());
+    }
+  }
+
+  void solve_pass(int iterations, bool robust, BaResult* result) {
+    ceres::Problem prob(borrowed_problem_options());
+    std::vector<std::uint8_t> kf_in(ba_.keyframes.size(), 0), pt_in(ba_.points.size(), 0);
+    add_residuals(&prob, robust, &kf_in, &pt_in);
+    if (prob.NumResidualBlocks() == 0) return;
+    // Schur ordering: points (group 0) are eliminated first, then poses.
+    // Every block must be listed, the constant ones included.
+    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    for (std::size_t p = 0; p < points_.size(); ++p)
+      if (pt_in[p]) ordering->AddElementToGroup(points_[p].data(), 0);
+    for (std::size_t k = 0; k < poses_.size(); ++k)
+      if (kf_in[k]) ordering->AddElementToGroup(poses_[k].pose, 1);
+
+    ceres::Solver::Options solver_options;
+    solver_options.linear_solver_type = options_.sparse_schur ? ceres::SPARSE_SCHUR : ceres::DENSE_SCHUR;
+    solver_options.linear_solver_ordering = ordering;
+    solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+    solver_options.max_num_iterations = iterations;
+    solver_options.num_threads = 1;  // deterministic
+    solver_options.logging_type = ceres::SILENT;
+    if (options_.abort_flag != nullptr || options_.on_iteration) solver_options.callbacks.push_back(&abort_callback_);
+
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &prob, &summary);
+    // summary.iterations[0] (also counted in num_successful_steps) is the
+    // initial state, not a step.
+    result->iterations += static_cast<int>(summary.iterations.size()) - 1;
+    result->converged = summary.termination_type == ceres::CONVERGENCE;
+    for (std::size_t k = 0; k < kf_in.size(); ++k) keyframe_used_[k] |= kf_in[k];
+    for (std::size_t p = 0; p < pt_in.size(); ++p) point_used_[p] |= pt_in[p];
+  }
+
+  BaProblem& ba_;
+  const StereoIntrinsics& K_;
+  const BaOptions& options_;
+  std::vector<PoseBlock> poses_;
+  std::vector<Eigen::Vector3d> points_;
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs_;
+  ceres::HuberLoss huber_mono_, huber_stereo_;
+  optim_detail::SE3LeftManifold se3_manifold_;
+  std::vector<std::uint8_t> active_, keyframe_used_, point_used_;
+  AbortCallback abort_callback_;
+};
+
+}  // namespace
+
 BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, const BaOptions& options) {
   if (problem == nullptr) throw std::invalid_argument("local_bundle_adjustment: null problem");
   BaProblem& ba = *problem;
@@ -235,116 +367,9 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
     result.stopped = true;
     return result;
   }
-
-  std::vector<PoseBlock> poses(ba.keyframes.size());
-  for (std::size_t k = 0; k < ba.keyframes.size(); ++k) poses[k] = PoseBlock::from_se3(ba.keyframes[k].T_c_w);
-  std::vector<Eigen::Vector3d> points(ba.points.size());
-  for (std::size_t p = 0; p < ba.points.size(); ++p) points[p] = ba.points[p].p_w;
-
-  std::vector<std::unique_ptr<ceres::CostFunction>> costs(num_edges);
-  for (std::size_t e = 0; e < num_edges; ++e) costs[e].reset(optim_detail::make_ba_cost(K, ba.edges[e].obs));
-  ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
-  ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
-  optim_detail::SE3LeftManifold se3_manifold;
-
-  const auto edge_chi2 = [&](std::size_t e) {
-    const BaEdge& edge = ba.edges[e];
-    return observation_chi2(K, poses[edge.keyframe].to_se3(), points[edge.point], edge.obs);
-  };
-  const auto edge_bad = [&](std::size_t e) {
-    // chi2 is +inf for a point behind the camera (ORB-SLAM2's isDepthPositive).
-    return !(edge_chi2(e) <= chi2_threshold(ba.edges[e].obs, options.chi2_mono, options.chi2_stereo));
-  };
-
-  // Edges whose point is behind the camera have no defined residual; they
-  // never enter the problem and are reported as outliers.
-  std::vector<std::uint8_t> active(num_edges, 0);
-  for (std::size_t e = 0; e < num_edges; ++e) active[e] = std::isfinite(edge_chi2(e)) ? 1 : 0;
-
-  std::vector<std::uint8_t> keyframe_used(ba.keyframes.size(), 0), point_used(ba.points.size(), 0);
-  AbortCallback abort_callback(options.abort_flag, options.on_iteration);
-
-  const auto solve_pass = [&](int iterations, bool robust) {
-    ceres::Problem prob(borrowed_problem_options());
-    std::vector<std::uint8_t> kf_in(ba.keyframes.size(), 0), pt_in(ba.points.size(), 0);
-    for (std::size_t e = 0; e < num_edges; ++e) {
-      if (!active[e]) continue;
-      const BaEdge& edge = ba.edges[e];
-      PoseBlock& pose = poses[edge.keyframe];
-      if (!kf_in[edge.keyframe]) {
-        prob.AddParameterBlock(pose.pose, optim_detail::kPoseSize, &se3_manifold);
-        // Fixed keyframes (ORB-SLAM2: covisible keyframes outside the local
-        // window) anchor the gauge and the scale of the local map; they
-        // constrain the local points but must not move.
-        if (ba.keyframes[edge.keyframe].fixed) {
-          prob.SetParameterBlockConstant(pose.pose);
-        }
-        kf_in[edge.keyframe] = 1;
-      }
-      pt_in[edge.point] = 1;
-      ceres::LossFunction* loss = nullptr;
-      if (robust) loss = is_stereo(edge.obs) ? &huber_stereo : &huber_mono;
-      prob.AddResidualBlock(costs[e].get(), loss, pose.pose, points[edge.point].data());
-    }
-    if (prob.NumResidualBlocks() == 0) return;
-
-    // Schur ordering: points (group 0) are eliminated first, then poses.
-    // Every block must be listed, the constant ones included.
-    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-    for (std::size_t p = 0; p < points.size(); ++p) {
-      if (pt_in[p]) ordering->AddElementToGroup(points[p].data(), 0);
-    }
-    for (std::size_t k = 0; k < poses.size(); ++k) {
-      if (!kf_in[k]) continue;
-      ordering->AddElementToGroup(poses[k].pose, 1);
-    }
-
-    ceres::Solver::Options solver_options;
-    solver_options.linear_solver_type = options.sparse_schur ? ceres::SPARSE_SCHUR : ceres::DENSE_SCHUR;
-    solver_options.linear_solver_ordering = ordering;
-    solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-    solver_options.max_num_iterations = iterations;
-    solver_options.num_threads = 1;  // deterministic
-    solver_options.logging_type = ceres::SILENT;
-    if (options.abort_flag != nullptr || options.on_iteration)
-      solver_options.callbacks.push_back(&abort_callback);
-
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver_options, &prob, &summary);
-    // summary.iterations[0] (also counted in num_successful_steps) is the
-    // initial state, not a step.
-    result.iterations += static_cast<int>(summary.iterations.size()) - 1;
-    result.converged = summary.termination_type == ceres::CONVERGENCE;
-    for (std::size_t k = 0; k < kf_in.size(); ++k) keyframe_used[k] |= kf_in[k];
-    for (std::size_t p = 0; p < pt_in.size(); ++p) point_used[p] |= pt_in[p];
-  };
-
-  // Pass 1: all edges, Huber loss.
-  solve_pass(options.iterations_first, true);
-  const bool skip_second = aborted(options.abort_flag);
-  if (!skip_second) {
-    // Pass 2: without the outliers of pass 1 and without robust kernel.
-    for (std::size_t e = 0; e < num_edges; ++e) {
-      if (active[e] && edge_bad(e)) active[e] = 0;
-    }
-    solve_pass(options.iterations_second, false);
-  }
-  result.stopped = abort_callback.fired() || skip_second;
-
-  // Outliers: excluded from the last pass, or chi2 too big / behind the
-  // camera at the final estimate.
-  for (std::size_t e = 0; e < num_edges; ++e) {
-    if (!active[e] || edge_bad(e)) result.outlier_edges.push_back(e);
-  }
-
-  // Write back only what was optimised, so untouched keyframes keep their
-  // exact input pose (no quaternion round trip).
-  for (std::size_t k = 0; k < ba.keyframes.size(); ++k) {
-    if (keyframe_used[k] && !ba.keyframes[k].fixed) ba.keyframes[k].T_c_w = poses[k].to_se3();
-  }
-  for (std::size_t p = 0; p < ba.points.size(); ++p) {
-    if (point_used[p]) ba.points[p].p_w = points[p];
-  }
+  LocalBa local_ba(ba, K, options);
+  local_ba.run(&result);
+  local_ba.write_back();
   return result;
 }
 

@@ -151,6 +151,22 @@ class PeMatcher {
   }
 
  private:
+  /// The global best: its fitness (-1: none yet), position and F.
+  struct Best {
+    int fit = -1;
+    ParticlePos pos{};
+    Eigen::Matrix3d F = Eigen::Matrix3d::Zero();
+  };
+  /// Hartley normalisation of all n matches and the j-sample of step 3(c).
+  void prepare(const PointMatch* matches, std::size_t n);
+  /// Step 2: the swarm at eight distinct random matches per particle.
+  Best init_swarm(int pop, PeMatchResult& out);
+  /// Step 5 (eq. 9) for every particle, then steps 3-4 on where it lands.
+  void move_particles(int pop, Best& best, PeMatchResult& out);
+  /// Step 6: mutation (eq. 10) and crossover (eq. 11) on every Pbest.
+  void mutate_pbests(int pop, Best& best, PeMatchResult& out);
+  /// Optional refinement of the best F, then step 8: the inlier mask.
+  void filter_matches(const Eigen::Matrix3d& F_best, PeMatchResult& out) const;
   /// Fitness of the particle with indices idx (eq. 8 inliers among the j
   /// samples) and its F in pixels; -1 when the sample is degenerate.
   int evaluate(const std::array<int, 8>& idx, Eigen::Matrix3d& F);
@@ -172,6 +188,7 @@ class PeMatcher {
   std::vector<ParticlePos> last_pos_;       ///< position last evaluated per particle
   std::vector<int> last_fit_;               ///< its fitness
   std::vector<Eigen::Matrix3d> last_F_;     ///< its F
+  std::array<int, 8> idx_{};                ///< scratch: a repaired position's indices
 };
 
 }  // namespace pvb::slam
