@@ -138,6 +138,48 @@ TEST(LocalMapping, KeyframeQueuedDuringTheBaStopsIt) {
   EXPECT_TRUE(mapping.idle());
 }
 
+/// Keyframe `id` as keyframe() makes it, holding a (blank) grey pyramid.
+std::shared_ptr<KeyFrame> keyframe_with_pyramid(Map& map, std::uint64_t id,
+                                                std::vector<std::shared_ptr<MapPoint>>& pts) {
+  auto kf = keyframe(map, id, pts);
+  ImagePyramid levels;
+  for (int l = 0; l < 8; ++l) levels.emplace_back(48, 64, CV_8U, cv::Scalar(0));
+  kf->frame_for_alignment().pyramid = std::make_shared<const ImagePyramid>(std::move(levels));
+  return kf;
+}
+
+// A keyframe keeps its pyramid while it is among the newest
+// pyramid_window keyframes or covisible with the newest, and loses it for
+// good once it is neither; memory counts the keyframes without one.
+TEST(LocalMapping, KeyframesLeavingTheLocalMapReleaseTheirPyramid) {
+  Map map;
+  LocalMappingOptions opt;
+  opt.pyramid_window = 1;
+  LocalMapping mapping(map, camera(), opt);
+  std::vector<std::shared_ptr<MapPoint>> a, b, c;
+  const auto kf0 = keyframe_with_pyramid(map, 0, a);
+  mapping.insert(kf0);
+  EXPECT_TRUE(kf0->frame().pyramid);
+  const auto kf1 = keyframe_with_pyramid(map, 1, b);  // sees none of kf0's points
+  mapping.insert(kf1);
+  EXPECT_FALSE(kf0->frame().pyramid);
+  EXPECT_TRUE(kf1->frame().pyramid);
+  const auto kf2 = keyframe_with_pyramid(map, 2, b);  // covisible with kf1
+  mapping.insert(kf2);
+  EXPECT_TRUE(kf1->frame().pyramid) << "covisible with the newest keyframe";
+  EXPECT_TRUE(kf2->frame().pyramid);
+  const auto kf3 = keyframe_with_pyramid(map, 3, c);  // a new place
+  mapping.insert(kf3);
+  EXPECT_FALSE(kf1->frame().pyramid);
+  EXPECT_FALSE(kf2->frame().pyramid);
+  EXPECT_TRUE(kf3->frame().pyramid);
+  const MapMemory m = map.memory();
+  EXPECT_EQ(m.keyframes, 4u);
+  EXPECT_EQ(m.keyframes_outside, 3u);
+  EXPECT_EQ(m.outside_bytes.frame.pyramid, 0u);
+  EXPECT_GT(m.keyframe_bytes.frame.pyramid, 0u);
+}
+
 TEST(LocalMapping, StatsAsJson) {
   LocalMappingStats s;
   s.keyframes = 12;
