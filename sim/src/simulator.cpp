@@ -14,23 +14,6 @@ namespace {
 
 constexpr double kSettleS = 0.3;
 
-/// MuJoCo's message as one line: line breaks become spaces, the ends trimmed.
-std::string one_line(const char* msg) {
-  std::string out;
-  for (const char* c = msg; c != nullptr && *c != '\0'; ++c) {
-    const bool space = *c == '\n' || *c == '\r' || *c == '\t' || *c == ' ';
-    if (space && (out.empty() || out.back() == ' ')) continue;
-    out += space ? ' ' : *c;
-  }
-  while (!out.empty() && out.back() == ' ') out.pop_back();
-  return out;
-}
-
-void mujoco_error(const char* msg) { throw Error("MuJoCo: " + one_line(msg)); }
-void mujoco_warning(const char* msg) {
-  std::fprintf(stderr, "pvbench: warning: MuJoCo: %s\n", one_line(msg).c_str());
-}
-
 double yaw_of(const mjtNum* q) {  // MuJoCo quaternion w, x, y, z
   return std::atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]));
 }
@@ -42,14 +25,6 @@ int actuator(const mjModel* m, const char* name) {
 }
 
 }  // namespace
-
-void install_mujoco_handlers() {
-  // Only where none is set: a process may hold two copies of this library
-  // (pvbench and the OpenNI2 sim:// driver plug-in, which OpenNI2 unloads at
-  // shutdown), and the first one installed stays.
-  if (mju_user_error == nullptr) mju_user_error = mujoco_error;
-  if (mju_user_warning == nullptr) mju_user_warning = mujoco_warning;
-}
 
 Simulator::Simulator(scenes::Scenario scenario) : scenario_(std::move(scenario)) {
   install_mujoco_handlers();
