@@ -74,19 +74,21 @@ place::BowVector PlaceRecognizer::bag_of(const KeyFrame& kf) const {
 
 std::vector<KeyFramePtr> PlaceRecognizer::loop_candidates(const Map& map, const KeyFrame& kf,
                                                           int min_keyframe_gap) const {
+  // ORB-SLAM2: the least score of the covisibles is the threshold (0 for a
+  // keyframe without any); the database computes it in the same walk.
   std::set<std::uint64_t> connected = {kf.id()};
-  double min_score = 1.0;
+  std::vector<std::uint64_t> reference;
   for (const auto& n : kf.best_covisibles(-1)) {
     connected.insert(n->id());
-    if (!n->bad()) min_score = std::min(min_score, place::Vocabulary::score(kf.bow(), bag_of(*n)));
+    if (!n->bad()) reference.push_back(n->id());
   }
-  if (connected.size() == 1) min_score = 0;
   const auto skip = [&](std::uint64_t id) {
     if (connected.count(id) || id + static_cast<std::uint64_t>(min_keyframe_gap) > kf.id()) return true;
     auto it = map.keyframes().find(id);
     return it == map.keyframes().end() || it->second->bad();
   };
-  return accumulate_groups(map, database_.query(kf.bow(), min_score, 0.8, skip));
+  if (connected.size() == 1) return accumulate_groups(map, database_.query(kf.bow(), 0.0, 0.8, skip));
+  return accumulate_groups(map, database_.query_above(kf.bow(), reference, 0.8, skip));
 }
 
 std::vector<KeyFramePtr> PlaceRecognizer::relocalisation_candidates(const Map& map,

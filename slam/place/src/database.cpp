@@ -90,33 +90,51 @@ std::size_t Database::memory_bytes() const {
 std::vector<Candidate> Database::query(const BowVector& query, double min_score, double min_common_ratio,
                                        const std::function<bool(std::uint64_t)>& skip) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  // Per keyframe: words in common (-1: skipped, so that skip() is asked
-  // once per keyframe) and Vocabulary::score's sum, term by term in the
-  // same ascending word order, so the score is the same double.
-  struct Tally {
-    int common = 0;
-    double sum = 0;
-  };
+  return select(tally(query, skip), min_score, min_common_ratio);
+}
+
+std::vector<Candidate> Database::query_above(const BowVector& query, const std::vector<std::uint64_t>& reference,
+                                             double min_common_ratio,
+                                             const std::function<bool(std::uint64_t)>& skip) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::unordered_map<std::uint64_t, Tally> t = tally(query, skip);
+  double min_score = 1.0;
+  for (std::uint64_t id : reference) {
+    const auto it = t.find(id);
+    min_score = std::min(min_score, it == t.end() ? 0.0 : score_of(it->second));
+  }
+  return select(t, min_score, min_common_ratio);
+}
+
+std::unordered_map<std::uint64_t, Database::Tally> Database::tally(
+    const BowVector& query, const std::function<bool(std::uint64_t)>& skip) const {
+  // The sum runs over the query's words in ascending order, as
+  // Vocabulary::score merges two bags, so the scores are the same doubles.
   std::unordered_map<std::uint64_t, Tally> tally;
   for (const auto& [word, x] : query) {
     const auto list = inverted_.find(word);
     if (list == inverted_.end()) continue;
     for (const Posting& p : list->second) {
       auto [it, inserted] = tally.try_emplace(p.id);
-      if (inserted && skip && skip(p.id)) it->second.common = -1;
-      if (it->second.common < 0) continue;
+      if (inserted && skip) it->second.skipped = skip(p.id);
       ++it->second.common;
       it->second.sum += std::fabs(x - p.weight) - std::fabs(x) - std::fabs(p.weight);
     }
   }
+  return tally;
+}
+
+std::vector<Candidate> Database::select(const std::unordered_map<std::uint64_t, Tally>& tally, double min_score,
+                                        double min_common_ratio) {
   int max_common = 0;
-  for (const auto& [id, t] : tally) max_common = std::max(max_common, t.common);
+  for (const auto& [id, t] : tally)
+    if (!t.skipped) max_common = std::max(max_common, t.common);
   std::vector<Candidate> out;
   if (max_common == 0) return out;
   const double min_common = min_common_ratio * max_common;
   for (const auto& [id, t] : tally) {
-    if (t.common <= 0 || t.common < min_common) continue;
-    const double s = 0.0 - 0.5 * t.sum;  // as Vocabulary::score
+    if (t.skipped || t.common < min_common) continue;
+    const double s = score_of(t);
     if (s >= min_score) out.push_back({id, t.common, s});
   }
   std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) {

@@ -79,6 +79,22 @@ TEST(Database, SkippedKeyframesAreNeitherCandidatesNorCounted) {
   EXPECT_EQ(calls, 5);  // once per keyframe sharing a word: 9, 10, 11, 12, 14
 }
 
+TEST(Database, QueryAboveTakesTheLeastScoreOfTheReferenceKeyframes) {
+  Database db;
+  fill(db);
+  const auto skip = [](std::uint64_t id) { return id == 11 || id == 14; };  // the "covisibles"
+  // The least of kf 11's 0.5 and kf 14's 0.3 is 0.3: every other keyframe
+  // sharing a word qualifies; with kf 11 alone, 0.5.
+  const auto low = db.query_above(kQuery, {11, 14}, 0.0, skip);
+  EXPECT_EQ(ids(low), (std::vector<std::uint64_t>{10, 9, 12}));
+  EXPECT_EQ(ids(db.query_above(kQuery, {11}, 0.0, skip)), ids(db.query(kQuery, 0.5, 0.0, skip)));
+  // A reference keyframe sharing no word scores 0; none at all leaves 1.
+  EXPECT_EQ(ids(db.query_above(kQuery, {13}, 0.0, skip)), ids(db.query(kQuery, 0.0, 0.0, skip)));
+  EXPECT_EQ(ids(db.query_above(kQuery, {}, 0.0, skip)), (std::vector<std::uint64_t>{10}));
+  // The same doubles as Vocabulary::score of the two bags.
+  for (const Candidate& c : low) EXPECT_EQ(c.score, Vocabulary::score(kQuery, db.bag(c.id)));
+}
+
 TEST(Database, EraseAndReplaceUpdateTheIndex) {
   Database db;
   fill(db);

@@ -46,6 +46,14 @@ class Database {
   /// database's mutex held: it must not call back into the database.
   std::vector<Candidate> query(const BowVector& query, double min_score, double min_common_ratio = 0.8,
                                const std::function<bool(std::uint64_t)>& skip = {}) const;
+  /// query() with min_score the least score among the `reference`
+  /// keyframes (ORB-SLAM2: the new keyframe's covisibles), taken from the
+  /// same walk of the lists: 1 when `reference` is empty, 0 when one of
+  /// them shares no word.  The same candidates as query() with that score
+  /// computed beforehand by Vocabulary::score, without putting bags together.
+  std::vector<Candidate> query_above(const BowVector& query, const std::vector<std::uint64_t>& reference,
+                                     double min_common_ratio = 0.8,
+                                     const std::function<bool(std::uint64_t)>& skip = {}) const;
   /// Keyframes (ids, ascending) listed under `word`.
   std::vector<std::uint64_t> keyframes_with(WordId word) const;
   /// The bag added for keyframe `id`, the same words and weights (empty when
@@ -55,6 +63,18 @@ class Database {
   std::size_t memory_bytes() const;
 
  private:
+  struct Tally {
+    int common = 0;  ///< words shared with the query
+    double sum = 0;  ///< DBoW2's L1 sum over them
+    bool skipped = false;
+  };
+  static double score_of(const Tally& t) { return 0.0 - 0.5 * t.sum; }  // as Vocabulary::score
+  /// Walks the lists of the query's words (mutex held by the caller).
+  std::unordered_map<std::uint64_t, Tally> tally(const BowVector& query,
+                                                 const std::function<bool(std::uint64_t)>& skip) const;
+  static std::vector<Candidate> select(const std::unordered_map<std::uint64_t, Tally>& tally, double min_score,
+                                       double min_common_ratio);
+
   mutable std::mutex mutex_;
   std::unordered_map<WordId, std::vector<Posting>> inverted_;  ///< word -> keyframes, ascending ids
   std::unordered_map<std::uint64_t, std::vector<WordId>> words_;  ///< keyframe id -> its words, ascending
