@@ -100,4 +100,18 @@ std::vector<KeyFramePtr> PlaceRecognizer::relocalisation_candidates(const Map& m
   return accumulate_groups(map, database_.query(bow, 0.0, 0.8, skip));
 }
 
+std::vector<KeyFramePtr> PlaceRecognizer::lookalike_candidates(const Map& map, const place::BowVector& bow,
+                                                               std::size_t n) const {
+  const auto skip = [&](std::uint64_t id) {
+    auto it = map.keyframes().find(id);
+    return it == map.keyframes().end() || it->second->bad();
+  };
+  std::vector<KeyFramePtr> out;
+  for (const place::Candidate& c : database_.query(bow, 0.0, 0.5, skip)) {
+    if (out.size() == n) break;
+    out.push_back(map.keyframes().at(c.id));
+  }
+  return out;
+}
+
 }  // namespace pvb::slam

@@ -309,6 +309,7 @@ Settings read_settings(const std::string& path) {
   read_camera(r, &s);
   read_orb(r, &s);
   s.align_patches = r.flag("Tracking.alignPatches", false, s.align_patches);  // ours, optional
+  s.reloc_lookalikes = r.integer("Tracking.relocLookalikes", false, s.reloc_lookalikes, 0, 1000);  // ours, optional
   read_pe_match(r, &s.pe_match);
   read_keyframe(r, &s.keyframe);
   read_point_cloud(r, &s.dense);

@@ -40,6 +40,7 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.patch_align.scale_factor = settings.orb.scale_factor;
   topt.reloc_ambiguity_check = settings.loop.ambiguity_check;
   topt.reloc_ambiguity_distance_m = settings.loop.ambiguity_distance_m;
+  topt.reloc_lookalikes = settings.reloc_lookalikes;
   if (settings.vocabulary_path != "none") {
     auto vocabulary = std::make_shared<const place::Vocabulary>(place::Vocabulary::load(settings.vocabulary_path));
     vocabulary_fingerprint_ = vocabulary->fingerprint();

@@ -340,9 +340,9 @@ bool Tracking::relocalize(Frame& f) {
   // Candidates from the bag of words anywhere in the map (ORB-SLAM2
   // DetectRelocalizationCandidates), or the recent keyframes without one.
   place::FeatureVector f_features;
+  place::BowVector bow;
   std::vector<std::shared_ptr<KeyFrame>> cands;
   if (place_) {
-    place::BowVector bow;
     place_->transform(f, &bow, &f_features);
     cands = place_->relocalisation_candidates(map_, bow);
     if (cands.size() > kMaxRelocCandidates) cands.resize(kMaxRelocCandidates);
@@ -379,11 +379,36 @@ bool Tracking::relocalize(Frame& f) {
                     " m apart)");
   const std::size_t best = static_cast<std::size_t>(
       std::max_element(found_inliers.begin(), found_inliers.end()) - found_inliers.begin());
+  if (place_ && options_.reloc_ambiguity_check && options_.reloc_lookalikes > 0) {
+    const std::string why = lookalike(f, found[best].first, bow, f_features, cands);
+    if (!why.empty()) return fail(why);
+  }
   f = std::move(found[best].first);
   last_reloc_frame_id_ = f.id;
   reloc_kf_ = found[best].second;
   reloc_candidates_ = static_cast<int>(cands.size());
   return true;
+}
+
+std::string Tracking::lookalike(const Frame& f, const Frame& found, const place::BowVector& bow,
+                                const place::FeatureVector& f_features,
+                                const std::vector<std::shared_ptr<KeyFrame>>& tried) {
+  // The grouped candidates can all lie at one of two look-alike places (a
+  // ground texture repeating along the route): the best-scoring keyframes
+  // one by one are tried too, and one matching elsewhere makes it ambiguous.
+  std::set<std::uint64_t> seen;
+  for (const auto& kf : tried) seen.insert(kf->id());
+  for (const auto& kf : place_->lookalike_candidates(map_, bow, static_cast<std::size_t>(options_.reloc_lookalikes))) {
+    if (!seen.insert(kf->id()).second) continue;
+    Frame trial = f;
+    int matches = 0;
+    if (relocalize_against(trial, *kf, &f_features, &matches) < 50) continue;
+    const double apart_m = (trial.camera_center_w() - found.camera_center_w()).norm();
+    if (apart_m > options_.reloc_ambiguity_distance_m)
+      return "relocalisation: ambiguous (look-alike keyframe " + std::to_string(kf->id()) + " matched at a place " +
+             format_fixed(apart_m, 2) + " m from the candidates')";
+  }
+  return {};
 }
 
 void Tracking::update_local_map(const Frame& f) {

@@ -163,5 +163,59 @@ TEST_F(MapFile, LocaliseStartsLostRelocalisesAndNeverAddsKeyframes) {
   EXPECT_THROW(system.save_map(tmp_path("localised.pvbmap"), "{}"), ConfigError);
 }
 
+/// The pair's map with a look-alike place added: its first keyframe twice
+/// more, once at its own place observing its own points (so that their
+/// covisibility group outscores a lone keyframe, as a well-mapped place does)
+/// and once `shift_m` along x with its points moved along (a repeated
+/// texture two tiles away).
+std::string lookalike_map(const std::string& bytes, const std::string& file, double shift_m) {
+  const MapFileHeader h = read_map_header(bytes, file);
+  Map map;
+  decode_map(bytes, file, h, camera_for(h.settings), &map);
+  std::lock_guard<std::mutex> lock(map.mutex());
+  const auto kf0 = map.keyframes().begin()->second;
+  const auto twin = map.create_keyframe(kf0->frame());
+  const Eigen::Vector3d d_w(shift_m, 0, 0);
+  Frame moved = kf0->frame();
+  moved.T_c_w = kf0->T_c_w() * geom::SE3d(Eigen::Translation3d(-d_w));
+  const auto far = map.create_keyframe(moved);
+  for (const auto& kf : {twin, far}) {
+    kf->set_bow(kf0->bow(), kf0->features_by_node());
+    kf->set_session(kf0->session());
+  }
+  for (std::size_t i = 0; i < kf0->map_points().size(); ++i) {
+    const auto& mp = kf0->map_points()[i];
+    if (!mp || mp->bad()) continue;
+    mp->add_observation(twin, i);
+    const auto copy = map.create_point(mp->p_w() + d_w, far);
+    copy->add_observation(far, i);
+    far->set_map_point(i, copy);
+  }
+  for (const auto& kf : {kf0, twin, far}) kf->update_connections();
+  far->change_parent(kf0);
+  return encode_map(map, h.settings, h.sessions, h.app_json);
+}
+
+TEST_F(MapFile, ALookAlikePlaceOutsideTheCandidateGroupsKeepsTheFrameLost) {
+  const std::string p = tmp_path("lookalike.pvbmap");
+  write_file(p, lookalike_map(bytes_, path_, 6.0));
+  const auto first_frame = [&](int lookalikes) {
+    Settings s = read_settings(kTum3);
+    s.reloc_lookalikes = lookalikes;
+    System system(s, sync_options());
+    system.load_map(p, MapStart::kLocalise);
+    return system.track(pair_frames(s).front());
+  };
+  // Checked against the best-scoring keyframes one by one, the place 6 m
+  // away matches too: ambiguous, no pose.
+  const FrameResult checked = first_frame(10);
+  EXPECT_FALSE(checked.T_w_c);
+  EXPECT_NE(checked.tracking.failure.find("look-alike keyframe"), std::string::npos) << checked.tracking.failure;
+  // The grouped candidates alone are all at the first place: relocalised.
+  const FrameResult grouped = first_frame(0);
+  ASSERT_TRUE(grouped.T_w_c) << grouped.tracking.failure;
+  EXPECT_LT(grouped.T_w_c->translation().norm(), 0.01);
+}
+
 }  // namespace
 }  // namespace pvb::slam

@@ -46,6 +46,11 @@ class PlaceRecognizer {
   /// Call with the map mutex held.
   std::vector<std::shared_ptr<KeyFrame>> relocalisation_candidates(const Map& map,
                                                                    const place::BowVector& bow) const;
+  /// The `n` best-scoring keyframes for `bow` one by one, without grouping
+  /// and keeping those sharing at least half of the most shared words: the
+  /// look-alike places a relocalisation is checked against.
+  std::vector<std::shared_ptr<KeyFrame>> lookalike_candidates(const Map& map, const place::BowVector& bow,
+                                                              std::size_t n) const;
 
  private:
   std::shared_ptr<const place::Vocabulary> vocabulary_;

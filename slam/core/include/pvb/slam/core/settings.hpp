@@ -88,6 +88,9 @@ struct Settings {
   /// to their reference keyframe's patch before the local-map pose
   /// optimisation (TrackingOptions::align_patches).
   bool align_patches = true;
+  /// Tracking.relocLookalikes (ours, optional): best-scoring keyframes a
+  /// relocalisation is also checked against (TrackingOptions::reloc_lookalikes).
+  int reloc_lookalikes = 10;
   PeMatchSettings pe_match;         ///< PEMatch.* (optional section)
   KeyFrameSettings keyframe;        ///< KeyFrame.* (optional section)
   PointCloudMappingSettings dense;  ///< PointCloudMapping.* (optional section)

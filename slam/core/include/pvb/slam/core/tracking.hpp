@@ -115,6 +115,11 @@ struct TrackingOptions {
   /// stays lost (LoopClosing.ambiguityCheck / ambiguityDistance).
   bool reloc_ambiguity_check = true;
   double reloc_ambiguity_distance_m = 0.3;
+  /// Relocalization.lookalikes: with the ambiguity check, a relocalisation
+  /// is also tried against this many best-scoring keyframes one by one
+  /// (not grouped), and refused when one of them matches at another place;
+  /// 0 turns it off.
+  int reloc_lookalikes = 10;
 };
 
 /// "Already seen in this pass" marks for map-point ids: a pass stamp per
@@ -178,6 +183,10 @@ class Tracking {
   /// given), PnP RANSAC and pose optimisation; returns the pose inliers
   /// (0 when a step failed) and the descriptor matches in *matches.
   int relocalize_against(Frame& f, const KeyFrame& kf, const place::FeatureVector* f_features, int* matches);
+  /// After a relocalisation to `found`: why it is ambiguous against the
+  /// best-scoring keyframes not among `tried`, or empty.
+  std::string lookalike(const Frame& f, const Frame& found, const place::BowVector& bow,
+                        const place::FeatureVector& f_features, const std::vector<std::shared_ptr<KeyFrame>>& tried);
   static constexpr std::size_t kMaxRelocCandidates = 20;
   /// Appends the RelocEvent of f, just relocalised and tracked.
   void record_relocalisation(const Frame& f);
