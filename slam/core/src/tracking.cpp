@@ -359,7 +359,7 @@ bool Tracking::relocalize(Frame& f) {
     const int good = relocalize_against(trial, *kf, place_ ? &f_features : nullptr, &matches);
     best_matches = std::max(best_matches, matches);
     best_inliers = std::max(best_inliers, good);
-    if (good < 50) continue;
+    if (good < kRelocMinInliers) continue;
     found.emplace_back(std::move(trial), kf);
     found_inliers.push_back(good);
     if (!options_.reloc_ambiguity_check) break;
@@ -368,7 +368,7 @@ bool Tracking::relocalize(Frame& f) {
   if (found.empty())
     return fail("relocalisation: no candidate keyframe matched (" + std::to_string(cands.size()) +
                 " candidates, best " + std::to_string(best_matches) + " descriptor matches (need 15), best " +
-                std::to_string(best_inliers) + " pose inliers (need 50))");
+                std::to_string(best_inliers) + " pose inliers (need " + std::to_string(kRelocMinInliers) + "))");
   for (std::size_t i = 0; i < found.size(); ++i)
     for (std::size_t j = i + 1; j < found.size(); ++j)
       if ((found[i].first.camera_center_w() - found[j].first.camera_center_w()).norm() >
@@ -402,7 +402,7 @@ std::string Tracking::lookalike(const Frame& f, const Frame& found, const place:
     if (!seen.insert(kf->id()).second) continue;
     Frame trial = f;
     int matches = 0;
-    if (relocalize_against(trial, *kf, &f_features, &matches) < 50) continue;
+    if (relocalize_against(trial, *kf, &f_features, &matches) < kRelocMinInliers) continue;
     const double apart_m = (trial.camera_center_w() - found.camera_center_w()).norm();
     if (apart_m > options_.reloc_ambiguity_distance_m)
       return "relocalisation: ambiguous (look-alike keyframe " + std::to_string(kf->id()) + " matched at a place " +

@@ -115,7 +115,7 @@ struct TrackingOptions {
   /// stays lost (LoopClosing.ambiguityCheck / ambiguityDistance).
   bool reloc_ambiguity_check = true;
   double reloc_ambiguity_distance_m = 0.3;
-  /// Relocalization.lookalikes: with the ambiguity check, a relocalisation
+  /// Tracking.relocLookalikes: with the ambiguity check, a relocalisation
   /// is also tried against this many best-scoring keyframes one by one
   /// (not grouped), and refused when one of them matches at another place;
   /// 0 turns it off.
@@ -188,6 +188,8 @@ class Tracking {
   std::string lookalike(const Frame& f, const Frame& found, const place::BowVector& bow,
                         const place::FeatureVector& f_features, const std::vector<std::shared_ptr<KeyFrame>>& tried);
   static constexpr std::size_t kMaxRelocCandidates = 20;
+  /// Pose inliers a relocalisation candidate needs (ORB-SLAM2: 50).
+  static constexpr int kRelocMinInliers = 50;
   /// Appends the RelocEvent of f, just relocalised and tracked.
   void record_relocalisation(const Frame& f);
   bool track_local_map(Frame& f);
