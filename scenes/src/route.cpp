@@ -156,16 +156,18 @@ std::vector<Eigen::Vector2d> route_polyline(const Scenario& s, double spacing_m)
       const double v1 = (a.rows - 1) * a.row_pitch_m + row_footprint_m(a) + rt.offset_m;
       const double r = std::min({1.5, 0.45 * (v1 - v0), 0.45 * (u1 - u0)});
       const double um = 0.5 * (u0 + u1);
-      // counter-clockwise from the middle of the front side
-      append_segment(&uv, {um, v0}, {u1 - r, v0}, spacing_m);
-      append_arc(&uv, {u1 - r, v0 + r}, r, -M_PI / 2, 0, spacing_m);
-      append_segment(&uv, {u1, v0 + r}, {u1, v1 - r}, spacing_m);
-      append_arc(&uv, {u1 - r, v1 - r}, r, 0, M_PI / 2, spacing_m);
-      append_segment(&uv, {u1 - r, v1}, {u0 + r, v1}, spacing_m);
-      append_arc(&uv, {u0 + r, v1 - r}, r, M_PI / 2, M_PI, spacing_m);
-      append_segment(&uv, {u0, v1 - r}, {u0, v0 + r}, spacing_m);
-      append_arc(&uv, {u0 + r, v0 + r}, r, M_PI, 1.5 * M_PI, spacing_m);
-      append_segment(&uv, {u0 + r, v0}, {um, v0}, spacing_m);
+      // counter-clockwise from the middle of the front side, `laps` times
+      for (int lap = 0; lap < rt.laps; ++lap) {
+        append_segment(&uv, {um, v0}, {u1 - r, v0}, spacing_m);
+        append_arc(&uv, {u1 - r, v0 + r}, r, -M_PI / 2, 0, spacing_m);
+        append_segment(&uv, {u1, v0 + r}, {u1, v1 - r}, spacing_m);
+        append_arc(&uv, {u1 - r, v1 - r}, r, 0, M_PI / 2, spacing_m);
+        append_segment(&uv, {u1 - r, v1}, {u0 + r, v1}, spacing_m);
+        append_arc(&uv, {u0 + r, v1 - r}, r, M_PI / 2, M_PI, spacing_m);
+        append_segment(&uv, {u0, v1 - r}, {u0, v0 + r}, spacing_m);
+        append_arc(&uv, {u0 + r, v0 + r}, r, M_PI, 1.5 * M_PI, spacing_m);
+        append_segment(&uv, {u0 + r, v0}, {um, v0}, spacing_m);
+      }
       break;
     }
     case RoutePattern::kWaypoints:

@@ -201,6 +201,10 @@ void read_route(MapReader& r, Route& rt) {
   rt.array = r.integer("array", rt.array, 0, 1000);
   rt.aisle = r.integer("aisle", rt.aisle, 0, 1000);
   rt.aisles = r.integer("aisles", rt.aisles, 1, 100);
+  if (r.has("laps") && rt.pattern != RoutePattern::kLoop)
+    r.fail(r.full("laps"), r.child("laps"), "no laps unless route.pattern is loop (it would be ignored)",
+           r.child("laps").Scalar());
+  rt.laps = r.integer("laps", rt.laps, 1, 100);
   rt.return_to_start = r.boolean("return_to_start", rt.return_to_start);
   if (rt.return_to_start && rt.pattern != RoutePattern::kLawnmower)
     r.fail(r.full("return_to_start"), r.child("return_to_start"), "false unless route.pattern is lawnmower",

@@ -43,6 +43,16 @@ TEST(Route, LoopReturnsToItsStart) {
   for (std::size_t i = 1; i < pts.size(); ++i) EXPECT_LT((pts[i] - pts[i - 1]).norm(), 0.0501);
 }
 
+TEST(Route, LoopLapsDriveTheSameLoopAgain) {
+  const auto one = route_polyline(array_scenario("{pattern: loop, offset_m: 1.5}"), 0.05);
+  const auto three = route_polyline(array_scenario("{pattern: loop, offset_m: 1.5, laps: 3}"), 0.05);
+  EXPECT_NEAR(polyline_length(three), 3 * polyline_length(one), 1e-6);
+  ASSERT_EQ(three.size(), 3 * one.size() - 2);  // each lap after the first starts at the last one's end
+  for (std::size_t lap = 1; lap < 3; ++lap)
+    for (std::size_t i = 0; i < one.size(); ++i)
+      EXPECT_LT((three[lap * (one.size() - 1) + i] - one[i]).norm(), 1e-9) << "lap " << lap << ", point " << i;
+}
+
 TEST(Route, LawnmowerAlternatesDirection) {
   const Scenario s = array_scenario("{pattern: lawnmower, aisles: 3, margin_m: 1.5}");
   const auto pts = route_polyline(s, 0.05);

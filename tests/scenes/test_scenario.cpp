@@ -327,6 +327,19 @@ TEST(Scenario, KidnapIsValidatedWithFileAndLine) {
     EXPECT_EQ(body.find('\n'), std::string::npos) << body;
 }
 
+TEST(Scenario, LoopLapsAreReadAndRefusedOnOtherPatterns) {
+  const std::string arrays = "pv_arrays:\n  - {rows: 2, tables_per_row: 2, panels_per_table: 4}\n";
+  EXPECT_EQ(parse_scenario(std::string(kMinimal) + arrays, "a.yaml").route.laps, 1);
+  EXPECT_EQ(parse_scenario(arrays + "route: {pattern: loop, laps: 5}\n", "l.yaml").route.laps, 5);
+  std::string e = error_of(arrays + "route:\n  pattern: lawnmower\n  laps: 2\n");
+  EXPECT_NE(e.find("bad.yaml:5"), std::string::npos) << e;
+  EXPECT_NE(e.find("route.laps: expected no laps unless route.pattern is loop (it would be ignored), got 2"),
+            std::string::npos)
+      << e;
+  e = error_of(arrays + "route: {pattern: loop, laps: 0}\n");
+  EXPECT_NE(e.find("route.laps"), std::string::npos) << e;
+}
+
 TEST(Scenario, IdenticalTablesAndLawnmowerReturnAreRead) {
   const std::string arrays = "pv_arrays:\n  - {rows: 2, tables_per_row: 2, panels_per_table: 4}\n";
   const Scenario none = parse_scenario(std::string(kMinimal) + arrays, "a.yaml");

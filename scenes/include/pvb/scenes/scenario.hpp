@@ -156,6 +156,7 @@ struct Route {
   int array = 0;                             ///< pattern routes: which array
   int aisle = 0;                             ///< along_row: aisle in front of this row
   int aisles = 2;                            ///< lawnmower: number of aisles driven
+  int laps = 1;                              ///< loop: times around the array
   /// lawnmower: after the last aisle, drive back to the start beyond the row
   /// ends and re-drive the first aisle's first return_overlap_m metres in
   /// the direction of the start.
