@@ -274,6 +274,7 @@ void read_expect(MapReader& r, Expectations& e) {
   if (r.has("rpe_trans_rmse_m_max"))
     e.rpe_trans_rmse_m_max = r.number("rpe_trans_rmse_m_max", 0.0, 1e-6, 100);
   if (r.has("lost_frames_max")) e.lost_frames_max = r.integer("lost_frames_max", 0, 0, 1000000);
+  if (r.has("keyframes_max")) e.keyframes_max = r.integer("keyframes_max", 0, 1, 1000000);
   if (r.has("refined_ate_rmse_m_max"))
     e.refined_ate_rmse_m_max = r.number("refined_ate_rmse_m_max", 0.0, 1e-6, 100);
   if (r.has("false_loops_max")) e.false_loops_max = r.integer("false_loops_max", 0, 0, 1000000);

@@ -111,6 +111,7 @@ TEST(Scenario, ExpectSectionIsReadAndOptional) {
                                         "  ate_rmse_m_max: 0.01\n"
                                         "  rpe_trans_rmse_m_max: 0.005\n"
                                         "  lost_frames_max: 0\n"
+                                        "  keyframes_max: 400\n"
                                         "  ci_frames: 240\n"
                                         "  sweep: {pe_not_significantly_worse: true, min_seeds: 12}\n",
                                     "e.yaml");
@@ -121,6 +122,9 @@ TEST(Scenario, ExpectSectionIsReadAndOptional) {
   EXPECT_DOUBLE_EQ(*s.expect.rpe_trans_rmse_m_max, 0.005);
   ASSERT_TRUE(s.expect.lost_frames_max);
   EXPECT_EQ(*s.expect.lost_frames_max, 0);
+  ASSERT_TRUE(s.expect.keyframes_max);
+  EXPECT_EQ(*s.expect.keyframes_max, 400);
+  EXPECT_FALSE(none.expect.keyframes_max);
   EXPECT_FALSE(s.expect.tracking_loss_expected);
   EXPECT_EQ(s.expect.ci_frames, 240);
   EXPECT_TRUE(s.expect.sweep.pe_not_significantly_worse);

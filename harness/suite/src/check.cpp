@@ -135,6 +135,13 @@ std::vector<Violation> check_expectations(const scenes::Expectations& expect, co
   if (expect.lost_frames_max && run.lost_frames > *expect.lost_frames_max)
     out.push_back({"lost_frames_max", std::to_string(run.lost_frames) + " lost frames > " +
                                           std::to_string(*expect.lost_frames_max)});
+  if (expect.keyframes_max) {
+    if (!run.keyframes)
+      out.push_back({"keyframes_max", "no keyframe count in the metrics (keyframes is absent)"});
+    else if (*run.keyframes > *expect.keyframes_max)
+      out.push_back({"keyframes_max", std::to_string(*run.keyframes) + " keyframes in the final map > " +
+                                          std::to_string(*expect.keyframes_max)});
+  }
   if (expect.refined_ate_rmse_m_max) {
     if (!run.refined_ate_rmse_m)
       out.push_back({"refined_ate_rmse_m_max", "no refined ATE in the metrics (refined is absent)"});

@@ -100,6 +100,7 @@ class Reader {
       fail(obj["status"], "status", "expected completed, interrupted or aborted, got " + r.status);
     r.frames = integer(obj, "frames");
     r.lost_frames = integer(obj, "lost_frames");
+    if (obj["keyframes"].IsDefined() && !obj["keyframes"].IsNull()) r.keyframes = integer(obj, "keyframes");
     r.ate_rmse_m = stats_rmse(obj, "ate", {});
     r.rpe_trans_rmse_m = stats_rmse(obj, "rpe", {"trans"});
     r.tracking_ms_median = optional_number(obj, "tracking_ms", "median");

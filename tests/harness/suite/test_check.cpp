@@ -99,6 +99,21 @@ TEST(SuiteCheck, BoundsAreInclusiveAndUnsetBoundsAreNotChecked) {
   EXPECT_TRUE(suite::check_expectations(scenes::Expectations{}, fixture("worse_than_baseline.json")).empty());
 }
 
+TEST(SuiteCheck, KeyframesOfTheFinalMapAreBounded) {
+  scenes::Expectations e;
+  e.keyframes_max = 30;  // worse_than_baseline.json: 30 keyframes
+  EXPECT_TRUE(suite::check_expectations(e, fixture("worse_than_baseline.json")).empty());
+  e.keyframes_max = 29;
+  const auto v = suite::check_expectations(e, fixture("worse_than_baseline.json"));
+  ASSERT_EQ(v.size(), 1u);
+  EXPECT_EQ(v[0].line(), "keyframes_max: 30 keyframes in the final map > 29");
+  suite::MetricsFile m = suite::read_metrics_file(fixture("worse_than_baseline.json"));
+  m.primary.keyframes.reset();
+  const auto missing = suite::check_expectations(e, m);
+  ASSERT_EQ(missing.size(), 1u);
+  EXPECT_EQ(missing[0].line(), "keyframes_max: no keyframe count in the metrics (keyframes is absent)");
+}
+
 TEST(SuiteCheck, NullMetricsAndMissingBaselineAreViolations) {
   // An aborted run has no ATE; without tracking_loss_expected, every bound fails.
   const auto v = suite::check_expectations(nominal(), fixture("lost_aborted.json"));

@@ -251,6 +251,9 @@ struct Expectations {
   std::optional<double> ate_rmse_m_max;        ///< ATE RMSE of the primary run, metres
   std::optional<double> rpe_trans_rmse_m_max;  ///< RPE translation RMSE of the primary run, metres
   std::optional<int> lost_frames_max;          ///< frames in the Lost state
+  /// Keyframes in the final map (after culling): a map that keeps growing
+  /// over ground it has mapped fails it.
+  std::optional<int> keyframes_max;
   /// ATE RMSE of the refined trajectory (every frame re-anchored on its
   /// keyframe's final pose, after local BA and loop closing), metres.
   std::optional<double> refined_ate_rmse_m_max;
@@ -273,7 +276,7 @@ struct Expectations {
   SweepExpectations sweep;                     ///< judged over a seed sweep only
   /// True when a bound on a single run is set.
   bool any_run_bound() const {
-    return ate_rmse_m_max || rpe_trans_rmse_m_max || lost_frames_max || tracking_loss_expected ||
+    return ate_rmse_m_max || rpe_trans_rmse_m_max || lost_frames_max || keyframes_max || tracking_loss_expected ||
            refined_ate_rmse_m_max || false_loops_max || relocalised_within_frames || loops_min ||
            map_accuracy_m_max || map_completeness_min;
   }

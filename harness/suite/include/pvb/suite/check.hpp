@@ -25,6 +25,8 @@ struct Violation {
 /// - ate_rmse_m_max / rpe_trans_rmse_m_max: the primary run's RMSE <= bound
 ///   (a null ate / rpe is a violation);
 /// - lost_frames_max: the primary run's lost_frames <= bound;
+/// - keyframes_max: the primary run's final map has at most this many
+///   keyframes (a file without the count is a violation);
 /// - refined_ate_rmse_m_max: the refined trajectory's ATE RMSE <= bound;
 /// - false_loops_max: loops_false <= bound and relocalisations_false <=
 ///   bound (the run must carry ground-truth labels);

@@ -40,6 +40,7 @@ struct RunMetrics {
   std::string status;  ///< "completed", "interrupted" or "aborted"
   int frames = 0;
   int lost_frames = 0;
+  std::optional<int> keyframes;            ///< the final map's; absent in files without it
   std::optional<double> ate_rmse_m;        ///< absent when "ate" is null
   std::optional<double> rpe_trans_rmse_m;  ///< absent when "rpe" is null
   std::optional<double> refined_ate_rmse_m;  ///< "refined.ate_rmse", absent when not evaluated
