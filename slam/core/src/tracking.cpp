@@ -396,17 +396,29 @@ std::string Tracking::lookalike(const Frame& f, const Frame& found, const place:
   // The grouped candidates can all lie at one of two look-alike places (a
   // ground texture repeating along the route): the best-scoring keyframes
   // one by one are tried too, and one matching elsewhere makes it ambiguous.
+  // A best-scoring keyframe at another place that does not match is tried
+  // through its best covisibles: its neighbours may see the view's part of
+  // that place better (a frame between two keyframes of it).
   std::set<std::uint64_t> seen;
   for (const auto& kf : tried) seen.insert(kf->id());
-  for (const auto& kf : place_->lookalike_candidates(map_, bow, static_cast<std::size_t>(options_.reloc_lookalikes))) {
-    if (!seen.insert(kf->id()).second) continue;
+  const double far_m = options_.reloc_ambiguity_distance_m;
+  const auto matches_elsewhere = [&](const KeyFrame& kf) -> std::string {
     Frame trial = f;
     int matches = 0;
-    if (relocalize_against(trial, *kf, &f_features, &matches) < kRelocMinInliers) continue;
+    if (relocalize_against(trial, kf, &f_features, &matches) < kRelocMinInliers) return {};
     const double apart_m = (trial.camera_center_w() - found.camera_center_w()).norm();
-    if (apart_m > options_.reloc_ambiguity_distance_m)
-      return "relocalisation: ambiguous (look-alike keyframe " + std::to_string(kf->id()) + " matched at a place " +
-             format_fixed(apart_m, 2) + " m from the candidates')";
+    if (apart_m <= far_m) return {};
+    return "relocalisation: ambiguous (look-alike keyframe " + std::to_string(kf.id()) + " matched at a place " +
+           format_fixed(apart_m, 2) + " m from the candidates')";
+  };
+  for (const auto& kf : place_->lookalike_candidates(map_, bow, static_cast<std::size_t>(options_.reloc_lookalikes))) {
+    if (!seen.insert(kf->id()).second) continue;
+    if (std::string why = matches_elsewhere(*kf); !why.empty()) return why;
+    if ((kf->camera_center_w() - found.camera_center_w()).norm() <= far_m) continue;
+    for (const auto& n : kf->best_covisibles(kLookalikeNeighbours)) {
+      if (n->bad() || !seen.insert(n->id()).second) continue;
+      if (std::string why = matches_elsewhere(*n); !why.empty()) return why;
+    }
   }
   return {};
 }

@@ -184,12 +184,16 @@ class Tracking {
   /// (0 when a step failed) and the descriptor matches in *matches.
   int relocalize_against(Frame& f, const KeyFrame& kf, const place::FeatureVector* f_features, int* matches);
   /// After a relocalisation to `found`: why it is ambiguous against the
-  /// best-scoring keyframes not among `tried`, or empty.
+  /// best-scoring keyframes not among `tried` (and the best covisibles of
+  /// those at another place), or empty.
   std::string lookalike(const Frame& f, const Frame& found, const place::BowVector& bow,
                         const place::FeatureVector& f_features, const std::vector<std::shared_ptr<KeyFrame>>& tried);
   static constexpr std::size_t kMaxRelocCandidates = 20;
   /// Pose inliers a relocalisation candidate needs (ORB-SLAM2: 50).
   static constexpr int kRelocMinInliers = 50;
+  /// Covisibles tried for a look-alike keyframe at another place that does
+  /// not match itself.
+  static constexpr int kLookalikeNeighbours = 5;
   /// Appends the RelocEvent of f, just relocalised and tracked.
   void record_relocalisation(const Frame& f);
   bool track_local_map(Frame& f);
