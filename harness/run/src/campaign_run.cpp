@@ -96,14 +96,15 @@ std::string session_json(const SessionResult& r) {
   return out + "}";
 }
 
-/// "P, S, U": matched landmarks on panels, on what stays (ground, posts,
-/// walls, frames, shrubs), and unlabelled; "-" when not classified.
+/// "P, S, U": matched landmarks on panels and their frames (backsheets,
+/// rails: what turns on a tracker), on what stays (ground, posts, walls,
+/// shrubs), and unlabelled; "-" when not classified.
 std::string landmark_cell(const SessionResult& s) {
   if (!s.map || s.map->matched_landmarks.empty()) return "-";
   int panel = 0, unlabelled = 0, total = 0;
   for (const auto& [name, n] : s.map->matched_landmarks) {
     if (name == "total") total = n;
-    else if (name == "panel") panel = n;
+    else if (name == "panel" || name == "frame") panel += n;
     else if (name == "unlabelled") unlabelled = n;
   }
   return std::to_string(panel) + ", " + std::to_string(total - panel - unlabelled) + ", " + std::to_string(unlabelled);
@@ -113,7 +114,7 @@ std::string landmark_cell(const SessionResult& s) {
 std::string campaign_markdown(const CampaignReport& r) {
   std::string out = "# Campaign " + r.campaign.name + "\n\n" + r.campaign.description + "\n\n";
   out += "| session | mode | map | frames | lost | keyframes (loaded) | within 0.05 m/1 deg | within 0.25 m/2 deg "
-         "| wrong place | first pose (frame) | tracking ms median | matched landmarks: panels, static, unlabelled |\n";
+         "| wrong place | first pose (frame) | tracking ms median | matched landmarks: panels and frames, static, unlabelled |\n";
   out += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const SessionResult& s : r.sessions) {
     const auto* l = s.map && s.map->localisation ? &*s.map->localisation : nullptr;
