@@ -155,6 +155,7 @@ void finish_map(slam::System& system, const MapOptions& options, const eval::Tra
                 const eval::Trajectory& est, const std::string& name, std::uint64_t station_seed, MapReport* r,
                 const std::string& scenario_file) {
   r->relocalisations = system.relocalisations().size();
+  for (const auto& e : system.loop_stats().loops) r->merges += e.merge ? 1 : 0;
   score_map_localisation(r, gt, est);
   if (!r->load && !gt.empty()) r->T_world_map = T_world_new_map(gt, est);
   save_map(system, options, name, station_seed, r, scenario_file);
@@ -173,6 +174,7 @@ std::vector<std::string> map_log_lines(const MapReport& m) {
                 " m/" + format_g(classes[k].max_rotation_deg) + " deg, ";
       line += std::to_string(l.wrong_place) + " wrong-place poses, first pose at frame " +
               (l.first_pose_frame ? std::to_string(*l.first_pose_frame) : std::string("-"));
+      if (m.merges) line += ", " + std::to_string(m.merges) + " provisional map(s) merged";
     } else {
       line += "not scored: " + m.localisation_note;
     }
@@ -183,7 +185,11 @@ std::vector<std::string> map_log_lines(const MapReport& m) {
     lines.push_back("map saved to " + m.saved_to + ": " + std::to_string(m.save->sessions) + " sessions, " +
                     std::to_string(m.save->keyframes) + " keyframes, " + std::to_string(m.save->points) +
                     " points, " + std::to_string(m.save->bytes) + " bytes in " + format_fixed(m.save->save_ms, 0) +
-                    " ms");
+                    " ms" +
+                    (m.save->unmerged_keyframes
+                         ? "; " + std::to_string(m.save->unmerged_keyframes) +
+                               " keyframes of a provisional map never merged were left out"
+                         : std::string()));
   return lines;
 }
 
@@ -194,7 +200,8 @@ std::string map_report_json(const MapReport& r) {
     out += ", \"loaded\": {\"file\": \"" + json_escape(r.loaded_from) + "\", \"sessions\": " +
            std::to_string(l.sessions) + ", \"keyframes\": " + std::to_string(l.keyframes) +
            ", \"points\": " + std::to_string(l.points) + ", \"bytes\": " + std::to_string(l.bytes) +
-           ", \"load_ms\": " + num(l.load_ms) + "}, \"relocalisations\": " + std::to_string(r.relocalisations);
+           ", \"load_ms\": " + num(l.load_ms) + "}, \"relocalisations\": " + std::to_string(r.relocalisations) +
+           ", \"merges\": " + std::to_string(r.merges);
   }
   out += ", \"T_world_map\": " + (r.T_world_map ? pose_json(*r.T_world_map) : std::string("null"));
   if (r.save) {
@@ -203,7 +210,8 @@ std::string map_report_json(const MapReport& r) {
            std::to_string(s.sessions) + ", \"keyframes\": " + std::to_string(s.keyframes) +
            ", \"points\": " + std::to_string(s.points) + ", \"bytes\": " + std::to_string(s.bytes) +
            ", \"bytes_per_keyframe\": " + num(s.keyframes ? double(s.bytes) / double(s.keyframes) : 0.0) +
-           ", \"save_ms\": " + num(s.save_ms) + "}";
+           ", \"save_ms\": " + num(s.save_ms) + ", \"unmerged_keyframes\": " + std::to_string(s.unmerged_keyframes) +
+           "}";
   }
   if (!r.save_note.empty()) out += ", \"save_note\": \"" + json_escape(r.save_note) + "\"";
   if (!r.matched_landmarks.empty()) {

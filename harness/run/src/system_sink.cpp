@@ -27,7 +27,9 @@ void record_state_change(SlamRun& run, slam::TrackingState prev_state, const sla
     log.line(head + std::string("lost tracking: ") + reason);
   } else if (r.state == slam::TrackingState::kOk && prev_state == slam::TrackingState::kLost) {
     if (!run.loss_events.empty()) run.loss_events.back().recovered_frame = index;
-    log.line(head + std::string("relocalised"));
+    log.line(head + std::string(r.tracking.method == slam::TrackingMethod::kInitialization
+                                    ? "began a provisional map (lost in the loaded map for too long)"
+                                    : "relocalised"));
   } else if (r.state == slam::TrackingState::kNotInitialized && run.frames == 1) {
     log.line(head + "not initialised: " + reason);
   } else if (r.state == slam::TrackingState::kOk && prev_state == slam::TrackingState::kNotInitialized) {
@@ -71,7 +73,10 @@ slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log)
   if (r.tracking.new_keyframe) keyframe_t_ns.push_back(r.t_ns);
   write_lines(r, index);
   record_state_change(run, prev_state, r, index, t_s, log);
+  if (prev_provisional && r.T_w_c)
+    log.line("frame " + std::to_string(index) + ": the provisional map was merged into the loaded map");
   prev_state = r.state;
+  prev_provisional = r.provisional;
   return r;
 }
 

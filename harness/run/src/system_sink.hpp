@@ -27,6 +27,7 @@ struct SystemSink {
   eval::Trajectory est;
   eval::Trajectory refined;  ///< filled by finish()
   slam::TrackingState prev_state = slam::TrackingState::kNotInitialized;
+  bool prev_provisional = false;  ///< the last frame was tracked in a provisional map
   double tracking_ms = 0, orb_ms = 0, inline_mapping_ms = 0;
   std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made, for the revisit labels
   /// The dense maps written by finish(), by name (corrected, live, and

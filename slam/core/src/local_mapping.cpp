@@ -328,7 +328,7 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
     std::map<std::uint64_t, std::size_t> kf_index, pt_index;
     auto add_kf = [&](const std::shared_ptr<KeyFrame>& k, bool fixed) {
       kf_index[k->id()] = problem.keyframes.size();
-      problem.keyframes.push_back({k->id(), k->T_c_w(), fixed || k->id() == 0 || k->fixed()});
+      problem.keyframes.push_back({k->id(), k->T_c_w(), fixed || k->id() == 0 || k->root() || k->fixed()});
       kfs.push_back(k);
     };
     add_kf(kf, false);
@@ -382,7 +382,7 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
 
 void LocalMapping::cull_keyframes(const std::shared_ptr<KeyFrame>& kf) {
   for (const auto& n : kf->best_covisibles(-1)) {
-    if (n->id() == 0 || n->bad()) continue;
+    if (n->id() == 0 || n->root() || n->bad()) continue;
     if (is_redundant_keyframe(*n, cam_->th_depth_m, options_.redundant_ratio, options_.redundant_observers))
       map_.erase_keyframe(n);
   }

@@ -48,6 +48,10 @@ void pose_difference(const geom::SE3d& a, const geom::SE3d& b, double* dist_m, d
   *angle_deg = geom::rotation_angle_rad(a.linear() * b.linear().transpose()) * kRadToDeg;
 }
 
+/// Moves the provisional map of `kf` into the frame of `loop_kf`'s map (defined with step 4).
+void merge_into(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf,
+                const geom::SE3d& T_c_w_into);
+
 }  // namespace
 
 std::vector<std::shared_ptr<KeyFrame>> pose_candidates(const Map& map, const KeyFrame& kf,
@@ -60,7 +64,7 @@ std::vector<std::shared_ptr<KeyFrame>> pose_candidates(const Map& map, const Key
   std::vector<std::pair<double, std::shared_ptr<KeyFrame>>> found;
   for (const auto& [id, k] : map.keyframes()) {
     if (id + static_cast<std::uint64_t>(options.min_keyframe_gap) > kf.id()) break;  // ordered by id
-    if (k->bad() || connected.count(id)) continue;
+    if (k->bad() || connected.count(id) || map.map_of(*k) != map.map_of(kf)) continue;
     const double d = (k->camera_center_w() - c).norm();
     if (d > options.search_radius_m) continue;
     if (optical_axis_w(*k).dot(axis) < min_cos) continue;
@@ -129,7 +133,8 @@ std::string to_json(const LoopClosingStats& stats) {
            ", \"graph_keyframes\": " + std::to_string(e.graph_keyframes) +
            ", \"graph_edges\": " + std::to_string(e.graph_edges) + ", \"detect_ms\": " + num(e.detect_ms) +
            ", \"correct_ms\": " + num(e.correct_ms) + ", \"global_ba_ms\": " + num(e.global_ba_ms) +
-           ", \"global_ba_outliers\": " + std::to_string(e.global_ba_outliers) + "}";
+           ", \"global_ba_outliers\": " + std::to_string(e.global_ba_outliers) +
+           ", \"merge\": " + (e.merge ? "true" : "false") + "}";
   }
   out += "], \"keyframes\": " + std::to_string(stats.keyframes) + ", \"candidates\": " +
          std::to_string(stats.candidates) + ", \"consistent\": " + std::to_string(stats.consistent) +
@@ -159,7 +164,10 @@ LoopClosingStats LoopClosing::stats() const {
 std::vector<std::shared_ptr<KeyFrame>> LoopClosing::propose(const std::shared_ptr<KeyFrame>& kf) {
   std::vector<std::shared_ptr<KeyFrame>> candidates;
   if (place_ && !options_.pose_proximity) {
-    candidates = place_->loop_candidates(map_, *kf, options_.min_keyframe_gap);
+    // Within the keyframe's own map, or from a provisional map into the map's own frame (a merge).
+    const std::uint32_t own = map_.map_of(*kf);
+    for (const auto& c : place_->loop_candidates(map_, *kf, options_.min_keyframe_gap))
+      if (const std::uint32_t m = map_.map_of(*c); m == own || m == 0) candidates.push_back(c);
     if (static_cast<int>(candidates.size()) > options_.max_candidates) candidates.resize(options_.max_candidates);
     return candidates;
   }
@@ -224,7 +232,7 @@ double LoopClosing::path_length_m(std::uint64_t from, std::uint64_t to) const {
 
 std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& kf,
                                               const std::vector<std::shared_ptr<KeyFrame>>& consistent,
-                                              LoopMatch* best) {
+                                              bool merge, LoopMatch* best) {
   std::shared_ptr<KeyFrame> loop_kf;
   std::vector<Eigen::Vector3d> verified_centres_w;
   int drift = 0;
@@ -240,13 +248,13 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
     }
     double dist_m = 0, angle_deg = 0;
     pose_difference(m.T_c_w, kf->T_c_w(), &dist_m, &angle_deg);
-    if (dist_m > options_.max_correction_m || angle_deg > options_.max_correction_deg) {
+    if (!merge && (dist_m > options_.max_correction_m || angle_deg > options_.max_correction_deg)) {
       ++refused_correction;
       continue;
     }
     verified_centres_w.push_back(m.T_c_w.inverse().translation());
     const double bound_m = options_.drift_floor_m + options_.max_drift_rate * path_length_m(cand->id(), kf->id());
-    if (options_.max_drift_rate > 0 && dist_m > bound_m) {
+    if (!merge && options_.max_drift_rate > 0 && dist_m > bound_m) {
       ++drift;
       continue;
     }
@@ -288,9 +296,18 @@ bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
     groups_.clear();
     return false;
   }
-  const std::vector<std::shared_ptr<KeyFrame>> consistent = detect(kf);
+  std::vector<std::shared_ptr<KeyFrame>> consistent = detect(kf);
+  // A provisional map that meets the map's own keyframes merges into them
+  // (before any loop within itself).
+  const bool merge = map_.map_of(*kf) != 0 && std::any_of(consistent.begin(), consistent.end(), [&](const auto& c) {
+                       return map_.map_of(*c) == 0;
+                     });
+  if (merge)
+    consistent.erase(std::remove_if(consistent.begin(), consistent.end(),
+                                    [&](const auto& c) { return map_.map_of(*c) != 0; }),
+                     consistent.end());
   LoopMatch best;
-  const std::shared_ptr<KeyFrame> loop_kf = consistent.empty() ? nullptr : verify(kf, consistent, &best);
+  const std::shared_ptr<KeyFrame> loop_kf = consistent.empty() ? nullptr : verify(kf, consistent, merge, &best);
   const double detect_ms = ms_since(t0);
   {
     std::lock_guard<std::mutex> s(stats_mutex_);
@@ -312,12 +329,14 @@ bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
   event.inliers = best.inliers;
   pose_difference(best.T_c_w, kf->T_c_w(), &event.correction_m, &event.correction_deg);
   event.detect_ms = detect_ms;
+  event.merge = merge;
   const auto t1 = std::chrono::steady_clock::now();
+  if (merge) merge_into(map_, kf, loop_kf, best.T_c_w);
   correct(kf, loop_kf, best, &event);
   event.correct_ms = ms_since(t1);
   if (options_.global_ba) {
     const auto t2 = std::chrono::steady_clock::now();
-    global_bundle_adjustment(&event);
+    global_bundle_adjustment(&event, map_.map_of(*loop_kf));
     event.global_ba_ms = ms_since(t2);
   }
   groups_.clear();
@@ -446,8 +465,8 @@ class EssentialGraph {
   EssentialGraph(const Map& map, const KeyFramePtr& loop_kf, double rotation_weight)
       : rotation_weight_(rotation_weight) {
     for (const auto& [id, k] : map.keyframes()) {
-      if (k->bad()) continue;
-      const bool in_tree = id == 0 || k->parent() != nullptr || k == loop_kf;
+      if (k->bad() || map.map_of(*k) != map.map_of(*loop_kf)) continue;  // other maps lie in frames of their own
+      const bool in_tree = id == 0 || k->root() || k->parent() != nullptr || k == loop_kf;
       initial[id] = k->T_c_w();
       if (!in_tree) continue;  // queued, not yet processed by local mapping: moved in step 4.5
       node[id] = problem.nodes.size();
@@ -555,6 +574,27 @@ void write_back(Map& map, const EssentialGraph& g, const KeyFramePtr& kf, const 
     if (!mp->bad()) mp->update_normal_and_depth();
 }
 
+/// A merge: the provisional map of `kf` moves rigidly into the frame of
+/// `loop_kf`'s map, where the verification put `kf` (`T_c_w_into`), and
+/// its spanning tree is hung under `loop_kf` (ORB-SLAM3 MergeLocal, scale 1).
+void merge_into(Map& map, const KeyFramePtr& kf, const KeyFramePtr& loop_kf, const geom::SE3d& T_c_w_into) {
+  const std::uint32_t from = map.map_of(*kf), into = map.map_of(*loop_kf);
+  const geom::SE3d T_into_from = T_c_w_into.inverse() * kf->T_c_w();
+  const geom::SE3d T_from_into = T_into_from.inverse();
+  std::vector<std::shared_ptr<MapPoint>> moved;
+  std::set<std::uint64_t> seen;
+  for (const auto& [id, k] : map.keyframes()) {
+    if (k->bad() || map.map_of(*k) != from) continue;
+    for (const auto& mp : k->map_points())
+      if (mp && !mp->bad() && seen.insert(mp->id()).second) moved.push_back(mp);
+    k->set_T_c_w(k->T_c_w() * T_from_into);
+  }
+  for (const auto& mp : moved) mp->set_p_w(T_into_from * mp->p_w());
+  map.merge_provisional(from, into);
+  kf->reroot_under(loop_kf);
+  for (const auto& mp : moved) mp->update_normal_and_depth();
+}
+
 }  // namespace
 
 void LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf,
@@ -575,16 +615,16 @@ void LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared
   loop_kf->add_loop_edge(kf);
 }
 
-void LoopClosing::global_bundle_adjustment(LoopEvent* event) {
+void LoopClosing::global_bundle_adjustment(LoopEvent* event, std::uint32_t map_id) {
   BaProblem problem;
   std::vector<std::shared_ptr<KeyFrame>> kfs;
   std::vector<std::shared_ptr<MapPoint>> pts;
   std::map<std::uint64_t, std::size_t> kf_index;
   for (const auto& [id, k] : map_.keyframes()) {
-    if (k->bad()) continue;
+    if (k->bad() || map_.map_of(*k) != map_id) continue;  // a provisional map lies in a frame of its own
     kf_index[id] = kfs.size();
-    // keyframe 0 fixes the gauge (the world frame), a loaded map its own
-    problem.keyframes.push_back({id, k->T_c_w(), id == 0 || k->fixed()});
+    // keyframe 0 (or a provisional map's root) fixes the gauge (the world frame), a loaded map its own
+    problem.keyframes.push_back({id, k->T_c_w(), id == 0 || k->root() || k->fixed()});
     kfs.push_back(k);
   }
   if (kfs.size() < 2) return;

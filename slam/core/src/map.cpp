@@ -282,8 +282,20 @@ void KeyFrame::change_parent(const std::shared_ptr<KeyFrame>& kf) {
   kf->add_child(shared_from_this());
 }
 
+void KeyFrame::reroot_under(const std::shared_ptr<KeyFrame>& parent) {
+  std::vector<std::shared_ptr<KeyFrame>> path = {shared_from_this()};
+  while (auto p = path.back()->parent()) path.push_back(p);
+  for (std::size_t i = path.size() - 1; i > 0; --i) {
+    path[i]->erase_child(path[i - 1]->id());
+    path[i]->change_parent(path[i - 1]);
+    path[i]->root_ = false;
+  }
+  root_ = false;
+  change_parent(parent);
+}
+
 bool KeyFrame::set_bad() {
-  if (id_ == 0 || bad_ || fixed_ || !loop_edges_.empty()) return false;
+  if (id_ == 0 || root_ || bad_ || fixed_ || !loop_edges_.empty()) return false;
   for (const auto& [kid, c] : connections_)
     if (auto k = c.first.lock()) k->erase_connection(id_);
   for (std::size_t i = 0; i < frame_.map_points.size(); ++i)
@@ -396,6 +408,12 @@ MapMemory Map::memory() const {
   }
   m.points = points_.size();
   for (const auto& [id, mp] : points_) m.point_bytes += mp->memory_bytes();
+  return m;
+}
+
+std::uint32_t Map::map_of(const KeyFrame& kf) const {
+  std::uint32_t m = kf.provisional();
+  for (auto it = merged_.find(m); it != merged_.end(); it = merged_.find(m)) m = it->second;
   return m;
 }
 

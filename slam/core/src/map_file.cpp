@@ -1,5 +1,6 @@
 #include "pvb/slam/core/map_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <set>
@@ -61,13 +62,13 @@ void put_keyframe(ByteWriter& w, const KeyFrame& kf, const std::set<std::uint64_
   }
 }
 
-void put_graph(ByteWriter& w, const KeyFrame& kf, const Map& map) {
+void put_graph(ByteWriter& w, const KeyFrame& kf, const std::set<std::uint64_t>& kf_ids) {
   w.u64(kf.id());
   const auto parent = kf.parent();
-  w.u64(parent && map.keyframes().count(parent->id()) ? parent->id() : kNone);
+  w.u64(parent && kf_ids.count(parent->id()) ? parent->id() : kNone);
   std::vector<std::pair<std::uint64_t, int>> edges;
   for (const auto& [id, weight] : kf.connection_weights())
-    if (map.keyframes().count(id)) edges.emplace_back(id, weight);
+    if (kf_ids.count(id)) edges.emplace_back(id, weight);
   w.u64(edges.size());
   for (const auto& [id, weight] : edges) {
     w.u64(id);
@@ -75,7 +76,7 @@ void put_graph(ByteWriter& w, const KeyFrame& kf, const Map& map) {
   }
   std::vector<std::uint64_t> loops;
   for (const auto& k : kf.loop_edges())
-    if (map.keyframes().count(k->id())) loops.push_back(k->id());
+    if (kf_ids.count(k->id())) loops.push_back(k->id());
   w.u64(loops.size());
   for (std::uint64_t id : loops) w.u64(id);
 }
@@ -108,12 +109,20 @@ void put_section(ByteWriter& out, const char* tag, const std::string& payload) {
 
 std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
                        const std::string& app_json, const BagOf& bag_of) {
-  std::set<std::uint64_t> point_ids;
-  for (const auto& [id, mp] : map.points())
-    if (!mp->bad()) point_ids.insert(id);
   std::vector<std::shared_ptr<KeyFrame>> kfs;
+  std::set<std::uint64_t> kf_ids;
   for (const auto& [id, kf] : map.keyframes())
-    if (!kf->bad()) kfs.push_back(kf);
+    if (!kf->bad() && map.map_of(*kf) == 0) {
+      kfs.push_back(kf);
+      kf_ids.insert(id);
+    }
+  // A point seen only by keyframes left out is left out too.
+  std::set<std::uint64_t> point_ids;
+  for (const auto& [id, mp] : map.points()) {
+    const auto& obs = mp->observations();
+    const bool seen = obs.empty() || std::any_of(obs.begin(), obs.end(), [&](const auto& o) { return kf_ids.count(o.first) > 0; });
+    if (!mp->bad() && seen) point_ids.insert(id);
+  }
 
   ByteWriter head, keyf, poin, grap, bowv;
   put_settings(head, settings, sessions);
@@ -125,13 +134,13 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
     poin.u64(id);
     for (int r = 0; r < 3; ++r) poin.f64(mp.p_w()(r));
     const auto ref = mp.reference_keyframe();
-    poin.u64(ref && !ref->bad() ? ref->id() : kNone);
+    poin.u64(ref && !ref->bad() && kf_ids.count(ref->id()) ? ref->id() : kNone);
     poin.u64(mp.first_kf_id());
     poin.i32(mp.visible());
     poin.i32(mp.found());
   }
   grap.u64(kfs.size());
-  for (const auto& kf : kfs) put_graph(grap, *kf, map);
+  for (const auto& kf : kfs) put_graph(grap, *kf, kf_ids);
   for (const auto& kf : kfs) put_bow(bowv, *kf, bag_of);
 
   ByteWriter out;

@@ -18,7 +18,7 @@ MapSnapshot snapshot_map(const Map& map, const StereoIntrinsics& K, double scale
   s.scale_factor = scale_factor;
   std::map<std::uint64_t, std::size_t> kf_index;
   for (const auto& [id, kf] : map.keyframes()) {
-    if (kf->bad()) continue;
+    if (kf->bad() || map.map_of(*kf) != 0) continue;  // a provisional map lies in a frame of its own
     kf_index[id] = s.keyframes.size();
     s.keyframes.push_back({id, kf->t_ns(), kf->T_c_w()});
   }

@@ -41,6 +41,7 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.reloc_ambiguity_check = settings.loop.ambiguity_check;
   topt.reloc_ambiguity_distance_m = settings.loop.ambiguity_distance_m;
   topt.reloc_lookalikes = settings.reloc_lookalikes;
+  topt.new_map_after_lost = settings.new_map_after_lost;
   if (settings.vocabulary_path != "none") {
     auto vocabulary = std::make_shared<const place::Vocabulary>(place::Vocabulary::load(settings.vocabulary_path));
     vocabulary_fingerprint_ = vocabulary->fingerprint();
@@ -100,11 +101,11 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
   out.state = tracking_->state();
   out.tracking = tracking_->stats();
   if (out.state == TrackingState::kOk) {
-    out.T_w_c = tracking_->last_frame().T_c_w.inverse();
-    if (auto ref = tracking_->reference_keyframe()) {
-      std::lock_guard<std::mutex> lock(map_.mutex());
-      records_.push_back({in.t_ns, ref, tracking_->last_frame().T_c_w * ref->T_c_w().inverse()});
-    }
+    const auto ref = tracking_->reference_keyframe();
+    std::lock_guard<std::mutex> lock(map_.mutex());
+    out.provisional = ref && map_.map_of(*ref) != 0;
+    if (!out.provisional) out.T_w_c = tracking_->last_frame().T_c_w.inverse();
+    if (ref) records_.push_back({in.t_ns, ref, tracking_->last_frame().T_c_w * ref->T_c_w().inverse()});
   }
   if (kf && dense_) {
     // Only keyframes keep their images.  The worker gets its own copy (a
@@ -194,10 +195,10 @@ MapSaveInfo System::save_map(const std::string& path, const std::string& app_jso
     if (map_.num_keyframes() == 0) throw ConfigError(path, "map", "a map with keyframes (this run made none)");
     info.sessions = loaded_sessions_;
     for (const auto& [id, kf] : map_.keyframes())
-      if (kf->session() == map_.session()) info.sessions = map_.session() + 1;
+      if (kf->session() == map_.session() && map_.map_of(*kf) == 0) info.sessions = map_.session() + 1;
     const BagOf bag_of = [this](const KeyFrame& kf) { return place_ ? place_->bag_of(kf) : kf.bow(); };
     bytes = encode_map(map_, map_settings(), info.sessions, app_json, bag_of);
-    info.keyframes = map_.num_keyframes();
+    for (const auto& [id, kf] : map_.keyframes()) ++(map_.map_of(*kf) == 0 ? info.keyframes : info.unmerged_keyframes);
     info.points = map_.num_points();
   }
   write_file(path, bytes);
@@ -210,7 +211,7 @@ std::vector<geom::StampedPose> System::keyframe_trajectory() {
   std::lock_guard<std::mutex> lock(map_.mutex());
   std::vector<geom::StampedPose> out;
   for (const auto& [id, kf] : map_.keyframes())
-    if (!kf->bad()) out.push_back({kf->t_ns(), kf->T_c_w().inverse()});
+    if (!kf->bad() && map_.map_of(*kf) == 0) out.push_back({kf->t_ns(), kf->T_c_w().inverse()});
   return out;
 }
 
@@ -223,7 +224,8 @@ std::vector<geom::StampedPose> System::refined_trajectory() {
   std::lock_guard<std::mutex> lock(map_.mutex());
   std::vector<geom::StampedPose> out;
   out.reserve(records_.size());
-  for (const FrameRecord& r : records_) out.push_back({r.t_ns, (r.T_c_r * r.ref->T_c_w_via_tree()).inverse()});
+  for (const FrameRecord& r : records_)
+    if (map_.map_of(*r.ref) == 0) out.push_back({r.t_ns, (r.T_c_r * r.ref->T_c_w_via_tree()).inverse()});
   return out;
 }
 

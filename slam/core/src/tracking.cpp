@@ -50,6 +50,13 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
   std::lock_guard<std::mutex> lock(map_.mutex());
   stats_ = {};
   std::shared_ptr<KeyFrame> new_kf;
+  if (state_ == TrackingState::kLost && may_begin_map_ && options_.new_map_after_lost > 0 &&
+      lost_in_row_ >= options_.new_map_after_lost) {
+    // Lost in the loaded map for too long: a provisional map begins here.
+    state_ = TrackingState::kNotInitialized;
+    provisional_ = map_.begin_provisional();
+    lost_in_row_ = 0;
+  }
   if (state_ == TrackingState::kNotInitialized) {
     if (initialize(f)) {
       stats_.method = TrackingMethod::kInitialization;
@@ -82,6 +89,7 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
   if (ok) ok = track_local_map(f);
   if (ok && stats_.method == TrackingMethod::kRelocalization) record_relocalisation(f);
   state_ = ok ? TrackingState::kOk : TrackingState::kLost;
+  lost_in_row_ = ok ? 0 : lost_in_row_ + 1;
 
   if (ok) {
     if (last_.has_pose) velocity_ = f.T_c_w * last_.T_c_w.inverse();
@@ -113,6 +121,7 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
 void Tracking::start_in_map(bool localise_only) {
   state_ = TrackingState::kLost;
   localise_only_ = localise_only;
+  may_begin_map_ = !localise_only;
 }
 
 void Tracking::record_relocalisation(const Frame& f) {
@@ -137,6 +146,10 @@ bool Tracking::initialize(Frame& f) {
   f.T_c_w = geom::SE3d::Identity();
   f.has_pose = true;
   auto kf = map_.create_keyframe(f);
+  if (provisional_ > 0) {  // its own frame until merged: a root like keyframe 0
+    kf->set_provisional(provisional_);
+    kf->make_root();
+  }
   for (std::size_t i = 0; i < f.size(); ++i)
     if (f.depth_m[i] > 0) add_point_from_depth(f, kf, i);
   ref_kf_ = kf;
@@ -585,6 +598,7 @@ void Tracking::add_point_from_depth(Frame& f, const std::shared_ptr<KeyFrame>& k
 
 std::shared_ptr<KeyFrame> Tracking::create_keyframe(Frame& f) {
   auto kf = map_.create_keyframe(f);
+  if (ref_kf_) kf->set_provisional(ref_kf_->provisional());
   ref_kf_ = kf;
   // New points from depth: the closest keypoints first, all nearer than the
   // close/far threshold and at least 100 (ORB-SLAM2 CreateNewKeyFrame).

@@ -107,6 +107,35 @@ TEST_F(MapFile, EncodeOfADecodedMapIsTheFileItCameFrom) {
   EXPECT_EQ(encode_map(map, h.settings, h.sessions, h.app_json), bytes_);
 }
 
+TEST_F(MapFile, AProvisionalMapNeverMergedIsLeftOutOfTheFile) {
+  const MapFileHeader h = read_map_header(bytes_, path_);
+  Map map;
+  decode_map(bytes_, path_, h, camera_for(h.settings), &map);
+  std::lock_guard<std::mutex> lock(map.mutex());
+  // A provisional map (in a frame of its own) of two keyframes sharing points.
+  const auto kf0 = map.keyframes().begin()->second;
+  const std::uint32_t p = map.begin_provisional();
+  Frame f = kf0->frame();
+  std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
+  const auto root = map.create_keyframe(f), next = map.create_keyframe(f);
+  for (const auto& kf : {root, next}) kf->set_provisional(p);
+  root->make_root();
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (!(f.depth_m[i] > 0)) continue;
+    const auto mp = map.create_point(f.unproject_world(i), root);
+    for (const auto& kf : {root, next}) {
+      mp->add_observation(kf, i);
+      kf->set_map_point(i, mp);
+    }
+  }
+  for (const auto& kf : {root, next}) kf->update_connections();
+  EXPECT_EQ(encode_map(map, h.settings, h.sessions, h.app_json), bytes_);
+  // Once merged, it is in the file.
+  next->reroot_under(kf0);
+  map.merge_provisional(p, 0);
+  EXPECT_GT(encode_map(map, h.settings, h.sessions, h.app_json).size(), bytes_.size());
+}
+
 TEST_F(MapFile, EveryTruncationIsOneErrorNamingTheFile) {
   for (std::size_t n : {std::size_t(0), std::size_t(5), std::size_t(8), std::size_t(12), std::size_t(20),
                         bytes_.size() / 3, bytes_.size() / 2, bytes_.size() - 9, bytes_.size() - 1}) {

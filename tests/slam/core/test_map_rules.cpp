@@ -154,5 +154,50 @@ TEST(Covisibility, OrderedByWeightThenIdWithThreshold15) {
   EXPECT_EQ(kfs[0]->best_covisibles(1).size(), 1u);
 }
 
+/// A provisional map a <- b <- c under its root a: each keyframe shares 20 points with the next.
+TEST(ProvisionalMap, ARootStaysARootUntilItsMapIsHungUnderAnother) {
+  Map map;
+  const auto kf0 = map.create_keyframe(make_frame(0, 40));  // the loaded map
+  const std::uint32_t p = map.begin_provisional();
+  EXPECT_GT(p, 0u);
+  EXPECT_NE(map.begin_provisional(), p);  // every provisional map has its own id
+  std::vector<std::shared_ptr<KeyFrame>> chain;
+  for (std::uint64_t i = 1; i <= 3; ++i) {
+    chain.push_back(map.create_keyframe(make_frame(i, 40)));
+    chain.back()->set_provisional(p);
+  }
+  chain[0]->make_root();
+  for (std::size_t k = 0; k + 1 < chain.size(); ++k)
+    for (int i = 0; i < 20; ++i) {
+      auto mp = map.create_point(Eigen::Vector3d(0, 0, 1), chain[k]);
+      const auto idx = static_cast<std::size_t>(20 * k) + static_cast<std::size_t>(i);  // own keypoints per pair
+      observe(mp, chain[k], idx);
+      observe(mp, chain[k + 1], idx);
+    }
+  for (const auto& kf : chain) kf->update_connections();
+  // The root is never attached under its children, nor culled.
+  EXPECT_EQ(chain[0]->parent(), nullptr);
+  ASSERT_EQ(chain[1]->parent(), chain[0]);
+  ASSERT_EQ(chain[2]->parent(), chain[1]);
+  EXPECT_FALSE(map.erase_keyframe(chain[0]));
+  EXPECT_EQ(map.map_of(*chain[2]), p);
+  EXPECT_EQ(map.map_of(*kf0), 0u);
+
+  // The merge hangs the last keyframe under the map's own: the path to the
+  // old root is reversed, and the old root becomes an ordinary keyframe.
+  chain[2]->reroot_under(kf0);
+  map.merge_provisional(p, 0);
+  EXPECT_EQ(chain[2]->parent(), kf0);
+  EXPECT_EQ(chain[1]->parent(), chain[2]);
+  EXPECT_EQ(chain[0]->parent(), chain[1]);
+  EXPECT_FALSE(chain[0]->root());
+  const auto kids = chain[1]->children();
+  ASSERT_EQ(kids.size(), 1u);
+  EXPECT_EQ(kids[0], chain[0]);
+  EXPECT_TRUE(chain[0]->children().empty());
+  for (const auto& kf : chain) EXPECT_EQ(map.map_of(*kf), 0u);
+  EXPECT_TRUE(map.erase_keyframe(chain[0]));
+}
+
 }  // namespace
 }  // namespace pvb::slam

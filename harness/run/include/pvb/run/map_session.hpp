@@ -43,6 +43,8 @@ struct MapReport {
   std::optional<slam::MapSaveInfo> save;
   std::string save_note;  ///< why a map to save was not saved (none: the run made no keyframe)
   std::size_t relocalisations = 0;                        ///< tracking found again (the first pose included)
+  /// Provisional maps (begun while lost outside the loaded map) merged into it.
+  std::size_t merges = 0;
   /// Times each loaded landmark had been matched when the map was loaded,
   /// by id: what this session matched is the difference at its end.
   std::map<std::uint64_t, int> found_at_load;

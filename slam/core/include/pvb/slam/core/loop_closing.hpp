@@ -26,6 +26,15 @@
 //   5. optionally (`global_ba`, off by default) a bundle adjustment of the
 //      whole map, inline, with the map locked (tracking waits).
 //
+// A keyframe of a provisional map (begun while lost in a loaded map that
+// is being extended, Tracking) is also checked against the map's own
+// keyframes.  A verified match there merges the two (ORB-SLAM3's map
+// merge with the scale known): the provisional map moves rigidly to where
+// the verification put the keyframe, its spanning tree is hung under the
+// matched keyframe, and step 4 welds the seam.  The correction bounds and
+// the drift check do not apply to a merge (the two frames are unrelated);
+// the ambiguity check does.
+//
 // Step 1 by default asks the bag-of-words database (PlaceRecognizer:
 // ORB-SLAM2's DetectLoopCandidates) instead of pose proximity, and step 3
 // verifies every consistent candidate, refusing the loop when the
@@ -96,6 +105,7 @@ struct LoopEvent {
   double correct_ms = 0;      ///< correction (fusion, pose graph, points)
   double global_ba_ms = 0;    ///< global bundle adjustment afterwards (0 when off)
   int global_ba_outliers = 0; ///< observations it removed
+  bool merge = false;         ///< a provisional map merged into the map (correction_m: how far it moved)
 };
 
 /// Running totals (all keyframes).
@@ -173,14 +183,16 @@ class LoopClosing {
   /// Step 1: pose-proximity candidates with the appearance check, or BoW candidates.
   std::vector<std::shared_ptr<KeyFrame>> propose(const std::shared_ptr<KeyFrame>& kf);
   /// Step 3 over every consistent candidate, with the drift and ambiguity
-  /// checks; the accepted candidate (most inliers) or null.
+  /// checks (for a merge, the ambiguity check only); the accepted candidate
+  /// (most inliers) or null.
   std::shared_ptr<KeyFrame> verify(const std::shared_ptr<KeyFrame>& kf,
-                                   const std::vector<std::shared_ptr<KeyFrame>>& consistent, LoopMatch* best);
+                                   const std::vector<std::shared_ptr<KeyFrame>>& consistent, bool merge,
+                                   LoopMatch* best);
   /// Camera path length (current estimates) over the keyframes from `from` to `to` by id.
   double path_length_m(std::uint64_t from, std::uint64_t to) const;
   /// Step 5 (optional): bundle adjustment of every keyframe and point,
   /// keyframe 0 fixed, map locked throughout.
-  void global_bundle_adjustment(LoopEvent* event);
+  void global_bundle_adjustment(LoopEvent* event, std::uint32_t map_id);
   /// Step 4.
   void correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf, const LoopMatch& m,
                LoopEvent* event);

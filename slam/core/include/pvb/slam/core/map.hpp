@@ -151,6 +151,22 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   /// (the keyframes of a loaded map that a session extends).
   bool fixed() const { return fixed_; }
   void set_fixed(bool f) { fixed_ = f; }
+  /// The provisional map the keyframe was made in (0: the map's own frame);
+  /// Map::map_of says which map it belongs to now.
+  std::uint32_t provisional() const { return provisional_; }
+  void set_provisional(std::uint32_t m) { provisional_ = m; }
+  /// The first keyframe of a provisional map: a root of the spanning tree
+  /// like keyframe 0 (never re-parented by update_connections(), never
+  /// culled, the gauge of local BA) until reroot_under() joins it.
+  bool root() const { return root_; }
+  void make_root() {
+    root_ = true;
+    first_connection_ = false;
+  }
+  /// Hangs this keyframe under `parent` (a merge of two maps): the tree
+  /// path from here up to this keyframe's root is reversed first, so the
+  /// old root becomes a descendant of this keyframe.
+  void reroot_under(const std::shared_ptr<KeyFrame>& parent);
 
   /// Map points per keypoint (null where none).
   const std::vector<std::shared_ptr<MapPoint>>& map_points() const { return frame_.map_points; }
@@ -234,6 +250,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   bool bad_ = false;
   std::uint32_t session_ = 0;
   bool fixed_ = false;
+  std::uint32_t provisional_ = 0;
+  bool root_ = false;
   std::shared_ptr<KeyFrame> removed_parent_;          ///< parent at removal (kept alive for trajectories)
   geom::SE3d T_c_parent_ = geom::SE3d::Identity();  ///< pose relative to it at removal
 };
@@ -272,6 +290,16 @@ class Map {
   std::uint64_t next_keyframe_id() const { return next_kf_id_; }
   std::uint64_t next_point_id() const { return next_point_id_; }
 
+  // Provisional maps ------------------------------------------------------------
+  /// A new provisional map: begun while lost in a loaded map (extend mode),
+  /// in a frame of its own until it is merged.  Returns its id (> 0).
+  std::uint32_t begin_provisional() { return next_provisional_++; }
+  /// Provisional map `from` now lies in the frame of map `into` (its
+  /// keyframes and points were moved there).
+  void merge_provisional(std::uint32_t from, std::uint32_t into) { merged_[from] = into; }
+  /// The map a keyframe belongs to now: 0 for the map's own frame.
+  std::uint32_t map_of(const KeyFrame& kf) const;
+
  private:
   std::mutex mutex_;
   std::map<std::uint64_t, std::shared_ptr<KeyFrame>> keyframes_;
@@ -279,6 +307,8 @@ class Map {
   std::uint64_t next_kf_id_ = 0;
   std::uint64_t next_point_id_ = 0;
   std::uint32_t session_ = 0;
+  std::uint32_t next_provisional_ = 1;
+  std::map<std::uint32_t, std::uint32_t> merged_;  ///< provisional map -> the map it was merged into
 };
 
 }  // namespace pvb::slam

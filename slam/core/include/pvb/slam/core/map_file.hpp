@@ -57,8 +57,9 @@ constexpr std::uint32_t kMapFileVersion = 1;
 using BagOf = std::function<place::BowVector(const KeyFrame&)>;
 
 /// The map file's bytes for every keyframe and point in `map` (bad ones
-/// are not in it); bags of words from `bag_of`, or each keyframe's own when
-/// it is empty.  Call with the map's mutex held.
+/// are not in it, nor a provisional map that was never merged: it lies in
+/// a frame of its own); bags of words from `bag_of`, or each keyframe's own
+/// when it is empty.  Call with the map's mutex held.
 std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
                        const std::string& app_json, const BagOf& bag_of = nullptr);
 

@@ -91,6 +91,10 @@ struct Settings {
   /// Tracking.relocLookalikes (ours, optional): best-scoring keyframes a
   /// relocalisation is also checked against (TrackingOptions::reloc_lookalikes).
   int reloc_lookalikes = 10;
+  /// Tracking.newMapAfter (ours, optional): frames lost in a row after
+  /// which an extending run begins a provisional map
+  /// (TrackingOptions::new_map_after_lost); 0: never.
+  int new_map_after_lost = 30;
   PeMatchSettings pe_match;         ///< PEMatch.* (optional section)
   KeyFrameSettings keyframe;        ///< KeyFrame.* (optional section)
   PointCloudMappingSettings dense;  ///< PointCloudMapping.* (optional section)

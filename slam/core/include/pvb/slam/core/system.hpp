@@ -39,6 +39,9 @@ struct MapLoadInfo {
 struct MapSaveInfo {
   std::uint32_t sessions = 0;
   std::size_t keyframes = 0, points = 0, bytes = 0;
+  /// Keyframes of provisional maps never merged into the map: not saved
+  /// (they lie in frames of their own).
+  std::size_t unmerged_keyframes = 0;
   double save_ms = 0;          ///< encoding and the atomic write
 };
 
@@ -51,7 +54,11 @@ struct SystemOptions {
 struct FrameResult {
   std::int64_t t_ns = 0;
   TrackingState state = TrackingState::kNotInitialized;
-  std::optional<geom::SE3d> T_w_c;  ///< when state == kOk
+  std::optional<geom::SE3d> T_w_c;  ///< when state == kOk, in the map's frame
+  /// Tracked in a provisional map not merged yet (extending a loaded map,
+  /// begun while lost): its pose in the map's frame is not known, so
+  /// T_w_c is empty although state == kOk.
+  bool provisional = false;
   TrackingStats tracking;
   double tracking_ms = 0;           ///< extraction + tracking (not inline mapping)
   double orb_ms = 0;                ///< of which ORB extraction
@@ -95,9 +102,11 @@ class System {
   void shutdown();
 
   /// Every tracked frame's pose recomputed from its reference keyframe's
-  /// current (bundle-adjusted) pose, as ORB-SLAM2 saves its trajectory.
+  /// current (bundle-adjusted) pose, as ORB-SLAM2 saves its trajectory
+  /// (frames of a provisional map never merged are left out).
   std::vector<geom::StampedPose> refined_trajectory();
-  /// Poses of the keyframes still in the map, by id (T_w_c).
+  /// Poses of the keyframes still in the map, by id (T_w_c; not those of a
+  /// provisional map never merged).
   std::vector<geom::StampedPose> keyframe_trajectory();
   std::size_t num_keyframes();
   std::size_t num_map_points();

@@ -120,6 +120,11 @@ struct TrackingOptions {
   /// (not grouped), and refused when one of them matches at another place;
   /// 0 turns it off.
   int reloc_lookalikes = 10;
+  /// Tracking.newMapAfter: in a loaded map that is being extended, after
+  /// this many frames lost in a row a provisional map begins at the next
+  /// frame (the robot started or went outside the map); loop closing
+  /// merges it into the map when it finds the map.  0: never.
+  int new_map_after_lost = 30;
 };
 
 /// "Already seen in this pass" marks for map-point ids: a pass stamp per
@@ -155,7 +160,9 @@ class Tracking {
 
   /// Starts in a loaded map: lost until a global relocalisation finds the
   /// first pose in it.  `localise_only`: the map stays as it is, no
-  /// keyframe is ever made (localisation mode).  Before the first frame.
+  /// keyframe is ever made (localisation mode); otherwise a long loss
+  /// begins a provisional map (TrackingOptions::new_map_after_lost).
+  /// Before the first frame.
   void start_in_map(bool localise_only);
   bool localise_only() const { return localise_only_; }
 
@@ -219,6 +226,9 @@ class Tracking {
   TrackingState state_ = TrackingState::kNotInitialized;
   TrackingStats stats_;
   bool localise_only_ = false;
+  bool may_begin_map_ = false;     ///< extending a loaded map: a long loss begins a provisional map
+  int lost_in_row_ = 0;            ///< frames lost since the last one tracked
+  std::uint32_t provisional_ = 0;  ///< the provisional map the next initialisation begins (0: none)
 
   Frame last_;
   bool last_is_keyframe_ = false;
