@@ -21,6 +21,8 @@ void read_top(detail::MapReader& top, Scenario& s) {
     s.ground.type = r.choice<GroundType>("type", s.ground.type,
                                          {{"soil", GroundType::kSoil}, {"gravel", GroundType::kGravel}});
     s.ground.size_m = r.vec2("size_m", s.ground.size_m, 5, 2000);
+    s.ground.tiling = r.choice<GroundTiling>("tiling", s.ground.tiling,
+                                             {{"repeat", GroundTiling::kRepeat}, {"varied", GroundTiling::kVaried}});
   });
   detail::read_arrays(top, s.pv_arrays);
   detail::read_walls(top, s.walls);

@@ -5,6 +5,7 @@
 #include "pvb/common/error.hpp"
 #include "pvb/sim/scene_builder.hpp"
 #include "pvb/sim/simulator.hpp"
+#include "pvb/sim/textures.hpp"
 
 namespace pvb::sim {
 
@@ -20,7 +21,7 @@ Renderer::Renderer(const mjModel* model, GlBackend backend, int width, int heigh
   mjv_defaultScene(&scene_);
   mjv_defaultOption(&option_);
   mjv_defaultCamera(&camera_);
-  mjv_makeScene(model, &scene_, 4000);
+  mjv_makeScene(model, &scene_, 4000 + kMaxGroundTiles);  // the scene limit and a varied ground (textures.hpp)
   mjr_makeContext(model, &con_, mjFONTSCALE_100);
   mjr_setBuffer(mjFB_OFFSCREEN, &con_);
   if (con_.currentBuffer != mjFB_OFFSCREEN) {

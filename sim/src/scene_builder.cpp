@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -227,10 +228,48 @@ ShadowMap shadow_map_for(const scenes::Light& light, const std::vector<Eigen::Ve
 
 namespace {
 
+/// One 3 m tile of a varied ground: its centre and its image's seed.
+struct GroundTile {
+  Eigen::Vector2d centre_m;
+  std::uint64_t seed = 0;
+};
+
+/// The tiles of a varied ground (none for a repeated one): every 3 m cell
+/// of the ground whose centre lies within kGroundVariedCorridorM (and half
+/// a tile's diagonal) of the route.  A cell's image seed comes from the
+/// station's seed and the cell alone, so the route picks which cells are
+/// drawn, never how one looks.
+std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std::vector<Eigen::Vector2d>& route) {
+  std::vector<GroundTile> tiles;
+  if (s.ground.tiling != scenes::GroundTiling::kVaried) return tiles;
+  const double tile = kGroundTileM, half_x = s.ground.size_m.x() / 2, half_y = s.ground.size_m.y() / 2;
+  const double reach = kGroundVariedCorridorM + tile / std::sqrt(2.0);
+  const auto cells_x = static_cast<long long>(std::floor(s.ground.size_m.x() / tile + 1e-9));
+  const auto cells_y = static_cast<long long>(std::floor(s.ground.size_m.y() / tile + 1e-9));
+  for (long long i = 0; i < cells_x; ++i)
+    for (long long j = 0; j < cells_y; ++j) {
+      const Eigen::Vector2d c(-half_x + (static_cast<double>(i) + 0.5) * tile,
+                              -half_y + (static_cast<double>(j) + 0.5) * tile);
+      if (std::none_of(route.begin(), route.end(), [&](const Eigen::Vector2d& p) { return (p - c).norm() <= reach; }))
+        continue;
+      if (static_cast<int>(tiles.size()) == kMaxGroundTiles)
+        throw ConfigError(s.source_file, "ground.tiling",
+                          "a varied ground of at most " + std::to_string(kMaxGroundTiles) + " tiles of " + f(tile) +
+                              " m along the route (a route of about 140 m)",
+                          "more");
+      const std::uint64_t cell = static_cast<std::uint64_t>(i * cells_y + j);
+      tiles.push_back({c, s.station_seed_or_seed() * 2654435761ULL + 1000003ULL * (cell + 1)});
+    }
+  return tiles;
+}
+
 /// The textures: the station's, but for the day's dust on the panels.
-void add_textures(const scenes::Scenario& s, SceneAssets* out) {
+void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tiles, SceneAssets* out) {
   const std::uint64_t station_seed = s.station_seed_or_seed(), day_seed = s.seed;
   out->files.emplace_back("textures/ground.png", png(make_ground_texture(s.ground.type, station_seed)));
+  for (std::size_t k = 0; k < tiles.size(); ++k)
+    out->files.emplace_back("textures/groundt" + std::to_string(k) + ".png",
+                            png(make_ground_texture(s.ground.type, tiles[k].seed)));
   out->files.emplace_back("textures/brick.png", png(make_brick_texture(station_seed)));
   out->files.emplace_back("textures/foliage.png", png(make_foliage_texture(station_seed)));
   out->files.emplace_back("textures/bark.png", png(make_bark_texture(station_seed)));
@@ -293,8 +332,12 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
     const std::string name = file.first.substr(9, file.first.size() - 13);  // textures/NAME.png
     x.line("<texture name=\"" + name + "\" type=\"2d\" file=\"" + file.first + "\"/>");
   }
-  x.line("<material name=\"ground\" texture=\"ground\" texuniform=\"true\" texrepeat=\"" +
-         f(1.0 / kGroundTileM) + " " + f(1.0 / kGroundTileM) + "\" specular=\"0.02\" shininess=\"0.05\"/>");
+  for (const auto& file : out.files) {
+    const std::string name = file.first.substr(9, file.first.size() - 13);  // textures/NAME.png
+    if (name.rfind("ground", 0) != 0) continue;  // the ground, and a varied ground's tiles
+    x.line("<material name=\"" + name + "\" texture=\"" + name + "\" texuniform=\"true\" texrepeat=\"" +
+           f(1.0 / kGroundTileM) + " " + f(1.0 / kGroundTileM) + "\" specular=\"0.02\" shininess=\"0.05\"/>");
+  }
   x.line("<material name=\"brick\" texture=\"brick\" texuniform=\"true\" texrepeat=\"" + f(1.0 / kBrickTileWidthM) +
          " " + f(1.0 / kBrickTileHeightM) + "\" specular=\"0.05\" shininess=\"0.1\"/>");
   x.line("<material name=\"foliage\" texture=\"foliage\" texuniform=\"true\" texrepeat=\"2 2\" specular=\"0.05\"/>");
@@ -465,6 +508,23 @@ void add_robot_and_sun(XmlWriter& x, const scenes::Scenario& s, const std::vecto
                     Eigen::Vector3d(shadow.centre_xy_m.x(), shadow.centre_xy_m.y(), 0) + to_sun(s.light) * 20.0));
 }
 
+/// The ground: one plane that the robot drives on, with the soil image
+/// repeated every kGroundTileM.  A varied ground hides that plane (group 3,
+/// still colliding) and draws its tiles, each with its own image, over a
+/// copy of the repeated plane 5 mm lower for the distance.
+void add_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<GroundTile>& tiles) {
+  const std::string size = v3(s.ground.size_m.x() / 2, s.ground.size_m.y() / 2, 1);
+  const bool varied = s.ground.tiling == scenes::GroundTiling::kVaried;
+  x.line("<geom name=\"ground\" type=\"plane\" size=\"" + size + "\" material=\"ground\" condim=\"3\" " +
+         std::string(varied ? "group=\"3\" " : "") + "friction=\"1 0.005 0.0001\"/>");
+  if (!varied) return;
+  x.line("<geom class=\"scenery\" type=\"plane\" size=\"" + size + "\" pos=\"0 0 -0.005\" material=\"ground\"/>");
+  for (std::size_t k = 0; k < tiles.size(); ++k)
+    x.line("<geom class=\"scenery\" type=\"plane\" size=\"" + v3(kGroundTileM / 2, kGroundTileM / 2, 1) +
+           "\" pos=\"" + v3(tiles[k].centre_m.x(), tiles[k].centre_m.y(), 0) + "\" material=\"groundt" +
+           std::to_string(k) + "\"/>");
+}
+
 }  // namespace
 
 SceneAssets build_scene(const scenes::Scenario& s) {
@@ -486,15 +546,15 @@ SceneAssets build_scene(const scenes::Scenario& s) {
     out.route_xy.push_back(p.x());
     out.route_xy.push_back(p.y());
   }
-  add_textures(s, &out);
+  const std::vector<GroundTile> tiles = varied_ground_tiles(s, route);
+  add_textures(s, tiles, &out);
 
   XmlWriter x;
   x.open("<mujoco model=\"" + s.name + "\">");
   write_settings(x, s, out, shadow);
   write_assets(x, s, out);
   x.open("<worldbody>");
-  x.line("<geom name=\"ground\" type=\"plane\" size=\"" + v3(s.ground.size_m.x() / 2, s.ground.size_m.y() / 2, 1) +
-         "\" material=\"ground\" condim=\"3\" friction=\"1 0.005 0.0001\"/>");
+  add_ground(x, s, tiles);
   for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) add_array(x, s.pv_arrays[i], static_cast<int>(i), s.seed);
   add_walls(x, s);
   add_vegetation(x, s, route);

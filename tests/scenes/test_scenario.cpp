@@ -81,6 +81,8 @@ TEST(Scenario, OutOfRangeIsNamed) {
 TEST(Scenario, BadEnumListsChoices) {
   const std::string msg = error_of(std::string(kMinimal) + "ground: {type: sand}\n");
   EXPECT_NE(msg.find("ground.type: expected one of soil, gravel, got sand"), std::string::npos) << msg;
+  const std::string tiling = error_of(std::string(kMinimal) + "ground: {tiling: random}\n");
+  EXPECT_NE(tiling.find("ground.tiling: expected one of repeat, varied, got random"), std::string::npos) << tiling;
 }
 
 TEST(Scenario, CrossFieldChecks) {

@@ -228,6 +228,16 @@ TEST(ScenarioDays, TrackerRotationFollowsTheSun) {
               a.clearance_m, 1e-12);
 }
 
+// A day keeps its station's ground, varied or repeated, and may not change it.
+TEST(ScenarioDays, TheGroundsTilingIsTheStations) {
+  EXPECT_EQ(load_scenario(kScenes + "days/loop_varied_part.yaml").ground.tiling, GroundTiling::kVaried);
+  EXPECT_EQ(load_scenario(kScenes + "days/pv_station_1200.yaml").ground.tiling, GroundTiling::kRepeat);
+  const Folder f("tiling");
+  f.write("station.yaml", kStation);
+  const std::string e = f.error_of("day.yaml", "base: station.yaml\nground: {tiling: varied}\n");
+  EXPECT_NE(e.find("day.yaml:2: ground: expected a key a derived file may change"), std::string::npos) << e;
+}
+
 TEST(ScenarioDays, TrackerKeysAreCheckedWithFileAndLine) {
   const Folder f("tracker");
   const std::string route = "route: {pattern: along_row, aisle: 1}\n";

@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <algorithm>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -232,4 +235,43 @@ TEST(SceneBuilder, TwoDaysOfOneStationDifferOnlyInPanelsAndLight) {
     EXPECT_EQ(ground_xy(la[i]), ground_xy(lg[i])) << la[i];  // where it stood
   }
   EXPECT_GT(plants, 0);
+}
+
+TEST(SceneBuilder, AVariedGroundGivesEveryTileAlongTheRouteAnImageOfItsOwn) {
+  scenes::Scenario s = station();
+  s.ground.tiling = scenes::GroundTiling::kVaried;
+  const sim::SceneAssets a = sim::build_scene(s);
+  const sim::ModelPtr m = sim::compile_scene(a);
+  const int ground = mj_name2id(m.get(), mjOBJ_GEOM, "ground");
+  ASSERT_GE(ground, 0);
+  EXPECT_EQ(m->geom_group[ground], 3);  // not drawn, still what the robot drives on
+  EXPECT_NE(m->geom_contype[ground], 0);
+  std::vector<Eigen::Vector2d> centres;
+  std::set<int> materials;
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (m->geom_type[g] != mjGEOM_PLANE || g == ground || std::abs(m->geom_size[3 * g] - 1.5) > 1e-9) continue;
+    EXPECT_EQ(m->geom_contype[g], 0);  // drawn only
+    centres.emplace_back(m->geom_pos[3 * g], m->geom_pos[3 * g + 1]);
+    materials.insert(m->geom_matid[g]);
+  }
+  EXPECT_GT(centres.size(), 10u);
+  EXPECT_EQ(materials.size(), centres.size());
+  // No two tiles show the same image: no place looks like another.
+  std::set<std::vector<unsigned char>> images;
+  for (const auto& [path, bytes] : a.files)
+    if (path.rfind("textures/groundt", 0) == 0) EXPECT_TRUE(images.insert(bytes).second) << path;
+  EXPECT_EQ(images.size(), centres.size());
+  // Every point of the route lies on a tile.
+  for (std::size_t k = 0; k + 1 < a.route_xy.size(); k += 2) {
+    const Eigen::Vector2d p(a.route_xy[k], a.route_xy[k + 1]);
+    EXPECT_TRUE(std::any_of(centres.begin(), centres.end(), [&](const Eigen::Vector2d& c) {
+      return (p - c).cwiseAbs().maxCoeff() <= 1.5 + 1e-9;
+    })) << p.transpose();
+  }
+  // The repeated ground has one drawn plane and no tiles.
+  const sim::ModelPtr r = sim::compile_scene(sim::build_scene(station()));
+  int planes = 0;
+  for (int g = 0; g < r->ngeom; ++g) planes += r->geom_type[g] == mjGEOM_PLANE ? 1 : 0;
+  EXPECT_EQ(planes, 1);
+  EXPECT_EQ(r->geom_group[mj_name2id(r.get(), mjOBJ_GEOM, "ground")], 0);
 }

@@ -52,6 +52,30 @@ void pose_difference(const geom::SE3d& a, const geom::SE3d& b, double* dist_m, d
 void merge_into(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf,
                 const geom::SE3d& T_c_w_into);
 
+/// Matches by projection, at the probe's pose, the points of `root`, its
+/// covisibles and, with two rings, theirs, that the probe does not hold yet.
+void search_around(Frame* probe, const std::shared_ptr<KeyFrame>& root, int rings) {
+  std::set<std::uint64_t> have, in_group = {root->id()};
+  for (const auto& mp : probe->map_points)
+    if (mp) have.insert(mp->id());
+  std::vector<std::shared_ptr<KeyFrame>> group = {root};
+  for (std::size_t begin = 0, ring = 0; ring < static_cast<std::size_t>(rings); ++ring) {
+    const std::size_t end = group.size();
+    for (std::size_t i = begin; i < end; ++i)
+      for (const auto& n : group[i]->best_covisibles(-1))
+        if (in_group.insert(n->id()).second) group.push_back(n);
+    begin = end;
+  }
+  std::vector<ProjectedPoint> proj;
+  for (const auto& g : group)
+    for (const auto& mp : g->map_points()) {
+      if (!mp || mp->bad() || !have.insert(mp->id()).second) continue;
+      ProjectedPoint p;
+      if (project_in_frustum(*probe, mp, &p)) proj.push_back(p);
+    }
+  search_local_points(*probe, proj, 10.0 / 4.0);
+}
+
 }  // namespace
 
 std::vector<std::shared_ptr<KeyFrame>> pose_candidates(const Map& map, const KeyFrame& kf,
@@ -99,23 +123,32 @@ LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand,
 
   // Guided search: the points of the candidate and its covisibles, projected
   // with the verified pose (ORB-SLAM2 SearchByProjection of mvpLoopMapPoints).
-  std::set<std::uint64_t> have;
-  for (const auto& mp : probe.map_points)
-    if (mp) have.insert(mp->id());
-  std::vector<std::shared_ptr<KeyFrame>> group = {cand};
-  for (const auto& n : cand->best_covisibles(-1)) group.push_back(n);
-  std::vector<ProjectedPoint> proj;
-  for (const auto& g : group)
-    for (const auto& mp : g->map_points()) {
-      if (!mp || mp->bad() || !have.insert(mp->id()).second) continue;
-      ProjectedPoint p;
-      if (project_in_frustum(probe, mp, &p)) proj.push_back(p);
-    }
-  search_local_points(probe, proj, 10.0 / 4.0);
+  search_around(&probe, cand, 1);
   out.inliers = optimize_and_prune(probe);
   out.T_c_w = probe.T_c_w;
   out.points = probe.map_points;
   out.accepted = out.inliers >= options.min_inliers;
+  if (out.accepted) out.stage = LoopMatch::Stage::kAccepted;
+  return out;
+}
+
+LoopMatch verify_at(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, const geom::SE3d& T_c_w,
+                    const LoopClosingOptions& options) {
+  LoopMatch out;
+  out.stage = LoopMatch::Stage::kInliers;
+  Frame probe = kf.frame();
+  std::fill(probe.map_points.begin(), probe.map_points.end(), nullptr);
+  probe.T_c_w = T_c_w;
+  search_around(&probe, cand, 2);
+  out.initial_matches = static_cast<int>(
+      std::count_if(probe.map_points.begin(), probe.map_points.end(), [](const auto& mp) { return mp != nullptr; }));
+  out.inliers = out.initial_matches > 0 ? optimize_and_prune(probe) : 0;
+  out.T_c_w = probe.T_c_w;
+  out.points = probe.map_points;
+  double dist_m = 0, angle_deg = 0;
+  pose_difference(probe.T_c_w, T_c_w, &dist_m, &angle_deg);
+  out.accepted = out.inliers >= options.min_inliers && dist_m <= options.max_correction_m &&
+                 angle_deg <= options.max_correction_deg;
   if (out.accepted) out.stage = LoopMatch::Stage::kAccepted;
   return out;
 }
@@ -141,6 +174,8 @@ std::string to_json(const LoopClosingStats& stats) {
          ", \"rejected\": " + std::to_string(stats.rejected) +
          ", \"refused_drift\": " + std::to_string(stats.refused_drift) +
          ", \"refused_ambiguous\": " + std::to_string(stats.refused_ambiguous) +
+         ", \"merge_confirmed\": " + std::to_string(stats.merge_confirmed) +
+         ", \"merge_unconfirmed\": " + std::to_string(stats.merge_unconfirmed) +
          ", \"verified\": " + std::to_string(stats.verified) +
          ", \"refused_matches\": " + std::to_string(stats.refused_matches) +
          ", \"refused_ransac\": " + std::to_string(stats.refused_ransac) +
@@ -283,6 +318,62 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
   return loop_kf;
 }
 
+std::shared_ptr<KeyFrame> LoopClosing::find(const std::shared_ptr<KeyFrame>& kf, LoopMatch* best, bool* merge,
+                                            std::chrono::steady_clock::time_point t0) {
+  std::vector<std::shared_ptr<KeyFrame>> consistent = detect(kf);
+  // A provisional map that meets the map's own keyframes merges into them
+  // (before any loop within itself).
+  *merge = map_.map_of(*kf) != 0 && std::any_of(consistent.begin(), consistent.end(), [&](const auto& c) {
+             return map_.map_of(*c) == 0;
+           });
+  if (*merge)
+    consistent.erase(std::remove_if(consistent.begin(), consistent.end(),
+                                    [&](const auto& c) { return map_.map_of(*c) != 0; }),
+                     consistent.end());
+  const std::shared_ptr<KeyFrame> loop_kf = consistent.empty() ? nullptr : verify(kf, consistent, *merge, best);
+  const double detect_ms = ms_since(t0);
+  std::lock_guard<std::mutex> s(stats_mutex_);
+  stats_.detect_ms_total += detect_ms;
+  stats_.detect_ms.push_back(detect_ms);
+  if (!consistent.empty()) ++stats_.consistent;
+  if (!consistent.empty() && !loop_kf) ++stats_.rejected;
+  return loop_kf;
+}
+
+bool LoopClosing::confirm_merge(const std::shared_ptr<KeyFrame>& kf, LoopMatch* best,
+                                std::shared_ptr<KeyFrame>* loop_kf) {
+  PendingMerge& p = *pending_merge_;
+  LoopMatch m = verify_at(*kf, p.anchor, kf->T_c_w() * p.T_into_from.inverse(), options_);
+  std::lock_guard<std::mutex> s(stats_mutex_);
+  if (!m.accepted) {
+    ++stats_.merge_unconfirmed;
+    pending_merge_.reset();
+    return false;
+  }
+  ++stats_.merge_confirmed;
+  p.T_into_from = m.T_c_w.inverse() * kf->T_c_w();
+  // The next prediction is checked around the map's keyframe that saw most of these matches.
+  std::map<std::uint64_t, std::pair<std::shared_ptr<KeyFrame>, int>> votes;
+  for (const auto& mp : m.points)
+    if (mp && !mp->bad())
+      for (const auto& [kid, o] : mp->observations())
+        if (auto k = o.kf.lock(); k && !k->bad() && map_.map_of(*k) == 0) {
+          votes[kid].first = k;
+          ++votes[kid].second;
+        }
+  int most = 0;
+  for (const auto& [kid, v] : votes)
+    if (v.second > most) {
+      most = v.second;
+      p.anchor = v.first;
+    }
+  if (++p.confirmed < options_.merge_confirmations) return false;
+  *best = std::move(m);
+  *loop_kf = p.anchor;
+  pending_merge_.reset();
+  return true;
+}
+
 bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
   if (!options_.enabled) return false;
   const auto t0 = std::chrono::steady_clock::now();
@@ -292,32 +383,31 @@ bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
     ++stats_.keyframes;
   }
   if (kf->bad()) return false;
-  if (any_loop_ && kf->id() < last_loop_kf_id_ + static_cast<std::uint64_t>(options_.keyframes_between_loops)) {
-    groups_.clear();
-    return false;
-  }
-  std::vector<std::shared_ptr<KeyFrame>> consistent = detect(kf);
-  // A provisional map that meets the map's own keyframes merges into them
-  // (before any loop within itself).
-  const bool merge = map_.map_of(*kf) != 0 && std::any_of(consistent.begin(), consistent.end(), [&](const auto& c) {
-                       return map_.map_of(*c) == 0;
-                     });
-  if (merge)
-    consistent.erase(std::remove_if(consistent.begin(), consistent.end(),
-                                    [&](const auto& c) { return map_.map_of(*c) != 0; }),
-                     consistent.end());
   LoopMatch best;
-  const std::shared_ptr<KeyFrame> loop_kf = consistent.empty() ? nullptr : verify(kf, consistent, merge, &best);
-  const double detect_ms = ms_since(t0);
-  {
-    std::lock_guard<std::mutex> s(stats_mutex_);
-    stats_.detect_ms_total += detect_ms;
-    stats_.detect_ms.push_back(detect_ms);
-    if (!consistent.empty()) ++stats_.consistent;
-    if (!consistent.empty() && !loop_kf) ++stats_.rejected;
+  std::shared_ptr<KeyFrame> loop_kf;
+  bool merge = false;
+  if (pending_merge_ && pending_merge_->from == map_.map_of(*kf)) {
+    merge = true;
+    if (!confirm_merge(kf, &best, &loop_kf)) return false;
+  } else {
+    if (any_loop_ && kf->id() < last_loop_kf_id_ + static_cast<std::uint64_t>(options_.keyframes_between_loops)) {
+      groups_.clear();
+      return false;
+    }
+    loop_kf = find(kf, &best, &merge, t0);
+    if (!loop_kf) return false;
+    if (merge && options_.merge_confirmations > 1) {  // held back until the next keyframes confirm it
+      pending_merge_ = PendingMerge{map_.map_of(*kf), best.T_c_w.inverse() * kf->T_c_w(), loop_kf, 1};
+      groups_.clear();
+      return false;
+    }
   }
-  if (!loop_kf) return false;
+  close(kf, loop_kf, best, merge, ms_since(t0));
+  return true;
+}
 
+void LoopClosing::close(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf,
+                        const LoopMatch& best, bool merge, double detect_ms) {
   LoopEvent event;
   event.keyframe_id = kf->id();
   event.frame_id = kf->frame_id();
@@ -344,7 +434,6 @@ bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
   last_loop_kf_id_ = kf->id();
   std::lock_guard<std::mutex> s(stats_mutex_);
   stats_.loops.push_back(event);
-  return true;
 }
 
 namespace {

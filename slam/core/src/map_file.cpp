@@ -120,7 +120,8 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   std::set<std::uint64_t> point_ids;
   for (const auto& [id, mp] : map.points()) {
     const auto& obs = mp->observations();
-    const bool seen = obs.empty() || std::any_of(obs.begin(), obs.end(), [&](const auto& o) { return kf_ids.count(o.first) > 0; });
+    const bool seen =
+        obs.empty() || std::any_of(obs.begin(), obs.end(), [&](const auto& o) { return kf_ids.count(o.first) > 0; });
     if (!mp->bad() && seen) point_ids.insert(id);
   }
 

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "pvb/common/text.hpp"
+#include "campaign_session.hpp"
 #include "run_pvbench.hpp"
 
 using namespace pvb;
@@ -25,12 +26,7 @@ std::string fresh(const std::string& name) {
 
 bool exists(const std::string& path) { return std::ifstream(path).good(); }
 
-YAML::Node session(const YAML::Node& campaign, const std::string& name) {
-  for (const auto& s : campaign["sessions"])
-    if (s["name"].as<std::string>() == name) return s;
-  ADD_FAILURE() << "no session " << name;
-  return {};
-}
+using test::campaign_session;
 
 TEST(MapReuse, ACampaignMapsLocalisesAndExtendsJudgedInTheMapsFrame) {
   const std::string d = fresh("campaign");
@@ -43,7 +39,8 @@ TEST(MapReuse, ACampaignMapsLocalisesAndExtendsJudgedInTheMapsFrame) {
   ASSERT_EQ(r.code, 0) << r.output;
   const YAML::Node c = YAML::Load(read_file(d + "/out/campaign.json"));
   EXPECT_EQ(c["seed"].as<int>(), 3);
-  const YAML::Node noon = session(c, "noon"), again = session(c, "again"), more = session(c, "more");
+  const YAML::Node noon = campaign_session(c, "noon"), again = campaign_session(c, "again"),
+                   more = campaign_session(c, "more");
   EXPECT_EQ(noon["seed"].as<int>(), 3000);
   EXPECT_EQ(again["seed"].as<int>(), 3001);
   // The same conditions with other noise, from 0.4 m along: found at once,

@@ -176,6 +176,26 @@ TEST(LoopVerification, RejectsAWrongPlaceAtTheSameEstimatedPose) {
   EXPECT_TRUE(lc.stats().loops.empty());
 }
 
+// A held-back merge transform is confirmed by a keyframe only at the pose it
+// predicts: near the truth the keyframe is found there, a metre off or
+// turned round it is not.
+TEST(LoopVerification, AMergeIsConfirmedOnlyNearThePredictedPose) {
+  Map map;
+  const cv::Mat tex = make_texture(1);
+  auto kf0 = add_keyframe(map, tex, pose(0, 0, 0), pose(0, 0, 0));
+  const geom::SE3d T_true = pose(4, 0.12, -0.05);
+  // Its own pose in a provisional map's frame: anything at all.
+  auto kf1 = add_keyframe(map, tex, T_true, pose(70, 3.0, 1.0));
+  const LoopMatch near = verify_at(*kf1, kf0, drifted(T_true), test_options());
+  EXPECT_TRUE(near.accepted);
+  EXPECT_GE(near.inliers, 100);
+  EXPECT_LT(centre_error_m(near.T_c_w, T_true), 0.005);
+  const geom::SE3d metre_off =
+      T_true * geom::make_se3(geom::so3_exp(Eigen::Vector3d::Zero()), Eigen::Vector3d(1.0, 0, 0));
+  EXPECT_FALSE(verify_at(*kf1, kf0, metre_off, test_options()).accepted);
+  EXPECT_FALSE(verify_at(*kf1, kf0, pose(184, 0.12, -0.05), test_options()).accepted);
+}
+
 TEST(LoopClosing, CountsAVerifiedPlaceBeyondTheCorrectionBound) {
   Map map;
   const cv::Mat tex = make_texture(1);

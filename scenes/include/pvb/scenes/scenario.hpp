@@ -12,6 +12,9 @@
 namespace pvb::scenes {
 
 enum class GroundType { kSoil, kGravel };
+/// How the ground's soil image covers it: one image repeated every 3 m, or
+/// near the route each 3 m tile one of several images at one of four turns.
+enum class GroundTiling { kRepeat, kVaried };
 enum class PanelOrientation { kPortrait, kLandscape };
 enum class RoutePattern { kWaypoints, kAlongRow, kLawnmower, kLoop };
 enum class DepthNoiseModel { kNone, kKinect };
@@ -35,6 +38,7 @@ struct TrackerMount {
 struct Ground {
   GroundType type = GroundType::kSoil;
   Eigen::Vector2d size_m{60.0, 60.0};  ///< extent along x and y, centred at origin
+  GroundTiling tiling = GroundTiling::kRepeat;
 };
 
 /// Trackers: the panels sit this far above the torque tube's axis, along

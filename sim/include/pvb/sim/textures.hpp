@@ -22,6 +22,12 @@ constexpr double kBrickTileHeightM = 0.75;  // 10 courses of 0.065 m + 10 mm joi
 /// Soil or gravel; the image covers kGroundTileM x kGroundTileM.
 cv::Mat make_ground_texture(scenes::GroundType type, std::uint64_t seed);
 constexpr double kGroundTileM = 3.0;
+/// A varied ground (ground.tiling: varied) gives every 3 m tile within
+/// this distance of the route an image of its own (the camera resolves the
+/// soil's stones closer than that); the repeated image lies beyond.
+constexpr double kGroundVariedCorridorM = 4.0;
+/// At most this many varied tiles (a route of about 140 m): 512 x 512 RGB each.
+constexpr int kMaxGroundTiles = 200;
 /// Leaves for shrubs and tree crowns.
 cv::Mat make_foliage_texture(std::uint64_t seed);
 /// Tree bark.

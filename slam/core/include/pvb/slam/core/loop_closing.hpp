@@ -33,7 +33,12 @@
 // the verification put the keyframe, its spanning tree is hung under the
 // matched keyframe, and step 4 welds the seam.  The correction bounds and
 // the drift check do not apply to a merge (the two frames are unrelated);
-// the ambiguity check does.
+// the ambiguity check does.  Without a bound on the transform, one view
+// is not enough (a place outside the map can look like one in it): the
+// transform is held back until `merge_confirmations` keyframes of the
+// provisional map in a row have been verified at the pose it predicts, by
+// projecting the map's points around the last match (ORB-SLAM3 asks for
+// three).
 //
 // Step 1 by default asks the bag-of-words database (PlaceRecognizer:
 // ORB-SLAM2's DetectLoopCandidates) instead of pose proximity, and step 3
@@ -41,9 +46,11 @@
 // correction is implausible for the path driven or when two candidates
 // verify at different places (docs/place_recognition.md).  Pose proximity
 // only works while the drift is small compared with the search radius.
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -84,6 +91,10 @@ struct LoopClosingOptions {
   /// apart, the place is ambiguous (a repeated structure) and the loop is refused.
   bool ambiguity_check = true;
   double ambiguity_distance_m = 0.3;
+  /// LoopClosing.mergeConfirmations: keyframes of a provisional map in a
+  /// row (the first match included) verified at the pose the merge
+  /// transform predicts before the maps are merged.
+  int merge_confirmations = 3;
 };
 
 /// One closed loop.
@@ -117,6 +128,8 @@ struct LoopClosingStats {
   int rejected = 0;               ///< consistent detections refused by geometry or the correction bound
   int refused_drift = 0;          ///< of those, verified but implausible against the drift bound
   int refused_ambiguous = 0;      ///< of those, verified at two places apart
+  int merge_confirmed = 0;        ///< keyframes that confirmed a held-back merge transform
+  int merge_unconfirmed = 0;      ///< held-back merge transforms the next keyframe did not confirm (dropped)
   /// Per candidate verified (step 3), the stage that refused it.
   int verified = 0;               ///< candidates verified
   int refused_matches = 0;        ///< fewer than min_matches descriptor matches
@@ -158,6 +171,12 @@ std::vector<std::shared_ptr<KeyFrame>> pose_candidates(const Map& map, const Key
 /// Geometric verification of `cand` for `kf` (step 3).  Call with the map
 /// mutex held.  Deterministic (fixed RANSAC seed).
 LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, const LoopClosingOptions& options);
+/// Verification of `kf` at a predicted pose `T_c_w` in `cand`'s map (a
+/// held-back merge): the points of `cand`, its covisibles and theirs,
+/// projected and matched, then a pose optimisation; accepted with
+/// min_inliers inliers within max_correction of the prediction.
+LoopMatch verify_at(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, const geom::SE3d& T_c_w,
+                    const LoopClosingOptions& options);
 
 class LoopClosing {
  public:
@@ -173,6 +192,17 @@ class LoopClosing {
   const LoopClosingOptions& options() const { return options_; }
 
  private:
+  /// A merge transform held back until confirmed (merge_confirmations).
+  struct PendingMerge {
+    std::uint32_t from = 0;            ///< the provisional map
+    geom::SE3d T_into_from;            ///< its frame into the map's own
+    std::shared_ptr<KeyFrame> anchor;  ///< the map's keyframe around which the last match lay
+    int confirmed = 0;                 ///< keyframes verified so far
+  };
+  /// For a keyframe of a provisional map with a held-back transform: its
+  /// verification at the predicted pose; true (with *best and *loop_kf)
+  /// when that makes merge_confirmations and the maps are to be merged.
+  bool confirm_merge(const std::shared_ptr<KeyFrame>& kf, LoopMatch* best, std::shared_ptr<KeyFrame>* loop_kf);
   /// A candidate and its covisibles, with how many times in a row it was consistent.
   struct Group {
     std::set<std::uint64_t> ids;
@@ -193,6 +223,13 @@ class LoopClosing {
   /// Step 5 (optional): bundle adjustment of every keyframe and point,
   /// keyframe 0 fixed, map locked throughout.
   void global_bundle_adjustment(LoopEvent* event, std::uint32_t map_id);
+  /// Steps 1-3 for a keyframe: the verified candidate (or null), whether it
+  /// merges a provisional map, and the detection figures.
+  std::shared_ptr<KeyFrame> find(const std::shared_ptr<KeyFrame>& kf, LoopMatch* best, bool* merge,
+                                 std::chrono::steady_clock::time_point t0);
+  /// Steps 4-6 (a merge first moves the provisional map) and the event.
+  void close(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf, const LoopMatch& best,
+             bool merge, double detect_ms);
   /// Step 4.
   void correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf, const LoopMatch& m,
                LoopEvent* event);
@@ -201,6 +238,7 @@ class LoopClosing {
   LoopClosingOptions options_;
   PlaceRecognizer* place_ = nullptr;
   std::vector<Group> groups_;  ///< consistency groups of the previous keyframe
+  std::optional<PendingMerge> pending_merge_;
   std::uint64_t last_loop_kf_id_ = 0;
   bool any_loop_ = false;
   mutable std::mutex stats_mutex_;
