@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include "pvb/common/error.hpp"
@@ -240,26 +241,37 @@ struct GroundTile {
 /// station's seed and the cell alone, so the route picks which cells are
 /// drawn, never how one looks.
 std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std::vector<Eigen::Vector2d>& route) {
-  std::vector<GroundTile> tiles;
-  if (s.ground.tiling != scenes::GroundTiling::kVaried) return tiles;
+  if (s.ground.tiling != scenes::GroundTiling::kVaried) return {};
   const double tile = kGroundTileM, half_x = s.ground.size_m.x() / 2, half_y = s.ground.size_m.y() / 2;
   const double reach = kGroundVariedCorridorM + tile / std::sqrt(2.0);
   const auto cells_x = static_cast<long long>(std::floor(s.ground.size_m.x() / tile + 1e-9));
   const auto cells_y = static_cast<long long>(std::floor(s.ground.size_m.y() / tile + 1e-9));
-  for (long long i = 0; i < cells_x; ++i)
-    for (long long j = 0; j < cells_y; ++j) {
-      const Eigen::Vector2d c(-half_x + (static_cast<double>(i) + 0.5) * tile,
-                              -half_y + (static_cast<double>(j) + 0.5) * tile);
-      if (std::none_of(route.begin(), route.end(), [&](const Eigen::Vector2d& p) { return (p - c).norm() <= reach; }))
-        continue;
-      if (static_cast<int>(tiles.size()) == kMaxGroundTiles)
-        throw ConfigError(s.source_file, "ground.tiling",
-                          "a varied ground of at most " + std::to_string(kMaxGroundTiles) + " tiles of " + f(tile) +
-                              " m along the route (a route of about 140 m)",
-                          "more");
-      const std::uint64_t cell = static_cast<std::uint64_t>(i * cells_y + j);
-      tiles.push_back({c, s.station_seed_or_seed() * 2654435761ULL + 1000003ULL * (cell + 1)});
-    }
+  const auto centre = [&](long long i, long long j) {
+    return Eigen::Vector2d(-half_x + (static_cast<double>(i) + 0.5) * tile,
+                           -half_y + (static_cast<double>(j) + 0.5) * tile);
+  };
+  // The cells within reach of each route point (a window of cells around it), in (i, j) order.
+  std::set<std::pair<long long, long long>> cells;
+  for (const Eigen::Vector2d& p : route) {
+    const auto first = [&](double v, double half) { return static_cast<long long>(std::floor((v + half) / tile)); };
+    const long long i0 = std::max(0LL, first(p.x() - reach, half_x));
+    const long long i1 = std::min(cells_x - 1, first(p.x() + reach, half_x));
+    const long long j0 = std::max(0LL, first(p.y() - reach, half_y));
+    const long long j1 = std::min(cells_y - 1, first(p.y() + reach, half_y));
+    for (long long i = i0; i <= i1; ++i)
+      for (long long j = j0; j <= j1; ++j)
+        if ((p - centre(i, j)).norm() <= reach) cells.insert({i, j});
+  }
+  if (cells.size() > static_cast<std::size_t>(kMaxGroundTiles))
+    throw ConfigError(s.source_file, "ground.tiling",
+                      "a varied ground of at most " + std::to_string(kMaxGroundTiles) + " tiles of " + f(tile) +
+                          " m along the route (a route of about 140 m)",
+                      std::to_string(cells.size()) + " tiles");
+  std::vector<GroundTile> tiles;
+  for (const auto& [i, j] : cells) {
+    const auto cell = static_cast<std::uint64_t>(i * cells_y + j);
+    tiles.push_back({centre(i, j), s.station_seed_or_seed() * 2654435761ULL + 1000003ULL * (cell + 1)});
+  }
   return tiles;
 }
 
@@ -332,6 +344,7 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
     const std::string name = file.first.substr(9, file.first.size() - 13);  // textures/NAME.png
     x.line("<texture name=\"" + name + "\" type=\"2d\" file=\"" + file.first + "\"/>");
   }
+  // The materials after every texture, as a scene without varied ground always had them.
   for (const auto& file : out.files) {
     const std::string name = file.first.substr(9, file.first.size() - 13);  // textures/NAME.png
     if (name.rfind("ground", 0) != 0) continue;  // the ground, and a varied ground's tiles

@@ -259,7 +259,9 @@ TEST(SceneBuilder, AVariedGroundGivesEveryTileAlongTheRouteAnImageOfItsOwn) {
   // No two tiles show the same image: no place looks like another.
   std::set<std::vector<unsigned char>> images;
   for (const auto& [path, bytes] : a.files)
-    if (path.rfind("textures/groundt", 0) == 0) EXPECT_TRUE(images.insert(bytes).second) << path;
+    if (path.rfind("textures/groundt", 0) == 0) {
+      EXPECT_TRUE(images.insert(bytes).second) << path;
+    }
   EXPECT_EQ(images.size(), centres.size());
   // Every point of the route lies on a tile.
   for (std::size_t k = 0; k + 1 < a.route_xy.size(); k += 2) {

@@ -48,6 +48,10 @@ void pose_difference(const geom::SE3d& a, const geom::SE3d& b, double* dist_m, d
   *angle_deg = geom::rotation_angle_rad(a.linear() * b.linear().transpose()) * kRadToDeg;
 }
 
+/// A provisional map's frame in the map's own (T_into_from), from its
+/// keyframe `kf`'s pose there, `T_c_w_into`.
+geom::SE3d frame_into(const geom::SE3d& T_c_w_into, const KeyFrame& kf) { return T_c_w_into.inverse() * kf.T_c_w(); }
+
 /// Moves the provisional map of `kf` into the frame of `loop_kf`'s map (defined with step 4).
 void merge_into(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf,
                 const geom::SE3d& T_c_w_into);
@@ -85,10 +89,11 @@ std::vector<std::shared_ptr<KeyFrame>> pose_candidates(const Map& map, const Key
   const Eigen::Vector3d c = kf.camera_center_w();
   const Eigen::Vector3d axis = optical_axis_w(kf);
   const double min_cos = std::cos(options.max_angle_deg / kRadToDeg);
+  const std::uint32_t own = map.map_of(kf);
   std::vector<std::pair<double, std::shared_ptr<KeyFrame>>> found;
   for (const auto& [id, k] : map.keyframes()) {
     if (id + static_cast<std::uint64_t>(options.min_keyframe_gap) > kf.id()) break;  // ordered by id
-    if (k->bad() || connected.count(id) || map.map_of(*k) != map.map_of(kf)) continue;
+    if (k->bad() || connected.count(id) || map.map_of(*k) != own) continue;
     const double d = (k->camera_center_w() - c).norm();
     if (d > options.search_radius_m) continue;
     if (optical_axis_w(*k).dot(axis) < min_cos) continue;
@@ -351,7 +356,7 @@ bool LoopClosing::confirm_merge(const std::shared_ptr<KeyFrame>& kf, LoopMatch* 
     return false;
   }
   ++stats_.merge_confirmed;
-  p.T_into_from = m.T_c_w.inverse() * kf->T_c_w();
+  p.T_into_from = frame_into(m.T_c_w, *kf);
   // The next prediction is checked around the map's keyframe that saw most of these matches.
   std::map<std::uint64_t, std::pair<std::shared_ptr<KeyFrame>, int>> votes;
   for (const auto& mp : m.points)
@@ -397,7 +402,7 @@ bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
     loop_kf = find(kf, &best, &merge, t0);
     if (!loop_kf) return false;
     if (merge && options_.merge_confirmations > 1) {  // held back until the next keyframes confirm it
-      pending_merge_ = PendingMerge{map_.map_of(*kf), best.T_c_w.inverse() * kf->T_c_w(), loop_kf, 1};
+      pending_merge_ = PendingMerge{map_.map_of(*kf), frame_into(best.T_c_w, *kf), loop_kf, 1};
       groups_.clear();
       return false;
     }
@@ -553,8 +558,9 @@ class EssentialGraph {
  public:
   EssentialGraph(const Map& map, const KeyFramePtr& loop_kf, double rotation_weight)
       : rotation_weight_(rotation_weight) {
+    const std::uint32_t own = map.map_of(*loop_kf);
     for (const auto& [id, k] : map.keyframes()) {
-      if (k->bad() || map.map_of(*k) != map.map_of(*loop_kf)) continue;  // other maps lie in frames of their own
+      if (k->bad() || map.map_of(*k) != own) continue;  // other maps lie in frames of their own
       const bool in_tree = id == 0 || k->root() || k->parent() != nullptr || k == loop_kf;
       initial[id] = k->T_c_w();
       if (!in_tree) continue;  // queued, not yet processed by local mapping: moved in step 4.5
@@ -668,7 +674,7 @@ void write_back(Map& map, const EssentialGraph& g, const KeyFramePtr& kf, const 
 /// its spanning tree is hung under `loop_kf` (ORB-SLAM3 MergeLocal, scale 1).
 void merge_into(Map& map, const KeyFramePtr& kf, const KeyFramePtr& loop_kf, const geom::SE3d& T_c_w_into) {
   const std::uint32_t from = map.map_of(*kf), into = map.map_of(*loop_kf);
-  const geom::SE3d T_into_from = T_c_w_into.inverse() * kf->T_c_w();
+  const geom::SE3d T_into_from = frame_into(T_c_w_into, *kf);
   const geom::SE3d T_from_into = T_into_from.inverse();
   std::vector<std::shared_ptr<MapPoint>> moved;
   std::set<std::uint64_t> seen;

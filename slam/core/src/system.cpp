@@ -194,11 +194,16 @@ MapSaveInfo System::save_map(const std::string& path, const std::string& app_jso
     // The sessions loaded, and this one when it made a keyframe.
     if (map_.num_keyframes() == 0) throw ConfigError(path, "map", "a map with keyframes (this run made none)");
     info.sessions = loaded_sessions_;
-    for (const auto& [id, kf] : map_.keyframes())
-      if (kf->session() == map_.session() && map_.map_of(*kf) == 0) info.sessions = map_.session() + 1;
+    for (const auto& [id, kf] : map_.keyframes()) {
+      if (map_.map_of(*kf) != 0) {  // a provisional map never merged: not saved
+        ++info.unmerged_keyframes;
+        continue;
+      }
+      ++info.keyframes;
+      if (kf->session() == map_.session()) info.sessions = map_.session() + 1;
+    }
     const BagOf bag_of = [this](const KeyFrame& kf) { return place_ ? place_->bag_of(kf) : kf.bow(); };
     bytes = encode_map(map_, map_settings(), info.sessions, app_json, bag_of);
-    for (const auto& [id, kf] : map_.keyframes()) ++(map_.map_of(*kf) == 0 ? info.keyframes : info.unmerged_keyframes);
     info.points = map_.num_points();
   }
   write_file(path, bytes);

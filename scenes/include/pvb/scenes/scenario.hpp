@@ -13,7 +13,7 @@ namespace pvb::scenes {
 
 enum class GroundType { kSoil, kGravel };
 /// How the ground's soil image covers it: one image repeated every 3 m, or
-/// near the route each 3 m tile one of several images at one of four turns.
+/// near the route every 3 m tile an image of its own.
 enum class GroundTiling { kRepeat, kVaried };
 enum class PanelOrientation { kPortrait, kLandscape };
 enum class RoutePattern { kWaypoints, kAlongRow, kLawnmower, kLoop };
