@@ -13,11 +13,18 @@
 // the route's frames (as many as the ground truth has).
 // Prints a table per class, writes map_accuracy.json and map_errors.ply
 // (each map point with its class and error, for CloudCompare or MeshLab).
+//
+// --map may be given several times: the dense maps of sessions that share
+// the first one's frame (a campaign's extend sessions, whose poses are in
+// the loaded map's frame), runs at the same station.  They are scored as
+// one merged map, and "ghosting between maps" says where two sessions drew
+// the same surface apart.
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "command.hpp"
 #include "pvb/common/clock.hpp"
@@ -39,7 +46,8 @@ namespace pvb::cli {
 namespace {
 
 struct EvalMapArgs {
-  std::string map, scenario, trajectory, gt, out;
+  std::vector<std::string> maps;
+  std::string scenario, trajectory, gt, out;
   std::optional<std::uint64_t> seed;
   double voxel_m = 0.01;
   int every = 5;
@@ -67,12 +75,26 @@ void print_alignment_gap(run::MapAlignment used, const eval::Sim3Transform& to_w
 /// The scenario and seed that the map's and the ground truth's folders say
 /// they were made from (a run's metrics.json, a recording's meta.json), if
 /// any, must be the ones given: a map is never scored against another world.
+std::string folder_of(const std::string& file) {
+  const std::size_t slash = file.rfind('/');
+  return slash == std::string::npos ? std::string(".") : file.substr(0, slash);
+}
+
+/// A further map must come from a run at the first map's station (when both
+/// folders say where they were made).
+void check_same_station(const suite::FolderIdentity& first, const std::string& map) {
+  const std::optional<suite::FolderIdentity> id = suite::read_folder_identity(folder_of(map));
+  if (!id) return;
+  if (!first.station_seed || !id->station_seed)
+    throw ConfigError(id->file, "world.station_seed",
+                      "a run at a station (metrics.json \"world\"), as " + first.file + " for a merged map", "none");
+  if (*id->station_seed != *first.station_seed || id->station_file != first.station_file)
+    throw ConfigError(id->file, "world", "station " + first.station_file + " seed " + std::to_string(*first.station_seed),
+                      id->station_file + " seed " + std::to_string(*id->station_seed));
+}
+
 void check_inputs_match(const scenes::Scenario& scenario, const EvalMapArgs& a) {
-  const auto folder = [](const std::string& file) {
-    const std::size_t slash = file.rfind('/');
-    return slash == std::string::npos ? std::string(".") : file.substr(0, slash);
-  };
-  for (const std::string& dir : {folder(a.map), folder(a.gt)}) {
+  for (const std::string& dir : {folder_of(a.maps.front()), folder_of(a.gt)}) {
     const std::optional<suite::FolderIdentity> id = suite::read_folder_identity(dir);
     if (!id) continue;
     if (!id->scenario.empty() && id->scenario != scenario.name)
@@ -84,6 +106,9 @@ void check_inputs_match(const scenes::Scenario& scenario, const EvalMapArgs& a) 
                             "; give --seed " + std::to_string(*id->seed) + " for this run)",
                         std::to_string(*id->seed));
   }
+  const std::optional<suite::FolderIdentity> first = suite::read_folder_identity(folder_of(a.maps.front()));
+  if (!first) return;
+  for (std::size_t i = 1; i < a.maps.size(); ++i) check_same_station(*first, a.maps[i]);
 }
 
 /// The map's points, refusing a map with none: an empty map scores nothing,
@@ -101,6 +126,26 @@ slam::dense::PointCloud read_map(const std::string& path, std::size_t* dropped) 
   return cloud;
 }
 
+std::string joined(const std::vector<std::string>& files) {
+  std::string s;
+  for (const std::string& f : files) s += (s.empty() ? "" : " + ") + f;
+  return s;
+}
+
+/// The maps' points in the world, each labelled by the map it came from.
+std::vector<eval::MapPoint> merged_in_world(const std::vector<std::string>& maps, const eval::Sim3Transform& to_world,
+                                            std::size_t* dropped) {
+  std::vector<eval::MapPoint> all;
+  for (std::size_t i = 0; i < maps.size(); ++i) {
+    std::size_t d = 0;
+    std::vector<eval::MapPoint> one = run::map_in_world(read_map(maps[i], &d), to_world);
+    for (eval::MapPoint& p : one) p.source = static_cast<int>(i);
+    all.insert(all.end(), one.begin(), one.end());
+    *dropped += d;
+  }
+  return all;
+}
+
 int run_eval_map(const EvalMapArgs& a) {
   scenes::Scenario scenario = scenes::load_scenario(a.scenario);
   if (a.seed) scenario.seed = *a.seed;
@@ -112,7 +157,7 @@ int run_eval_map(const EvalMapArgs& a) {
   const run::MapAlignment alignment = alignment_of(a.align);
   const eval::Sim3Transform to_world = run::map_to_world(alignment, ate, gt, est);
   std::size_t dropped = 0;
-  const std::vector<eval::MapPoint> map = run::map_in_world(read_map(a.map, &dropped), to_world);
+  const std::vector<eval::MapPoint> map = merged_in_world(a.maps, to_world, &dropped);
   if (!a.out.empty()) prepare_output_folder(a.out, a.overwrite, "eval-map");
   sim::TruthSurfaceOptions to;
   to.voxel_m = a.voxel_m;
@@ -127,7 +172,7 @@ int run_eval_map(const EvalMapArgs& a) {
   const eval::MapAccuracy r = eval::evaluate_map(map, surface, {}, &point_scores);
   std::printf("true surface sampled in %.2f s, map scored in %.2f s\n", truth_s, seconds_since(t1));
   std::printf("map %s: %zu points; true surface: %zu samples (%.0f mm voxels, every %d of %zu frames); ATE %.4f m\n",
-              a.map.c_str(), map.size(), surface.size(), 1000 * a.voxel_m, a.every, gt.size(), ate.ate.rmse);
+              joined(a.maps).c_str(), map.size(), surface.size(), 1000 * a.voxel_m, a.every, gt.size(), ate.ate.rmse);
   print_alignment_gap(alignment, to_world, ate, gt, est);
   std::printf("%s", run::map_accuracy_table(r).c_str());
   std::printf("(accuracy in mm; completeness in %% of the surface within 1, 2, 5, 10 cm)\n");
@@ -148,7 +193,11 @@ int run_eval_map(const EvalMapArgs& a) {
 Command add_eval_map_command(CLI::App& app) {
   auto a = std::make_shared<EvalMapArgs>();
   CLI::App* sub = app.add_subcommand("eval-map", "accuracy and completeness of a dense map against the scene's true surface");
-  sub->add_option("--map", a->map, "the dense map (PointCloud.ply of pvbench slam or run)")->required();
+  sub->add_option("--map", a->maps,
+                  "the dense map (PointCloud.ply of pvbench slam or run); several: maps in the first one's frame "
+                  "(a campaign's extend sessions), scored as one")
+      ->required()
+      ->take_all();
   sub->add_option("--scenario", a->scenario, "the scenario the map was made in")->required();
   sub->add_option("--seed", a->seed, "the scenario's seed, when the run overrode it");
   sub->add_option("--trajectory", a->trajectory, "the estimated trajectory (TUM), for the alignment")->required();

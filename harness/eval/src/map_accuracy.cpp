@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <set>
+#include <tuple>
 #include <memory>
 #include <stdexcept>
 
@@ -65,31 +68,74 @@ double share_within(const std::vector<double>& d, double tau) {
          static_cast<double>(d.size());
 }
 
+/// The ghost flags of one surface point: 0 no, 1 yes, -1 not judged.
+struct GhostFlags {
+  int within = -1;   ///< any two layers
+  int between = -1;  ///< two source maps apart
+};
+
+/// Two layers: a gap wider than 2 tau in the sorted offsets with k points on each side.
+int two_layers(std::vector<double> offsets, const MapAccuracyOptions& o) {
+  const auto k = static_cast<std::size_t>(o.ghost_min_points);
+  if (offsets.size() < k) return -1;
+  std::sort(offsets.begin(), offsets.end());
+  for (std::size_t i = k; i + k <= offsets.size(); ++i)
+    if (offsets[i] - offsets[i - 1] > 2.0 * o.ghost_tau_m) return 1;
+  return 0;
+}
+
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// Two source maps apart: the median offsets of the sources with k points
+/// span more than 2 tau.
+int maps_apart(const std::map<int, std::vector<double>>& by_source, const MapAccuracyOptions& o) {
+  std::vector<double> medians;
+  for (const auto& [source, offsets] : by_source)
+    if (offsets.size() >= static_cast<std::size_t>(o.ghost_min_points)) medians.push_back(median_of(offsets));
+  if (medians.size() < 2) return -1;
+  const auto [lo, hi] = std::minmax_element(medians.begin(), medians.end());
+  return *hi - *lo > 2.0 * o.ghost_tau_m ? 1 : 0;
+}
+
 /// Ghosting of one surface point from the map points whose nearest surface
 /// point lies within the lateral radius: their offsets along this point's
-/// normal, split by a gap wider than 2 tau with enough points on each side.
-/// 0 no, 1 yes, -1 not judged (too few map points).
-int ghosted(std::size_t at, const std::vector<SurfacePoint>& surface, const Tree& surface_tree,
-            const std::vector<std::vector<std::size_t>>& map_by_surface, const std::vector<Eigen::Vector3d>& map,
-            const MapAccuracyOptions& o) {
+/// normal, split by a gap wider than 2 tau with enough points on each side;
+/// and, for merged maps, split by source.
+GhostFlags ghosted(std::size_t at, const std::vector<SurfacePoint>& surface, const Tree& surface_tree,
+                   const std::vector<std::vector<std::size_t>>& map_by_surface, const std::vector<MapPoint>& map,
+                   const MapAccuracyOptions& o, bool merged) {
   const SurfacePoint& s = surface[at];
   std::vector<std::pair<std::size_t, double>> near;
   surface_tree.radiusSearch(s.p_w.data(), o.ghost_radius_m * o.ghost_radius_m, near, nanoflann::SearchParams());
   std::vector<double> offsets;
+  std::map<int, std::vector<double>> by_source;
   for (const auto& [j, d2] : near)
-    for (std::size_t m : map_by_surface[j]) offsets.push_back((map[m] - s.p_w).dot(s.n_w));
-  const auto k = static_cast<std::size_t>(o.ghost_min_points);
-  if (offsets.size() < k) return -1;
-  std::sort(offsets.begin(), offsets.end());
-  for (std::size_t i = k; i + k <= offsets.size(); ++i)  // a gap with k points on each side
-    if (offsets[i] - offsets[i - 1] > 2.0 * o.ghost_tau_m) return 1;
-  return 0;
+    for (std::size_t m : map_by_surface[j]) {
+      offsets.push_back((map[m].p_w - s.p_w).dot(s.n_w));
+      if (merged) by_source[map[m].source].push_back(offsets.back());
+    }
+  return {two_layers(std::move(offsets), o), merged ? maps_apart(by_source, o) : -1};
+}
+
+/// The share of judged flags that are set, and how many were judged.
+std::pair<double, std::size_t> share_flagged(const std::vector<int>& flags) {
+  std::size_t judged = 0, yes = 0;
+  for (int g : flags) {
+    if (g < 0) continue;
+    ++judged;
+    yes += static_cast<std::size_t>(g);
+  }
+  return {judged ? static_cast<double>(yes) / static_cast<double>(judged) : 0.0, judged};
 }
 
 /// The scores of a subset: accuracy distances of its map points,
 /// completeness distances and ghost flags of its surface points.
 MapScores score(const std::vector<double>& acc, const std::vector<double>& comp, const std::vector<int>& ghosts,
-                const MapAccuracyOptions& o) {
+                const std::vector<int>& ghosts_between, const MapAccuracyOptions& o) {
   MapScores s;
   s.accuracy = summarise(acc);
   s.completeness = summarise(comp);
@@ -100,13 +146,8 @@ MapScores score(const std::vector<double>& acc, const std::vector<double>& comp,
     s.fscore_at.push_back(p + r > 0 ? 2 * p * r / (p + r) : 0.0);
   }
   s.chamfer_m = 0.5 * (s.accuracy.mean + s.completeness.mean);
-  std::size_t yes = 0;
-  for (int g : ghosts) {
-    if (g < 0) continue;
-    ++s.ghosting_judged;
-    yes += static_cast<std::size_t>(g);
-  }
-  s.ghosting = s.ghosting_judged ? static_cast<double>(yes) / static_cast<double>(s.ghosting_judged) : 0.0;
+  std::tie(s.ghosting, s.ghosting_judged) = share_flagged(ghosts);
+  std::tie(s.ghosting_between, s.ghosting_between_judged) = share_flagged(ghosts_between);
   return s;
 }
 
@@ -146,13 +187,19 @@ MapAccuracy evaluate_map(const std::vector<MapPoint>& map, const std::vector<Sur
   const Nearest comp = nearest(surf_p, map_tree.get());
   std::vector<std::vector<std::size_t>> map_by_surface(surface.size());
   for (std::size_t i = 0; i < map.size(); ++i) map_by_surface[acc.index[i]].push_back(i);
-  std::vector<int> ghosts(surface.size(), -1);
-  for (std::size_t i = 0; i < surface.size(); ++i)
-    ghosts[i] = ghosted(i, surface, surf_tree, map_by_surface, map_p, options);
+  std::set<int> sources;
+  for (const MapPoint& m : map) sources.insert(m.source);
+  std::vector<int> ghosts(surface.size(), -1), between(surface.size(), -1);
+  for (std::size_t i = 0; i < surface.size(); ++i) {
+    const GhostFlags g = ghosted(i, surface, surf_tree, map_by_surface, map, options, sources.size() > 1);
+    ghosts[i] = g.within;
+    between[i] = g.between;
+  }
 
   MapAccuracy out;
   out.options = options;
-  out.all = score(acc.dist_m, comp.dist_m, ghosts, options);
+  out.sources = std::max<int>(1, static_cast<int>(sources.size()));
+  out.all = score(acc.dist_m, comp.dist_m, ghosts, between, options);
   std::vector<int> map_class(map.size()), surf_class(surface.size()), map_bin(map.size()), surf_bin(surface.size());
   for (std::size_t i = 0; i < map.size(); ++i) {
     const SurfacePoint& nearest_surface = surface[acc.index[i]];
@@ -170,10 +217,10 @@ MapAccuracy evaluate_map(const std::vector<MapPoint>& map, const std::vector<Sur
   for (int c : surf_class)
     if (!out.per_class.count(c))
       out.per_class[c] = score(select(acc.dist_m, map_class, c), select(comp.dist_m, surf_class, c),
-                               select(ghosts, surf_class, c), options);
+                               select(ghosts, surf_class, c), select(between, surf_class, c), options);
   for (int b = 0; b + 1 < static_cast<int>(options.range_edges_m.size()); ++b)
     out.per_range.push_back(score(select(acc.dist_m, map_bin, b), select(comp.dist_m, surf_bin, b),
-                                  select(ghosts, surf_bin, b), options));
+                                  select(ghosts, surf_bin, b), select(between, surf_bin, b), options));
   return out;
 }
 

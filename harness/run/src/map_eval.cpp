@@ -66,7 +66,7 @@ namespace {
 /// One subset's scores.  What a subset without map points (or without
 /// surface points) cannot have is null, and "null_reason" says why: an
 /// empty map is never scored as a perfect one.
-std::string scores_json(const eval::MapScores& s) {
+std::string scores_json(const eval::MapScores& s, bool merged) {
   const bool has_map = s.accuracy.count > 0, has_surface = s.completeness.count > 0;
   std::ostringstream js;
   auto list = [&js](bool known, const std::vector<double>& v) {
@@ -93,6 +93,9 @@ std::string scores_json(const eval::MapScores& s) {
   list(has_map && has_surface, s.fscore_at);
   js << ", \"chamfer_m\": " << (has_map && has_surface ? json_number(s.chamfer_m, 6) : "null")
      << ", \"ghosting\": " << json_number(s.ghosting, 6) << ", \"ghosting_judged\": " << s.ghosting_judged;
+  if (merged)
+    js << ", \"ghosting_between_maps\": " << json_number(s.ghosting_between, 6)
+       << ", \"ghosting_between_maps_judged\": " << s.ghosting_between_judged;
   if (!has_map || !has_surface)
     js << ", \"null_reason\": \"" << (has_map ? "no surface points" : "no map points") << " in this subset\"";
   js << "}";
@@ -119,17 +122,20 @@ std::string map_accuracy_json(const eval::MapAccuracy& r, int indent) {
   std::ostringstream js;
   js << "{" << nl << "  \"tau_m\": [";
   for (std::size_t i = 0; i < r.options.tau_m.size(); ++i) js << (i ? ", " : "") << json_number(r.options.tau_m[i], 6);
-  js << "]," << nl << "  \"all\": " << scores_json(r.all) << "," << nl << "  \"per_class\": {";
+  const bool merged = r.sources > 1;
+  js << "]";
+  if (merged) js << "," << nl << "  \"maps_merged\": " << r.sources;
+  js << "," << nl << "  \"all\": " << scores_json(r.all, merged) << "," << nl << "  \"per_class\": {";
   bool first = true;
   for (const auto& [c, s] : r.per_class) {
     js << (first ? "" : ",") << nl << "    \"" << sim::to_string(static_cast<sim::SurfaceClass>(c))
-       << "\": " << scores_json(s);
+       << "\": " << scores_json(s, merged);
     first = false;
   }
   js << nl << "  }," << nl << "  \"per_range\": [";
   for (std::size_t b = 0; b < r.per_range.size(); ++b)
     js << (b ? "," : "") << nl << "    {\"from_m\": " << json_number(r.options.range_edges_m[b], 6)
-       << ", \"to_m\": " << json_number(r.options.range_edges_m[b + 1], 6) << ", \"scores\": " << scores_json(r.per_range[b])
+       << ", \"to_m\": " << json_number(r.options.range_edges_m[b + 1], 6) << ", \"scores\": " << scores_json(r.per_range[b], merged)
        << "}";
   js << nl << "  ]" << nl << "}";
   return js.str();
@@ -140,6 +146,10 @@ std::string map_accuracy_table(const eval::MapAccuracy& r) {
       "class     map pts  surf pts  acc med  acc mean  acc p95  comp1  comp2  comp5 comp10  F@2cm  ghost%\n";
   t += scores_row("all", r.all);
   for (const auto& [c, s] : r.per_class) t += scores_row(sim::to_string(static_cast<sim::SurfaceClass>(c)), s);
+  if (r.sources > 1)
+    t += "ghosting between the " + std::to_string(r.sources) + " maps: " +
+         format_number("%.2f", 100 * r.all.ghosting_between) + " % of " + std::to_string(r.all.ghosting_between_judged) +
+         " surface points seen by two of them\n";
   return t;
 }
 

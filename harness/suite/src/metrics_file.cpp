@@ -196,6 +196,17 @@ class Reader {
   std::string prefix_;
 };
 
+/// The station of a day's run, from "world" (informative: left unread when
+/// its shape is not the expected one).
+void read_station(const YAML::Node& world, MetricsFile* m) {
+  if (!world.IsMap()) return;
+  const YAML::Node seed = world["station_seed"], files = world["base_files"];
+  unsigned long long v = 0;
+  if (seed.IsDefined() && Reader::is_plain_scalar(seed) && YAML::convert<unsigned long long>::decode(seed, v))
+    m->station_seed = v;
+  if (files.IsSequence() && files.size() > 0 && files[0].IsScalar()) m->station_file = files[0].Scalar();
+}
+
 }  // namespace
 
 const MapMetrics* RunMetrics::map(const std::string& name) const {
@@ -238,6 +249,7 @@ MetricsFile read_metrics_file(const std::string& path) {
       top.fail(seed, "seed", "expected a non-negative integer, got " + Reader::shown(seed));
     m.seed = v;
   }
+  read_station(root["world"], &m);
   m.primary = top.run(root);
   const YAML::Node base = root["baseline"];
   if (base.IsDefined() && !base.IsNull()) {
@@ -264,7 +276,7 @@ std::optional<FolderIdentity> read_folder_identity(const std::string& dir) {
   struct stat st {};
   if (::stat(metrics.c_str(), &st) == 0) {
     const MetricsFile m = read_metrics_file(metrics);
-    return FolderIdentity{metrics, m.scenario, m.seed};
+    return FolderIdentity{metrics, m.scenario, m.seed, m.station_seed, m.station_file};
   }
   if (::stat(meta.c_str(), &st) != 0) return std::nullopt;
   YAML::Node root;
@@ -273,7 +285,7 @@ std::optional<FolderIdentity> read_folder_identity(const std::string& dir) {
   } catch (const YAML::Exception& e) {
     throw IoError(meta, "not valid JSON: " + e.msg, e.mark.line + 1);
   }
-  FolderIdentity id{meta, "", std::nullopt};
+  FolderIdentity id{meta, "", std::nullopt, std::nullopt, ""};
   const YAML::Node name = root.IsMap() && root["scenario"].IsMap() ? root["scenario"]["name"] : YAML::Node();
   if (name.IsDefined() && name.IsScalar()) id.scenario = name.Scalar();
   const YAML::Node seed = root.IsMap() ? root["seed"] : YAML::Node();

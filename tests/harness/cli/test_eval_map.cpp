@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -30,6 +31,44 @@ double number_after(const std::string& text, const std::string& pattern) {
   std::smatch m;
   if (!std::regex_search(text, m, std::regex(pattern + "([-0-9.eE+]+)"))) return -1;
   return std::stod(m[1]);
+}
+
+/// A copy of a dense map (x y z float, red green blue uchar per vertex)
+/// moved by `dy_m` along the first camera's y axis (down).
+void write_moved_map(const std::string& from, const std::string& to, float dy_m) {
+  std::string ply = pvb::read_file(from);
+  const std::size_t body = ply.find("end_header\n") + 11;
+  for (std::size_t at = body; at + 15 <= ply.size(); at += 15) {
+    float y = 0;
+    std::memcpy(&y, ply.data() + at + 4, 4);
+    y += dy_m;
+    std::memcpy(ply.data() + at + 4, &y, 4);
+  }
+  std::filesystem::create_directories(to.substr(0, to.rfind('/')));
+  pvb::write_file(to, ply);
+}
+
+/// Two sessions' maps in one frame: the same map twice is one surface;
+/// the map and a copy 8 cm above it are the surface drawn twice, apart.
+void expect_merged_maps_judged(const std::string& dir, const std::string& scenario) {
+  const std::string map = dir + "/slam/PointCloud.ply", inputs = " --scenario " + scenario + " --trajectory " + dir +
+                                                                 "/slam/CameraTrajectory.txt --gt " + dir +
+                                                                 "/seq/groundtruth.txt";
+  write_moved_map(map, dir + "/moved/PointCloud.ply", -0.08f);
+  auto r = pvb::test::run_pvbench("eval-map --map " + map + " --map " + map + inputs + " --out " + dir + "/same");
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::string js = pvb::read_file(dir + "/same/map_accuracy.json");
+  EXPECT_NE(js.find("\"maps_merged\": 2"), std::string::npos) << js;
+  std::string all = js.substr(js.find("\"all\""));
+  EXPECT_EQ(number_after(all, "\"ghosting_between_maps\": "), 0.0) << all;
+  EXPECT_GT(number_after(all, "\"ghosting_between_maps_judged\": "), 1000) << all;
+  r = pvb::test::run_pvbench("eval-map --map " + map + " --map " + dir + "/moved/PointCloud.ply" + inputs +
+                             " --out " + dir + "/apart");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("ghosting between the 2 maps: "), std::string::npos) << r.output;
+  js = pvb::read_file(dir + "/apart/map_accuracy.json");
+  all = js.substr(js.find("\"all\""));
+  EXPECT_GT(number_after(all, "\"ghosting_between_maps\": "), 0.5) << all;
 }
 
 }  // namespace
@@ -60,6 +99,7 @@ TEST(EvalMapCli, ScoresAShortPvStationMap) {
   const std::string ply = pvb::read_file(dir + "/eval/map_errors.ply");
   EXPECT_NE(ply.find("property uchar class"), std::string::npos);
   EXPECT_NE(ply.find("property float error"), std::string::npos);
+  expect_merged_maps_judged(dir, scenario);
   std::filesystem::remove_all(dir);
 }
 

@@ -1,7 +1,8 @@
 // Map accuracy on synthetic surfaces: a map sampled from the surface itself
 // scores 0 and 100 %, a map shifted by 1 cm scores 1 cm, half a map covers
-// half the surface, a surface mapped twice is ghosting, and the per-class
-// and per-range splits partition the points.
+// half the surface, a surface mapped twice is ghosting (between two merged
+// maps when each drew one layer), and the per-class and per-range splits
+// partition the points.
 #include "pvb/eval/map_accuracy.hpp"
 
 #include <gtest/gtest.h>
@@ -83,6 +84,42 @@ TEST(MapAccuracy, ASurfaceMappedTwiceIsGhosting) {
   std::vector<MapPoint> thick = map_from(s, 0.0, 2);
   for (const auto& m : map_from(s, 0.03, 2)) thick.push_back(m);
   EXPECT_LT(pvb::eval::evaluate_map(thick, s).all.ghosting, 0.05);
+}
+
+/// `m` labelled as coming from map `source`.
+std::vector<MapPoint> from_source(std::vector<MapPoint> m, int source) {
+  for (MapPoint& p : m) p.source = source;
+  return m;
+}
+
+TEST(MapAccuracy, TwoSessionsDrawingASurfaceApartAreGhostingBetweenMaps) {
+  const auto s = two_surfaces();
+  std::vector<MapPoint> merged = from_source(map_from(s, 0.0), 0);
+  for (const auto& m : from_source(map_from(s, 0.06), 1)) merged.push_back(m);  // the second session 6 cm off
+  const auto apart = pvb::eval::evaluate_map(merged, s);
+  EXPECT_EQ(apart.sources, 2);
+  EXPECT_GT(apart.all.ghosting_between, 0.95);
+  EXPECT_GT(apart.all.ghosting_between_judged, s.size() / 2);
+  // The same two sessions in register: one surface, however many maps drew it.
+  std::vector<MapPoint> together = from_source(map_from(s, 0.0), 0);
+  for (const auto& m : from_source(map_from(s, 0.005), 1)) together.push_back(m);
+  const auto one = pvb::eval::evaluate_map(together, s);
+  EXPECT_EQ(one.all.ghosting_between, 0.0);
+  EXPECT_GT(one.all.ghosting_between_judged, s.size() / 2);
+  // Where only one session drew the surface there is nothing to judge between maps.
+  std::vector<MapPoint> split;
+  for (const auto& m : map_from(s, 0.0)) split.push_back(from_source({m}, m.p_w.y() < 0.5 ? 0 : 1).front());
+  EXPECT_LT(pvb::eval::evaluate_map(split, s).all.ghosting_between_judged, s.size() / 10);
+}
+
+TEST(MapAccuracy, ASingleMapHasNoGhostingBetweenMaps) {
+  const auto s = two_surfaces();
+  std::vector<MapPoint> twice = map_from(s, 0.0, 2);
+  for (const auto& m : map_from(s, 0.06, 2)) twice.push_back(m);
+  const auto r = pvb::eval::evaluate_map(twice, s);
+  EXPECT_EQ(r.sources, 1);
+  EXPECT_GT(r.all.ghosting, 0.95);  // mapped twice, but by one map
+  EXPECT_EQ(r.all.ghosting_between_judged, 0u);
 }
 
 TEST(MapAccuracy, ClassesAndRangesSplitThePoints) {

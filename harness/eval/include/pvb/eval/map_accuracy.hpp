@@ -12,6 +12,12 @@
 //                  form two layers more than 2 tau_ghost apart along the
 //                  normal, each of at least ghost_min_points (a surface
 //                  mapped twice); judged where there are that many at all
+//   ghosting between maps
+//                  for a map merged from several (sessions in one frame):
+//                  share of the surface points where two of them, each
+//                  with ghost_min_points there, lie more than 2 tau_ghost
+//                  apart along the normal (their median offsets); judged
+//                  where two maps have that many
 //
 // Each figure is given for the whole map, per surface class (a map point
 // takes the class of its nearest surface point) and per range bin (map
@@ -36,6 +42,7 @@ struct SurfacePoint {
 struct MapPoint {
   Eigen::Vector3d p_w = Eigen::Vector3d::Zero();
   double range_m = -1;  ///< camera distance it was measured at; < 0 unknown
+  int source = 0;       ///< which of several merged maps it came from
 };
 
 struct MapAccuracyOptions {
@@ -61,6 +68,8 @@ struct MapScores {
   double chamfer_m = 0;
   double ghosting = 0;                ///< share of the judged surface points
   std::size_t ghosting_judged = 0;    ///< surface points with enough map points around
+  double ghosting_between = 0;                ///< share of the surface points judged between maps
+  std::size_t ghosting_between_judged = 0;    ///< surface points with two maps around
 };
 
 struct MapAccuracy {
@@ -68,6 +77,7 @@ struct MapAccuracy {
   std::map<int, MapScores> per_class;
   std::vector<MapScores> per_range;  ///< one per range bin
   MapAccuracyOptions options;
+  int sources = 1;  ///< distinct MapPoint::source values (maps merged)
 };
 
 /// What one map point scored: the class of its nearest surface point and

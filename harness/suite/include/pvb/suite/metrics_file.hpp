@@ -60,6 +60,10 @@ struct MetricsFile {
   int version = 1;  ///< "metrics_version" (absent in version 1 files)
   std::string scenario;
   std::optional<unsigned long long> seed;
+  /// The station a day's run was made at ("world": "station_seed" and the
+  /// first of "base_files"); absent in runs of a scenario without a station.
+  std::optional<unsigned long long> station_seed;
+  std::string station_file;
   RunMetrics primary;                  ///< the top-level run (PE-SLAM with --compare)
   std::optional<RunMetrics> baseline;  ///< only with --compare
 };
@@ -78,6 +82,8 @@ struct FolderIdentity {
   std::string file;      ///< the file read
   std::string scenario;  ///< "" when the file names none
   std::optional<unsigned long long> seed;
+  std::optional<unsigned long long> station_seed;  ///< metrics.json's "world", when there
+  std::string station_file;
 };
 std::optional<FolderIdentity> read_folder_identity(const std::string& dir);
 
