@@ -206,9 +206,12 @@ void link_points(ByteReader r, const PointIdsByKf& ids, const std::map<std::uint
     for (std::size_t i = 0; i < pids.size(); ++i) {
       if (pids[i] == kNone) continue;
       const auto it = map->points().find(pids[i]);
-      const std::string where = "keyframe " + std::to_string(kf_id) + ", keypoint " + std::to_string(i);
-      if (it == map->points().end()) r.fail(where + ": point " + std::to_string(pids[i]) + " is not in the map");
-      if (!seen.insert(pids[i]).second) r.fail(where + ": point " + std::to_string(pids[i]) + " seen twice");
+      const auto fail = [&](const char* what) {  // the message is built only for a bad file
+        r.fail("keyframe " + std::to_string(kf_id) + ", keypoint " + std::to_string(i) + ": point " +
+               std::to_string(pids[i]) + what);
+      };
+      if (it == map->points().end()) fail(" is not in the map");
+      if (!seen.insert(pids[i]).second) fail(" seen twice");
       kf->set_map_point(i, it->second);
       it->second->add_observation(kf, i);
     }

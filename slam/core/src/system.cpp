@@ -164,6 +164,9 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
   {
     std::lock_guard<std::mutex> lock(map_.mutex());
     decode_map(bytes, path, head, cam_, &map_);
+    std::size_t words = 0;
+    for (const auto& [id, kf] : map_.keyframes()) words += kf->bow().size();
+    place_->reserve(map_.num_keyframes(), words);  // an upper bound on the distinct words
     for (const auto& [id, kf] : map_.keyframes()) {
       kf->set_fixed(start == MapStart::kExtend);
       if (kf->bow().empty()) place_->compute_bow(*kf);  // saved with the map (the same vocabulary)

@@ -47,6 +47,12 @@ void Database::add(std::uint64_t id, const BowVector& bow) {
   words_[id] = std::move(words);
 }
 
+void Database::reserve(std::size_t keyframes, std::size_t words) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  words_.reserve(keyframes);
+  inverted_.reserve(words);
+}
+
 void Database::erase(std::uint64_t id) {
   std::lock_guard<std::mutex> lock(mutex_);
   const auto it = words_.find(id);

@@ -31,6 +31,8 @@ class PlaceRecognizer {
   /// weights from then on: the keyframe's own bag is dropped.  Culled
   /// keyframes stay in it; queries skip keyframes no longer in the map or bad.
   void add(KeyFrame& kf);
+  /// Makes room for a loaded map's keyframes and the words of their bags.
+  void reserve(std::size_t keyframes, std::size_t words) { database_.reserve(keyframes, words); }
   /// A keyframe's bag: its own until add(), then the database's (the same
   /// words and weights).
   place::BowVector bag_of(const KeyFrame& kf) const;

@@ -35,6 +35,8 @@ class Database {
   };
   /// Adds (or replaces) a keyframe's bag.
   void add(std::uint64_t id, const BowVector& bow);
+  /// Makes room for this many keyframes and words (a map's worth, added at once).
+  void reserve(std::size_t keyframes, std::size_t words);
   /// Removes a keyframe (no-op when absent).
   void erase(std::uint64_t id);
   std::size_t size() const;
