@@ -7,6 +7,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "pvb/common/memory.hpp"
+#include "pvb/common/popcount.hpp"
 #include "pvb/slam/core/map.hpp"
 
 namespace pvb::slam {
@@ -278,7 +279,7 @@ int descriptor_distance(const unsigned char* a, const unsigned char* b) {
     std::uint64_t x, y;
     std::memcpy(&x, a + k, 8);
     std::memcpy(&y, b + k, 8);
-    d += __builtin_popcountll(x ^ y);
+    d += popcount64(x ^ y);
   }
   return d;
 }
