@@ -138,6 +138,10 @@ std::vector<eval::MapPoint> merged_in_world(const std::vector<std::string>& maps
   std::vector<eval::MapPoint> all;
   for (std::size_t i = 0; i < maps.size(); ++i) {
     std::size_t d = 0;
+    if (i > 0 && slam::dense::read_ply(maps[i]).empty()) {  // a session that added no keyframe
+      std::printf("map %s: no points (its session added no keyframe)\n", maps[i].c_str());
+      continue;
+    }
     std::vector<eval::MapPoint> one = run::map_in_world(read_map(maps[i], &d), to_world);
     for (eval::MapPoint& p : one) p.source = static_cast<int>(i);
     all.insert(all.end(), one.begin(), one.end());
