@@ -18,6 +18,9 @@ namespace pvb::slam {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+/// Best-scoring keyframes of the map, one by one, that a merge is also
+/// verified against (as a relocalisation is, Tracking.relocLookalikes).
+constexpr std::size_t kMergeLookalikes = 10;
 
 /// Nearest-rank quantile q of the values (0 for none).
 double quantile(std::vector<double> v, double q) {
@@ -136,6 +139,25 @@ LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand,
   if (out.accepted) out.stage = LoopMatch::Stage::kAccepted;
   return out;
 }
+
+namespace {
+
+/// The grouped candidates of a merge can all lie at one of two look-alike
+/// places (a ground texture repeating along the route), and no later check
+/// tells them apart: the map's best-scoring keyframes one by one are
+/// verified too, and the camera centre of each that verifies is added to
+/// `centres_w` for the ambiguity check.
+void add_lookalikes(const PlaceRecognizer& place, const Map& map, const LoopClosingOptions& options,
+                    const KeyFrame& kf, const std::vector<std::shared_ptr<KeyFrame>>& tried,
+                    std::vector<Eigen::Vector3d>* centres_w) {
+  for (const auto& c : place.lookalike_candidates(map, place.bag_of(kf), kMergeLookalikes)) {
+    if (map.map_of(*c) != 0 || std::find(tried.begin(), tried.end(), c) != tried.end()) continue;
+    const LoopMatch m = verify_loop(kf, c, options);
+    if (m.accepted) centres_w->push_back(m.T_c_w.inverse().translation());
+  }
+}
+
+}  // namespace
 
 LoopMatch verify_at(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, const geom::SE3d& T_c_w,
                     const LoopClosingOptions& options) {
@@ -304,6 +326,8 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
     }
     if (!options_.ambiguity_check) break;  // ORB-SLAM2: the first verified candidate
   }
+  if (merge && loop_kf && options_.ambiguity_check && place_)
+    add_lookalikes(*place_, map_, options_, *kf, consistent, &verified_centres_w);
   bool ambiguous = false;
   for (std::size_t i = 0; i < verified_centres_w.size() && options_.ambiguity_check; ++i)
     for (std::size_t j = i + 1; j < verified_centres_w.size(); ++j)
