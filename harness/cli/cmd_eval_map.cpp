@@ -72,9 +72,6 @@ void print_alignment_gap(run::MapAlignment used, const eval::Sim3Transform& to_w
               1000 * (to_world.apply(c) - b.apply(c)).norm());
 }
 
-/// The scenario and seed that the map's and the ground truth's folders say
-/// they were made from (a run's metrics.json, a recording's meta.json), if
-/// any, must be the ones given: a map is never scored against another world.
 std::string folder_of(const std::string& file) {
   const std::size_t slash = file.rfind('/');
   return slash == std::string::npos ? std::string(".") : file.substr(0, slash);
@@ -93,6 +90,10 @@ void check_same_station(const suite::FolderIdentity& first, const std::string& m
                       id->station_file + " seed " + std::to_string(*id->station_seed));
 }
 
+/// The scenario and seed that the map's and the ground truth's folders say
+/// they were made from (a run's metrics.json, a recording's meta.json), if
+/// any, must be the ones given: a map is never scored against another world.
+/// Further maps must come from runs at the first map's station.
 void check_inputs_match(const scenes::Scenario& scenario, const EvalMapArgs& a) {
   for (const std::string& dir : {folder_of(a.maps.front()), folder_of(a.gt)}) {
     const std::optional<suite::FolderIdentity> id = suite::read_folder_identity(dir);
@@ -113,11 +114,11 @@ void check_inputs_match(const scenes::Scenario& scenario, const EvalMapArgs& a) 
 
 /// The map's points, refusing a map with none: an empty map scores nothing,
 /// never a perfect accuracy.
-slam::dense::PointCloud read_map(const std::string& path, std::size_t* dropped) {
+slam::dense::PointCloud read_map(const std::string& path, std::size_t* dropped, bool may_be_empty = false) {
   slam::dense::PlyReadStats stats;
   slam::dense::PointCloud cloud = slam::dense::read_ply(path, &stats);
   *dropped = stats.non_finite_dropped;
-  if (cloud.empty())
+  if (cloud.empty() && !may_be_empty)
     throw IoError(path, "the map has no points to score" +
                             (*dropped ? " (" + std::to_string(*dropped) + " vertices with a NaN or infinite coordinate)"
                                       : std::string()));
@@ -138,11 +139,12 @@ std::vector<eval::MapPoint> merged_in_world(const std::vector<std::string>& maps
   std::vector<eval::MapPoint> all;
   for (std::size_t i = 0; i < maps.size(); ++i) {
     std::size_t d = 0;
-    if (i > 0 && slam::dense::read_ply(maps[i]).empty()) {  // a session that added no keyframe
+    const slam::dense::PointCloud cloud = read_map(maps[i], &d, i > 0);
+    if (cloud.empty()) {  // a further map: a session that added no keyframe
       std::printf("map %s: no points (its session added no keyframe)\n", maps[i].c_str());
       continue;
     }
-    std::vector<eval::MapPoint> one = run::map_in_world(read_map(maps[i], &d), to_world);
+    std::vector<eval::MapPoint> one = run::map_in_world(cloud, to_world);
     for (eval::MapPoint& p : one) p.source = static_cast<int>(i);
     all.insert(all.end(), one.begin(), one.end());
     *dropped += d;

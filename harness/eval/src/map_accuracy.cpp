@@ -84,18 +84,12 @@ int two_layers(std::vector<double> offsets, const MapAccuracyOptions& o) {
   return 0;
 }
 
-double median_of(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 /// Two source maps apart: the median offsets of the sources with k points
 /// span more than 2 tau.
 int maps_apart(const std::map<int, std::vector<double>>& by_source, const MapAccuracyOptions& o) {
   std::vector<double> medians;
   for (const auto& [source, offsets] : by_source)
-    if (offsets.size() >= static_cast<std::size_t>(o.ghost_min_points)) medians.push_back(median_of(offsets));
+    if (offsets.size() >= static_cast<std::size_t>(o.ghost_min_points)) medians.push_back(summarise(offsets).median);
   if (medians.size() < 2) return -1;
   const auto [lo, hi] = std::minmax_element(medians.begin(), medians.end());
   return *hi - *lo > 2.0 * o.ghost_tau_m ? 1 : 0;
