@@ -203,6 +203,7 @@ std::string to_json(const LoopClosingStats& stats) {
          ", \"refused_ambiguous\": " + std::to_string(stats.refused_ambiguous) +
          ", \"merge_confirmed\": " + std::to_string(stats.merge_confirmed) +
          ", \"merge_unconfirmed\": " + std::to_string(stats.merge_unconfirmed) +
+         ", \"merge_suggested\": " + std::to_string(stats.merge_suggested) +
          ", \"verified\": " + std::to_string(stats.verified) +
          ", \"refused_matches\": " + std::to_string(stats.refused_matches) +
          ", \"refused_ransac\": " + std::to_string(stats.refused_ransac) +
@@ -401,6 +402,16 @@ bool LoopClosing::confirm_merge(const std::shared_ptr<KeyFrame>& kf, LoopMatch* 
   *loop_kf = p.anchor;
   pending_merge_.reset();
   return true;
+}
+
+void LoopClosing::suggest_merge(std::uint32_t from, const geom::SE3d& T_into_from, std::shared_ptr<KeyFrame> anchor) {
+  if (!options_.enabled || !anchor) return;
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  if (pending_merge_ || from == 0 || anchor->bad() || map_.map_of(*anchor) != 0) return;
+  pending_merge_ = PendingMerge{from, T_into_from, std::move(anchor), 1};
+  groups_.clear();
+  std::lock_guard<std::mutex> s(stats_mutex_);
+  ++stats_.merge_suggested;
 }
 
 bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {

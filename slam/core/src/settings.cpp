@@ -313,6 +313,7 @@ Settings read_settings(const std::string& path) {
   s.align_patches = r.flag("Tracking.alignPatches", false, s.align_patches);  // ours, optional
   s.reloc_lookalikes = r.integer("Tracking.relocLookalikes", false, s.reloc_lookalikes, 0, 1000);  // ours, optional
   s.new_map_after_lost = r.integer("Tracking.newMapAfter", false, s.new_map_after_lost, 0, 100000);  // ours, optional
+  s.merge_reloc_every = r.integer("Tracking.mergeRelocEvery", false, s.merge_reloc_every, 0, 100000);  // ours, optional
   read_pe_match(r, &s.pe_match);
   read_keyframe(r, &s.keyframe);
   read_point_cloud(r, &s.dense);

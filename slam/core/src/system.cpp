@@ -42,6 +42,7 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.reloc_ambiguity_distance_m = settings.loop.ambiguity_distance_m;
   topt.reloc_lookalikes = settings.reloc_lookalikes;
   topt.new_map_after_lost = settings.new_map_after_lost;
+  topt.merge_reloc_every = settings.merge_reloc_every;
   if (settings.vocabulary_path != "none") {
     auto vocabulary = std::make_shared<const place::Vocabulary>(place::Vocabulary::load(settings.vocabulary_path));
     vocabulary_fingerprint_ = vocabulary->fingerprint();
@@ -97,6 +98,8 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
   Frame frame(next_frame_id_++, in.t_ns, std::move(features), in.depth_m, cam_);
   if (settings_.align_patches) frame.pyramid = std::make_shared<const ImagePyramid>(copy_pyramid(extractor_.pyramid()));
   std::shared_ptr<KeyFrame> kf = tracking_->track(std::move(frame), mapping_->idle(), mapping_->queue_size());
+  if (auto hint = tracking_->take_merge_hint(); hint && loop_)
+    loop_->suggest_merge(hint->from, hint->T_into_from, hint->anchor);
   out.tracking_ms = ms_since(t0);
   out.state = tracking_->state();
   out.tracking = tracking_->stats();

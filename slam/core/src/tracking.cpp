@@ -87,6 +87,7 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
     if (ok) stats_.method = TrackingMethod::kRelocalization;
   }
   if (ok) ok = track_local_map(f);
+  if (ok) probe_merge(f);
   if (ok && stats_.method == TrackingMethod::kRelocalization) record_relocalisation(f);
   state_ = ok ? TrackingState::kOk : TrackingState::kLost;
   lost_in_row_ = ok ? 0 : lost_in_row_ + 1;
@@ -350,6 +351,17 @@ int Tracking::relocalize_against(Frame& f, const KeyFrame& kf, const place::Feat
 }
 
 bool Tracking::relocalize(Frame& f) {
+  std::shared_ptr<KeyFrame> kf;
+  int candidates = 0;
+  if (std::string why = relocalise_in(f, std::nullopt, &kf, &candidates); !why.empty()) return fail(why);
+  last_reloc_frame_id_ = f.id;
+  reloc_kf_ = std::move(kf);
+  reloc_candidates_ = candidates;
+  return true;
+}
+
+std::string Tracking::relocalise_in(Frame& f, std::optional<std::uint32_t> only_map, std::shared_ptr<KeyFrame>* kf_out,
+                                    int* candidates) {
   // Candidates from the bag of words anywhere in the map (ORB-SLAM2
   // DetectRelocalizationCandidates), or the recent keyframes without one.
   place::FeatureVector f_features;
@@ -358,6 +370,9 @@ bool Tracking::relocalize(Frame& f) {
   if (place_) {
     place_->transform(f, &bow, &f_features);
     cands = place_->relocalisation_candidates(map_, bow);
+    if (only_map)
+      cands.erase(std::remove_if(cands.begin(), cands.end(), [&](const auto& k) { return map_.map_of(*k) != *only_map; }),
+                  cands.end());
     if (cands.size() > kMaxRelocCandidates) cands.resize(kMaxRelocCandidates);
   } else {
     cands = recent_keyframes();
@@ -379,33 +394,45 @@ bool Tracking::relocalize(Frame& f) {
   }
   std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
   if (found.empty())
-    return fail("relocalisation: no candidate keyframe matched (" + std::to_string(cands.size()) +
-                " candidates, best " + std::to_string(best_matches) + " descriptor matches (need 15), best " +
-                std::to_string(best_inliers) + " pose inliers (need " + std::to_string(kRelocMinInliers) + "))");
+    return "relocalisation: no candidate keyframe matched (" + std::to_string(cands.size()) + " candidates, best " +
+           std::to_string(best_matches) + " descriptor matches (need 15), best " + std::to_string(best_inliers) +
+           " pose inliers (need " + std::to_string(kRelocMinInliers) + "))";
   for (std::size_t i = 0; i < found.size(); ++i)
     for (std::size_t j = i + 1; j < found.size(); ++j)
       if ((found[i].first.camera_center_w() - found[j].first.camera_center_w()).norm() >
           options_.reloc_ambiguity_distance_m)
-        return fail("relocalisation: ambiguous (keyframes " + std::to_string(found[i].second->id()) + " and " +
-                    std::to_string(found[j].second->id()) + " both matched, at places " +
-                    format_fixed((found[i].first.camera_center_w() - found[j].first.camera_center_w()).norm(), 2) +
-                    " m apart)");
+        return "relocalisation: ambiguous (keyframes " + std::to_string(found[i].second->id()) + " and " +
+               std::to_string(found[j].second->id()) + " both matched, at places " +
+               format_fixed((found[i].first.camera_center_w() - found[j].first.camera_center_w()).norm(), 2) +
+               " m apart)";
   const std::size_t best = static_cast<std::size_t>(
       std::max_element(found_inliers.begin(), found_inliers.end()) - found_inliers.begin());
   if (place_ && options_.reloc_ambiguity_check && options_.reloc_lookalikes > 0) {
-    const std::string why = lookalike(f, found[best].first, bow, f_features, cands);
-    if (!why.empty()) return fail(why);
+    std::string why = lookalike(f, found[best].first, bow, f_features, cands, only_map);
+    if (!why.empty()) return why;
   }
   f = std::move(found[best].first);
-  last_reloc_frame_id_ = f.id;
-  reloc_kf_ = found[best].second;
-  reloc_candidates_ = static_cast<int>(cands.size());
-  return true;
+  *kf_out = found[best].second;
+  *candidates = static_cast<int>(cands.size());
+  return {};
+}
+
+void Tracking::probe_merge(const Frame& f) {
+  if (!place_ || options_.merge_reloc_every <= 0 || !ref_kf_) return;
+  const std::uint32_t from = map_.map_of(*ref_kf_);
+  if (from == 0 || ++since_merge_probe_ < options_.merge_reloc_every) return;
+  since_merge_probe_ = 0;
+  Frame probe = f;
+  std::shared_ptr<KeyFrame> kf;
+  int candidates = 0;
+  if (!relocalise_in(probe, 0u, &kf, &candidates).empty()) return;
+  merge_hint_ = MergeHint{from, probe.T_c_w.inverse() * f.T_c_w, std::move(kf), f.id};
 }
 
 std::string Tracking::lookalike(const Frame& f, const Frame& found, const place::BowVector& bow,
                                 const place::FeatureVector& f_features,
-                                const std::vector<std::shared_ptr<KeyFrame>>& tried) {
+                                const std::vector<std::shared_ptr<KeyFrame>>& tried,
+                                std::optional<std::uint32_t> only_map) {
   // The grouped candidates can all lie at one of two look-alike places (a
   // ground texture repeating along the route): the best-scoring keyframes
   // one by one are tried too, and one matching elsewhere makes it ambiguous.
@@ -424,12 +451,13 @@ std::string Tracking::lookalike(const Frame& f, const Frame& found, const place:
     return "relocalisation: ambiguous (look-alike keyframe " + std::to_string(kf.id()) + " matched at a place " +
            format_fixed(apart_m, 2) + " m from the candidates')";
   };
+  const auto other_map = [&](const KeyFrame& kf) { return only_map && map_.map_of(kf) != *only_map; };
   for (const auto& kf : place_->lookalike_candidates(map_, bow, static_cast<std::size_t>(options_.reloc_lookalikes))) {
-    if (!seen.insert(kf->id()).second) continue;
+    if (other_map(*kf) || !seen.insert(kf->id()).second) continue;
     if (std::string why = matches_elsewhere(*kf); !why.empty()) return why;
     if ((kf->camera_center_w() - found.camera_center_w()).norm() <= far_m) continue;
     for (const auto& n : kf->best_covisibles(kLookalikeNeighbours)) {
-      if (n->bad() || !seen.insert(n->id()).second) continue;
+      if (n->bad() || other_map(*n) || !seen.insert(n->id()).second) continue;
       if (std::string why = matches_elsewhere(*n); !why.empty()) return why;
     }
   }

@@ -196,6 +196,68 @@ TEST(LoopVerification, AMergeIsConfirmedOnlyNearThePredictedPose) {
   EXPECT_FALSE(verify_at(*kf1, kf0, pose(184, 0.12, -0.05), test_options()).accepted);
 }
 
+/// Two keyframes of a provisional map whose frame lies at T_w_p in the
+/// map's own frame (their true poses `truth`, made in that frame).
+std::vector<std::shared_ptr<KeyFrame>> add_provisional(Map& map, const cv::Mat& tex, const geom::SE3d& T_w_p,
+                                                       const std::vector<geom::SE3d>& truth) {
+  const std::uint32_t m = map.begin_provisional();
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  for (const geom::SE3d& T : truth) {
+    kfs.push_back(add_keyframe(map, tex, T, T * T_w_p));
+    kfs.back()->set_provisional(m);
+  }
+  kfs.front()->make_root();
+  return kfs;
+}
+
+// A merge suggested by a relocalisation in the map counts as its first
+// match: the provisional map's next two keyframes confirm it and the
+// second one merges the maps, every keyframe back on its true pose.
+TEST(LoopClosing, AMergeSuggestedByARelocalisationIsConfirmedThenMerged) {
+  Map map;
+  const cv::Mat tex = make_texture(1);
+  auto kf0 = add_keyframe(map, tex, pose(0, 0, 0), pose(0, 0, 0));
+  const geom::SE3d T_w_p = pose(70, 3.0, 1.0).inverse();  // the provisional map's frame: anywhere
+  const std::vector<geom::SE3d> truth = {pose(3, 0.10, 0), pose(2, 0.06, 0.02)};
+  const auto kfs = add_provisional(map, tex, T_w_p, truth);
+  LoopClosingOptions o = test_options();
+  o.global_ba = false;
+  LoopClosing lc(map, o);
+  // As tracking finds it: a frame's pose in the map against its pose in the provisional map.
+  lc.suggest_merge(map.map_of(*kfs[0]), drifted(truth[0]).inverse() * kfs[0]->T_c_w(), kf0);
+  EXPECT_FALSE(lc.process(kfs[0]));  // confirmed: 2 of 3
+  EXPECT_TRUE(lc.process(kfs[1]));   // confirmed: 3 of 3, merged
+  const LoopClosingStats s = lc.stats();
+  EXPECT_EQ(s.merge_suggested, 1);
+  EXPECT_EQ(s.merge_confirmed, 2);
+  ASSERT_EQ(s.loops.size(), 1u);
+  EXPECT_TRUE(s.loops[0].merge);
+  for (std::size_t k = 0; k < kfs.size(); ++k) {
+    EXPECT_EQ(map.map_of(*kfs[k]), 0u) << "keyframe " << k;
+    EXPECT_LT(centre_error_m(kfs[k]->T_c_w(), truth[k]), 0.01) << "keyframe " << k;
+  }
+}
+
+// A suggestion a metre off is not confirmed by the next keyframe: dropped, nothing merged.
+TEST(LoopClosing, AMergeSuggestedAMetreOffIsDropped) {
+  Map map;
+  const cv::Mat tex = make_texture(1);
+  auto kf0 = add_keyframe(map, tex, pose(0, 0, 0), pose(0, 0, 0));
+  const geom::SE3d T_w_p = pose(70, 3.0, 1.0).inverse();
+  const std::vector<geom::SE3d> truth = {pose(3, 0.10, 0), pose(2, 0.06, 0.02)};
+  const auto kfs = add_provisional(map, tex, T_w_p, truth);
+  LoopClosing lc(map, test_options());
+  const geom::SE3d metre_off =
+      truth[0] * geom::make_se3(geom::so3_exp(Eigen::Vector3d::Zero()), Eigen::Vector3d(1.0, 0, 0));
+  lc.suggest_merge(map.map_of(*kfs[0]), metre_off.inverse() * kfs[0]->T_c_w(), kf0);
+  EXPECT_FALSE(lc.process(kfs[0]));
+  const LoopClosingStats s = lc.stats();
+  EXPECT_EQ(s.merge_suggested, 1);
+  EXPECT_EQ(s.merge_unconfirmed, 1);
+  EXPECT_TRUE(s.loops.empty());
+  EXPECT_NE(map.map_of(*kfs[0]), 0u);
+}
+
 TEST(LoopClosing, CountsAVerifiedPlaceBeyondTheCorrectionBound) {
   Map map;
   const cv::Mat tex = make_texture(1);

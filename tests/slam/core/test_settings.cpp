@@ -412,6 +412,26 @@ TEST(Settings, ReadsPlaceRecognitionKeys) {
   }
 }
 
+TEST(Settings, ReadsMapReuseTrackingKeys) {
+  const Settings d = read_settings(kTum1);
+  EXPECT_EQ(d.reloc_lookalikes, 10);
+  EXPECT_EQ(d.new_map_after_lost, 30);
+  EXPECT_EQ(d.merge_reloc_every, 5);
+  const Settings s = read_settings(temp_copy("reuse", read_file(kTum1) +
+                                                          "\nTracking.relocLookalikes: 4\nTracking.newMapAfter: 0\n"
+                                                          "Tracking.mergeRelocEvery: 0\n"));
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_EQ(s.reloc_lookalikes, 4);
+  EXPECT_EQ(s.new_map_after_lost, 0);
+  EXPECT_EQ(s.merge_reloc_every, 0);
+  try {
+    read_settings(temp_copy("bad_reuse", read_file(kTum1) + "\nTracking.mergeRelocEvery: -1\n"));
+    ADD_FAILURE() << "a negative Tracking.mergeRelocEvery was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "Tracking.mergeRelocEvery") << e.what();
+  }
+}
+
 // OpenCV's parser reads the first of two equal keys and ignores the second:
 // a key given twice is an error naming both lines.
 TEST(Settings, DuplicateKeyNamesBothLines) {

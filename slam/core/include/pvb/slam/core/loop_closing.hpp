@@ -38,7 +38,9 @@
 // transform is held back until `merge_confirmations` keyframes of the
 // provisional map in a row have been verified at the pose it predicts, by
 // projecting the map's points around the last match (ORB-SLAM3 asks for
-// three).
+// three).  Tracking offers a second way in (suggest_merge): a frame of the
+// provisional map relocalised among the map's keyframes, with the
+// relocalisation's look-alike checks, counts as the first match.
 //
 // Step 1 by default asks the bag-of-words database (PlaceRecognizer:
 // ORB-SLAM2's DetectLoopCandidates) instead of pose proximity, and step 3
@@ -130,6 +132,7 @@ struct LoopClosingStats {
   int refused_ambiguous = 0;      ///< of those, verified at two places apart
   int merge_confirmed = 0;        ///< keyframes that confirmed a held-back merge transform
   int merge_unconfirmed = 0;      ///< held-back merge transforms the next keyframe did not confirm (dropped)
+  int merge_suggested = 0;        ///< merge transforms held back from a relocalisation (suggest_merge)
   /// Per candidate verified (step 3), the stage that refused it.
   int verified = 0;               ///< candidates verified
   int refused_matches = 0;        ///< fewer than min_matches descriptor matches
@@ -187,6 +190,13 @@ class LoopClosing {
   /// has just processed.  Takes the map mutex.  Returns true when a loop
   /// was closed.
   bool process(const std::shared_ptr<KeyFrame>& kf);
+
+  /// A merge hypothesis from tracking: provisional map `from` lies at
+  /// T_into_from in the map's own frame, found around the map's keyframe
+  /// `anchor` (a frame relocalised there).  Held back as a first match
+  /// that the provisional map's next keyframes confirm, unless a merge
+  /// transform is held back already.  Takes the map mutex.
+  void suggest_merge(std::uint32_t from, const geom::SE3d& T_into_from, std::shared_ptr<KeyFrame> anchor);
 
   LoopClosingStats stats() const;
   const LoopClosingOptions& options() const { return options_; }

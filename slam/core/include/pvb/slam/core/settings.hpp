@@ -95,6 +95,10 @@ struct Settings {
   /// which an extending run begins a provisional map
   /// (TrackingOptions::new_map_after_lost); 0: never.
   int new_map_after_lost = 30;
+  /// Tracking.mergeRelocEvery (ours, optional): while in a provisional
+  /// map, frames between tries to relocalise in the loaded map
+  /// (TrackingOptions::merge_reloc_every); 0: never.
+  int merge_reloc_every = 5;
   PeMatchSettings pe_match;         ///< PEMatch.* (optional section)
   KeyFrameSettings keyframe;        ///< KeyFrame.* (optional section)
   PointCloudMappingSettings dense;  ///< PointCloudMapping.* (optional section)

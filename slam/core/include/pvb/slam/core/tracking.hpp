@@ -8,6 +8,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pvb/slam/core/map.hpp"
@@ -125,6 +126,21 @@ struct TrackingOptions {
   /// frame (the robot started or went outside the map); loop closing
   /// merges it into the map when it finds the map.  0: never.
   int new_map_after_lost = 30;
+  /// Tracking.mergeRelocEvery: while tracking in a provisional map, every
+  /// this many frames tracked the frame is also relocalised among the
+  /// loaded map's keyframes alone (with the look-alike checks); a success
+  /// is a merge hypothesis for loop closing (take_merge_hint).  0: never.
+  int merge_reloc_every = 5;
+};
+
+/// A provisional map's frame in the map's own, from one frame tracked in
+/// the provisional map and relocalised in the map (a merge hypothesis,
+/// LoopClosing::suggest_merge).
+struct MergeHint {
+  std::uint32_t from = 0;            ///< the provisional map
+  geom::SE3d T_into_from;            ///< its frame into the map's own
+  std::shared_ptr<KeyFrame> anchor;  ///< the map's keyframe the relocalisation matched
+  std::uint64_t frame_id = 0;        ///< the frame relocalised
 };
 
 /// "Already seen in this pass" marks for map-point ids: a pass stamp per
@@ -174,6 +190,9 @@ class Tracking {
   const std::vector<RelocEvent>& relocalisations() const { return relocs_; }
   /// Reference keyframe of the last frame tracked.
   std::shared_ptr<KeyFrame> reference_keyframe() const { return ref_kf_; }
+  /// The merge hypothesis found since the last call, if any
+  /// (TrackingOptions::merge_reloc_every).
+  std::optional<MergeHint> take_merge_hint() { return std::exchange(merge_hint_, std::nullopt); }
 
  private:
   bool initialize(Frame& f);
@@ -184,6 +203,16 @@ class Tracking {
   double translation_parallax_px(const std::vector<IndexMatch>& m, const geom::SE3d& T_cur_last) const;
   bool track_reference_keyframe(Frame& f);
   bool relocalize(Frame& f);
+  /// Global relocalisation of f among the keyframes of map `only_map` (of
+  /// any map without one), with the ambiguity and look-alike checks:
+  /// empty with f at its pose, *kf the keyframe matched and *candidates
+  /// the candidates tried, or why it failed (f's matches cleared).
+  std::string relocalise_in(Frame& f, std::optional<std::uint32_t> only_map, std::shared_ptr<KeyFrame>* kf,
+                            int* candidates);
+  /// While tracking in a provisional map: relocalises a copy of f in the
+  /// loaded map every merge_reloc_every frames; a success is kept as
+  /// merge_hint_.
+  void probe_merge(const Frame& f);
   /// Relocalisation candidates without a vocabulary.
   std::vector<std::shared_ptr<KeyFrame>> recent_keyframes() const;
   /// Matches f against kf (through the direct index when f_features is
@@ -194,7 +223,8 @@ class Tracking {
   /// best-scoring keyframes not among `tried` (and the best covisibles of
   /// those at another place), or empty.
   std::string lookalike(const Frame& f, const Frame& found, const place::BowVector& bow,
-                        const place::FeatureVector& f_features, const std::vector<std::shared_ptr<KeyFrame>>& tried);
+                        const place::FeatureVector& f_features, const std::vector<std::shared_ptr<KeyFrame>>& tried,
+                        std::optional<std::uint32_t> only_map);
   static constexpr std::size_t kMaxRelocCandidates = 20;
   /// Pose inliers a relocalisation candidate needs (ORB-SLAM2: 50).
   static constexpr int kRelocMinInliers = 50;
@@ -229,6 +259,8 @@ class Tracking {
   bool may_begin_map_ = false;     ///< extending a loaded map: a long loss begins a provisional map
   int lost_in_row_ = 0;            ///< frames lost since the last one tracked
   std::uint32_t provisional_ = 0;  ///< the provisional map the next initialisation begins (0: none)
+  int since_merge_probe_ = 0;      ///< frames tracked in a provisional map since the last probe_merge
+  std::optional<MergeHint> merge_hint_;
 
   Frame last_;
   bool last_is_keyframe_ = false;
