@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <set>
 #include <sstream>
 
 #include "map_file_bytes.hpp"
@@ -36,7 +35,11 @@ void put_pose(ByteWriter& w, const geom::SE3d& T) {
   for (int r = 0; r < 3; ++r) w.f64(T.translation()(r));
 }
 
-void put_keyframe(ByteWriter& w, const KeyFrame& kf, const std::set<std::uint64_t>& point_ids) {
+/// Ids in ascending order (of the keyframes or points saved).
+using SortedIds = std::vector<std::uint64_t>;
+bool has(const SortedIds& ids, std::uint64_t id) { return std::binary_search(ids.begin(), ids.end(), id); }
+
+void put_keyframe(ByteWriter& w, const KeyFrame& kf, const SortedIds& point_ids) {
   const Frame& f = kf.frame();
   w.u64(kf.id());
   w.u64(f.id);
@@ -55,20 +58,20 @@ void put_keyframe(ByteWriter& w, const KeyFrame& kf, const std::set<std::uint64_
     const auto& mp = f.map_points[i];
     // A keyframe can hold a point at a second keypoint after fusion; the
     // point's own observation says which one counts.
-    const bool observed = mp && !mp->bad() && point_ids.count(mp->id()) &&
+    const bool observed = mp && !mp->bad() && has(point_ids, mp->id()) &&
                           mp->index_in(kf.id()) == static_cast<long>(i);
     w.u64(observed ? mp->id() : kNone);
     w.bytes(f.descriptors.ptr<unsigned char>(static_cast<int>(i)), 32);
   }
 }
 
-void put_graph(ByteWriter& w, const KeyFrame& kf, const std::set<std::uint64_t>& kf_ids) {
+void put_graph(ByteWriter& w, const KeyFrame& kf, const SortedIds& kf_ids) {
   w.u64(kf.id());
   const auto parent = kf.parent();
-  w.u64(parent && kf_ids.count(parent->id()) ? parent->id() : kNone);
+  w.u64(parent && has(kf_ids, parent->id()) ? parent->id() : kNone);
   std::vector<std::pair<std::uint64_t, int>> edges;
   for (const auto& [id, weight] : kf.connection_weights())
-    if (kf_ids.count(id)) edges.emplace_back(id, weight);
+    if (has(kf_ids, id)) edges.emplace_back(id, weight);
   w.u64(edges.size());
   for (const auto& [id, weight] : edges) {
     w.u64(id);
@@ -76,7 +79,7 @@ void put_graph(ByteWriter& w, const KeyFrame& kf, const std::set<std::uint64_t>&
   }
   std::vector<std::uint64_t> loops;
   for (const auto& k : kf.loop_edges())
-    if (kf_ids.count(k->id())) loops.push_back(k->id());
+    if (has(kf_ids, k->id())) loops.push_back(k->id());
   w.u64(loops.size());
   for (std::uint64_t id : loops) w.u64(id);
 }
@@ -110,23 +113,26 @@ void put_section(ByteWriter& out, const char* tag, const std::string& payload) {
 std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
                        const std::string& app_json, const BagOf& bag_of) {
   std::vector<std::shared_ptr<KeyFrame>> kfs;
-  std::set<std::uint64_t> kf_ids;
+  SortedIds kf_ids;  // the maps iterate in id order
+  std::size_t keypoints = 0;
   for (const auto& [id, kf] : map.keyframes())
     if (!kf->bad() && map.map_of(*kf) == 0) {
       kfs.push_back(kf);
-      kf_ids.insert(id);
+      kf_ids.push_back(id);
+      keypoints += kf->frame().size();
     }
   // A point seen only by keyframes left out is left out too.
-  std::set<std::uint64_t> point_ids;
+  SortedIds point_ids;
   for (const auto& [id, mp] : map.points()) {
     const auto& obs = mp->observations();
     const bool seen =
-        obs.empty() || std::any_of(obs.begin(), obs.end(), [&](const auto& o) { return kf_ids.count(o.first) > 0; });
-    if (!mp->bad() && seen) point_ids.insert(id);
+        obs.empty() || std::any_of(obs.begin(), obs.end(), [&](const auto& o) { return has(kf_ids, o.first); });
+    if (!mp->bad() && seen) point_ids.push_back(id);
   }
 
   ByteWriter head, keyf, poin, grap, bowv;
   put_settings(head, settings, sessions);
+  keyf.reserve(8 + kfs.size() * (8 + 8 + 8 + 4 + 96 + 4) + keypoints * kKeypointBytes);
   keyf.u64(kfs.size());
   for (const auto& kf : kfs) put_keyframe(keyf, *kf, point_ids);
   poin.u64(point_ids.size());
@@ -135,7 +141,7 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
     poin.u64(id);
     for (int r = 0; r < 3; ++r) poin.f64(mp.p_w()(r));
     const auto ref = mp.reference_keyframe();
-    poin.u64(ref && !ref->bad() && kf_ids.count(ref->id()) ? ref->id() : kNone);
+    poin.u64(ref && !ref->bad() && has(kf_ids, ref->id()) ? ref->id() : kNone);
     poin.u64(mp.first_kf_id());
     poin.i32(mp.visible());
     poin.i32(mp.found());
@@ -145,6 +151,10 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   for (const auto& kf : kfs) put_bow(bowv, *kf, bag_of);
 
   ByteWriter out;
+  std::size_t total = kMagicBytes + 8;
+  for (const std::string* p : {&head.data(), &keyf.data(), &poin.data(), &grap.data(), &bowv.data(), &app_json})
+    total += 4 + 8 + p->size() + 8;
+  out.reserve(total);
   out.bytes(kMagic, kMagicBytes);
   out.u32(kMapFileVersion);
   out.u32(static_cast<std::uint32_t>(kSections.size()));

@@ -35,11 +35,14 @@ class ByteWriter {
     le(b, 8);
   }
   void bytes(const void* p, std::size_t n) { data_.append(static_cast<const char*>(p), n); }
+  void reserve(std::size_t n) { data_.reserve(n); }
   const std::string& data() const { return data_; }
 
  private:
   void le(std::uint64_t v, int n) {
-    for (int i = 0; i < n; ++i) data_.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+    char b[8];  // one append of n bytes (a loop of push_back was most of a save)
+    for (int i = 0; i < n; ++i) b[i] = static_cast<char>((v >> (8 * i)) & 0xff);
+    data_.append(b, static_cast<std::size_t>(n));
   }
   std::string data_;
 };

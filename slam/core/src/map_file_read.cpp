@@ -5,7 +5,7 @@
 #include <array>
 #include <cmath>
 #include <map>
-#include <set>
+#include <unordered_map>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -176,13 +176,15 @@ std::map<std::uint64_t, SavedPoint> read_points(ByteReader r, const Map& map) {
     p.first = r.u64();
     p.visible = r.i32();
     p.found = r.i32();
-    const std::string what = "point " + std::to_string(id);
-    if (id == kNone || out.count(id)) r.fail(what + " given twice");
-    if (!p.p_w.allFinite()) r.fail(what + " has a position that is not finite");
+    const auto fail = [&](const std::string& why) { r.fail("point " + std::to_string(id) + why); };
+    // Saved in id order: a hint at the end makes each insertion constant time.
+    const bool after_last = out.empty() || out.rbegin()->first < id;
+    if (id == kNone || (!after_last && out.count(id))) fail(" given twice");
+    if (!p.p_w.allFinite()) fail(" has a position that is not finite");
     if (p.ref != kNone && !map.keyframes().count(p.ref))
-      r.fail(what + ": its reference keyframe " + std::to_string(p.ref) + " is not in the map");
-    if (p.visible < 0 || p.found < 0) r.fail(what + " has negative counts");
-    out[id] = p;
+      fail(": its reference keyframe " + std::to_string(p.ref) + " is not in the map");
+    if (p.visible < 0 || p.found < 0) fail(" has negative counts");
+    out.emplace_hint(after_last ? out.end() : out.lower_bound(id), id, p);
   }
   if (!r.at_end()) r.fail("longer than its points");
   return out;
@@ -190,7 +192,8 @@ std::map<std::uint64_t, SavedPoint> read_points(ByteReader r, const Map& map) {
 
 /// Creates the points and their observations from the keyframes' side.
 void link_points(ByteReader r, const PointIdsByKf& ids, const std::map<std::uint64_t, SavedPoint>& saved, Map* map) {
-  std::map<std::uint64_t, std::uint64_t> first_observer;
+  std::unordered_map<std::uint64_t, std::uint64_t> first_observer;
+  first_observer.reserve(saved.size());
   for (const auto& [kf_id, pids] : ids)
     for (std::uint64_t pid : pids)
       if (pid != kNone) first_observer.emplace(pid, kf_id);
@@ -202,7 +205,6 @@ void link_points(ByteReader r, const PointIdsByKf& ids, const std::map<std::uint
   }
   for (const auto& [kf_id, pids] : ids) {
     const auto& kf = map->keyframes().at(kf_id);
-    std::set<std::uint64_t> seen;
     for (std::size_t i = 0; i < pids.size(); ++i) {
       if (pids[i] == kNone) continue;
       const auto it = map->points().find(pids[i]);
@@ -211,7 +213,7 @@ void link_points(ByteReader r, const PointIdsByKf& ids, const std::map<std::uint
                std::to_string(pids[i]) + what);
       };
       if (it == map->points().end()) fail(" is not in the map");
-      if (!seen.insert(pids[i]).second) fail(" seen twice");
+      if (it->second->observations().count(kf_id)) fail(" seen twice");  // linked at an earlier keypoint
       kf->set_map_point(i, it->second);
       it->second->add_observation(kf, i);
     }
