@@ -132,7 +132,7 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
 
   ByteWriter head, keyf, poin, grap, bowv;
   put_settings(head, settings, sessions);
-  keyf.reserve(8 + kfs.size() * (8 + 8 + 8 + 4 + 96 + 4) + keypoints * kKeypointBytes);
+  keyf.reserve(8 + kfs.size() * kKeyframeHeadBytes + keypoints * kKeypointBytes);
   keyf.u64(kfs.size());
   for (const auto& kf : kfs) put_keyframe(keyf, *kf, point_ids);
   poin.u64(point_ids.size());
@@ -150,15 +150,14 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   for (const auto& kf : kfs) put_graph(grap, *kf, kf_ids);
   for (const auto& kf : kfs) put_bow(bowv, *kf, bag_of);
 
-  ByteWriter out;
+  const std::string* payloads[] = {&head.data(), &keyf.data(), &poin.data(), &grap.data(), &bowv.data(), &app_json};
   std::size_t total = kMagicBytes + 8;
-  for (const std::string* p : {&head.data(), &keyf.data(), &poin.data(), &grap.data(), &bowv.data(), &app_json})
-    total += 4 + 8 + p->size() + 8;
+  for (const std::string* p : payloads) total += 4 + 8 + p->size() + 8;  // tag, size, payload, checksum
+  ByteWriter out;
   out.reserve(total);
   out.bytes(kMagic, kMagicBytes);
   out.u32(kMapFileVersion);
   out.u32(static_cast<std::uint32_t>(kSections.size()));
-  const std::string* payloads[] = {&head.data(), &keyf.data(), &poin.data(), &grap.data(), &bowv.data(), &app_json};
   for (std::size_t s = 0; s < kSections.size(); ++s) put_section(out, kSections[s], *payloads[s]);
   return out.data();
 }

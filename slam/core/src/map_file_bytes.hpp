@@ -15,6 +15,9 @@ constexpr std::uint64_t kNone = ~std::uint64_t(0);  ///< no keyframe, no point
 constexpr std::array<const char*, 6> kSections = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "META"};
 /// Bytes of one keypoint in KEYF: 7 f32, the octave, depth, point id, descriptor.
 constexpr std::size_t kKeypointBytes = 7 * 4 + 1 + 4 + 8 + 32;
+/// Bytes of a keyframe in KEYF before its keypoints: id, frame id, time,
+/// session, pose (12 f64), keypoint count.
+constexpr std::size_t kKeyframeHeadBytes = 8 + 8 + 8 + 4 + 96 + 4;
 constexpr std::uint32_t kMaxKeypoints = 100000;
 
 class ByteWriter {

@@ -136,7 +136,7 @@ using PointIdsByKf = std::map<std::uint64_t, std::vector<std::uint64_t>>;
 PointIdsByKf read_keyframes(ByteReader r, const std::shared_ptr<const CameraModel>& cam, std::uint32_t sessions,
                             Map* map) {
   PointIdsByKf ids;
-  const std::uint64_t n = r.count(8 + 8 + 8 + 4 + 96 + 4, "keyframes");
+  const std::uint64_t n = r.count(kKeyframeHeadBytes, "keyframes");
   for (std::uint64_t k = 0; k < n; ++k) {
     const std::uint64_t id = r.u64();
     if (id == kNone || map->keyframes().count(id)) r.fail("keyframe id " + std::to_string(id) + " given twice");

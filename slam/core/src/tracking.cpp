@@ -426,7 +426,7 @@ void Tracking::probe_merge(const Frame& f) {
   std::shared_ptr<KeyFrame> kf;
   int candidates = 0;
   if (!relocalise_in(probe, 0u, &kf, &candidates).empty()) return;
-  merge_hint_ = MergeHint{from, probe.T_c_w.inverse() * f.T_c_w, std::move(kf), f.id};
+  merge_hint_ = MergeHint{from, probe.T_c_w.inverse() * f.T_c_w, std::move(kf)};
 }
 
 std::string Tracking::lookalike(const Frame& f, const Frame& found, const place::BowVector& bow,

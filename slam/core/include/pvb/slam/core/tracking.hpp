@@ -140,7 +140,6 @@ struct MergeHint {
   std::uint32_t from = 0;            ///< the provisional map
   geom::SE3d T_into_from;            ///< its frame into the map's own
   std::shared_ptr<KeyFrame> anchor;  ///< the map's keyframe the relocalisation matched
-  std::uint64_t frame_id = 0;        ///< the frame relocalised
 };
 
 /// "Already seen in this pass" marks for map-point ids: a pass stamp per
