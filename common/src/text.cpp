@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -159,6 +160,16 @@ std::string format_number(const char* printf_format, double v) {
 std::string format_g(double v, int significant_digits) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*g", significant_digits, v);
+  return buf;
+}
+
+std::string format_exact(double v) {
+  char buf[64];
+  for (int digits = 6; digits < 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    if (std::strtod(buf, nullptr) == v) return buf;
+  }
+  std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
 }
 

@@ -5,6 +5,7 @@
 // scenario_document.hpp) and the full key.
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -15,9 +16,8 @@
 #include <utility>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
 #include "scenario_document.hpp"
 
 namespace pvb::scenes::detail {
@@ -81,10 +81,15 @@ class MapReader {
     return v;
   }
 
+  /// A string of text: no control characters (a quoted "\0" or "\x07" is
+  /// one; a NUL would cut the scene's XML short) but tabs and line breaks.
   std::string string(const std::string& key, const std::string& def) {
     const YAML::Node n = take(key);
     if (!n) return def;
     if (!n.IsScalar()) fail(full(key), n, "a string");
+    for (const char c : n.Scalar())
+      if ((static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f)
+        fail(full(key), n, "a string without control characters", printable(n.Scalar()));
     return n.Scalar();
   }
 

@@ -45,6 +45,7 @@ Scenario read_scenario(const detail::ScenarioDocument& doc) {
   detail::MapReader top(doc.root, ctx, "");
   read_top(top, s);
   top.finish();
+  detail::refuse_station_keys(doc);  // after the reader named any unknown key as one
   detail::check_scene_size(s, ctx);
   detail::check_route(s, ctx);
   detail::resolve_day(s, ctx);

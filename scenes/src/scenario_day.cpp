@@ -3,6 +3,8 @@
 // angle of every single-axis tracker (pvlib's singleaxis, tracker.hpp).
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
 
 #include "pvb/common/text.hpp"
 #include "pvb/scenes/solar_position.hpp"
@@ -42,6 +44,28 @@ SolarPosition site_sun(const Scenario& s, const ReadContext& ctx) {
   return *pos;
 }
 
+/// The site's keys that put the sun where it is, as the most derived file
+/// that gives any of them wrote them, and where the first was written:
+/// site.time when that file gives the time, else the keys it gives ("site.
+/// latitude_deg, site.date"): a derived file that moves the site or the
+/// date is named, not the base that gave the time.
+std::pair<std::string, std::string> sun_keys(const ReadContext& ctx) {
+  static const char* const kKeys[] = {"latitude_deg", "longitude_deg", "date", "time", "utc_offset_h"};
+  int depth = 1 << 30;
+  for (const char* k : kKeys)
+    if (const KeyOrigin* o = ctx.origins->find(std::string("site.") + k)) depth = std::min(depth, o->depth);
+  const KeyOrigin* time = ctx.origins->find("site.time");
+  if (!time || time->depth == depth) return {"site.time", where(ctx, "site.time")};
+  std::string keys, at;
+  for (const char* k : kKeys) {
+    const KeyOrigin* o = ctx.origins->find(std::string("site.") + k);
+    if (!o || o->depth != depth) continue;
+    keys += (keys.empty() ? "site." : ", site.") + std::string(k);
+    if (at.empty()) at = where(ctx, std::string("site.") + k);
+  }
+  return {keys, at};
+}
+
 /// The light follows the site's sun, except for what a file at least as
 /// derived as the one that gives site: says itself (a base's light keys
 /// are the base's day, not this one).
@@ -54,12 +78,18 @@ void resolve_sun_from_site(Scenario& s, const ReadContext& ctx) {
   };
   Light& l = s.light;
   if (from_site("sun_elevation_deg")) {
-    if (pos.elevation_deg < 1.0)
-      throw ConfigError(where(ctx, "site.time"), "site.time",
-                        "a time when the sun is up (at least 1 deg above the horizon at the site)",
-                        "the sun " + format_number("%.1f deg", pos.elevation_deg) + " above the horizon on " +
-                            s.site->date + " at " + s.site->time + " (UTC" +
-                            format_number("%+g", s.site->utc_offset_h) + ")");
+    if (pos.elevation_deg < 1.0) {
+      const auto [keys, at] = sun_keys(ctx);
+      throw ConfigError(at, keys,
+                        keys == "site.time"
+                            ? "a time when the sun is up (at least 1 deg above the horizon at the site)"
+                            : "a place and date where the sun is up at the site's time (at least 1 "
+                              "deg above the horizon)",
+                        "the sun " + format_number("%.1f deg", pos.elevation_deg) + " above the horizon at " +
+                            format_exact(s.site->latitude_deg) + " deg N, " +
+                            format_exact(s.site->longitude_deg) + " deg E on " + s.site->date + " at " +
+                            s.site->time + " (UTC" + format_number("%+g", s.site->utc_offset_h) + ")");
+    }
     l.sun_elevation_deg = pos.elevation_deg;
   }
   if (from_site("sun_azimuth_deg")) l.sun_azimuth_deg = scene_sun_azimuth_deg(pos.azimuth_deg);

@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <yaml-cpp/depthguard.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <optional>
 #include <regex>
@@ -52,6 +53,14 @@ YAML::Node parse_yaml(const std::string& text, const std::string& origin) {
                       "a scenario file of at most " + std::to_string(kMaxScenarioBytes / 1024) +
                           " KiB (the largest scene the renderer draws takes far less)",
                       std::to_string(text.size() / 1024) + " KiB");
+  // YAML is text: yaml-cpp reads a raw NUL byte as the start of an escape
+  // and names some other character, so a NUL (a binary file, a damaged
+  // one) is named here, with its line.
+  if (const std::size_t nul = text.find('\0'); nul != std::string::npos) {
+    const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(nul), '\n');
+    throw ConfigError(origin + ":" + std::to_string(line), "(file)", "YAML text (a NUL byte is never in one)",
+                      "a NUL byte at byte " + std::to_string(nul));
+  }
   YAML::Node root;
   try {
     root = YAML::Load(text);
@@ -97,23 +106,16 @@ void collect_origins(const YAML::Node& n, const std::string& file, int depth, co
   }
 }
 
-/// A derived file changes the day, never the station.
-void check_day_keys(const YAML::Node& n, const std::string& path, const KeyOrigins& origins) {
-  const auto refuse = [&](const std::string& full) {
-    std::string allowed;
-    for (const std::string& k : day_keys())
-      if (k.find('*') == std::string::npos || k.size() < 3 || k.compare(k.size() - 2, 2, ".*") != 0)
-        allowed += (allowed.empty() ? "" : ", ") + k;
-    throw ConfigError(origins.where(full, ""), full,
-                      "a key a derived file may change (" + allowed + "; and whatever is below site, light, "
-                      "camera.depth_noise, camera.rgb, kidnap, expect and slam)",
-                      "a key of the station, which stays as its base has it");
-  };
+/// A derived file changes the day, never the station: the keys of `n` it
+/// may not give, with where each was written.  Not refused here: an unknown
+/// key is named as one by the reader first.
+void find_station_keys(const YAML::Node& n, const std::string& path, const KeyOrigins& origins,
+                       std::vector<StationKey>* out) {
   if (n.IsSequence()) {
     for (std::size_t i = 0; i < n.size(); ++i) {
       const std::string item = path + "[" + std::to_string(i) + "]";
-      if (!is_day_key(item)) refuse(item);
-      check_day_keys(n[i], item, origins);
+      if (!is_day_key(item)) out->push_back({item, origins.where(item, "")});
+      find_station_keys(n[i], item, origins, out);
     }
     return;
   }
@@ -121,8 +123,8 @@ void check_day_keys(const YAML::Node& n, const std::string& path, const KeyOrigi
   for (const auto& kv : n) {
     if (!kv.first.IsScalar()) continue;
     const std::string full = path.empty() ? kv.first.Scalar() : path + "." + kv.first.Scalar();
-    if (!is_day_key(full)) refuse(full);
-    check_day_keys(kv.second, full, origins);
+    if (!is_day_key(full)) out->push_back({full, origins.where(full, "")});
+    find_station_keys(kv.second, full, origins, out);
   }
 }
 
@@ -193,7 +195,8 @@ void apply_base(ScenarioDocument& doc, const YAML::Node& base_key, int depth, st
   chain->push_back(canonical);
   ScenarioDocument base = read_document(read_file(base_file), base_file, depth + 1, chain);
   chain->pop_back();
-  check_day_keys(doc.root, "", doc.origins);
+  std::vector<StationKey> station_keys = base.station_keys;  // a derived base's own, first
+  find_station_keys(doc.root, "", doc.origins, &station_keys);
   // A derived file keeps its base's station: the station seed is pinned.
   const auto [station_seed, seed_origin] = station_seed_of(base);
   const YAML::Node& droot = doc.root;
@@ -215,6 +218,7 @@ void apply_base(ScenarioDocument& doc, const YAML::Node& base_key, int depth, st
   doc.root = base.root;
   doc.origins = base.origins;
   doc.bases = base.bases;
+  doc.station_keys = std::move(station_keys);
 }
 
 ScenarioDocument read_document(const std::string& text, const std::string& origin, int depth,
@@ -230,6 +234,20 @@ ScenarioDocument read_document(const std::string& text, const std::string& origi
 }
 
 }  // namespace
+
+void refuse_station_keys(const ScenarioDocument& doc) {
+  if (doc.station_keys.empty()) return;
+  std::string allowed;
+  for (const std::string& k : day_keys())
+    if (k.find('*') == std::string::npos || k.size() < 3 || k.compare(k.size() - 2, 2, ".*") != 0)
+      allowed += (allowed.empty() ? "" : ", ") + k;
+  const StationKey& first = doc.station_keys.front();
+  throw ConfigError(first.where, first.key,
+                    "a key a derived file may change (" + allowed +
+                        "; and whatever is below site, light, "
+                        "camera.depth_noise, camera.rgb, kidnap, expect and slam)",
+                    "a key of the station, which stays as its base has it");
+}
 
 const KeyOrigin* KeyOrigins::find(const std::string& key) const {
   const auto it = map_.find(key);

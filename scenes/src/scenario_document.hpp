@@ -39,12 +39,25 @@ class KeyOrigins {
   std::map<std::string, KeyOrigin> map_;
 };
 
+/// A key that a derived file gave but only a station file may, and the
+/// "FILE:LINE" it was written at.
+struct StationKey {
+  std::string key;
+  std::string where;
+};
+
 struct ScenarioDocument {
   YAML::Node root;                 ///< the merged document (a map)
   KeyOrigins origins;              ///< of every key of `root`
   std::string file;                ///< the file given ("origin" of in-memory text)
   std::vector<std::string> bases;  ///< the files it derives from, nearest first
+  /// Keys a derived file gave that belong to the station; refused by
+  /// refuse_station_keys() once the reader has named any unknown key.
+  std::vector<StationKey> station_keys;
 };
+
+/// Throws ConfigError for the first of doc.station_keys (none: nothing).
+void refuse_station_keys(const ScenarioDocument& doc);
 
 /// Reads `path` and every base it names.  Throws ConfigError or IoError
 /// naming the file, the line and the key.

@@ -35,8 +35,8 @@ void read_mount(MapReader& r, PvArray& a) {
       const double rot = t.number("rotation_deg", 0.0, -90, 90);
       if (std::abs(rot) > a.tracker.max_angle_deg)
         t.fail(t.full("rotation_deg"), t.child("rotation_deg"),
-               "a rotation within the mount's limit of +-" + format_number("%g", a.tracker.max_angle_deg) + " deg",
-               format_number("%g", rot));
+               "a rotation within the mount's limit of +-" + format_exact(a.tracker.max_angle_deg) + " deg",
+               format_exact(rot));
       a.tracker.fixed_rotation_deg = rot;
     }
   });
@@ -323,25 +323,25 @@ void read_kidnap(MapReader& top, Scenario& s) {
   const double frame_s = 1.0 / s.camera.fps;
   if (!(k.at_s < s.duration_s))
     r.fail(r.full("at_s"), node_of(n, "at_s"),
-           "a time before duration_s (" + format_number("%g", s.duration_s) + " s)", format_number("%g", k.at_s));
+           "a time before duration_s (" + format_exact(s.duration_s) + " s)", format_exact(k.at_s));
   // At least one frame period (1e-9 s: a period written in decimals).
   if (k.covered_s < frame_s - 1e-9)
     r.fail(r.full("covered_s"), node_of(n, "covered_s"),
            "at least one frame period (1 / camera.fps = " + format_number("%g", frame_s) + " s)",
-           format_number("%g", k.covered_s));
+           format_exact(k.covered_s));
   const KidnapFrames f = kidnap_frames(k, s.camera.fps);
   if (!(k.to_route_s < k.at_s) || f.target >= f.cover_begin)
     r.fail(r.full("to_route_s"), node_of(n, "to_route_s"),
-           "a time at least one frame before kidnap.at_s (" + format_number("%g", k.at_s) + " s)",
-           format_number("%g", k.to_route_s));
+           "a time at least one frame before kidnap.at_s (" + format_exact(k.at_s) + " s)",
+           format_exact(k.to_route_s));
   if (!(k.at_s + k.covered_s < s.duration_s))
     r.fail(r.full("covered_s"), node_of(n, "covered_s"),
-           "at_s + covered_s before duration_s (" + format_number("%g", s.duration_s) + " s)",
-           format_number("%g", k.at_s + k.covered_s) + " s");
+           "at_s + covered_s before duration_s (" + format_exact(s.duration_s) + " s)",
+           format_exact(k.at_s + k.covered_s) + " s");
   if (f.cover_end <= f.cover_begin)
     r.fail(r.full("covered_s"), node_of(n, "covered_s"),
            "at least one frame period (1 / camera.fps = " + format_number("%g", 1.0 / s.camera.fps) + " s)",
-           format_number("%g", k.covered_s));
+           format_exact(k.covered_s));
   s.kidnap = k;
 }
 
@@ -369,15 +369,16 @@ void check_route(const Scenario& s, const ReadContext& ctx) {
     if (rt.pattern == RoutePattern::kLawnmower && rt.return_to_start && rt.return_overlap_m > first_aisle_m)
       throw ConfigError(at("return_overlap_m"), "route.return_overlap_m",
                         "at most the first aisle's length, " + format_number("%.2f m", first_aisle_m),
-                        format_number("%g", rt.return_overlap_m));
+                        format_exact(rt.return_overlap_m));
   }
   if (rt.start_m > 0) {
     // A start part-way must leave a route to drive.
     const double length = polyline_length(route_polyline(s));
     if (!(rt.start_m < length - 1.0))
-      throw ConfigError(at("start_m"), "route.start_m",
-                        "a distance at least 1 m before the route's end (" + format_number("%.2f m", length) + " long)",
-                        format_number("%g", rt.start_m));
+      throw ConfigError(
+          at("start_m"), "route.start_m",
+          "a distance at least 1 m before the route's end (" + format_number("%.2f m", length) + " long)",
+          format_exact(rt.start_m));
   }
 }
 

@@ -101,6 +101,26 @@ TEST(Scenario, SyntaxErrorNamesLine) {
   EXPECT_NE(msg.find("valid YAML"), std::string::npos) << msg;
 }
 
+TEST(Scenario, ANulByteIsNamedNotTakenForAnEscape) {
+  // A raw NUL in the text (yaml-cpp called it "unknown escape character").
+  std::string raw = "name: ab";
+  raw += '\0';
+  raw += "cd\n" + std::string(kMinimal);
+  const std::string msg = error_of(raw);
+  EXPECT_NE(
+      msg.find(
+          "bad.yaml:1: (file): expected YAML text (a NUL byte is never in one), got a NUL byte at byte 8"),
+      std::string::npos)
+      << msg;
+  // A quoted escape that makes one (it would cut the scene's XML short).
+  const std::string quoted = error_of("name: \"ab\\0cd\"\n" + std::string(kMinimal));
+  EXPECT_NE(quoted.find("bad.yaml:1: name: expected a string without control characters, got ab\\x00cd"),
+            std::string::npos)
+      << quoted;
+  EXPECT_EQ(parse_scenario("description: |\n  two\n  lines\n" + std::string(kMinimal), "ok.yaml").description,
+            "two\nlines\n");
+}
+
 TEST(Scenario, MissingFileIsAnIoError) { EXPECT_THROW(load_scenario("/nonexistent/x.yaml"), pvb::IoError); }
 
 TEST(Scenario, ExpectSectionIsReadAndOptional) {

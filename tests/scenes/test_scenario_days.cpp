@@ -102,6 +102,26 @@ TEST(ScenarioDays, BadSitesAreOneLineNamingTheKey) {
                    "the site), got the sun -"),
             std::string::npos)
       << e;
+  // A derived file that moves the site into the polar night is named, with
+  // the keys it gives, not the base whose time it keeps.
+  f.write("noon.yaml", route +
+                           "site:\n  latitude_deg: 48.1\n  longitude_deg: 11.6\n  date: 2026-06-21\n"
+                           "  time: \"12:00\"\n  utc_offset_h: 2\n");
+  e = f.error_of("south.yaml", "base: noon.yaml\nsite:\n  latitude_deg: -80\n");
+  EXPECT_NE(
+      e.find("south.yaml:3: site.latitude_deg: expected a place and date where the sun is up at the site's "
+             "time (at least 1 deg above the horizon), got the sun -"),
+      std::string::npos)
+      << e;
+  EXPECT_NE(e.find("above the horizon at -80 deg N, 11.6 deg E on 2026-06-21 at 12:00 (UTC+2)"),
+            std::string::npos)
+      << e;
+  e = f.error_of("winter.yaml", "base: noon.yaml\nsite:\n  latitude_deg: -80\n  date: 2026-06-22\n");
+  EXPECT_NE(e.find("winter.yaml:3: site.latitude_deg, site.date: expected a place and date"),
+            std::string::npos)
+      << e;
+  e = f.error_of("early.yaml", "base: noon.yaml\nsite:\n  latitude_deg: -80\n  time: \"11:00\"\n");
+  EXPECT_NE(e.find("early.yaml:4: site.time: expected a time when the sun is up"), std::string::npos) << e;
   e = f.error_of("date.yaml", route + "site:\n  latitude_deg: 48\n  longitude_deg: 11\n  date: 2026-02-30\n"
                                       "  time: \"12:00\"\n  utc_offset_h: 1\n");
   EXPECT_NE(e.find("date.yaml:5: site.date: expected a date YYYY-MM-DD (years 1901-2099), got date 2026-02-30: day 30 "
@@ -165,6 +185,12 @@ TEST(ScenarioDays, DerivedFileMayNotChangeTheStation) {
   EXPECT_NE(e.find("route.yaml:3: route.aisle: expected a key a derived file may change"), std::string::npos) << e;
   e = f.error_of("more.yaml", "base: station.yaml\npv_arrays:\n  - dirt: 0.1\n  - dirt: 0.1\n  - dirt: 0.1\n");
   EXPECT_NE(e.find("more.yaml:5: pv_arrays: expected at most the station's 2 arrays"), std::string::npos) << e;
+  // A key no scenario knows is named as unknown, not as the station's.
+  e = f.error_of("typo.yaml", "base: station.yaml\nlihgt: {ambient: 0.3}\n");
+  EXPECT_NE(e.find("typo.yaml:2: lihgt: expected a known key ("), std::string::npos) << e;
+  EXPECT_NE(e.find("got unknown key"), std::string::npos) << e;
+  e = f.error_of("deep.yaml", "base: station.yaml\nground: {colour: red}\n");
+  EXPECT_NE(e.find("deep.yaml:2: ground.colour: expected a known key ("), std::string::npos) << e;
   e = f.error_of("plants.yaml", "base: station.yaml\nvegetation: {shrubs: 40}\n");
   EXPECT_NE(e.find("plants.yaml:2: vegetation.shrubs: expected a key a derived file may change"), std::string::npos)
       << e;
@@ -251,6 +277,11 @@ TEST(ScenarioDays, TrackerKeysAreCheckedWithFileAndLine) {
                    "+-55 deg, got 60"),
             std::string::npos)
       << e;
+  // Just beyond the limit is printed with the digits that make it so.
+  e = f.error_of("edge.yaml", route +
+                                  "pv_arrays:\n  - mount: single_axis\n    panel_lines: 1\n"
+                                  "    tracker:\n      rotation_deg: 55.0000001\n");
+  EXPECT_NE(e.find("limit of +-55 deg, got 55.0000001"), std::string::npos) << e;
   e = f.error_of("tilt.yaml", route + "pv_arrays:\n  - mount: single_axis\n    tilt_deg: 20\n");
   EXPECT_NE(e.find("tilt.yaml:4: pv_arrays[0].tilt_deg: expected no tilt_deg for a single_axis mount"),
             std::string::npos)

@@ -30,6 +30,10 @@ std::string json_number(double v, int significant_digits = 17);
 std::string format_number(const char* printf_format, double v);
 /// `significant_digits` significant digits (%.Ng): format_g(0.0123456) = "0.0123456".
 std::string format_g(double v, int significant_digits = 6);
+/// The fewest significant digits (at least 6) that read back as `v` exactly:
+/// format_exact(55.0000001) = "55.0000001", format_exact(55) = "55", so a
+/// value just outside a limit is never printed as the limit.
+std::string format_exact(double v);
 /// `decimals` digits after the point (%.Nf): format_fixed(2.5, 2) = "2.50".
 std::string format_fixed(double v, int decimals);
 
