@@ -8,6 +8,8 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "pvb/common/error.hpp"
+
 namespace pvb::slam {
 namespace {
 
@@ -257,7 +259,10 @@ OrbExtractor::OrbExtractor(const OrbParams& params) : params_(params) {
 void OrbExtractor::build_pyramid(const cv::Mat& grey) {
   for (int l = 0; l < params_.num_levels; ++l) {
     const double s = 1.0 / scales_[l];
-    const cv::Size sz(static_cast<int>(std::lround(grey.cols * s)), static_cast<int>(std::lround(grey.rows * s)));
+    // At least a pixel: a tiny image's coarse levels would round to none
+    // (they give no features either way).
+    const cv::Size sz(std::max(1, static_cast<int>(std::lround(grey.cols * s))),
+                      std::max(1, static_cast<int>(std::lround(grey.rows * s))));
     cv::Mat level;
     if (l == 0)
       level = grey;
@@ -344,6 +349,15 @@ std::vector<cv::KeyPoint> OrbExtractor::detect_level(int level, int num_wanted) 
 }
 
 OrbFeatures OrbExtractor::extract(const cv::Mat& image) {
+  // OpenCV's border copy spins for ever on an empty image (an image file
+  // that did not load), so what cannot be a camera image is an error.
+  if (image.empty() || image.depth() != CV_8U ||
+      (image.channels() != 1 && image.channels() != 3 && image.channels() != 4))
+    throw Error("ORB extraction: expected an 8-bit grey, BGR or BGRA image, got " +
+                (image.empty() ? std::string("an empty one (an image that did not load?)")
+                               : std::to_string(image.cols) + "x" + std::to_string(image.rows) + " with " +
+                                     std::to_string(image.channels()) + " channels of depth " +
+                                     std::to_string(image.depth())));
   cv::Mat grey;
   if (image.channels() == 3)
     cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);

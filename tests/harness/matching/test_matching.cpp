@@ -14,11 +14,13 @@
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/harness/matching/experiment.hpp"
+#include "shared_data.hpp"
 
 namespace pvb::harness {
 namespace {
 
-const std::string kShared = PVB_SHARED_DIR;
+/// A file or folder under ../shared.
+std::string shared(const std::string& relative) { return pvb::test::shared_path(relative); }
 
 TEST(MatchGroundTruth, HomographyLabels) {
   Eigen::Matrix3d H;
@@ -78,7 +80,7 @@ TEST(MatchGroundTruth, TumPoseParsingAndInterpolation) {
 
 
 TEST(MatchGroundTruth, SettingsFromOrbSlamYaml) {
-  const CameraSettings s = load_camera_settings(kShared + "/data/tum/TUM1.yaml");
+  const CameraSettings s = load_camera_settings(shared("data/tum/TUM1.yaml"));
   EXPECT_DOUBLE_EQ(s.K.fx, 517.306408);
   EXPECT_DOUBLE_EQ(s.K.cy, 255.313989);
   EXPECT_DOUBLE_EQ(s.depth_map_factor, 5000.0);
@@ -106,7 +108,7 @@ TEST(MatchMetrics, ScoreAndSpread) {
 }
 
 TEST(MatchExperiment, OxfordWallFiltersImprovePrecision) {
-  const std::string dir = kShared + "/data/oxford/wall/";
+  const std::string dir = shared("data/oxford/wall/");
   const cv::Mat a = cv::imread(dir + "img1.ppm"), b = cv::imread(dir + "img3.ppm");
   CoarseSet cs = make_coarse_set(a, b);
   cs.labels = label_by_homography(cs.points, load_homography(dir + "H1to3p"));
@@ -128,7 +130,7 @@ std::string slurp(const std::string& p) {
 }
 
 TEST(MatchCli, OxfordWallJson) {
-  const std::string dir = kShared + "/data/oxford/wall/";
+  const std::string dir = shared("data/oxford/wall/");
   const std::string json = ::testing::TempDir() + "/match_wall.json";
   const std::string png = ::testing::TempDir() + "/match_wall.png";
   std::remove(json.c_str());
@@ -150,11 +152,11 @@ TEST(MatchCli, OxfordWallJson) {
 }
 
 TEST(MatchCli, TumSequencePair) {
-  const std::string seq = kShared + "/data/tum/fr1_xyz_pair";
+  const std::string seq = shared("data/tum/fr1_xyz_pair");
   const std::string json = ::testing::TempDir() + "/match_tum.json";
   const std::string cmd = std::string(PVB_BINARY_DIR) + "/bin/pvbench match --sequence " + seq +
-                          " --frames 0,1 --settings " + kShared + "/data/tum/TUM1.yaml --runs 1 --method orb,pe --json " +
-                          json + " > /dev/null";
+                          " --frames 0,1 --settings " + shared("data/tum/TUM1.yaml") +
+                          " --runs 1 --method orb,pe --json " + json + " > /dev/null";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   const std::string j = slurp(json);
   EXPECT_NE(j.find("\"name\":\"pe\""), std::string::npos);
@@ -238,7 +240,7 @@ int run_pvbench(const std::string& args, std::string* out) {
 // depth image are each one error line naming the file (exit 1, not an
 // internal error, and nothing from OpenCV or libpng).
 TEST(MatchCli, BadInputsAreOneErrorLineEach) {
-  const std::string wall = kShared + "/data/oxford/wall/";
+  const std::string wall = shared("data/oxford/wall/");
   const std::string dot = temp_file("dot.ppm"), cut = temp_file("cut.ppm"), H = temp_file("H"),
                     zero = temp_file("zero.png");
   ASSERT_TRUE(cv::imwrite(dot, cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(9))));
@@ -256,8 +258,8 @@ TEST(MatchCli, BadInputsAreOneErrorLineEach) {
       {"--img1 " + wall + "img1.ppm --img2 " + wall + "img2.ppm --homography " + H,
        H + ": the homography is singular"},
       {"--img1 " + wall + "img1.ppm --img2 " + wall + "img1.ppm --depth1 " + zero + " --depth2 " + zero +
-           " --pose1 " + pose + " --pose2 " + pose + " --settings " + kShared +
-           "/data/tum/TUM1.yaml --runs 1",
+           " --pose1 " + pose + " --pose2 " + pose + " --settings " + shared("data/tum/TUM1.yaml") +
+           " --runs 1",
        zero + ": depth image holds no valid depth"}};
   for (const auto& [args, expected] : cases) {
     std::string out;

@@ -12,12 +12,13 @@
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/slam/core/system.hpp"
+#include "shared_data.hpp"
 
 namespace pvb::slam {
 namespace {
 
-const std::string kData = std::string(PVB_SHARED_DIR) + "/data/tum/";
-const std::string kTum1 = kData + "TUM1.yaml";
+/// A file or folder of the real Kinect excerpts in ../shared/data/tum.
+std::string tum(const std::string& name) { return pvb::test::shared_path("data/tum/" + name); }
 const std::string kTum3 = std::string(PVB_SOURCE_DIR) + "/configs/tum/TUM3.yaml";
 
 /// Ground-truth pose at t_ns: linear / slerp interpolation, clamped to the ends.
@@ -41,7 +42,7 @@ struct PairError {
 PairError track_pair(const std::string& name, const std::string& settings_file, double gt_offset_s, bool pe_match) {
   Settings settings = read_settings(settings_file);
   settings.pe_match.enabled = pe_match;
-  dataset::TumSequenceReader reader(kData + name, settings.depth_map_factor);
+  dataset::TumSequenceReader reader(tum(name), settings.depth_map_factor);
   SystemOptions options;
   options.synchronous = true;
   System system(settings, options);
@@ -52,7 +53,7 @@ PairError track_pair(const std::string& name, const std::string& settings_file, 
   EXPECT_EQ(results[0].state, TrackingState::kOk);
   EXPECT_EQ(results[1].state, TrackingState::kOk);
   if (!results[0].T_w_c || !results[1].T_w_c) return {1e9, 1e9, 0};
-  const eval::Trajectory gt = eval::read_tum(kData + name + "/groundtruth.txt");
+  const eval::Trajectory gt = eval::read_tum(tum(name) + "/groundtruth.txt");
   const auto off = static_cast<std::int64_t>(gt_offset_s * 1e9);
   const geom::SE3d gt_rel = gt_at(gt, results[0].t_ns + off).inverse() * gt_at(gt, results[1].t_ns + off);
   const geom::SE3d est_rel = results[0].T_w_c->inverse() * *results[1].T_w_c;
@@ -62,7 +63,7 @@ PairError track_pair(const std::string& name, const std::string& settings_file, 
 
 TEST(KinectPairs, Fr1XyzWithin2cmAnd1deg) {
   for (bool pe : {true, false}) {
-    const PairError e = track_pair("fr1_xyz_pair", kTum1, -0.02, pe);
+    const PairError e = track_pair("fr1_xyz_pair", tum("TUM1.yaml"), -0.02, pe);
     std::printf("fr1_xyz pair (%s): %.2f cm, %.3f deg (motion %.2f cm)\n", pe ? "PE" : "baseline",
                 e.trans_m * 100, e.rot_deg, e.gt_trans_m * 100);
     EXPECT_LT(e.trans_m, 0.02);
@@ -85,8 +86,8 @@ TEST(KinectPairs, Fr3LongOfficeWithin2cmAnd1deg) {
 // track: lost), then frame 2 again found within 2 cm / 1 deg.
 TEST(KinectPairs, LostOnABlankFrameThenRelocalised) {
   const std::string name = "fr1_xyz_pair";
-  Settings settings = read_settings(kTum1);
-  dataset::TumSequenceReader reader(kData + name, settings.depth_map_factor);
+  Settings settings = read_settings(tum("TUM1.yaml"));
+  dataset::TumSequenceReader reader(tum(name), settings.depth_map_factor);
   SystemOptions options;
   options.synchronous = true;
   System system(settings, options);
@@ -113,7 +114,7 @@ TEST(KinectPairs, LostOnABlankFrameThenRelocalised) {
   ASSERT_EQ(r2.state, TrackingState::kOk);
   EXPECT_TRUE(r2.tracking.failure.empty()) << r2.tracking.failure;
   EXPECT_EQ(r2.tracking.method, TrackingMethod::kRelocalization);
-  const eval::Trajectory gt = eval::read_tum(kData + name + "/groundtruth.txt");
+  const eval::Trajectory gt = eval::read_tum(tum(name) + "/groundtruth.txt");
   const auto off = static_cast<std::int64_t>(-0.02 * 1e9);
   const geom::SE3d gt_rel = gt_at(gt, f1.t_ns + off).inverse() * gt_at(gt, f2.t_ns + off);
   const geom::SE3d err = gt_rel.inverse() * (r1.T_w_c->inverse() * *r2.T_w_c);

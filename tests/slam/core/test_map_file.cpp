@@ -14,11 +14,13 @@
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/slam/core/map_file.hpp"
 #include "pvb/slam/core/system.hpp"
+#include "shared_data.hpp"
 
 namespace pvb::slam {
 namespace {
 
-const std::string kPair = std::string(PVB_SHARED_DIR) + "/data/tum/fr3_long_office_household_pair";
+/// A real two-frame Kinect sequence in ../shared/data.
+std::string pair_dir() { return pvb::test::shared_path("data/tum/fr3_long_office_household_pair"); }
 const std::string kTum3 = std::string(PVB_SOURCE_DIR) + "/configs/tum/TUM3.yaml";
 
 std::string tmp_path(const std::string& name) {
@@ -27,7 +29,7 @@ std::string tmp_path(const std::string& name) {
 }
 
 std::vector<sensor::RgbdFrame> pair_frames(const Settings& s) {
-  dataset::TumSequenceReader reader(kPair, s.depth_map_factor);
+  dataset::TumSequenceReader reader(pair_dir(), s.depth_map_factor);
   std::vector<sensor::RgbdFrame> out;
   while (auto f = reader.next()) out.push_back(*f);
   return out;

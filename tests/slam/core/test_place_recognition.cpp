@@ -8,11 +8,13 @@
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/features/orb_extractor.hpp"
 #include "pvb/slam/place/vocabulary.hpp"
+#include "shared_data.hpp"
 
 namespace pvb::slam {
 namespace {
 
-const std::string kTum = std::string(PVB_SHARED_DIR) + "/data/tum/";
+/// A file of the real Kinect excerpts in ../shared/data/tum.
+std::string tum(const std::string& file) { return pvb::test::shared_path("data/tum/" + file); }
 
 cv::Mat descriptors_of(const std::string& path) {
   const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
@@ -26,13 +28,12 @@ cv::Mat descriptors_of(const std::string& path) {
 // match among the other five is its own pair's other frame.
 TEST(PlaceRecognitionRealFrames, EachKinectFrameScoresItsPairHighest) {
   const place::Vocabulary vocab = place::Vocabulary::load(kDefaultVocabularyPath);
-  const std::vector<std::string> images = {
-      kTum + "fr1_xyz_pair/rgb/1305031102.175304.png",
-      kTum + "fr1_xyz_pair/rgb/1305031102.275326.png",
-      kTum + "fr2_desk_pair/1.png",
-      kTum + "fr2_desk_pair/2.png",
-      kTum + "fr3_long_office_household_pair/rgb/1341847980.722988.png",
-      kTum + "fr3_long_office_household_pair/rgb/1341847982.998783.png"};
+  const std::vector<std::string> images = {tum("fr1_xyz_pair/rgb/1305031102.175304.png"),
+                                           tum("fr1_xyz_pair/rgb/1305031102.275326.png"),
+                                           tum("fr2_desk_pair/1.png"),
+                                           tum("fr2_desk_pair/2.png"),
+                                           tum("fr3_long_office_household_pair/rgb/1341847980.722988.png"),
+                                           tum("fr3_long_office_household_pair/rgb/1341847982.998783.png")};
   std::vector<place::BowVector> bows(images.size());
   for (std::size_t i = 0; i < images.size(); ++i) vocab.transform(descriptors_of(images[i]), &bows[i]);
   for (std::size_t i = 0; i < images.size(); ++i) {

@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-
 #include <fstream>
 #include <regex>
 #include <utility>
@@ -14,11 +13,13 @@
 #include "pvb/common/text.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
+#include "shared_data.hpp"
 
 namespace pvb::slam {
 namespace {
 
-const std::string kTum1 = std::string(PVB_SHARED_DIR) + "/data/tum/TUM1.yaml";
+/// ORB-SLAM2's TUM1.yaml in ../shared/data.
+std::string tum1() { return pvb::test::shared_path("data/tum/TUM1.yaml"); }
 const std::string kTum3 = std::string(PVB_SOURCE_DIR) + "/configs/tum/TUM3.yaml";
 
 std::string temp_copy(const std::string& name, const std::string& content) {
@@ -29,7 +30,7 @@ std::string temp_copy(const std::string& name, const std::string& content) {
 }
 
 TEST(Settings, ReadsTum1Unchanged) {
-  const Settings s = read_settings(kTum1);
+  const Settings s = read_settings(tum1());
   EXPECT_DOUBLE_EQ(s.K.fx, 517.306408);
   EXPECT_DOUBLE_EQ(s.K.fy, 516.469215);
   EXPECT_DOUBLE_EQ(s.K.cx, 318.643040);
@@ -77,7 +78,7 @@ TEST(Settings, ShippedTum3IsCompleteAndUndistorted) {
 
 TEST(Settings, ReadsPeMatchSection) {
   const std::string path =
-      temp_copy("pe", read_file(kTum1) +
+      temp_copy("pe", read_file(tum1()) +
                           "\nPEMatch.enabled: 0\nPEMatch.population: 30\nPEMatch.j: 80\n"
                           "PEMatch.stallIterations: 9\nPEMatch.threshold: 2.5\nPEMatch.refine: 0\n"
                           "PEMatch.sampson: 0\nPEMatch.skipLowParallax: 1\n");
@@ -94,13 +95,13 @@ TEST(Settings, ReadsPeMatchSection) {
 }
 
 TEST(Settings, ReadsKeyFrameSection) {
-  const Settings d = read_settings(kTum1);  // absent: the documented defaults
+  const Settings d = read_settings(tum1());  // absent: the documented defaults
   EXPECT_EQ(d.keyframe.min_tracked_close, 200);
   EXPECT_EQ(d.keyframe.min_untracked_close, 70);
   EXPECT_EQ(d.keyframe.ref_overlap, 0.0);  // ORB-SLAM2's 75 % rule
-  const Settings s = read_settings(temp_copy("kf", read_file(kTum1) + "\nKeyFrame.minTrackedClose: 100\n"
-                                                                      "KeyFrame.minUntrackedClose: 50\n"
-                                                                      "KeyFrame.refOverlap: 0.4\n"));
+  const Settings s = read_settings(temp_copy("kf", read_file(tum1()) + "\nKeyFrame.minTrackedClose: 100\n"
+                                                                       "KeyFrame.minUntrackedClose: 50\n"
+                                                                       "KeyFrame.refOverlap: 0.4\n"));
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_EQ(s.keyframe.min_tracked_close, 100);  // ORB-SLAM2's value
   EXPECT_EQ(s.keyframe.min_untracked_close, 50);
@@ -109,7 +110,7 @@ TEST(Settings, ReadsKeyFrameSection) {
        {"KeyFrame.minTrackedClose: 0", "KeyFrame.minUntrackedClose: -3", "KeyFrame.minTrackedClose: 1.5",
         "KeyFrame.refOverlap: 1.0", "KeyFrame.refOverlap: -0.1", "KeyFrame.refOverlap: many"}) {
     try {
-      read_settings(temp_copy("kfbad", read_file(kTum1) + "\n" + bad + "\n"));
+      read_settings(temp_copy("kfbad", read_file(tum1()) + "\n" + bad + "\n"));
       FAIL() << "expected ConfigError for " << bad;
     } catch (const ConfigError& e) {
       EXPECT_EQ(e.key(), bad.substr(0, bad.find(':')));
@@ -122,12 +123,12 @@ TEST(Settings, ReadsKeyFrameSection) {
 void expect_optional_flag(const std::string& key, const std::string& bad_value,
                           bool (*get)(const Settings&)) {
   SCOPED_TRACE(key);
-  EXPECT_TRUE(get(read_settings(kTum1)));
-  const Settings s = read_settings(temp_copy("flag", read_file(kTum1) + "\n" + key + ": 0\n"));
+  EXPECT_TRUE(get(read_settings(tum1())));
+  const Settings s = read_settings(temp_copy("flag", read_file(tum1()) + "\n" + key + ": 0\n"));
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_FALSE(get(s));
   try {
-    read_settings(temp_copy("flagbad", read_file(kTum1) + "\n" + key + ": " + bad_value + "\n"));
+    read_settings(temp_copy("flagbad", read_file(tum1()) + "\n" + key + ": " + bad_value + "\n"));
     FAIL() << "expected ConfigError";
   } catch (const ConfigError& e) {
     EXPECT_EQ(e.key(), key);
@@ -144,11 +145,11 @@ TEST(Settings, ReadsTrackingAlignPatchesFlag) {
 }
 
 TEST(Settings, ReadsLoopClosingSection) {
-  const Settings d = read_settings(kTum1);  // absent: on, with the documented defaults
+  const Settings d = read_settings(tum1());  // absent: on, with the documented defaults
   EXPECT_TRUE(d.loop.enabled);
   EXPECT_EQ(d.loop.min_inliers, 40);
   const std::string path =
-      temp_copy("loop", read_file(kTum1) +
+      temp_copy("loop", read_file(tum1()) +
                             "\nLoopClosing.enabled: 0\nLoopClosing.searchRadius: 2.5\n"
                             "LoopClosing.maxAngle: 45\nLoopClosing.minKeyFrameGap: 20\n"
                             "LoopClosing.maxCandidates: 3\nLoopClosing.minMatches: 25\n"
@@ -177,7 +178,7 @@ TEST(Settings, ReadsLoopClosingSection) {
         "LoopClosing.maxAngle: 200", "LoopClosing.consistency: 1.5", "LoopClosing.rotationWeight: 0"}) {
     const std::string key = bad.substr(0, bad.find(':'));
     try {
-      read_settings(temp_copy("loopbad", read_file(kTum1) + "\n" + bad + "\n"));
+      read_settings(temp_copy("loopbad", read_file(tum1()) + "\n" + bad + "\n"));
       FAIL() << "expected ConfigError for " << bad;
     } catch (const ConfigError& e) {
       EXPECT_EQ(e.key(), key);
@@ -186,7 +187,7 @@ TEST(Settings, ReadsLoopClosingSection) {
 }
 
 TEST(Settings, MissingKeyIsAnErrorNamingIt) {
-  const std::string text = std::regex_replace(read_file(kTum1), std::regex("Camera\\.bf: 40\\.0"), "");
+  const std::string text = std::regex_replace(read_file(tum1()), std::regex("Camera\\.bf: 40\\.0"), "");
   const std::string path = temp_copy("missing", text);
   try {
     read_settings(path);
@@ -198,33 +199,33 @@ TEST(Settings, MissingKeyIsAnErrorNamingIt) {
 }
 
 TEST(Settings, UnknownKeyIsAWarning) {
-  const std::string path = temp_copy("unknown", read_file(kTum1) + "\nCamera.fxx: 500.0\n");
+  const std::string path = temp_copy("unknown", read_file(tum1()) + "\nCamera.fxx: 500.0\n");
   const Settings s = read_settings(path);
   ASSERT_EQ(s.warnings.size(), 1u);
   EXPECT_NE(s.warnings[0].find("Camera.fxx"), std::string::npos);
 }
 
 TEST(Settings, WrongTypeAndBadValuesAreErrors) {
-  EXPECT_THROW(read_settings(
-                   temp_copy("type", std::regex_replace(read_file(kTum1), std::regex("Camera.fx: 517.306408"),
-                                                        "Camera.fx: \"abc\""))),
+  EXPECT_THROW(read_settings(temp_copy(
+                   "type", std::regex_replace(read_file(tum1()), std::regex("Camera.fx: 517.306408"),
+                                              "Camera.fx: \"abc\""))),
                ConfigError);
   EXPECT_THROW(read_settings(temp_copy(
-                   "lev", std::regex_replace(read_file(kTum1), std::regex("nLevels: 8"), "nLevels: 0"))),
+                   "lev", std::regex_replace(read_file(tum1()), std::regex("nLevels: 8"), "nLevels: 0"))),
                ConfigError);
 }
 
 TEST(Settings, PointCloudMappingSection) {
   // absent: enabled with the documented defaults
-  const Settings d = read_settings(kTum1);
+  const Settings d = read_settings(tum1());
   EXPECT_TRUE(d.dense.enabled);
   EXPECT_DOUBLE_EQ(d.dense.resolution_m, 0.02);
   EXPECT_EQ(d.dense.stride_px, 3);
   EXPECT_DOUBLE_EQ(d.dense.max_depth_m, 4.0);
   const Settings s = read_settings(temp_copy(
-      "pc", read_file(kTum1) + "\nPointCloudMapping.Enabled: 0\nPointCloudMapping.Resolution: 0.05\n"
-                               "PointCloudMapping.Stride: 2\nPointCloudMapping.MinDepth: 0.3\n"
-                               "PointCloudMapping.MaxDepth: 6.5\n"));
+      "pc", read_file(tum1()) + "\nPointCloudMapping.Enabled: 0\nPointCloudMapping.Resolution: 0.05\n"
+                                "PointCloudMapping.Stride: 2\nPointCloudMapping.MinDepth: 0.3\n"
+                                "PointCloudMapping.MaxDepth: 6.5\n"));
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_FALSE(s.dense.enabled);
   EXPECT_DOUBLE_EQ(s.dense.resolution_m, 0.05);
@@ -233,7 +234,7 @@ TEST(Settings, PointCloudMappingSection) {
   EXPECT_DOUBLE_EQ(s.dense.max_depth_m, 6.5);
   // unknown key in the section: a warning naming it
   const Settings w =
-      read_settings(temp_copy("pcw", read_file(kTum1) + "\nPointCloudMapping.Resolutoin: 0.05\n"));
+      read_settings(temp_copy("pcw", read_file(tum1()) + "\nPointCloudMapping.Resolutoin: 0.05\n"));
   ASSERT_EQ(w.warnings.size(), 1u);
   EXPECT_NE(w.warnings[0].find("PointCloudMapping.Resolutoin"), std::string::npos);
   // wrong type or value: an error naming the key
@@ -244,7 +245,7 @@ TEST(Settings, PointCloudMappingSection) {
                                                                 {"PointCloudMapping.MaxDepth", "0.05"}};
   for (const auto& [key, value] : bad) {
     try {
-      read_settings(temp_copy("pcbad", read_file(kTum1) + "\n" + key + ": " + value + "\n"));
+      read_settings(temp_copy("pcbad", read_file(tum1()) + "\n" + key + ": " + value + "\n"));
       ADD_FAILURE() << key << ": " << value << " accepted";
     } catch (const ConfigError& e) {
       EXPECT_EQ(e.key(), key) << e.what();
@@ -254,7 +255,7 @@ TEST(Settings, PointCloudMappingSection) {
 
 /// TUM1.yaml with `key` set to `value` (replaced where TUM1 has it, else appended).
 std::string tum1_with(const std::string& key, const std::string& value) {
-  const std::string text = read_file(kTum1);
+  const std::string text = read_file(tum1());
   const std::regex line("(^|\n)" + std::regex_replace(key, std::regex("\\."), "\\.") + ":[^\n]*");
   if (std::regex_search(text, line)) return std::regex_replace(text, line, "$1" + key + ": " + value);
   return text + "\n" + key + ": " + value + "\n";
@@ -381,16 +382,17 @@ TEST(Settings, DocumentMarkerMustStandAlone) {
 TEST(Settings, MissingFileIsAnIoError) { EXPECT_THROW(read_settings("/nonexistent/settings.yaml"), IoError); }
 
 TEST(Settings, ReadsPlaceRecognitionKeys) {
-  const Settings d = read_settings(kTum1);  // absent: the default vocabulary, BoW loops, both checks on
+  const Settings d = read_settings(tum1());  // absent: the default vocabulary, BoW loops, both checks on
   EXPECT_EQ(d.vocabulary_path, kDefaultVocabularyPath);
   EXPECT_FALSE(d.loop.pose_proximity);
   EXPECT_TRUE(d.loop.ambiguity_check);
   EXPECT_DOUBLE_EQ(d.loop.max_drift_rate, 0.01);
-  const std::string path = temp_copy("place", read_file(kTum1) +
-                                                  "\nVocabulary.path: \"voc/ORBvoc.txt\"\n"
-                                                  "LoopClosing.poseProximity: 1\nLoopClosing.maxDriftRate: 0\n"
-                                                  "LoopClosing.driftFloor: 0.1\nLoopClosing.ambiguityCheck: 0\n"
-                                                  "LoopClosing.ambiguityDistance: 0.5\n");
+  const std::string path =
+      temp_copy("place", read_file(tum1()) +
+                             "\nVocabulary.path: \"voc/ORBvoc.txt\"\n"
+                             "LoopClosing.poseProximity: 1\nLoopClosing.maxDriftRate: 0\n"
+                             "LoopClosing.driftFloor: 0.1\nLoopClosing.ambiguityCheck: 0\n"
+                             "LoopClosing.ambiguityDistance: 0.5\n");
   const Settings s = read_settings(path);
   EXPECT_TRUE(s.warnings.empty());
   // relative to the settings file's folder
@@ -400,11 +402,12 @@ TEST(Settings, ReadsPlaceRecognitionKeys) {
   EXPECT_DOUBLE_EQ(s.loop.drift_floor_m, 0.1);
   EXPECT_FALSE(s.loop.ambiguity_check);
   EXPECT_DOUBLE_EQ(s.loop.ambiguity_distance_m, 0.5);
-  EXPECT_EQ(read_settings(temp_copy("none", read_file(kTum1) + "\nVocabulary.path: none\n")).vocabulary_path, "none");
+  EXPECT_EQ(read_settings(temp_copy("none", read_file(tum1()) + "\nVocabulary.path: none\n")).vocabulary_path,
+            "none");
   for (const std::string bad : {"Vocabulary.path: 3", "LoopClosing.maxDriftRate: 2", "LoopClosing.ambiguityDistance: 0"}) {
     const std::string key = bad.substr(0, bad.find(':'));
     try {
-      read_settings(temp_copy("bad_place", read_file(kTum1) + "\n" + bad + "\n"));
+      read_settings(temp_copy("bad_place", read_file(tum1()) + "\n" + bad + "\n"));
       ADD_FAILURE() << bad;
     } catch (const ConfigError& e) {
       EXPECT_EQ(e.key(), key) << e.what();
@@ -413,19 +416,19 @@ TEST(Settings, ReadsPlaceRecognitionKeys) {
 }
 
 TEST(Settings, ReadsMapReuseTrackingKeys) {
-  const Settings d = read_settings(kTum1);
+  const Settings d = read_settings(tum1());
   EXPECT_EQ(d.reloc_lookalikes, 10);
   EXPECT_EQ(d.new_map_after_lost, 30);
   EXPECT_EQ(d.merge_reloc_every, 5);
-  const Settings s = read_settings(temp_copy("reuse", read_file(kTum1) +
-                                                          "\nTracking.relocLookalikes: 4\nTracking.newMapAfter: 0\n"
-                                                          "Tracking.mergeRelocEvery: 0\n"));
+  const Settings s = read_settings(
+      temp_copy("reuse", read_file(tum1()) + "\nTracking.relocLookalikes: 4\nTracking.newMapAfter: 0\n"
+                                             "Tracking.mergeRelocEvery: 0\n"));
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_EQ(s.reloc_lookalikes, 4);
   EXPECT_EQ(s.new_map_after_lost, 0);
   EXPECT_EQ(s.merge_reloc_every, 0);
   try {
-    read_settings(temp_copy("bad_reuse", read_file(kTum1) + "\nTracking.mergeRelocEvery: -1\n"));
+    read_settings(temp_copy("bad_reuse", read_file(tum1()) + "\nTracking.mergeRelocEvery: -1\n"));
     ADD_FAILURE() << "a negative Tracking.mergeRelocEvery was accepted";
   } catch (const ConfigError& e) {
     EXPECT_EQ(e.key(), "Tracking.mergeRelocEvery") << e.what();
@@ -435,7 +438,7 @@ TEST(Settings, ReadsMapReuseTrackingKeys) {
 // OpenCV's parser reads the first of two equal keys and ignores the second:
 // a key given twice is an error naming both lines.
 TEST(Settings, DuplicateKeyNamesBothLines) {
-  const std::string text = read_file(kTum1);
+  const std::string text = read_file(tum1());
   const int lines = static_cast<int>(std::count(text.begin(), text.end(), '\n'));
   const std::string path = temp_copy("dup", text + "Vocabulary.path: none\nVocabulary.path: other.txt\n");
   try {
@@ -468,7 +471,7 @@ TEST(Settings, FifoIsRefusedBeforeItIsOpened) {
 }
 
 TEST(Settings, MissingVocabularyIsOneIoErrorNamingIt) {
-  Settings s = read_settings(kTum1);
+  Settings s = read_settings(tum1());
   s.vocabulary_path = "/nonexistent/voc.pvbvoc";
   try {
     System system(s, {});

@@ -8,14 +8,17 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "pvb/common/error.hpp"
 #include "pvb/slam/features/coarse_match.hpp"
 #include "pvb/slam/features/orb_extractor.hpp"
+#include "shared_data.hpp"
 #include "texture.hpp"
 
 namespace pvb::slam {
 namespace {
 
-const std::string kOxford = std::string(PVB_SHARED_DIR) + "/data/oxford/";
+/// A file of the Oxford matching scenes in ../shared/data.
+std::string oxford(const std::string& file) { return pvb::test::shared_path("data/oxford/" + file); }
 
 cv::Mat load_grey(const std::string& path) {
   cv::Mat img = cv::imread(path, cv::IMREAD_GRAYSCALE);
@@ -32,7 +35,7 @@ cv::Matx33d load_h(const std::string& path) {
 }
 
 TEST(OrbExtractor, AtMostThousandWellDistributedFeatures) {
-  const cv::Mat img = load_grey(kOxford + "wall/img1.ppm");
+  const cv::Mat img = load_grey(oxford("wall/img1.ppm"));
   OrbExtractor ex;
   const OrbFeatures f = ex.extract(img);
   EXPECT_LE(f.keypoints.size(), 1000u);
@@ -64,7 +67,7 @@ TEST(OrbExtractor, AtMostThousandWellDistributedFeatures) {
 TEST(OrbExtractor, OrientationAndDescriptorMatchOpenCvOrb) {
   // cv::ORB uses the same learned pattern and intensity centroid; on level 0
   // with its own keypoints our functions must reproduce its output.
-  const cv::Mat img = load_grey(kOxford + "trees/img1.ppm");
+  const cv::Mat img = load_grey(oxford("trees/img1.ppm"));
   auto orb = cv::ORB::create(500, 1.2f, 1, 31, 0, 2, cv::ORB::FAST_SCORE, 31, 20);
   std::vector<cv::KeyPoint> kps;
   cv::Mat desc_cv;
@@ -162,7 +165,7 @@ TEST(OrbExtractor, KeypointsOfEveryLevelLandWhereAKnownZoomPutsThem) {
 }
 
 TEST(OrbExtractor, Fast9ScoreIsOpenCvsFastResponse) {
-  const cv::Mat img = load_grey(kOxford + "wall/img1.ppm");
+  const cv::Mat img = load_grey(oxford("wall/img1.ppm"));
   ASSERT_FALSE(img.empty());
   std::vector<cv::KeyPoint> corners;
   cv::FAST(img, corners, 10, true, cv::FastFeatureDetector::TYPE_9_16);  // scores only with NMS
@@ -178,6 +181,29 @@ TEST(OrbExtractor, Fast9ScoreIsOpenCvsFastResponse) {
   // A flat patch has no corner at any threshold.
   const cv::Mat flat(16, 16, CV_8U, cv::Scalar(90));
   EXPECT_EQ(fast9_score(flat, 8, 8), 0);
+}
+
+TEST(OrbExtractor, AnEmptyImageOrAnotherTypeIsAnErrorNotAHang) {
+  // An image file that did not load reads as an empty matrix; OpenCV's
+  // border copy spins on it for ever.
+  OrbExtractor orb;
+  EXPECT_THROW(orb.extract(cv::Mat()), pvb::Error);
+  EXPECT_THROW(orb.extract(cv::Mat(64, 64, CV_16UC1, cv::Scalar(0))), pvb::Error);
+  EXPECT_THROW(orb.extract(cv::Mat(64, 64, CV_8UC2, cv::Scalar(0))), pvb::Error);
+  // tiny images are images: no features, no error
+  for (const int side : {1, 2, 5, 40})
+    EXPECT_TRUE(orb.extract(cv::Mat(side, side, CV_8UC1, cv::Scalar(128))).keypoints.empty()) << side;
+}
+
+TEST(SharedData, AMissingFileFailsAtOnceNamingItsPath) {
+  try {
+    pvb::test::shared_path("data/no_such_folder/img1.ppm");
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(std::string(PVB_SHARED_DIR) + "/data/no_such_folder/img1.ppm"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(OrbExtractor, QuadraticPeakOffsetRecoversTheVertex) {
@@ -253,9 +279,9 @@ TEST(OrbExtractor, SubPixelKeypointsFollowAFractionalShiftBetterThanWholePixels)
 }
 
 TEST(CoarseMatch, WallPairOneTwoMostlyCorrect) {
-  const cv::Mat a = load_grey(kOxford + "wall/img1.ppm");
-  const cv::Mat b = load_grey(kOxford + "wall/img2.ppm");
-  const cv::Matx33d H = load_h(kOxford + "wall/H1to2p");
+  const cv::Mat a = load_grey(oxford("wall/img1.ppm"));
+  const cv::Mat b = load_grey(oxford("wall/img2.ppm"));
+  const cv::Matx33d H = load_h(oxford("wall/H1to2p"));
   OrbExtractor ex;
   const OrbFeatures fa = ex.extract(a);
   const OrbFeatures fb = ex.extract(b);

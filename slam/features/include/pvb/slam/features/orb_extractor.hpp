@@ -48,8 +48,9 @@ class OrbExtractor {
  public:
   explicit OrbExtractor(const OrbParams& params = {});
 
-  /// Extracts features from an 8-bit image (grey or BGR; BGR is converted).
-  /// Returns at most params.num_features keypoints.
+  /// Extracts features from an 8-bit image (grey, BGR or BGRA; colour is
+  /// converted).  Returns at most params.num_features keypoints.  Throws
+  /// pvb::Error for an empty image or one of another type.
   OrbFeatures extract(const cv::Mat& image);
 
   /// Scale of pyramid level `level` relative to level 0 (scale_factor^level).
