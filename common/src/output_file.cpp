@@ -1,16 +1,20 @@
 #include "pvb/common/output_file.hpp"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
-
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <optional>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "pvb/common/error.hpp"
 
@@ -175,6 +179,39 @@ OutputFile create_temporary(const std::string& final_path, std::string* tmp_path
   throw IoError(final_path, "cannot create a temporary file beside it: too many exist");
 }
 
+/// True for "NAME.tmp.PID.N" (digits only after the name), giving PID.
+bool temporary_of(const std::string& entry, const std::string& name, long* pid) {
+  const std::string head = name + ".tmp.";
+  if (entry.size() <= head.size() || entry.compare(0, head.size(), head) != 0) return false;
+  const std::string rest = entry.substr(head.size());
+  const std::size_t dot = rest.find('.');
+  if (dot == 0 || dot == std::string::npos || dot + 1 == rest.size() || dot > 9) return false;
+  for (std::size_t i = 0; i < rest.size(); ++i)
+    if (i != dot && !std::isdigit(static_cast<unsigned char>(rest[i]))) return false;
+  *pid = std::stol(rest.substr(0, dot));
+  return true;
+}
+
+/// Removes the temporary files of earlier writes of `final_path` whose
+/// process no longer exists (one killed during a write leaves its
+/// temporary file behind); a live process's temporary file is kept.
+void remove_stale_temporaries(const std::string& final_path) {
+  const std::size_t slash = final_path.rfind('/');
+  const std::string dir = slash == std::string::npos ? "." : final_path.substr(0, slash + 1);
+  const std::string name = slash == std::string::npos ? final_path : final_path.substr(slash + 1);
+  DIR* d = ::opendir(dir.c_str());
+  if (!d) return;
+  std::vector<std::string> stale;
+  while (const dirent* e = ::readdir(d)) {
+    long pid = 0;
+    if (temporary_of(e->d_name, name, &pid) && pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 &&
+        errno == ESRCH)
+      stale.push_back(e->d_name);
+  }
+  ::closedir(d);
+  for (const std::string& f : stale) ::unlink((slash == std::string::npos ? f : dir + f).c_str());
+}
+
 void write_through(const std::string& path, const OutputTarget& target,
                    const std::function<void(OutputFile&)>& write) {
   try {
@@ -191,6 +228,7 @@ void write_through(const std::string& path, const OutputTarget& target,
 void write_file_via_temp(const std::string& path, const std::function<void(OutputFile&)>& write) {
   const OutputTarget target = resolve_output_target(path);
   if (target.kind == OutputTarget::Kind::kStream) return write_through(path, target, write);
+  remove_stale_temporaries(target.path);
   std::string tmp;
   try {
     OutputFile out = create_temporary(target.path, &tmp);

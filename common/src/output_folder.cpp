@@ -1,11 +1,16 @@
 #include "pvb/common/output_folder.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <map>
+#include <mutex>
+#include <utility>
 #include <vector>
 
 #include "pvb/common/error.hpp"
@@ -59,13 +64,73 @@ std::string listing(const std::vector<fs::path>& entries) {
   return std::to_string(entries.size()) + (entries.size() == 1 ? " entry: " : " entries: ") + names;
 }
 
+[[noreturn]] void throw_busy(const std::string& dir) {
+  throw IoError(dir,
+                "another pvbench process is writing this output folder now; wait for it to end, or give "
+                "another folder");
+}
+
+/// Opens `dir` and takes its lock without blocking: the descriptor, or -1
+/// when another process holds it.  Throws IoError when it cannot open it.
+int try_lock(const std::string& dir) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) throw IoError(dir, std::string("cannot open the output folder: ") + std::strerror(errno));
+  if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return fd;
+  const int err = errno;
+  ::close(fd);
+  if (err == EWOULDBLOCK) return -1;
+  throw IoError(dir, std::string("cannot lock the output folder: ") + std::strerror(err));
+}
+
+/// Locks `dir` for the rest of this process's life (the lock goes with the
+/// process, also when it is killed); a folder this process locked before
+/// stays locked.  Throws IoError when another process holds it.
+/// The folders this process locked: (device, inode) -> the locked descriptor.
+struct HeldLocks {
+  std::mutex mutex;
+  std::map<std::pair<dev_t, ino_t>, int> fds;
+};
+HeldLocks& held_locks() {
+  static HeldLocks held;
+  return held;
+}
+
+std::pair<dev_t, ino_t> folder_key(const std::string& dir) {
+  struct stat st {};
+  if (::stat(dir.c_str(), &st) != 0)
+    throw IoError(dir, std::string("cannot examine: ") + std::strerror(errno));
+  return {st.st_dev, st.st_ino};
+}
+
+void lock_for_process(const std::string& dir) {
+  HeldLocks& held = held_locks();
+  const auto key = folder_key(dir);
+  const std::lock_guard<std::mutex> lock(held.mutex);
+  if (held.fds.count(key)) return;
+  const int fd = try_lock(dir);
+  if (fd < 0) throw_busy(dir);
+  held.fds[key] = fd;
+}
+
+/// Throws when another process holds the lock of `dir` (an existing folder).
+void check_not_locked(const std::string& dir) {
+  HeldLocks& held = held_locks();
+  const auto key = folder_key(dir);
+  const std::lock_guard<std::mutex> lock(held.mutex);
+  if (held.fds.count(key)) return;  // this process's own
+  const int fd = try_lock(dir);
+  if (fd < 0) throw_busy(dir);
+  ::close(fd);  // closing the only descriptor that holds it releases it
+}
+
 /// The entries to remove for `overwrite` (none for a new or empty folder);
 /// throws for a folder that may not be written.  Nothing is changed.
-std::vector<fs::path> entries_to_replace(const std::string& dir, bool overwrite) {
+std::vector<fs::path> entries_to_replace(const std::string& dir, bool overwrite, bool check_lock) {
   if (dir.empty()) throw IoError("(empty path)", "expected an output folder");
   struct stat st {};
   if (::stat(dir.c_str(), &st) != 0) return {};
   if (!S_ISDIR(st.st_mode)) throw IoError(dir, "is not a folder; expected a new or empty output folder");
+  if (check_lock) check_not_locked(dir);
   bool has_marker = false;
   std::vector<fs::path> entries = entries_of(dir, &has_marker);
   if (!entries.empty()) {
@@ -81,11 +146,15 @@ std::vector<fs::path> entries_to_replace(const std::string& dir, bool overwrite)
 
 }  // namespace
 
-void check_output_folder(const std::string& dir, bool overwrite) { entries_to_replace(dir, overwrite); }
+void check_output_folder(const std::string& dir, bool overwrite) { entries_to_replace(dir, overwrite, true); }
 
 void prepare_output_folder(const std::string& dir, bool overwrite, const std::string& command) {
-  const std::vector<fs::path> entries = entries_to_replace(dir, overwrite);
+  entries_to_replace(dir, overwrite, false);  // refused before anything is created
   create_folder(dir);
+  lock_for_process(dir);
+  // Under the lock: what is there now (another process may have written
+  // into the folder since the first look).
+  const std::vector<fs::path> entries = entries_to_replace(dir, overwrite, false);
   for (const fs::path& p : entries) {
     std::error_code ec;
     fs::remove_all(p, ec);

@@ -10,10 +10,11 @@
 // files, and the checks that fail the run after everything was written
 // (stream error, recording short of frames, SLAM never initialised).
 #include <chrono>
-#include <cstdlib>
-#include <limits>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -21,17 +22,18 @@
 
 #include "command.hpp"
 #include "count_option.hpp"
+#include "io_plan.hpp"
 #include "map_options.hpp"
 #include "pvb/common/error.hpp"
-#include "pvb/common/output_folder.hpp"
-#include "pvb/dataset/fakenect_dump.hpp"
 #include "pvb/common/output_file.hpp"
+#include "pvb/common/output_folder.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/dataset/fakenect_dump.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/evaluate.hpp"
-#include "pvb/geometry/time.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
+#include "pvb/geometry/time.hpp"
 #include "pvb/openni/oni_file.hpp"
 #include "pvb/openni/openni_source.hpp"
 #include "pvb/openni/record_target.hpp"
@@ -125,6 +127,7 @@ bool readable(const std::string& path) { return static_cast<bool>(std::ifstream(
 struct CameraSettings {
   slam::Settings slam;
   std::string file;
+  std::string text;  ///< saved as camera.yaml once the folder is prepared
 };
 
 /// Where the settings will come from, checked before anything is written:
@@ -147,27 +150,48 @@ void check_settings_source(const CameraArgs& a, const std::optional<scenes::Scen
                     "have their own)");
 }
 
-CameraSettings prepare_settings(const CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
-  const std::string saved = a.out + "/camera.yaml";
+/// The settings, read before anything is written (camera.yaml is written
+/// from `text` once the output folder is prepared).
+CameraSettings read_camera_settings(const CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
   CameraSettings s;
   if (!a.settings.empty()) {
-    const std::string text = read_file(a.settings);
-    if (!openni::same_file(a.settings, saved)) write_file(saved, text);
     s.file = a.settings;
   } else if (scenario) {
     dataset::OrbSlamSettings o = run::orbslam_settings_for(*scenario);
     o.depth_map_factor = 1000.0;  // OpenNI2 depth is in millimetres
-    dataset::write_orbslam_settings(saved, o);
-    s.file = saved;
+    s.text = dataset::orbslam_settings_text(o);
+    s.file = a.out + "/camera.yaml";
+    s.slam = slam::read_settings_text(s.text, s.file);
   } else {  // a fakenect dump's own (check_settings_source)
     s.file = fakenect_dump_dir(a) + "/camera.yaml";
-    write_file(saved, read_file(s.file));
   }
-  s.slam = slam::read_settings(s.file);
+  if (s.text.empty()) {
+    s.text = read_file(s.file);
+    s.slam = slam::read_settings(s.file);
+  }
   for (const std::string& w : s.slam.warnings)
     std::fprintf(stderr, "pvbench camera: warning: %s\n", w.c_str());
   if (a.no_pe_match) s.slam.pe_match.enabled = false;
   return s;
+}
+
+/// What camera reads and writes, checked before any device opens: no output
+/// lands on the recording played, the settings, the scenario, a fakenect
+/// dump's files or the map, and the recording on none of the outputs.
+void check_camera_paths(const CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
+  IoPlan plan;
+  plan.input("the --oni recording", a.oni).input("the --settings file", a.settings);
+  if (scenario) add_scenario_inputs(&plan, "sim:// scenario", *scenario);
+  if (const std::string dump = fakenect_dump_dir(a); !dump.empty()) {
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(dump, ec))
+      if (e.is_regular_file(ec)) plan.input("a file of the fakenect dump (FAKENECT_PATH)", e.path().string());
+  }
+  plan.input("the --map file", a.map.load_path);
+  plan.output_folder("--out", a.out).output_file("--save-map", a.map.save_path);
+  plan.output_file("--record", a.record);
+  plan.check();
+  check_output_folder(a.out, a.overwrite);
 }
 
 openni::OpenniOptions source_options(const CameraArgs& a, const slam::Settings& settings, int timeout_ms) {
@@ -422,16 +446,17 @@ int run_camera(CameraArgs a) {
   const std::optional<scenes::Scenario> scenario = check_inputs(a);
   check_settings_source(a, scenario);
   a.map.check();
-  prepare_output_folder(a.out, a.overwrite, "camera");
-  const CameraSettings settings = prepare_settings(a, scenario);
-  openni::OpenniSource source(source_options(a, settings.slam, timeout_ms));
-
+  check_camera_paths(a, scenario);
+  const CameraSettings settings = read_camera_settings(a, scenario);
   slam::SystemOptions options;
   options.synchronous = a.sync;
   options.seed = a.seed;
   slam::System system(settings.slam, options);
-  std::optional<run::MapReport> map;
+  std::optional<run::MapReport> map;  // read (and refused when bad) before the folder is made
   if (!a.map.load_path.empty() || !a.map.save_path.empty()) map = run::start_map(system, a.map);
+  prepare_output_folder(a.out, a.overwrite, "camera");
+  write_file(a.out + "/camera.yaml", settings.text);
+  openni::OpenniSource source(source_options(a, settings.slam, timeout_ms));
   LiveOutputs live = open_live_outputs(a, scenario);
 
   const TrackCounts counts = track_frames(source, max_frames, settings, system, live);
@@ -455,12 +480,16 @@ Command add_camera_command(CLI::App& app) {
       sub->add_option("--uri", args->uri,
                       "OpenNI2 device URI: sim://<scenario.yaml>[?seed=S&frames=N&gl=egl], freenect://<index> "
                       "(a Kinect v1, or a fakenect dump), a camera's URI, or 'any' for the first device");
-  auto* oni = sub->add_option("--oni", args->oni, "play back an .oni recording (in lockstep)");
+  auto* oni = sub->add_option("--oni", args->oni, "play back an .oni recording (in lockstep)")
+                  ->check(path_check("camera", "--oni"));
   uri->excludes(oni);
   sub->add_option("--settings", args->settings,
                   "ORB-SLAM2 RGB-D settings YAML with the calibrated intrinsics (default for sim://: the "
-                  "scenario's camera)");
-  sub->add_option("--out", args->out, "output folder (created; refused when not empty)")->required();
+                  "scenario's camera)")
+      ->check(path_check("camera", "--settings"));
+  sub->add_option("--out", args->out, "output folder (created; refused when not empty)")
+      ->required()
+      ->check(path_check("camera", "--out"));
   sub->add_flag("--overwrite", args->overwrite, "empty an earlier pvbench output in --out first");
   sub->add_option(
       "--record", args->record,

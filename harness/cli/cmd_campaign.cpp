@@ -8,6 +8,7 @@
 
 #include "command.hpp"
 #include "count_option.hpp"
+#include "io_plan.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/run/campaign_run.hpp"
 #include "stop_signals.hpp"
@@ -33,6 +34,9 @@ int run_campaign_command(CampaignArgs& a) {
     std::printf("%s\n", line.c_str());
     std::fflush(stdout);
   };
+  IoPlan plan;
+  add_campaign_inputs(&plan, "--campaign", run::load_campaign(o.campaign_file));
+  plan.output_folder("--out", o.out_dir).check();
   const StopSignals signals;
   const run::CampaignReport report = run::run_campaign(o);
   std::printf("campaign report: %s/index.html (campaign.json, campaign.md, matrix.png)\n", o.out_dir.c_str());
@@ -45,8 +49,12 @@ Command add_campaign_command(CLI::App& app) {
   auto args = std::make_shared<CampaignArgs>();
   CLI::App* sub = app.add_subcommand(
       "campaign", "run the sessions of a campaign file (one station over several days) and report them together");
-  sub->add_option("--campaign", args->options.campaign_file, "campaign YAML file")->required();
-  sub->add_option("--out", args->options.out_dir, "report folder (created; refused when not empty)")->required();
+  sub->add_option("--campaign", args->options.campaign_file, "campaign YAML file")
+      ->required()
+      ->check(path_check("campaign", "--campaign"));
+  sub->add_option("--out", args->options.out_dir, "report folder (created; refused when not empty)")
+      ->required()
+      ->check(path_check("campaign", "--out"));
   sub->add_flag("--overwrite", args->options.overwrite, "empty an earlier pvbench output in --out first");
   sub->add_option("--seed", args->seed, "session i runs with seed * 1000 + i (default: each scenario's seed)")
       ->check(seed_check("campaign", "--seed", std::numeric_limits<std::uint64_t>::max() / 1000 - 1));

@@ -7,6 +7,7 @@
 
 #include "check_report.hpp"
 #include "command.hpp"
+#include "count_option.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -25,8 +26,12 @@ Command add_check_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "check",
       "Compare a run's metrics.json with its scenario's expect: bounds (exit 3 when one is violated)");
-  sub->add_option("--scenario", args->scenario, "scenario YAML file with an expect: section")->required();
-  sub->add_option("--metrics", args->metrics, "metrics.json written by pvbench run")->required();
+  sub->add_option("--scenario", args->scenario, "scenario YAML file with an expect: section")
+      ->required()
+      ->check(path_check("check", "--scenario"));
+  sub->add_option("--metrics", args->metrics, "metrics.json written by pvbench run")
+      ->required()
+      ->check(path_check("check", "--metrics"));
   return {sub, [args] { return run_check(*args); }};
 }
 

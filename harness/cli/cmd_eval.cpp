@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "command.hpp"
+#include "count_option.hpp"
+#include "pvb/common/io_paths.hpp"
 #include "pvb/common/output_file.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/eval/evaluate.hpp"
@@ -62,7 +64,30 @@ std::string text_of(double v) {
   return buf;
 }
 
+/// What eval reads and writes: an output never replaces a trajectory or a
+/// timestamps file, nor another output (each --plot figure and its PNG).
+void check_eval_paths(const EvalArgs& a, std::size_t figures) {
+  IoPlan plan;
+  plan.input("the --gt trajectory", a.gt).inputs("an --est trajectory", a.est);
+  plan.input("the --timestamps file", a.gt_timestamps).inputs("an --est-timestamps file", a.est_timestamps);
+  plan.output_file("--json", a.json);
+  bool stream = false;
+  try {
+    stream = !a.plot.empty() && resolve_output_target(a.plot).kind == OutputTarget::Kind::kStream;
+  } catch (const IoError&) {  // a folder, a socket: the plan names it
+  }
+  if (stream || a.plot.empty()) {
+    plan.output_file("--plot", a.plot);
+  } else {
+    for (std::size_t k = 0; k < figures; ++k)
+      plan.output_file("--plot", numbered(a.plot, k))
+          .output_file("--plot (PNG)", png_beside(numbered(a.plot, k)));
+  }
+  plan.check();
+}
+
 int run_eval(const EvalArgs& a) {
+  check_eval_paths(a, a.est.size());
   eval::TrajectoryFormat format = eval::TrajectoryFormat::kTum;
   if (a.format == "kitti") format = eval::TrajectoryFormat::kKitti;
   else if (a.format != "tum") throw ConfigError("command line", "--format", "tum or kitti", a.format);
@@ -126,14 +151,19 @@ int run_eval(const EvalArgs& a) {
 Command add_eval_command(CLI::App& app) {
   auto args = std::make_shared<EvalArgs>();
   CLI::App* sub = app.add_subcommand("eval", "ATE and RPE of estimated trajectories against ground truth");
-  sub->add_option("--gt", args->gt, "ground-truth trajectory")->required();
-  sub->add_option("--est", args->est, "estimated trajectory (repeat to compare runs; the first is the reference)")
-      ->required();
+  sub->add_option("--gt", args->gt, "ground-truth trajectory")->required()->check(path_check("eval", "--gt"));
+  sub->add_option("--est", args->est,
+                  "estimated trajectory (repeat to compare runs; the first is the reference)")
+      ->required()
+      ->check(path_check("eval", "--est"));
   sub->add_option("--format", args->format, "trajectory format: tum or kitti")
       ->check(CLI::IsMember({"tum", "kitti"}))
       ->capture_default_str();
-  sub->add_option("--timestamps", args->gt_timestamps, "KITTI: timestamps file of the ground truth");
-  sub->add_option("--est-timestamps", args->est_timestamps, "KITTI: timestamps file of each --est, in order (default: --timestamps)");
+  sub->add_option("--timestamps", args->gt_timestamps, "KITTI: timestamps file of the ground truth")
+      ->check(path_check("eval", "--timestamps"));
+  sub->add_option("--est-timestamps", args->est_timestamps,
+                  "KITTI: timestamps file of each --est, in order (default: --timestamps)")
+      ->check(path_check("eval", "--est-timestamps"));
   sub->add_option("--align", args->align, "alignment: se3, sim3, none or origin")
       ->check(CLI::IsMember({"se3", "sim3", "none", "origin"}))
       ->capture_default_str();
@@ -147,8 +177,11 @@ Command add_eval_command(CLI::App& app) {
   sub->add_option("--rpe-pairs", args->rpe_pairs, "RPE pairs: all (every start pose) or consecutive")
       ->check(CLI::IsMember({"all", "consecutive"}))
       ->capture_default_str();
-  sub->add_option("--json", args->json, "write the results as JSON to this file");
-  sub->add_option("--plot", args->plot, "write the error figure as SVG here, and PNG beside it (_2, _3... for further --est)");
+  sub->add_option("--json", args->json, "write the results as JSON to this file")
+      ->check(path_check("eval", "--json"));
+  sub->add_option("--plot", args->plot,
+                  "write the error figure as SVG here, and PNG beside it (_2, _3... for further --est)")
+      ->check(path_check("eval", "--plot"));
   return {sub, [args] { return run_eval(*args); }};
 }
 

@@ -27,10 +27,12 @@
 #include <vector>
 
 #include "command.hpp"
+#include "count_option.hpp"
+#include "io_plan.hpp"
 #include "pvb/common/clock.hpp"
 #include "pvb/common/error.hpp"
-#include "pvb/common/output_folder.hpp"
 #include "pvb/common/output_file.hpp"
+#include "pvb/common/output_folder.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/evaluate.hpp"
@@ -155,6 +157,12 @@ std::vector<eval::MapPoint> merged_in_world(const std::vector<std::string>& maps
 int run_eval_map(const EvalMapArgs& a) {
   scenes::Scenario scenario = scenes::load_scenario(a.scenario);
   if (a.seed) scenario.seed = *a.seed;
+  IoPlan plan;
+  add_scenario_inputs(&plan, "--scenario", scenario);
+  plan.inputs("a --map file", a.maps)
+      .input("the --trajectory file", a.trajectory)
+      .input("the --gt file", a.gt);
+  plan.output_folder("--out", a.out).check();
   if (!a.out.empty()) check_output_folder(a.out, a.overwrite);  // before the work
   check_inputs_match(scenario, a);
   const eval::Trajectory gt = eval::read_tum(a.gt);
@@ -199,16 +207,25 @@ int run_eval_map(const EvalMapArgs& a) {
 Command add_eval_map_command(CLI::App& app) {
   auto a = std::make_shared<EvalMapArgs>();
   CLI::App* sub = app.add_subcommand("eval-map", "accuracy and completeness of a dense map against the scene's true surface");
-  sub->add_option("--map", a->maps,
-                  "the dense map (PointCloud.ply of pvbench slam or run); several: maps in the first one's frame "
-                  "(a campaign's extend sessions), scored as one")
+  sub->add_option(
+         "--map", a->maps,
+         "the dense map (PointCloud.ply of pvbench slam or run); several: maps in the first one's frame "
+         "(a campaign's extend sessions), scored as one")
       ->required()
-      ->take_all();
-  sub->add_option("--scenario", a->scenario, "the scenario the map was made in")->required();
+      ->take_all()
+      ->check(path_check("eval-map", "--map"));
+  sub->add_option("--scenario", a->scenario, "the scenario the map was made in")
+      ->required()
+      ->check(path_check("eval-map", "--scenario"));
   sub->add_option("--seed", a->seed, "the scenario's seed, when the run overrode it");
-  sub->add_option("--trajectory", a->trajectory, "the estimated trajectory (TUM), for the alignment")->required();
-  sub->add_option("--gt", a->gt, "the ground truth (TUM) of the same run")->required();
-  sub->add_option("--out", a->out, "folder for map_accuracy.json and map_errors.ply (refused when not empty)");
+  sub->add_option("--trajectory", a->trajectory, "the estimated trajectory (TUM), for the alignment")
+      ->required()
+      ->check(path_check("eval-map", "--trajectory"));
+  sub->add_option("--gt", a->gt, "the ground truth (TUM) of the same run")
+      ->required()
+      ->check(path_check("eval-map", "--gt"));
+  sub->add_option("--out", a->out, "folder for map_accuracy.json and map_errors.ply (refused when not empty)")
+      ->check(path_check("eval-map", "--out"));
   sub->add_flag("--overwrite", a->overwrite, "empty an earlier pvbench output in --out first");
   sub->add_option("--voxel", a->voxel_m, "true-surface sampling, metres")->capture_default_str()->check(CLI::Range(0.002, 0.5));
   sub->add_option("--every", a->every, "render every k-th frame of the route")->capture_default_str()->check(CLI::Range(1, 1000));

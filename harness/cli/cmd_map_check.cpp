@@ -45,8 +45,12 @@ Command add_map_check_command(CLI::App& app) {
   auto args = std::make_shared<MapCheckArgs>();
   CLI::App* sub = app.add_subcommand(
       "map-check", "global BA of a dumped map (pvbench slam --dump-map) from ground truth: bias or noise?");
-  sub->add_option("--map", args->map, "Map.txt written by pvbench slam --dump-map")->required();
-  sub->add_option("--gt", args->gt, "ground-truth trajectory (TUM format)")->required();
+  sub->add_option("--map", args->map, "Map.txt written by pvbench slam --dump-map")
+      ->required()
+      ->check(path_check("map-check", "--map"));
+  sub->add_option("--gt", args->gt, "ground-truth trajectory (TUM format)")
+      ->required()
+      ->check(path_check("map-check", "--gt"));
   sub->add_option("--draws", args->draws, "synthetic draws per noise kind")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));

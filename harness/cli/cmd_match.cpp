@@ -5,6 +5,7 @@
 
 #include "command.hpp"
 #include "count_option.hpp"
+#include "io_plan.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/image_file.hpp"
@@ -110,8 +111,27 @@ harness::CoarseSet rgbd_coarse_set(const MatchOptions& o, cv::Mat* img1, cv::Mat
   return cs;
 }
 
+/// The file of a GROUNDTRUTH_FILE@TIMESTAMP pose ("" for a pose given inline).
+std::string pose_file(const std::string& arg) {
+  const auto at = arg.rfind('@');
+  return at == std::string::npos ? std::string() : arg.substr(0, at);
+}
+
+/// What match reads and writes: --json and --draw never replace an input.
+void check_match_paths(const MatchOptions& o) {
+  IoPlan plan;
+  plan.input("the --img1 image", o.img1).input("the --img2 image", o.img2);
+  plan.input("the --homography file", o.homography).input("the --depth1 image", o.depth1);
+  plan.input("the --depth2 image", o.depth2).input("the --settings file", o.settings);
+  plan.input("the --pose1 file", pose_file(o.pose1)).input("the --pose2 file", pose_file(o.pose2));
+  add_sequence_inputs(&plan, "--sequence", o.sequence);
+  plan.output_file("--json", o.json).output_file("--draw", o.draw);
+  plan.check();
+}
+
 int run_match(const MatchOptions& o) {
   using namespace pvb::harness;
+  check_match_paths(o);
   const std::vector<MatchMethod> methods = parse_methods(o.method);
   if (o.runs < 1) throw ConfigError("<command line>", "--runs", "a positive integer", std::to_string(o.runs));
 
@@ -166,18 +186,23 @@ Command add_match_command(CLI::App& app) {
       "match",
       "Feature-matching experiment (paper sec. 5.1): ORB coarse matches filtered by each method, "
       "scored against ground truth");
-  sub->add_option("--img1", opts->img1, "first image");
-  sub->add_option("--img2", opts->img2, "second image");
-  sub->add_option("--homography", opts->homography, "ground truth: 3x3 homography file mapping img1 to img2");
-  sub->add_option("--depth1", opts->depth1, "ground truth: depth image of img1 (16-bit PNG)");
-  sub->add_option("--depth2", opts->depth2, "ground truth: depth image of img2");
+  sub->add_option("--img1", opts->img1, "first image")->check(path_check("match", "--img1"));
+  sub->add_option("--img2", opts->img2, "second image")->check(path_check("match", "--img2"));
+  sub->add_option("--homography", opts->homography, "ground truth: 3x3 homography file mapping img1 to img2")
+      ->check(path_check("match", "--homography"));
+  sub->add_option("--depth1", opts->depth1, "ground truth: depth image of img1 (16-bit PNG)")
+      ->check(path_check("match", "--depth1"));
+  sub->add_option("--depth2", opts->depth2, "ground truth: depth image of img2")
+      ->check(path_check("match", "--depth2"));
   sub->add_option("--pose1", opts->pose1,
                   "pose T_w_c of img1: \"tx ty tz qx qy qz qw\" or GROUNDTRUTH_FILE@TIMESTAMP");
   sub->add_option("--pose2", opts->pose2, "pose T_w_c of img2 (same forms as --pose1)");
   sub->add_option("--settings", opts->settings,
                   "ORB-SLAM2 camera yaml (Camera.fx/fy/cx/cy, k1.., DepthMapFactor); with --sequence it "
-                  "overrides DIR/camera.yaml");
-  sub->add_option("--sequence", opts->sequence, "TUM-layout folder (rgb.txt, depth.txt, groundtruth.txt)");
+                  "overrides DIR/camera.yaml")
+      ->check(path_check("match", "--settings"));
+  sub->add_option("--sequence", opts->sequence, "TUM-layout folder (rgb.txt, depth.txt, groundtruth.txt)")
+      ->check(path_check("match", "--sequence"));
   sub->add_option("--frames", opts->frames, "I,J: rgb.txt entries (0-based) to match with --sequence");
   sub->add_option("--gt-time-offset", opts->gt_time_offset_s,
                   "with --sequence: seconds added to the rgb stamps before looking up ground-truth poses "
@@ -186,10 +211,11 @@ Command add_match_command(CLI::App& app) {
                   "all|orb|hamming|ransac|magsac|pe|pe-refined (comma list allowed)");
   sub->add_option("--runs", opts->runs, "repetitions with seeds S, S+1, ... (default 10)");
   sub->add_option("--seed", opts->seed, "first seed (default 1)")->check(seed_check("match", "--seed"));
-  sub->add_option("--json", opts->json, "write the results as JSON");
+  sub->add_option("--json", opts->json, "write the results as JSON")->check(path_check("match", "--json"));
   sub->add_option("--draw", opts->draw,
                   "write an image of the kept matches of the last method (green correct, "
-                  "red wrong, yellow unchecked)");
+                  "red wrong, yellow unchecked)")
+      ->check(path_check("match", "--draw"));
   return {sub, [opts] { return run_match(*opts); }};
 }
 

@@ -10,12 +10,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <memory>
 #include <functional>
+#include <memory>
 #include <optional>
 
 #include "command.hpp"
 #include "count_option.hpp"
+#include "io_plan.hpp"
 #include "pvb/common/clock.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/output_folder.hpp"
@@ -23,12 +24,12 @@
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/fakenect_dump.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
-#include "pvb/sensor/kinect_v1.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/plot/contact_sheet.hpp"
 #include "pvb/run/run.hpp"
 #include "pvb/run/world_json.hpp"
 #include "pvb/scenes/scenario.hpp"
+#include "pvb/sensor/kinect_v1.hpp"
 #include "pvb/sim/sim_frame_source.hpp"
 #include "stop_signals.hpp"
 
@@ -160,6 +161,9 @@ int run_record(const RecordOptions& opt, bool frames_given) {
   const sim::GlBackend backend = sim::parse_gl_backend(opt.gl);
   scenes::Scenario scenario = scenes::load_scenario(opt.scenario);
   if (opt.seed) scenario.seed = *opt.seed;
+  IoPlan plan;
+  add_scenario_inputs(&plan, "--scenario", scenario);
+  plan.output_folder("--out", opt.out).check();
   prepare_output_folder(opt.out, opt.overwrite, "record");  // before the work: never into another recording
   const StopSignals stop_signals;  // Ctrl-C during the set-up stops before the first frame
 
@@ -203,8 +207,12 @@ int run_record(const RecordOptions& opt, bool frames_given) {
 Command add_record_command(CLI::App& app) {
   auto opt = std::make_shared<RecordOptions>();
   CLI::App* sub = app.add_subcommand("record", "Render a scenario into a TUM RGB-D sequence folder");
-  sub->add_option("--scenario", opt->scenario, "scenario YAML file")->required();
-  sub->add_option("--out", opt->out, "output folder (created; refused when not empty)")->required();
+  sub->add_option("--scenario", opt->scenario, "scenario YAML file")
+      ->required()
+      ->check(path_check("record", "--scenario"));
+  sub->add_option("--out", opt->out, "output folder (created; refused when not empty)")
+      ->required()
+      ->check(path_check("record", "--out"));
   sub->add_flag("--overwrite", opt->overwrite, "empty an earlier pvbench output in --out first");
   CLI::Option* frames =
       sub->add_option("--frames", opt->frames, "record at most N frames (default: the scenario's duration)");

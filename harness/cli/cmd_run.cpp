@@ -59,6 +59,9 @@ int run_run(RunArgs& a) {
   const run::RunReport report = run::run_scenario(o);
   if (bar) bar->finish();
   std::printf("report: %s/index.html (metrics.json, trajectories, figures, run.log)\n", o.out_dir.c_str());
+  std::fflush(stdout);
+  if (report.status == run::RunStatus::kFailed)  // after the report: it is kept
+    throw IoError(o.scenario_file, report.status_detail + "; the report is in " + o.out_dir);
   const int code = run::exit_code(report.status);
   if (!a.check || report.status == run::RunStatus::kInterrupted) return code;
   // --check: the scenario's expect: bounds judge the run.  An aborted run
@@ -72,8 +75,12 @@ Command add_run_command(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* sub = app.add_subcommand(
       "run", "simulate a scenario and run PE-SLAM on it in memory; write a report folder (index.html)");
-  sub->add_option("--scenario", args->options.scenario_file, "scenario YAML file")->required();
-  sub->add_option("--out", args->options.out_dir, "report folder (created; refused when not empty)")->required();
+  sub->add_option("--scenario", args->options.scenario_file, "scenario YAML file")
+      ->required()
+      ->check(path_check("run", "--scenario"));
+  sub->add_option("--out", args->options.out_dir, "report folder (created; refused when not empty)")
+      ->required()
+      ->check(path_check("run", "--out"));
   sub->add_flag("--overwrite", args->options.overwrite, "empty an earlier pvbench output in --out first");
   sub->add_option("--seed", args->seed, "override the scenario's seed (also seeds PE-match)")
       ->check(seed_check("run", "--seed", std::numeric_limits<std::uint64_t>::max()));

@@ -11,6 +11,7 @@
 
 #include "command.hpp"
 #include "count_option.hpp"
+#include "io_plan.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/plot/contact_sheet.hpp"
@@ -61,6 +62,9 @@ int run_sheet(const SheetArgs& a) {
   const sim::GlBackend backend = sim::parse_gl_backend(a.gl);
   std::vector<scenes::Scenario> scenarios;
   for (const std::string& file : a.scenarios) scenarios.push_back(scenes::load_scenario(file));  // all, before any work
+  IoPlan plan;
+  for (const scenes::Scenario& s : scenarios) add_scenario_inputs(&plan, "--scenario", s);
+  plan.output_file("--out", a.out).check();
   std::vector<plot::Thumbnail> thumbs;
   for (const scenes::Scenario& s : scenarios) {
     thumbs.push_back({render_frame(s, backend, frame), label_of(s)});
@@ -76,9 +80,11 @@ int run_sheet(const SheetArgs& a) {
 Command add_sheet_command(CLI::App& app) {
   auto a = std::make_shared<SheetArgs>();
   CLI::App* sub = app.add_subcommand("sheet", "one frame of each of several scenarios side by side, labelled");
-  sub->add_option("--scenario", a->scenarios, "a scenario file (repeat: one tile each)")->required();
+  sub->add_option("--scenario", a->scenarios, "a scenario file (repeat: one tile each)")
+      ->required()
+      ->check(path_check("sheet", "--scenario"));
   sub->add_option("--frame", a->frame, "the frame to show of each")->capture_default_str();
-  sub->add_option("--out", a->out, "the sheet (PNG)")->required();
+  sub->add_option("--out", a->out, "the sheet (PNG)")->required()->check(path_check("sheet", "--out"));
   sub->add_option("--columns", a->columns, "tiles per row")->capture_default_str()->check(CLI::Range(1, 12));
   sub->add_option("--gl", a->gl, "rendering backend")->check(CLI::IsMember({"auto", "egl", "osmesa"}));
   return {sub, [a] { return run_sheet(*a); }};

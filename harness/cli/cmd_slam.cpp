@@ -16,6 +16,7 @@
 
 #include "command.hpp"
 #include "count_option.hpp"
+#include "io_plan.hpp"
 #include "map_options.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/output_file.hpp"
@@ -242,6 +243,19 @@ slam::Settings settings_for(const SlamArgs& a) {
   return settings;
 }
 
+/// What slam reads and writes, checked before any work: no output lands on
+/// a file of the sequence, the settings, their vocabulary or the map.
+void check_slam_paths(const SlamArgs& a, const slam::Settings& settings) {
+  IoPlan plan;
+  add_sequence_inputs(&plan, "--sequence", a.sequence);
+  plan.input("the --settings file", a.settings).input("the --map file", a.map.load_path);
+  if (settings.vocabulary_path != "none")
+    plan.input("the vocabulary of the --settings file", settings.vocabulary_path);
+  plan.output_folder("--out", a.out).output_file("--save-map", a.map.save_path);
+  plan.check();
+  check_output_folder(a.out, a.overwrite);
+}
+
 SlamRun::SlamRun(const SlamArgs& a)
     : a_(a), settings_(settings_for(a)), reader_(a.sequence, settings_.depth_map_factor) {
   // One rule for missing frames (docs/slam.md): more than --max-missing of
@@ -250,12 +264,14 @@ SlamRun::SlamRun(const SlamArgs& a)
       kMinMissingAllowed,
       static_cast<std::size_t>(std::floor(a.max_missing * static_cast<double>(reader_.size_hint())))));
   a.map.check();
-  prepare_output_folder(a.out, a.overwrite, "slam");
+  check_slam_paths(a, settings_);
   slam::SystemOptions options;
   options.synchronous = a.sync;
   options.seed = *a.seed;
   system_ = std::make_unique<slam::System>(settings_, options);
+  // The map is read (and refused when bad) before the folder is made.
   if (!a.map.load_path.empty() || !a.map.save_path.empty()) map_ = run::start_map(*system_, a.map);
+  prepare_output_folder(a.out, a.overwrite, "slam");
   open_outputs();
 }
 
@@ -546,6 +562,12 @@ int SlamRun::run() {
       "%s/{CameraTrajectory.txt,CameraTrajectoryRefined.txt,KeyFrameTrajectory.txt,timing.csv,stats.json}\n",
       a_.out.c_str());
   fail_if_incomplete(stop);
+  if (stop != StopReason::kSignal && StopSignals::requested()) {
+    // Every frame was tracked; the signal came while the outputs (the map
+    // among them) were being written, and each was finished whole.
+    std::printf("slam: stopped by a signal after the last frame; the outputs are whole\n");
+    return 130;
+  }
   return stop == StopReason::kSignal ? 130 : 0;
 }
 
@@ -576,10 +598,15 @@ int run_slam(SlamArgs a) {
 Command add_slam_command(CLI::App& app) {
   auto args = std::make_shared<SlamArgs>();
   CLI::App* sub = app.add_subcommand("slam", "run PE-SLAM (RGB-D) on a TUM-format sequence folder");
-  sub->add_option("--sequence", args->sequence, "TUM RGB-D sequence folder")->required();
+  sub->add_option("--sequence", args->sequence, "TUM RGB-D sequence folder")
+      ->required()
+      ->check(path_check("slam", "--sequence"));
   sub->add_option("--settings", args->settings, "ORB-SLAM2 RGB-D settings YAML (plus optional PEMatch.*)")
-      ->required();
-  sub->add_option("--out", args->out, "output folder (created; refused when not empty)")->required();
+      ->required()
+      ->check(path_check("slam", "--settings"));
+  sub->add_option("--out", args->out, "output folder (created; refused when not empty)")
+      ->required()
+      ->check(path_check("slam", "--out"));
   sub->add_flag("--overwrite", args->overwrite, "empty an earlier pvbench output in --out first");
   sub->add_flag("--no-pe-match", args->no_pe_match, "baseline: ORB-SLAM2 motion model without PE-match");
   sub->add_flag("--no-dense", args->no_dense, "skip the dense point-cloud map (PointCloud.ply)");

@@ -27,6 +27,7 @@
 
 #include "command.hpp"
 #include "count_option.hpp"
+#include "io_plan.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/output_folder.hpp"
 #include "pvb/common/text.hpp"
@@ -361,11 +362,25 @@ bool check_sweep_and_print(const std::string& scenario_file, const suite::SweepA
   return violations.empty();
 }
 
+/// The sweep's outputs against its inputs (`plan`): the folder, or with
+/// --aggregate-only the aggregate files written into it.
+void check_sweep_paths(const SweepArgs& a, IoPlan* plan, const std::vector<std::string>& aggregate_files) {
+  if (!a.aggregate_only) {
+    plan->output_folder("--out", a.out);
+  } else {
+    for (const std::string& f : aggregate_files) plan->output_file("--out", (fs::path(a.out) / f).string());
+  }
+  plan->check();
+}
+
 /// A sweep of a campaign: each seed a `pvbench campaign` child process.
 int run_campaign_sweep(const SweepArgs& a) {
   if (!a.scenario.empty() || a.compare || a.baseline || a.check)
     throw ConfigError("command line", "--campaign", "no --scenario, --compare, --baseline or --check with it");
   const run::Campaign campaign = run::load_campaign(a.campaign);  // validates the file early
+  IoPlan plan;
+  add_campaign_inputs(&plan, "--campaign", campaign);
+  check_sweep_paths(a, &plan, {"aggregate.md", "aggregate.json", "matrix.svg", "matrix.png"});
   std::vector<std::uint64_t> seeds;
   if (a.aggregate_only) {
     seeds = a.seeds.empty() ? discover_seeds(a.out) : suite::parse_seed_list(a.seeds);
@@ -396,10 +411,16 @@ int run_sweep(SweepArgs a) {
     throw ConfigError("command line", "--baseline", "either --compare or --baseline, not both");
   if (!a.campaign.empty()) return run_campaign_sweep(a);
   std::string scenario_name;
-  if (!a.scenario.empty())
-    scenario_name = scenes::load_scenario(a.scenario).name;  // validates the file early
-  else if (!a.aggregate_only)
+  IoPlan plan;
+  if (!a.scenario.empty()) {
+    const scenes::Scenario scenario = scenes::load_scenario(a.scenario);  // validates the file early
+    scenario_name = scenario.name;
+    add_scenario_inputs(&plan, "--scenario", scenario);
+  } else if (!a.aggregate_only) {
     throw ConfigError("command line", "--scenario", "a scenario file (or --campaign)");
+  }
+  check_sweep_paths(a, &plan,
+                    {"aggregate.md", "aggregate.csv", "aggregate.json", "aggregate.svg", "aggregate.png"});
 
   if (a.check && a.scenario.empty())
     throw ConfigError("command line", "--check", "a --scenario whose expect: section judges the sweep");
@@ -439,12 +460,17 @@ Command add_sweep_command(CLI::App& app) {
   auto args = std::make_shared<SweepArgs>();
   CLI::App* sub = app.add_subcommand(
       "sweep", "Run a scenario over many seeds in parallel processes and aggregate the results");
-  sub->add_option("--scenario", args->scenario, "scenario YAML file");
-  sub->add_option("--campaign", args->campaign, "campaign YAML file: sweep pvbench campaign instead of pvbench run");
+  sub->add_option("--scenario", args->scenario, "scenario YAML file")
+      ->check(path_check("sweep", "--scenario"));
+  sub->add_option("--campaign", args->campaign,
+                  "campaign YAML file: sweep pvbench campaign instead of pvbench run")
+      ->check(path_check("sweep", "--campaign"));
   sub->add_option("--seeds", args->seeds, "seed list: 1-20, 1,3,5 or 1-5,9");
   sub->add_option("--jobs,-j", args->jobs_text, "seeds run at once")->capture_default_str();
-  sub->add_option("--out", args->out, "sweep folder (DIR/seed_S per seed, DIR/aggregate.*; refused when not empty)")
-      ->required();
+  sub->add_option("--out", args->out,
+                  "sweep folder (DIR/seed_S per seed, DIR/aggregate.*; refused when not empty)")
+      ->required()
+      ->check(path_check("sweep", "--out"));
   sub->add_flag("--overwrite", args->overwrite, "empty an earlier pvbench output in --out first");
   sub->add_option("--frames", args->frames_text, "passed to pvbench run: at most N frames");
   sub->add_flag("--compare", args->compare, "passed to pvbench run: PE-SLAM and the baseline (PE-match off)");

@@ -11,6 +11,7 @@
 
 #include "command.hpp"
 #include "count_option.hpp"
+#include "io_plan.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/common/text.hpp"
@@ -130,10 +131,26 @@ void check_option_sources(const VocabOptions& o, const VocabGiven& given) {
     throw ConfigError("command line", "--every", "a --sequence or --scenario (every image of --images is used)");
 }
 
+/// The vocabulary written never replaces an image, a sequence's file or a
+/// scenario it is trained from.
+void check_vocab_paths(const VocabOptions& o) {
+  IoPlan plan;
+  for (const std::string& dir : o.images) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec))
+      if (e.is_regular_file(ec)) plan.input("an image of the --images folder", e.path().string());
+  }
+  for (const std::string& dir : o.sequences) add_sequence_inputs(&plan, "--sequence", dir);
+  for (const std::string& file : o.scenarios)
+    add_scenario_inputs(&plan, "--scenario", scenes::load_scenario(file));
+  plan.output_file("--out", o.out).check();
+}
+
 int run_vocab(const VocabOptions& o, const VocabGiven& given) {
   if (o.images.empty() && o.sequences.empty() && o.scenarios.empty())
     throw ConfigError("command line", "--images/--sequence/--scenario", "at least one source of images");
   check_option_sources(o, given);
+  check_vocab_paths(o);
   const auto t0 = std::chrono::steady_clock::now();
   Collector c(o.features);
   const std::vector<std::uint64_t> seeds = o.seeds.empty() ? std::vector<std::uint64_t>{}
@@ -165,10 +182,15 @@ int run_vocab(const VocabOptions& o, const VocabGiven& given) {
 Command add_vocab_command(CLI::App& app) {
   auto opt = std::make_shared<VocabOptions>();
   CLI::App* sub = app.add_subcommand("vocab", "Train a bag-of-words vocabulary for place recognition");
-  sub->add_option("--out", opt->out, "vocabulary file to write")->required();
-  sub->add_option("--images", opt->images, "a folder of images (.png .jpg .ppm .pgm), every one used");
-  sub->add_option("--sequence", opt->sequences, "a TUM RGB-D folder (rgb.txt), every --every-th frame");
-  sub->add_option("--scenario", opt->scenarios, "a scenario rendered in memory, every --every-th frame");
+  sub->add_option("--out", opt->out, "vocabulary file to write")
+      ->required()
+      ->check(path_check("vocab", "--out"));
+  sub->add_option("--images", opt->images, "a folder of images (.png .jpg .ppm .pgm), every one used")
+      ->check(path_check("vocab", "--images"));
+  sub->add_option("--sequence", opt->sequences, "a TUM RGB-D folder (rgb.txt), every --every-th frame")
+      ->check(path_check("vocab", "--sequence"));
+  sub->add_option("--scenario", opt->scenarios, "a scenario rendered in memory, every --every-th frame")
+      ->check(path_check("vocab", "--scenario"));
   auto given = std::make_shared<VocabGiven>();
   given->seeds_opt = sub->add_option("--seeds", opt->seeds, "scenario seeds, e.g. 101-103 or 101,105 (default: each scenario's own)");
   given->every_opt = sub->add_option("--every", opt->every, "use every n-th frame of sequences and scenarios")->check(CLI::Range(1, 100000));

@@ -57,4 +57,15 @@ inline CLI::Validator seed_check(const std::string& command, const std::string& 
       "SEED");
 }
 
+/// A CLI11 check for a path option: an empty path (`--save-map ''`) names
+/// no file, and would otherwise read as the option not given at all.
+inline CLI::Validator path_check(const std::string& command, const std::string& option) {
+  return CLI::Validator(
+      [=](std::string& text) {
+        if (text.empty()) throw ConfigError("pvbench " + command, option, "a path", "an empty one");
+        return std::string();
+      },
+      "PATH");
+}
+
 }  // namespace pvb::cli

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -40,7 +41,7 @@ void make_dirs(const std::string& dir) {
     throw IoError(dir, std::string("folder is not writable: ") + std::strerror(errno));
 }
 
-void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s) {
+std::string orbslam_settings_text(const OrbSlamSettings& s) {
   char buf[4096];
   std::snprintf(
       buf, sizeof buf,
@@ -77,7 +78,11 @@ void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s) {
     std::snprintf(ov, sizeof ov, "%.6g", *s.kf_ref_overlap);  // as given, not rounded to a grid
     text += std::string("KeyFrame.refOverlap: ") + ov + "\n";
   }
-  write_file(path, text);
+  return text;
+}
+
+void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s) {
+  write_file(path, orbslam_settings_text(s));
 }
 
 namespace {
@@ -162,6 +167,23 @@ std::vector<std::pair<int, std::vector<std::string>>> list_lines(const std::stri
   }
   return out;
 }
+
+}  // namespace
+
+std::vector<std::string> sequence_files(const std::string& dir) {
+  std::vector<std::string> out;
+  for (const char* name :
+       {"associations.txt", "rgb.txt", "depth.txt", "groundtruth.txt", "meta.json", "camera.yaml"})
+    out.push_back(dir + "/" + name);
+  for (const char* images : {"rgb", "depth"}) {
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(dir + "/" + images, ec))
+      if (e.is_regular_file(ec)) out.push_back(e.path().string());
+  }
+  return out;
+}
+
+namespace {
 
 /// associations.txt: "t_rgb rgb t_depth depth" lines with increasing t_rgb
 /// (the order frames are tracked in).

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/io_paths.hpp"
 
 namespace pvb::openni {
 
@@ -23,20 +24,9 @@ namespace {
 
 }  // namespace
 
-bool same_file(const std::string& a, const std::string& b) {
-  struct stat sa {
-  }, sb{};
-  if (::stat(a.c_str(), &sa) == 0 && ::stat(b.c_str(), &sb) == 0)
-    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
-  std::error_code ea, eb;
-  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ea), ea);
-  const fs::path cb = fs::weakly_canonical(fs::absolute(b, eb), eb);
-  return !ea && !eb && ca == cb;
-}
-
 void check_record_not_on(const std::string& record_path, const std::vector<RunFile>& files) {
   for (const RunFile& f : files)
-    if (!f.path.empty() && same_file(record_path, f.path))
+    if (!f.path.empty() && pvb::same_file(record_path, f.path))
       throw IoError(record_path, "is " + f.role + " (" + f.path + "); record to a new file");
 }
 

@@ -179,6 +179,8 @@ const char* to_string(RunStatus s) {
       return "interrupted";
     case RunStatus::kAborted:
       return "aborted";
+    case RunStatus::kFailed:
+      return "failed";
   }
   return "?";
 }
@@ -191,6 +193,8 @@ int exit_code(RunStatus s) {
       return 130;
     case RunStatus::kAborted:
       return 4;
+    case RunStatus::kFailed:
+      return 1;
   }
   return 1;
 }

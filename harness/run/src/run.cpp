@@ -7,17 +7,18 @@
 
 #include "closed_loop.hpp"
 #include "frame_pipeline.hpp"
+#include "landmark_classes.hpp"
+#include "map_scoring.hpp"
+#include "pvb/common/io_paths.hpp"
 #include "pvb/common/output_folder.hpp"
 #include "pvb/common/text.hpp"
-#include "pvb/run/world_json.hpp"
-#include "pvb/scenes/route.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
+#include "pvb/run/world_json.hpp"
+#include "pvb/scenes/route.hpp"
 #include "pvb/slam/core/settings.hpp"
-#include "landmark_classes.hpp"
-#include "map_scoring.hpp"
 #include "run_log.hpp"
 #include "system_sink.hpp"
 
@@ -40,12 +41,31 @@ scenes::Scenario load_run_scenario(const RunOptions& opt) {
   return scenario;
 }
 
-/// SLAM settings from the scenario's camera, kept in the report as camera.yaml.
-slam::Settings slam_settings(const scenes::Scenario& scenario, const std::string& out_dir, RunLog& log) {
-  dataset::write_orbslam_settings(out_dir + "/camera.yaml", orbslam_settings_for(scenario));
-  slam::Settings settings = slam::read_settings(out_dir + "/camera.yaml");
-  for (const std::string& w : settings.warnings) log.line("warning: " + w);
-  return settings;
+/// SLAM settings from the scenario's camera (kept in the report as
+/// camera.yaml, written once the folder is prepared).
+struct RunSettings {
+  std::string text;  ///< camera.yaml
+  slam::Settings slam;
+};
+
+RunSettings slam_settings(const scenes::Scenario& scenario, const std::string& out_dir) {
+  RunSettings s;
+  s.text = dataset::orbslam_settings_text(orbslam_settings_for(scenario));
+  s.slam = slam::read_settings_text(s.text, out_dir + "/camera.yaml");
+  return s;
+}
+
+/// What the run reads and writes, refused before any work when an output
+/// would land on an input (the scenario, its bases, the map).
+void check_run_paths(const RunOptions& opt, const scenes::Scenario& scenario) {
+  IoPlan plan;
+  plan.input("the --scenario file", opt.scenario_file)
+      .inputs("a base of the --scenario file", scenario.base_files)
+      .input("the --map file", opt.map.load_path)
+      .output_folder("--out", opt.out_dir)
+      .output_file("--save-map", opt.map.save_path);
+  plan.check();
+  check_output_folder(opt.out_dir, opt.overwrite);
 }
 
 RunReport new_report(const scenes::Scenario& scenario, const RunOptions& opt) {
@@ -200,6 +220,26 @@ void finish_loop(const RunOptions& opt, const LoopTimes& loop, bool aborted, int
   }
 }
 
+/// A run whose primary system never initialised failed: it tracked nothing,
+/// and a map it was asked to save does not exist.
+void fail_if_never_initialised(const SlamRun& p, RunReport& report, RunLog& log) {
+  if (report.status != RunStatus::kCompleted || p.frames == 0 || p.not_initialized_frames < p.frames) return;
+  report.status = RunStatus::kFailed;
+  report.status_detail = "tracking never initialised in " + std::to_string(p.frames) + " frames (" +
+                         (p.init_failure.empty() ? std::string("no reason given") : p.init_failure) + ")";
+  log.line("failed: " + report.status_detail);
+}
+
+/// A stop asked for after the last frame (while the map was saved or the
+/// maps scored): the work in hand was finished, and the run still ends as
+/// interrupted.
+void note_late_stop(const RunOptions& opt, RunReport& report, RunLog& log) {
+  if (!opt.stop || !opt.stop->load() || report.status != RunStatus::kCompleted) return;
+  report.status = RunStatus::kInterrupted;
+  report.status_detail = "interrupted after the last frame, while the run was being finished";
+  log.line("interrupted: " + report.status_detail + "; writing the report");
+}
+
 /// Evaluates every system against the ground truth; returns the time it took (ms).
 double evaluate_systems(SystemSinks& sinks, const eval::Trajectory& gt) {
   const auto t_eval = Clock::now();
@@ -349,16 +389,20 @@ dataset::OrbSlamSettings orbslam_settings_for(const scenes::Scenario& s) {
 }
 
 RunReport run_scenario(const RunOptions& opt) {
-  // Build: the scenario, the report folder and its log, the SLAM systems.
+  // Build: the scenario, the SLAM systems (a saved map loaded and checked),
+  // and only then the report folder and its log.
   const sim::GlBackend backend = sim::parse_gl_backend(opt.gl);
   const scenes::Scenario scenario = load_run_scenario(opt);
   const int n = scenes::frame_count(scenario, opt.max_frames);
   opt.map.check();
+  check_run_paths(opt, scenario);
+  const RunSettings settings = slam_settings(scenario, opt.out_dir);
+  SystemSinks sinks = make_systems(settings.slam, opt, static_cast<std::uint32_t>(scenario.seed));
   prepare_output_folder(opt.out_dir, opt.overwrite, "run");
-  if (opt.mode == SlamMode::kCompare) dataset::make_dirs(opt.out_dir + "/baseline");
+  write_file(opt.out_dir + "/camera.yaml", settings.text);
   RunLog log(opt.out_dir + "/run.log", opt.on_log);
-  SystemSinks sinks =
-      make_systems(slam_settings(scenario, opt.out_dir, log), opt, static_cast<std::uint32_t>(scenario.seed));
+  for (const std::string& w : settings.slam.warnings) log.line("warning: " + w);
+  for (auto& sink : sinks) sink->open_outputs();
   RunReport report = new_report(scenario, opt);
   GroundTruthSink gt(opt.out_dir + "/groundtruth.txt");
   std::optional<ClosedLoop> closed_loop;
@@ -372,8 +416,10 @@ RunReport run_scenario(const RunOptions& opt) {
 
   // Results and metrics.
   finish_loop(opt, loop, consumer.aborted(), n, sinks, report, log);
+  fail_if_never_initialised(sinks.front()->run, report, log);
   gt.close();
   const double eval_ms = evaluate_systems(sinks, gt.trajectory());
+  if (!opt.map.save_path.empty()) log.line("saving the map to " + opt.map.save_path);
   for (auto& sink : sinks)
     sink->finish_map(gt.trajectory(), scenario.name, scenario.station_seed_or_seed(), opt.scenario_file);
   if (SlamRun& p = sinks.front()->run; p.map && p.map->localisation)
@@ -384,6 +430,7 @@ RunReport run_scenario(const RunOptions& opt) {
   if (sinks.size() > 1) report.baseline = sinks[1]->run;
   report.profile = profile_entries(opt, loop, consumer.costs(), sinks, report.primary.frames, eval_ms);
   report.profile.push_back({"map_eval", map_ms, 1, "main"});
+  note_late_stop(opt, report, log);
   log_summary(report, log);
 
   write_run_report(report, log, opt.out_dir);

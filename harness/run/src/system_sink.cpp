@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "pvb/common/text.hpp"
+#include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
@@ -54,6 +55,10 @@ SystemSink::SystemSink(const std::string& mode, const slam::Settings& settings, 
   system = std::make_unique<slam::System>(settings, options);
   if (!map.load_path.empty() || !map.save_path.empty()) run.map = start_map(*system, map);
   prev_state = system->state();  // lost in a loaded map until it relocalises
+}
+
+void SystemSink::open_outputs() {
+  dataset::make_dirs(dir);
   cam_traj = OutputFile(dir + "/CameraTrajectory.txt");
   kf_traj = OutputFile(dir + "/KeyFrameTrajectory.txt");
   timing = OutputFile(dir + "/timing.csv");
@@ -83,7 +88,10 @@ slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log)
 void SystemSink::count(const slam::FrameResult& r, int index, double t_s) {
   ++run.frames;
   if (r.state == slam::TrackingState::kLost) ++run.lost_frames;
-  if (r.state == slam::TrackingState::kNotInitialized) ++run.not_initialized_frames;
+  if (r.state == slam::TrackingState::kNotInitialized) {
+    ++run.not_initialized_frames;
+    run.init_failure = r.tracking.failure;
+  }
   tracking_ms += r.tracking_ms;
   orb_ms += r.orb_ms;
   inline_mapping_ms += r.mapping_ms;

@@ -34,8 +34,13 @@ struct SystemSink {
   /// before_loop / after_loop when a loop was closed); kept for scoring.
   NamedClouds clouds;
 
+  /// The system, with the saved map loaded when `map` names one; nothing
+  /// is written until open_outputs().
   SystemSink(const std::string& mode, const slam::Settings& settings, bool sync, std::uint32_t seed,
              const std::string& out_dir, const MapOptions& map = {});
+
+  /// Creates the folder (when missing) and the per-frame output files.
+  void open_outputs();
 
   /// Tracks one frame, writes its lines and records loss and recovery.
   slam::FrameResult track(const sensor::RgbdFrame& frame, RunLog& log);
@@ -64,7 +69,8 @@ using SystemSinks = std::vector<std::unique_ptr<SystemSink>>;
 
 /// The systems that see the frames (options.mode): PE-SLAM or the baseline
 /// in out_dir, and with kCompare the baseline beside PE-SLAM in
-/// out_dir/baseline.  The first is the primary run.
+/// out_dir/baseline.  The first is the primary run.  Their saved maps are
+/// loaded; their output files are not opened yet (open_outputs()).
 SystemSinks make_systems(const slam::Settings& settings, const RunOptions& options, std::uint32_t seed);
 
 }  // namespace pvb::run

@@ -96,8 +96,8 @@ class Reader {
     RunMetrics r;
     if (obj["mode"].IsDefined()) r.mode = eval::normalized_mode(text(obj, "mode"));
     r.status = text(obj, "status");
-    if (r.status != "completed" && r.status != "interrupted" && r.status != "aborted")
-      fail(obj["status"], "status", "expected completed, interrupted or aborted, got " + r.status);
+    if (r.status != "completed" && r.status != "interrupted" && r.status != "aborted" && r.status != "failed")
+      fail(obj["status"], "status", "expected completed, interrupted, aborted or failed, got " + r.status);
     r.frames = integer(obj, "frames");
     r.lost_frames = integer(obj, "lost_frames");
     if (obj["keyframes"].IsDefined() && !obj["keyframes"].IsNull()) r.keyframes = integer(obj, "keyframes");

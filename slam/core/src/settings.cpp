@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 #include <regex>
 #include <set>
+#include <sstream>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
@@ -41,10 +42,10 @@ std::string number_text(double v) {
 
 /// Integer literals beyond int's range, by key: OpenCV's YAML parser wraps
 /// them (4294967297 reads as 1), so the reader reports them itself.
-std::map<std::string, std::string> wide_integer_literals(const std::string& path) {
+std::map<std::string, std::string> wide_integer_literals(const std::string& text) {
   static const std::regex key_int(R"(^\s*([A-Za-z][\w.]*)\s*:\s*([-+]?\d+)\s*(#.*)?\r?$)");
   std::map<std::string, std::string> out;
-  std::ifstream in(path);
+  std::istringstream in(text);
   for (std::string line; std::getline(in, line);) {
     std::smatch m;
     if (!std::regex_match(line, m, key_int)) continue;
@@ -61,8 +62,8 @@ std::map<std::string, std::string> wide_integer_literals(const std::string& path
 /// not be converted).
 class Reader {
  public:
-  Reader(const cv::FileStorage& fs, std::string path)
-      : fs_(fs), path_(std::move(path)), wide_literals_(wide_integer_literals(path_)) {}
+  Reader(const cv::FileStorage& fs, std::string path, const std::string& text)
+      : fs_(fs), path_(std::move(path)), wide_literals_(wide_integer_literals(text)) {}
 
   /// A number in `range`; `fallback` when the key is absent and not required.
   double real(const std::string& key, bool required, double fallback, const Range& range,
@@ -258,8 +259,8 @@ std::string vocabulary_path(const std::string& settings_path, const std::string&
 /// Lines OpenCV's YAML parser cannot read: it loops for ever on a line that
 /// starts with "----" and goes on (found by fuzz_settings), so a line that
 /// starts with "---" must be the document marker alone.
-void check_document_markers(const std::string& path) {
-  std::ifstream in(path);
+void check_document_markers(const std::string& text, const std::string& path) {
+  std::istringstream in(text);
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
     if (line.rfind("---", 0) != 0) continue;
@@ -273,10 +274,10 @@ void check_document_markers(const std::string& path) {
 /// looks at the second; a key given twice is an error naming both lines.
 /// Keys are compared within their map: a nested map (an !!opencv-matrix)
 /// opens a new scope at a deeper indentation.
-void check_duplicate_keys(const std::string& path) {
+void check_duplicate_keys(const std::string& text, const std::string& path) {
   static const std::regex key_line(R"(^( *)([A-Za-z_][\w.\-]*)\s*:(\s|$))");
   std::vector<std::pair<std::size_t, std::map<std::string, int>>> scopes{{0, {}}};  // (indent, key -> line)
-  std::ifstream in(path);
+  std::istringstream in(text);
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
     std::smatch m;
@@ -291,23 +292,17 @@ void check_duplicate_keys(const std::string& path) {
   }
 }
 
-Settings read_settings(const std::string& path) {
-  require_regular_file(path);  // before any open: a FIFO would block
-  check_document_markers(path);
-  check_duplicate_keys(path);
-  cv::FileStorage fs;
-  try {
-    if (!fs.open(path, cv::FileStorage::READ)) throw IoError(path, "cannot open settings file");
-  } catch (const cv::Exception& e) {
-    throw parse_error(path, e);
-  }
+namespace {
+
+/// The settings of an opened document whose text is `text`.
+Settings settings_from(const cv::FileStorage& fs, const std::string& text, const std::string& path) {
   // cv::FileStorage asserts (an internal error) when a key is looked up
   // in a root that is a list or a scalar (found by fuzz_settings).
   if (!fs.root().isMap())
     throw IoError(path, "expected ORB-SLAM2 settings: keys and values (a YAML map) at the top level");
   Settings s;
   s.source = path;
-  Reader r(fs, path);
+  Reader r(fs, path, text);
   read_camera(r, &s);
   read_orb(r, &s);
   s.align_patches = r.flag("Tracking.alignPatches", false, s.align_patches);  // ours, optional
@@ -326,6 +321,35 @@ Settings read_settings(const std::string& path) {
       s.warnings.push_back(path + ": unknown key '" + key + "' ignored");
   }
   return s;
+}
+
+}  // namespace
+
+Settings read_settings(const std::string& path) {
+  require_regular_file(path);  // before any open: a FIFO would block
+  const std::string text = read_file(path);
+  check_document_markers(text, path);
+  check_duplicate_keys(text, path);
+  cv::FileStorage fs;
+  try {
+    if (!fs.open(path, cv::FileStorage::READ)) throw IoError(path, "cannot open settings file");
+  } catch (const cv::Exception& e) {
+    throw parse_error(path, e);
+  }
+  return settings_from(fs, text, path);
+}
+
+Settings read_settings_text(const std::string& text, const std::string& name) {
+  check_document_markers(text, name);
+  check_duplicate_keys(text, name);
+  cv::FileStorage fs;
+  try {
+    if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY))
+      throw IoError(name, "cannot parse settings text");
+  } catch (const cv::Exception& e) {
+    throw parse_error(name, e);
+  }
+  return settings_from(fs, text, name);
 }
 
 }  // namespace pvb::slam

@@ -364,6 +364,79 @@ TEST(RunCli, SigintWritesThePartialReport) {
   EXPECT_NE(read_file(d + "/run.log").find("interrupted"), std::string::npos);
 }
 
+// Ctrl-C once the frames are done and the map is being saved: the save
+// finishes (the map is whole), and the run still ends as interrupted.
+TEST(RunCli, SigintWhileTheMapIsSavedEndsInterruptedWithAWholeMap) {
+  const std::string d = fresh("sigint_save");
+  const std::string map = d + "_map.pvbmap";
+  std::remove(map.c_str());
+  const std::string log = ::testing::TempDir() + "pvb_run_sigint_save_" + std::to_string(::getpid()) + ".txt";
+  const pid_t pid = test::spawn_pvbench(
+      {"run", "--scenario", kStation, "--out", d, "--frames", "40", "--sync", "--save-map", map}, log);
+  ASSERT_GE(pid, 0);
+  ASSERT_TRUE(test::wait_until(
+      pid, [&] { return exists(log) && read_file(log).find("saving the map to") != std::string::npos; }, 300))
+      << read_file(log);
+  const std::optional<int> ended = test::interrupt_and_wait(pid, 120);
+  ASSERT_TRUE(ended.has_value() && WIFEXITED(*ended)) << read_file(log);
+  EXPECT_EQ(WEXITSTATUS(*ended), 130) << read_file(log);
+  EXPECT_EQ(metrics(d)["status"].as<std::string>(), "interrupted");
+  // The map is whole: a localise run loads it.
+  const test::RunResult again = test::run_pvbench("run --scenario " + kStation + " --out " + d +
+                                                  "_again --frames 2 "
+                                                  "--sync --no-map-eval --map " +
+                                                  map + " --map-mode localise");
+  EXPECT_EQ(again.code, 0) << again.output;
+}
+
+// Two runs into one folder at once: the second is refused while the first
+// holds it, and the first's report is its own.
+TEST(RunCli, ASecondRunIntoAFolderInUseIsRefused) {
+  const std::string d = fresh("busy");
+  const std::string log = ::testing::TempDir() + "pvb_run_busy_" + std::to_string(::getpid()) + ".txt";
+  const pid_t pid = test::spawn_pvbench({"run", "--scenario", kStation, "--out", d, "--overwrite"}, log);
+  ASSERT_GE(pid, 0);
+  ASSERT_TRUE(test::wait_until(
+      pid, [&] { return data_lines(d + "/CameraTrajectory.txt").size() >= 5; }, 300))
+      << read_file(log);
+  const test::RunResult second =
+      test::run_pvbench("run --scenario " + kStation + " --out " + d + " --overwrite --frames 2 --sync");
+  EXPECT_EQ(second.code, 1) << second.output;
+  EXPECT_NE(second.output.find(d + ": another pvbench process is writing this output folder now"),
+            std::string::npos)
+      << second.output;
+  const std::optional<int> ended = test::interrupt_and_wait(pid, 120);
+  ASSERT_TRUE(ended.has_value() && WIFEXITED(*ended)) << read_file(log);
+  EXPECT_EQ(WEXITSTATUS(*ended), 130);
+  EXPECT_GE(metrics(d)["frames"].as<int>(), 5);  // the first run's own metrics, not the second's 2 frames
+}
+
+// SLAM that never initialises (a 320x240 camera gives fewer than the 500
+// keypoints with depth it needs): the report is written and the run fails,
+// exit 1, with no map.
+TEST(RunCli, ARunThatNeverInitialisesFailsAndSavesNoMap) {
+  const std::string d = fresh("noinit");
+  const std::string scenario = d + "_small.yaml";
+  std::string text = read_file(kStation);
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"  width: 640\n", "  width: 320\n"},
+                                 {"  height: 480\n", "  height: 240\n"}}) {
+    ASSERT_NE(text.find(from), std::string::npos) << from;
+    text.replace(text.find(from), from.size(), to);
+  }
+  write_file(scenario, text);
+  const std::string map = d + "_map.pvbmap";
+  std::remove(map.c_str());
+  const test::RunResult r = test::run_pvbench("run --scenario " + scenario + " --out " + d +
+                                              " --frames 5 --sync --no-map-eval --save-map " + map);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("pvbench: error: " + scenario + ": tracking never initialised in 5 frames ("),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(metrics(d)["status"].as<std::string>(), "failed");
+  EXPECT_TRUE(exists(d + "/index.html"));
+  EXPECT_FALSE(exists(map));
+}
+
 TEST(RunCli, BadInputIsOneClearError) {
   const std::string d = fresh("bad");
   test::RunResult r = test::run_pvbench("run --scenario /nonexistent/scene.yaml --out " + d);

@@ -80,7 +80,9 @@ OutputTarget resolve_output_target(const std::string& path);
 /// removed, the old file is left as it was, and IoError names `path`, so no
 /// half-written file ever carries the final name.  A character device, a
 /// FIFO or a standard stream is written through (a write to /dev/full fails
-/// as on a full disk); nothing else is ever replaced.
+/// as on a full disk); nothing else is ever replaced.  The temporary file is
+/// named PATH.tmp.PID.N; those of earlier writes of `path` whose process is
+/// gone (killed during the write) are removed first.
 void write_file_via_temp(const std::string& path, const std::function<void(OutputFile&)>& write);
 
 }  // namespace pvb

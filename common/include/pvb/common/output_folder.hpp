@@ -19,12 +19,15 @@ inline constexpr const char* kOutputFolderMarker = ".pvbench";
 /// option to give and what is there) unless `overwrite`, and then emptied
 /// if pvbench made it.  The files that are this process's own standard
 /// output and error (a sweep's DIR/seed_S/stdout.log) do not count and are
-/// kept.  Writes the marker, naming `command`.
+/// kept.  Writes the marker, naming `command`.  The folder is locked
+/// (flock) until this process ends: a second process that prepares it
+/// meanwhile is refused, so two runs never write one folder.
 void prepare_output_folder(const std::string& dir, bool overwrite, const std::string& command);
 
 /// What prepare_output_folder() would refuse, checked without creating or
 /// removing anything: for a command that reads its inputs first and must
-/// not do its work only to fail at the output.
+/// not do its work only to fail at the output (a folder another process
+/// holds included).
 void check_output_folder(const std::string& dir, bool overwrite);
 
 }  // namespace pvb

@@ -39,7 +39,9 @@ struct OrbSlamSettings {
   std::optional<double> kf_ref_overlap;
 };
 
-/// Writes settings as an OpenCV FileStorage YAML file ORB-SLAM2 reads.
+/// The settings as the text of an OpenCV FileStorage YAML file ORB-SLAM2 reads.
+std::string orbslam_settings_text(const OrbSlamSettings& s);
+/// Writes that text to `path`.
 void write_orbslam_settings(const std::string& path, const OrbSlamSettings& s);
 
 /// Writes a sequence frame by frame; every text file is flushed after each
@@ -107,6 +109,12 @@ class TumSequenceReader : public sensor::FrameSource {
   std::size_t skipped_ = 0;
   std::size_t max_skipped_ = 0;
 };
+
+/// The files of a TUM RGB-D folder that a reader of it may read: its lists
+/// (associations.txt, rgb.txt, depth.txt, groundtruth.txt), meta.json,
+/// camera.yaml, and the images in rgb/ and depth/.  Other files in the
+/// folder (a map saved beside the sequence) are not among them.
+std::vector<std::string> sequence_files(const std::string& dir);
 
 /// Parses a TUM list file (rgb.txt / depth.txt): "t path" lines, # comments.
 /// The result is sorted by time.  Throws IoError naming the file and line for

@@ -18,10 +18,6 @@ struct RunFile {
   std::string role;
 };
 
-/// True when a and b are the same file: the same inode when both exist
-/// (links and different spellings included), else the same canonical path.
-bool same_file(const std::string& a, const std::string& b);
-
 /// Throws IoError(record_path, ...) naming the role when the recording would
 /// land on one of `files` (empty paths are skipped).
 void check_record_not_on(const std::string& record_path, const std::vector<RunFile>& files);

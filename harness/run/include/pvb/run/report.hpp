@@ -23,11 +23,12 @@ enum class RunStatus {
   kCompleted,    ///< every frame of the scenario (or of --frames) was processed
   kInterrupted,  ///< stopped by SIGINT/SIGTERM; the report is partial
   kAborted,      ///< closed loop, tracking lost and the scenario says on_loss: abort
+  kFailed,       ///< tracking never initialised: nothing was tracked (the report is kept)
 };
 const char* to_string(RunStatus s);
 
 /// Process exit code for a status: 0 completed, 130 interrupted (as a shell
-/// reports SIGINT), 4 aborted.
+/// reports SIGINT), 4 aborted, 1 failed.
 int exit_code(RunStatus s);
 
 /// Tracking was lost at `frame` (it was Ok, or not yet initialised, before).
@@ -93,6 +94,7 @@ struct SlamRun {
   std::size_t frames = 0;
   std::size_t lost_frames = 0;  ///< frames in state Lost
   std::size_t not_initialized_frames = 0;
+  std::string init_failure;  ///< why the last frame not initialised failed to initialise
   std::size_t keyframes = 0;
   std::size_t map_points = 0;
   std::vector<FrameRecord> per_frame;

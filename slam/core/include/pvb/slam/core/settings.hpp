@@ -128,4 +128,9 @@ struct Settings {
 /// counts and distances in the optional sections.
 Settings read_settings(const std::string& path);
 
+/// The same from settings text held in memory (a run's own camera.yaml
+/// before it is written); `name` stands for the file in messages and is
+/// the folder a relative Vocabulary.path is taken from.
+Settings read_settings_text(const std::string& text, const std::string& name);
+
 }  // namespace pvb::slam
