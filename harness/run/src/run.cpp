@@ -32,7 +32,7 @@ scenes::Scenario load_run_scenario(const RunOptions& opt) {
   if (opt.start_m) {
     const double length = scenes::polyline_length(scenes::route_polyline(scenario));
     if (!(*opt.start_m >= 0 && *opt.start_m < length - 1.0))
-      throw ConfigError("--start-m", "",
+      throw ConfigError("command line", "--start-m",
                         "a distance from 0 to 1 m before the route's end (" + format_fixed(length, 2) + " m long)",
                         format_g(*opt.start_m));
     scenario.route.start_m = *opt.start_m;
