@@ -76,3 +76,38 @@ TEST(Campaign, MistakesAreOneLineNamingFileLineAndKey) {
   e = error_of("name: c\nsessions: []\n");
   EXPECT_NE(e.find("sessions: expected a list of at least one session"), std::string::npos) << e;
 }
+
+// A session may not take the name of what the campaign writes beside the
+// sessions' folders: a session "maps" would run in the maps folder.
+TEST(Campaign, ANameTheCampaignWritesItselfIsRefused) {
+  const std::string e = error_of("name: c\nsessions:\n  - {name: noon, scenario: STATION, mode: map}\n"
+                                 "  - {name: maps, scenario: STATION, mode: localise, map: noon}\n");
+  EXPECT_NE(e.find("c.yaml:4: sessions[1].name: expected a name other than those the campaign writes beside the "
+                   "sessions' folders (maps, campaign.json, campaign.md, matrix.svg, matrix.png, index.html, "
+                   "stdout.log), got maps"),
+            std::string::npos)
+      << e;
+  EXPECT_EQ(run::campaign_top_level_names().front(), "maps");
+}
+
+// Every session's scenario is loaded with the file: a later session's bad
+// scenario or start beyond its route fails before any session runs.
+TEST(Campaign, EverySessionsScenarioAndStartAreCheckedWithTheFile) {
+  std::string e = error_of("name: c\nsessions:\n  - {name: a, scenario: STATION, mode: map}\n"
+                           "  - {name: b, scenario: STATION, mode: localise, map: a, start_m: 500}\n");
+  EXPECT_NE(e.find("c.yaml:4: sessions[1].start_m: expected a distance from 0 to 1 m before the route's end (the "
+                   "route of "),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("/scenes/pv_station.yaml is "), std::string::npos) << e;
+  EXPECT_NE(e.find(" m long), got 500"), std::string::npos) << e;
+  const std::string dir = ::testing::TempDir() + "pvb_campaign_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  write_file(dir + "/bad_day.yaml", "base: " + std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml\nspeed: 3\n");
+  e = error_of("name: c\nsessions:\n  - {name: a, scenario: STATION, mode: map}\n"
+               "  - {name: b, scenario: bad_day.yaml, mode: localise, map: a}\n");
+  EXPECT_NE(e.find("bad_day.yaml:2: speed"), std::string::npos) << e;
+  // The scenario's own seed is kept for a campaign run without --seed.
+  const run::Campaign daily = run::load_campaign(kCampaigns + "daily.yaml");
+  EXPECT_EQ(daily.sessions[0].scenario_seed, 71200u);
+}
