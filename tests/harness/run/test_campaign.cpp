@@ -2,13 +2,16 @@
 // one error naming the file, the line and the key.
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
+#include <atomic>
 #include <filesystem>
 #include <string>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/run/campaign.hpp"
+#include "pvb/run/campaign_run.hpp"
 
 using namespace pvb;
 
@@ -110,4 +113,119 @@ TEST(Campaign, EverySessionsScenarioAndStartAreCheckedWithTheFile) {
   // The scenario's own seed is kept for a campaign run without --seed.
   const run::Campaign daily = run::load_campaign(kCampaigns + "daily.yaml");
   EXPECT_EQ(daily.sessions[0].scenario_seed, 71200u);
+}
+
+namespace {
+
+/// A campaign of five sessions on the default station (every status a
+/// session can end with).
+run::Campaign five_sessions() {
+  const std::string dir = ::testing::TempDir() + "pvb_campaign_five_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  const std::string station = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
+  write_file(dir + "/five.yaml", "name: five\nsessions:\n"
+                                 "  - {name: noon, scenario: " + station + ", mode: map}\n"
+                                 "  - {name: again, scenario: " + station + ", mode: localise, map: noon}\n"
+                                 "  - {name: more, scenario: " + station + ", mode: extend, map: noon}\n"
+                                 "  - {name: after, scenario: " + station + ", mode: localise, map: more}\n"
+                                 "  - {name: last, scenario: " + station + ", mode: localise, map: noon}\n");
+  return run::load_campaign(dir + "/five.yaml");
+}
+
+std::vector<std::string> table_rows(const std::string& md) {
+  std::vector<std::string> rows;
+  std::size_t at = 0;
+  for (std::size_t nl; (nl = md.find('\n', at)) != std::string::npos; at = nl + 1)
+    if (md.compare(at, 2, "| ") == 0) rows.push_back(md.substr(at, nl - at));
+  return rows;
+}
+
+}  // namespace
+
+// A session that did not complete is shown with its status, and a figure
+// it lacks is null in campaign.json and "-" in campaign.md, never 0.
+TEST(CampaignReport, EverySessionHasARowWithItsStatusAndNoInventedFigures) {
+  run::CampaignReport r;
+  r.campaign = five_sessions();
+  r.seed = 4;
+  r.stopped = true;
+  const run::SessionStatus statuses[] = {run::SessionStatus::kCompleted, run::SessionStatus::kInterrupted,
+                                         run::SessionStatus::kFailed, run::SessionStatus::kSkipped,
+                                         run::SessionStatus::kNotRun};
+  for (std::size_t i = 0; i < 5; ++i) {
+    run::SessionResult s;
+    s.session = r.campaign.sessions[i];
+    s.seed = 4000 + i;
+    s.status = statuses[i];
+    if (s.ran()) s.frames = 90, s.lost_frames = 2, s.keyframes = 12, s.tracking_ms_median = 9.5;
+    if (s.status == run::SessionStatus::kFailed) s.error = "out/more/metrics.json: cannot write";
+    if (s.status == run::SessionStatus::kSkipped) s.error = "session more left no map (out/maps/more.pvbmap)";
+    r.sessions.push_back(s);
+  }
+  const YAML::Node j = YAML::Load(run::campaign_json(r));
+  EXPECT_EQ(j["campaign_version"].as<int>(), 2);
+  ASSERT_EQ(j["sessions"].size(), 5u);
+  const char* expected[] = {"completed", "interrupted", "failed", "skipped", "not_run"};
+  for (std::size_t i = 0; i < 5; ++i) {
+    const YAML::Node s = j["sessions"][i];
+    EXPECT_EQ(s["status"].as<std::string>(), expected[i]);
+    EXPECT_EQ(s["seed"].as<int>(), 4000 + static_cast<int>(i));
+    EXPECT_EQ(s["tracking_ms_median"].IsNull(), i >= 2) << i;
+    EXPECT_EQ(s["frames"].IsNull(), i >= 2) << i;
+    EXPECT_EQ(s["keyframes"].IsNull(), i >= 2) << i;
+  }
+  EXPECT_EQ(j["sessions"][2]["error"].as<std::string>(), "out/more/metrics.json: cannot write");
+
+  const std::vector<std::string> rows = table_rows(run::campaign_markdown(r));
+  ASSERT_EQ(rows.size(), 6u);  // the header and a row per session
+  EXPECT_EQ(rows[1].rfind("| noon | map | - | completed | 90 | 2 | 12 (0) |", 0), 0u) << rows[1];
+  EXPECT_NE(rows[1].find("| 9.50 |"), std::string::npos) << rows[1];
+  EXPECT_EQ(rows[2].rfind("| again | localise | noon | interrupted | 90 |", 0), 0u) << rows[2];
+  EXPECT_EQ(rows[3].rfind("| more | extend | noon | failed: out/more/metrics.json: cannot write | - | - | - |", 0), 0u)
+      << rows[3];
+  EXPECT_EQ(rows[3].find("0.00"), std::string::npos) << rows[3];
+  EXPECT_EQ(rows[4].rfind("| after | localise | more | skipped: session more left no map", 0), 0u) << rows[4];
+  EXPECT_EQ(rows[5].rfind("| last | localise | noon | not run (the campaign was stopped) | - | - | - |", 0), 0u)
+      << rows[5];
+
+  // The page links the reports that exist and names the sessions without one.
+  const std::string html = run::campaign_html(r, run::campaign_markdown(r));
+  EXPECT_NE(html.find("<a href=\"again/index.html\">again</a> (interrupted)"), std::string::npos) << html;
+  EXPECT_EQ(html.find("href=\"last/index.html\""), std::string::npos) << html;
+  EXPECT_NE(html.find("<li>last: not run (the campaign was stopped)</li>"), std::string::npos) << html;
+  EXPECT_EQ(run::campaign_exit_code(r), 130);
+  r.stopped = false;
+  EXPECT_EQ(run::campaign_exit_code(r), 3);
+}
+
+// A campaign stopped before its first session lists every session as not
+// run, in campaign.json and in campaign.md.
+TEST(CampaignReport, AStoppedCampaignListsTheSessionsItDidNotRun) {
+  const std::string out = ::testing::TempDir() + "pvb_campaign_stopped_" + std::to_string(::getpid());
+  std::filesystem::remove_all(out);
+  const run::Campaign c = five_sessions();
+  std::atomic<bool> stop{true};
+  run::CampaignOptions o;
+  o.campaign_file = c.file;
+  o.out_dir = out;
+  o.seed = 2;
+  o.stop = &stop;
+  const run::CampaignReport r = run::run_campaign(o);
+  EXPECT_TRUE(r.stopped);
+  ASSERT_EQ(r.sessions.size(), 5u);
+  const YAML::Node j = YAML::Load(read_file(out + "/campaign.json"));
+  ASSERT_EQ(j["sessions"].size(), 5u);
+  for (std::size_t i = 0; i < 5; ++i) {
+    EXPECT_EQ(j["sessions"][i]["name"].as<std::string>(), c.sessions[i].name);
+    EXPECT_EQ(j["sessions"][i]["status"].as<std::string>(), "not_run");
+    EXPECT_EQ(j["sessions"][i]["seed"].as<int>(), 2000 + static_cast<int>(i));
+  }
+  const std::vector<std::string> rows = table_rows(read_file(out + "/campaign.md"));
+  ASSERT_EQ(rows.size(), 6u);
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    EXPECT_NE(rows[i].find(" | not run (the campaign was stopped) | "), std::string::npos) << rows[i];
+  EXPECT_NE(read_file(out + "/index.html").find("<li>noon: not run (the campaign was stopped)</li>"),
+            std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(out + "/noon"));
+  std::filesystem::remove_all(out);
 }
