@@ -12,6 +12,7 @@
 #include "pvb/common/text.hpp"
 #include "pvb/run/campaign.hpp"
 #include "pvb/run/campaign_run.hpp"
+#include "pvb/suite/campaign_aggregate.hpp"
 
 using namespace pvb;
 
@@ -83,12 +84,14 @@ TEST(Campaign, MistakesAreOneLineNamingFileLineAndKey) {
 // A session may not take the name of what the campaign writes beside the
 // sessions' folders: a session "maps" would run in the maps folder.
 TEST(Campaign, ANameTheCampaignWritesItselfIsRefused) {
-  const std::string e = error_of("name: c\nsessions:\n  - {name: noon, scenario: STATION, mode: map}\n"
-                                 "  - {name: maps, scenario: STATION, mode: localise, map: noon}\n");
-  EXPECT_NE(e.find("c.yaml:4: sessions[1].name: expected a name other than those the campaign writes beside the "
-                   "sessions' folders (maps, campaign.json, campaign.md, matrix.svg, matrix.png, index.html, "
-                   "stdout.log), got maps"),
-            std::string::npos)
+  const std::string e = error_of(
+      "name: c\nsessions:\n  - {name: noon, scenario: STATION, mode: map}\n"
+      "  - {name: maps, scenario: STATION, mode: localise, map: noon}\n");
+  EXPECT_NE(
+      e.find("c.yaml:4: sessions[1].name: expected a name other than those the campaign writes beside the "
+             "sessions' folders (maps, campaign.json, campaign.md, matrix.svg, matrix.png, index.html, "
+             "stdout.log), got maps"),
+      std::string::npos)
       << e;
   EXPECT_EQ(run::campaign_top_level_names().front(), "maps");
 }
@@ -96,19 +99,23 @@ TEST(Campaign, ANameTheCampaignWritesItselfIsRefused) {
 // Every session's scenario is loaded with the file: a later session's bad
 // scenario or start beyond its route fails before any session runs.
 TEST(Campaign, EverySessionsScenarioAndStartAreCheckedWithTheFile) {
-  std::string e = error_of("name: c\nsessions:\n  - {name: a, scenario: STATION, mode: map}\n"
-                           "  - {name: b, scenario: STATION, mode: localise, map: a, start_m: 500}\n");
-  EXPECT_NE(e.find("c.yaml:4: sessions[1].start_m: expected a distance from 0 to 1 m before the route's end (the "
-                   "route of "),
-            std::string::npos)
+  std::string e = error_of(
+      "name: c\nsessions:\n  - {name: a, scenario: STATION, mode: map}\n"
+      "  - {name: b, scenario: STATION, mode: localise, map: a, start_m: 500}\n");
+  EXPECT_NE(
+      e.find("c.yaml:4: sessions[1].start_m: expected a distance from 0 to 1 m before the route's end (the "
+             "route of "),
+      std::string::npos)
       << e;
   EXPECT_NE(e.find("/scenes/pv_station.yaml is "), std::string::npos) << e;
   EXPECT_NE(e.find(" m long), got 500"), std::string::npos) << e;
   const std::string dir = ::testing::TempDir() + "pvb_campaign_" + std::to_string(::getpid());
   std::filesystem::create_directories(dir);
-  write_file(dir + "/bad_day.yaml", "base: " + std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml\nspeed: 3\n");
-  e = error_of("name: c\nsessions:\n  - {name: a, scenario: STATION, mode: map}\n"
-               "  - {name: b, scenario: bad_day.yaml, mode: localise, map: a}\n");
+  write_file(dir + "/bad_day.yaml",
+             "base: " + std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml\nspeed: 3\n");
+  e = error_of(
+      "name: c\nsessions:\n  - {name: a, scenario: STATION, mode: map}\n"
+      "  - {name: b, scenario: bad_day.yaml, mode: localise, map: a}\n");
   EXPECT_NE(e.find("bad_day.yaml:2: speed"), std::string::npos) << e;
   // The scenario's own seed is kept for a campaign run without --seed.
   const run::Campaign daily = run::load_campaign(kCampaigns + "daily.yaml");
@@ -123,12 +130,22 @@ run::Campaign five_sessions() {
   const std::string dir = ::testing::TempDir() + "pvb_campaign_five_" + std::to_string(::getpid());
   std::filesystem::create_directories(dir);
   const std::string station = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
-  write_file(dir + "/five.yaml", "name: five\nsessions:\n"
-                                 "  - {name: noon, scenario: " + station + ", mode: map}\n"
-                                 "  - {name: again, scenario: " + station + ", mode: localise, map: noon}\n"
-                                 "  - {name: more, scenario: " + station + ", mode: extend, map: noon}\n"
-                                 "  - {name: after, scenario: " + station + ", mode: localise, map: more}\n"
-                                 "  - {name: last, scenario: " + station + ", mode: localise, map: noon}\n");
+  write_file(dir + "/five.yaml",
+             "name: five\nsessions:\n"
+             "  - {name: noon, scenario: " +
+                 station +
+                 ", mode: map}\n"
+                 "  - {name: again, scenario: " +
+                 station +
+                 ", mode: localise, map: noon}\n"
+                 "  - {name: more, scenario: " +
+                 station +
+                 ", mode: extend, map: noon}\n"
+                 "  - {name: after, scenario: " +
+                 station +
+                 ", mode: localise, map: more}\n"
+                 "  - {name: last, scenario: " +
+                 station + ", mode: localise, map: noon}\n");
   return run::load_campaign(dir + "/five.yaml");
 }
 
@@ -181,11 +198,14 @@ TEST(CampaignReport, EverySessionHasARowWithItsStatusAndNoInventedFigures) {
   EXPECT_EQ(rows[1].rfind("| noon | map | - | completed | 90 | 2 | 12 (0) |", 0), 0u) << rows[1];
   EXPECT_NE(rows[1].find("| 9.50 |"), std::string::npos) << rows[1];
   EXPECT_EQ(rows[2].rfind("| again | localise | noon | interrupted | 90 |", 0), 0u) << rows[2];
-  EXPECT_EQ(rows[3].rfind("| more | extend | noon | failed: out/more/metrics.json: cannot write | - | - | - |", 0), 0u)
+  EXPECT_EQ(
+      rows[3].rfind("| more | extend | noon | failed: out/more/metrics.json: cannot write | - | - | - |", 0),
+      0u)
       << rows[3];
   EXPECT_EQ(rows[3].find("0.00"), std::string::npos) << rows[3];
   EXPECT_EQ(rows[4].rfind("| after | localise | more | skipped: session more left no map", 0), 0u) << rows[4];
-  EXPECT_EQ(rows[5].rfind("| last | localise | noon | not run (the campaign was stopped) | - | - | - |", 0), 0u)
+  EXPECT_EQ(rows[5].rfind("| last | localise | noon | not run (the campaign was stopped) | - | - | - |", 0),
+            0u)
       << rows[5];
 
   // The page links the reports that exist and names the sessions without one.
@@ -227,5 +247,16 @@ TEST(CampaignReport, AStoppedCampaignListsTheSessionsItDidNotRun) {
   EXPECT_NE(read_file(out + "/index.html").find("<li>noon: not run (the campaign was stopped)</li>"),
             std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(out + "/noon"));
+  // The sweep's aggregate reads what the campaign writes, as this campaign's file of seed 2.
+  EXPECT_EQ(run::kCampaignJsonVersion, suite::kCampaignVersionRead);
+  const suite::CampaignSeed read = suite::read_campaign_seed(2, out + "/campaign.json");
+  EXPECT_EQ(read.error, "");
+  suite::ExpectedCampaign expected{c.file, c.name, {}};
+  for (const run::CampaignSession& s : c.sessions)
+    expected.sessions.push_back({s.name, run::to_string(s.mode), s.map});
+  EXPECT_NO_THROW(suite::expect_campaign_identity(read, expected));
+  ASSERT_EQ(read.sessions.size(), 5u);
+  EXPECT_EQ(read.sessions[4].status, "not_run");
+  EXPECT_FALSE(read.sessions[4].frames.has_value());
   std::filesystem::remove_all(out);
 }
