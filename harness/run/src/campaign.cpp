@@ -63,8 +63,8 @@ CampaignSession read_session(const Ctx& c, const YAML::Node& n, const std::strin
   if (std::find(taken.begin(), taken.end(), s.name) != taken.end()) {
     std::string list;
     for (const std::string& t : taken) list += (list.empty() ? "" : ", ") + t;
-    c.fail(n["name"], path + ".name", "a name other than those the campaign writes beside the sessions' folders (" +
-                                          list + ")", s.name);
+    c.fail(n["name"], path + ".name",
+           "a name other than those the campaign writes beside the sessions' folders (" + list + ")", s.name);
   }
   const std::string scenario = text(c, n, "scenario", path, true);
   s.scenario_file = scenario[0] == '/' ? scenario : (std::filesystem::path(dir) / scenario).lexically_normal().string();
@@ -116,14 +116,15 @@ void check_scenarios(const Ctx& c, const YAML::Node& list, Campaign* k) {
     if (!s.start_m) continue;
     const std::string expected = start_m_expectation(scenario, *s.start_m, s.scenario_file);
     if (!expected.empty())
-      c.fail(list[i]["start_m"], "sessions[" + std::to_string(i) + "].start_m", expected, format_g(*s.start_m));
+      c.fail(list[i]["start_m"], "sessions[" + std::to_string(i) + "].start_m", expected,
+             format_g(*s.start_m));
   }
 }
 
 }  // namespace
 
 const std::vector<std::string>& campaign_top_level_names() {
-  static const std::vector<std::string> names = {"maps",      "campaign.json", "campaign.md", "matrix.svg",
+  static const std::vector<std::string> names = {"maps",       "campaign.json", "campaign.md", "matrix.svg",
                                                  "matrix.png", "index.html",    "stdout.log"};
   return names;
 }

@@ -101,17 +101,20 @@ void run_session(const CampaignOptions& opt, std::size_t i, SessionResult* resul
 std::string num_or_null(const std::optional<double>& v) { return v ? json_number(*v) : "null"; }
 
 /// A count of the run, null for a session without one.
-std::string count_or_null(const SessionResult& r, std::size_t n) { return r.ran() ? std::to_string(n) : "null"; }
+std::string count_or_null(const SessionResult& r, std::size_t n) {
+  return r.ran() ? std::to_string(n) : "null";
+}
 
 std::string session_json(const SessionResult& r) {
   const CampaignSession& s = r.session;
   std::string out = "{\"name\": \"" + json_escape(s.name) + "\", \"mode\": \"" + to_string(s.mode) +
                     "\", \"map\": " + (s.map.empty() ? "null" : "\"" + json_escape(s.map) + "\"") +
-                    ", \"scenario\": \"" + json_escape(s.scenario_file) + "\", \"start_m\": " +
-                    num_or_null(s.start_m) + ", \"seed\": " + std::to_string(r.seed) + ", \"status\": \"" +
-                    to_string(r.status) + "\", \"error\": " +
-                    (r.error.empty() ? "null" : "\"" + json_escape(r.error) + "\"");
-  out += ", \"frames\": " + count_or_null(r, r.frames) + ", \"lost_frames\": " + count_or_null(r, r.lost_frames) +
+                    ", \"scenario\": \"" + json_escape(s.scenario_file) +
+                    "\", \"start_m\": " + num_or_null(s.start_m) + ", \"seed\": " + std::to_string(r.seed) +
+                    ", \"status\": \"" + to_string(r.status) +
+                    "\", \"error\": " + (r.error.empty() ? "null" : "\"" + json_escape(r.error) + "\"");
+  out += ", \"frames\": " + count_or_null(r, r.frames) +
+         ", \"lost_frames\": " + count_or_null(r, r.lost_frames) +
          ", \"keyframes\": " + count_or_null(r, r.keyframes) +
          ", \"keyframes_loaded\": " + count_or_null(r, r.keyframes_loaded) +
          ", \"ate_rmse\": " + num_or_null(r.ate_rmse_m) +
@@ -134,8 +137,18 @@ std::string status_cell(const CampaignReport& rep, const SessionResult& r) {
 
 std::string html_escape(const std::string& s) {
   std::string out;
-  for (char c : s)
-    out += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : c == '"' ? "&quot;" : std::string(1, c);
+  for (char c : s) {
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else if (c == '"')
+      out += "&quot;";
+    else
+      out += c;
+  }
   return out;
 }
 
@@ -181,9 +194,10 @@ bool SessionResult::ran() const {
 std::string campaign_markdown(const CampaignReport& r) {
   std::string out = "# Campaign " + r.campaign.name + "\n\n";
   if (!r.campaign.description.empty()) out += r.campaign.description + "\n\n";
-  out += "| session | mode | map | status | frames | lost | keyframes (loaded) | within 0.05 m/1 deg "
-         "| within 0.25 m/2 deg | wrong place | first pose (frame) | tracking ms median "
-         "| matched landmarks: panels and frames, static, unlabelled |\n";
+  out +=
+      "| session | mode | map | status | frames | lost | keyframes (loaded) | within 0.05 m/1 deg "
+      "| within 0.25 m/2 deg | wrong place | first pose (frame) | tracking ms median "
+      "| matched landmarks: panels and frames, static, unlabelled |\n";
   out += "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const SessionResult& s : r.sessions) {
     const bool ran = s.ran();
@@ -191,25 +205,27 @@ std::string campaign_markdown(const CampaignReport& r) {
     const auto pct = [&](std::size_t k) { return l ? format_fixed(100 * l->share_within[k], 1) + " %" : "-"; };
     const auto count = [&](std::size_t n) { return ran ? std::to_string(n) : std::string("-"); };
     out += "| " + s.session.name + " | " + to_string(s.session.mode) + " | " +
-           (s.session.map.empty() ? "-" : s.session.map) + " | " + status_cell(r, s) + " | " + count(s.frames) +
-           " | " + count(s.lost_frames) + " | " +
-           (ran ? std::to_string(s.keyframes) + " (" + std::to_string(s.keyframes_loaded) + ")" : "-") + " | " +
-           pct(0) + " | " + pct(1) + " | " + (l ? std::to_string(l->wrong_place) : "-") + " | " +
+           (s.session.map.empty() ? "-" : s.session.map) + " | " + status_cell(r, s) + " | " +
+           count(s.frames) + " | " + count(s.lost_frames) + " | " +
+           (ran ? std::to_string(s.keyframes) + " (" + std::to_string(s.keyframes_loaded) + ")" : "-") +
+           " | " + pct(0) + " | " + pct(1) + " | " + (l ? std::to_string(l->wrong_place) : "-") + " | " +
            (l && l->first_pose_frame ? std::to_string(*l->first_pose_frame) : "-") + " | " +
-           (s.tracking_ms_median ? format_fixed(*s.tracking_ms_median, 2) : "-") + " | " + landmark_cell(s) + " |\n";
+           (s.tracking_ms_median ? format_fixed(*s.tracking_ms_median, 2) : "-") + " | " + landmark_cell(s) +
+           " |\n";
   }
   return out;
 }
 
 std::string campaign_html(const CampaignReport& r, const std::string& markdown) {
-  std::string out = "<!doctype html><html><head><meta charset=\"utf-8\"><title>campaign " +
-                    html_escape(r.campaign.name) + "</title></head><body style=\"font-family:sans-serif\">\n<pre>" +
-                    html_escape(markdown) + "</pre>\n";
+  std::string out =
+      "<!doctype html><html><head><meta charset=\"utf-8\"><title>campaign " + html_escape(r.campaign.name) +
+      "</title></head><body style=\"font-family:sans-serif\">\n<pre>" + html_escape(markdown) + "</pre>\n";
   out += "<img src=\"matrix.png\" alt=\"map session x query session\">\n<ul>\n";
   // A link to each session's report; a session that did not run has none.
   for (const SessionResult& s : r.sessions) {
     const std::string name = html_escape(s.session.name);
-    out += s.ran() ? "<li><a href=\"" + name + "/index.html\">" + name + "</a> (" + to_string(s.status) + ")</li>\n"
+    out += s.ran() ? "<li><a href=\"" + name + "/index.html\">" + name + "</a> (" + to_string(s.status) +
+                         ")</li>\n"
                    : "<li>" + name + ": " + html_escape(status_cell(r, s)) + "</li>\n";
   }
   return out + "</ul></body></html>\n";
@@ -234,7 +250,8 @@ CampaignReport run_campaign(const CampaignOptions& opt) {
     }
     SessionResult& s = report.sessions[i];
     run_session(opt, i, &s);
-    if (!s.error.empty() && opt.on_log) opt.on_log("[" + s.session.name + "] " + to_string(s.status) + ": " + s.error);
+    if (!s.error.empty() && opt.on_log)
+      opt.on_log("[" + s.session.name + "] " + to_string(s.status) + ": " + s.error);
     // Written after every session: a stopped campaign keeps what it did.
     write_file(opt.out_dir + "/campaign.json", campaign_json(report));
   }
@@ -247,10 +264,10 @@ CampaignReport run_campaign(const CampaignOptions& opt) {
 }
 
 std::string campaign_json(const CampaignReport& r) {
-  std::string out = "{\n  \"campaign_version\": " + std::to_string(kCampaignJsonVersion) +
-                    ",\n  \"campaign\": \"" + json_escape(r.campaign.name) +
-                    "\",\n  \"file\": \"" + json_escape(r.campaign.file) + "\",\n  \"seed\": " +
-                    (r.seed ? std::to_string(*r.seed) : std::string("null")) + ",\n  \"sessions\": [";
+  std::string out =
+      "{\n  \"campaign_version\": " + std::to_string(kCampaignJsonVersion) + ",\n  \"campaign\": \"" +
+      json_escape(r.campaign.name) + "\",\n  \"file\": \"" + json_escape(r.campaign.file) +
+      "\",\n  \"seed\": " + (r.seed ? std::to_string(*r.seed) : std::string("null")) + ",\n  \"sessions\": [";
   for (std::size_t i = 0; i < r.sessions.size(); ++i) out += (i ? ",\n    " : "\n    ") + session_json(r.sessions[i]);
   return out + "\n  ]\n}\n";
 }

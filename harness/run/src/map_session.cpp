@@ -59,9 +59,11 @@ void MapOptions::check() const {
   if (!load_path.empty() && use == MapUse::kFresh)
     throw ConfigError("command line", "--map-mode", "localise or extend with --map");
   if (load_path.empty() && use != MapUse::kFresh)
-    throw ConfigError("command line", "--map", "the saved map to " + std::string(to_string(use)) + " (--map-mode needs it)");
+    throw ConfigError("command line", "--map",
+                      "the saved map to " + std::string(to_string(use)) + " (--map-mode needs it)");
   if (use == MapUse::kLocalise && !save_path.empty())
-    throw ConfigError("command line", "--save-map", "a map made or extended by the run, not with --map-mode localise");
+    throw ConfigError("command line", "--save-map",
+                      "a map made or extended by the run, not with --map-mode localise");
 }
 
 std::string map_app_json(const std::string& scenario, std::uint64_t station_seed,

@@ -345,7 +345,8 @@ dataset::OrbSlamSettings orbslam_settings_for(const scenes::Scenario& s) {
   return o;
 }
 
-std::string start_m_expectation(const scenes::Scenario& scenario, double start_m, const std::string& scenario_file) {
+std::string start_m_expectation(const scenes::Scenario& scenario, double start_m,
+                                const std::string& scenario_file) {
   const double length = scenes::polyline_length(scenes::route_polyline(scenario));
   if (start_m >= 0 && start_m < length - 1.0) return "";
   return "a distance from 0 to 1 m before the route's end (" +

@@ -65,7 +65,8 @@ double JsonFields::number_at(const YAML::Node& n, const std::string& key, double
   double v = 0;
   if (!is_plain_scalar(n) || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
     fail(n, key, "expected a number, got " + shown(n));
-  if (v < lo || v > hi) fail(n, key, "expected a number" + range_text(lo, hi, false, bound_name) + ", got " + shown(n));
+  if (v < lo || v > hi)
+    fail(n, key, "expected a number" + range_text(lo, hi, false, bound_name) + ", got " + shown(n));
   return v;
 }
 
@@ -80,7 +81,8 @@ int JsonFields::integer_at(const YAML::Node& n, const std::string& key, long lon
   if (!is_plain_scalar(n) || !YAML::convert<long long>::decode(n, v) || v < INT_MIN || v > INT_MAX)
     fail(n, key, "expected an integer, got " + shown(n));
   if (v < lo || v > hi)
-    fail(n, key, "expected an integer" + range_text(double(lo), double(hi), true, bound_name) + ", got " + shown(n));
+    fail(n, key,
+         "expected an integer" + range_text(double(lo), double(hi), true, bound_name) + ", got " + shown(n));
   return static_cast<int>(v);
 }
 

@@ -40,11 +40,13 @@ class JsonFields {
   /// from another field ("frames"; the upper one when both are finite).
   double number(const YAML::Node& obj, const std::string& key,
                 double lo = -std::numeric_limits<double>::infinity(),
-                double hi = std::numeric_limits<double>::infinity(), const std::string& bound_name = "") const;
+                double hi = std::numeric_limits<double>::infinity(),
+                const std::string& bound_name = "") const;
   /// The same for the value `n` itself, named `key` (a list's item).
   double number_at(const YAML::Node& n, const std::string& key,
                    double lo = -std::numeric_limits<double>::infinity(),
-                   double hi = std::numeric_limits<double>::infinity(), const std::string& bound_name = "") const;
+                   double hi = std::numeric_limits<double>::infinity(),
+                   const std::string& bound_name = "") const;
   /// A number in [0, 1].
   double share(const YAML::Node& obj, const std::string& key) const { return number(obj, key, 0.0, 1.0); }
   /// A whole number in [lo, hi].

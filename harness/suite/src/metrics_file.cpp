@@ -1,16 +1,15 @@
 #include "pvb/suite/metrics_file.hpp"
 
-#include <yaml-cpp/yaml.h>
-
 #include <sys/stat.h>
+#include <yaml-cpp/yaml.h>
 
 #include <climits>
 #include <cmath>
 
+#include "json_fields.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/eval/slam_mode.hpp"
-#include "json_fields.hpp"
 
 namespace pvb::suite {
 namespace {
@@ -90,7 +89,8 @@ class Reader : public detail::JsonFields {
     if (cover.IsDefined() && !cover.IsNull()) {
       if (!cover.IsSequence() || cover.size() != 2) fail(cover, "camera_covered_frames", "expected [first, last]");
       const int first = integer_at(cover[0], "camera_covered_frames[0]", 0);
-      r.camera_covered_frames = {first, integer_at(cover[1], "camera_covered_frames[1]", first, INT_MAX, "first")};
+      r.camera_covered_frames = {first,
+                                 integer_at(cover[1], "camera_covered_frames[1]", first, INT_MAX, "first")};
     }
     return r;
   }

@@ -70,20 +70,24 @@ TEST(MapReuse, MapOptionsThatDoNotFitAreOneErrorLine) {
   const std::string run = "run --scenario " + kNoon + " --frames 5 --sync --no-map-eval --out " + d + "/x";
   const auto no_map = test::run_pvbench(run + " --map-mode localise");
   EXPECT_EQ(no_map.code, 1);
-  EXPECT_EQ(no_map.output,
-            "pvbench: error: command line: --map: expected the saved map to localise (--map-mode needs it)\n");
+  EXPECT_EQ(
+      no_map.output,
+      "pvbench: error: command line: --map: expected the saved map to localise (--map-mode needs it)\n");
   write_file(d + "/junk.pvbmap", "not a map at all");
   const auto save_loc = test::run_pvbench(run + " --map " + d + "/junk.pvbmap --map-mode localise --save-map " + d + "/y");
   EXPECT_NE(save_loc.code, 0);
   EXPECT_NE(save_loc.output.find("--save-map"), std::string::npos) << save_loc.output;
   const auto bad_mode = test::run_pvbench(run + " --map " + d + "/junk.pvbmap --map-mode relocate");
   EXPECT_EQ(bad_mode.code, 1);
-  EXPECT_EQ(bad_mode.output, "pvbench: error: command line: --map-mode: expected localise or extend, got relocate\n");
+  EXPECT_EQ(bad_mode.output,
+            "pvbench: error: command line: --map-mode: expected localise or extend, got relocate\n");
   // A start beyond the route is named by its option, with the route's length.
   const auto far = test::run_pvbench(run + " --start-m 500");
   EXPECT_EQ(far.code, 1);
-  EXPECT_EQ(far.output.rfind("pvbench: error: command line: --start-m: expected a distance from 0 to 1 m before the "
-                             "route's end (", 0),
+  EXPECT_EQ(far.output.rfind(
+                "pvbench: error: command line: --start-m: expected a distance from 0 to 1 m before the "
+                "route's end (",
+                0),
             0u)
       << far.output;
   EXPECT_NE(far.output.find(" m long), got 500\n"), std::string::npos) << far.output;

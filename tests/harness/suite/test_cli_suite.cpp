@@ -127,8 +127,9 @@ TEST(CliCheck, RunOfAnotherSeedIsRefused) {
   write_metrics("good_compare.json", metrics, "pv_station", 5);
   auto r = run_pvbench("check --scenario " + scenario + " --metrics " + metrics);
   EXPECT_EQ(r.code, 1) << r.output;
-  EXPECT_EQ(r.output, "pvbench: error: " + metrics +
-                          ": seed: expected 7 (the scenario's seed; give --seed 5 for a run of that seed), got 5\n");
+  EXPECT_EQ(r.output,
+            "pvbench: error: " + metrics +
+                ": seed: expected 7 (the scenario's seed; give --seed 5 for a run of that seed), got 5\n");
   r = run_pvbench("check --scenario " + scenario + " --metrics " + metrics + " --seed 6");
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_EQ(r.output, "pvbench: error: " + metrics + ": seed: expected 6 (--seed), got 5\n");
@@ -148,8 +149,8 @@ TEST(CliCheck, ValuesOutOfRangeAreOneErrorLine) {
   pvb::write_file(metrics, text);
   const auto r = run_pvbench("check --scenario " + scenario_file() + " --metrics " + metrics);
   EXPECT_EQ(r.code, 1) << r.output;
-  EXPECT_EQ(r.output,
-            "pvbench: error: " + metrics + ":5: lost_frames: expected an integer in [0, frames = 300], got -3\n");
+  EXPECT_EQ(r.output, "pvbench: error: " + metrics +
+                          ":5: lost_frames: expected an integer in [0, frames = 300], got -3\n");
 }
 
 TEST(CliSweep, AggregateOnlyRefusesRunsOfAnotherScenarioOrSeed) {
@@ -188,7 +189,8 @@ TEST(CliSweep, AggregateOnlyLeavesOutMetricsWithValuesOutOfRange) {
   const std::string out = scratch("range");
   for (int seed : {1, 2}) {
     fs::create_directories(out + "/seed_" + std::to_string(seed));
-    write_metrics("good_compare.json", out + "/seed_" + std::to_string(seed) + "/metrics.json", "pv_station", seed);
+    write_metrics("good_compare.json", out + "/seed_" + std::to_string(seed) + "/metrics.json", "pv_station",
+                  seed);
   }
   std::string text = pvb::read_file(out + "/seed_2/metrics.json");
   const std::string ate = "\"ate\": {\"rmse\": 0.0042";
