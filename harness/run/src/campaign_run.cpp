@@ -255,6 +255,8 @@ CampaignReport run_campaign(const CampaignOptions& opt) {
     // Written after every session: a stopped campaign keeps what it did.
     write_file(opt.out_dir + "/campaign.json", campaign_json(report));
   }
+  // A stop during the last session stops the campaign too.
+  if (opt.stop && opt.stop->load()) report.stopped = true;
   const std::string md = campaign_markdown(report);
   write_file(opt.out_dir + "/campaign.md", md);
   plot::write_matrix(campaign_matrix(report), opt.out_dir + "/matrix");

@@ -260,3 +260,41 @@ TEST(CampaignReport, AStoppedCampaignListsTheSessionsItDidNotRun) {
   EXPECT_FALSE(read.sessions[4].frames.has_value());
   std::filesystem::remove_all(out);
 }
+
+// Sessions that fail are stored with their real status and no figures: the
+// first run cannot start (an unknown GL backend), so the second, which
+// needs its map, is skipped.  A stop that comes during the last session
+// stops the campaign (exit 130).
+TEST(CampaignReport, FailedAndSkippedSessionsKeepTheirStatusAndNoFigures) {
+  const std::string out = ::testing::TempDir() + "pvb_campaign_failed_" + std::to_string(::getpid());
+  std::filesystem::remove_all(out);
+  const run::Campaign c = five_sessions();
+  std::atomic<bool> stop{false};
+  run::CampaignOptions o;
+  o.campaign_file = c.file;
+  o.out_dir = out;
+  o.gl = "vulkan";
+  o.stop = &stop;
+  o.on_log = [&](const std::string& line) {
+    if (line.rfind("[last] ", 0) == 0) stop = true;
+  };
+  const run::CampaignReport r = run::run_campaign(o);
+  const YAML::Node j = YAML::Load(read_file(out + "/campaign.json"));
+  ASSERT_EQ(j["sessions"].size(), 5u);
+  EXPECT_EQ(j["sessions"][0]["status"].as<std::string>(), "failed");
+  EXPECT_NE(j["sessions"][0]["error"].as<std::string>().find("vulkan"), std::string::npos);
+  EXPECT_TRUE(j["sessions"][0]["tracking_ms_median"].IsNull());
+  EXPECT_TRUE(j["sessions"][0]["frames"].IsNull());
+  EXPECT_EQ(j["sessions"][0]["seed"].as<std::uint64_t>(), c.sessions[0].scenario_seed);  // no --seed
+  for (std::size_t i = 1; i < 5; ++i) {
+    EXPECT_EQ(j["sessions"][i]["status"].as<std::string>(), "skipped") << i;
+    EXPECT_TRUE(j["sessions"][i]["tracking_ms_median"].IsNull()) << i;
+  }
+  const std::vector<std::string> rows = table_rows(read_file(out + "/campaign.md"));
+  ASSERT_EQ(rows.size(), 6u);
+  EXPECT_NE(rows[1].find("| noon | map | - | failed: "), std::string::npos) << rows[1];
+  EXPECT_EQ(rows[1].find("0.00"), std::string::npos) << rows[1];
+  EXPECT_TRUE(r.stopped);
+  EXPECT_EQ(run::campaign_exit_code(r), 130);
+  std::filesystem::remove_all(out);
+}
