@@ -4,7 +4,8 @@ namespace pvb {
 namespace {
 std::string config_message(const std::string& file, const std::string& key, const std::string& expected,
                            const std::string& got) {
-  std::string msg = file + ": " + key + ": expected " + expected;
+  // A message without a key (an option's own value) reads "FILE: expected ...".
+  std::string msg = file + ": " + (key.empty() ? std::string() : key + ": ") + "expected " + expected;
   if (!got.empty()) msg += ", got " + got;
   return msg;
 }

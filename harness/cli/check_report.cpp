@@ -9,16 +9,22 @@
 
 namespace pvb::cli {
 
-int check_and_print(const std::string& scenario_file, const std::string& metrics_path, int no_expect_code) {
+int check_and_print(const std::string& scenario_file, const std::string& metrics_path,
+                    std::optional<std::uint64_t> seed, int no_expect_code) {
   const scenes::Scenario s = scenes::load_scenario(scenario_file);
   if (!s.expect.any()) {
     std::printf("%s: no expect: section, nothing to check\n", scenario_file.c_str());
     return no_expect_code;
   }
-  // The run must be one of this scenario: another's metrics would be
-  // judged by the wrong bounds.
+  // The run must be one of this scenario and seed: another's metrics would
+  // be judged by the wrong bounds, or stand for a run that was not made.
   const suite::MetricsFile metrics = suite::read_metrics_file(metrics_path);
-  suite::expect_run_identity(metrics, s.name, scenario_file, std::nullopt);
+  const std::string seed_source =
+      seed ? std::string("--seed")
+           : "the scenario's seed" +
+                 (metrics.seed ? "; give --seed " + std::to_string(*metrics.seed) + " for a run of that seed"
+                               : std::string());
+  suite::expect_run_identity(metrics, s.name, scenario_file, seed.value_or(s.seed), seed_source);
   std::vector<std::string> notes;
   const std::vector<suite::Violation> violations = suite::check_expectations(s.expect, metrics, &notes);
   if (s.expect.sweep.any())

@@ -1,7 +1,8 @@
 // pvbench campaign: the sessions of a campaign file in order (map,
 // localise, extend), the maps passed along, one report for all
 // (docs/map_reuse.md).  Ctrl-C stops after the running session's partial
-// report; what finished stays in campaign.json.
+// report; campaign.json lists it as interrupted and the sessions after it
+// as not run.
 #include <cstdio>
 #include <memory>
 #include <optional>

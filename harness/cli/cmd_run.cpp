@@ -66,7 +66,7 @@ int run_run(RunArgs& a) {
   if (!a.check || report.status == run::RunStatus::kInterrupted) return code;
   // --check: the scenario's expect: bounds judge the run.  An aborted run
   // (on_loss: abort) passes when the scenario expects tracking to be lost.
-  return check_and_print(o.scenario_file, o.out_dir + "/metrics.json", code);
+  return check_and_print(o.scenario_file, o.out_dir + "/metrics.json", report.seed, code);
 }
 
 }  // namespace

@@ -180,12 +180,26 @@ std::string seed_summary(const suite::SeedRun& r) {
   return s;
 }
 
-std::string campaign_seed_summary(const std::string& dir, std::uint64_t seed) {
+/// The campaign file's name and sessions, which every seed's campaign.json must match.
+suite::ExpectedCampaign expected_campaign(const run::Campaign& c) {
+  suite::ExpectedCampaign e{c.file, c.name, {}};
+  for (const run::CampaignSession& s : c.sessions)
+    e.sessions.push_back({s.name, run::to_string(s.mode), s.map});
+  return e;
+}
+
+std::string campaign_seed_summary(const suite::ExpectedCampaign& campaign, const std::string& dir,
+                                  std::uint64_t seed) {
   const suite::CampaignSeed c = suite::read_campaign_seed(seed, dir + "/campaign.json");
-  if (!c.error.empty()) return "no campaign.json: " + c.error;
+  if (!c.error.empty()) return "no campaign figures: " + c.error;
+  try {
+    suite::expect_campaign_identity(c, campaign);
+  } catch (const Error& e) {
+    return std::string("refused: ") + e.what();
+  }
   int completed = 0, wrong = 0;
   for (const auto& s : c.sessions) {
-    completed += s.status == "completed";
+    completed += s.completed();
     wrong += s.wrong_place.value_or(0);
   }
   return std::to_string(completed) + " of " + std::to_string(c.sessions.size()) + " sessions completed, " +
@@ -194,7 +208,8 @@ std::string campaign_seed_summary(const std::string& dir, std::uint64_t seed) {
 
 /// Runs every seed, at most a.jobs at once.  Returns each seed's exit code
 /// (-1 for a seed never started because the sweep was stopped).
-std::map<std::uint64_t, int> run_seeds(const SweepArgs& a, const std::vector<std::uint64_t>& seeds) {
+std::map<std::uint64_t, int> run_seeds(const SweepArgs& a, const std::vector<std::uint64_t>& seeds,
+                                       const suite::ExpectedCampaign* campaign = nullptr) {
   struct sigaction sa {};
   sa.sa_handler = sweep_on_stop_signal;
   sigemptyset(&sa.sa_mask);
@@ -242,8 +257,9 @@ std::map<std::uint64_t, int> run_seeds(const SweepArgs& a, const std::vector<std
         WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
     exit_codes[seed] = code;
     const std::string summary =
-        a.campaign.empty() ? seed_summary(suite::read_seed_run(seed, seed_dir(a.out, seed) + "/metrics.json", code))
-                           : campaign_seed_summary(seed_dir(a.out, seed), seed);
+        campaign == nullptr
+            ? seed_summary(suite::read_seed_run(seed, seed_dir(a.out, seed) + "/metrics.json", code))
+            : campaign_seed_summary(*campaign, seed_dir(a.out, seed), seed);
     std::printf("[%zu/%zu] seed %llu: %s; %s\n", done, seeds.size(), static_cast<unsigned long long>(seed),
                 describe_exit(status).c_str(), summary.c_str());
     if (code != 0) std::printf("  see %s/stdout.log\n", seed_dir(a.out, seed).c_str());
@@ -254,6 +270,18 @@ std::map<std::uint64_t, int> run_seeds(const SweepArgs& a, const std::vector<std
   ::sigaction(SIGINT, &old_int, nullptr);
   ::sigaction(SIGTERM, &old_term, nullptr);
   return exit_codes;
+}
+
+/// --aggregate-only reads an existing sweep folder: a missing one is said
+/// to be missing, before any seed is read or anything written.
+void require_sweep_folder(const std::string& out) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(out, ec);
+  if (st.type() == fs::file_type::not_found)
+    throw IoError(out, "missing; expected the sweep folder that holds the seed_S folders");
+  if (ec) throw IoError(out, "cannot read the sweep folder: " + ec.message());
+  if (st.type() != fs::file_type::directory)
+    throw IoError(out, "not a folder; expected the sweep folder that holds the seed_S folders");
 }
 
 /// Seeds with a DIR/seed_S folder, in numeric order.
@@ -322,10 +350,16 @@ suite::SweepAggregate write_aggregate(const SweepArgs& a, const std::string& sce
 
 /// A campaign sweep: DIR/aggregate.{md,json} per session and the matrix of
 /// the mean shares within (0.25 m, 2 deg).  Returns the seeds that failed.
-int write_campaign_aggregate(const SweepArgs& a, const std::vector<std::uint64_t>& seeds) {
+int write_campaign_aggregate(const SweepArgs& a, const suite::ExpectedCampaign& campaign,
+                             const std::vector<std::uint64_t>& seeds) {
   std::vector<suite::CampaignSeed> runs;
-  for (std::uint64_t s : seeds) runs.push_back(suite::read_campaign_seed(s, seed_dir(a.out, s) + "/campaign.json"));
-  const suite::CampaignAggregate agg = suite::aggregate_campaign(runs);
+  for (std::uint64_t s : seeds) {
+    runs.push_back(suite::read_campaign_seed(s, seed_dir(a.out, s) + "/campaign.json"));
+    // A seed folder holds that seed's run of this campaign, or the sweep
+    // would report another campaign's sessions as these.
+    if (runs.back().error.empty()) suite::expect_campaign_identity(runs.back(), campaign);
+  }
+  const suite::CampaignAggregate agg = suite::aggregate_campaign(campaign, runs);
   const fs::path out(a.out);
   write_file((out / "aggregate.md").string(), suite::format_campaign_markdown(agg));
   write_file((out / "aggregate.json").string(), suite::format_campaign_json(agg));
@@ -377,15 +411,18 @@ void check_sweep_paths(const SweepArgs& a, IoPlan* plan, const std::vector<std::
 int run_campaign_sweep(const SweepArgs& a) {
   if (!a.scenario.empty() || a.compare || a.baseline || a.check)
     throw ConfigError("command line", "--campaign", "no --scenario, --compare, --baseline or --check with it");
-  const run::Campaign campaign = run::load_campaign(a.campaign);  // validates the file early
+  // Validates the file early: every session's scenario, before any seed runs.
+  const run::Campaign campaign = run::load_campaign(a.campaign);
+  const suite::ExpectedCampaign expected = expected_campaign(campaign);
   IoPlan plan;
   add_campaign_inputs(&plan, "--campaign", campaign);
+  if (a.aggregate_only) require_sweep_folder(a.out);
   check_sweep_paths(a, &plan, {"aggregate.md", "aggregate.json", "matrix.svg", "matrix.png"});
   std::vector<std::uint64_t> seeds;
   if (a.aggregate_only) {
     seeds = a.seeds.empty() ? discover_seeds(a.out) : suite::parse_seed_list(a.seeds);
     if (seeds.empty()) throw ConfigError(a.out, "seed_*/campaign.json", "at least one seed folder", "none");
-    return write_campaign_aggregate(a, seeds) > 0 ? kSeedFailedExit : 0;
+    return write_campaign_aggregate(a, expected, seeds) > 0 ? kSeedFailedExit : 0;
   }
   if (a.seeds.empty()) throw ConfigError("command line", "--seeds", "a seed list like 1-20, 1,3,5 or 1-5,9");
   seeds = suite::parse_seed_list(a.seeds);
@@ -397,8 +434,8 @@ int run_campaign_sweep(const SweepArgs& a) {
   prepare_output_folder(a.out, a.overwrite, "sweep");
   std::printf("sweep: campaign %s, %zu seed(s), %d at once, into %s\n", campaign.name.c_str(), seeds.size(), a.jobs,
               a.out.c_str());
-  run_seeds(a, seeds);
-  const int failed = write_campaign_aggregate(a, seeds);
+  run_seeds(a, seeds, &expected);
+  const int failed = write_campaign_aggregate(a, expected, seeds);
   if (g_stop_signal != 0) return kInterruptedExit;
   return failed > 0 ? kSeedFailedExit : 0;
 }
@@ -419,6 +456,7 @@ int run_sweep(SweepArgs a) {
   } else if (!a.aggregate_only) {
     throw ConfigError("command line", "--scenario", "a scenario file (or --campaign)");
   }
+  if (a.aggregate_only) require_sweep_folder(a.out);
   check_sweep_paths(a, &plan,
                     {"aggregate.md", "aggregate.csv", "aggregate.json", "aggregate.svg", "aggregate.png"});
 

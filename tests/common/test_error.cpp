@@ -14,3 +14,8 @@ TEST(Error, IoErrorNamesFileAndLine) {
   const pvb::IoError e2("x.png", "cannot read");
   EXPECT_STREQ(e2.what(), "x.png: cannot read");
 }
+
+TEST(Error, ConfigErrorWithoutAKeyHasNoEmptyField) {
+  const pvb::ConfigError e("command line", "", "a seed list");
+  EXPECT_STREQ(e.what(), "command line: expected a seed list");
+}

@@ -4,6 +4,7 @@
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -11,6 +12,8 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/run/run.hpp"
+#include "pvb/scenes/scenario.hpp"
 
 namespace pvb::run {
 namespace {
@@ -56,6 +59,13 @@ CampaignSession read_session(const Ctx& c, const YAML::Node& n, const std::strin
   s.name = text(c, n, "name", path, true);
   if (s.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") != std::string::npos)
     c.fail(n["name"], path + ".name", "letters, digits, '_' and '-' (it names a folder)", s.name);
+  const auto& taken = campaign_top_level_names();
+  if (std::find(taken.begin(), taken.end(), s.name) != taken.end()) {
+    std::string list;
+    for (const std::string& t : taken) list += (list.empty() ? "" : ", ") + t;
+    c.fail(n["name"], path + ".name",
+           "a name other than those the campaign writes beside the sessions' folders (" + list + ")", s.name);
+  }
   const std::string scenario = text(c, n, "scenario", path, true);
   s.scenario_file = scenario[0] == '/' ? scenario : (std::filesystem::path(dir) / scenario).lexically_normal().string();
   struct stat st {};
@@ -96,7 +106,28 @@ void check_maps(const Ctx& c, const YAML::Node& list, const Campaign& k) {
   }
 }
 
+/// Every session's scenario, loaded before any session runs: its seed, and
+/// its start_m against the route.
+void check_scenarios(const Ctx& c, const YAML::Node& list, Campaign* k) {
+  for (std::size_t i = 0; i < k->sessions.size(); ++i) {
+    CampaignSession& s = k->sessions[i];
+    const scenes::Scenario scenario = scenes::load_scenario(s.scenario_file);
+    s.scenario_seed = scenario.seed;
+    if (!s.start_m) continue;
+    const std::string expected = start_m_expectation(scenario, *s.start_m, s.scenario_file);
+    if (!expected.empty())
+      c.fail(list[i]["start_m"], "sessions[" + std::to_string(i) + "].start_m", expected,
+             format_g(*s.start_m));
+  }
+}
+
 }  // namespace
+
+const std::vector<std::string>& campaign_top_level_names() {
+  static const std::vector<std::string> names = {"maps",       "campaign.json", "campaign.md", "matrix.svg",
+                                                 "matrix.png", "index.html",    "stdout.log"};
+  return names;
+}
 
 const char* to_string(SessionMode m) {
   switch (m) {
@@ -145,6 +176,7 @@ Campaign load_campaign(const std::string& path) {
              k.sessions.back().name);
   }
   check_maps(c, list, k);
+  check_scenarios(c, list, &k);
   return k;
 }
 

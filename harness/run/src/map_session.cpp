@@ -52,16 +52,18 @@ const char* to_string(MapUse u) {
 MapUse parse_map_use(const std::string& text, const std::string& option) {
   if (text == "localise") return MapUse::kLocalise;
   if (text == "extend") return MapUse::kExtend;
-  throw ConfigError(option, "", "localise or extend", text);
+  throw ConfigError("command line", option, "localise or extend", text);
 }
 
 void MapOptions::check() const {
   if (!load_path.empty() && use == MapUse::kFresh)
-    throw ConfigError("--map-mode", "", "localise or extend with --map");
+    throw ConfigError("command line", "--map-mode", "localise or extend with --map");
   if (load_path.empty() && use != MapUse::kFresh)
-    throw ConfigError("--map", "", "the saved map to " + std::string(to_string(use)) + " (--map-mode needs it)");
+    throw ConfigError("command line", "--map",
+                      "the saved map to " + std::string(to_string(use)) + " (--map-mode needs it)");
   if (use == MapUse::kLocalise && !save_path.empty())
-    throw ConfigError("--save-map", "", "a map made or extended by the run, not with --map-mode localise");
+    throw ConfigError("command line", "--save-map",
+                      "a map made or extended by the run, not with --map-mode localise");
 }
 
 std::string map_app_json(const std::string& scenario, std::uint64_t station_seed,

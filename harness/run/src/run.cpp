@@ -31,11 +31,8 @@ scenes::Scenario load_run_scenario(const RunOptions& opt) {
   scenes::Scenario scenario = scenes::load_scenario(opt.scenario_file);
   if (opt.seed) scenario.seed = *opt.seed;
   if (opt.start_m) {
-    const double length = scenes::polyline_length(scenes::route_polyline(scenario));
-    if (!(*opt.start_m >= 0 && *opt.start_m < length - 1.0))
-      throw ConfigError("--start-m", "",
-                        "a distance from 0 to 1 m before the route's end (" + format_fixed(length, 2) + " m long)",
-                        format_g(*opt.start_m));
+    const std::string expected = start_m_expectation(scenario, *opt.start_m);
+    if (!expected.empty()) throw ConfigError("command line", "--start-m", expected, format_g(*opt.start_m));
     scenario.route.start_m = *opt.start_m;
   }
   return scenario;
@@ -386,6 +383,15 @@ dataset::OrbSlamSettings orbslam_settings_for(const scenes::Scenario& s) {
   o.kf_min_tracked_close = s.slam.keyframe_min_tracked_close;
   o.kf_ref_overlap = s.slam.keyframe_ref_overlap;
   return o;
+}
+
+std::string start_m_expectation(const scenes::Scenario& scenario, double start_m,
+                                const std::string& scenario_file) {
+  const double length = scenes::polyline_length(scenes::route_polyline(scenario));
+  if (start_m >= 0 && start_m < length - 1.0) return "";
+  return "a distance from 0 to 1 m before the route's end (" +
+         (scenario_file.empty() ? std::string() : "the route of " + scenario_file + " is ") +
+         format_fixed(length, 2) + " m long)";
 }
 
 RunReport run_scenario(const RunOptions& opt) {

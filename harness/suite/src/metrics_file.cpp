@@ -1,13 +1,12 @@
 #include "pvb/suite/metrics_file.hpp"
 
-#include <yaml-cpp/depthguard.h>
-#include <yaml-cpp/yaml.h>
-
 #include <sys/stat.h>
+#include <yaml-cpp/yaml.h>
 
 #include <climits>
 #include <cmath>
 
+#include "json_fields.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/eval/slam_mode.hpp"
@@ -16,64 +15,20 @@ namespace pvb::suite {
 namespace {
 
 // Reads one metrics object; `prefix` names nested keys in errors ("baseline.").
-class Reader {
+class Reader : public detail::JsonFields {
  public:
-  Reader(std::string path, std::string prefix) : path_(std::move(path)), prefix_(std::move(prefix)) {}
+  using JsonFields::JsonFields;
 
-  [[noreturn]] void fail(const YAML::Node& at, const std::string& key, const std::string& what) const {
-    const YAML::Mark m = at.Mark();
-    throw IoError(path_, prefix_ + key + ": " + what, m.line >= 0 ? m.line + 1 : 0);
-  }
-
-  YAML::Node required(const YAML::Node& obj, const std::string& key) const {
-    const YAML::Node n = obj[key];
-    if (!n.IsDefined()) fail(obj, key, "missing");
-    return n;
-  }
-
-  /// yaml-cpp reads JSON, and would decode the string "0.003" as a number:
-  /// a quoted scalar (tag "!") is a string, never a number.
-  static bool is_plain_scalar(const YAML::Node& n) { return n.IsScalar() && n.Tag() != "!"; }
-
-  double number(const YAML::Node& obj, const std::string& key) const {
-    const YAML::Node n = required(obj, key);
-    double v = 0;
-    if (!is_plain_scalar(n) || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
-      fail(n, key, "expected a number, got " + shown(n));
-    return v;
-  }
-
-  int integer(const YAML::Node& obj, const std::string& key) const {
-    const YAML::Node n = required(obj, key);
-    long long v = 0;
-    if (!is_plain_scalar(n) || !YAML::convert<long long>::decode(n, v) || v < INT_MIN || v > INT_MAX)
-      fail(n, key, "expected an integer, got " + shown(n));
-    return static_cast<int>(v);
-  }
-
-  /// A value as the message shows it: a string in quotes.
-  static std::string shown(const YAML::Node& n) {
-    if (!n.IsScalar()) return n.IsNull() ? "null" : "a list or an object";
-    return n.Tag() == "!" ? "the string \"" + n.Scalar() + "\"" : n.Scalar();
-  }
-
-  std::string text(const YAML::Node& obj, const std::string& key) const {
-    const YAML::Node n = required(obj, key);
-    if (!n.IsScalar()) fail(n, key, "expected a string");
-    return n.Scalar();
-  }
-
-  /// An optional number under obj[key][sub] (absent or null object -> nullopt).
+  /// An optional number >= 0 under obj[key][sub] (absent or null object -> nullopt).
   std::optional<double> optional_number(const YAML::Node& obj, const std::string& key,
                                         const std::string& sub) const {
     const YAML::Node n = obj[key];
     if (!n.IsDefined() || n.IsNull()) return std::nullopt;
     if (!n.IsMap()) fail(n, key, "expected an object or null");
-    const Reader inner(path_, prefix_ + key + ".");
-    return inner.number(n, sub);
+    return nested(key + ".").number(n, sub, 0.0);
   }
 
-  /// "ate"/"rpe" must be present, and an object or null.
+  /// "ate"/"rpe" must be present, and an object or null; the RMSE is >= 0.
   std::optional<double> stats_rmse(const YAML::Node& obj, const std::string& key,
                                    const std::vector<std::string>& path) const {
     YAML::Node n = required(obj, key);
@@ -87,8 +42,29 @@ class Reader {
       name += "." + p;
     }
     if (!n.IsMap()) fail(n, name, "expected an object");
-    const Reader inner(path_, prefix_ + name + ".");
-    return inner.number(n, "rmse");
+    return nested(name + ".").number(n, "rmse", 0.0);
+  }
+
+  /// "loss_events": each loss's frame, time and recovery (not before the loss).
+  std::vector<LossEvent> loss_events(const YAML::Node& obj) const {
+    const YAML::Node events = obj["loss_events"];
+    if (!events.IsDefined() || events.IsNull()) return {};
+    if (!events.IsSequence()) fail(events, "loss_events", "expected a list");
+    std::vector<LossEvent> out;
+    for (std::size_t i = 0; i < events.size(); ++i) {
+      const Reader inner(path(), prefix() + "loss_events[" + std::to_string(i) + "].");
+      if (!events[i].IsMap()) inner.fail(events[i], "", "expected an object");
+      LossEvent e;
+      e.frame = inner.integer(events[i], "frame", 0);
+      if (events[i]["t_s"].IsDefined()) e.t_s = inner.number(events[i], "t_s", 0.0);
+      const YAML::Node reason = events[i]["reason"];
+      if (reason.IsDefined() && !reason.IsNull()) e.reason = inner.text(events[i], "reason");
+      const YAML::Node rec = events[i]["recovered_frame"];
+      if (rec.IsDefined() && !rec.IsNull())
+        e.recovered_frame = inner.integer(events[i], "recovered_frame", e.frame, INT_MAX, "frame");
+      out.push_back(e);
+    }
+    return out;
   }
 
   RunMetrics run(const YAML::Node& obj) const {
@@ -98,37 +74,23 @@ class Reader {
     r.status = text(obj, "status");
     if (r.status != "completed" && r.status != "interrupted" && r.status != "aborted" && r.status != "failed")
       fail(obj["status"], "status", "expected completed, interrupted, aborted or failed, got " + r.status);
-    r.frames = integer(obj, "frames");
-    r.lost_frames = integer(obj, "lost_frames");
-    if (obj["keyframes"].IsDefined() && !obj["keyframes"].IsNull()) r.keyframes = integer(obj, "keyframes");
+    r.frames = integer(obj, "frames", 0);
+    r.lost_frames = integer(obj, "lost_frames", 0, r.frames, "frames");
+    if (!absent(obj, "keyframes")) r.keyframes = integer(obj, "keyframes", 0);
     r.ate_rmse_m = stats_rmse(obj, "ate", {});
     r.rpe_trans_rmse_m = stats_rmse(obj, "rpe", {"trans"});
     r.tracking_ms_median = optional_number(obj, "tracking_ms", "median");
-    const YAML::Node rtf = obj["realtime_factor"];
-    if (rtf.IsDefined() && !rtf.IsNull()) r.realtime_factor = number(obj, "realtime_factor");
-    const YAML::Node events = obj["loss_events"];
-    if (events.IsDefined() && !events.IsNull()) {
-      if (!events.IsSequence()) fail(events, "loss_events", "expected a list");
-      for (std::size_t i = 0; i < events.size(); ++i) {
-        const Reader inner(path_, prefix_ + "loss_events[" + std::to_string(i) + "].");
-        if (!events[i].IsMap()) inner.fail(events[i], "", "expected an object");
-        LossEvent e;
-        e.frame = inner.integer(events[i], "frame");
-        if (events[i]["t_s"].IsDefined()) e.t_s = inner.number(events[i], "t_s");
-        const YAML::Node reason = events[i]["reason"];
-        if (reason.IsDefined() && !reason.IsNull()) e.reason = inner.text(events[i], "reason");
-        const YAML::Node rec = events[i]["recovered_frame"];
-        if (rec.IsDefined() && !rec.IsNull()) e.recovered_frame = inner.integer(events[i], "recovered_frame");
-        r.loss_events.push_back(e);
-      }
-    }
+    if (!absent(obj, "realtime_factor")) r.realtime_factor = number(obj, "realtime_factor", 0.0);
+    r.loss_events = loss_events(obj);
     r.refined_ate_rmse_m = optional_number(obj, "refined", "ate_rmse");
     r.place = place(obj);
     r.maps = maps(obj);
     const YAML::Node cover = obj["camera_covered_frames"];
     if (cover.IsDefined() && !cover.IsNull()) {
       if (!cover.IsSequence() || cover.size() != 2) fail(cover, "camera_covered_frames", "expected [first, last]");
-      r.camera_covered_frames = {cover[0].as<int>(-1), cover[1].as<int>(-1)};
+      const int first = integer_at(cover[0], "camera_covered_frames[0]", 0);
+      r.camera_covered_frames = {first,
+                                 integer_at(cover[1], "camera_covered_frames[1]", first, INT_MAX, "first")};
     }
     return r;
   }
@@ -144,26 +106,21 @@ class Reader {
     std::vector<MapMetrics> out;
     for (const auto& kv : maps) {
       const std::string name = kv.first.Scalar();
-      const Reader in(path_, prefix_ + "dense_map.maps." + name + ".");
+      const JsonFields in = nested("dense_map.maps." + name + ".");
       const YAML::Node all = in.required(kv.second, "all");
-      const Reader all_in(path_, prefix_ + "dense_map.maps." + name + ".all.");
+      const JsonFields all_in = in.nested("all.");
       const YAML::Node comp = all_in.required(all, "completeness_at");
       if (!comp.IsSequence() || comp.size() < 3) all_in.fail(comp, "completeness_at", "expected 4 shares (1, 2, 5, 10 cm)");
       MapMetrics m;
       m.name = name;
       const YAML::Node acc = all_in.required(all, "accuracy_m");
-      if (!acc.IsNull())
-        m.accuracy_median_m =
-            Reader(path_, prefix_ + "dense_map.maps." + name + ".all.accuracy_m.").number(acc, "median");
+      if (!acc.IsNull()) m.accuracy_median_m = all_in.nested("accuracy_m.").number(acc, "median", 0.0);
       const auto share = [&](std::size_t i) {
-        double v = 0;
-        if (!is_plain_scalar(comp[i]) || !YAML::convert<double>::decode(comp[i], v) || !std::isfinite(v))
-          all_in.fail(comp[i], "completeness_at[" + std::to_string(i) + "]", "expected a number");
-        return v;
+        return all_in.number_at(comp[i], "completeness_at[" + std::to_string(i) + "]", 0.0, 1.0);
       };
       m.completeness_2cm = share(1);
       m.completeness_5cm = share(2);
-      m.ghosting = all_in.number(all, "ghosting");
+      m.ghosting = all_in.share(all, "ghosting");
       out.push_back(m);
     }
     return out;
@@ -174,13 +131,13 @@ class Reader {
     const YAML::Node n = obj["place_recognition"];
     if (!n.IsDefined() || n.IsNull()) return std::nullopt;
     if (!n.IsMap()) fail(n, "place_recognition", "expected an object or null");
-    const Reader in(path_, prefix_ + "place_recognition.");
+    const JsonFields in = nested("place_recognition.");
     PlaceMetrics p;
-    p.loops_proposed = in.integer(n, "loops_proposed");
-    p.loops_accepted = in.integer(n, "loops_accepted");
-    p.relocalisations = in.integer(n, "relocalisations");
+    p.loops_proposed = in.integer(n, "loops_proposed", 0);
+    p.loops_accepted = in.integer(n, "loops_accepted", 0);
+    p.relocalisations = in.integer(n, "relocalisations", 0);
     const auto opt = [&](const char* key, std::optional<int>* v) {
-      if (n[key].IsDefined()) *v = in.integer(n, key);
+      if (n[key].IsDefined()) *v = in.integer(n, key, 0);
     };
     opt("loops_true", &p.loops_true);
     opt("loops_false", &p.loops_false);
@@ -190,10 +147,6 @@ class Reader {
     opt("relocalisations_false", &p.relocalisations_false);
     return p;
   }
-
- private:
-  std::string path_;
-  std::string prefix_;
 };
 
 /// The station of a day's run, from "world" (informative: left unread when
@@ -216,16 +169,7 @@ const MapMetrics* RunMetrics::map(const std::string& name) const {
 }
 
 MetricsFile read_metrics_file(const std::string& path) {
-  const std::string text = read_file(path);
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::DeepRecursion& e) {
-    throw IoError(path, "not valid JSON: nested too deeply for the parser", e.mark.line + 1);
-  } catch (const YAML::Exception& e) {
-    throw IoError(path, "not valid JSON: " + e.msg, e.mark.line + 1);
-  }
-  if (!root.IsMap()) throw IoError(path, "expected a JSON object at the top level");
+  YAML::Node root = detail::load_json_object(path);
   MetricsFile m;
   m.path = path;
   const Reader top(path, "");
@@ -241,14 +185,7 @@ MetricsFile read_metrics_file(const std::string& path) {
     m.version = v;
   }
   if (root["scenario"].IsDefined()) m.scenario = top.text(root, "scenario");
-  const YAML::Node seed = root["seed"];
-  if (seed.IsDefined() && !seed.IsNull()) {
-    unsigned long long v = 0;
-    if (!Reader::is_plain_scalar(seed) || seed.Scalar().empty() || seed.Scalar()[0] == '-' ||
-        !YAML::convert<unsigned long long>::decode(seed, v))
-      top.fail(seed, "seed", "expected a non-negative integer, got " + Reader::shown(seed));
-    m.seed = v;
-  }
+  if (!Reader::absent(root, "seed")) m.seed = top.seed(root, "seed");
   read_station(root["world"], &m);
   m.primary = top.run(root);
   const YAML::Node base = root["baseline"];

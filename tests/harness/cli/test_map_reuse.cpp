@@ -5,8 +5,11 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <sys/wait.h>
+
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 
 #include "pvb/common/text.hpp"
 #include "campaign_session.hpp"
@@ -65,19 +68,76 @@ TEST(MapReuse, ACampaignMapsLocalisesAndExtendsJudgedInTheMapsFrame) {
   EXPECT_EQ(m["map"]["localisation"]["wrong_place"].as<int>(), 0);
 }
 
+// Ctrl-C during the first session: that session is reported as
+// interrupted, the sessions after it as not run, in campaign.json,
+// campaign.md and index.html; the campaign exits 130.
+TEST(MapReuse, ACampaignStoppedByCtrlCListsEverySessionWithItsStatus) {
+  const std::string d = fresh("campaign_sigint");
+  write_file(d + "/three.yaml", "name: three\nsessions:\n"
+                                "  - {name: noon, scenario: " + kNoon + ", mode: map}\n"
+                                "  - {name: again, scenario: " + kNoon + ", mode: localise, map: noon}\n"
+                                "  - {name: more, scenario: " + kNoon + ", mode: extend, map: noon}\n");
+  const std::string log = d + "/stdout.txt";
+  const pid_t pid = test::spawn_pvbench({"campaign", "--campaign", d + "/three.yaml", "--frames", "600", "--sync",
+                                         "--no-map-eval", "--seed", "2", "--out", d + "/out"},
+                                        log);
+  ASSERT_GE(pid, 0);
+  const auto lines = [](const std::string& path) {
+    std::ifstream in(path);
+    int n = 0;
+    for (std::string line; std::getline(in, line);) n += !line.empty() && line[0] != '#';
+    return n;
+  };
+  ASSERT_TRUE(test::wait_until(pid, [&] { return lines(d + "/out/noon/CameraTrajectory.txt") >= 5; }, 300))
+      << read_file(log);
+  const std::optional<int> ended = test::interrupt_and_wait(pid, 120);
+  ASSERT_TRUE(ended.has_value()) << read_file(log);
+  EXPECT_TRUE(WIFEXITED(*ended) && WEXITSTATUS(*ended) == 130) << read_file(log);
+  const YAML::Node c = YAML::Load(read_file(d + "/out/campaign.json"));
+  ASSERT_EQ(c["sessions"].size(), 3u);
+  EXPECT_EQ(c["sessions"][0]["status"].as<std::string>(), "interrupted");
+  EXPECT_GE(c["sessions"][0]["frames"].as<int>(), 5);
+  EXPECT_LT(c["sessions"][0]["frames"].as<int>(), 600);
+  for (int i : {1, 2}) {
+    EXPECT_EQ(c["sessions"][i]["status"].as<std::string>(), "not_run") << i;
+    EXPECT_TRUE(c["sessions"][i]["frames"].IsNull()) << i;
+  }
+  const std::string md = read_file(d + "/out/campaign.md");
+  EXPECT_NE(md.find("| noon | map | - | interrupted | "), std::string::npos) << md;
+  EXPECT_NE(md.find("| again | localise | noon | not run (the campaign was stopped) | - |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| more | extend | noon | not run (the campaign was stopped) | - |"), std::string::npos) << md;
+  const std::string html = read_file(d + "/out/index.html");
+  EXPECT_NE(html.find("<a href=\"noon/index.html\">noon</a> (interrupted)"), std::string::npos) << html;
+  EXPECT_NE(html.find("<li>more: not run (the campaign was stopped)</li>"), std::string::npos) << html;
+}
+
 TEST(MapReuse, MapOptionsThatDoNotFitAreOneErrorLine) {
   const std::string d = fresh("options");
   const std::string run = "run --scenario " + kNoon + " --frames 5 --sync --no-map-eval --out " + d + "/x";
   const auto no_map = test::run_pvbench(run + " --map-mode localise");
-  EXPECT_NE(no_map.code, 0);
-  EXPECT_NE(no_map.output.find("--map"), std::string::npos) << no_map.output;
+  EXPECT_EQ(no_map.code, 1);
+  EXPECT_EQ(
+      no_map.output,
+      "pvbench: error: command line: --map: expected the saved map to localise (--map-mode needs it)\n");
   write_file(d + "/junk.pvbmap", "not a map at all");
   const auto save_loc = test::run_pvbench(run + " --map " + d + "/junk.pvbmap --map-mode localise --save-map " + d + "/y");
   EXPECT_NE(save_loc.code, 0);
   EXPECT_NE(save_loc.output.find("--save-map"), std::string::npos) << save_loc.output;
   const auto bad_mode = test::run_pvbench(run + " --map " + d + "/junk.pvbmap --map-mode relocate");
-  EXPECT_NE(bad_mode.code, 0);
-  EXPECT_NE(bad_mode.output.find("localise or extend"), std::string::npos) << bad_mode.output;
+  EXPECT_EQ(bad_mode.code, 1);
+  EXPECT_EQ(bad_mode.output,
+            "pvbench: error: command line: --map-mode: expected localise or extend, got relocate\n");
+  // A start beyond the route is named by its option, with the route's length.
+  const auto far = test::run_pvbench(run + " --start-m 500");
+  EXPECT_EQ(far.code, 1);
+  EXPECT_EQ(far.output.rfind(
+                "pvbench: error: command line: --start-m: expected a distance from 0 to 1 m before the "
+                "route's end (",
+                0),
+            0u)
+      << far.output;
+  EXPECT_NE(far.output.find(" m long), got 500\n"), std::string::npos) << far.output;
+  EXPECT_FALSE(exists(d + "/x/metrics.json"));
   const auto junk = test::run_pvbench(run + " --map " + d + "/junk.pvbmap --map-mode localise");
   EXPECT_NE(junk.code, 0);
   EXPECT_NE(junk.output.find(d + "/junk.pvbmap: not a map file"), std::string::npos) << junk.output;

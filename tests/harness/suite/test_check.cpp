@@ -194,6 +194,55 @@ TEST(SuiteCheck, StringsAreNotNumbersAndUnknownVersionsAreRefused) {
   std::remove(path.c_str());
 }
 
+// A value out of its range is refused naming the file, the line and the
+// key: a negative ATE would be averaged as a good run, a lost-frame count
+// below 0 or above the frames would pass any bound.
+TEST(SuiteCheck, ValuesOutOfRangeAreRefusedNamingFileLineAndKey) {
+  const std::string path = ::testing::TempDir() + "pvb_metrics_range_" + std::to_string(::getpid()) + ".json";
+  auto message = [&path](const std::string& fixture_name, const std::string& from, const std::string& to) {
+    std::string text = read_file(fixture(fixture_name));
+    const std::size_t at = text.find(from);
+    if (at == std::string::npos) return "(" + from + " not in " + fixture_name + ")";
+    write_file(path, text.replace(at, from.size(), to));
+    try {
+      suite::read_metrics_file(path);
+    } catch (const IoError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  const std::string f = path + ":";
+  EXPECT_EQ(message("good_compare.json", "\"lost_frames\": 0", "\"lost_frames\": -3"),
+            f + "5: lost_frames: expected an integer in [0, frames = 300], got -3");
+  EXPECT_EQ(message("good_compare.json", "\"lost_frames\": 0", "\"lost_frames\": 301"),
+            f + "5: lost_frames: expected an integer in [0, frames = 300], got 301");
+  EXPECT_EQ(message("good_compare.json", "\"frames\": 300", "\"frames\": -1"),
+            f + "5: frames: expected an integer >= 0, got -1");
+  EXPECT_EQ(message("good_compare.json", "\"ate\": {\"rmse\": 0.0042", "\"ate\": {\"rmse\": -1"),
+            f + "6: ate.rmse: expected a number >= 0, got -1");
+  EXPECT_EQ(message("good_compare.json", "\"rmse\": 0.0051", "\"rmse\": -0.5"),
+            f + "16: baseline.ate.rmse: expected a number >= 0, got -0.5");
+  EXPECT_EQ(message("good_compare.json", "\"median\": 17.5", "\"median\": -2"),
+            f + "10: tracking_ms.median: expected a number >= 0, got -2");
+  EXPECT_EQ(message("good_compare.json", "\"realtime_factor\": 1.12", "\"realtime_factor\": -1"),
+            f + "11: realtime_factor: expected a number >= 0, got -1");
+  EXPECT_EQ(message("good_compare.json", "\"keyframes\": 21", "\"keyframes\": -21"),
+            f + "5: keyframes: expected an integer >= 0, got -21");
+  EXPECT_EQ(message("dense_map.json", "\"ghosting\": 0.001", "\"ghosting\": 1.5"),
+            f + "23: dense_map.maps.corrected.all.ghosting: expected a number in [0, 1], got 1.5");
+  EXPECT_EQ(message("dense_map.json", "[0.5, 0.8, 0.9, 0.95]", "[0.5, 0.8, 7.5, 0.95]"),
+            f + "22: dense_map.maps.corrected.all.completeness_at[2]: expected a number in [0, 1], got 7.5");
+  EXPECT_EQ(message("dense_map.json", "\"recovered_frame\": 675", "\"recovered_frame\": 500"),
+            f + "32: loss_events[0].recovered_frame: expected an integer >= frame = 601, got 500");
+  EXPECT_EQ(message("dense_map.json", "\"loops_false\": 0", "\"loops_false\": -1"),
+            f + "12: place_recognition.loops_false: expected an integer >= 0, got -1");
+  EXPECT_EQ(message("dense_map.json", "[600, 659]", "[600, 599]"),
+            f + "5: camera_covered_frames[1]: expected an integer >= first = 600, got 599");
+  EXPECT_EQ(message("dense_map.json", "[600, 659]", "[\"600\", 659]"),
+            f + "5: camera_covered_frames[0]: expected an integer, got the string \"600\"");
+  std::remove(path.c_str());
+}
+
 // A run of another scenario or seed is refused, not judged by the wrong bounds.
 TEST(SuiteCheck, MetricsOfAnotherRunAreRefused) {
   const suite::MetricsFile m = suite::read_metrics_file(fixture("good_compare.json"));

@@ -27,11 +27,11 @@ std::string scratch(const std::string& name) {
   return dir.string();
 }
 
-// A scenario with the nominal bounds.
+// A scenario with the nominal bounds, seed 7 (good_compare.json's).
 std::string scenario_file() {
   const std::string path = scratch("scenario") + "/s.yaml";
   pvb::write_file(path,
-                  "name: pv_station\nroute: {waypoints_m: [[0, 0], [5, 0]]}\n"
+                  "name: pv_station\nseed: 7\nroute: {waypoints_m: [[0, 0], [5, 0]]}\n"
                   "expect:\n  ate_rmse_m_max: 0.01\n  rpe_trans_rmse_m_max: 0.005\n  lost_frames_max: 0\n"
                   "  sweep: {pe_not_significantly_worse: true}\n");
   return path;
@@ -66,7 +66,7 @@ TEST(CliCheck, PassingRunExitsZero) {
 TEST(CliCheck, ViolationsExitThreeWithOneLineEach) {
   const std::string metrics = scratch("violations") + "/worse_than_baseline.json";
   write_metrics("worse_than_baseline.json", metrics, "pv_station", 3);
-  const auto r = run_pvbench("check --scenario " + scenario_file() + " --metrics " + metrics);
+  const auto r = run_pvbench("check --scenario " + scenario_file() + " --metrics " + metrics + " --seed 3");
   EXPECT_EQ(r.code, 3) << r.output;
   // Three violations and two notes: PE against the baseline (never judged on
   // one run) and where the sweep expectation is judged.
@@ -95,11 +95,11 @@ TEST(CliCheck, MalformedMetricsIsOneErrorLine) {
 TEST(CliCheck, ShippedFailureScenarioAcceptsAReportedLoss) {
   const std::string scenes = std::string(PVB_SOURCE_DIR) + "/scenes/";
   EXPECT_EQ(run_pvbench("check --scenario " + scenes + "tracking_failure.yaml --metrics " +
-                        fixture("lost_aborted.json"))
+                        fixture("lost_aborted.json") + " --seed 5")
                 .code,
             0);
   const std::string completed = scratch("failure") + "/good_compare.json";
-  write_metrics("good_compare.json", completed, "tracking_failure", 7);
+  write_metrics("good_compare.json", completed, "tracking_failure", 97);  // the scenario's seed
   const auto r = run_pvbench("check --scenario " + scenes + "tracking_failure.yaml --metrics " + completed);
   EXPECT_EQ(r.code, 3) << r.output;
   EXPECT_NE(r.output.find("tracking_loss_expected: no tracking loss was reported"), std::string::npos)
@@ -117,6 +117,40 @@ TEST(CliCheck, RunOfAnotherScenarioIsRefused) {
   EXPECT_NE(r.output.find("good_compare.json: scenario: expected a run of lawnmower_return ("), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("got pv_station"), std::string::npos) << r.output;
+}
+
+// A run of another seed than the one judged (the scenario's, or --seed) is
+// refused with one line.
+TEST(CliCheck, RunOfAnotherSeedIsRefused) {
+  const std::string scenario = scenario_file();  // seed 7
+  const std::string metrics = scratch("other_seed") + "/metrics.json";
+  write_metrics("good_compare.json", metrics, "pv_station", 5);
+  auto r = run_pvbench("check --scenario " + scenario + " --metrics " + metrics);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(r.output,
+            "pvbench: error: " + metrics +
+                ": seed: expected 7 (the scenario's seed; give --seed 5 for a run of that seed), got 5\n");
+  r = run_pvbench("check --scenario " + scenario + " --metrics " + metrics + " --seed 6");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(r.output, "pvbench: error: " + metrics + ": seed: expected 6 (--seed), got 5\n");
+  EXPECT_EQ(run_pvbench("check --scenario " + scenario + " --metrics " + metrics + " --seed 5").code, 0);
+  r = run_pvbench("check --scenario " + scenario + " --metrics " + metrics + " --seed -5");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(count_lines(r.output), 1) << r.output;
+}
+
+// A count or error out of its range is one error line, never judged.
+TEST(CliCheck, ValuesOutOfRangeAreOneErrorLine) {
+  const std::string metrics = scratch("range") + "/metrics.json";
+  write_metrics("good_compare.json", metrics, "pv_station", 7);
+  std::string text = pvb::read_file(metrics);
+  const std::string lost = "\"lost_frames\": 0";
+  text.replace(text.find(lost), lost.size(), "\"lost_frames\": -3");
+  pvb::write_file(metrics, text);
+  const auto r = run_pvbench("check --scenario " + scenario_file() + " --metrics " + metrics);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(r.output, "pvbench: error: " + metrics +
+                          ":5: lost_frames: expected an integer in [0, frames = 300], got -3\n");
 }
 
 TEST(CliSweep, AggregateOnlyRefusesRunsOfAnotherScenarioOrSeed) {
@@ -146,6 +180,30 @@ TEST(CliSweep, AggregateOnlyRefusesRunsOfAnotherScenarioOrSeed) {
   EXPECT_NE(r.output.find("seed_2/metrics.json: scenario: expected a run of pv_station (the sweep's other seeds)"),
             std::string::npos)
       << r.output;
+}
+
+// A seed whose metrics.json holds a value out of its range is a failed
+// seed, named with the file, line and key, and left out of the means: a
+// negative ATE is not averaged as a good run.
+TEST(CliSweep, AggregateOnlyLeavesOutMetricsWithValuesOutOfRange) {
+  const std::string out = scratch("range");
+  for (int seed : {1, 2}) {
+    fs::create_directories(out + "/seed_" + std::to_string(seed));
+    write_metrics("good_compare.json", out + "/seed_" + std::to_string(seed) + "/metrics.json", "pv_station",
+                  seed);
+  }
+  std::string text = pvb::read_file(out + "/seed_2/metrics.json");
+  const std::string ate = "\"ate\": {\"rmse\": 0.0042";
+  text.replace(text.find(ate), ate.size(), "\"ate\": {\"rmse\": -1");
+  pvb::write_file(out + "/seed_2/metrics.json", text);
+  const auto r = run_pvbench("sweep --out " + out + " --aggregate-only");
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find(out + "/seed_2/metrics.json:6: ate.rmse: expected a number >= 0, got -1"),
+            std::string::npos)
+      << r.output;
+  const std::string md = pvb::read_file(out + "/aggregate.md");
+  EXPECT_NE(md.find("2 seeds, 1 with metrics, 1 failed"), std::string::npos) << md;
+  EXPECT_EQ(md.find("-1000"), std::string::npos) << md;
 }
 
 TEST(CliSweep, BadSeedListIsOneErrorLine) {

@@ -11,6 +11,7 @@
 //   sessions:
 //     - {name: noon, scenario: ../scenes/days/pv_station_1200.yaml, mode: map}
 //     - {name: h0800, scenario: ../scenes/days/pv_station_0800.yaml, mode: localise, map: noon, start_m: 3}
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,7 +29,13 @@ struct CampaignSession {
   /// empty for a map session.
   std::string map;
   std::optional<double> start_m;  ///< overrides the scenario's route.start_m
+  std::uint64_t scenario_seed = 0;  ///< the scenario's own seed (a campaign without --seed runs with it)
 };
+
+/// What a campaign writes at the top of its folder beside the sessions'
+/// folders: the maps folder and the reports.  No session may take one of
+/// these names.
+const std::vector<std::string>& campaign_top_level_names();
 
 struct Campaign {
   std::string file;
@@ -40,9 +47,12 @@ struct Campaign {
 };
 
 /// Reads and checks a campaign file: every key known and given once, names
-/// unique, a map session names no map, a localise or extend session names
-/// an earlier session that leaves a map (map or extend), the scenario files
-/// exist.  Throws ConfigError naming the file, the line and the key.
+/// unique and none of campaign_top_level_names(), a map session names no
+/// map, a localise or extend session names an earlier session that leaves a
+/// map (map or extend).  Every session's scenario is loaded (a bad one
+/// fails before any session runs) and its start_m checked against the
+/// route.  Throws ConfigError naming the file, the line and the key (a
+/// scenario's own mistakes name the scenario file).
 Campaign load_campaign(const std::string& path);
 
 }  // namespace pvb::run

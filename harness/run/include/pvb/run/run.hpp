@@ -78,6 +78,13 @@ struct RunOptions {
 /// `pvbench record` and of a run's report).
 dataset::OrbSlamSettings orbslam_settings_for(const scenes::Scenario& scenario);
 
+/// Where a run may start along the scenario's route: from 0 to 1 m before
+/// its end.  "" when `start_m` fits, else what was expected, e.g. "a
+/// distance from 0 to 1 m before the route's end (12.50 m long)", or with
+/// `scenario_file` "(the route of FILE is 12.50 m long)".
+std::string start_m_expectation(const scenes::Scenario& scenario, double start_m,
+                                const std::string& scenario_file = "");
+
 /// Runs the scenario and writes the report folder (also when interrupted or
 /// aborted).  Throws pvb::Error for bad configuration or I/O.
 RunReport run_scenario(const RunOptions& options);
