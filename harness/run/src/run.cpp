@@ -357,8 +357,10 @@ RunReport run_scenario(const RunOptions& opt) {
   prepare_output_folder(opt.out_dir, opt.overwrite, "run");
   if (opt.mode == SlamMode::kCompare) dataset::make_dirs(opt.out_dir + "/baseline");
   RunLog log(opt.out_dir + "/run.log", opt.on_log);
-  SystemSinks sinks =
-      make_systems(slam_settings(scenario, opt.out_dir, log), opt, static_cast<std::uint32_t>(scenario.seed));
+  MapOptions map = opt.map;
+  map.station = station_of(scenario);
+  SystemSinks sinks = make_systems(slam_settings(scenario, opt.out_dir, log), opt,
+                                   static_cast<std::uint32_t>(scenario.seed), map);
   RunReport report = new_report(scenario, opt);
   GroundTruthSink gt(opt.out_dir + "/groundtruth.txt");
   std::optional<ClosedLoop> closed_loop;
@@ -374,8 +376,7 @@ RunReport run_scenario(const RunOptions& opt) {
   finish_loop(opt, loop, consumer.aborted(), n, sinks, report, log);
   gt.close();
   const double eval_ms = evaluate_systems(sinks, gt.trajectory());
-  for (auto& sink : sinks)
-    sink->finish_map(gt.trajectory(), scenario.name, scenario.station_seed_or_seed(), opt.scenario_file);
+  for (auto& sink : sinks) sink->finish_map(gt.trajectory(), scenario.name, opt.scenario_file);
   if (SlamRun& p = sinks.front()->run; p.map && p.map->localisation)
     classify_matched_landmarks(*sinks.front()->system, backend, &*p.map);
   const double map_ms = score_or_skip_maps(opt, scenario, backend, gt.trajectory(), sinks, log);
