@@ -26,7 +26,7 @@ constexpr std::uint64_t kSectionHeadBytes = 12, kSectionTailBytes = 8;
 /// session goes on to give never reach the "none" marker (all ones).
 constexpr std::uint64_t kMaxId = std::uint64_t(1) << 48;
 /// A point's times predicted visible (and found) are at most 2^30: a year
-/// of frames at 30 Hz is 0.95 * 2^30.  Counting on from there cannot
+/// of frames at 30 Hz is 0.88 * 2^30.  Counting on from there cannot
 /// overflow an int.
 constexpr std::int32_t kMaxVisible = std::int32_t(1) << 30;
 

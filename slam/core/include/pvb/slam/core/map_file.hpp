@@ -51,8 +51,8 @@ struct MapFileHeader {
 };
 
 constexpr std::uint32_t kMapFileVersion = 1;
-/// The largest map file read: 4 GiB, about 28 000 keyframes of 1000
-/// features (a 709-keyframe map is 103 MB).  Reading one takes its size in
+/// The largest map file read: 4 GiB, about 30 000 keyframes (a
+/// 709-keyframe lawnmower map is 103 MB).  Reading one takes its size in
 /// memory, and the map about as much again.
 constexpr std::uint64_t kMaxMapFileBytes = std::uint64_t(4) << 30;
 /// Every keyframe's camera centre and every point lies within this many
