@@ -468,6 +468,29 @@ TEST(MapFileChecks, EveryImpossibleMapIsRefusedForItsReason) {
   }
 }
 
+/// The corpus's map of the pair, of 600-feature keyframes (half the size
+/// of the default 1000), and its first 1000 bytes.
+void write_pair_seeds(const std::string& dir) {
+  Settings s = read_settings(kTum3);
+  s.orb.num_features = 600;
+  System system(s, sync_options());
+  for (const auto& f : pair_frames(s)) system.track(f);
+  system.shutdown();
+  system.save_map(dir + "/fr3_pair_600.pvbmap", R"({"station": "fr3"})");
+  write_file(dir + "/truncated.pvbmap", read_file(dir + "/fr3_pair_600.pvbmap").substr(0, 1000));
+}
+
+// The seeds that are whole maps are maps the reader reads.
+TEST(MapFileChecks, TheWholeMapsOfTheCorpusAreRead) {
+  if (const char* out = std::getenv("PVB_WRITE_MAP_CORPUS")) write_pair_seeds(out);
+  for (const char* seed : {"tiny.pvbmap", "fr3_pair_600.pvbmap"}) {
+    std::ifstream in(kCorpus + "/" + seed, std::ios::binary);
+    ASSERT_TRUE(in.good()) << seed;
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(decode_error(bytes, seed), "") << seed;
+  }
+}
+
 // A point whose first keyframe was culled, or whose reference keyframe does
 // not observe it, is saved with keyframes of the file in their place.
 TEST(MapFileChecks, TheWriterNeverWritesWhatTheReaderRefuses) {
