@@ -298,7 +298,9 @@ void link_points(ByteReader r, const PointIdsByKf& ids, const std::map<std::uint
     const std::uint64_t ref = p.ref != kNone ? p.ref : obs->second;
     map->add_loaded_point(id, p.p_w, map->keyframes().at(ref))->restore(p.first, p.visible, p.found);
   }
-  for (const auto& [kf_id, pids] : ids) {
+  for (const auto& entry : ids) {  // not a structured binding: C++17 lambdas cannot capture one
+    const std::uint64_t kf_id = entry.first;
+    const std::vector<std::uint64_t>& pids = entry.second;
     const auto& kf = map->keyframes().at(kf_id);
     for (std::size_t i = 0; i < pids.size(); ++i) {
       if (pids[i] == kNone) continue;
