@@ -159,14 +159,11 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   if (sessions < 1 || sessions > kfs.size())
     throw std::logic_error("encode_map: " + std::to_string(sessions) + " sessions for " +
                            std::to_string(kfs.size()) + " keyframes");
-  // A point seen only by keyframes left out is left out too.
+  // A point no keyframe of the file names (seen only by keyframes left out)
+  // is left out too: the reader links points from the keyframes' side.
   SortedIds point_ids;
-  for (const auto& [id, mp] : map.points()) {
-    const auto& obs = mp->observations();
-    const bool seen =
-        obs.empty() || std::any_of(obs.begin(), obs.end(), [&](const auto& o) { return has(kf_ids, o.first); });
-    if (!mp->bad() && seen) point_ids.push_back(id);
-  }
+  for (const auto& [id, mp] : map.points())
+    if (!mp->bad() && saved_observer(*mp, kf_ids, kNone) != kNone) point_ids.push_back(id);
 
   ByteWriter head, keyf, poin, grap, bowv;
   put_settings(head, settings, sessions);

@@ -57,6 +57,7 @@ TEST(MapSession, ADamagedMetaIsRefusedNamingTheFileMetaAndTheDamage) {
       {"{\"T_world_map\": [1, 0", "not JSON"},
       {"", "empty, expected a JSON object"},
       {"[1, 2, 3]", "not a JSON object"},
+      {"T_world_map: null", "not a JSON object"},  // YAML, not JSON
       {"{\"scenario\": \"x\"}", "no T_world_map"},
       {meta("[NaN, 0, 0, 0.5, 0, 1, 0, 0, 0, 0, 1, 0]"), "T_world_map number 1 is not a finite number (NaN)"},
       {meta("[1, 0, 0, 0.5, 0, 1, 0, 0, 0, 0, 1]"), "T_world_map has 11 numbers, expected 12"},

@@ -492,7 +492,8 @@ TEST(MapFileChecks, TheWholeMapsOfTheCorpusAreRead) {
 }
 
 // A point whose first keyframe was culled, or whose reference keyframe does
-// not observe it, is saved with keyframes of the file in their place.
+// not observe it, is saved with keyframes of the file in their place; a
+// point no keyframe names is not saved.
 TEST(MapFileChecks, TheWriterNeverWritesWhatTheReaderRefuses) {
   const std::string tiny = test::tiny_map();
   const MapFileHeader h = read_map_header(tiny, "tiny.pvbmap");
@@ -507,6 +508,7 @@ TEST(MapFileChecks, TheWriterNeverWritesWhatTheReaderRefuses) {
     far->add_observation(map.keyframes().at(k), 7);
     map.keyframes().at(k)->set_map_point(7, far);
   }
+  const auto unseen = map.create_point(Eigen::Vector3d(0, 0, 3), kf2);  // observed by none
   const std::string bytes = encode_map(map, h.settings, 1, "{}");
   const MapFileHeader h2 = read_map_header(bytes, "again.pvbmap");
   Map again;
@@ -514,6 +516,7 @@ TEST(MapFileChecks, TheWriterNeverWritesWhatTheReaderRefuses) {
   decode_map(bytes, "again.pvbmap", h2, camera_for(h2.settings), &again);
   EXPECT_EQ(again.points().at(0)->first_kf_id(), 0u);                       // its reference keyframe
   EXPECT_EQ(again.points().at(far->id())->reference_keyframe()->id(), 0u);  // its first observer
+  EXPECT_EQ(again.points().count(unseen->id()), 0u);
   EXPECT_THROW(encode_map(map, h.settings, 0, "{}"), std::logic_error);
   EXPECT_THROW(encode_map(map, h.settings, 4, "{}"), std::logic_error);  // more sessions than keyframes
 }
