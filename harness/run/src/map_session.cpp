@@ -194,7 +194,8 @@ MapMeta read_map_meta(const std::string& app_json, const std::string& file) {
     fail("not JSON (" + e.msg + ")");
   }
   const YAML::Node& root = loaded;
-  if (!root.IsMap()) fail("not a JSON object");
+  // yaml-cpp reads YAML too: a JSON object is one in braces.
+  if (!root.IsMap() || app_json[app_json.find_first_not_of(" \t\r\n")] != '{') fail("not a JSON object");
   MapMeta meta;
   meta.T_world_map = read_T_world_map(root["T_world_map"], fail);
   meta.station = read_station(root, fail);
