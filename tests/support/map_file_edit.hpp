@@ -91,7 +91,7 @@ inline slam::MapSettings tiny_settings() {
 /// The tiny map's shape: keyframes 0, 1, 2 (0.1 m apart along x, each
 /// with kTinyKeypoints keypoints), kTinyPoints points 2 m ahead, point i at
 /// keypoint i of every keyframe, except that keyframe 2 does not observe
-/// the last point.  Keyframe 1 hangs under 0, keyframe 2 under 1.
+/// the last point.  Keyframes 1 and 2 hang under 0 in the spanning tree.
 constexpr int kTinyKeyframes = 3, kTinyKeypoints = 8, kTinyPoints = 6;
 
 /// Byte offsets in the tiny map's payloads (docs/map_file.md, "Layout").
