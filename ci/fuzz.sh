@@ -54,7 +54,7 @@ for t in "${TARGETS[@]}"; do
   echo "fuzz: $t for ${SECONDS_EACH} s (seeds: ${dirs[*]:-none})"
   set +e
   max_len=65536
-  [ "$t" = fuzz_map_file ] && max_len=262144  # its seed, a two-keyframe map, is 129 KB
+  [ "$t" = fuzz_map_file ] && max_len=262144  # its largest seed, a two-keyframe map, is 150 KB
   "$B/fuzz/$t" -max_total_time="$SECONDS_EACH" -timeout=10 -rss_limit_mb=4096 -max_len=$max_len \
     -print_final_stats=1 -artifact_prefix="$B/artifacts/$t-" "$corpus" "${dirs[@]}" > "$log" 2>&1
   rc=$?

@@ -372,7 +372,7 @@ void finish_camera_map(const CameraArgs& a, const std::string& source, slam::Sys
     }
   };
   const eval::Trajectory gt = readable(a.out + "/groundtruth.txt") ? read(a.out + "/groundtruth.txt") : eval::Trajectory{};
-  run::finish_map(system, a.map, gt, read(a.out + "/CameraTrajectory.txt"), source, 0, map);
+  run::finish_map(system, a.map, gt, read(a.out + "/CameraTrajectory.txt"), source, map);
   for (const std::string& line : run::map_log_lines(*map)) std::printf("%s\n", line.c_str());
   js << ",\n  \"map\": " << run::map_report_json(*map);
 }
@@ -446,6 +446,9 @@ int run_camera(CameraArgs a) {
   const std::optional<scenes::Scenario> scenario = check_inputs(a);
   check_settings_source(a, scenario);
   a.map.check();
+  // A map of another station than a sim:// scenario's is used after a warning.
+  if (scenario) a.map.station = run::station_of(*scenario);
+  a.map.allow_other_station = true;
   check_camera_paths(a, scenario);
   const CameraSettings settings = read_camera_settings(a, scenario);
   slam::SystemOptions options;

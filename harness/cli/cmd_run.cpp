@@ -103,6 +103,9 @@ Command add_run_command(CLI::App& app) {
                   "pipelined: nice value of the local/dense mapping workers (default 10 when paced, else 0)")
       ->check(CLI::Range(-20, 19));
   add_map_options(sub, &args->options.map, &args->map_mode);
+  sub->add_flag(
+      "--allow-other-station", args->options.map.allow_other_station,
+      "use a --map whose META names another station (scenario file or station seed) after a warning");
   sub->add_option("--start-m", args->options.start_m,
                   "start this many metres along the route (overrides the scenario's route.start_m)");
   sub->add_flag("--check", args->check, "check metrics.json against the scenario's expect: bounds (exit 3)");

@@ -451,7 +451,7 @@ void SlamRun::finish_map(std::ostringstream* js) {
                                   : eval::Trajectory{};
   const eval::Trajectory est =
       tally_.poses > 0 ? eval::read_tum(a_.out + "/CameraTrajectory.txt") : eval::Trajectory{};
-  run::finish_map(*system_, a_.map, gt, est, a_.sequence, 0, &*map_);
+  run::finish_map(*system_, a_.map, gt, est, a_.sequence, &*map_);
   for (const std::string& line : run::map_log_lines(*map_)) std::printf("%s\n", line.c_str());
   *js << ",\n  \"map\": " << run::map_report_json(*map_);
 }
@@ -589,6 +589,9 @@ void resolve_seed(SlamArgs* a) {
 int run_slam(SlamArgs a) {
   if (!a.map_mode.empty()) a.map.use = run::parse_map_use(a.map_mode, "--map-mode");
   resolve_seed(&a);
+  // A map of another station than the recording's is used after a warning.
+  a.map.station = run::recording_station(a.sequence + "/meta.json");
+  a.map.allow_other_station = true;
   SlamRun run(a);
   return run.run();
 }

@@ -1,11 +1,18 @@
 #include "pvb/run/map_session.hpp"
 
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/slam/core/map_file.hpp"
 
 namespace pvb::run {
 namespace {
@@ -66,11 +73,55 @@ void MapOptions::check() const {
                       "a map made or extended by the run, not with --map-mode localise");
 }
 
-std::string map_app_json(const std::string& scenario, std::uint64_t station_seed,
+bool MapStation::differs_from(const MapStation& o) const {
+  return (!name.empty() && !o.name.empty() && name != o.name) || (seed && o.seed && *seed != *o.seed);
+}
+
+std::string MapStation::describe() const {
+  if (!known()) return "an unknown station";
+  const std::string s = seed ? "station seed " + std::to_string(*seed) : "";
+  return name.empty() ? s : s.empty() ? name : name + ", " + s;
+}
+
+namespace {
+
+/// The name of a station file: "scenes/pv_station.yaml" -> "pv_station".
+std::string station_name(const std::string& file) { return std::filesystem::path(file).stem().string(); }
+
+}  // namespace
+
+MapStation station_of(const scenes::Scenario& s) {
+  const std::string& file = s.base_files.empty() ? s.source_file : s.base_files.back();
+  return MapStation{file.empty() ? std::string() : station_name(file), s.station_seed_or_seed()};
+}
+
+MapStation recording_station(const std::string& meta_json_path) {
+  MapStation st;
+  if (!std::ifstream(meta_json_path).good()) return st;
+  try {
+    const YAML::Node root = YAML::Load(read_file(meta_json_path));
+    const YAML::Node world = root["world"], scenario = root["scenario"];
+    if (world.IsMap() && world["station_seed"].IsScalar())
+      st.seed = world["station_seed"].as<std::uint64_t>();
+    const YAML::Node bases = world.IsMap() ? world["base_files"] : YAML::Node();
+    if (bases.IsSequence() && bases.size() > 0 && bases[bases.size() - 1].IsScalar())
+      st.name = station_name(bases[bases.size() - 1].Scalar());
+    else if (scenario.IsMap() && scenario["file"].IsScalar())
+      st.name = station_name(scenario["file"].Scalar());
+  } catch (const YAML::Exception&) {
+    return MapStation{};  // informative only: a recording that does not say has no station
+  }
+  return st;
+}
+
+std::string map_app_json(const std::string& scenario, const MapStation& station,
                          const std::optional<geom::SE3d>& T_world_map, const std::string& scenario_file) {
-  return "{\"scenario\": \"" + json_escape(scenario) + "\", \"scenario_file\": " +
-         (scenario_file.empty() ? std::string("null") : "\"" + json_escape(scenario_file) + "\"") +
-         ", \"station_seed\": " + std::to_string(station_seed) +
+  const auto str = [](const std::string& v) {
+    return v.empty() ? std::string("null") : "\"" + json_escape(v) + "\"";
+  };
+  return "{\"scenario\": \"" + json_escape(scenario) + "\", \"scenario_file\": " + str(scenario_file) +
+         ", \"station\": " + str(station.name) +
+         ", \"station_seed\": " + (station.seed ? std::to_string(*station.seed) : std::string("null")) +
          ", \"T_world_map\": " + (T_world_map ? pose_json(*T_world_map) : std::string("null")) + "}";
 }
 
@@ -83,23 +134,74 @@ std::string map_scenario_file(const std::string& app_json) {
   return file.find('\\') == std::string::npos ? file : "";  // an escaped name is not read back
 }
 
-std::optional<geom::SE3d> T_world_map_of(const std::string& app_json) {
-  const std::string key = "\"T_world_map\": [";
-  const std::size_t at = app_json.find(key);
-  if (at == std::string::npos) return std::nullopt;
-  const char* p = app_json.c_str() + at + key.size();
+namespace {
+
+/// T_world_map of META: null, or 12 finite numbers that make a rotation
+/// and a translation within slam::kMaxMapCoordinateM.  `fail` throws.
+template <class Fail>
+std::optional<geom::SE3d> read_T_world_map(const YAML::Node& v, const Fail& fail) {
+  if (!v.IsDefined()) fail("no T_world_map (expected 12 numbers, a 3x4 matrix row by row, or null)");
+  if (v.IsNull()) return std::nullopt;
+  if (!v.IsSequence() || v.size() != 12)
+    fail("T_world_map has " +
+         (v.IsSequence() ? std::to_string(v.size()) + " numbers" : std::string("no list")) +
+         ", expected 12 (a 3x4 matrix row by row) or null");
   Eigen::Matrix<double, 3, 4> m;
   for (int k = 0; k < 12; ++k) {
-    char* end = nullptr;
-    const double v = std::strtod(p, &end);
-    if (end == p || !std::isfinite(v)) return std::nullopt;
-    m(k / 4, k % 4) = v;
-    p = end;
-    while (*p == ',' || *p == ' ') ++p;
+    double x = 0;
+    if (!v[k].IsScalar() || !YAML::convert<double>::decode(v[k], x) || !std::isfinite(x))
+      fail("T_world_map number " + std::to_string(k + 1) + " is not a finite number (" +
+           printable(v[k].IsScalar() ? v[k].Scalar() : std::string("not a scalar")) + ")");
+    m(k / 4, k % 4) = x;
   }
   const Eigen::Matrix3d R = m.leftCols<3>();
-  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6) return std::nullopt;
+  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 || R.determinant() < 0)
+    fail("T_world_map's first three columns are not a rotation");
+  if (m.col(3).cwiseAbs().maxCoeff() > slam::kMaxMapCoordinateM)
+    fail("T_world_map's translation lies beyond " + format_g(slam::kMaxMapCoordinateM) + " m");
   return geom::make_se3(R, m.col(3));
+}
+
+/// META's station: "station" a string or null, "station_seed" a whole
+/// number or null (either may be missing: a map made before they were written).
+template <class Fail>
+MapStation read_station(const YAML::Node& root, const Fail& fail) {
+  MapStation st;
+  const YAML::Node name = root["station"], seed = root["station_seed"];
+  if (name.IsDefined() && !name.IsNull()) {
+    if (!name.IsScalar() || name.Scalar().empty()) fail("station is not a name (a string) or null");
+    st.name = name.Scalar();
+  }
+  if (seed.IsDefined() && !seed.IsNull()) {
+    const std::string t = seed.IsScalar() ? seed.Scalar() : "";
+    const bool digits =
+        !t.empty() && t.size() <= 20 && t.find_first_not_of("0123456789") == std::string::npos;
+    errno = 0;
+    const unsigned long long v = digits ? std::strtoull(t.c_str(), nullptr, 10) : 0;
+    if (!digits || errno == ERANGE) fail("station_seed is not a whole number from 0 (" + printable(t) + ")");
+    st.seed = v;
+  }
+  return st;
+}
+
+}  // namespace
+
+MapMeta read_map_meta(const std::string& app_json, const std::string& file) {
+  const auto fail = [&](const std::string& what) -> void { throw IoError(file, "META section: " + what); };
+  if (app_json.find_first_not_of(" \t\r\n") == std::string::npos) fail("empty, expected a JSON object");
+  YAML::Node loaded;
+  try {
+    loaded = YAML::Load(app_json);
+  } catch (const YAML::Exception& e) {
+    fail("not JSON (" + e.msg + ")");
+  }
+  const YAML::Node& root = loaded;
+  // yaml-cpp reads YAML too: a JSON object is one in braces.
+  if (!root.IsMap() || app_json[app_json.find_first_not_of(" \t\r\n")] != '{') fail("not a JSON object");
+  MapMeta meta;
+  meta.T_world_map = read_T_world_map(root["T_world_map"], fail);
+  meta.station = read_station(root, fail);
+  return meta;
 }
 
 eval::Trajectory ground_truth_at(const eval::Trajectory& gt, const std::vector<std::int64_t>& t_ns) {
@@ -124,7 +226,19 @@ MapReport start_map(slam::System& system, const MapOptions& options) {
   r.loaded_from = options.load_path;
   r.load = system.load_map(options.load_path, options.use == MapUse::kLocalise ? slam::MapStart::kLocalise
                                                                                : slam::MapStart::kExtend);
-  r.T_world_map = T_world_map_of(r.load->app_json);
+  const MapMeta meta = read_map_meta(r.load->app_json, options.load_path);
+  r.T_world_map = meta.T_world_map;
+  r.loaded_station = meta.station;
+  if (meta.station.differs_from(options.station)) {
+    if (!options.allow_other_station)
+      throw ConfigError(options.load_path, "META station",
+                        "a map of this run's station, " + options.station.describe() +
+                            " (--allow-other-station uses it all the same)",
+                        meta.station.describe());
+    r.station_warning = "the map " + options.load_path + " shows " + meta.station.describe() +
+                        ", this run is on " + options.station.describe();
+    std::fprintf(stderr, "pvbench: warning: %s\n", r.station_warning.c_str());
+  }
   for (const auto& l : system.landmark_uses()) r.found_at_load[l.id] = l.found;
   return r;
 }
@@ -134,37 +248,41 @@ void score_map_localisation(MapReport* r, const eval::Trajectory& gt, const eval
   if (gt.empty()) {
     r->localisation_note = "no ground truth";
   } else if (!r->T_world_map) {
-    r->localisation_note = "the map does not say where its frame lies in the world (no T_world_map)";
+    r->localisation_note =
+        "the map does not say where its frame lies in the world (T_world_map null: made without ground "
+        "truth)";
   } else {
     r->localisation = eval::score_localisation(gt, est, *r->T_world_map);
   }
 }
 
-void save_map(slam::System& system, const MapOptions& options, const std::string& scenario,
-              std::uint64_t station_seed, MapReport* r, const std::string& scenario_file) {
+void save_map(slam::System& system, const MapOptions& options, const std::string& scenario, MapReport* r,
+              const std::string& scenario_file) {
   if (options.save_path.empty()) return;
   r->saved_to = options.save_path;
   if (system.num_keyframes() == 0) {
     r->save_note = "not saved: the run made no keyframe";
     return;
   }
-  // An extended map keeps the scenario it was first made from.
+  // An extended map keeps the scenario it was first made from, and its station.
   const std::string made_from = r->load ? map_scenario_file(r->load->app_json) : scenario_file;
-  r->save = system.save_map(options.save_path, map_app_json(scenario, station_seed, r->T_world_map, made_from));
+  const MapStation& station = r->load ? r->loaded_station : options.station;
+  r->save = system.save_map(options.save_path, map_app_json(scenario, station, r->T_world_map, made_from));
 }
 
 void finish_map(slam::System& system, const MapOptions& options, const eval::Trajectory& gt,
-                const eval::Trajectory& est, const std::string& name, std::uint64_t station_seed, MapReport* r,
+                const eval::Trajectory& est, const std::string& name, MapReport* r,
                 const std::string& scenario_file) {
   r->relocalisations = system.relocalisations().size();
   for (const auto& e : system.loop_stats().loops) r->merges += e.merge ? 1 : 0;
   score_map_localisation(r, gt, est);
   if (!r->load && !gt.empty()) r->T_world_map = T_world_new_map(gt, est);
-  save_map(system, options, name, station_seed, r, scenario_file);
+  save_map(system, options, name, r, scenario_file);
 }
 
 std::vector<std::string> map_log_lines(const MapReport& m) {
   std::vector<std::string> lines;
+  if (!m.station_warning.empty()) lines.push_back("warning: " + m.station_warning);
   if (m.load) {
     std::string line = "map " + m.loaded_from + " (" + to_string(m.use) + ", " + std::to_string(m.load->keyframes) +
                        " keyframes, loaded in " + format_fixed(m.load->load_ms, 0) + " ms): ";

@@ -403,7 +403,9 @@ RunReport run_scenario(const RunOptions& opt) {
   opt.map.check();
   check_run_paths(opt, scenario);
   const RunSettings settings = slam_settings(scenario, opt.out_dir);
-  SystemSinks sinks = make_systems(settings.slam, opt, static_cast<std::uint32_t>(scenario.seed));
+  MapOptions map = opt.map;
+  map.station = station_of(scenario);
+  SystemSinks sinks = make_systems(settings.slam, opt, static_cast<std::uint32_t>(scenario.seed), map);
   prepare_output_folder(opt.out_dir, opt.overwrite, "run");
   write_file(opt.out_dir + "/camera.yaml", settings.text);
   RunLog log(opt.out_dir + "/run.log", opt.on_log);
@@ -426,8 +428,7 @@ RunReport run_scenario(const RunOptions& opt) {
   gt.close();
   const double eval_ms = evaluate_systems(sinks, gt.trajectory());
   if (!opt.map.save_path.empty()) log.line("saving the map to " + opt.map.save_path);
-  for (auto& sink : sinks)
-    sink->finish_map(gt.trajectory(), scenario.name, scenario.station_seed_or_seed(), opt.scenario_file);
+  for (auto& sink : sinks) sink->finish_map(gt.trajectory(), scenario.name, opt.scenario_file);
   if (SlamRun& p = sinks.front()->run; p.map && p.map->localisation)
     classify_matched_landmarks(*sinks.front()->system, backend, &*p.map);
   const double map_ms = score_or_skip_maps(opt, scenario, backend, gt.trajectory(), sinks, log);

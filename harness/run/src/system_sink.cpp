@@ -158,9 +158,9 @@ void SystemSink::save_dense_maps() {
   run.dense_map = std::move(d);
 }
 
-void SystemSink::finish_map(const eval::Trajectory& gt, const std::string& scenario, std::uint64_t station_seed,
+void SystemSink::finish_map(const eval::Trajectory& gt, const std::string& scenario,
                             const std::string& scenario_file) {
-  if (run.map) run::finish_map(*system, map_options, gt, est, scenario, station_seed, &*run.map, scenario_file);
+  if (run.map) run::finish_map(*system, map_options, gt, est, scenario, &*run.map, scenario_file);
 }
 
 void SystemSink::evaluate(const eval::Trajectory& gt) {
@@ -192,16 +192,17 @@ void SystemSink::evaluate(const eval::Trajectory& gt) {
   }
 }
 
-SystemSinks make_systems(const slam::Settings& settings, const RunOptions& opt, std::uint32_t seed) {
+SystemSinks make_systems(const slam::Settings& settings, const RunOptions& opt, std::uint32_t seed,
+                         const MapOptions& map) {
   SystemSinks sinks;
   slam::Settings s = settings;
   s.loop.enabled = s.loop.enabled && opt.loop_closing;
   s.pe_match.enabled = opt.mode != SlamMode::kBaseline;
   sinks.push_back(std::make_unique<SystemSink>(s.pe_match.enabled ? eval::kPeSlamMode : eval::kBaselineMode,
-                                               s, opt.sync, seed, opt.out_dir, opt.map));
+                                               s, opt.sync, seed, opt.out_dir, map));
   if (opt.mode == SlamMode::kCompare) {
     s.pe_match.enabled = false;
-    MapOptions baseline_map = opt.map;  // starts from the same map; only the primary run saves
+    MapOptions baseline_map = map;  // starts from the same map; only the primary run saves
     baseline_map.save_path.clear();
     sinks.push_back(std::make_unique<SystemSink>(eval::kBaselineMode, s, opt.sync, seed,
                                                  opt.out_dir + "/baseline", baseline_map));

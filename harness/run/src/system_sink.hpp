@@ -53,8 +53,7 @@ struct SystemSink {
   void evaluate(const eval::Trajectory& gt);
   /// The localisation in a loaded map against `gt`, and the final map
   /// saved when the options say so (run::finish_map).
-  void finish_map(const eval::Trajectory& gt, const std::string& scenario, std::uint64_t station_seed,
-                  const std::string& scenario_file);
+  void finish_map(const eval::Trajectory& gt, const std::string& scenario, const std::string& scenario_file);
 
  private:
   /// The dense maps into `clouds` and their PLY files; run.dense_map.
@@ -69,8 +68,10 @@ using SystemSinks = std::vector<std::unique_ptr<SystemSink>>;
 
 /// The systems that see the frames (options.mode): PE-SLAM or the baseline
 /// in out_dir, and with kCompare the baseline beside PE-SLAM in
-/// out_dir/baseline.  The first is the primary run.  Their saved maps are
+/// out_dir/baseline.  The first is the primary run.  `map`: the map
+/// options (options.map with the run's station).  Their saved maps are
 /// loaded; their output files are not opened yet (open_outputs()).
-SystemSinks make_systems(const slam::Settings& settings, const RunOptions& options, std::uint32_t seed);
+SystemSinks make_systems(const slam::Settings& settings, const RunOptions& options, std::uint32_t seed,
+                         const MapOptions& map);
 
 }  // namespace pvb::run

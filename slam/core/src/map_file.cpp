@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <sstream>
+#include <stdexcept>
 
 #include "map_file_bytes.hpp"
 #include "pvb/common/error.hpp"
@@ -84,6 +85,39 @@ void put_graph(ByteWriter& w, const KeyFrame& kf, const SortedIds& kf_ids) {
   for (std::uint64_t id : loops) w.u64(id);
 }
 
+/// The id of a keyframe in the file that observes `mp` at the keypoint its
+/// observation names (the reader links points from the keyframes' side),
+/// `preferred` when it is one; kNone when none is.
+std::uint64_t saved_observer(const MapPoint& mp, const SortedIds& kf_ids, std::uint64_t preferred) {
+  const auto observes = [&](std::uint64_t kf_id, const MapPoint::Obs& o) {
+    const auto kf = o.kf.lock();
+    return kf && has(kf_ids, kf_id) && kf->map_points()[o.idx].get() == &mp;
+  };
+  const auto& obs = mp.observations();
+  if (const auto it = obs.find(preferred); it != obs.end() && observes(it->first, it->second))
+    return preferred;
+  for (const auto& [kf_id, o] : obs)
+    if (observes(kf_id, o)) return kf_id;
+  return kNone;
+}
+
+void put_point(ByteWriter& w, const MapPoint& mp, const SortedIds& kf_ids) {
+  w.u64(mp.id());
+  for (int r = 0; r < 3; ++r) w.f64(mp.p_w()(r));
+  // The reference keyframe when it is saved and observes the point (else
+  // none: the reader takes the first observer).
+  const auto ref = mp.reference_keyframe();
+  const bool ref_saved = ref && !ref->bad() && saved_observer(mp, kf_ids, ref->id()) == ref->id();
+  w.u64(ref_saved ? ref->id() : kNone);
+  // The keyframe that made the point; when it was culled, an observer
+  // that is saved stands for it (the id only orders the culling of recent
+  // points within the session that made them).
+  w.u64(has(kf_ids, mp.first_kf_id()) ? mp.first_kf_id()
+                                      : saved_observer(mp, kf_ids, ref ? ref->id() : kNone));
+  w.i32(mp.visible());
+  w.i32(mp.found());
+}
+
 /// The keyframe's bag of words and direct index (as the place database and
 /// relocalisation use them): recomputing them is most of a load's time.
 void put_bow(ByteWriter& w, const KeyFrame& kf, const BagOf& bag_of) {
@@ -121,14 +155,15 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
       kf_ids.push_back(id);
       keypoints += kf->frame().size();
     }
-  // A point seen only by keyframes left out is left out too.
+  // Each session counted holds a keyframe (the reader checks it).
+  if (sessions < 1 || sessions > kfs.size())
+    throw std::logic_error("encode_map: " + std::to_string(sessions) + " sessions for " +
+                           std::to_string(kfs.size()) + " keyframes");
+  // A point no keyframe of the file names (seen only by keyframes left out)
+  // is left out too: the reader links points from the keyframes' side.
   SortedIds point_ids;
-  for (const auto& [id, mp] : map.points()) {
-    const auto& obs = mp->observations();
-    const bool seen =
-        obs.empty() || std::any_of(obs.begin(), obs.end(), [&](const auto& o) { return has(kf_ids, o.first); });
-    if (!mp->bad() && seen) point_ids.push_back(id);
-  }
+  for (const auto& [id, mp] : map.points())
+    if (!mp->bad() && saved_observer(*mp, kf_ids, kNone) != kNone) point_ids.push_back(id);
 
   ByteWriter head, keyf, poin, grap, bowv;
   put_settings(head, settings, sessions);
@@ -136,16 +171,7 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   keyf.u64(kfs.size());
   for (const auto& kf : kfs) put_keyframe(keyf, *kf, point_ids);
   poin.u64(point_ids.size());
-  for (std::uint64_t id : point_ids) {
-    const MapPoint& mp = *map.points().at(id);
-    poin.u64(id);
-    for (int r = 0; r < 3; ++r) poin.f64(mp.p_w()(r));
-    const auto ref = mp.reference_keyframe();
-    poin.u64(ref && !ref->bad() && has(kf_ids, ref->id()) ? ref->id() : kNone);
-    poin.u64(mp.first_kf_id());
-    poin.i32(mp.visible());
-    poin.i32(mp.found());
-  }
+  for (std::uint64_t id : point_ids) put_point(poin, *map.points().at(id), kf_ids);
   grap.u64(kfs.size());
   for (const auto& kf : kfs) put_graph(grap, *kf, kf_ids);
   for (const auto& kf : kfs) put_bow(bowv, *kf, bag_of);

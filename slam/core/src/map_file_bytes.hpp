@@ -19,6 +19,16 @@ constexpr std::size_t kKeypointBytes = 7 * 4 + 1 + 4 + 8 + 32;
 /// session, pose (12 f64), keypoint count.
 constexpr std::size_t kKeyframeHeadBytes = 8 + 8 + 8 + 4 + 96 + 4;
 constexpr std::uint32_t kMaxKeypoints = 100000;
+/// Bytes before a section's payload (tag, length) and after it (checksum).
+constexpr std::uint64_t kSectionHeadBytes = 12, kSectionTailBytes = 8;
+/// Keyframe and point ids lie below 2^48: a run that made a keyframe every
+/// frame at 30 Hz would take 297 000 years to reach it, and the ids a
+/// session goes on to give never reach the "none" marker (all ones).
+constexpr std::uint64_t kMaxId = std::uint64_t(1) << 48;
+/// A point's times predicted visible (and found) are at most 2^30: a year
+/// of frames at 30 Hz is 0.88 * 2^30.  Counting on from there cannot
+/// overflow an int.
+constexpr std::int32_t kMaxVisible = std::int32_t(1) << 30;
 
 class ByteWriter {
  public:
@@ -50,12 +60,23 @@ class ByteWriter {
   std::string data_;
 };
 
-/// Reads a byte range; running past its end throws IoError naming the
-/// file, the section and the offset (a truncated or damaged file).
+/// Reads a byte range of one section; running past its end throws IoError
+/// naming the file, the section and the offset (a truncated or damaged
+/// file).  Offsets are 64-bit: a map file may be larger than 2 GiB.
 class ByteReader {
  public:
-  ByteReader(const char* p, std::size_t n, std::string file, std::string section, std::size_t base_offset)
-      : p_(p), n_(n), file_(std::move(file)), section_(std::move(section)), base_(base_offset) {}
+  /// `p`, `n`: the range of the part named `label` ("KEYF section", "file
+  /// header"); the range begins at byte `section_offset` of that part
+  /// (counted from a section's tag: 12 for a payload) and `file_offset` of
+  /// the file.
+  ByteReader(const char* p, std::uint64_t n, std::string file, std::string label,
+             std::uint64_t section_offset, std::uint64_t file_offset)
+      : p_(p),
+        n_(n),
+        file_(std::move(file)),
+        label_(std::move(label)),
+        section_base_(section_offset),
+        file_base_(file_offset) {}
 
   std::uint8_t u8() { return static_cast<std::uint8_t>(le(1)); }
   std::uint32_t u32() { return static_cast<std::uint32_t>(le(4)); }
@@ -74,20 +95,30 @@ class ByteReader {
     std::memcpy(&v, &b, 8);
     return v;
   }
-  const char* bytes(std::size_t n) {
+  const char* bytes(std::uint64_t n) {
     need(n);
     const char* p = p_ + pos_;
     pos_ += n;
     return p;
   }
-  std::size_t remaining() const { return n_ - pos_; }
+  std::uint64_t remaining() const { return n_ - pos_; }
   bool at_end() const { return pos_ == n_; }
-  /// Throws IoError "FILE: SECTION section at byte OFFSET: what".
+  /// Throws IoError "FILE: LABEL at byte N (file byte M): what", N counted
+  /// from the section's tag.
   [[noreturn]] void fail(const std::string& what) const {
-    throw IoError(file_, section_ + " section at byte " + std::to_string(base_ + pos_) + ": " + what);
+    throw IoError(file_, where(label_, section_base_ + pos_, file_base_ + pos_) + what);
+  }
+  /// "KEYF section at byte N (file byte M): ", as every error inside a
+  /// section begins ("file header at byte N: " where the two are one).
+  static std::string where(const std::string& label, std::uint64_t section_offset,
+                           std::uint64_t file_offset) {
+    return label + " at byte " + std::to_string(section_offset) +
+           (section_offset == file_offset ? std::string()
+                                          : " (file byte " + std::to_string(file_offset) + ")") +
+           ": ";
   }
   /// A count of items of at least `min_bytes` each that the rest can hold.
-  std::uint64_t count(std::size_t min_bytes, const char* what) {
+  std::uint64_t count(std::uint64_t min_bytes, const char* what) {
     const std::uint64_t n = u64();
     if (min_bytes > 0 && n > remaining() / min_bytes)
       fail(std::to_string(n) + " " + what + " cannot fit in the " + std::to_string(remaining()) + " bytes left");
@@ -95,21 +126,21 @@ class ByteReader {
   }
 
  private:
-  void need(std::size_t n) const {
+  void need(std::uint64_t n) const {
     if (n > n_ - pos_) fail("ends early (needs " + std::to_string(n) + " more bytes)");
   }
   std::uint64_t le(int n) {
-    need(static_cast<std::size_t>(n));
+    need(static_cast<std::uint64_t>(n));
     std::uint64_t v = 0;
     for (int i = 0; i < n; ++i) v |= std::uint64_t(static_cast<unsigned char>(p_[pos_ + i])) << (8 * i);
-    pos_ += n;
+    pos_ += static_cast<std::uint64_t>(n);
     return v;
   }
   const char* p_;
-  std::size_t n_;
-  std::size_t pos_ = 0;
-  std::string file_, section_;
-  std::size_t base_;
+  std::uint64_t n_;
+  std::uint64_t pos_ = 0;
+  std::string file_, label_;
+  std::uint64_t section_base_, file_base_;
 };
 
 }  // namespace pvb::slam::mapfile

@@ -2,17 +2,23 @@
 // it is used, so that a truncated, damaged or hostile file gives one error
 // naming the file and what is wrong (the fuzz target tests/fuzz/
 // fuzz_map_file.cpp runs this reader).
+#include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <fstream>
+#include <functional>
 #include <map>
-#include <unordered_map>
 #include <stdexcept>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
 #include "map_file_bytes.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/fnv.hpp"
+#include "pvb/common/text.hpp"
 #include "pvb/slam/core/map_file.hpp"
 
 namespace pvb::slam {
@@ -20,14 +26,24 @@ namespace {
 
 using namespace mapfile;
 
-
 /// Where each section's payload lies in the file: (offset, length).
-using Sections = std::vector<std::pair<std::size_t, std::size_t>>;
+using Sections = std::vector<std::pair<std::uint64_t, std::uint64_t>>;
 
-Sections split_sections(const std::string& b, const std::string& file) {
-  if (b.size() < kMagicBytes || b.compare(0, kMagicBytes, kMagic, kMagicBytes) != 0)
+/// Reads up to `n` bytes at `offset` of the file (fewer at its end).
+using ReadAt = std::function<std::string(std::uint64_t offset, std::uint64_t n)>;
+
+std::uint64_t le64(const std::string& b, std::size_t at) {
+  std::uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v |= std::uint64_t(static_cast<unsigned char>(b[at + i])) << (8 * i);
+  return v;
+}
+
+/// The file header: magic, version, section count.
+void check_file_header(const std::string& head, const std::string& file) {
+  if (head.size() < kMagicBytes || head.compare(0, kMagicBytes, kMagic, kMagicBytes) != 0)
     throw IoError(file, "not a map file (it does not start with PVBMAP)");
-  ByteReader r(b.data() + kMagicBytes, b.size() - kMagicBytes, file, "file header", kMagicBytes);
+  ByteReader r(head.data() + kMagicBytes, head.size() - kMagicBytes, file, "file header", kMagicBytes,
+               kMagicBytes);
   const std::uint32_t version = r.u32();
   if (version > kMapFileVersion)
     throw IoError(file, "map file version " + std::to_string(version) + " is newer than this build reads (" +
@@ -36,24 +52,57 @@ Sections split_sections(const std::string& b, const std::string& file) {
   const std::uint32_t count = r.u32();
   if (count != kSections.size())
     r.fail(std::to_string(count) + " sections, expected " + std::to_string(kSections.size()));
+}
+
+/// The sections of a file of `size` bytes, from the file header and each
+/// section's tag and length alone (16 bytes, then 12 a section): their
+/// lengths must add up to the file's size.
+Sections frame_sections(const ReadAt& read_at, std::uint64_t size, const std::string& file) {
+  check_file_header(read_at(0, kMagicBytes + 8), file);
   Sections out(kSections.size());
+  std::uint64_t at = kMagicBytes + 8;  // where the section begins
   for (std::size_t s = 0; s < kSections.size(); ++s) {
-    const std::string tag(r.bytes(4), 4);
-    if (tag != kSections[s]) r.fail("section " + std::to_string(s) + " is not " + kSections[s]);
-    const std::uint64_t length = r.u64();
-    if (length > r.remaining()) r.fail(std::string(kSections[s]) + " is cut short (the file is truncated)");
-    out[s].first = b.size() - r.remaining();
-    out[s].second = length;
-    const char* payload = r.bytes(length);
-    if (r.u64() != fnv1a64(payload, length))
-      r.fail(std::string(kSections[s]) + " checksum does not match (the file is damaged)");
+    const std::string label = std::string(kSections[s]) + " section";
+    const auto fail = [&](std::uint64_t offset, const std::string& what) {
+      throw IoError(file, ByteReader::where(label, offset, at + offset) + what);
+    };
+    if (size - at < kSectionHeadBytes)
+      fail(0, at == size ? "missing (the file ends before it)"
+                         : "its tag and length are cut short (the file is truncated)");
+    const std::string head = read_at(at, kSectionHeadBytes);
+    if (head.compare(0, 4, kSections[s]) != 0)
+      fail(0, "tag \"" + printable(head.substr(0, 4)) + "\", expected " + kSections[s]);
+    const std::uint64_t length = le64(head, 4);
+    const std::uint64_t left = size - at - kSectionHeadBytes;
+    if (length > left || left - length < kSectionTailBytes)
+      fail(4, "a payload of " + std::to_string(length) + " bytes and its checksum do not fit in the " +
+                  std::to_string(left) + " bytes left (the file is truncated)");
+    out[s] = {at + kSectionHeadBytes, length};
+    at += kSectionHeadBytes + length + kSectionTailBytes;
   }
-  if (!r.at_end()) r.fail(std::to_string(r.remaining()) + " bytes after the last section");
+  if (at != size)
+    throw IoError(file, std::to_string(size - at) + " bytes after the last section (from file byte " +
+                            std::to_string(at) + ")");
+  return out;
+}
+
+Sections split_sections(const std::string& b, const std::string& file) {
+  const ReadAt in_memory = [&](std::uint64_t offset, std::uint64_t n) { return b.substr(offset, n); };
+  const Sections out = frame_sections(in_memory, b.size(), file);
+  for (std::size_t s = 0; s < kSections.size(); ++s) {
+    const auto [payload, length] = out[s];
+    if (le64(b, payload + length) != fnv1a64(b.data() + payload, length))
+      throw IoError(file, ByteReader::where(std::string(kSections[s]) + " section",
+                                            kSectionHeadBytes + length, payload + length) +
+                              "checksum does not match its " + std::to_string(length) +
+                              "-byte payload (the file is damaged)");
+  }
   return out;
 }
 
 ByteReader reader_for(const std::string& b, const Sections& s, std::size_t i, const std::string& file) {
-  return ByteReader(b.data() + s[i].first, s[i].second, file, kSections[i], s[i].first);
+  return ByteReader(b.data() + s[i].first, s[i].second, file, std::string(kSections[i]) + " section",
+                    kSectionHeadBytes, s[i].first);
 }
 
 void check_settings(ByteReader& r, const MapSettings& s) {
@@ -100,7 +149,35 @@ geom::SE3d read_pose(ByteReader& r) {
   if (!R.allFinite() || !t.allFinite()) r.fail("a pose is not finite");
   if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 || R.determinant() < 0)
     r.fail("a pose's rotation is not a rotation");
+  const Eigen::Vector3d centre = -R.transpose() * t;
+  if (centre.cwiseAbs().maxCoeff() > kMaxMapCoordinateM)
+    r.fail("a camera centre at (" + format_g(centre.x()) + ", " + format_g(centre.y()) + ", " +
+           format_g(centre.z()) + ") m lies beyond " + format_g(kMaxMapCoordinateM) +
+           " m of the map's origin");
   return geom::make_se3(R, t);
+}
+
+/// Refuses a keypoint that a camera of the map's settings cannot have made:
+/// values not finite, a position beyond the image widened by its own size
+/// on every side (as detected and undistorted), an angle outside
+/// 0-360 degrees, a depth beyond kMaxMapCoordinateM, an octave beyond the
+/// pyramid.  `v`: x, y, undistorted x, y, angle, two reserved.
+void check_keypoint(ByteReader& r, std::uint32_t i, const float (&v)[7], float depth, std::uint8_t octave,
+                    const CameraModel& cam) {
+  const auto bad = [&](const std::string& what) { r.fail("keypoint " + std::to_string(i) + " " + what); };
+  for (int k = 0; k < 7; ++k)
+    if (!std::isfinite(v[k])) bad("has a value that is not finite");
+  if (!std::isfinite(depth)) bad("has a depth that is not finite");
+  const double w = cam.width, h = cam.height;
+  for (int k : {0, 2})
+    if (!(v[k] >= -w && v[k] <= 2 * w && v[k + 1] >= -h && v[k + 1] <= 2 * h))
+      bad(std::string(k == 0 ? "as detected" : "undistorted") + " at (" + format_g(v[k]) + ", " +
+          format_g(v[k + 1]) + ") lies beyond the " + std::to_string(cam.width) + "x" +
+          std::to_string(cam.height) + " image widened by its size on every side");
+  if (!(v[4] >= 0 && v[4] <= 360)) bad("has angle " + format_g(v[4]) + ", outside 0-360 degrees");
+  if (depth > kMaxMapCoordinateM)
+    bad("has depth " + format_g(depth) + " m, beyond " + format_g(kMaxMapCoordinateM) + " m");
+  if (octave >= cam.num_levels) bad("has octave " + std::to_string(octave));
 }
 
 /// The keypoints of one keyframe, after its id, time, session and pose;
@@ -121,10 +198,7 @@ Frame read_frame(ByteReader& r, std::uint64_t frame_id, std::int64_t t_ns,
     depth[i] = r.f32();
     (*point_ids)[i] = r.u64();
     std::memcpy(desc.ptr<unsigned char>(static_cast<int>(i)), r.bytes(32), 32);
-    for (float x : v)
-      if (!std::isfinite(x)) r.fail("keypoint " + std::to_string(i) + " has a value that is not finite");
-    if (!std::isfinite(depth[i])) r.fail("keypoint " + std::to_string(i) + " has a depth that is not finite");
-    if (octave >= cam->num_levels) r.fail("keypoint " + std::to_string(i) + " has octave " + std::to_string(octave));
+    check_keypoint(r, i, v, depth[i], octave, *cam);
     keys[i] = cv::Point2f(v[0], v[1]);
     keys_un[i] = Keypoint{cv::Point2f(v[2], v[3]), v[4], octave};
   }
@@ -139,7 +213,8 @@ PointIdsByKf read_keyframes(ByteReader r, const std::shared_ptr<const CameraMode
   const std::uint64_t n = r.count(kKeyframeHeadBytes, "keyframes");
   for (std::uint64_t k = 0; k < n; ++k) {
     const std::uint64_t id = r.u64();
-    if (id == kNone || map->keyframes().count(id)) r.fail("keyframe id " + std::to_string(id) + " given twice");
+    if (id >= kMaxId) r.fail("keyframe id " + std::to_string(id) + " is not below 2^48");
+    if (map->keyframes().count(id)) r.fail("keyframe id " + std::to_string(id) + " given twice");
     const std::uint64_t frame_id = r.u64();
     const std::int64_t t_ns = r.i64();
     const std::uint32_t session = r.u32();
@@ -165,6 +240,29 @@ struct SavedPoint {
   std::int32_t visible = 0, found = 0;
 };
 
+/// Refuses a point that cannot be: an id at or above 2^48, a position not
+/// finite or beyond kMaxMapCoordinateM, a reference or first keyframe not
+/// in the map, counts below 0, above kMaxVisible or found more often than
+/// predicted visible.
+void check_point(ByteReader& r, std::uint64_t id, const SavedPoint& p, const Map& map) {
+  const auto fail = [&](const std::string& why) { r.fail("point " + std::to_string(id) + why); };
+  if (id >= kMaxId) fail(": its id is not below 2^48");
+  if (!p.p_w.allFinite()) fail(" has a position that is not finite");
+  if (p.p_w.cwiseAbs().maxCoeff() > kMaxMapCoordinateM)
+    fail(" at (" + format_g(p.p_w.x()) + ", " + format_g(p.p_w.y()) + ", " + format_g(p.p_w.z()) +
+         ") m lies beyond " + format_g(kMaxMapCoordinateM) + " m of the map's origin");
+  if (p.ref != kNone && !map.keyframes().count(p.ref))
+    fail(": its reference keyframe " + std::to_string(p.ref) + " is not in the map");
+  if (!map.keyframes().count(p.first))
+    fail(": its first keyframe " + std::to_string(p.first) + " is not in the map");
+  if (p.visible < 0 || p.found < 0) fail(" has negative counts");
+  if (p.visible > kMaxVisible)
+    fail(" was predicted visible " + std::to_string(p.visible) + " times, more than 2^30");
+  if (p.found > p.visible)
+    fail(" was found " + std::to_string(p.found) + " times but predicted visible only " +
+         std::to_string(p.visible));
+}
+
 std::map<std::uint64_t, SavedPoint> read_points(ByteReader r, const Map& map) {
   std::map<std::uint64_t, SavedPoint> out;
   const std::uint64_t n = r.count(8 + 24 + 8 + 8 + 8, "points");
@@ -176,21 +274,18 @@ std::map<std::uint64_t, SavedPoint> read_points(ByteReader r, const Map& map) {
     p.first = r.u64();
     p.visible = r.i32();
     p.found = r.i32();
-    const auto fail = [&](const std::string& why) { r.fail("point " + std::to_string(id) + why); };
     // Saved in id order: a hint at the end makes each insertion constant time.
     const bool after_last = out.empty() || out.rbegin()->first < id;
-    if (id == kNone || (!after_last && out.count(id))) fail(" given twice");
-    if (!p.p_w.allFinite()) fail(" has a position that is not finite");
-    if (p.ref != kNone && !map.keyframes().count(p.ref))
-      fail(": its reference keyframe " + std::to_string(p.ref) + " is not in the map");
-    if (p.visible < 0 || p.found < 0) fail(" has negative counts");
+    if (!after_last && out.count(id)) r.fail("point " + std::to_string(id) + " given twice");
+    check_point(r, id, p, map);
     out.emplace_hint(after_last ? out.end() : out.lower_bound(id), id, p);
   }
   if (!r.at_end()) r.fail("longer than its points");
   return out;
 }
 
-/// Creates the points and their observations from the keyframes' side.
+/// Creates the points and their observations from the keyframes' side;
+/// a point's reference keyframe must be one of them.
 void link_points(ByteReader r, const PointIdsByKf& ids, const std::map<std::uint64_t, SavedPoint>& saved, Map* map) {
   std::unordered_map<std::uint64_t, std::uint64_t> first_observer;
   first_observer.reserve(saved.size());
@@ -203,7 +298,9 @@ void link_points(ByteReader r, const PointIdsByKf& ids, const std::map<std::uint
     const std::uint64_t ref = p.ref != kNone ? p.ref : obs->second;
     map->add_loaded_point(id, p.p_w, map->keyframes().at(ref))->restore(p.first, p.visible, p.found);
   }
-  for (const auto& [kf_id, pids] : ids) {
+  for (const auto& entry : ids) {  // not a structured binding: C++17 lambdas cannot capture one
+    const std::uint64_t kf_id = entry.first;
+    const std::vector<std::uint64_t>& pids = entry.second;
     const auto& kf = map->keyframes().at(kf_id);
     for (std::size_t i = 0; i < pids.size(); ++i) {
       if (pids[i] == kNone) continue;
@@ -218,11 +315,52 @@ void link_points(ByteReader r, const PointIdsByKf& ids, const std::map<std::uint
       it->second->add_observation(kf, i);
     }
   }
+  for (const auto& [id, p] : saved)
+    if (p.ref != kNone && !map->points().at(id)->observations().count(p.ref))
+      r.fail("point " + std::to_string(id) + ": its reference keyframe " + std::to_string(p.ref) +
+             " does not observe it");
   for (const auto& [id, mp] : map->points()) {
     mp->compute_distinctive_descriptor();
     mp->update_normal_and_depth();
   }
 }
+
+/// Refuses a spanning tree with other than one root, or with a cycle.
+/// `ids`: the keyframes in ascending order; `parents`: each one's parent
+/// (kNone: a root), every one a keyframe of `ids` other than itself.
+void check_tree(ByteReader& r, const std::vector<std::uint64_t>& ids,
+                const std::vector<std::uint64_t>& parents) {
+  std::vector<std::uint64_t> roots;
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    if (parents[i] == kNone) roots.push_back(ids[i]);
+  if (roots.size() != 1)
+    r.fail("the spanning tree has " + std::to_string(roots.size()) + " roots" +
+           (roots.size() > 1
+                ? " (keyframes " + std::to_string(roots[0]) + " and " + std::to_string(roots[1]) + ")"
+                : std::string()) +
+           ", expected one");
+  const auto index_of = [&](std::uint64_t id) {
+    return static_cast<std::size_t>(std::lower_bound(ids.begin(), ids.end(), id) - ids.begin());
+  };
+  enum : std::uint8_t { kUnseen, kOnPath, kReachesRoot };
+  std::vector<std::uint8_t> state(ids.size(), kUnseen);
+  std::vector<std::size_t> path;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    path.clear();
+    std::size_t j = i;
+    while (state[j] == kUnseen) {  // up the tree until the root or a keyframe known to reach it
+      state[j] = kOnPath;
+      path.push_back(j);
+      if (parents[j] == kNone) break;
+      j = index_of(parents[j]);
+    }
+    if (state[j] == kOnPath && parents[j] != kNone)
+      r.fail("the spanning tree has a cycle through keyframe " + std::to_string(ids[j]));
+    for (std::size_t k : path) state[k] = kReachesRoot;
+  }
+}
+
+using KeyFrameList = std::vector<std::shared_ptr<KeyFrame>>;
 
 void read_graph(ByteReader r, Map* map) {
   const auto& kfs = map->keyframes();
@@ -234,22 +372,42 @@ void read_graph(ByteReader r, Map* map) {
       r.fail("keyframe " + std::to_string(self) + ": " + what + " " + std::to_string(id) + " is not another keyframe");
     return it->second;
   };
-  for (auto it = kfs.begin(); it != kfs.end(); ++it) {
+  // Each list in ascending id order, so that none names a keyframe twice.
+  const auto repeated = [&](std::uint64_t self, const char* what, std::uint64_t id) {
+    r.fail("keyframe " + std::to_string(self) + ": " + what + " " + std::to_string(id) +
+           " repeated or out of order");
+  };
+  std::vector<std::uint64_t> ids, parents;
+  std::vector<std::vector<std::pair<std::shared_ptr<KeyFrame>, int>>> edges(kfs.size());
+  std::vector<KeyFrameList> loops(kfs.size());
+  std::size_t k = 0;
+  for (auto it = kfs.begin(); it != kfs.end(); ++it, ++k) {
     const std::uint64_t id = r.u64();
     if (id != it->first) r.fail("graph entry for keyframe " + std::to_string(id) + " out of order");
     const std::uint64_t parent_id = r.u64();
-    const auto parent = parent_id == kNone ? nullptr : keyframe(parent_id, id, "parent");
-    std::vector<std::pair<std::shared_ptr<KeyFrame>, int>> edges(r.count(12, "edges"));
-    for (auto& [kf, w] : edges) {
-      kf = keyframe(r.u64(), id, "neighbour");
-      w = r.i32();
+    if (parent_id != kNone) keyframe(parent_id, id, "parent");
+    ids.push_back(id);
+    parents.push_back(parent_id);
+    edges[k].resize(r.count(12, "edges"));
+    for (std::size_t e = 0; e < edges[k].size(); ++e) {
+      const std::uint64_t other = r.u64();
+      if (e > 0 && other <= edges[k][e - 1].first->id()) repeated(id, "neighbour", other);
+      edges[k][e].first = keyframe(other, id, "neighbour");
+      const int w = edges[k][e].second = r.i32();
       if (w <= 0) r.fail("keyframe " + std::to_string(id) + ": an edge of weight " + std::to_string(w));
     }
-    std::vector<std::shared_ptr<KeyFrame>> loops(r.count(8, "loop edges"));
-    for (auto& kf : loops) kf = keyframe(r.u64(), id, "loop edge");
-    it->second->restore_graph(parent, edges, loops);
+    loops[k].resize(r.count(8, "loop edges"));
+    for (std::size_t e = 0; e < loops[k].size(); ++e) {
+      const std::uint64_t other = r.u64();
+      if (e > 0 && other <= loops[k][e - 1]->id()) repeated(id, "loop edge", other);
+      loops[k][e] = keyframe(other, id, "loop edge");
+    }
   }
   if (!r.at_end()) r.fail("longer than its graph");
+  check_tree(r, ids, parents);
+  k = 0;
+  for (auto it = kfs.begin(); it != kfs.end(); ++it, ++k)
+    it->second->restore_graph(parents[k] == kNone ? nullptr : kfs.at(parents[k]), edges[k], loops[k]);
 }
 
 /// The bags of words and direct indices, in keyframe order.
@@ -286,6 +444,28 @@ void read_bows(ByteReader r, Map* map) {
 
 }  // namespace
 
+std::string read_map_file(const std::string& path) {
+  require_regular_file(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path, std::string("cannot open for reading: ") + std::strerror(errno));
+  in.seekg(0, std::ios::end);
+  const std::streamoff end = in.tellg();
+  if (end < 0) throw IoError(path, "cannot tell its size");
+  const auto size = static_cast<std::uint64_t>(end);
+  if (size > kMaxMapFileBytes)
+    throw IoError(path, std::to_string(size) + " bytes, larger than a map file may be (" +
+                            std::to_string(kMaxMapFileBytes) + " bytes, 4 GiB)");
+  const ReadAt from_file = [&](std::uint64_t offset, std::uint64_t n) {
+    std::string b(static_cast<std::size_t>(std::min(n, size - std::min(offset, size))), '\0');
+    in.seekg(static_cast<std::streamoff>(offset));
+    in.read(b.data(), static_cast<std::streamsize>(b.size()));
+    if (in.gcount() != static_cast<std::streamsize>(b.size())) throw IoError(path, "cannot read it");
+    return b;
+  };
+  frame_sections(from_file, size, path);  // before reading the payloads
+  return from_file(0, size);
+}
+
 MapFileHeader read_map_header(const std::string& bytes, const std::string& file) {
   const Sections s = split_sections(bytes, file);
   MapFileHeader h = parse_head(reader_for(bytes, s, 0, file));
@@ -300,6 +480,12 @@ void decode_map(const std::string& bytes, const std::string& file, const MapFile
   if (s.size() != kSections.size()) throw std::logic_error("decode_map: a header not from read_map_header");
   const PointIdsByKf ids = read_keyframes(reader_for(bytes, s, 1, file), cam, h.sessions, map);
   if (map->keyframes().empty()) throw IoError(file, "the map has no keyframes");
+  if (h.sessions > map->keyframes().size())  // every session counted made a keyframe that is kept
+    throw IoError(
+        file,
+        ByteReader::where("HEAD section", kSectionHeadBytes + s[0].second - 4, s[0].first + s[0].second - 4) +
+            std::to_string(h.sessions) + " sessions in a map of " + std::to_string(map->keyframes().size()) +
+            " keyframes (each session holds one at least)");
   const auto saved = read_points(reader_for(bytes, s, 2, file), *map);
   link_points(reader_for(bytes, s, 2, file), ids, saved, map);
   read_graph(reader_for(bytes, s, 3, file), map);

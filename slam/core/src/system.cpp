@@ -159,7 +159,7 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!place_) throw ConfigError(settings_.source, "Vocabulary.path", "a vocabulary to relocalise in a saved map");
   if (next_frame_id_ > 0 || map_start_) throw std::logic_error("System::load_map: after the first frame");
-  const std::string bytes = read_file(path);
+  const std::string bytes = read_map_file(path);
   const MapFileHeader head = read_map_header(bytes, path);
   const std::string diff = head.settings.difference(map_settings());
   if (!diff.empty()) throw ConfigError(path, "settings", "a map made with this run's settings", diff);
@@ -199,15 +199,20 @@ MapSaveInfo System::save_map(const std::string& path, const std::string& app_jso
     std::lock_guard<std::mutex> lock(map_.mutex());
     // The sessions loaded, and this one when it made a keyframe.
     if (map_.num_keyframes() == 0) throw ConfigError(path, "map", "a map with keyframes (this run made none)");
-    info.sessions = loaded_sessions_;
+    std::uint64_t sessions = loaded_sessions_;  // counted on in 64 bits: no wrap to 0
     for (const auto& [id, kf] : map_.keyframes()) {
       if (map_.map_of(*kf) != 0) {  // a provisional map never merged: not saved
         ++info.unmerged_keyframes;
         continue;
       }
       ++info.keyframes;
-      if (kf->session() == map_.session()) info.sessions = map_.session() + 1;
+      if (kf->session() == map_.session()) sessions = std::uint64_t(map_.session()) + 1;
     }
+    if (sessions > info.keyframes)  // the reader refuses more sessions than keyframes
+      throw IoError(path, std::to_string(sessions) + " sessions in a map of " +
+                              std::to_string(info.keyframes) +
+                              " keyframes (each session holds one at least)");
+    info.sessions = static_cast<std::uint32_t>(sessions);
     const BagOf bag_of = [this](const KeyFrame& kf) { return place_ ? place_->bag_of(kf) : kf.bow(); };
     bytes = encode_map(map_, map_settings(), info.sessions, app_json, bag_of);
     info.points = map_.num_points();

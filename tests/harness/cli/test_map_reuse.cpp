@@ -143,4 +143,30 @@ TEST(MapReuse, MapOptionsThatDoNotFitAreOneErrorLine) {
   EXPECT_NE(junk.output.find(d + "/junk.pvbmap: not a map file"), std::string::npos) << junk.output;
 }
 
+// A map shows its station (META): pvbench run on another station (here
+// the station seed) refuses it, unless --allow-other-station, which uses it
+// after a warning.
+TEST(MapReuse, RunRefusesAMapOfAnotherStationUnlessAllowed) {
+  const std::string d = fresh("station");
+  const std::string station = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
+  const std::string run = "run --scenario " + station + " --frames 3 --sync --no-map-eval";
+  const auto made = test::run_pvbench(run + " --save-map " + d + "/seed7.pvbmap --out " + d + "/made");
+  ASSERT_EQ(made.code, 0) << made.output;
+  const std::string other = run + " --seed 8 --map " + d + "/seed7.pvbmap --map-mode localise";
+  const auto refused = test::run_pvbench(other + " --out " + d + "/refused");
+  EXPECT_NE(refused.code, 0);
+  EXPECT_NE(refused.output.find(
+                d + "/seed7.pvbmap: META station: expected a map of this run's station, pv_station, "
+                    "station seed 8 (--allow-other-station uses it all the same), got pv_station, "
+                    "station seed 7"),
+            std::string::npos)
+      << refused.output;
+  const auto allowed = test::run_pvbench(other + " --allow-other-station --out " + d + "/allowed");
+  EXPECT_EQ(allowed.code, 0) << allowed.output;
+  EXPECT_NE(allowed.output.find("pvbench: warning: the map " + d +
+                                "/seed7.pvbmap shows pv_station, station seed 7"),
+            std::string::npos)
+      << allowed.output;
+}
+
 }  // namespace

@@ -3,12 +3,21 @@
 // kind of bad file is one IoError or ConfigError naming the file; and a
 // run that loads the map to localise in it starts lost, relocalises on the
 // first frame at the map's own pose, never adds a keyframe, and tracks the
-// second frame where the mapping run put it.
+// second frame where the mapping run put it.  A tiny map made
+// impossible in one way at a time, its checksums made right, is refused for
+// that reason (the same files seed the fuzz target).
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
+#include <limits>
 
+#include "map_file_edit.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
@@ -279,6 +288,239 @@ TEST_F(MapFile, ALookAlikePlaceIsTriedThroughTheCovisiblesOfItsKeyframe) {
   EXPECT_NE(r.tracking.failure.find("look-alike keyframe " + std::to_string(far_id) + " matched at a place 6.0"),
             std::string::npos)
       << r.tracking.failure;
+}
+
+// --- Framing and size ---------------------------------------------------------
+
+TEST_F(MapFile, AFramingOrChecksumErrorNamesItsSectionAndAByteInIt) {
+  const std::string tiny = test::tiny_map();
+  std::size_t at = 16;
+  for (const char* tag : {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "META"}) {
+    const std::uint64_t length = test::get_u64(tiny, at + 4);
+    std::string damaged = tiny;
+    if (length > 0)
+      damaged[at + 12 + length / 2] ^= 0x20;
+    else
+      damaged[at + 12] ^= 0x20;  // an empty payload: its checksum
+    const std::string sum =
+        std::to_string(12 + length) + " (file byte " + std::to_string(at + 12 + length) + ")";
+    EXPECT_NE(load_error(damaged, "damaged.pvbmap")
+                  .find(std::string(tag) + " section at byte " + sum + ": checksum does not match"),
+              std::string::npos)
+        << tag << ": " << load_error(damaged, "damaged.pvbmap");
+    const std::string cut = load_error(tiny.substr(0, at + 12 + length / 2), "cut.pvbmap");
+    EXPECT_NE(cut.find(std::string(tag) + " section at byte 4 (file byte " + std::to_string(at + 4) +
+                       "): a payload of " + std::to_string(length) + " bytes"),
+              std::string::npos)
+        << cut;
+    at += 12 + length + 8;
+  }
+  const std::size_t head_end = 16 + 12 + test::get_u64(tiny, 20) + 8;  // the file cut after HEAD
+  EXPECT_NE(load_error(tiny.substr(0, head_end), "cut.pvbmap")
+                .find("KEYF section at byte 0 (file byte " + std::to_string(head_end) + "): missing"),
+            std::string::npos);
+}
+
+/// `bytes` written to a file then stretched to `size` bytes (a sparse file:
+/// nothing is written past the map); the error loading it ("" when none)
+/// and how long that took.
+std::pair<std::string, double> load_stretched(const std::string& bytes, std::uint64_t size) {
+  const std::string p = tmp_path("stretched.pvbmap");
+  write_file(p, bytes);
+  const int fd = ::open(p.c_str(), O_WRONLY);
+  EXPECT_GE(fd, 0);
+  EXPECT_EQ(::ftruncate(fd, static_cast<off_t>(size)), 0);
+  ::close(fd);
+  System system(read_settings(kTum3), sync_options());
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string what;
+  try {
+    system.load_map(p, MapStart::kLocalise);
+  } catch (const Error& e) {
+    what = e.what();
+  }
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::remove(p.c_str());
+  return {what, s};
+}
+
+TEST_F(MapFile, AFileLargerThanTheLimitIsRefusedBeforeItsBytesAreRead) {
+  const auto [what, seconds] = load_stretched(bytes_, std::uint64_t(20) << 30);
+  EXPECT_NE(what.find("21474836480 bytes, larger than a map file may be (4294967296 bytes, 4 GiB)"),
+            std::string::npos)
+      << what;
+  EXPECT_LT(seconds, 1.0);
+}
+
+TEST_F(MapFile, AFileWhoseSectionsDoNotAddUpIsRefusedBeforeItsBytesAreRead) {
+  const std::uint64_t size = std::uint64_t(3) << 30;  // within the limit, above 2^31
+  const auto [what, seconds] = load_stretched(bytes_, size);
+  EXPECT_NE(what.find(std::to_string(size - bytes_.size()) +
+                      " bytes after the last section (from file byte " + std::to_string(bytes_.size()) + ")"),
+            std::string::npos)
+      << what;
+  EXPECT_LT(seconds, 1.0);
+}
+
+// --- Impossible maps ------------------------------------------------------------
+
+/// Reads `bytes` as a map: what() of the error thrown ("" when none).
+std::string decode_error(const std::string& bytes, const std::string& file = "m.pvbmap") {
+  try {
+    const MapFileHeader h = read_map_header(bytes, file);
+    Map map;
+    decode_map(bytes, file, h, camera_for(h.settings), &map);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+struct ImpossibleMap {
+  std::string name;    ///< the corpus file is impossible_NAME.pvbmap
+  std::string bytes;   ///< checksums right
+  std::string reason;  ///< in the error
+};
+
+/// The tiny map made impossible one way at a time.
+std::vector<ImpossibleMap> impossible_maps() {
+  using namespace test;
+  const std::string tiny = tiny_map();
+  const auto edit = [&](int section, const std::function<void(std::string&)>& change) {
+    std::vector<std::string> p = map_sections(tiny);
+    change(p[static_cast<std::size_t>(section)]);
+    return map_file_of(p);
+  };
+  const auto graph = [&](const std::vector<GraphEntry>& g) {
+    return edit(3, [&](std::string& b) { b = graph_payload(g); });
+  };
+  const std::uint64_t none = ~std::uint64_t(0);
+  const std::vector<std::pair<std::uint64_t, std::int32_t>> e0 = {{1, 6}, {2, 5}}, e1 = {{0, 6}},
+                                                            e2 = {{0, 5}};
+  return {
+      {"first_keyframe_missing", edit(2, [](std::string& b) { put_u64(b, poin_point(0) + 40, 99); }),
+       "point 0: its first keyframe 99 is not in the map"},
+      {"reference_does_not_observe", edit(2, [](std::string& b) { put_u64(b, poin_point(5) + 32, 2); }),
+       "point 5: its reference keyframe 2 does not observe it"},
+      {"tree_cycle", graph({{none, e0, {}}, {2, e1, {}}, {1, e2, {}}}),
+       "the spanning tree has a cycle through keyframe"},
+      {"tree_two_roots", graph({{none, e0, {}}, {0, e1, {}}, {none, e2, {}}}),
+       "the spanning tree has 2 roots (keyframes 0 and 2), expected one"},
+      {"duplicate_edge", graph({{none, {{1, 6}, {1, 6}, {2, 5}}, {}}, {0, e1, {}}, {0, e2, {}}}),
+       "keyframe 0: neighbour 1 repeated or out of order"},
+      {"duplicate_loop_edge", graph({{none, e0, {2, 2}}, {0, e1, {}}, {0, e2, {0}}}),
+       "keyframe 0: loop edge 2 repeated or out of order"},
+      {"sessions_4294967295", edit(0, [](std::string& b) { put_u32(b, b.size() - 4, 4294967295u); }),
+       "HEAD section at byte 140 (file byte 156): 4294967295 sessions in a map of 3 keyframes"},
+      {"keypoint_x_1e6", edit(1, [](std::string& b) { put_f32(b, keyf_keypoint(0, 0), 1e6f); }),
+       "keypoint 0 as detected at (1e+06, 200) lies beyond the 640x480 image widened by its size on every "
+       "side"},
+      {"keypoint_angle", edit(1, [](std::string& b) { put_f32(b, keyf_keypoint(1, 2) + 16, -1e30f); }),
+       "keypoint 2 has angle -1e+30, outside 0-360 degrees"},
+      {"keypoint_depth_1e30", edit(1, [](std::string& b) { put_f32(b, keyf_keypoint(0, 3) + 29, 1e30f); }),
+       "keypoint 3 has depth 1e+30 m, beyond 1e+06 m"},
+      {"translation_1e300", edit(1, [](std::string& b) { put_f64(b, keyf_translation(2), 1e300); }),
+       "a camera centre at (-1e+300, -0, -0) m lies beyond 1e+06 m of the map's origin"},
+      {"keyframe_id_2e48",
+       edit(1, [](std::string& b) { put_u64(b, keyf_keyframe(2), std::uint64_t(1) << 48); }),
+       "keyframe id 281474976710656 is not below 2^48"},
+      {"point_1e308", edit(2, [](std::string& b) { put_f64(b, poin_point(1) + 8, 1e308); }),
+       "point 1 at (1e+308, "},
+      {"found_above_visible",
+       edit(2,
+            [](std::string& b) {
+              put_i32(b, poin_point(0) + 48, 2);
+              put_i32(b, poin_point(0) + 52, 3);
+            }),
+       "point 0 was found 3 times but predicted visible only 2"},
+      {"visible_2e31", edit(2, [](std::string& b) { put_i32(b, poin_point(0) + 48, 2147483647); }),
+       "point 0 was predicted visible 2147483647 times, more than 2^30"},
+  };
+}
+
+const std::string kCorpus = std::string(PVB_SOURCE_DIR) + "/tests/fuzz/corpus/map_file";
+
+TEST(MapFileChecks, TheTinyMapIsWhatItsOffsetsSay) {
+  const std::string tiny = test::tiny_map();
+  EXPECT_EQ(decode_error(tiny), "");
+  const auto p = test::map_sections(tiny);
+  EXPECT_EQ(p[1].size(), 8 + 3 * test::kTinyKeyframeBytes);
+  EXPECT_EQ(p[2].size(), 8 + 6 * 56u);
+  EXPECT_EQ(test::map_file_of(p), tiny);
+  const std::vector<std::pair<std::uint64_t, std::int32_t>> e0 = {{1, 6}, {2, 5}}, e1 = {{0, 6}},
+                                                            e2 = {{0, 5}};
+  const std::uint64_t none = ~std::uint64_t(0);
+  EXPECT_EQ(p[3], test::graph_payload({{none, e0, {}}, {0, e1, {}}, {0, e2, {}}}));
+}
+
+// Each is refused for its reason, and the fuzz target's seed corpus holds
+// each (PVB_WRITE_MAP_CORPUS=DIR writes them to DIR).
+TEST(MapFileChecks, EveryImpossibleMapIsRefusedForItsReason) {
+  const char* out = std::getenv("PVB_WRITE_MAP_CORPUS");
+  if (out) write_file(std::string(out) + "/tiny.pvbmap", test::tiny_map());
+  for (const ImpossibleMap& m : impossible_maps()) {
+    const std::string what = decode_error(m.bytes, "m.pvbmap");
+    EXPECT_NE(what.find(m.reason), std::string::npos) << m.name << ": " << what;
+    const std::string seed = "impossible_" + m.name + ".pvbmap";
+    if (out) write_file(std::string(out) + "/" + seed, m.bytes);
+    std::ifstream in(kCorpus + "/" + seed, std::ios::binary);
+    ASSERT_TRUE(in.good()) << seed << " is not in " << kCorpus;
+    const std::string committed((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(decode_error(committed, seed).find(m.reason), std::string::npos) << seed;
+  }
+}
+
+/// The corpus's map of the pair, of 600-feature keyframes (half the size
+/// of the default 1000), and its first 1000 bytes.
+void write_pair_seeds(const std::string& dir) {
+  Settings s = read_settings(kTum3);
+  s.orb.num_features = 600;
+  System system(s, sync_options());
+  for (const auto& f : pair_frames(s)) system.track(f);
+  system.shutdown();
+  system.save_map(dir + "/fr3_pair_600.pvbmap", R"({"station": "fr3"})");
+  write_file(dir + "/truncated.pvbmap", read_file(dir + "/fr3_pair_600.pvbmap").substr(0, 1000));
+}
+
+// The seeds that are whole maps are maps the reader reads.
+TEST(MapFileChecks, TheWholeMapsOfTheCorpusAreRead) {
+  if (const char* out = std::getenv("PVB_WRITE_MAP_CORPUS")) write_pair_seeds(out);
+  for (const char* seed : {"tiny.pvbmap", "fr3_pair_600.pvbmap"}) {
+    std::ifstream in(kCorpus + "/" + seed, std::ios::binary);
+    ASSERT_TRUE(in.good()) << seed;
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(decode_error(bytes, seed), "") << seed;
+  }
+}
+
+// A point whose first keyframe was culled, or whose reference keyframe does
+// not observe it, is saved with keyframes of the file in their place; a
+// point no keyframe names is not saved.
+TEST(MapFileChecks, TheWriterNeverWritesWhatTheReaderRefuses) {
+  const std::string tiny = test::tiny_map();
+  const MapFileHeader h = read_map_header(tiny, "tiny.pvbmap");
+  Map map;
+  decode_map(tiny, "tiny.pvbmap", h, camera_for(h.settings), &map);
+  std::lock_guard<std::mutex> lock(map.mutex());
+  map.points().at(0)->restore(77, 4, 3);  // made by keyframe 77, since culled
+  const auto kf2 = map.keyframes().at(2);
+  const auto far =
+      map.create_point(Eigen::Vector3d(0, 0, 2), kf2);  // referred to keyframe 2, seen by 0 and 1
+  for (std::uint64_t k : {0, 1}) {
+    far->add_observation(map.keyframes().at(k), 7);
+    map.keyframes().at(k)->set_map_point(7, far);
+  }
+  const auto unseen = map.create_point(Eigen::Vector3d(0, 0, 3), kf2);  // observed by none
+  const std::string bytes = encode_map(map, h.settings, 1, "{}");
+  const MapFileHeader h2 = read_map_header(bytes, "again.pvbmap");
+  Map again;
+  ASSERT_EQ(decode_error(bytes, "again.pvbmap"), "");
+  decode_map(bytes, "again.pvbmap", h2, camera_for(h2.settings), &again);
+  EXPECT_EQ(again.points().at(0)->first_kf_id(), 0u);                       // its reference keyframe
+  EXPECT_EQ(again.points().at(far->id())->reference_keyframe()->id(), 0u);  // its first observer
+  EXPECT_EQ(again.points().count(unseen->id()), 0u);
+  EXPECT_THROW(encode_map(map, h.settings, 0, "{}"), std::logic_error);
+  EXPECT_THROW(encode_map(map, h.settings, 4, "{}"), std::logic_error);  // more sessions than keyframes
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "pvb/eval/localisation.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/geometry/se3.hpp"
+#include "pvb/scenes/scenario.hpp"
 #include "pvb/slam/core/system.hpp"
 
 namespace pvb::run {
@@ -22,10 +23,35 @@ const char* to_string(MapUse u);
 /// "localise" or "extend"; anything else throws ConfigError naming `option`.
 MapUse parse_map_use(const std::string& text, const std::string& option);
 
+/// The station a map shows or a run is on: the name of its station file
+/// (the file its days derive from, without folder and ".yaml";
+/// "pv_station" for every scenes/days/pv_station_*.yaml) and its station
+/// seed.  Either may be unknown.
+struct MapStation {
+  std::string name;  ///< "" when not known
+  std::optional<std::uint64_t> seed;
+  bool known() const { return !name.empty() || seed.has_value(); }
+  /// True when both name a part (name, seed) and that part differs.
+  bool differs_from(const MapStation& o) const;
+  /// "pv_station, station seed 7" (the parts known).
+  std::string describe() const;
+};
+/// The station of a scenario (its last base file, else its own file).
+MapStation station_of(const scenes::Scenario& s);
+/// The station of a recording by `pvbench record`, from its meta.json
+/// ("world": station_seed, base_files; "scenario": file); unknown when the
+/// file is not there or does not say.
+MapStation recording_station(const std::string& meta_json_path);
+
 struct MapOptions {
   std::string load_path;           ///< the saved map to start from (empty: a fresh map)
   MapUse use = MapUse::kFresh;     ///< kLocalise or kExtend with load_path
   std::string save_path;           ///< where to save the final map (empty: not saved)
+  /// The run's station, when known: written into a new map's META, and a
+  /// loaded map that shows another is refused (ConfigError) or, with
+  /// allow_other_station, used after a warning.
+  MapStation station;
+  bool allow_other_station = false;  ///< --allow-other-station; slam and camera only warn
   /// Checks the combination: a use needs a map and a map a use, and a map
   /// only localised in is not saved again.  Throws ConfigError.
   void check() const;
@@ -36,6 +62,8 @@ struct MapReport {
   std::string loaded_from;
   MapUse use = MapUse::kFresh;
   std::optional<slam::MapLoadInfo> load;
+  MapStation loaded_station;    ///< what the loaded map's META says; an extended map keeps it
+  std::string station_warning;  ///< the loaded map shows another station (allowed)
   /// The map's frame in the world (its first session's first camera), from
   /// the loaded map's data or, for a new map, the ground truth.
   std::optional<geom::SE3d> T_world_map;
@@ -57,14 +85,25 @@ struct MapReport {
   std::string localisation_note;                          ///< why there is none
 };
 
-/// The application data of a map file: the station it shows (its scenario
-/// name and, when known, file) and T_world_map.
-std::string map_app_json(const std::string& scenario, std::uint64_t station_seed,
+/// The application data of a map file (its META section): the scenario it
+/// was made from (name and, when known, file), the station it shows and
+/// T_world_map (null: not known).
+std::string map_app_json(const std::string& scenario, const MapStation& station,
                          const std::optional<geom::SE3d>& T_world_map, const std::string& scenario_file = "");
 /// The scenario file a map was made from, when its data names one.
 std::string map_scenario_file(const std::string& app_json);
-/// T_world_map from a map file's application data, when it has one.
-std::optional<geom::SE3d> T_world_map_of(const std::string& app_json);
+
+/// A map file's META as pvbench reads it.
+struct MapMeta {
+  std::optional<geom::SE3d> T_world_map;  ///< null in the file: made without ground truth
+  MapStation station;
+};
+/// Reads a map file's META: a JSON object whose T_world_map is null or 12
+/// finite numbers (a 3x4 matrix, row by row: a rotation, and a
+/// translation within slam::kMaxMapCoordinateM), whose station_seed, when
+/// there, is a whole number or null and whose station a string or null.
+/// Throws IoError "FILE: META section: what is wrong".
+MapMeta read_map_meta(const std::string& app_json, const std::string& file);
 
 /// Ground truth at the camera's frame times (within 1 ms, or interpolated
 /// between poses at most 50 ms apart), for sequences whose ground truth
@@ -76,20 +115,24 @@ eval::Trajectory ground_truth_at(const eval::Trajectory& gt, const std::vector<s
 /// camera; in a simulated run that pose is the first one, at identity).
 std::optional<geom::SE3d> T_world_new_map(const eval::Trajectory& gt, const eval::Trajectory& est);
 
-/// Loads the map into `system` when the options name one.
+/// Loads the map into `system` when the options name one, and reads its
+/// META; a map of another station than options.station is refused
+/// (ConfigError) unless options.allow_other_station, which prints a
+/// "pvbench: warning:" line instead.
 MapReport start_map(slam::System& system, const MapOptions& options);
 /// Scores localisation in the loaded map against ground truth.
 void score_map_localisation(MapReport* report, const eval::Trajectory& gt, const eval::Trajectory& est);
-/// Saves the final map when the options say so (after System::shutdown()).
-void save_map(slam::System& system, const MapOptions& options, const std::string& scenario,
-              std::uint64_t station_seed, MapReport* report, const std::string& scenario_file = "");
+/// Saves the final map when the options say so (after System::shutdown()),
+/// with the station of the loaded map, else options.station.
+void save_map(slam::System& system, const MapOptions& options, const std::string& scenario, MapReport* report,
+              const std::string& scenario_file = "");
 
 /// After a run (System::shutdown() done): the localisation in a loaded map
 /// scored against `gt` (may be empty: no ground truth), then the map saved
 /// when the options say so, with its frame in the world (the loaded map's,
 /// or the ground truth at the first pose of `est`).
 void finish_map(slam::System& system, const MapOptions& options, const eval::Trajectory& gt,
-                const eval::Trajectory& est, const std::string& name, std::uint64_t station_seed, MapReport* report,
+                const eval::Trajectory& est, const std::string& name, MapReport* report,
                 const std::string& scenario_file = "");
 
 /// What the run did with maps, one line per loaded or saved map.

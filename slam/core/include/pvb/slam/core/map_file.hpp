@@ -47,10 +47,24 @@ struct MapFileHeader {
   std::string app_json;        ///< the META section (the caller's JSON, "" when none)
   /// Where each section's payload lies in the file (offset, length), in
   /// file order; checked by read_map_header, used by decode_map.
-  std::vector<std::pair<std::size_t, std::size_t>> sections;
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> sections;
 };
 
 constexpr std::uint32_t kMapFileVersion = 1;
+/// The largest map file read: 4 GiB, about 30 000 keyframes (a
+/// 709-keyframe lawnmower map is 103 MB).  Reading one takes its size in
+/// memory, and the map about as much again.
+constexpr std::uint64_t kMaxMapFileBytes = std::uint64_t(4) << 30;
+/// Every keyframe's camera centre and every point lies within this many
+/// metres of the map's origin on each axis, and no keypoint's depth is
+/// larger: 1000 km, far beyond any station.
+constexpr double kMaxMapCoordinateM = 1e6;
+
+/// Reads a map file whole, once its size and framing allow: a file larger
+/// than kMaxMapFileBytes, or whose sections' lengths (read from their
+/// heads, without reading the payloads) do not add up to its size, is
+/// refused before its bytes are read.  Throws IoError naming `path`.
+std::string read_map_file(const std::string& path);
 
 /// A keyframe's bag of words, wherever it is kept (a keyframe in the place
 /// database has handed its own to the database: PlaceRecognizer::bag_of).
@@ -65,7 +79,9 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
 
 /// Checks the whole file (magic, version, sections, checksums) and returns
 /// its header.  Throws IoError naming `file` and what is wrong (truncated,
-/// damaged, not a map file, a newer version).
+/// damaged, not a map file, a newer version), with the section and the byte
+/// ("KEYF section at byte N (file byte M): ...", N counted from the
+/// section's tag).
 MapFileHeader read_map_header(const std::string& bytes, const std::string& file);
 
 /// The camera model of the map's settings (that read_map_header checked).
@@ -73,9 +89,11 @@ std::shared_ptr<const CameraModel> camera_for(const MapSettings& settings);
 
 /// Reads the keyframes, points and graph of the file whose header
 /// read_map_header gave into `map` (empty), with frames on camera `cam`
-/// (the checksums are not checked again).  Every reference is checked (ids, keypoint indices,
-/// octaves, rotations); a bad one throws IoError naming `file`, the section
-/// and the item.  Point descriptors, normals and scale ranges are computed.
+/// (the checksums are not checked again).  Every reference is checked
+/// (ids, keypoint indices, the spanning tree) and every value against what
+/// a camera of the map's settings could have made (docs/map_file.md, "Bad
+/// files"); a bad one throws IoError naming `file`, the section and the
+/// item.  Point descriptors, normals and scale ranges are computed.
 void decode_map(const std::string& bytes, const std::string& file, const MapFileHeader& header,
                 const std::shared_ptr<const CameraModel>& cam, Map* map);
 
