@@ -419,9 +419,12 @@ void read_bows(ByteReader r, Map* map) {
     for (std::uint64_t k = 0; k < words; ++k) {
       const std::uint32_t word = r.u32();
       const double weight = r.f64();
-      if (!(std::isfinite(weight) && weight >= 0) || (!bow.empty() && bow.back().first >= word))
-        r.fail(what + ": word " + std::to_string(word) + " out of order, repeated or weighted " +
-               std::to_string(weight));
+      if (!(std::isfinite(weight) && weight >= 0))
+        r.fail(what + ": word " + std::to_string(word) + " has weight " + std::to_string(weight) +
+               ", expected a finite weight >= 0");
+      if (!bow.empty() && bow.back().first >= word)
+        r.fail(what + ": word " + std::to_string(word) + " after word " + std::to_string(bow.back().first) +
+               ", expected words in ascending order, each once");
       bow.emplace_back(word, weight);
     }
     place::FeatureVector features;
@@ -431,10 +434,13 @@ void read_bows(ByteReader r, Map* map) {
       std::vector<std::uint32_t> indices(r.count(4, "keypoint indices"));
       for (std::uint32_t& i : indices) {
         i = r.u32();
-        if (i >= kf->frame().size()) r.fail(what + ": keypoint " + std::to_string(i) + " of node " + std::to_string(node));
+        if (i >= kf->frame().size())
+          r.fail(what + ": direct-index node " + std::to_string(node) + " names keypoint " + std::to_string(i) +
+                 ", but the keyframe has " + std::to_string(kf->frame().size()) + " keypoints");
       }
       if (!features.empty() && features.back().first >= node)
-        r.fail(what + ": node " + std::to_string(node) + " out of order or repeated");
+        r.fail(what + ": direct-index node " + std::to_string(node) + " after node " +
+               std::to_string(features.back().first) + ", expected nodes in ascending order, each once");
       features.emplace_back(node, std::move(indices));
     }
     kf->set_bow(std::move(bow), std::move(features));

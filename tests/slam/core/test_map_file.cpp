@@ -382,6 +382,23 @@ struct ImpossibleMap {
   std::string reason;  ///< in the error
 };
 
+/// A BOWV payload for `keyframes` keyframes without words, the first with
+/// one direct-index node and its keypoint indices.
+std::string bow_payload(int keyframes, const std::pair<std::uint32_t, std::vector<std::uint32_t>>& node) {
+  std::string b;
+  const auto u64 = [&](std::uint64_t v) { b.append(8, '\0'), test::put_u64(b, b.size() - 8, v); };
+  const auto u32 = [&](std::uint32_t v) { b.append(4, '\0'), test::put_u32(b, b.size() - 4, v); };
+  for (int k = 0; k < keyframes; ++k) {
+    u64(0);  // words
+    u64(k == 0 ? 1 : 0);
+    if (k != 0) continue;
+    u32(node.first);
+    u64(node.second.size());
+    for (std::uint32_t i : node.second) u32(i);
+  }
+  return b;
+}
+
 /// The tiny map made impossible one way at a time.
 std::vector<ImpossibleMap> impossible_maps() {
   using namespace test;
@@ -435,6 +452,9 @@ std::vector<ImpossibleMap> impossible_maps() {
        "point 0 was found 3 times but predicted visible only 2"},
       {"visible_2e31", edit(2, [](std::string& b) { put_i32(b, poin_point(0) + 48, 2147483647); }),
        "point 0 was predicted visible 2147483647 times, more than 2^30"},
+      {"bow_keypoint_995", edit(4, [](std::string& b) { b = bow_payload(3, {11, {995}}); }),
+       "keyframe 0: direct-index node 11 names keypoint 995, but the keyframe has " +
+           std::to_string(test::kTinyKeypoints) + " keypoints"},
   };
 }
 
