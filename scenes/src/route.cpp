@@ -2,10 +2,12 @@
 
 #include <cmath>
 
+#include "pvb/geometry/angles.hpp"
+
 namespace pvb::scenes {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
+using geom::kDegToRad;
 
 void append_segment(std::vector<Eigen::Vector2d>* out, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                     double spacing) {

@@ -3,13 +3,17 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <sstream>
+
+#include "pvb/common/text.hpp"
+#include "pvb/geometry/angles.hpp"
 
 namespace pvb::scenes {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
-constexpr double kRadToDeg = 180.0 / M_PI;
+using geom::cos_deg;
+using geom::kDegToRad;
+using geom::kRadToDeg;
+using geom::sin_deg;
 // NOAA's spreadsheet works on Excel dates, hence its stated validity range.
 constexpr int kFirstYear = 1901;
 constexpr int kLastYear = 2099;
@@ -17,8 +21,6 @@ constexpr std::array<const char*, 12> kMonthNames = {"January",   "February", "M
                                                      "May",       "June",     "July",     "August",
                                                      "September", "October",  "November", "December"};
 
-double sin_deg(double a) { return std::sin(a * kDegToRad); }
-double cos_deg(double a) { return std::cos(a * kDegToRad); }
 double tan_deg(double a) { return std::tan(a * kDegToRad); }
 
 bool is_leap_year(int year) { return (year % 4 == 0 && year % 100 != 0) || year % 400 == 0; }
@@ -28,11 +30,6 @@ int days_in_month(int year, int month) {
   return month == 2 && is_leap_year(year) ? 29 : kDays[static_cast<std::size_t>(month - 1)];
 }
 
-std::string fmt(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 std::optional<std::string> date_error(int year, int month, int day) {
   if (year < kFirstYear || year > kLastYear)
@@ -49,13 +46,13 @@ std::optional<std::string> date_error(int year, int month, int day) {
 std::optional<std::string> clock_error(int hour, int minute, double second) {
   if (hour < 0 || hour > 23) return "hour " + std::to_string(hour) + " is outside 0..23";
   if (minute < 0 || minute > 59) return "minute " + std::to_string(minute) + " is outside 0..59";
-  if (!(second >= 0.0 && second < 60.0)) return "second " + fmt(second) + " is outside [0, 60)";
+  if (!(second >= 0.0 && second < 60.0)) return "second " + format_g(second) + " is outside [0, 60)";
   return std::nullopt;
 }
 
 std::optional<std::string> offset_error(double utc_offset_h) {
   if (!(utc_offset_h >= -12.0 && utc_offset_h <= 14.0))
-    return "utc offset " + fmt(utc_offset_h) + " h is outside -12..14";
+    return "utc offset " + format_g(utc_offset_h) + " h is outside -12..14";
   return std::nullopt;
 }
 
@@ -162,13 +159,13 @@ std::optional<std::string> civil_time_error(const CivilTime& t) {
 std::optional<std::string> solar_input_error(double latitude_deg, double longitude_deg, const CivilTime& t,
                                              const Atmosphere& air) {
   if (!(latitude_deg >= -90.0 && latitude_deg <= 90.0))
-    return "latitude " + fmt(latitude_deg) + " deg is outside [-90, 90]";
+    return "latitude " + format_g(latitude_deg) + " deg is outside [-90, 90]";
   if (!(longitude_deg >= -180.0 && longitude_deg <= 180.0))
-    return "longitude " + fmt(longitude_deg) + " deg is outside [-180, 180]";
+    return "longitude " + format_g(longitude_deg) + " deg is outside [-180, 180]";
   if (!(air.pressure_hpa > 0.0 && air.pressure_hpa <= 1200.0))
-    return "pressure " + fmt(air.pressure_hpa) + " hPa is outside (0, 1200]";
+    return "pressure " + format_g(air.pressure_hpa) + " hPa is outside (0, 1200]";
   if (!(air.temperature_c > -100.0 && air.temperature_c < 60.0))
-    return "temperature " + fmt(air.temperature_c) + " C is outside (-100, 60)";
+    return "temperature " + format_g(air.temperature_c) + " C is outside (-100, 60)";
   return civil_time_error(t);
 }
 

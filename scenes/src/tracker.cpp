@@ -3,22 +3,18 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+
+#include "pvb/common/text.hpp"
+#include "pvb/geometry/angles.hpp"
 
 namespace pvb::scenes {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
-constexpr double kRadToDeg = 180.0 / M_PI;
+using geom::cos_deg;
+using geom::kDegToRad;
+using geom::kRadToDeg;
+using geom::sin_deg;
 
-double sin_deg(double a) { return std::sin(a * kDegToRad); }
-double cos_deg(double a) { return std::cos(a * kDegToRad); }
-
-std::string fmt(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 // True-tracking angle: the sun vector in the tracker frame, projected on its
 // x-z plane (Anderson and Mikofski 2020, eqs. 4-5; pvlib
@@ -37,14 +33,14 @@ double ideal_angle_deg(double zenith_deg, double azimuth_deg, const SingleAxisTr
 
 std::optional<std::string> tracker_error(const SingleAxisTracker& t) {
   if (!(t.axis_tilt_deg >= -90.0 && t.axis_tilt_deg <= 90.0))
-    return "axis tilt " + fmt(t.axis_tilt_deg) + " deg is outside [-90, 90]";
+    return "axis tilt " + format_g(t.axis_tilt_deg) + " deg is outside [-90, 90]";
   if (!std::isfinite(t.axis_azimuth_deg))
-    return "axis azimuth " + fmt(t.axis_azimuth_deg) + " deg is not finite";
+    return "axis azimuth " + format_g(t.axis_azimuth_deg) + " deg is not finite";
   if (!(t.max_angle_deg > 0.0 && t.max_angle_deg <= 180.0))
-    return "max angle " + fmt(t.max_angle_deg) + " deg is outside (0, 180]";
-  if (!(t.gcr > 0.0 && t.gcr <= 1.0)) return "ground coverage ratio " + fmt(t.gcr) + " is outside (0, 1]";
+    return "max angle " + format_g(t.max_angle_deg) + " deg is outside (0, 180]";
+  if (!(t.gcr > 0.0 && t.gcr <= 1.0)) return "ground coverage ratio " + format_g(t.gcr) + " is outside (0, 1]";
   if (!(t.cross_axis_tilt_deg > -90.0 && t.cross_axis_tilt_deg < 90.0))
-    return "cross-axis tilt " + fmt(t.cross_axis_tilt_deg) + " deg is outside (-90, 90)";
+    return "cross-axis tilt " + format_g(t.cross_axis_tilt_deg) + " deg is outside (-90, 90)";
   return std::nullopt;
 }
 

@@ -28,7 +28,7 @@ std::string fresh(const std::string& name) {
   return d;
 }
 
-std::string error_of(const std::function<void()>& f) {
+std::string message_of(const std::function<void()>& f) {
   try {
     f();
   } catch (const Error& e) {
@@ -84,14 +84,14 @@ TEST(IoPlan, AnOutputThatIsAnInputIsRefusedNamingBoth) {
   ASSERT_EQ(::symlink("scene.yaml", (d + "/link.yaml").c_str()), 0);
   IoPlan plan;
   plan.input("the --scenario file", d + "/scene.yaml").output_file("--save-map", d + "/link.yaml");
-  EXPECT_EQ(error_of([&] { plan.check(); }),
+  EXPECT_EQ(message_of([&] { plan.check(); }),
             d + "/link.yaml: is the --scenario file (" + d +
                 "/scene.yaml), an input of this command; give --save-map another path");
   EXPECT_EQ(read_file(d + "/scene.yaml"), "name: x\n");
   // another file of the same folder is fine
   IoPlan other;
   other.input("the --scenario file", d + "/scene.yaml").output_file("--save-map", d + "/map.pvbmap");
-  EXPECT_EQ(error_of([&] { other.check(); }), "");
+  EXPECT_EQ(message_of([&] { other.check(); }), "");
 }
 
 TEST(IoPlan, AnInputInsideAnExistingOutputFolderIsRefused) {
@@ -100,20 +100,20 @@ TEST(IoPlan, AnInputInsideAnExistingOutputFolderIsRefused) {
   write_file(d + "/out/map.pvbmap", "m");
   IoPlan plan;
   plan.input("the --map file", d + "/out/map.pvbmap").output_folder("--out", d + "/out");
-  EXPECT_EQ(error_of([&] { plan.check(); }),
+  EXPECT_EQ(message_of([&] { plan.check(); }),
             d + "/out: the --out folder holds the --map file (" + d +
                 "/out/map.pvbmap), an input of this command, which --overwrite "
                 "would remove; give --out another folder");
   IoPlan fresh_folder;
   fresh_folder.input("the --map file", d + "/out/map.pvbmap").output_folder("--out", d + "/new");
-  EXPECT_EQ(error_of([&] { fresh_folder.check(); }), "");
+  EXPECT_EQ(message_of([&] { fresh_folder.check(); }), "");
 }
 
 TEST(IoPlan, TwoOutputsOnOneFileAreRefused) {
   const std::string d = fresh("twice");
   IoPlan plan;
   plan.output_file("--json", d + "/x").output_file("--plot", d + "/./x");
-  EXPECT_TRUE(contains(error_of([&] { plan.check(); }), "--json and --plot name the same file"));
+  EXPECT_TRUE(contains(message_of([&] { plan.check(); }), "--json and --plot name the same file"));
 }
 
 TEST(IoPlan, AnOutputFileMustGoIntoAnExistingFolderOrAnOutputFolder) {
@@ -121,7 +121,7 @@ TEST(IoPlan, AnOutputFileMustGoIntoAnExistingFolderOrAnOutputFolder) {
   write_file(d + "/file", "f");
   fs::create_directories(d + "/dir");
   const auto check_one = [&](const std::string& path) {
-    return error_of([&] { IoPlan().output_file("--save-map", path).check(); });
+    return message_of([&] { IoPlan().output_file("--save-map", path).check(); });
   };
   EXPECT_TRUE(contains(check_one(d + "/missing/map.pvbmap"), "the folder " + d + "/missing does not exist"));
   EXPECT_TRUE(contains(check_one(d + "/file/map.pvbmap"), d + "/file is not a folder"));
@@ -131,13 +131,13 @@ TEST(IoPlan, AnOutputFileMustGoIntoAnExistingFolderOrAnOutputFolder) {
   // inside an output folder the command creates
   IoPlan in_out;
   in_out.output_folder("--out", d + "/new").output_file("--save-map", d + "/new/map.pvbmap");
-  EXPECT_EQ(error_of([&] { in_out.check(); }), "");
+  EXPECT_EQ(message_of([&] { in_out.check(); }), "");
 }
 
 TEST(IoPlan, StreamsAreNeverComparedWithInputs) {
   IoPlan plan;
   plan.input("the --gt trajectory", "/dev/null").output_file("--json", "/dev/null");
-  EXPECT_EQ(error_of([&] { plan.check(); }), "");
+  EXPECT_EQ(message_of([&] { plan.check(); }), "");
 }
 
 TEST(OutputFolder, AFolderAnotherProcessWritesIsRefusedUntilItEnds) {
@@ -153,15 +153,15 @@ TEST(OutputFolder, AFolderAnotherProcessWritesIsRefusedUntilItEnds) {
   }
   char c = 0;
   ASSERT_EQ(::read(ready[0], &c, 1), 1);
-  const std::string busy = error_of([&] { prepare_output_folder(d, true, "test"); });
+  const std::string busy = message_of([&] { prepare_output_folder(d, true, "test"); });
   EXPECT_TRUE(contains(busy, "another pvbench process is writing this output folder")) << busy;
-  EXPECT_TRUE(contains(error_of([&] { check_output_folder(d, true); }), "another pvbench process")) << busy;
+  EXPECT_TRUE(contains(message_of([&] { check_output_folder(d, true); }), "another pvbench process")) << busy;
   ::kill(child, SIGKILL);
   waitpid(child, nullptr, 0);
-  EXPECT_EQ(error_of([&] { prepare_output_folder(d, true, "test"); }), "");
+  EXPECT_EQ(message_of([&] { prepare_output_folder(d, true, "test"); }), "");
   // this process holds it now, and may prepare it again
-  EXPECT_EQ(error_of([&] { check_output_folder(d, true); }), "");
-  EXPECT_EQ(error_of([&] { prepare_output_folder(d, true, "test"); }), "");
+  EXPECT_EQ(message_of([&] { check_output_folder(d, true); }), "");
+  EXPECT_EQ(message_of([&] { prepare_output_folder(d, true, "test"); }), "");
   ::close(ready[0]);
   ::close(ready[1]);
 }

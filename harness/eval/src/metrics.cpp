@@ -5,11 +5,12 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/eval/trajectory.hpp"
+#include "pvb/geometry/angles.hpp"
 #include "pvb/geometry/time.hpp"
 
 namespace pvb::eval {
 namespace {
-constexpr double kRadToDeg = 180.0 / M_PI;
+using geom::kRadToDeg;
 
 /// Index of the element of sorted `v` closest to x; the lower one on a tie.
 std::size_t closest_index(const std::vector<double>& v, double x) {

@@ -6,11 +6,12 @@
 #include <optional>
 
 #include "pvb/common/text.hpp"
+#include "pvb/geometry/angles.hpp"
 
 namespace pvb::eval {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+using geom::kRadToDeg;
 
 /// The ground-truth pose nearest in time to t_ns, when within max_dt_s.
 std::optional<geom::SE3d> gt_at(const Trajectory& gt, std::int64_t t_ns, double max_dt_s) {

@@ -10,6 +10,7 @@
 
 #include "pvb/common/clock.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/geometry/angles.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/matcher.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
@@ -17,7 +18,7 @@
 namespace pvb::slam {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+using geom::kRadToDeg;
 /// Best-scoring keyframes of the map, one by one, that a merge is also
 /// verified against (as a relocalisation is, Tracking.relocLookalikes).
 constexpr std::size_t kMergeLookalikes = 10;
