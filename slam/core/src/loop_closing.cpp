@@ -46,6 +46,15 @@ int optimize_and_prune(Frame& f) {
   return inliers;
 }
 
+/// Median depth of the keyframe's map points in its camera (ORB-SLAM2
+/// ComputeSceneMedianDepth); 0 without points.
+double scene_median_depth_m(const KeyFrame& kf) {
+  std::vector<double> z;
+  for (const auto& mp : kf.map_points())
+    if (mp && !mp->bad()) z.push_back((kf.T_c_w() * mp->p_w()).z());
+  return quantile(std::move(z), 0.5);
+}
+
 /// Rotation angle (degrees) and camera-centre distance (metres) between two poses T_c_w.
 void pose_difference(const geom::SE3d& a, const geom::SE3d& b, double* dist_m, double* angle_deg) {
   *dist_m = (a.inverse().translation() - b.inverse().translation()).norm();
@@ -294,6 +303,15 @@ double LoopClosing::path_length_m(std::uint64_t from, std::uint64_t to) const {
   return length;
 }
 
+double LoopClosing::drift_bound_m(const KeyFrame& kf, const KeyFrame& cand, double angle_deg) const {
+  // Drift along the path, plus the swing of a rotation drift: a small
+  // rotation and a sideways move look alike in the image, so tracking that
+  // drifts in rotation turns the camera about the scene it holds, and the
+  // correction moves the camera centre by 2 sin(angle / 2) x the scene depth.
+  const double swing_m = 2.0 * std::sin(angle_deg / kRadToDeg / 2.0) * scene_median_depth_m(kf);
+  return options_.drift_floor_m + options_.max_drift_rate * path_length_m(cand.id(), kf.id()) + swing_m;
+}
+
 std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& kf,
                                               const std::vector<std::shared_ptr<KeyFrame>>& consistent,
                                               bool merge, LoopMatch* best) {
@@ -317,7 +335,7 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
       continue;
     }
     verified_centres_w.push_back(m.T_c_w.inverse().translation());
-    const double bound_m = options_.drift_floor_m + options_.max_drift_rate * path_length_m(cand->id(), kf->id());
+    const double bound_m = drift_bound_m(*kf, *cand, angle_deg);
     if (!merge && options_.max_drift_rate > 0 && dist_m > bound_m) {
       ++drift;
       continue;

@@ -279,6 +279,59 @@ TEST(LoopClosing, CountsAVerifiedPlaceBeyondTheCorrectionBound) {
   EXPECT_EQ(s.rejected, 1);
 }
 
+/// The estimate of a camera whose tracking drifted by `deg` in rotation:
+/// a small turn and a sideways move look alike in the image, so the drift
+/// swings the camera about the scene it holds, here the wall straight ahead.
+geom::SE3d swung(const geom::SE3d& T_c_w, double deg) {
+  const geom::SE3d T_w_c = T_c_w.inverse();
+  const Eigen::Vector3d pivot_w = T_w_c * Eigen::Vector3d(0, 0, kWallZ_m);
+  const Eigen::Matrix3d R = geom::so3_exp(Eigen::Vector3d(0, deg * M_PI / 180.0, 0));
+  return (geom::make_se3(R, pivot_w - R * pivot_w) * T_w_c).inverse();
+}
+
+/// Loop closing of `kf1` against the keyframe before it, detected twice.
+LoopClosingStats close_twice(Map& map, const std::shared_ptr<KeyFrame>& kf1) {
+  LoopClosingOptions o = test_options();
+  o.consistency = 1;
+  LoopClosing lc(map, o);
+  lc.process(kf1);  // a first detection: not consistent yet
+  lc.process(kf1);  // detected again: verified, then judged by the bounds
+  return lc.stats();
+}
+
+TEST(LoopClosing, DriftBoundAllowsTheSwingOfARotationDrift) {
+  // 4 deg of rotation drift swing the camera centre 14 cm about the wall,
+  // over a path of 10 cm: far beyond driftFloor + 1 % of the path (5.1 cm),
+  // but the correction's own turn explains it (2 sin 2 deg x 2 m).
+  Map map;
+  const cv::Mat tex = make_texture(1);
+  add_keyframe(map, tex, pose(0, 0, 0), pose(0, 0, 0));
+  const geom::SE3d T = pose(3, 0.10, 0);
+  auto kf1 = add_keyframe(map, tex, T, swung(T, 4.0));
+  ASSERT_NEAR(centre_error_m(kf1->T_c_w(), T), 0.14, 0.005);
+  const LoopClosingStats s = close_twice(map, kf1);
+  EXPECT_EQ(s.refused_drift, 0);
+  ASSERT_EQ(s.loops.size(), 1u);
+  EXPECT_NEAR(s.loops[0].correction_deg, 4.0, 0.5);
+  EXPECT_LT(centre_error_m(kf1->T_c_w(), T), 0.005);
+}
+
+TEST(LoopClosing, DriftBoundRefusesTheSameCentreMoveWithoutATurn) {
+  // The same 14 cm moved sideways with no turn (a place one step along, or
+  // drift the path does not explain) is still refused.
+  Map map;
+  const cv::Mat tex = make_texture(1);
+  add_keyframe(map, tex, pose(0, 0, 0), pose(0, 0, 0));
+  const geom::SE3d T = pose(3, 0.10, 0);
+  const geom::SE3d shifted = geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.14, 0, 0)) * T;
+  auto kf1 = add_keyframe(map, tex, T, shifted);
+  ASSERT_NEAR(centre_error_m(kf1->T_c_w(), T), 0.14, 0.005);
+  const LoopClosingStats s = close_twice(map, kf1);
+  EXPECT_EQ(s.verified, 1);
+  EXPECT_EQ(s.refused_drift, 1);
+  EXPECT_TRUE(s.loops.empty());
+}
+
 TEST(LoopClosing, ClosesOnlyAfterConsistentDetectionsAndRemovesTheDrift) {
   Map map;
   const cv::Mat tex = make_texture(1);

@@ -83,9 +83,11 @@ struct LoopClosingOptions {
   /// loop after a drift larger than searchRadius.
   bool pose_proximity = false;
   /// Beyond ORB-SLAM2, against look-alike places (docs/place_recognition.md):
-  /// LoopClosing.maxDriftRate / driftFloor: a correction larger than
-  /// driftFloor + maxDriftRate x the path driven between the two keyframes
-  /// (as estimated) is implausible and refused; 0 turns the check off.
+  /// LoopClosing.maxDriftRate / driftFloor: a correction moving the camera
+  /// centre further than driftFloor + maxDriftRate x the path driven between
+  /// the two keyframes (as estimated) + the swing of the correction's own
+  /// turn about the keyframe's scene (2 sin(angle / 2) x its median depth)
+  /// is implausible and refused; 0 turns the check off.
   double max_drift_rate = 0.01;
   double drift_floor_m = 0.05;
   /// LoopClosing.ambiguityCheck (0/1) / ambiguityDistance: when two
@@ -230,6 +232,9 @@ class LoopClosing {
                                    LoopMatch* best);
   /// Camera path length (current estimates) over the keyframes from `from` to `to` by id.
   double path_length_m(std::uint64_t from, std::uint64_t to) const;
+  /// The drift bound on moving `kf`'s camera centre to close a loop with
+  /// `cand` by a correction turning it through `angle_deg`.
+  double drift_bound_m(const KeyFrame& kf, const KeyFrame& cand, double angle_deg) const;
   /// Step 5 (optional): bundle adjustment of every keyframe and point,
   /// keyframe 0 fixed, map locked throughout.
   void global_bundle_adjustment(LoopEvent* event, std::uint32_t map_id);
