@@ -179,6 +179,25 @@ std::string format_fixed(double v, int decimals) {
   return buf;
 }
 
+std::string json_string(const std::string& s) { return "\"" + json_escape(s) + "\""; }
+
+std::string html_escape(const std::string& s) {
+  std::string out;
+  for (const char c : s) {
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else if (c == '"')
+      out += "&quot;";
+    else
+      out += c;
+  }
+  return out;
+}
+
 std::string json_number(double v, int significant_digits) {
   if (!std::isfinite(v)) return "null";
   char buf[48];

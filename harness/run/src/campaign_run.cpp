@@ -137,23 +137,6 @@ std::string status_cell(const CampaignReport& rep, const SessionResult& r) {
   return out;
 }
 
-std::string html_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '&')
-      out += "&amp;";
-    else if (c == '"')
-      out += "&quot;";
-    else
-      out += c;
-  }
-  return out;
-}
-
 /// "P, S, U": matched landmarks on panels and their frames (backsheets,
 /// rails: what turns on a tracker), on what stays (ground, posts, walls,
 /// shrubs), and unlabelled; "-" when not classified.

@@ -17,8 +17,6 @@
 namespace pvb::run {
 namespace {
 
-std::string num(double v) { return json_number(v); }
-
 /// The ground-truth pose at t_ns: one within 1 ms, or interpolated between
 /// two at most 50 ms apart around it (a motion-capture rate unlike the
 /// camera's); nullopt otherwise.
@@ -38,7 +36,7 @@ std::optional<geom::SE3d> pose_at(const eval::Trajectory& t, std::int64_t t_ns) 
 std::string pose_json(const geom::SE3d& T) {
   std::string out = "[";
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) out += (r || c ? ", " : "") + num(T.matrix()(r, c));
+    for (int c = 0; c < 4; ++c) out += (r || c ? ", " : "") + json_number(T.matrix()(r, c));
   return out + "]";
 }
 
@@ -317,21 +315,23 @@ std::string map_report_json(const MapReport& r) {
   std::string out = "{\"use\": \"" + std::string(to_string(r.use)) + "\"";
   if (r.load) {
     const slam::MapLoadInfo& l = *r.load;
-    out += ", \"loaded\": {\"file\": \"" + json_escape(r.loaded_from) + "\", \"sessions\": " +
-           std::to_string(l.sessions) + ", \"keyframes\": " + std::to_string(l.keyframes) +
-           ", \"points\": " + std::to_string(l.points) + ", \"bytes\": " + std::to_string(l.bytes) +
-           ", \"load_ms\": " + num(l.load_ms) + "}, \"relocalisations\": " + std::to_string(r.relocalisations) +
+    out += ", \"loaded\": {\"file\": \"" + json_escape(r.loaded_from) +
+           "\", \"sessions\": " + std::to_string(l.sessions) +
+           ", \"keyframes\": " + std::to_string(l.keyframes) + ", \"points\": " + std::to_string(l.points) +
+           ", \"bytes\": " + std::to_string(l.bytes) + ", \"load_ms\": " + json_number(l.load_ms) +
+           "}, \"relocalisations\": " + std::to_string(r.relocalisations) +
            ", \"merges\": " + std::to_string(r.merges);
   }
   out += ", \"T_world_map\": " + (r.T_world_map ? pose_json(*r.T_world_map) : std::string("null"));
   if (r.save) {
     const slam::MapSaveInfo& s = *r.save;
-    out += ", \"saved\": {\"file\": \"" + json_escape(r.saved_to) + "\", \"sessions\": " +
-           std::to_string(s.sessions) + ", \"keyframes\": " + std::to_string(s.keyframes) +
-           ", \"points\": " + std::to_string(s.points) + ", \"bytes\": " + std::to_string(s.bytes) +
-           ", \"bytes_per_keyframe\": " + num(s.keyframes ? double(s.bytes) / double(s.keyframes) : 0.0) +
-           ", \"save_ms\": " + num(s.save_ms) + ", \"unmerged_keyframes\": " + std::to_string(s.unmerged_keyframes) +
-           "}";
+    out += ", \"saved\": {\"file\": \"" + json_escape(r.saved_to) +
+           "\", \"sessions\": " + std::to_string(s.sessions) +
+           ", \"keyframes\": " + std::to_string(s.keyframes) + ", \"points\": " + std::to_string(s.points) +
+           ", \"bytes\": " + std::to_string(s.bytes) + ", \"bytes_per_keyframe\": " +
+           json_number(s.keyframes ? double(s.bytes) / double(s.keyframes) : 0.0) +
+           ", \"save_ms\": " + json_number(s.save_ms) +
+           ", \"unmerged_keyframes\": " + std::to_string(s.unmerged_keyframes) + "}";
   }
   if (!r.save_note.empty()) out += ", \"save_note\": \"" + json_escape(r.save_note) + "\"";
   if (!r.matched_landmarks.empty()) {

@@ -18,8 +18,6 @@ namespace {
 /// JSON number: finite values with enough digits, null otherwise.
 std::string num(double v) { return json_number(v, 10); }
 
-std::string str(const std::string& s) { return "\"" + json_escape(s) + "\""; }
-
 std::vector<double> tracking_times(const SlamRun& run) {
   std::vector<double> v;
   v.reserve(run.per_frame.size());
@@ -35,7 +33,7 @@ double mean_of(const std::vector<double>& v) {
 std::string slam_fields(const SlamRun& run, const std::string& in) {
   const std::vector<double> ms = tracking_times(run);
   std::string out;
-  out += in + "\"mode\": " + str(run.mode) + ",\n";
+  out += in + "\"mode\": " + json_string(run.mode) + ",\n";
   out += in + "\"frames\": " + std::to_string(run.frames) + ",\n";
   out += in + "\"lost_frames\": " + std::to_string(run.lost_frames) + ",\n";
   out += in + "\"not_initialized_frames\": " + std::to_string(run.not_initialized_frames) + ",\n";
@@ -44,11 +42,11 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
   if (run.eval) {
     out += in + "\"ate\": " + eval::stats_json(run.eval->ate) + ",\n";
     out += in + "\"rpe\": " + eval::rpe_json(*run.eval) + ",\n";
-    out += in + "\"alignment\": " + str(eval::alignment_name(run.eval->alignment_kind)) + ",\n";
+    out += in + "\"alignment\": " + json_string(eval::alignment_name(run.eval->alignment_kind)) + ",\n";
   } else {
     out += in + "\"ate\": null,\n" + in + "\"rpe\": null,\n" + in + "\"alignment\": null,\n";
   }
-  if (!run.eval_note.empty()) out += in + "\"eval_note\": " + str(run.eval_note) + ",\n";
+  if (!run.eval_note.empty()) out += in + "\"eval_note\": " + json_string(run.eval_note) + ",\n";
   if (run.refined_eval)
     out += in + "\"refined\": {\"ate_rmse\": " + num(run.refined_eval->ate.rmse) +
            ", \"rpe_trans_rmse\": " + num(run.refined_eval->rpe_trans_m.rmse) + "},\n";
@@ -63,7 +61,7 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
   for (std::size_t k = 0; k < run.loss_events.size(); ++k) {
     const LossEvent& e = run.loss_events[k];
     out += (k ? ",\n" : "\n") + in + "  {\"frame\": " + std::to_string(e.frame) + ", \"t_s\": " + num(e.t_s) +
-           ", \"reason\": " + str(e.reason) + ", \"recovered_frame\": " +
+           ", \"reason\": " + json_string(e.reason) + ", \"recovered_frame\": " +
            (e.recovered_frame ? std::to_string(*e.recovered_frame) : std::string("null")) + "}";
   }
   out += run.loss_events.empty() ? "]" : "\n" + in + "]";
@@ -73,14 +71,14 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
 /// Run-level keys (shared by the top level and "baseline").
 std::string run_fields(const RunReport& r, const std::string& in) {
   std::string out;
-  out += in + "\"scenario\": " + str(r.scenario) + ",\n";
-  out += in + "\"scenario_file\": " + str(r.scenario_file) + ",\n";
+  out += in + "\"scenario\": " + json_string(r.scenario) + ",\n";
+  out += in + "\"scenario_file\": " + json_string(r.scenario_file) + ",\n";
   out += in + "\"seed\": " + std::to_string(r.seed) + ",\n";
   if (!r.world.empty()) out += in + "\"world\": " + r.world + ",\n";
-  out += in + "\"status\": " + str(to_string(r.status)) + ",\n";
-  if (!r.status_detail.empty()) out += in + "\"status_detail\": " + str(r.status_detail) + ",\n";
+  out += in + "\"status\": " + json_string(to_string(r.status)) + ",\n";
+  if (!r.status_detail.empty()) out += in + "\"status_detail\": " + json_string(r.status_detail) + ",\n";
   out += in + "\"sync\": " + (r.sync ? "true" : "false") + ",\n";
-  out += in + "\"renderer\": " + str(r.renderer) + ",\n";
+  out += in + "\"renderer\": " + json_string(r.renderer) + ",\n";
   out += in + "\"fps\": " + num(r.fps) + ",\n";
   out += in + "\"realtime_factor\": " + num(realtime_factor(r.sim_s, r.wall_s)) + ",\n";
   out += in + "\"sim_s\": " + num(r.sim_s) + ",\n";
@@ -109,14 +107,15 @@ std::string dense_map_json(const DenseMapReport& d, const std::string& in) {
                     "}, \"loop_update_ms\": [";
   for (std::size_t i = 0; i < d.loop_update_ms.size(); ++i) out += (i ? ", " : "") + num(d.loop_update_ms[i]);
   out += "], \"files\": [";
-  for (std::size_t i = 0; i < d.files.size(); ++i) out += (i ? ", " : "") + str(d.files[i]);
+  for (std::size_t i = 0; i < d.files.size(); ++i) out += (i ? ", " : "") + json_string(d.files[i]);
   out += "]";
-  if (!d.note.empty()) out += ", \"note\": " + str(d.note);
+  if (!d.note.empty()) out += ", \"note\": " + json_string(d.note);
   if (!d.maps.empty()) {
-    out += ",\n" + in + "  \"alignment\": " + str(d.alignment) + ", \"surface_samples\": " +
-           std::to_string(d.surface_samples) + ", \"truth_s\": " + num(d.truth_s) + ",\n" + in + "  \"maps\": {";
+    out += ",\n" + in + "  \"alignment\": " + json_string(d.alignment) +
+           ", \"surface_samples\": " + std::to_string(d.surface_samples) +
+           ", \"truth_s\": " + num(d.truth_s) + ",\n" + in + "  \"maps\": {";
     for (std::size_t i = 0; i < d.maps.size(); ++i)
-      out += std::string(i ? "," : "") + "\n" + in + "    " + str(d.maps[i].name) + ": " +
+      out += std::string(i ? "," : "") + "\n" + in + "    " + json_string(d.maps[i].name) + ": " +
              map_accuracy_json(d.maps[i].accuracy, static_cast<int>(in.size()) + 4);
     out += "\n" + in + "  }";
   }
@@ -141,23 +140,6 @@ std::string closed_loop_json(const ClosedLoopMetrics& c) {
          ", \"path_error_max_m\": " + num(c.path_error_max_m) +
          ", \"hold_frames\": " + std::to_string(c.hold_frames) +
          ", \"frames\": " + std::to_string(c.t_s.size()) + "}";
-}
-
-std::string html_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '&')
-      out += "&amp;";
-    else if (c == '"')
-      out += "&quot;";
-    else
-      out += c;
-  }
-  return out;
 }
 
 std::string fixed(double v, int decimals) { return std::isfinite(v) ? format_fixed(v, decimals) : "-"; }
@@ -246,9 +228,9 @@ std::string metrics_json(const RunReport& r) {
   const double frames = std::max<double>(1.0, static_cast<double>(r.primary.frames));
   for (std::size_t k = 0; k < r.profile.size(); ++k) {
     const StageTime& s = r.profile[k];
-    out += (k ? ",\n    " : "\n    ") + str(s.name) + ": {\"total_ms\": " + num(s.total_ms) +
+    out += (k ? ",\n    " : "\n    ") + json_string(s.name) + ": {\"total_ms\": " + num(s.total_ms) +
            ", \"per_frame_ms\": " + num(s.total_ms / frames) + ", \"count\": " + std::to_string(s.count) +
-           ", \"thread\": " + str(s.thread) + "}";
+           ", \"thread\": " + json_string(s.thread) + "}";
   }
   out += r.profile.empty() ? "}" : "\n  }";
   out += "\n}\n";

@@ -5,8 +5,7 @@
 namespace pvb::run {
 namespace {
 
-std::string str(const std::string& s) { return "\"" + json_escape(s) + "\""; }
-std::string num(double v) { return json_number(v, 8); }
+std::string number8(double v) { return json_number(v, 8); }
 
 const char* source_name(scenes::SunPosition::Source s) {
   switch (s) {
@@ -21,31 +20,32 @@ const char* source_name(scenes::SunPosition::Source s) {
 }
 
 std::string site_json(const scenes::Site& site) {
-  return "{\"latitude_deg\": " + num(site.latitude_deg) + ", \"longitude_deg\": " + num(site.longitude_deg) +
-         ", \"date\": " + str(site.date) + ", \"time\": " + str(site.time) +
-         ", \"utc_offset_h\": " + num(site.utc_offset_h) + "}";
+  return "{\"latitude_deg\": " + number8(site.latitude_deg) +
+         ", \"longitude_deg\": " + number8(site.longitude_deg) + ", \"date\": " + json_string(site.date) +
+         ", \"time\": " + json_string(site.time) + ", \"utc_offset_h\": " + number8(site.utc_offset_h) + "}";
 }
 
 std::string array_json(const scenes::PvArray& a) {
   std::string out = "{\"mount\": ";
   if (a.mount == scenes::Mount::kSingleAxis) {
-    out += "\"single_axis\", \"rotation_deg\": " + num(a.rotation_deg) +
-           ", \"ideal_rotation_deg\": " + num(a.ideal_rotation_deg) +
+    out += "\"single_axis\", \"rotation_deg\": " + number8(a.rotation_deg) +
+           ", \"ideal_rotation_deg\": " + number8(a.ideal_rotation_deg) +
            ", \"rotation_fixed\": " + (a.tracker.fixed_rotation_deg ? "true" : "false") +
-           ", \"max_angle_deg\": " + num(a.tracker.max_angle_deg) +
+           ", \"max_angle_deg\": " + number8(a.tracker.max_angle_deg) +
            ", \"backtrack\": " + (a.tracker.backtrack ? "true" : "false") +
-           ", \"ground_coverage_ratio\": " + num(a.ground_coverage_ratio());
+           ", \"ground_coverage_ratio\": " + number8(a.ground_coverage_ratio());
   } else {
-    out += "\"fixed\", \"tilt_deg\": " + num(a.tilt_deg);
+    out += "\"fixed\", \"tilt_deg\": " + number8(a.tilt_deg);
   }
-  return out + ", \"dirt\": " + num(a.dirt) + "}";
+  return out + ", \"dirt\": " + number8(a.dirt) + "}";
 }
 
 }  // namespace
 
 std::string world_json(const scenes::Scenario& s) {
   std::string bases = "[";
-  for (std::size_t i = 0; i < s.base_files.size(); ++i) bases += (i ? ", " : "") + str(s.base_files[i]);
+  for (std::size_t i = 0; i < s.base_files.size(); ++i)
+    bases += (i ? ", " : "") + json_string(s.base_files[i]);
   bases += "]";
   std::string arrays = "[";
   for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) arrays += (i ? ", " : "") + array_json(s.pv_arrays[i]);
@@ -53,11 +53,11 @@ std::string world_json(const scenes::Scenario& s) {
   return "{\"station_seed\": " + std::to_string(s.station_seed_or_seed()) +
          ", \"day_seed\": " + std::to_string(s.seed) + ", \"base_files\": " + bases +
          ", \"site\": " + (s.site ? site_json(*s.site) : std::string("null")) + ", \"sun\": {\"source\": \"" +
-         source_name(s.sun.source) + "\", \"azimuth_deg\": " + num(s.sun.solar_azimuth_deg) +
-         ", \"elevation_deg\": " + num(s.sun.elevation_deg) +
-         ", \"scene_azimuth_deg\": " + num(s.light.sun_azimuth_deg) + ", \"intensity\": " + num(s.light.intensity) +
-         ", \"ambient\": " + num(s.light.ambient) + "}, \"vegetation_growth\": " + num(s.vegetation.growth) +
-         ", \"arrays\": " + arrays + "}";
+         source_name(s.sun.source) + "\", \"azimuth_deg\": " + number8(s.sun.solar_azimuth_deg) +
+         ", \"elevation_deg\": " + number8(s.sun.elevation_deg) +
+         ", \"scene_azimuth_deg\": " + number8(s.light.sun_azimuth_deg) +
+         ", \"intensity\": " + number8(s.light.intensity) + ", \"ambient\": " + number8(s.light.ambient) +
+         "}, \"vegetation_growth\": " + number8(s.vegetation.growth) + ", \"arrays\": " + arrays + "}";
 }
 
 }  // namespace pvb::run

@@ -130,7 +130,7 @@ std::string mean_or_dash(const Summary& s, int decimals) {
   return s.count ? format_fixed(s.mean, decimals) : std::string("-");
 }
 
-std::string summary_json(const Summary& s) {
+std::string campaign_summary_json(const Summary& s) {
   return "{\"count\": " + std::to_string(s.count) + ", \"mean\": " + json_number(s.mean) +
          ", \"sd\": " + json_number(s.sd) + ", \"min\": " + json_number(s.min) + ", \"max\": " + json_number(s.max) + "}";
 }
@@ -261,13 +261,15 @@ std::string format_campaign_json(const CampaignAggregate& a) {
   out += "],\n  \"sessions\": [";
   for (std::size_t i = 0; i < a.sessions.size(); ++i) {
     const auto& g = a.sessions[i];
-    out += std::string(i ? "," : "") + "\n    {\"name\": \"" + json_escape(g.name) + "\", \"mode\": \"" + g.mode +
-           "\", \"seeds\": " + std::to_string(g.seeds) + ", \"failed\": " + std::to_string(g.failed) +
-           ", \"fine\": " + summary_json(g.fine) + ", \"fine_ci95\": " + json_number(g.fine_ci95) +
-           ", \"high\": " + summary_json(g.high) + ", \"high_ci95\": " + json_number(g.high_ci95) +
-           ", \"wrong_place\": " + std::to_string(g.wrong_place) + ", \"first_pose_frame\": " +
-           summary_json(g.first_pose_frame) + ", \"never_posed\": " + std::to_string(g.never_posed) +
-           ", \"keyframes_added\": " + summary_json(g.keyframes_added) + "}";
+    out += std::string(i ? "," : "") + "\n    {\"name\": \"" + json_escape(g.name) + "\", \"mode\": \"" +
+           g.mode + "\", \"seeds\": " + std::to_string(g.seeds) +
+           ", \"failed\": " + std::to_string(g.failed) + ", \"fine\": " + campaign_summary_json(g.fine) +
+           ", \"fine_ci95\": " + json_number(g.fine_ci95) + ", \"high\": " + campaign_summary_json(g.high) +
+           ", \"high_ci95\": " + json_number(g.high_ci95) +
+           ", \"wrong_place\": " + std::to_string(g.wrong_place) +
+           ", \"first_pose_frame\": " + campaign_summary_json(g.first_pose_frame) +
+           ", \"never_posed\": " + std::to_string(g.never_posed) +
+           ", \"keyframes_added\": " + campaign_summary_json(g.keyframes_added) + "}";
   }
   return out + "\n  ]\n}\n";
 }

@@ -32,9 +32,11 @@ namespace {
 std::string pair_dir() { return pvb::test::shared_path("data/tum/fr3_long_office_household_pair"); }
 const std::string kTum3 = std::string(PVB_SOURCE_DIR) + "/configs/tum/TUM3.yaml";
 
+/// A file of this test process (CTest runs the tests of this program as
+/// processes side by side).
 std::string tmp_path(const std::string& name) {
   const char* dir = std::getenv("TEST_TMPDIR");
-  return std::string(dir ? dir : "/tmp") + "/map_file_" + name;
+  return std::string(dir ? dir : "/tmp") + "/map_file_" + std::to_string(::getpid()) + "_" + name;
 }
 
 std::vector<sensor::RgbdFrame> pair_frames(const Settings& s) {

@@ -22,6 +22,10 @@ void write_file(const std::string& path, const std::string& content);
 std::vector<std::string> split_ws(const std::string& line, const char* seps = " \t\r,");
 /// Escapes a string for a JSON string literal (without the quotes).
 std::string json_escape(const std::string& s);
+/// The JSON string literal of `s`: quoted and escaped.
+std::string json_string(const std::string& s);
+/// `s` safe in HTML text and attribute values (<, >, & and ").
+std::string html_escape(const std::string& s);
 /// A JSON number with `significant_digits` digits (%.Ng); null when not finite.
 std::string json_number(double v, int significant_digits = 17);
 
