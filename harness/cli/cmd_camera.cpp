@@ -44,6 +44,7 @@
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
 #include "stop_signals.hpp"
+#include "trajectory_output.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -77,10 +78,6 @@ void write_map_ply(const std::string& path, const std::vector<Eigen::Vector3d>& 
   for (const Eigen::Vector3d& p : points)
     s << format_g(p.x()) << " " << format_g(p.y()) << " " << format_g(p.z()) << "\n";
   write_file(path, s.str());
-}
-
-void write_tum_file(const std::string& path, const std::vector<geom::StampedPose>& poses) {
-  write_file(path, geom::format_tum(poses, "# timestamp tx ty tz qx qy qz qw (T_w_c)\n"));
 }
 
 // ---- inputs and settings ---------------------------------------------------

@@ -34,6 +34,7 @@
 #include "pvb/slam/dense/point_cloud.hpp"
 #include "pvb/suite/metrics_file.hpp"
 #include "stop_signals.hpp"
+#include "trajectory_output.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -149,10 +150,6 @@ double percentile(std::vector<double> v, double p) {
   const std::size_t lo = static_cast<std::size_t>(pos);
   const std::size_t hi = std::min(lo + 1, v.size() - 1);
   return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
-
-void write_tum_file(const std::string& path, const std::vector<geom::StampedPose>& poses) {
-  write_file(path, geom::format_tum(poses, "# timestamp tx ty tz qx qy qz qw (T_w_c)\n"));
 }
 
 /// Why the frame loop ended.

@@ -7,23 +7,22 @@
 #include <string>
 
 #include "pvb/suite/aggregate.hpp"
+#include "suite_fixtures.hpp"
 
 using namespace pvb;
 
-namespace {
+using pvb::test::suite_fixture;
 
-std::string fixture(const std::string& name) {
-  return std::string(PVB_SOURCE_DIR) + "/tests/harness/suite/fixtures/" + name;
-}
+namespace {
 
 // Seed 1: good (PE 4.2 mm, baseline 5.1 mm); seed 2: PE 23.5 mm, baseline
 // 15.0 mm, 4 lost; seed 3: no metrics.json; seed 4: aborted, no ATE, exit 0.
 suite::SweepAggregate sample() {
   std::vector<suite::SeedRun> runs;
-  runs.push_back(suite::read_seed_run(1, fixture("good_compare.json")));
-  runs.push_back(suite::read_seed_run(2, fixture("worse_than_baseline.json")));
-  runs.push_back(suite::read_seed_run(3, fixture("seed_3_never_written.json"), 1));
-  runs.push_back(suite::read_seed_run(4, fixture("lost_aborted.json")));
+  runs.push_back(suite::read_seed_run(1, suite_fixture("good_compare.json")));
+  runs.push_back(suite::read_seed_run(2, suite_fixture("worse_than_baseline.json")));
+  runs.push_back(suite::read_seed_run(3, suite_fixture("seed_3_never_written.json"), 1));
+  runs.push_back(suite::read_seed_run(4, suite_fixture("lost_aborted.json")));
   return suite::aggregate("pv_station", runs);
 }
 
@@ -265,7 +264,7 @@ TEST(SweepAggregate, SkipsMissingValuesAndCountsFailures) {
 }
 
 TEST(SweepAggregate, NoBaselineWithoutCompare) {
-  std::vector<suite::SeedRun> runs = {suite::read_seed_run(5, fixture("lost_aborted.json"))};
+  std::vector<suite::SeedRun> runs = {suite::read_seed_run(5, suite_fixture("lost_aborted.json"))};
   const suite::SweepAggregate a = suite::aggregate("tracking_failure", runs);
   EXPECT_FALSE(a.has_baseline);
   EXPECT_EQ(a.failed, 0);

@@ -12,14 +12,13 @@
 #include "pvb/suite/aggregate.hpp"
 #include "pvb/suite/check.hpp"
 #include "pvb/suite/metrics_file.hpp"
+#include "suite_fixtures.hpp"
 
 using namespace pvb;
 
-namespace {
+using pvb::test::suite_fixture;
 
-std::string fixture(const std::string& name) {
-  return std::string(PVB_SOURCE_DIR) + "/tests/harness/suite/fixtures/" + name;
-}
+namespace {
 
 // The expectations of a nominal PV scene.
 scenes::Expectations nominal() {
@@ -33,7 +32,7 @@ scenes::Expectations nominal() {
 
 // A seed of a sweep from a fixture, with its two ATEs (millimetres) replaced.
 suite::SeedRun seed_run(std::uint64_t seed, double pe_mm, double baseline_mm) {
-  suite::SeedRun r = suite::read_seed_run(seed, fixture("good_compare.json"));
+  suite::SeedRun r = suite::read_seed_run(seed, suite_fixture("good_compare.json"));
   r.metrics->primary.ate_rmse_m = pe_mm / 1000.0;
   r.metrics->baseline->ate_rmse_m = baseline_mm / 1000.0;
   return r;
@@ -55,7 +54,7 @@ bool has_key(const std::vector<suite::Violation>& v, const std::string& key) {
 }  // namespace
 
 TEST(SuiteCheck, ReadsTheContractKeys) {
-  const suite::MetricsFile m = suite::read_metrics_file(fixture("good_compare.json"));
+  const suite::MetricsFile m = suite::read_metrics_file(suite_fixture("good_compare.json"));
   EXPECT_EQ(m.scenario, "pv_station");
   ASSERT_TRUE(m.seed.has_value());
   EXPECT_EQ(*m.seed, 7u);
@@ -77,12 +76,12 @@ TEST(SuiteCheck, ReadsTheContractKeys) {
 }
 
 TEST(SuiteCheck, PassingRunHasNoViolations) {
-  const auto v = suite::check_expectations(nominal(), fixture("good_compare.json"));
+  const auto v = suite::check_expectations(nominal(), suite_fixture("good_compare.json"));
   EXPECT_TRUE(v.empty()) << v.front().line();
 }
 
 TEST(SuiteCheck, EachViolatedBoundIsOneLine) {
-  const auto v = suite::check_expectations(nominal(), fixture("worse_than_baseline.json"));
+  const auto v = suite::check_expectations(nominal(), suite_fixture("worse_than_baseline.json"));
   ASSERT_EQ(v.size(), 3u);
   EXPECT_EQ(v[0].line(), "ate_rmse_m_max: ATE RMSE 0.0235 m > 0.01 m");
   EXPECT_EQ(v[1].line(), "rpe_trans_rmse_m_max: RPE translation RMSE 0.0062 m > 0.005 m");
@@ -93,21 +92,21 @@ TEST(SuiteCheck, BoundsAreInclusiveAndUnsetBoundsAreNotChecked) {
   scenes::Expectations e;
   e.ate_rmse_m_max = 0.0235;  // exactly the measured value
   e.lost_frames_max = 4;
-  EXPECT_TRUE(suite::check_expectations(e, fixture("worse_than_baseline.json")).empty());
+  EXPECT_TRUE(suite::check_expectations(e, suite_fixture("worse_than_baseline.json")).empty());
   e.ate_rmse_m_max = 0.0234;
-  EXPECT_TRUE(has_key(suite::check_expectations(e, fixture("worse_than_baseline.json")), "ate_rmse_m_max"));
-  EXPECT_TRUE(suite::check_expectations(scenes::Expectations{}, fixture("worse_than_baseline.json")).empty());
+  EXPECT_TRUE(has_key(suite::check_expectations(e, suite_fixture("worse_than_baseline.json")), "ate_rmse_m_max"));
+  EXPECT_TRUE(suite::check_expectations(scenes::Expectations{}, suite_fixture("worse_than_baseline.json")).empty());
 }
 
 TEST(SuiteCheck, KeyframesOfTheFinalMapAreBounded) {
   scenes::Expectations e;
   e.keyframes_max = 30;  // worse_than_baseline.json: 30 keyframes
-  EXPECT_TRUE(suite::check_expectations(e, fixture("worse_than_baseline.json")).empty());
+  EXPECT_TRUE(suite::check_expectations(e, suite_fixture("worse_than_baseline.json")).empty());
   e.keyframes_max = 29;
-  const auto v = suite::check_expectations(e, fixture("worse_than_baseline.json"));
+  const auto v = suite::check_expectations(e, suite_fixture("worse_than_baseline.json"));
   ASSERT_EQ(v.size(), 1u);
   EXPECT_EQ(v[0].line(), "keyframes_max: 30 keyframes in the final map > 29");
-  suite::MetricsFile m = suite::read_metrics_file(fixture("worse_than_baseline.json"));
+  suite::MetricsFile m = suite::read_metrics_file(suite_fixture("worse_than_baseline.json"));
   m.primary.keyframes.reset();
   const auto missing = suite::check_expectations(e, m);
   ASSERT_EQ(missing.size(), 1u);
@@ -116,7 +115,7 @@ TEST(SuiteCheck, KeyframesOfTheFinalMapAreBounded) {
 
 TEST(SuiteCheck, NullMetricsAndMissingBaselineAreViolations) {
   // An aborted run has no ATE; without tracking_loss_expected, every bound fails.
-  const auto v = suite::check_expectations(nominal(), fixture("lost_aborted.json"));
+  const auto v = suite::check_expectations(nominal(), suite_fixture("lost_aborted.json"));
   EXPECT_TRUE(has_key(v, "status"));
   EXPECT_TRUE(has_key(v, "ate_rmse_m_max"));
   EXPECT_TRUE(has_key(v, "rpe_trans_rmse_m_max"));
@@ -127,18 +126,18 @@ TEST(SuiteCheck, NullMetricsAndMissingBaselineAreViolations) {
 TEST(SuiteCheck, ExpectedTrackingLossPassesWithAReason) {
   scenes::Expectations e;
   e.tracking_loss_expected = true;
-  EXPECT_TRUE(suite::check_expectations(e, fixture("lost_aborted.json")).empty());
+  EXPECT_TRUE(suite::check_expectations(e, suite_fixture("lost_aborted.json")).empty());
 }
 
 TEST(SuiteCheck, ExpectedTrackingLossFailsWithoutLossOrReason) {
   scenes::Expectations e;
   e.tracking_loss_expected = true;
-  const auto none = suite::check_expectations(e, fixture("good_compare.json"));
+  const auto none = suite::check_expectations(e, suite_fixture("good_compare.json"));
   ASSERT_EQ(none.size(), 1u);
   EXPECT_EQ(none[0].line(),
             "tracking_loss_expected: no tracking loss was reported (0 lost frames, no loss_events)");
 
-  const auto bad = suite::check_expectations(e, fixture("lost_no_reason.json"));
+  const auto bad = suite::check_expectations(e, suite_fixture("lost_no_reason.json"));
   ASSERT_EQ(bad.size(), 2u);
   EXPECT_EQ(bad[0].line(), "tracking_loss_expected: the run was interrupted before it ended");
   EXPECT_EQ(bad[1].line(), "tracking_loss_expected: loss event 0 (frame 88) gives no reason");
@@ -147,7 +146,7 @@ TEST(SuiteCheck, ExpectedTrackingLossFailsWithoutLossOrReason) {
 TEST(SuiteCheck, MalformedMetricsAreIoErrorsNamingFileAndKey) {
   auto message = [](const std::string& name) -> std::string {
     try {
-      suite::read_metrics_file(fixture(name));
+      suite::read_metrics_file(suite_fixture(name));
     } catch (const IoError& e) {
       return e.what();
     }
@@ -160,13 +159,13 @@ TEST(SuiteCheck, MalformedMetricsAreIoErrorsNamingFileAndKey) {
       << message("bad_type.json");
   EXPECT_NE(message("not_json.json").find("not_json.json"), std::string::npos);
   EXPECT_NE(message("not_json.json").find("not valid JSON"), std::string::npos) << message("not_json.json");
-  EXPECT_THROW(suite::read_metrics_file(fixture("does_not_exist.json")), IoError);
+  EXPECT_THROW(suite::read_metrics_file(suite_fixture("does_not_exist.json")), IoError);
 }
 
 // metrics.json is read as JSON is meant: a quoted number is a string, and a
 // version newer than this program's is refused, not read as its own.
 TEST(SuiteCheck, StringsAreNotNumbersAndUnknownVersionsAreRefused) {
-  const std::string good = read_file(fixture("good_compare.json"));
+  const std::string good = read_file(suite_fixture("good_compare.json"));
   const std::string path = ::testing::TempDir() + "pvb_metrics_strict_" + std::to_string(::getpid()) + ".json";
   auto message = [&path](const std::string& text) -> std::string {
     write_file(path, text);
@@ -200,7 +199,7 @@ TEST(SuiteCheck, StringsAreNotNumbersAndUnknownVersionsAreRefused) {
 TEST(SuiteCheck, ValuesOutOfRangeAreRefusedNamingFileLineAndKey) {
   const std::string path = ::testing::TempDir() + "pvb_metrics_range_" + std::to_string(::getpid()) + ".json";
   auto message = [&path](const std::string& fixture_name, const std::string& from, const std::string& to) {
-    std::string text = read_file(fixture(fixture_name));
+    std::string text = read_file(suite_fixture(fixture_name));
     const std::size_t at = text.find(from);
     if (at == std::string::npos) return "(" + from + " not in " + fixture_name + ")";
     write_file(path, text.replace(at, from.size(), to));
@@ -245,7 +244,7 @@ TEST(SuiteCheck, ValuesOutOfRangeAreRefusedNamingFileLineAndKey) {
 
 // A run of another scenario or seed is refused, not judged by the wrong bounds.
 TEST(SuiteCheck, MetricsOfAnotherRunAreRefused) {
-  const suite::MetricsFile m = suite::read_metrics_file(fixture("good_compare.json"));
+  const suite::MetricsFile m = suite::read_metrics_file(suite_fixture("good_compare.json"));
   ASSERT_TRUE(m.seed.has_value());
   EXPECT_NO_THROW(suite::expect_run_identity(m, m.scenario, "x.yaml", m.seed));
   try {
@@ -268,7 +267,7 @@ TEST(SuiteCheck, MetricsOfAnotherRunAreRefused) {
 TEST(SuiteCheck, PeAgainstBaselineIsANoteNeverAViolationOfOneRun) {
   // PE-SLAM 23.5 mm against the baseline's 15 mm: one run says nothing
   // about the distribution, so it is a note with both values.
-  const suite::MetricsFile m = suite::read_metrics_file(fixture("worse_than_baseline.json"));
+  const suite::MetricsFile m = suite::read_metrics_file(suite_fixture("worse_than_baseline.json"));
   std::vector<std::string> notes;
   scenes::Expectations e;
   e.sweep.pe_not_significantly_worse = true;
@@ -278,7 +277,7 @@ TEST(SuiteCheck, PeAgainstBaselineIsANoteNeverAViolationOfOneRun) {
       << notes[0];
   // Without a baseline there is nothing to note.
   notes.clear();
-  EXPECT_TRUE(suite::check_expectations(e, fixture("lost_aborted.json"), &notes).size() == 1);  // status
+  EXPECT_TRUE(suite::check_expectations(e, suite_fixture("lost_aborted.json"), &notes).size() == 1);  // status
   EXPECT_TRUE(notes.empty());
 }
 
@@ -329,7 +328,7 @@ TEST(SuiteCheckSweep, EverySeedIsJudgedByTheRunBounds) {
 
 namespace {
 
-suite::MetricsFile kidnapped() { return suite::read_metrics_file(fixture("kidnapped.json")); }
+suite::MetricsFile kidnapped() { return suite::read_metrics_file(suite_fixture("kidnapped.json")); }
 
 }  // namespace
 
@@ -420,7 +419,7 @@ TEST(SuiteCheckPlace, RefinedAteBound) {
 
 TEST(SuiteCheckPlace, SweepTotals) {
   std::vector<suite::SeedRun> runs;
-  for (int s = 1; s <= 3; ++s) runs.push_back(suite::read_seed_run(s, fixture("kidnapped.json")));
+  for (int s = 1; s <= 3; ++s) runs.push_back(suite::read_seed_run(s, suite_fixture("kidnapped.json")));
   runs[1].metrics->primary.place->loops_false = 2;
   const suite::SweepAggregate a = suite::aggregate("kidnapped", runs);
   EXPECT_EQ(a.primary_place.seeds, 3);
@@ -436,8 +435,8 @@ TEST(SuiteCheckPlace, SweepTotals) {
 TEST(SuiteCheckMap, SummaryTableStaysWholeWithMapAndPlaceLines) {
   std::vector<suite::SeedRun> runs;
   for (int s = 1; s <= 2; ++s) {
-    suite::SeedRun r = suite::read_seed_run(s, fixture("kidnapped.json"));
-    const suite::MetricsFile maps = suite::read_metrics_file(fixture("dense_map.json"));
+    suite::SeedRun r = suite::read_seed_run(s, suite_fixture("kidnapped.json"));
+    const suite::MetricsFile maps = suite::read_metrics_file(suite_fixture("dense_map.json"));
     r.metrics->primary.maps = maps.primary.maps;
     r.metrics->baseline = r.metrics->primary;
     r.metrics->baseline->mode = "baseline";
@@ -453,7 +452,7 @@ TEST(SuiteCheckMap, SummaryTableStaysWholeWithMapAndPlaceLines) {
 }
 
 TEST(SuiteCheckMap, ReadsTheScoredMaps) {
-  const suite::MetricsFile m = suite::read_metrics_file(fixture("dense_map.json"));
+  const suite::MetricsFile m = suite::read_metrics_file(suite_fixture("dense_map.json"));
   ASSERT_EQ(m.primary.maps.size(), 2u);
   const suite::MapMetrics* c = m.primary.map("corrected");
   ASSERT_NE(c, nullptr);
@@ -463,14 +462,14 @@ TEST(SuiteCheckMap, ReadsTheScoredMaps) {
   EXPECT_DOUBLE_EQ(c->ghosting, 0.001);
   EXPECT_DOUBLE_EQ(m.primary.map("live")->ghosting, 0.012);
   EXPECT_EQ(m.primary.map("before_loop"), nullptr);
-  EXPECT_TRUE(suite::read_metrics_file(fixture("kidnapped.json")).primary.maps.empty());
+  EXPECT_TRUE(suite::read_metrics_file(suite_fixture("kidnapped.json")).primary.maps.empty());
 }
 
 TEST(SuiteCheckMap, AccuracyAndCompletenessBoundsOnTheCorrectedMap) {
   scenes::Expectations e;
   e.map_accuracy_m_max = 0.012;  // inclusive
   e.map_completeness_min = 0.9;
-  suite::MetricsFile m = suite::read_metrics_file(fixture("dense_map.json"));
+  suite::MetricsFile m = suite::read_metrics_file(suite_fixture("dense_map.json"));
   EXPECT_TRUE(suite::check_expectations(e, m).empty());
   e.map_accuracy_m_max = 0.011;
   EXPECT_TRUE(has_key(suite::check_expectations(e, m), "map_accuracy_m_max"));
@@ -483,9 +482,9 @@ TEST(SuiteCheckMap, AccuracyAndCompletenessBoundsOnTheCorrectedMap) {
 }
 
 TEST(SuiteCheckMap, SweepsAggregateTheMaps) {
-  std::vector<suite::SeedRun> runs = {suite::read_seed_run(1, fixture("dense_map.json")),
-                                      suite::read_seed_run(2, fixture("dense_map.json")),
-                                      suite::read_seed_run(3, fixture("kidnapped.json"))};
+  std::vector<suite::SeedRun> runs = {suite::read_seed_run(1, suite_fixture("dense_map.json")),
+                                      suite::read_seed_run(2, suite_fixture("dense_map.json")),
+                                      suite::read_seed_run(3, suite_fixture("kidnapped.json"))};
   runs[1].metrics->primary.maps[0].accuracy_median_m = 0.016;
   const suite::SweepAggregate a = suite::aggregate("kidnapped", runs);
   EXPECT_EQ(a.primary.map_accuracy_median_m.count, 2);

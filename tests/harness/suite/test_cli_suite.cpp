@@ -10,15 +10,14 @@
 
 #include "pvb/common/text.hpp"
 #include "run_pvbench.hpp"
+#include "suite_fixtures.hpp"
 
 namespace fs = std::filesystem;
 using pvb::test::run_pvbench;
 
-namespace {
+using pvb::test::suite_fixture;
 
-std::string fixture(const std::string& name) {
-  return std::string(PVB_SOURCE_DIR) + "/tests/harness/suite/fixtures/" + name;
-}
+namespace {
 
 std::string scratch(const std::string& name) {
   const fs::path dir = fs::path(::testing::TempDir()) / ("pvb_cli_suite_" + std::to_string(::getpid())) / name;
@@ -42,7 +41,7 @@ std::string scenario_file() {
 /// folder whose metrics name another seed or scenario).
 void write_metrics(const std::string& fixture_name, const std::string& path, const std::string& scenario,
                    int seed) {
-  std::string text = pvb::read_file(fixture(fixture_name));
+  std::string text = pvb::read_file(suite_fixture(fixture_name));
   text = std::regex_replace(text, std::regex("\"scenario\": \"[^\"]*\""), "\"scenario\": \"" + scenario + "\"");
   text = std::regex_replace(text, std::regex("\"seed\": [0-9]+"), "\"seed\": " + std::to_string(seed));
   pvb::write_file(path, text);
@@ -58,7 +57,7 @@ int count_lines(const std::string& s) {
 
 TEST(CliCheck, PassingRunExitsZero) {
   const auto r =
-      run_pvbench("check --scenario " + scenario_file() + " --metrics " + fixture("good_compare.json"));
+      run_pvbench("check --scenario " + scenario_file() + " --metrics " + suite_fixture("good_compare.json"));
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("good_compare.json: ok (pv_station)"), std::string::npos) << r.output;
 }
@@ -85,7 +84,7 @@ TEST(CliCheck, ViolationsExitThreeWithOneLineEach) {
 
 TEST(CliCheck, MalformedMetricsIsOneErrorLine) {
   const auto r =
-      run_pvbench("check --scenario " + scenario_file() + " --metrics " + fixture("missing_status.json"));
+      run_pvbench("check --scenario " + scenario_file() + " --metrics " + suite_fixture("missing_status.json"));
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_EQ(count_lines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("pvbench: error: "), std::string::npos) << r.output;
@@ -95,7 +94,7 @@ TEST(CliCheck, MalformedMetricsIsOneErrorLine) {
 TEST(CliCheck, ShippedFailureScenarioAcceptsAReportedLoss) {
   const std::string scenes = std::string(PVB_SOURCE_DIR) + "/scenes/";
   EXPECT_EQ(run_pvbench("check --scenario " + scenes + "tracking_failure.yaml --metrics " +
-                        fixture("lost_aborted.json") + " --seed 5")
+                        suite_fixture("lost_aborted.json") + " --seed 5")
                 .code,
             0);
   const std::string completed = scratch("failure") + "/good_compare.json";
@@ -111,7 +110,7 @@ TEST(CliCheck, ShippedFailureScenarioAcceptsAReportedLoss) {
 TEST(CliCheck, RunOfAnotherScenarioIsRefused) {
   const std::string scenes = std::string(PVB_SOURCE_DIR) + "/scenes/";
   const auto r = run_pvbench("check --scenario " + scenes + "lawnmower_return.yaml --metrics " +
-                             fixture("good_compare.json"));
+                             suite_fixture("good_compare.json"));
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_EQ(count_lines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("good_compare.json: scenario: expected a run of lawnmower_return ("), std::string::npos)
