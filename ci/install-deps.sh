@@ -3,7 +3,7 @@
 # Run as root on a fresh Debian 12 machine.  Idempotent.
 set -euo pipefail
 PKGS=(
-  build-essential cmake pkg-config ccache git
+  build-essential cmake ninja-build pkg-config ccache git
   libeigen3-dev libopencv-dev libceres-dev libyaml-cpp-dev libcli11-dev
   libmujoco-dev libqhull-dev
   libegl-dev libegl-mesa0 libgl-dev libgles-dev libosmesa6-dev libgl1-mesa-dri
