@@ -5,5 +5,5 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS="${PVB_JOBS:-$(nproc)}"
 source ci/configure.sh
-pvb_configure build -DCMAKE_BUILD_TYPE=Release ${PVB_CMAKE_ARGS:-}
+pvb_configure build -DCMAKE_BUILD_TYPE=Release -DPVB_TEST_CXX_FLAGS=-O1 ${PVB_CMAKE_ARGS:-}
 cmake --build build -j "$JOBS"

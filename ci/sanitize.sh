@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The sanitizer job: builds the libraries, pvbench and the unit tests with
-# ASan and UBSan into build-asan/ (-O1, line tables, no benchmarks, no
-# scenario test programs; configured as ci/configure.sh says) and runs the
-# unit tests and one short scenario run under them.  A report from our own
-# code fails it; known reports inside Mesa, llvmpipe, MuJoCo and OpenNI2 are
-# suppressed by ci/sanitizers/*.supp, each entry with its reason.
+# ASan and UBSan into build-asan/ (-O1, line tables, the test programs' own
+# sources at -O0, no benchmarks, no scenario test programs; configured as
+# ci/configure.sh says) and runs the unit tests and one short scenario run
+# under them.  A report from our own code fails it; known reports inside
+# Mesa, llvmpipe, MuJoCo and OpenNI2 are suppressed by ci/sanitizers/*.supp,
+# each entry with its reason.
 # `.ci/run` runs it after the default tests (docs/testing.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,7 +17,7 @@ B=build-asan
 VOCAB="$PWD/build/vocabulary/pvbench_orb.pvbvoc"
 [ -f "$VOCAB" ] && VOCAB_ARG="-DPVB_PREBUILT_VOCABULARY=$VOCAB" || VOCAB_ARG=""
 source ci/configure.sh
-pvb_configure "$B" -DCMAKE_BUILD_TYPE=Release -DPVB_SANITIZE=address,undefined -DPVB_BUILD_BENCHMARKS=OFF -DPVB_UNIT_TESTS_ONLY=ON \
+pvb_configure "$B" -DCMAKE_BUILD_TYPE=Release -DPVB_SANITIZE=address,undefined -DPVB_BUILD_BENCHMARKS=OFF -DPVB_UNIT_TESTS_ONLY=ON -DPVB_TEST_CXX_FLAGS=-O0 \
   -DCMAKE_CXX_FLAGS_RELEASE="-O1 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELEASE="-O1 -g1 -DNDEBUG" $VOCAB_ARG ${PVB_CMAKE_ARGS:-}
 cmake --build "$B" -j "$JOBS"
 

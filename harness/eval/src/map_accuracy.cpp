@@ -104,7 +104,9 @@ GhostFlags ghosted(std::size_t at, const std::vector<SurfacePoint>& surface, con
                    const MapAccuracyOptions& o, bool merged) {
   const SurfacePoint& s = surface[at];
   std::vector<std::pair<std::size_t, double>> near;
-  surface_tree.radiusSearch(s.p_w.data(), o.ghost_radius_m * o.ghost_radius_m, near, nanoflann::SearchParams());
+  nanoflann::SearchParams unsorted;  // the offsets are sorted below, whatever order they come in
+  unsorted.sorted = false;
+  surface_tree.radiusSearch(s.p_w.data(), o.ghost_radius_m * o.ghost_radius_m, near, unsorted);
   std::vector<double> offsets;
   std::map<int, std::vector<double>> by_source;
   for (const auto& [j, d2] : near)
