@@ -196,18 +196,7 @@ std::string format_svg(const Figure& f) {
       std::snprintf(buf, sizeof buf, " transform=\"rotate(-90 %.2f %.2f)\"", t.x, t.y);
       out += buf;
     }
-    std::string esc;
-    for (char c : t.text) {
-      if (c == '<')
-        esc += "&lt;";
-      else if (c == '>')
-        esc += "&gt;";
-      else if (c == '&')
-        esc += "&amp;";
-      else
-        esc += c;
-    }
-    out += ">" + esc + "</text>\n";
+    out += ">" + html_escape(t.text) + "</text>\n";
   }
   out += "</svg>\n";
   return out;
