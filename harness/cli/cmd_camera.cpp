@@ -38,6 +38,7 @@
 #include "pvb/openni/openni_source.hpp"
 #include "pvb/openni/record_target.hpp"
 #include "pvb/openni/sim_uri.hpp"
+#include "pvb/run/motion_truth.hpp"
 #include "pvb/run/run.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/simulator.hpp"
@@ -67,7 +68,10 @@ struct CameraArgs {
 
 /// Files written into --out (a recording must not land on one of them).
 const char* const kOutputs[] = {"camera.yaml", "CameraTrajectory.txt", "KeyFrameTrajectory.txt",
-                                "map.ply",     "stats.json",           "groundtruth.txt"};
+                                "map.ply",     "stats.json",           "groundtruth.txt",
+                                "imu0",        "accelerometer.txt",    "wheels.csv",
+                                "odom.txt",    "imu.yaml",             "robot.yaml",
+                                "wheels_truth.csv", "robot_truth.yaml"};
 
 using Clock = std::chrono::steady_clock;
 
@@ -214,6 +218,8 @@ struct LiveOutputs {
   OutputFile cam_traj;
   std::unique_ptr<sim::Simulator> gt_sim;
   OutputFile gt_file;
+  std::unique_ptr<dataset::MotionFilesWriter> motion;  ///< a sim:// device's IMU and encoders
+  std::unique_ptr<run::MotionTruthWriter> motion_truth;
   std::string dump_gt;  ///< a fakenect dump's groundtruth.txt, copied at the end
   bool has_gt() const { return gt_sim || !dump_gt.empty(); }
 };
@@ -229,6 +235,9 @@ LiveOutputs open_live_outputs(const CameraArgs& a, const std::optional<scenes::S
     o.gt_sim = std::make_unique<sim::Simulator>(*scenario);
     o.gt_file = OutputFile(out + "/groundtruth.txt");
     o.gt_file.append("# timestamp tx ty tz qx qy qz qw (T_w_c, simulator ground truth)\n");
+    o.motion = std::make_unique<dataset::MotionFilesWriter>(out, run::robot_calibration_for(*scenario));
+    o.motion_truth = std::make_unique<run::MotionTruthWriter>(out);
+    run::write_robot_truth(out, *scenario, o.gt_sim->kinematics());
   }
   return o;
 }
@@ -281,6 +290,9 @@ slam::TrackingState track_frame(const sensor::RgbdFrame& frame, const CameraSett
   if (live.gt_sim) {
     while (live.gt_sim->frame_index() < static_cast<int>(frame.index)) live.gt_sim->advance();
     live.gt_file.append(geom::format_tum_line({frame.t_ns, live.gt_sim->T_w_c()}) + "\n");
+    const sim::MotionBatch b = live.gt_sim->take_motion();  // the readings up to this frame
+    live.motion->write(b.imu, b.ticks);
+    live.motion_truth->write(b.imu_truth, b.wheel_truth);
   }
   const slam::FrameResult r = system.track(frame);
   ++counts.frames;

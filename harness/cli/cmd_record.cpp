@@ -26,6 +26,7 @@
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/plot/contact_sheet.hpp"
+#include "pvb/run/motion_truth.hpp"
 #include "pvb/run/run.hpp"
 #include "pvb/run/world_json.hpp"
 #include "pvb/scenes/scenario.hpp"
@@ -57,7 +58,8 @@ class FakenectDump {
         min_m_(s.camera.depth_range_m[0]),
         max_m_(s.camera.depth_range_m[1]),
         registration_(sensor::kinect::Calibration{}),
-        writer_(dir, registration_.calibration()) {
+        writer_(dir, registration_.calibration()),
+        R_c_i_((scenes::T_base_camera(s).inverse() * scenes::T_base_imu(s)).linear()) {
     if (s.camera.width != sensor::kinect::kWidth || s.camera.height != sensor::kinect::kHeight)
       throw ConfigError(s.name, "camera.width/height", "640x480 for a fakenect dump (a Kinect v1's frames)",
                         std::to_string(s.camera.width) + "x" + std::to_string(s.camera.height));
@@ -67,16 +69,29 @@ class FakenectDump {
     cv::Mat depth_m = source_.last_depth_gt_m().clone();
     depth_m.setTo(0.0f, (depth_m < min_m_) | (depth_m > max_m_));
     if (cv::countNonZero(frame.depth_m) == 0) depth_m = 0.0f;  // a covered lens (kidnap) sees nothing
-    const Eigen::Vector3d up_w(0.0, 0.0, 9.80665);  // the specific force of a body at rest
-    writer_.write(frame.t_ns, frame.rgb, registration_.encode_ir_raw(depth_m),
-                  gt.T_w_c.linear().transpose() * up_w, gt.T_w_c);
+    writer_.write(frame.t_ns, frame.rgb, registration_.encode_ir_raw(depth_m), kinect_accel(frame, gt), gt.T_w_c);
   }
+
+ private:
+  /// The Kinect's accelerometer gives one reading a frame (its counts are
+  /// the writer's): the IMU's specific force over the frame, in camera
+  /// axes.  Frame 0 has no readings yet: the robot stands, the reading is
+  /// gravity's.
+  Eigen::Vector3d kinect_accel(const sensor::RgbdFrame& frame, const geom::StampedPose& gt) const {
+    if (frame.imu.empty()) return gt.T_w_c.linear().transpose() * Eigen::Vector3d(0.0, 0.0, 9.80665);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const sensor::ImuSample& s : frame.imu) sum += s.accel_mps2;
+    return R_c_i_ * sum / static_cast<double>(frame.imu.size());
+  }
+
+ public:
 
  private:
   sim::SimFrameSource& source_;
   double min_m_, max_m_;
   sensor::kinect::DepthRegistration registration_;
   dataset::FakenectWriter writer_;
+  Eigen::Matrix3d R_c_i_;  ///< the IMU's axes in the camera's
 };
 
 using Clock = std::chrono::steady_clock;
@@ -142,13 +157,17 @@ void write_meta(const std::string& path, const RecordOptions& opt, const scenes:
                 "  \"renderer\": {\"backend\": \"%s\", \"description\": \"%s\"},\n"
                 "  \"physics\": {\"timestep_s\": %.9g, \"substeps_per_frame\": %d},\n"
                 "  \"kinematics\": {\"wheel_radius_m\": %.6f, \"track_m\": %.6f},\n"
+                "  \"motion_sensors\": {\"imu\": \"%s\", \"imu_rate_hz\": %.9g, \"encoder_rate_hz\": %.9g, "
+                "\"ticks_per_rev\": %d},\n"
                 "  \"timings\": {\"total_s\": %.3f, \"setup_ms\": %.1f, \"capture_ms_per_frame\": %.3f, "
                 "\"write_ms_per_frame\": %.3f, \"frames_per_s\": %.2f}\n"
                 "}\n",
                 loop.frames, loop.interrupted ? "true" : "false", scenario.camera.fps, pvb::version(),
                 mj_versionString(), sim::to_string(source.camera().backend()),
                 json_escape(source.camera().description()).c_str(), sim.assets().timestep_s, sim.assets().substeps,
-                sim.kinematics().wheel_radius_m, sim.kinematics().track_m, total_s, setup_ms,
+                sim.kinematics().wheel_radius_m, sim.kinematics().track_m, scenes::to_string(scenario.imu.part),
+                scenes::imu_rate_hz(scenario), scenes::wheel_rate_hz(scenario), scenario.wheels.ticks_per_rev,
+                total_s, setup_ms,
                 loop.capture_ms * per_frame, loop.write_ms * per_frame,
                 loop.loop_s > 0 ? loop.frames / loop.loop_s : 0.0);
   meta += rest;
@@ -177,6 +196,8 @@ int run_record(const RecordOptions& opt, bool frames_given) {
   dataset::OrbSlamSettings settings = run::orbslam_settings_for(scenario);
   std::unique_ptr<dataset::TumSequenceWriter> tum;
   std::unique_ptr<FakenectDump> dump;
+  std::unique_ptr<dataset::MotionFilesWriter> motion;
+  std::unique_ptr<run::MotionTruthWriter> truth;
   FrameWriter write;
   if (opt.format == "fakenect") {
     settings.depth_map_factor = 1000.0;  // OpenNI2 serves depth in mm
@@ -185,7 +206,14 @@ int run_record(const RecordOptions& opt, bool frames_given) {
   } else {
     tum = std::make_unique<dataset::TumSequenceWriter>(opt.out, sensor::kTumDepthFactor,
                                                        std::string("pvbench ") + pvb::version());
-    write = [&tum](const sensor::RgbdFrame& f, const geom::StampedPose& p) { tum->write(f, p.T_w_c); };
+    motion = std::make_unique<dataset::MotionFilesWriter>(opt.out, run::robot_calibration_for(scenario));
+    truth = std::make_unique<run::MotionTruthWriter>(opt.out);
+    run::write_robot_truth(opt.out, scenario, source.simulator().kinematics());
+    write = [&](const sensor::RgbdFrame& f, const geom::StampedPose& p) {
+      tum->write(f, p.T_w_c);
+      motion->write(f);
+      truth->write(source.last_imu_truth(), source.last_wheel_truth());
+    };
   }
   dataset::write_orbslam_settings(opt.out + "/camera.yaml", settings);
   const RecordLoop loop = record_frames(source, gt, write, scenario.name, n);

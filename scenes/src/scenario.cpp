@@ -32,6 +32,7 @@ void read_top(detail::MapReader& top, Scenario& s) {
   detail::with_map(top, "route", [&](detail::MapReader& r) { detail::read_route(r, s.route); });
   detail::with_map(top, "robot", [&](detail::MapReader& r) { detail::read_robot(r, s.robot); });
   detail::with_map(top, "camera", [&](detail::MapReader& r) { detail::read_camera(r, s.camera); });
+  detail::read_body(top, s);
   detail::with_map(top, "slam", [&](detail::MapReader& r) { detail::read_slam(r, s.slam); });
   detail::read_kidnap(top, s);
   detail::with_map(top, "expect", [&](detail::MapReader& r) { detail::read_expect(r, s.expect); });

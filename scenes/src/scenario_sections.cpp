@@ -226,6 +226,10 @@ void read_robot(MapReader& r, Robot& rb) {
   rb.wheel_radius_m = r.number("wheel_radius_m", rb.wheel_radius_m, 0.03, 0.5);
   rb.track_m = r.number("track_m", rb.track_m, 0.1, 2);
   rb.max_wheel_speed_radps = r.number("max_wheel_speed_radps", rb.max_wheel_speed_radps, 1, 100);
+  if (r.has("max_wheel_accel_radps2"))
+    rb.max_wheel_accel_radps2 = r.number("max_wheel_accel_radps2", 0, 0.1, 1000);
+  rb.radius_error = r.number("radius_error", rb.radius_error, 0, 0.2);
+  rb.track_error = r.number("track_error", rb.track_error, 0, 0.2);
 }
 
 void read_camera(MapReader& r, Camera& c) {

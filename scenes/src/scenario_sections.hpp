@@ -25,6 +25,9 @@ void read_slam(MapReader& r, SlamTuning& t);
 void read_expect(MapReader& r, Expectations& e);
 /// The kidnap: section.  Read after duration_s and camera, which bound it.
 void read_kidnap(MapReader& top, Scenario& s);
+/// The physics:, imu: and wheels: sections.  Read after camera (the
+/// physics rate is a multiple of its frame rate).
+void read_body(MapReader& top, Scenario& s);
 /// The site: section (the station's place and the run's local time).
 void read_site(MapReader& top, Scenario& s);
 

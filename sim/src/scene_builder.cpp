@@ -543,9 +543,9 @@ void add_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<Groun
 SceneAssets build_scene(const scenes::Scenario& s) {
   SceneAssets out;
   const scenes::Camera& cam = s.camera;
-  // Physics step: the largest step <= 2 ms that divides the frame period, so
-  // frame i is rendered at exactly i / fps.
-  out.substeps = std::max(1, static_cast<int>(std::ceil(1.0 / cam.fps / 0.002 - 1e-9)));
+  // Physics step: physics.rate_hz, or the largest step <= 2 ms that divides
+  // the frame period, so frame i is rendered at exactly i / fps.
+  out.substeps = scenes::physics_substeps(s);
   out.timestep_s = 1.0 / (cam.fps * out.substeps);
   const double diag = std::hypot(s.ground.size_m.x(), s.ground.size_m.y()) + 20.0;
   out.max_scene_depth_m = 1.05 * diag;

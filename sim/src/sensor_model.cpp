@@ -8,23 +8,11 @@
 #include <opencv2/core/utility.hpp>
 
 #include "pvb/sensor/depth_encoding.hpp"
+#include "splitmix.hpp"
 
 namespace pvb::sim {
 namespace {
 
-// splitmix64: a fast generator whose output is fully specified, so noise is
-// identical on every platform.
-struct SplitMix {
-  explicit SplitMix(std::uint64_t seed, std::uint64_t stream)
-      : s(seed * 0x9E3779B97F4A7C15ull ^ (stream + 0x2545F4914F6CDD1Dull) * 0xBF58476D1CE4E5B9ull) {}
-  std::uint64_t next() {
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  std::uint64_t s;
-};
 
 // Standard normal quantiles at 4096 evenly spaced probabilities: a table
 // lookup per draw keeps per-pixel noise cheap.

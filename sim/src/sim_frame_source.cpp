@@ -36,6 +36,8 @@ std::optional<sensor::RgbdFrame> SimFrameSource::next() {
   Capture cap = camera_.sensor_model().apply(std::move(*rendered));
   last_times_.sensor_ms = cap.sensor_ms;
   last_depth_gt_m_ = cap.depth_gt_m;
+  last_imu_truth_ = std::move(cap.imu_truth);
+  last_wheel_truth_ = std::move(cap.wheel_truth);
   return std::move(cap.frame);
 }
 

@@ -1,5 +1,7 @@
 #include "pvb/sim/simulator.hpp"
 
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -8,6 +10,7 @@
 #include "pvb/geometry/time.hpp"
 #include "pvb/scenes/route.hpp"
 #include "pvb/sim/sensor_model.hpp"
+#include "carry_path.hpp"
 
 namespace pvb::sim {
 namespace {
@@ -16,6 +19,26 @@ constexpr double kSettleS = 0.3;
 
 double yaw_of(const mjtNum* q) {  // MuJoCo quaternion w, x, y, z
   return std::atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]));
+}
+
+FreeState free_state(const mjData* d, int qpos, int dof) {
+  FreeState f;
+  f.p_w = Eigen::Vector3d(d->qpos + qpos);
+  const mjtNum* q = d->qpos + qpos + 3;
+  f.R_w_b = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
+  f.v_w = Eigen::Vector3d(d->qvel + dof);
+  f.w_b = Eigen::Vector3d(d->qvel + dof + 3);
+  return f;
+}
+
+void set_free_state(mjData* d, int qpos, int dof, const FreeState& f) {
+  const Eigen::Quaterniond q(f.R_w_b);
+  const mjtNum values[7] = {f.p_w.x(), f.p_w.y(), f.p_w.z(), q.w(), q.x(), q.y(), q.z()};
+  std::copy(values, values + 7, d->qpos + qpos);
+  for (int i = 0; i < 3; ++i) {
+    d->qvel[dof + i] = f.v_w[i];
+    d->qvel[dof + 3 + i] = f.w_b[i];
+  }
 }
 
 int actuator(const mjModel* m, const char* name) {
@@ -36,6 +59,7 @@ Simulator::Simulator(scenes::Scenario scenario) : scenario_(std::move(scenario))
   const int body = mj_name2id(m, mjOBJ_BODY, kRobotBody);
   if (camera_id_ < 0 || body < 0) throw Error("generated model lacks the robot or its camera");
   free_qpos_ = m->jnt_qposadr[m->body_jntadr[body]];
+  free_dof_ = m->jnt_dofadr[m->body_jntadr[body]];
   act_left_ = actuator(m, kLeftActuator);
   act_right_ = actuator(m, kRightActuator);
 
@@ -80,26 +104,79 @@ Simulator::Simulator(scenes::Scenario scenario) : scenario_(std::move(scenario))
   step_physics(static_cast<int>(kSettleS / m->opt.timestep));
   mj_forward(m, data_.get());
   if (scenario_.kidnap) kidnap_ = scenes::kidnap_frames(*scenario_.kidnap, scenario_.camera.fps);
+  motion_ = std::make_unique<MotionSensors>(m, scenario_, body, T_b_c());
   kidnap_step();
+}
+
+Simulator::~Simulator() = default;
+
+geom::SE3d Simulator::T_b_c() const {
+  const mjModel* m = model_.get();
+  const mjtNum* q = m->cam_quat + 4 * camera_id_;
+  const mjtNum* p = m->cam_pos + 3 * camera_id_;
+  const Eigen::Matrix3d R_b_mj = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
+  // MuJoCo camera: x right, y up, looking along -z.  Optical: y down, z forward.
+  return geom::make_se3(R_b_mj * Eigen::Vector3d(1, -1, -1).asDiagonal(), Eigen::Vector3d(p[0], p[1], p[2]));
+}
+
+geom::SE3d Simulator::T_w_b() const {
+  const FreeState f = free_state(data_.get(), free_qpos_, free_dof_);
+  return geom::make_se3(f.R_w_b, f.p_w);
 }
 
 std::int64_t Simulator::t_ns() const { return geom::frame_time_ns(0, frame_, scenario_.camera.fps); }
 
 void Simulator::step_physics(int steps) {
-  for (int i = 0; i < steps; ++i) mj_step(model_.get(), data_.get());
+  for (int i = 0; i < steps; ++i) {
+    if (motion_) motion_->before_step(data_.get());
+    mj_step(model_.get(), data_.get());
+    if (motion_) motion_->after_step(model_.get(), data_.get(), false);
+  }
+}
+
+bool Simulator::carrying() const {
+  return kidnap_ && kidnap_data_ && frame_ >= kidnap_->cover_begin && frame_ < kidnap_->teleport;
+}
+
+void Simulator::carry_steps(int steps) {
+  const mjModel* m = model_.get();
+  mjData* d = data_.get();
+  if (!carry_) {
+    const double duration_s = (kidnap_->teleport - kidnap_->cover_begin) / scenario_.camera.fps;
+    carry_ = std::make_unique<CarryPath>(free_state(d, free_qpos_, free_dof_),
+                                         free_state(kidnap_data_.get(), free_qpos_, free_dof_), duration_s);
+    carry_step_ = 0;
+  }
+  for (int i = 0; i < steps; ++i) {
+    motion_->before_step(d);
+    ++carry_step_;
+    set_free_state(d, free_qpos_, free_dof_, carry_->at(carry_step_ * m->opt.timestep));
+    for (int dof = 0; dof < m->nv; ++dof)
+      if (dof < free_dof_ || dof >= free_dof_ + 6) d->qvel[dof] = 0;  // the wheels stand still
+    d->time += m->opt.timestep;
+    motion_->after_step(m, d, true);
+  }
 }
 
 void Simulator::advance() {
   Eigen::Vector2d lr = Eigen::Vector2d::Zero();
   if (wheel_override_) {
     lr = *wheel_override_;
-  } else if (!hold_) {
+  } else if (!hold_ && !carrying()) {
     const Eigen::Vector2d vw = follower_->command(steering_pose_ ? *steering_pose_ : base_pose());
     lr = kinematics_.wheel_speeds(vw.x(), vw.y());
   }
+  if (scenario_.robot.max_wheel_accel_radps2) {  // ramp towards the command
+    const double step = *scenario_.robot.max_wheel_accel_radps2 / scenario_.camera.fps;
+    const Eigen::Vector2d last(data_->ctrl[act_left_], data_->ctrl[act_right_]);
+    lr = last + (lr - last).cwiseMax(-step).cwiseMin(step);
+  }
   data_->ctrl[act_left_] = lr.x();
   data_->ctrl[act_right_] = lr.y();
-  step_physics(assets_.substeps);
+  if (carrying())
+    carry_steps(assets_.substeps);
+  else
+    step_physics(assets_.substeps);
   mj_forward(model_.get(), data_.get());  // camera poses for the new state
   ++frame_;
   kidnap_step();
@@ -115,6 +192,8 @@ void Simulator::kidnap_step() {
     // The whole physical state (positions, velocities, contacts, the
     // solver's warm start) and the follower as they were; only time goes on.
     const mjtNum time_s = data_->time;
+    if (motion_) motion_->rebase_wheels(data_.get(), kidnap_data_.get());
+    carry_.reset();
     mj_copyData(data_.get(), model_.get(), kidnap_data_.get());
     data_->time = time_s;
     *follower_ = *kidnap_follower_;
@@ -168,6 +247,7 @@ RenderedFrame RgbdCamera::render(Simulator& sim) {
   out.index = static_cast<std::uint64_t>(sim.frame_index());
   out.t_ns = sim.t_ns();
   out.T_w_c = sim.T_w_c();
+  out.motion = sim.take_motion();
   return out;
 }
 
@@ -197,6 +277,10 @@ Capture SensorModel::apply(RenderedFrame rendered) const {
   out.frame.t_ns = rendered.t_ns;
   out.frame.index = rendered.index;
   out.T_w_c = rendered.T_w_c;
+  out.frame.imu = std::move(rendered.motion.imu);
+  out.frame.wheel_ticks = std::move(rendered.motion.ticks);
+  out.imu_truth = std::move(rendered.motion.imu_truth);
+  out.wheel_truth = std::move(rendered.motion.wheel_truth);
   out.render_ms = rendered.render_ms;
   out.sensor_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   return out;

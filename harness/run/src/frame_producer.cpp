@@ -5,7 +5,8 @@ namespace pvb::run {
 FrameItem apply_sensor(const sim::SensorModel& sensor, RenderedItem&& item) {
   sim::Capture cap = sensor.apply(std::move(item.rendered));
   item.times.sensor_ms = cap.sensor_ms;
-  return FrameItem{std::move(cap.frame), item.gt, item.base_gt, item.times};
+  return FrameItem{std::move(cap.frame), item.gt, item.base_gt, std::move(cap.imu_truth),
+                   std::move(cap.wheel_truth), item.times};
 }
 
 FrameProducer::FrameProducer(const scenes::Scenario& scenario, sim::GlBackend backend, int frames,
@@ -14,6 +15,7 @@ FrameProducer::FrameProducer(const scenes::Scenario& scenario, sim::GlBackend ba
       steering_(steering) {
   info_.renderer = source_.camera().description();
   info_.route = source_.simulator().follower().path();
+  info_.kinematics = source_.simulator().kinematics();
   info_.sensor = source_.sensor_model();
 }
 

@@ -29,6 +29,8 @@ struct FrameItem {
   sensor::RgbdFrame frame;
   geom::StampedPose gt;  ///< T_w_c of the frame, from the ground-truth sink
   sim::Pose2d base_gt;   ///< robot axle centre, ground truth
+  std::vector<sim::ImuTruth> imu_truth;      ///< the truth behind frame.imu
+  std::vector<sim::WheelTruth> wheel_truth;  ///< the truth behind frame.wheel_ticks
   sim::SimFrameSource::StageTimes times;
 };
 
@@ -49,6 +51,7 @@ FrameItem apply_sensor(const sim::SensorModel& sensor, RenderedItem&& item);
 struct SimInfo {
   std::string renderer;
   std::vector<Eigen::Vector2d> route;
+  sim::DriveKinematics kinematics;  ///< the drive's effective radius and track
   std::optional<sim::SensorModel> sensor;  ///< a copy, for the sensor-model thread
 };
 

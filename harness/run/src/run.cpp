@@ -16,8 +16,10 @@
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
+#include "pvb/run/motion_truth.hpp"
 #include "pvb/run/world_json.hpp"
 #include "pvb/scenes/route.hpp"
+#include "pvb/sim/motion_sensors.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "run_log.hpp"
 #include "system_sink.hpp"
@@ -97,23 +99,36 @@ std::string start_line(const RunOptions& opt, const scenes::Scenario& scenario, 
 // --- The consumer side of each frame ---
 
 /// Ground truth of every frame: groundtruth.txt (flushed per frame) and the
-/// trajectory the systems are evaluated against.
+/// trajectory the systems are evaluated against; beside it the motion
+/// sensors' files and their truth (docs/sensors.md).
 class GroundTruthSink {
  public:
-  explicit GroundTruthSink(const std::string& path) : file_(path) {
+  GroundTruthSink(const std::string& dir, const scenes::Scenario& scenario)
+      : dir_(dir),
+        scenario_(scenario),
+        file_(dir + "/groundtruth.txt"),
+        motion_(dir, robot_calibration_for(scenario)),
+        motion_truth_(dir) {
     file_.append(
         "# timestamp tx ty tz qx qy qz qw (T_w_c: camera optical frame in the site frame, ground truth)\n");
-    trajectory_.source = path;
+    trajectory_.source = dir + "/groundtruth.txt";
   }
-  void add(const geom::StampedPose& pose) {
-    file_.append(geom::format_tum_line(pose) + "\n");
-    trajectory_.poses.push_back(pose);
+  void started(const SimInfo& info) { write_robot_truth(dir_, scenario_, info.kinematics); }
+  void add(const FrameItem& item) {
+    file_.append(geom::format_tum_line(item.gt) + "\n");
+    trajectory_.poses.push_back(item.gt);
+    motion_.write(item.frame);
+    motion_truth_.write(item.imu_truth, item.wheel_truth);
   }
   void close() { file_.close(); }
   const eval::Trajectory& trajectory() const { return trajectory_; }
 
  private:
+  std::string dir_;
+  const scenes::Scenario& scenario_;
   OutputFile file_;
+  dataset::MotionFilesWriter motion_;
+  MotionTruthWriter motion_truth_;
   eval::Trajectory trajectory_;
 };
 
@@ -142,6 +157,7 @@ class RunConsumer : public FrameConsumer {
 
   void started(const SimInfo& info) override {
     report_.renderer = info.renderer;
+    gt_.started(info);
     if (closed_loop_) closed_loop_->set_route(info.route);
   }
 
@@ -152,7 +168,7 @@ class RunConsumer : public FrameConsumer {
     std::vector<slam::FrameResult> results;
     for (auto& sink : sinks_) results.push_back(sink->track(item.frame, log_));
     const auto t0 = Clock::now();
-    gt_.add(item.gt);
+    gt_.add(item);
     keep_thumbnail(item);
     if (closed_loop_) {
       closed_loop_->update(item, results.front());
@@ -382,7 +398,22 @@ dataset::OrbSlamSettings orbslam_settings_for(const scenes::Scenario& s) {
   o.n_features = s.slam.orb_features;
   o.kf_min_tracked_close = s.slam.keyframe_min_tracked_close;
   o.kf_ref_overlap = s.slam.keyframe_ref_overlap;
+  o.robot = robot_calibration_for(s);
   return o;
+}
+
+dataset::RobotCalibration robot_calibration_for(const scenes::Scenario& s) {
+  dataset::RobotCalibration c;
+  c.imu.gyro_noise_density = s.imu.gyro.noise_density;
+  c.imu.gyro_random_walk = s.imu.gyro.random_walk;
+  c.imu.accel_noise_density = s.imu.accel.noise_density;
+  c.imu.accel_random_walk = s.imu.accel.random_walk;
+  c.imu.rate_hz = scenes::imu_rate_hz(s);
+  c.drive = sim::nominal_description(s);
+  c.encoder_rate_hz = scenes::wheel_rate_hz(s);
+  c.T_b_c = scenes::T_base_camera(s);
+  c.T_b_i = scenes::T_base_imu(s);
+  return c;
 }
 
 std::string start_m_expectation(const scenes::Scenario& scenario, double start_m,
@@ -412,7 +443,7 @@ RunReport run_scenario(const RunOptions& opt) {
   for (const std::string& w : settings.slam.warnings) log.line("warning: " + w);
   for (auto& sink : sinks) sink->open_outputs();
   RunReport report = new_report(scenario, opt);
-  GroundTruthSink gt(opt.out_dir + "/groundtruth.txt");
+  GroundTruthSink gt(opt.out_dir, scenario);
   std::optional<ClosedLoop> closed_loop;
   if (opt.closed_loop) closed_loop.emplace();
   RunConsumer consumer(opt, scenario, n, sinks, gt, closed_loop ? &*closed_loop : nullptr, report, log);

@@ -124,7 +124,10 @@ class Reader {
 
 // Keys ORB-SLAM2 files carry that the RGB-D core does not use.
 bool ignored_key(const std::string& key) {
-  return key.rfind("Viewer.", 0) == 0 || key == "Camera.type" || key == "Camera.bFishEye";
+  // IMU.* and Robot.*: a recording's motion sensors (ORB-SLAM3's IMU keys,
+  // the robot's description), which this RGB-D core does not read.
+  return key.rfind("Viewer.", 0) == 0 || key == "Camera.type" || key == "Camera.bFishEye" ||
+         key.rfind("IMU.", 0) == 0 || key.rfind("Robot.", 0) == 0;
 }
 
 /// Smallest side, in pixels, of the coarsest ORB pyramid level.

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "pvb/scenes/body.hpp"
+
 namespace pvb::scenes {
 
 enum class GroundType { kSoil, kGravel };
@@ -217,10 +219,20 @@ struct Camera {
   double fovy_deg() const;
 };
 
+/// The robot as built (the simulated one).  The description a SLAM core or
+/// an odometry gets (robot.yaml) has nominal values that differ from these
+/// by a calibration error drawn from the station seed, uniform within
+/// +-radius_error and +-track_error (relative), as a robot measured with a
+/// tape differs from its drawing.
 struct Robot {
   double wheel_radius_m = 0.1;
   double track_m = 0.42;  ///< distance between the wheel contact points
   double max_wheel_speed_radps = 12.0;
+  /// Largest change of a wheel's commanded speed, rad/s^2 (unset: none,
+  /// a command takes effect at once and a start or stop rocks the robot).
+  std::optional<double> max_wheel_accel_radps2;
+  double radius_error = 0.01;  ///< largest relative error of the nominal wheel radius
+  double track_error = 0.02;   ///< largest relative error of the nominal track
 };
 
 /// SLAM settings the scenario asks for (the `slam:` section).  They go into
@@ -334,6 +346,9 @@ struct Scenario {
   Route route;
   Robot robot;
   Camera camera;
+  Physics physics;
+  Imu imu;
+  Wheels wheels;
   SlamTuning slam;
   std::optional<Kidnap> kidnap;  ///< none unless the file has a kidnap: section
   Expectations expect;
@@ -356,6 +371,16 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
 
 /// Frames the scenario yields: floor(duration_s * fps) + 1, capped by max_frames if > 0.
 int frame_count(const Scenario& s, int max_frames = 0);
+
+/// Physics steps a camera frame: physics.rate_hz / fps, or, unset, the
+/// fewest steps of at most 2 ms each that fill the camera period.
+int physics_substeps(const Scenario& s);
+/// Physics steps a second: fps x physics_substeps.
+double physics_rate_hz(const Scenario& s);
+/// The IMU's and the wheel encoders' sample rates (body.hpp says how an
+/// unset rate is chosen).
+double imu_rate_hz(const Scenario& s);
+double wheel_rate_hz(const Scenario& s);
 
 /// The kidnap's frames at the scenario's frame rate.
 KidnapFrames kidnap_frames(const Kidnap& k, double fps);

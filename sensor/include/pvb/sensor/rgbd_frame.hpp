@@ -2,6 +2,9 @@
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
+
+#include "pvb/sensor/motion.hpp"
 
 namespace pvb::sensor {
 
@@ -13,6 +16,10 @@ struct RgbdFrame {
   cv::Mat depth_m;           ///< CV_32FC1 metres along the optical axis, 0 = invalid
   std::uint64_t index = 0;   ///< position in the stream, from 0
   std::string rgb_name;      ///< file or stream name, for messages (may be empty)
+  /// The motion sensors' readings since the previous frame, up to and with
+  /// t_ns, oldest first (empty for a source without them).
+  std::vector<ImuSample> imu;
+  std::vector<WheelTicks> wheel_ticks;
 };
 
 }  // namespace pvb::sensor

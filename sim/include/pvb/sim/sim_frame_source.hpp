@@ -41,6 +41,9 @@ class SimFrameSource : public sensor::FrameSource {
   const RgbdCamera& camera() const { return camera_; }
   /// Rendered (noise-free) depth of the last frame, for diagnostics.
   const cv::Mat& last_depth_gt_m() const { return last_depth_gt_m_; }
+  /// The truth behind the last next() frame's IMU and encoder readings.
+  const std::vector<ImuTruth>& last_imu_truth() const { return last_imu_truth_; }
+  const std::vector<WheelTruth>& last_wheel_truth() const { return last_wheel_truth_; }
 
   /// Where the time of the last next() went, milliseconds.
   struct StageTimes {
@@ -57,6 +60,8 @@ class SimFrameSource : public sensor::FrameSource {
   int next_index_ = 0;
   GroundTruthSink sink_;
   cv::Mat last_depth_gt_m_;
+  std::vector<ImuTruth> last_imu_truth_;
+  std::vector<WheelTruth> last_wheel_truth_;
   StageTimes last_times_;
 };
 

@@ -11,17 +11,22 @@
 #include "pvb/geometry/se3.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sensor/rgbd_frame.hpp"
+#include "pvb/sim/motion_sensors.hpp"
 #include "pvb/sim/renderer.hpp"
 #include "pvb/sim/robot.hpp"
 #include "pvb/sim/scene_builder.hpp"
 
 namespace pvb::sim {
 
+class CarryPath;
+
 class Simulator {
  public:
   /// Generates and compiles the scene, calibrates the drive kinematics and
   /// lets the robot settle on the ground.  Frame 0 is the settled state.
   explicit Simulator(scenes::Scenario scenario);
+  ~Simulator();
+  Simulator(Simulator&&) = delete;
 
   /// Frames in the scenario (duration x fps + 1).
   int frame_count() const { return scenes::frame_count(scenario_); }
@@ -30,11 +35,20 @@ class Simulator {
   /// Time of the current frame: exactly frame_index / fps.
   std::int64_t t_ns() const;
   /// Advances the physics by one camera period, steering at camera rate.
-  /// With a kidnap (scenario `kidnap:`), the frame kidnap_frames()->teleport
-  /// is the state kept at frame kidnap_frames()->target: the robot is
-  /// carried back there (pose, velocities, the route follower's progress)
-  /// and drives on from it; time goes on.
+  /// With a kidnap (scenario `kidnap:`), the robot is lifted at the first
+  /// covered frame and carried, its wheels still, along a smooth path to the
+  /// state kept at frame kidnap_frames()->target, which it reaches at frame
+  /// kidnap_frames()->teleport with that state's velocities; from there it
+  /// is that state (pose, velocities, the route follower's progress) and
+  /// drives on; time goes on.
   void advance();
+  /// The IMU and encoder readings (and their truth) since the last call.
+  MotionBatch take_motion() { return motion_ ? motion_->take() : MotionBatch{}; }
+  const MotionSensors& motion_sensors() const { return *motion_; }
+  /// The camera's optical frame in the robot's base (its free body).
+  geom::SE3d T_b_c() const;
+  /// Ground truth: the robot's base (free body frame: axle centre) in the world.
+  geom::SE3d T_w_b() const;
   /// The scenario's kidnap in frames, if it has one.
   const std::optional<scenes::KidnapFrames>& kidnap_frames() const { return kidnap_; }
 
@@ -66,6 +80,9 @@ class Simulator {
 
  private:
   void step_physics(int steps);
+  /// One camera period of the kidnap's carry (frames cover_begin..teleport).
+  void carry_steps(int steps);
+  bool carrying() const;
   /// Kidnap: keeps the state of the target frame, restores it at the teleport frame.
   void kidnap_step();
   scenes::Scenario scenario_;
@@ -80,10 +97,14 @@ class Simulator {
   int frame_ = 0;
   int camera_id_ = -1;
   int free_qpos_ = 0;
+  int free_dof_ = 0;
   int act_left_ = -1, act_right_ = -1;
   std::optional<scenes::KidnapFrames> kidnap_;
   DataPtr kidnap_data_;                           ///< the state at kidnap_->target
   std::optional<RouteFollower> kidnap_follower_;  ///< the follower at kidnap_->target
+  std::unique_ptr<MotionSensors> motion_;         ///< from frame 0 on
+  std::unique_ptr<CarryPath> carry_;        ///< while the kidnap carries the robot
+  int carry_step_ = 0;
 };
 
 /// One captured frame with its ground truth.
@@ -91,6 +112,8 @@ struct Capture {
   sensor::RgbdFrame frame;   ///< what the sensor delivers (noisy)
   cv::Mat depth_gt_m;        ///< rendered depth, exact, sky = 0
   geom::SE3d T_w_c;          ///< ground-truth camera pose
+  std::vector<ImuTruth> imu_truth;      ///< the truth behind frame.imu
+  std::vector<WheelTruth> wheel_truth;  ///< the truth behind frame.wheel_ticks
   double render_ms = 0;      ///< time spent rendering (GL + read-back)
   double sensor_ms = 0;      ///< time spent in the sensor model (depth and RGB noise)
 };
@@ -106,6 +129,7 @@ struct RenderedFrame {
   std::uint64_t index = 0;            ///< frame index
   std::int64_t t_ns = 0;
   geom::SE3d T_w_c;                   ///< ground-truth camera pose
+  MotionBatch motion;                 ///< motion sensor readings since the last rendered frame
   double render_ms = 0;               ///< GL rendering and read-back
 };
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "pvb/common/output_file.hpp"
+#include "pvb/dataset/motion_files.hpp"
 #include "pvb/geometry/pinhole.hpp"
 #include "pvb/geometry/se3.hpp"
 #include "pvb/sensor/depth_encoding.hpp"
@@ -37,6 +38,9 @@ struct OrbSlamSettings {
   std::optional<int> kf_min_tracked_close;
   /// pvbench's KeyFrame.refOverlap; written only when set.
   std::optional<double> kf_ref_overlap;
+  /// The IMU (ORB-SLAM3's IMU.* keys) and the robot (pvbench's Robot.*
+  /// keys); written only when set (ORB-SLAM2 ignores both).
+  std::optional<RobotCalibration> robot;
 };
 
 /// The settings as the text of an OpenCV FileStorage YAML file ORB-SLAM2 reads.

@@ -77,6 +77,9 @@ struct RunOptions {
 /// ORB-SLAM2 RGB-D settings for the scenario's camera (camera.yaml of
 /// `pvbench record` and of a run's report).
 dataset::OrbSlamSettings orbslam_settings_for(const scenes::Scenario& scenario);
+/// The scenario's IMU, encoders and mounts as a recording describes them
+/// (the nominal drive: sim::nominal_description).
+dataset::RobotCalibration robot_calibration_for(const scenes::Scenario& scenario);
 
 /// Where a run may start along the scenario's route: from 0 to 1 m before
 /// its end.  "" when `start_m` fits, else what was expected, e.g. "a

@@ -1,0 +1,53 @@
+#pragma once
+// The motion sensors' files of a recording (docs/sensors.md): EuRoC's
+// imu0/data.csv, TUM's accelerometer.txt, the raw encoder counts
+// (wheels.csv), an OpenLORIS-style odom.txt from those counts, Kalibr's
+// imu.yaml and the robot's description (robot.yaml).
+#include <string>
+#include <vector>
+
+#include "pvb/common/output_file.hpp"
+#include "pvb/geometry/se3.hpp"
+#include "pvb/sensor/rgbd_frame.hpp"
+#include "pvb/sensor/wheel_odometry.hpp"
+
+namespace pvb::dataset {
+
+/// Kalibr's IMU noise parameters (continuous time) and the sample rate.
+struct ImuCalibration {
+  double gyro_noise_density = 0;   ///< rad/s/sqrt(Hz)
+  double gyro_random_walk = 0;     ///< rad/s^2/sqrt(Hz)
+  double accel_noise_density = 0;  ///< m/s^2/sqrt(Hz)
+  double accel_random_walk = 0;    ///< m/s^3/sqrt(Hz)
+  double rate_hz = 200;
+};
+
+/// What a recording says of the robot carrying the camera.
+struct RobotCalibration {
+  ImuCalibration imu;
+  sensor::DriveDescription drive;        ///< nominal values
+  double encoder_rate_hz = 50;
+  geom::SE3d T_b_c = geom::SE3d::Identity();  ///< camera optical frame in the base
+  geom::SE3d T_b_i = geom::SE3d::Identity();  ///< IMU in the base
+};
+
+/// Kalibr's imu.yaml.
+std::string kalibr_imu_yaml(const ImuCalibration& c);
+/// robot.yaml: the nominal drive, the rates and both mounts.
+std::string robot_yaml(const RobotCalibration& c);
+
+/// Writes the readings that come with each frame; every file is flushed
+/// after each frame, so an interrupted recording keeps what it wrote.
+class MotionFilesWriter {
+ public:
+  /// Creates imu0/ in `dir` and the files, with imu.yaml and robot.yaml.
+  MotionFilesWriter(const std::string& dir, const RobotCalibration& c);
+  void write(const sensor::RgbdFrame& frame) { write(frame.imu, frame.wheel_ticks); }
+  void write(const std::vector<sensor::ImuSample>& imu, const std::vector<sensor::WheelTicks>& ticks);
+
+ private:
+  OutputFile imu_csv_, accel_txt_, wheels_csv_, odom_txt_;
+  sensor::WheelOdometry odometry_;
+};
+
+}  // namespace pvb::dataset

@@ -1,0 +1,99 @@
+#include "pvb/dataset/motion_files.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+
+#include "pvb/common/text.hpp"
+#include "pvb/dataset/tum_sequence.hpp"
+#include "pvb/geometry/time.hpp"
+
+namespace pvb::dataset {
+namespace {
+
+std::string g(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+/// A 4 x 4 transform as a YAML flow list of its 16 numbers, row by row.
+std::string matrix_row_major(const geom::SE3d& T) {
+  std::string out = "[";
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out += (r + c ? ", " : "") + g(T.matrix()(r, c));
+  return out + "]";
+}
+
+OutputFile open_with(const std::string& path, const std::string& header) {
+  OutputFile f(path);
+  f.append(header);
+  return f;
+}
+
+}  // namespace
+
+std::string kalibr_imu_yaml(const ImuCalibration& c) {
+  return "# Kalibr IMU noise model (continuous time), written by pvbench\n"
+         "rostopic: /imu0\n"
+         "update_rate: " + g(c.rate_hz) + "\n"
+         "accelerometer_noise_density: " + g(c.accel_noise_density) + "  # m/s^2/sqrt(Hz)\n"
+         "accelerometer_random_walk: " + g(c.accel_random_walk) + "  # m/s^3/sqrt(Hz)\n"
+         "gyroscope_noise_density: " + g(c.gyro_noise_density) + "  # rad/s/sqrt(Hz)\n"
+         "gyroscope_random_walk: " + g(c.gyro_random_walk) + "  # rad/s^2/sqrt(Hz)\n";
+}
+
+std::string robot_yaml(const RobotCalibration& c) {
+  return "# The robot's description (nominal values), written by pvbench.  Base frame b: the middle\n"
+         "# of the wheel axle, x forward, z up; camera c: optical (x right, y down, z forward);\n"
+         "# IMU i.  T_b_x maps points of frame x into the base (4 x 4, row by row).\n"
+         "wheel_radius_m: " + g(c.drive.wheel_radius_m) + "\n"
+         "track_m: " + g(c.drive.track_m) + "\n"
+         "ticks_per_rev: " + std::to_string(c.drive.ticks_per_rev) + "\n"
+         "encoder_rate_hz: " + g(c.encoder_rate_hz) + "\n"
+         "imu_rate_hz: " + g(c.imu.rate_hz) + "\n"
+         "T_b_c: " + matrix_row_major(c.T_b_c) + "\n"
+         "T_b_i: " + matrix_row_major(c.T_b_i) + "\n";
+}
+
+MotionFilesWriter::MotionFilesWriter(const std::string& dir, const RobotCalibration& c)
+    : imu_csv_(),
+      odometry_(c.drive) {
+  make_dirs(dir + "/imu0");
+  imu_csv_ = open_with(dir + "/imu0/data.csv",
+                       "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
+                       "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n");
+  accel_txt_ = open_with(dir + "/accelerometer.txt",
+                         "# accelerometer data\n# file: 'pvbench'\n# timestamp ax ay az\n");
+  wheels_csv_ = open_with(dir + "/wheels.csv", "#timestamp [ns],left [ticks],right [ticks]\n");
+  odom_txt_ = open_with(dir + "/odom.txt", "# wheel odometry of the base in the odometry frame\n"
+                                           "# timestamp tx ty tz qx qy qz qw vx vy vz wx wy wz\n");
+  write_file(dir + "/imu.yaml", kalibr_imu_yaml(c.imu));
+  write_file(dir + "/robot.yaml", robot_yaml(c));
+}
+
+void MotionFilesWriter::write(const std::vector<sensor::ImuSample>& imu_samples,
+                              const std::vector<sensor::WheelTicks>& ticks) {
+  std::string imu, accel, wheels, odom;
+  for (const sensor::ImuSample& s : imu_samples) {
+    const Eigen::Vector3d& w = s.gyro_radps;
+    const Eigen::Vector3d& a = s.accel_mps2;
+    imu += std::to_string(s.t_ns) + "," + g(w.x()) + "," + g(w.y()) + "," + g(w.z()) + "," + g(a.x()) + "," +
+           g(a.y()) + "," + g(a.z()) + "\n";
+    accel += geom::format_tum_time(s.t_ns) + " " + g(a.x()) + " " + g(a.y()) + " " + g(a.z()) + "\n";
+  }
+  for (const sensor::WheelTicks& t : ticks) {
+    wheels += std::to_string(t.t_ns) + "," + std::to_string(t.left) + "," + std::to_string(t.right) + "\n";
+    odometry_.add(t);
+    const sensor::OdometryState& o = odometry_.state();
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(o.yaw_rad, Eigen::Vector3d::UnitZ()));
+    odom += geom::format_tum_time(t.t_ns) + " " + g(o.x_m) + " " + g(o.y_m) + " 0 " + g(q.x()) + " " + g(q.y()) +
+            " " + g(q.z()) + " " + g(q.w()) + " " + g(o.v_mps) + " 0 0 0 0 " + g(o.w_radps) + "\n";
+  }
+  imu_csv_.append(imu);
+  accel_txt_.append(accel);
+  wheels_csv_.append(wheels);
+  odom_txt_.append(odom);
+}
+
+}  // namespace pvb::dataset
