@@ -67,9 +67,11 @@ YAML::Node parse(const std::string& text, const ReadContext& ctx) {
     if (ctx.errors == ErrorKind::kIo)
       throw IoError(ctx.file, "not valid " + format + ": nested too deeply for the parser", e.mark.line + 1);
     throw ConfigError(ctx.file + ":" + std::to_string(e.mark.line + 1), "(syntax)",
-                      format + " nested at most a few hundred levels deep", "nesting too deep for the parser");
+                      format + " nested at most a few hundred levels deep",
+                      "nesting too deep for the parser");
   } catch (const YAML::Exception& e) {
-    if (ctx.errors == ErrorKind::kIo) throw IoError(ctx.file, "not valid " + format + ": " + e.msg, e.mark.line + 1);
+    if (ctx.errors == ErrorKind::kIo)
+      throw IoError(ctx.file, "not valid " + format + ": " + e.msg, e.mark.line + 1);
     throw ConfigError(ctx.file + ":" + std::to_string(e.mark.line + 1), "(syntax)", "valid " + format, e.msg);
   }
   check_unique_keys(root, ctx);
@@ -224,7 +226,8 @@ YAML::Node MapReader::take(const std::string& key) {
   return n;
 }
 
-void MapReader::check_range(const std::string& key, const YAML::Node& n, double v, double lo, double hi) const {
+void MapReader::check_range(const std::string& key, const YAML::Node& n, double v, double lo,
+                            double hi) const {
   if (v >= lo && v <= hi) return;
   std::ostringstream ss;
   if (hi == kInf)

@@ -1,13 +1,12 @@
 // The strict YAML reader: every mistake is one error naming the file, the
 // line, the full key, what was expected and what was found.
-#include "pvb/common/yaml_reader.hpp"
-
 #include <gtest/gtest.h>
 
 #include <functional>
 #include <string>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/yaml_reader.hpp"
 
 using namespace pvb;
 
@@ -56,13 +55,16 @@ class LineFortyTwo : public yaml::KeyLocator {
 }  // namespace
 
 TEST(YamlReader, ADuplicateKeyNamesBothLinesAndTheFullKey) {
-  EXPECT_EQ(camera_error("camera:\n  depth_noise:\n    axial_scale: 2\n    axial_scale: 3\n"),
-            "cam.yaml:4: camera.depth_noise.axial_scale: expected each key once in its section (first given at "
-            "line 3), got a second axial_scale");
+  EXPECT_EQ(
+      camera_error("camera:\n  depth_noise:\n    axial_scale: 2\n    axial_scale: 3\n"),
+      "cam.yaml:4: camera.depth_noise.axial_scale: expected each key once in its section (first given at "
+      "line 3), got a second axial_scale");
   EXPECT_EQ(camera_error("camera: {fps: 15}\ncamera: {fps: 30}\n"),
-            "cam.yaml:2: camera: expected each key once in its section (first given at line 1), got a second camera");
-  EXPECT_EQ(camera_error("list:\n  - {a: 1, a: 2}\n"),
-            "cam.yaml:2: list[0].a: expected each key once in its section (first given at line 2), got a second a");
+            "cam.yaml:2: camera: expected each key once in its section (first given at line 1), got a second "
+            "camera");
+  EXPECT_EQ(
+      camera_error("list:\n  - {a: 1, a: 2}\n"),
+      "cam.yaml:2: list[0].a: expected each key once in its section (first given at line 2), got a second a");
   // The same key in two maps is no duplicate.
   EXPECT_EQ(camera_error("camera:\n  fps: 15\n  depth_noise: {fps: 1}\n"),
             "cam.yaml:3: camera.depth_noise.fps: expected a known key (axial_scale), got unknown key");
@@ -73,7 +75,8 @@ TEST(YamlReader, WrongTypesAndRangesNameTheLineOfTheValue) {
             "cam.yaml:4: camera.depth_noise.axial_scale: expected a number, got lots");
   EXPECT_EQ(camera_error("camera:\n  depth_noise:\n    axial_scale: [1]\n"),
             "cam.yaml:3: camera.depth_noise.axial_scale: expected a number, got a non-scalar");
-  EXPECT_EQ(camera_error("\n\ncamera:\n  fps: 500\n"), "cam.yaml:4: camera.fps: expected a value in [1, 240], got 500");
+  EXPECT_EQ(camera_error("\n\ncamera:\n  fps: 500\n"),
+            "cam.yaml:4: camera.fps: expected a value in [1, 240], got 500");
   EXPECT_EQ(camera_error("camera:\n  fps: 2.5\n"), "cam.yaml:2: camera.fps: expected an integer, got 2.5");
   EXPECT_EQ(camera_error("camera: 3\n"), "cam.yaml:1: camera: expected a mapping of keys");
   EXPECT_EQ(camera_error("camera: {fps: 15}\n"), "(no error)");
@@ -82,7 +85,8 @@ TEST(YamlReader, WrongTypesAndRangesNameTheLineOfTheValue) {
 TEST(YamlReader, UnknownKeysAreRefusedNamingTheKnownOnes) {
   EXPECT_EQ(camera_error("camera:\n  fps: 15\n  fsp: 15\n"),
             "cam.yaml:3: camera.fsp: expected a known key (depth_noise, fps), got unknown key");
-  EXPECT_EQ(camera_error("camera: {}\nlight: {}\n"), "cam.yaml:2: light: expected a known key (camera), got unknown key");
+  EXPECT_EQ(camera_error("camera: {}\nlight: {}\n"),
+            "cam.yaml:2: light: expected a known key (camera), got unknown key");
   // keys() refuses an unknown key before any value is read.
   const yaml::ReadContext ctx{"c.yaml"};
   const YAML::Node root = yaml::parse("name: 3\nspeed: x\n", ctx);
@@ -102,9 +106,12 @@ TEST(YamlReader, RequiredTextAndSyntaxErrors) {
   EXPECT_EQ(config_error([&] { r.text("name", true); }), "c.yaml:2: s.name: expected a value (required)");
   EXPECT_EQ(config_error([&] { r.text("empty", false); }), "c.yaml:3: s.empty: expected a non-empty string");
   EXPECT_EQ(r.text("absent", false), "");
-  EXPECT_EQ(config_error([] { yaml::parse("a: 1\nb: [1, 2\n", yaml::ReadContext{"s.yaml"}); }).rfind("s.yaml:", 0), 0u);
-  EXPECT_NE(config_error([] { yaml::parse("a: 1\nb: [1, 2\n", yaml::ReadContext{"s.yaml"}); })
-                .find(": (syntax): expected valid YAML, got "),
+  EXPECT_EQ(
+      config_error([] { yaml::parse("a: 1\nb: [1, 2\n", yaml::ReadContext{"s.yaml"}); }).rfind("s.yaml:", 0),
+      0u);
+  EXPECT_NE(config_error([] {
+              yaml::parse("a: 1\nb: [1, 2\n", yaml::ReadContext{"s.yaml"});
+            }).find(": (syntax): expected valid YAML, got "),
             std::string::npos);
 }
 
@@ -123,18 +130,21 @@ TEST(YamlReader, AKeyLocatorPlacesTheKeysOfAMergedDocument) {
 // number is a string, a key given twice is refused.
 TEST(YamlReader, JsonIsReadStrictlyWithIoErrors) {
   const yaml::ReadContext json{"m.json", nullptr, yaml::ErrorKind::kIo, true};
-  EXPECT_EQ(io_error([&] { yaml::parse("{\"frames\": 3,\n \"frames\": 4}\n", json); }),
-            "m.json:2: frames: expected each key once in its section (first given at line 1), got a second frames");
+  EXPECT_EQ(
+      io_error([&] { yaml::parse("{\"frames\": 3,\n \"frames\": 4}\n", json); }),
+      "m.json:2: frames: expected each key once in its section (first given at line 1), got a second frames");
   const YAML::Node root = yaml::parse("{\"a\": \"0.5\", \"b\": 0.5,\n \"c\": true}", json);
   double v = 0;
   EXPECT_FALSE(yaml::decode_number(root["a"], json, &v));
   EXPECT_TRUE(yaml::decode_number(root["b"], json, &v));
   EXPECT_EQ(yaml::shown(root["a"], json), "the string \"0.5\"");
   yaml::MapReader r(root, json, "x");
-  EXPECT_EQ(io_error([&] { r.number("a", 0, 0, 1); }), "m.json:1: x.a: expected a number, got the string \"0.5\"");
+  EXPECT_EQ(io_error([&] { r.number("a", 0, 0, 1); }),
+            "m.json:1: x.a: expected a number, got the string \"0.5\"");
   EXPECT_EQ(io_error([&] { r.text("d", true); }), "m.json:1: x.d: missing");
   EXPECT_EQ(io_error([&] { yaml::parse("{\"a\": [1,\n", json); }).rfind("m.json:", 0), 0u);
-  EXPECT_NE(io_error([&] { yaml::parse("{\"a\": [1,\n", json); }).find("not valid JSON: "), std::string::npos);
+  EXPECT_NE(io_error([&] { yaml::parse("{\"a\": [1,\n", json); }).find("not valid JSON: "),
+            std::string::npos);
 }
 
 TEST(YamlReader, ScalarDecodersRefuseWhatIsNotTheirType) {

@@ -38,10 +38,10 @@ enum class ErrorKind { kConfig, kIo };
 
 /// What every reader of one document shares.
 struct ReadContext {
-  std::string file;                      ///< the file given, as errors name it
-  const KeyLocator* locator = nullptr;   ///< where keys were written; null: each node's line
+  std::string file;                     ///< the file given, as errors name it
+  const KeyLocator* locator = nullptr;  ///< where keys were written; null: each node's line
   ErrorKind errors = ErrorKind::kConfig;
-  bool json = false;                     ///< JSON read by yaml-cpp: a quoted scalar is text, never a number
+  bool json = false;  ///< JSON read by yaml-cpp: a quoted scalar is text, never a number
 
   /// "FILE:LINE" of `key`: the locator's answer, else the line of `at` in
   /// the file given, else the file alone.
@@ -133,7 +133,8 @@ class MapReader {
 void with_map(MapReader& parent, const std::string& key, const std::function<void(MapReader&)>& fn);
 
 template <typename Enum>
-Enum MapReader::choice(const std::string& key, Enum def, const std::vector<std::pair<std::string, Enum>>& options) {
+Enum MapReader::choice(const std::string& key, Enum def,
+                       const std::vector<std::pair<std::string, Enum>>& options) {
   const YAML::Node n = take(key);
   if (!n) return def;
   std::string names;
