@@ -74,7 +74,8 @@ YAML::Node parse(const std::string& text, const ReadContext& ctx) {
       throw IoError(ctx.file, "not valid " + format + ": " + e.msg, e.mark.line + 1);
     throw ConfigError(ctx.file + ":" + std::to_string(e.mark.line + 1), "(syntax)", "valid " + format, e.msg);
   }
-  check_unique_keys(root, ctx);
+  // A document that is not a map is refused by its reader as a whole.
+  if (root.IsMap()) check_unique_keys(root, ctx);
   return root;
 }
 

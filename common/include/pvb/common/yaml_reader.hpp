@@ -61,8 +61,8 @@ std::string join(const std::string& path, const std::string& key);
 std::string shown(const YAML::Node& n, const ReadContext& ctx);
 
 /// Parses `text` (of ctx.file): a syntax error names the line ("(syntax):
-/// expected valid YAML, got ..."; JSON: "not valid JSON: ..."), then every
-/// mapping is checked for keys given twice.
+/// expected valid YAML, got ..."; JSON: "not valid JSON: ..."), then, when
+/// the document is a map, every mapping in it is checked for keys given twice.
 YAML::Node parse(const std::string& text, const ReadContext& ctx);
 /// Refuses a key given twice in one mapping of `n` (and below), naming the
 /// second one's line and the first's: "KEY: expected each key once in its
