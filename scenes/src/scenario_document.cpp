@@ -1,7 +1,6 @@
 #include "scenario_document.hpp"
 
 #include <sys/stat.h>
-#include <yaml-cpp/depthguard.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -61,24 +60,17 @@ YAML::Node parse_yaml(const std::string& text, const std::string& origin) {
     throw ConfigError(origin + ":" + std::to_string(line), "(file)", "YAML text (a NUL byte is never in one)",
                       "a NUL byte at byte " + std::to_string(nul));
   }
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::DeepRecursion& e) {
-    throw ConfigError(origin + ":" + std::to_string(e.mark.line + 1), "(syntax)",
-                      "YAML nested at most a few hundred levels deep", "nesting too deep for the parser");
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(origin + ":" + std::to_string(e.mark.line + 1), "(syntax)", "valid YAML", e.msg);
-  }
+  // Syntax errors, and a key given twice in one map (yaml-cpp keeps both
+  // and finds the first, so the second value would go unread and unchecked).
+  const YAML::Node root = yaml::parse(text, yaml::ReadContext{origin});
   if (!root.IsDefined() || root.IsNull())
     throw ConfigError(origin, "(top level)", "a scenario mapping", "an empty file");
   if (!root.IsMap()) throw ConfigError(origin + ":1", "(top level)", "a mapping of keys");
   return root;
 }
 
-/// Records where every key of `n` was written, and refuses a key given
-/// twice in one map: yaml-cpp keeps both and finds the first, so the second
-/// value would go unread and unchecked.
+/// Records where every key of `n` was written (each key once in its map:
+/// parse_yaml checked).
 void collect_origins(const YAML::Node& n, const std::string& file, int depth, const std::string& path,
                      KeyOrigins* origins) {
   if (n.IsSequence()) {
@@ -90,18 +82,10 @@ void collect_origins(const YAML::Node& n, const std::string& file, int depth, co
     return;
   }
   if (!n.IsMap()) return;
-  std::map<std::string, int> first_line;
   for (const auto& kv : n) {
     if (!kv.first.IsScalar()) continue;  // the reader names a non-scalar key
-    const std::string key = kv.first.Scalar();
-    const std::string full = path.empty() ? key : path + "." + key;
-    const int line = kv.first.Mark().line + 1;
-    const auto [seen, fresh] = first_line.emplace(key, line);
-    if (!fresh)
-      throw ConfigError(file + ":" + std::to_string(line), full,
-                        "each key once in its section (first given at line " + std::to_string(seen->second) + ")",
-                        "a second " + key);
-    origins->set(full, {file, line, depth});
+    const std::string full = path.empty() ? kv.first.Scalar() : path + "." + kv.first.Scalar();
+    origins->set(full, {file, kv.first.Mark().line + 1, depth});
     collect_origins(kv.second, file, depth, full, origins);
   }
 }

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "pvb/common/yaml_reader.hpp"
+
 namespace pvb::scenes::detail {
 
 /// Where a key was written: its file, line (1-based) and how many bases
@@ -22,9 +24,11 @@ struct KeyOrigin {
 };
 
 /// The origin of every key of a document, by its full path ("route.aisle",
-/// "pv_arrays[1].dirt"; "pv_arrays[1]" is the list item itself).
-class KeyOrigins {
+/// "pv_arrays[1].dirt"; "pv_arrays[1]" is the list item itself).  The
+/// reader's errors name the line a key was written on through it.
+class KeyOrigins : public yaml::KeyLocator {
  public:
+  std::string locate(const std::string& key) const override { return where(key, ""); }
   void set(const std::string& key, const KeyOrigin& origin) { map_[key] = origin; }
   const KeyOrigin* find(const std::string& key) const;
   /// Forgets `key` and everything below it (key.*, key[*]).

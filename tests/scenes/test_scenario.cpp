@@ -415,6 +415,22 @@ TEST(Scenario, DuplicateKeysAreRefusedWithBothLines) {
   EXPECT_EQ(error_of(std::string(kMinimal) + "camera: {fps: 15}\nlight: {ambient: 0.3}\nrobot: {track_m: 0.4}\n"), "");
 }
 
+// Three levels down, the error names the full key and the line of the value.
+TEST(Scenario, NestedMistakesNameTheFullKeyAndItsLine) {
+  const std::string cam = std::string(kMinimal) + "camera:\n  fps: 15\n  depth_noise:\n";
+  std::string e = error_of(cam + "    axial_scale: 0.5\n    axial_scale: 2\n");
+  EXPECT_NE(e.find("bad.yaml:6: camera.depth_noise.axial_scale: expected each key once in its section (first given at "
+                   "line 5), got a second axial_scale"),
+            std::string::npos)
+      << e;
+  e = error_of(cam + "    axial_scale: [2]\n");
+  EXPECT_NE(e.find("bad.yaml:5: camera.depth_noise.axial_scale: expected a number, got a non-scalar"), std::string::npos)
+      << e;
+  e = error_of(cam + "    axial_scale: 2\n    axial_scael: 2\n");
+  EXPECT_NE(e.find("bad.yaml:6: camera.depth_noise.axial_scael: expected a known key ("), std::string::npos) << e;
+  EXPECT_NE(e.find("got unknown key"), std::string::npos) << e;
+}
+
 TEST(Scenario, KidnapTimesAreJudgedByTheKeyThatIsWrong) {
   const std::string base = std::string(kMinimal) + "duration_s: 20\nkidnap:\n";
   // A cover shorter than one frame period is refused even where it happens

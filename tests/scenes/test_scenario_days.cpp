@@ -224,6 +224,13 @@ TEST(ScenarioDays, ErrorsNameTheFileTheValueCameFrom) {
   EXPECT_NE(e.find("day2.yaml:4: camera.rgb.sigma: expected a value in [0, 100], got -1"), std::string::npos) << e;
   e = f.error_of("dup.yaml", "base: station.yaml\nseed: 1\nseed: 2\n");
   EXPECT_NE(e.find("dup.yaml:3: seed: expected each key once in its section"), std::string::npos) << e;
+  // A key given twice in a base is named at the base's line.
+  f.write("dup_base.yaml", std::string(kStation) + "camera: {fps: 15, fps: 20}\n");
+  e = f.error_of("day3.yaml", "base: dup_base.yaml\nseed: 1\n");
+  EXPECT_NE(e.find(f.dir() + "/dup_base.yaml:8: camera.fps: expected each key once in its section (first given at "
+                             "line 8), got a second fps"),
+            std::string::npos)
+      << e;
 }
 
 // Trackers: the angle of true tracking with backtracking for the day's sun,

@@ -36,8 +36,7 @@ std::string read_status(const JsonFields& f, const YAML::Node& s, int version) {
   const std::string status = f.text(s, "status");
   if (!kRunStatuses.count(status) && (version == 1 || !kOtherStatuses.count(status)))
     f.fail(s["status"], "status",
-           "expected one of " + (version == 1 ? one_of(kRunStatuses) : one_of(kRunStatuses, kOtherStatuses)) +
-               ", got " + status);
+           "one of " + (version == 1 ? one_of(kRunStatuses) : one_of(kRunStatuses, kOtherStatuses)), status);
   return status;
 }
 
@@ -46,17 +45,17 @@ std::string read_status(const JsonFields& f, const YAML::Node& s, int version) {
 void read_localisation(const JsonFields& f, const YAML::Node& s, CampaignSessionMetrics* m) {
   const YAML::Node report = s["map_report"];
   if (JsonFields::absent(s, "map_report")) return;
-  if (!report.IsMap()) f.fail(report, "map_report", "expected an object or null");
+  if (!report.IsMap()) f.fail(report, "map_report", "an object or null");
   const YAML::Node l = report["localisation"];
   if (JsonFields::absent(report, "localisation")) return;
   const JsonFields lf = f.nested("map_report.localisation.");
-  if (!l.IsMap()) f.fail(l, "map_report.localisation", "expected an object or null");
+  if (!l.IsMap()) f.fail(l, "map_report.localisation", "an object or null");
   const int frames = lf.integer(l, "frames", 0);
   const YAML::Node within = lf.required(l, "within");
-  if (!within.IsMap()) lf.fail(within, "within", "expected an object");
+  if (!within.IsMap()) lf.fail(within, "within", "an object");
   for (const char* k : {"fine", "high"}) {
     const YAML::Node c = lf.nested("within.").required(within, k);
-    if (!c.IsMap()) lf.fail(c, std::string("within.") + k, "expected an object");
+    if (!c.IsMap()) lf.fail(c, std::string("within.") + k, "an object");
     (k[0] == 'f' ? m->share_fine : m->share_high) =
         lf.nested(std::string("within.") + k + ".").share(c, "share");
   }
@@ -66,12 +65,12 @@ void read_localisation(const JsonFields& f, const YAML::Node& s, CampaignSession
 }
 
 CampaignSessionMetrics read_session(const JsonFields& f, const YAML::Node& s, int version) {
-  if (!s.IsMap()) f.fail(s, "", "expected an object");
+  if (!s.IsMap()) f.fail(s, "", "an object");
   CampaignSessionMetrics m;
   m.name = f.text(s, "name");
   m.mode = f.text(s, "mode");
   if (m.mode != "map" && m.mode != "localise" && m.mode != "extend")
-    f.fail(s["mode"], "mode", "expected one of map, localise, extend, got " + m.mode);
+    f.fail(s["mode"], "mode", "one of map, localise, extend", m.mode);
   m.map = JsonFields::absent(s, "map") ? "" : f.text(s, "map");
   m.status = read_status(f, s, version);
   m.error = JsonFields::absent(s, "error") ? "" : f.text(s, "error");
@@ -84,8 +83,7 @@ CampaignSessionMetrics read_session(const JsonFields& f, const YAML::Node& s, in
       for (const char* key : kFigures)
         if (!JsonFields::absent(s, key))
           f.fail(s[key], key,
-                 "expected null for a session that did not run (" + m.status + "), got " +
-                     JsonFields::shown(s[key]));
+                 "null for a session that did not run (" + m.status + ")", JsonFields::shown(s[key]));
     return m;
   }
   m.frames = f.integer(s, "frames", 0);
@@ -109,7 +107,7 @@ void read_campaign_file(const std::string& path, CampaignSeed* c) {
   c->campaign = f.text(root, "campaign");
   if (!JsonFields::absent(root, "seed")) c->file_seed = f.seed(root, "seed");
   const YAML::Node sessions = f.required(root, "sessions");
-  if (!sessions.IsSequence()) f.fail(sessions, "sessions", "expected a list");
+  if (!sessions.IsSequence()) f.fail(sessions, "sessions", "a list");
   for (std::size_t i = 0; i < sessions.size(); ++i)
     c->sessions.push_back(
         read_session(f.nested("sessions[" + std::to_string(i) + "]."), sessions[i], c->version));

@@ -1,8 +1,7 @@
 #include "json_fields.hpp"
 
-#include <yaml-cpp/depthguard.h>
-
 #include <cmath>
+#include <cstdint>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
@@ -26,33 +25,34 @@ std::string range_text(double lo, double hi, bool whole, const std::string& boun
 }  // namespace
 
 YAML::Node load_json_object(const std::string& path) {
-  const std::string text = read_file(path);
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::DeepRecursion& e) {
-    throw IoError(path, "not valid JSON: nested too deeply for the parser", e.mark.line + 1);
-  } catch (const YAML::Exception& e) {
-    throw IoError(path, "not valid JSON: " + e.msg, e.mark.line + 1);
-  }
+  const yaml::ReadContext ctx{path, nullptr, yaml::ErrorKind::kIo, true};
+  YAML::Node root = yaml::parse(read_file(path), ctx);
   if (!root.IsMap()) throw IoError(path, "expected a JSON object at the top level");
   return root;
 }
 
-void JsonFields::fail(const YAML::Node& at, const std::string& key, const std::string& what) const {
-  const YAML::Mark m = at.Mark();
-  throw IoError(path_, prefix_ + key + ": " + what, m.line >= 0 ? m.line + 1 : 0);
+std::string JsonFields::name(const std::string& key) const {
+  if (!key.empty()) return prefix_ + key;
+  // The prefix's own object: "loss_events[0]." names loss_events[0].
+  return !prefix_.empty() && prefix_.back() == '.' ? prefix_.substr(0, prefix_.size() - 1) : prefix_;
 }
+
+void JsonFields::fail(const YAML::Node& at, const std::string& key, const std::string& expected,
+                      const std::string& got) const {
+  ctx_.fail(name(key), at, expected, got);
+}
+
+void JsonFields::missing(const YAML::Node& at, const std::string& key) const { ctx_.missing(name(key), at); }
 
 YAML::Node JsonFields::required(const YAML::Node& obj, const std::string& key) const {
   const YAML::Node n = obj[key];
-  if (!n.IsDefined()) fail(obj, key, "missing");
+  if (!n.IsDefined()) missing(obj, key);
   return n;
 }
 
 std::string JsonFields::shown(const YAML::Node& n) {
-  if (!n.IsScalar()) return n.IsNull() ? "null" : "a list or an object";
-  return n.Tag() == "!" ? "the string \"" + n.Scalar() + "\"" : n.Scalar();
+  static const yaml::ReadContext json{"", nullptr, yaml::ErrorKind::kIo, true};
+  return yaml::shown(n, json);
 }
 
 double JsonFields::number(const YAML::Node& obj, const std::string& key, double lo, double hi,
@@ -63,10 +63,8 @@ double JsonFields::number(const YAML::Node& obj, const std::string& key, double 
 double JsonFields::number_at(const YAML::Node& n, const std::string& key, double lo, double hi,
                              const std::string& bound_name) const {
   double v = 0;
-  if (!is_plain_scalar(n) || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
-    fail(n, key, "expected a number, got " + shown(n));
-  if (v < lo || v > hi)
-    fail(n, key, "expected a number" + range_text(lo, hi, false, bound_name) + ", got " + shown(n));
+  if (!yaml::decode_number(n, ctx_, &v)) fail(n, key, "a number", shown(n));
+  if (v < lo || v > hi) fail(n, key, "a number" + range_text(lo, hi, false, bound_name), shown(n));
   return v;
 }
 
@@ -78,26 +76,21 @@ int JsonFields::integer(const YAML::Node& obj, const std::string& key, long long
 int JsonFields::integer_at(const YAML::Node& n, const std::string& key, long long lo, long long hi,
                            const std::string& bound_name) const {
   long long v = 0;
-  if (!is_plain_scalar(n) || !YAML::convert<long long>::decode(n, v) || v < INT_MIN || v > INT_MAX)
-    fail(n, key, "expected an integer, got " + shown(n));
-  if (v < lo || v > hi)
-    fail(n, key,
-         "expected an integer" + range_text(double(lo), double(hi), true, bound_name) + ", got " + shown(n));
+  if (!yaml::decode_integer(n, ctx_, &v) || v < INT_MIN || v > INT_MAX) fail(n, key, "an integer", shown(n));
+  if (v < lo || v > hi) fail(n, key, "an integer" + range_text(double(lo), double(hi), true, bound_name), shown(n));
   return static_cast<int>(v);
 }
 
 unsigned long long JsonFields::seed(const YAML::Node& obj, const std::string& key) const {
   const YAML::Node n = required(obj, key);
-  unsigned long long v = 0;
-  if (!is_plain_scalar(n) || n.Scalar().empty() || n.Scalar()[0] == '-' ||
-      !YAML::convert<unsigned long long>::decode(n, v))
-    fail(n, key, "expected a non-negative integer, got " + shown(n));
+  std::uint64_t v = 0;
+  if (!yaml::decode_seed(n, ctx_, &v)) fail(n, key, "a non-negative integer", shown(n));
   return v;
 }
 
 std::string JsonFields::text(const YAML::Node& obj, const std::string& key) const {
   const YAML::Node n = required(obj, key);
-  if (!n.IsScalar()) fail(n, key, "expected a string");
+  if (!n.IsScalar()) fail(n, key, "a string");
   return n.Scalar();
 }
 

@@ -1,18 +1,24 @@
 #pragma once
 // Checked fields of the JSON files pvbench reads back (metrics.json,
-// campaign.json), read with yaml-cpp (which parses JSON).  Every mistake is
-// an IoError naming the file, the line and the key; a quoted number is a
-// string, NaN and infinities are not numbers, and a value outside its range
-// is refused rather than averaged.
+// campaign.json), read with the project's strict reader
+// (pvb/common/yaml_reader.hpp, which parses JSON with yaml-cpp).  Every
+// mistake is an IoError naming the file, the line and the key, a key given
+// twice in one object is refused; a quoted number is a string, NaN and
+// infinities are not numbers, and a value outside its range is refused
+// rather than averaged.  Keys the reader does not know are left alone: a
+// metrics.json holds far more than what is read back.
 #include <yaml-cpp/yaml.h>
 
 #include <climits>
 #include <limits>
 #include <string>
 
+#include "pvb/common/yaml_reader.hpp"
+
 namespace pvb::suite::detail {
 
-/// Reads `path` (a regular file) as a JSON object; IoError when it is not one.
+/// Reads `path` (a regular file) as a JSON object, each key once in its
+/// object; IoError when it is not one.
 /// Keep the node non-const: a const node's missing key is an invalid node
 /// that throws when asked its type.
 YAML::Node load_json_object(const std::string& path);
@@ -20,14 +26,19 @@ YAML::Node load_json_object(const std::string& path);
 class JsonFields {
  public:
   /// `prefix` names nested keys in errors ("baseline.", "sessions[2].").
-  JsonFields(std::string path, std::string prefix) : path_(std::move(path)), prefix_(std::move(prefix)) {}
+  JsonFields(std::string path, std::string prefix)
+      : ctx_{std::move(path), nullptr, yaml::ErrorKind::kIo, true}, prefix_(std::move(prefix)) {}
 
-  const std::string& path() const { return path_; }
+  const std::string& path() const { return ctx_.file; }
   const std::string& prefix() const { return prefix_; }
   /// The same file, keys under `more` ("loss_events[0].").
-  JsonFields nested(const std::string& more) const { return JsonFields(path_, prefix_ + more); }
+  JsonFields nested(const std::string& more) const { return JsonFields(ctx_.file, prefix_ + more); }
 
-  [[noreturn]] void fail(const YAML::Node& at, const std::string& key, const std::string& what) const;
+  /// "FILE:LINE: PREFIX.KEY: expected EXPECTED[, got GOT]" (key "": the prefix's own object).
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& key, const std::string& expected,
+                         const std::string& got = {}) const;
+  /// "FILE:LINE: PREFIX.KEY: missing", at the line of the object `at`.
+  [[noreturn]] void missing(const YAML::Node& at, const std::string& key) const;
   YAML::Node required(const YAML::Node& obj, const std::string& key) const;
 
   /// yaml-cpp reads JSON, and would decode the string "0.003" as a number:
@@ -64,7 +75,10 @@ class JsonFields {
   }
 
  private:
-  std::string path_;
+  /// The full key: the prefix, then `key`.
+  std::string name(const std::string& key) const;
+
+  yaml::ReadContext ctx_;
   std::string prefix_;
 };
 

@@ -9,6 +9,7 @@
 #include "json_fields.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/common/yaml_reader.hpp"
 #include "pvb/eval/slam_mode.hpp"
 
 namespace pvb::suite {
@@ -24,7 +25,7 @@ class Reader : public detail::JsonFields {
                                         const std::string& sub) const {
     const YAML::Node n = obj[key];
     if (!n.IsDefined() || n.IsNull()) return std::nullopt;
-    if (!n.IsMap()) fail(n, key, "expected an object or null");
+    if (!n.IsMap()) fail(n, key, "an object or null");
     return nested(key + ".").number(n, sub, 0.0);
   }
 
@@ -35,13 +36,13 @@ class Reader : public detail::JsonFields {
     if (n.IsNull()) return std::nullopt;
     std::string name = key;
     for (const auto& p : path) {
-      if (!n.IsMap()) fail(n, name, "expected an object or null");
+      if (!n.IsMap()) fail(n, name, "an object or null");
       const YAML::Node child = n[p];
-      if (!child.IsDefined()) fail(n, name + "." + p, "missing");
+      if (!child.IsDefined()) missing(n, name + "." + p);
       n = child;
       name += "." + p;
     }
-    if (!n.IsMap()) fail(n, name, "expected an object");
+    if (!n.IsMap()) fail(n, name, "an object");
     return nested(name + ".").number(n, "rmse", 0.0);
   }
 
@@ -49,11 +50,11 @@ class Reader : public detail::JsonFields {
   std::vector<LossEvent> loss_events(const YAML::Node& obj) const {
     const YAML::Node events = obj["loss_events"];
     if (!events.IsDefined() || events.IsNull()) return {};
-    if (!events.IsSequence()) fail(events, "loss_events", "expected a list");
+    if (!events.IsSequence()) fail(events, "loss_events", "a list");
     std::vector<LossEvent> out;
     for (std::size_t i = 0; i < events.size(); ++i) {
       const Reader inner(path(), prefix() + "loss_events[" + std::to_string(i) + "].");
-      if (!events[i].IsMap()) inner.fail(events[i], "", "expected an object");
+      if (!events[i].IsMap()) inner.fail(events[i], "", "an object");
       LossEvent e;
       e.frame = inner.integer(events[i], "frame", 0);
       if (events[i]["t_s"].IsDefined()) e.t_s = inner.number(events[i], "t_s", 0.0);
@@ -68,12 +69,12 @@ class Reader : public detail::JsonFields {
   }
 
   RunMetrics run(const YAML::Node& obj) const {
-    if (!obj.IsMap()) fail(obj, "(top level)", "expected a JSON object");
+    if (!obj.IsMap()) fail(obj, "(top level)", "a JSON object");
     RunMetrics r;
     if (obj["mode"].IsDefined()) r.mode = eval::normalized_mode(text(obj, "mode"));
     r.status = text(obj, "status");
     if (r.status != "completed" && r.status != "interrupted" && r.status != "aborted" && r.status != "failed")
-      fail(obj["status"], "status", "expected completed, interrupted, aborted or failed, got " + r.status);
+      fail(obj["status"], "status", "completed, interrupted, aborted or failed", r.status);
     r.frames = integer(obj, "frames", 0);
     r.lost_frames = integer(obj, "lost_frames", 0, r.frames, "frames");
     if (!absent(obj, "keyframes")) r.keyframes = integer(obj, "keyframes", 0);
@@ -87,7 +88,7 @@ class Reader : public detail::JsonFields {
     r.maps = maps(obj);
     const YAML::Node cover = obj["camera_covered_frames"];
     if (cover.IsDefined() && !cover.IsNull()) {
-      if (!cover.IsSequence() || cover.size() != 2) fail(cover, "camera_covered_frames", "expected [first, last]");
+      if (!cover.IsSequence() || cover.size() != 2) fail(cover, "camera_covered_frames", "[first, last]");
       const int first = integer_at(cover[0], "camera_covered_frames[0]", 0);
       r.camera_covered_frames = {first,
                                  integer_at(cover[1], "camera_covered_frames[1]", first, INT_MAX, "first")};
@@ -99,10 +100,10 @@ class Reader : public detail::JsonFields {
   std::vector<MapMetrics> maps(const YAML::Node& obj) const {
     const YAML::Node d = obj["dense_map"];
     if (!d.IsDefined() || d.IsNull()) return {};
-    if (!d.IsMap()) fail(d, "dense_map", "expected an object or null");
+    if (!d.IsMap()) fail(d, "dense_map", "an object or null");
     const YAML::Node maps = d["maps"];
     if (!maps.IsDefined()) return {};
-    if (!maps.IsMap()) fail(maps, "dense_map.maps", "expected an object");
+    if (!maps.IsMap()) fail(maps, "dense_map.maps", "an object");
     std::vector<MapMetrics> out;
     for (const auto& kv : maps) {
       const std::string name = kv.first.Scalar();
@@ -110,7 +111,7 @@ class Reader : public detail::JsonFields {
       const YAML::Node all = in.required(kv.second, "all");
       const JsonFields all_in = in.nested("all.");
       const YAML::Node comp = all_in.required(all, "completeness_at");
-      if (!comp.IsSequence() || comp.size() < 3) all_in.fail(comp, "completeness_at", "expected 4 shares (1, 2, 5, 10 cm)");
+      if (!comp.IsSequence() || comp.size() < 3) all_in.fail(comp, "completeness_at", "4 shares (1, 2, 5, 10 cm)");
       MapMetrics m;
       m.name = name;
       const YAML::Node acc = all_in.required(all, "accuracy_m");
@@ -130,7 +131,7 @@ class Reader : public detail::JsonFields {
   std::optional<PlaceMetrics> place(const YAML::Node& obj) const {
     const YAML::Node n = obj["place_recognition"];
     if (!n.IsDefined() || n.IsNull()) return std::nullopt;
-    if (!n.IsMap()) fail(n, "place_recognition", "expected an object or null");
+    if (!n.IsMap()) fail(n, "place_recognition", "an object or null");
     const JsonFields in = nested("place_recognition.");
     PlaceMetrics p;
     p.loops_proposed = in.integer(n, "loops_proposed", 0);
@@ -180,8 +181,9 @@ MetricsFile read_metrics_file(const std::string& path) {
     const int v = top.integer(root, "metrics_version");
     if (v < 1 || v > eval::kMetricsVersion)
       top.fail(version, "metrics_version",
-               "expected 1 to " + std::to_string(eval::kMetricsVersion) + " (this pvbench reads up to version " +
-                   std::to_string(eval::kMetricsVersion) + "), got " + std::to_string(v));
+               "1 to " + std::to_string(eval::kMetricsVersion) + " (this pvbench reads up to version " +
+                   std::to_string(eval::kMetricsVersion) + ")",
+               std::to_string(v));
     m.version = v;
   }
   if (root["scenario"].IsDefined()) m.scenario = top.text(root, "scenario");
@@ -190,7 +192,7 @@ MetricsFile read_metrics_file(const std::string& path) {
   m.primary = top.run(root);
   const YAML::Node base = root["baseline"];
   if (base.IsDefined() && !base.IsNull()) {
-    if (!base.IsMap()) top.fail(base, "baseline", "expected an object");
+    if (!base.IsMap()) top.fail(base, "baseline", "an object");
     m.baseline = Reader(path, "baseline.").run(base);
   }
   return m;
@@ -216,12 +218,8 @@ std::optional<FolderIdentity> read_folder_identity(const std::string& dir) {
     return FolderIdentity{metrics, m.scenario, m.seed, m.station_seed, m.station_file};
   }
   if (::stat(meta.c_str(), &st) != 0) return std::nullopt;
-  YAML::Node root;
-  try {
-    root = YAML::Load(read_file(meta));
-  } catch (const YAML::Exception& e) {
-    throw IoError(meta, "not valid JSON: " + e.msg, e.mark.line + 1);
-  }
+  const yaml::ReadContext json{meta, nullptr, yaml::ErrorKind::kIo, true};
+  YAML::Node root = yaml::parse(read_file(meta), json);
   FolderIdentity id{meta, "", std::nullopt, std::nullopt, ""};
   const YAML::Node name = root.IsMap() && root["scenario"].IsMap() ? root["scenario"]["name"] : YAML::Node();
   if (name.IsDefined() && name.IsScalar()) id.scenario = name.Scalar();

@@ -81,6 +81,33 @@ TEST(Campaign, MistakesAreOneLineNamingFileLineAndKey) {
   EXPECT_NE(e.find("sessions: expected a list of at least one session"), std::string::npos) << e;
 }
 
+// A campaign is read by the scenarios' strict reader: a key given twice in
+// a session, an unknown key and a wrong type each name the line and the key.
+TEST(Campaign, SessionsAreReadStrictly) {
+  std::string e = error_of("name: c\nsessions:\n  - {name: a, scenario: STATION, mode: map, name: b}\n");
+  EXPECT_NE(e.find("c.yaml:3: sessions[0].name: expected each key once in its section (first given at line 3), got a "
+                   "second name"),
+            std::string::npos)
+      << e;
+  e = error_of("name: c\nsessions:\n  - name: a\n    scenario: STATION\n    mode: map\n    mode: extend\n");
+  EXPECT_NE(e.find("c.yaml:6: sessions[0].mode: expected each key once in its section (first given at line 5)"),
+            std::string::npos)
+      << e;
+  e = error_of("name: c\nsessions:\n  - name: a\n    scenario: STATION\n    mode: map\n    start: 3\n");
+  EXPECT_NE(e.find("c.yaml:6: sessions[0].start: expected a known key (map, mode, name, scenario, start_m), got unknown "
+                   "key"),
+            std::string::npos)
+      << e;
+  e = error_of("name: c\nsessions:\n  - name: a\n    scenario: STATION\n    mode: [map]\n");
+  EXPECT_NE(e.find("c.yaml:5: sessions[0].mode: expected a non-empty string"), std::string::npos) << e;
+  e = error_of("name: c\nsessions:\n  - name: a\n    scenario: STATION\n    mode: map\n    start_m: near\n");
+  EXPECT_NE(e.find("c.yaml:6: sessions[0].start_m: expected a distance along the route in metres, >= 0, got near"),
+            std::string::npos)
+      << e;
+  e = error_of("description: d\nsessions:\n  - {name: a, scenario: STATION, mode: map}\n");
+  EXPECT_NE(e.find("c.yaml:1: name: expected a value (required)"), std::string::npos) << e;
+}
+
 // A session may not take the name of what the campaign writes beside the
 // sessions' folders: a session "maps" would run in the maps folder.
 TEST(Campaign, ANameTheCampaignWritesItselfIsRefused) {

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include "pvb/common/error.hpp"
@@ -240,6 +241,46 @@ TEST(SuiteCheck, ValuesOutOfRangeAreRefusedNamingFileLineAndKey) {
   EXPECT_EQ(message("dense_map.json", "[600, 659]", "[\"600\", 659]"),
             f + "5: camera_covered_frames[0]: expected an integer, got the string \"600\"");
   std::remove(path.c_str());
+}
+
+// yaml-cpp keeps both of two equal keys and finds the first: a key given
+// twice in one object is refused, read or not, naming both lines.
+TEST(SuiteCheck, DuplicateKeysInMetricsAreRefused) {
+  const std::string path = ::testing::TempDir() + "pvb_metrics_dup_" + std::to_string(::getpid()) + ".json";
+  auto message = [&path](const std::string& from, const std::string& to) {
+    std::string text = read_file(suite_fixture("good_compare.json"));
+    const std::size_t at = text.find(from);
+    if (at == std::string::npos) return "(" + from + " not in good_compare.json)";
+    write_file(path, text.replace(at, from.size(), to));
+    try {
+      suite::read_metrics_file(path);
+    } catch (const IoError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  const std::string f = path + ":";
+  EXPECT_EQ(message("\"frames\": 300,", "\"frames\": 300,\n  \"frames\": 3,"),
+            f + "6: frames: expected each key once in its section (first given at line 5), got a second frames");
+  EXPECT_EQ(message("\"count\": 300}", "\"count\": 300, \"count\": 1}"),
+            f + "6: ate.count: expected each key once in its section (first given at line 6), got a second count");
+  EXPECT_EQ(message("\"mode\": \"orb-slam2\",", "\"mode\": \"orb-slam2\", \"mode\": \"pe-slam\","),
+            f + "14: baseline.mode: expected each key once in its section (first given at line 14), got a second mode");
+  // Wrong types name the line too.
+  EXPECT_EQ(message("\"keyframes\": 21", "\"keyframes\": [21]"),
+            f + "5: keyframes: expected an integer, got a list or an object");
+  std::remove(path.c_str());
+  // The folder's identity is read the same way from meta.json.
+  const std::string dir = ::testing::TempDir() + "pvb_meta_dup_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  write_file(dir + "/meta.json", "{\"seed\": 1,\n \"seed\": 2}\n");
+  try {
+    suite::read_folder_identity(dir);
+    ADD_FAILURE() << "accepted";
+  } catch (const IoError& e) {
+    EXPECT_EQ(std::string(e.what()), dir + "/meta.json:2: seed: expected each key once in its section (first given "
+                                            "at line 1), got a second seed");
+  }
 }
 
 // A run of another scenario or seed is refused, not judged by the wrong bounds.
