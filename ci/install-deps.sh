@@ -10,6 +10,7 @@ PKGS=(
   libopenni2-dev
   libnanoflann-dev   # k-d trees for map accuracy
   nlohmann-json3-dev # the tests parse every JSON file pvbench writes with a strict parser
+  python3 python3-yaml   # the tests read the motion files back with Python's csv and yaml modules
   libfreenect-dev libfreenect0.5 libfreenect-bin   # Kinect v1 plug-in and fakenect playback
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev   # the libFuzzer targets (ci/fuzz.sh)

@@ -163,6 +163,13 @@ std::string format_g(double v, int significant_digits) {
   return buf;
 }
 
+std::string format_real(double v) {
+  std::string s = format_g(v, 9);
+  if (s.find_first_of(".n") != std::string::npos) return s;  // a point, or nan / inf
+  const std::size_t e = s.find('e');
+  return e == std::string::npos ? s + ".0" : s.insert(e, ".0");
+}
+
 std::string format_exact(double v) {
   char buf[64];
   for (int digits = 6; digits < 17; ++digits) {

@@ -11,17 +11,14 @@
 namespace pvb::dataset {
 namespace {
 
-std::string g(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
+std::string g(double v) { return format_g(v, 9); }
+std::string r(double v) { return format_real(v); }
 
 /// A 4 x 4 transform as a YAML flow list of its 16 numbers, row by row.
 std::string matrix_row_major(const geom::SE3d& T) {
   std::string out = "[";
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) out += (r + c ? ", " : "") + g(T.matrix()(r, c));
+  for (int row = 0; row < 4; ++row)
+    for (int c = 0; c < 4; ++c) out += (row + c ? ", " : "") + format_real(T.matrix()(row, c));
   return out + "]";
 }
 
@@ -36,22 +33,22 @@ OutputFile open_with(const std::string& path, const std::string& header) {
 std::string kalibr_imu_yaml(const ImuCalibration& c) {
   return "# Kalibr IMU noise model (continuous time), written by pvbench\n"
          "rostopic: /imu0\n"
-         "update_rate: " + g(c.rate_hz) + "\n"
-         "accelerometer_noise_density: " + g(c.accel_noise_density) + "  # m/s^2/sqrt(Hz)\n"
-         "accelerometer_random_walk: " + g(c.accel_random_walk) + "  # m/s^3/sqrt(Hz)\n"
-         "gyroscope_noise_density: " + g(c.gyro_noise_density) + "  # rad/s/sqrt(Hz)\n"
-         "gyroscope_random_walk: " + g(c.gyro_random_walk) + "  # rad/s^2/sqrt(Hz)\n";
+         "update_rate: " + r(c.rate_hz) + "\n"
+         "accelerometer_noise_density: " + r(c.accel_noise_density) + "  # m/s^2/sqrt(Hz)\n"
+         "accelerometer_random_walk: " + r(c.accel_random_walk) + "  # m/s^3/sqrt(Hz)\n"
+         "gyroscope_noise_density: " + r(c.gyro_noise_density) + "  # rad/s/sqrt(Hz)\n"
+         "gyroscope_random_walk: " + r(c.gyro_random_walk) + "  # rad/s^2/sqrt(Hz)\n";
 }
 
 std::string robot_yaml(const RobotCalibration& c) {
   return "# The robot's description (nominal values), written by pvbench.  Base frame b: the middle\n"
          "# of the wheel axle, x forward, z up; camera c: optical (x right, y down, z forward);\n"
          "# IMU i.  T_b_x maps points of frame x into the base (4 x 4, row by row).\n"
-         "wheel_radius_m: " + g(c.drive.wheel_radius_m) + "\n"
-         "track_m: " + g(c.drive.track_m) + "\n"
+         "wheel_radius_m: " + r(c.drive.wheel_radius_m) + "\n"
+         "track_m: " + r(c.drive.track_m) + "\n"
          "ticks_per_rev: " + std::to_string(c.drive.ticks_per_rev) + "\n"
-         "encoder_rate_hz: " + g(c.encoder_rate_hz) + "\n"
-         "imu_rate_hz: " + g(c.imu.rate_hz) + "\n"
+         "encoder_rate_hz: " + r(c.encoder_rate_hz) + "\n"
+         "imu_rate_hz: " + r(c.imu.rate_hz) + "\n"
          "T_b_c: " + matrix_row_major(c.T_b_c) + "\n"
          "T_b_i: " + matrix_row_major(c.T_b_i) + "\n";
 }

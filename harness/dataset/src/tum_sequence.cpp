@@ -46,32 +46,26 @@ namespace {
 /// A transform as an OpenCV matrix node (4 x 4 floats, row by row).
 std::string opencv_matrix(const std::string& key, const geom::SE3d& T) {
   std::string out = key + ": !!opencv-matrix\n   rows: 4\n   cols: 4\n   dt: f\n   data: [";
-  char v[32];
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) {
-      std::snprintf(v, sizeof v, "%.9g", T.matrix()(r, c));
-      out += (r + c ? ", " : "") + std::string(v);
+      out += (r + c ? ", " : "") + format_real(T.matrix()(r, c));
     }
   return out + "]\n";
 }
 
 std::string robot_settings_text(const RobotCalibration& c) {
-  char buf[1024];
-  std::snprintf(buf, sizeof buf,
-                "\n# IMU (ORB-SLAM3's keys; Kalibr's continuous-time noise: rad/s/sqrt(Hz), m/s^2/sqrt(Hz),\n"
-                "# rad/s^2/sqrt(Hz), m/s^3/sqrt(Hz)).  T_b_c1: the camera in the IMU frame (ORB-SLAM3's body).\n"
-                "IMU.NoiseGyro: %.9g\nIMU.NoiseAcc: %.9g\nIMU.GyroWalk: %.9g\nIMU.AccWalk: %.9g\n"
-                "IMU.Frequency: %.9g\n",
-                c.imu.gyro_noise_density, c.imu.accel_noise_density, c.imu.gyro_random_walk,
-                c.imu.accel_random_walk, c.imu.rate_hz);
-  std::string text = buf;
+  std::string text =
+      "\n# IMU (ORB-SLAM3's keys; Kalibr's continuous-time noise: rad/s/sqrt(Hz), m/s^2/sqrt(Hz),\n"
+      "# rad/s^2/sqrt(Hz), m/s^3/sqrt(Hz)).  T_b_c1: the camera in the IMU frame (ORB-SLAM3's body).\n"
+      "IMU.NoiseGyro: " + format_real(c.imu.gyro_noise_density) + "\nIMU.NoiseAcc: " + format_real(c.imu.accel_noise_density) +
+      "\nIMU.GyroWalk: " + format_real(c.imu.gyro_random_walk) + "\nIMU.AccWalk: " + format_real(c.imu.accel_random_walk) +
+      "\nIMU.Frequency: " + format_real(c.imu.rate_hz) + "\n";
   text += opencv_matrix("IMU.T_b_c1", c.T_b_i.inverse() * c.T_b_c);
-  std::snprintf(buf, sizeof buf,
-                "\n# The robot (pvbench's own keys): nominal drive, encoders, the camera in the base frame\n"
-                "# (axle centre, x forward, z up) and the IMU in it.\n"
-                "Robot.WheelRadius: %.9g\nRobot.Track: %.9g\nRobot.TicksPerRev: %d\nRobot.EncoderFrequency: %.9g\n",
-                c.drive.wheel_radius_m, c.drive.track_m, c.drive.ticks_per_rev, c.encoder_rate_hz);
-  text += buf;
+  text += "\n# The robot (pvbench's own keys): nominal drive, encoders, the camera in the base frame\n"
+          "# (axle centre, x forward, z up) and the IMU in it.\n"
+          "Robot.WheelRadius: " + format_real(c.drive.wheel_radius_m) + "\nRobot.Track: " + format_real(c.drive.track_m) +
+          "\nRobot.TicksPerRev: " + std::to_string(c.drive.ticks_per_rev) +
+          "\nRobot.EncoderFrequency: " + format_real(c.encoder_rate_hz) + "\n";
   text += opencv_matrix("Robot.T_base_c1", c.T_b_c);
   text += opencv_matrix("Robot.T_base_imu", c.T_b_i);
   return text;

@@ -7,11 +7,7 @@
 namespace pvb::run {
 namespace {
 
-std::string g(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
+std::string g(double v) { return format_g(v, 9); }
 
 std::string csv3(const Eigen::Vector3d& v) { return "," + g(v.x()) + "," + g(v.y()) + "," + g(v.z()); }
 std::string csv2(const Eigen::Vector2d& v) { return "," + g(v.x()) + "," + g(v.y()); }
@@ -19,14 +15,14 @@ std::string csv2(const Eigen::Vector2d& v) { return "," + g(v.x()) + "," + g(v.y
 std::string robot_truth_yaml(const scenes::Scenario& s, const sim::DriveKinematics& effective) {
   const sensor::DriveDescription nominal = sim::nominal_description(s);
   return "# The robot as built against its description (robot.yaml), written by pvbench.\n"
-         "wheel_radius_m: " + g(s.robot.wheel_radius_m) + "  # both wheels, as built\n"
-         "track_m: " + g(s.robot.track_m) + "  # between the wheels' contact points, as built\n"
-         "effective_wheel_radius_m: " + g(effective.wheel_radius_m) + "  # measured rolling straight\n"
-         "effective_track_m: " + g(effective.track_m) + "  # measured turning on the spot\n"
-         "nominal_wheel_radius_m: " + g(nominal.wheel_radius_m) + "\n"
-         "nominal_track_m: " + g(nominal.track_m) + "\n"
-         "radius_error: " + g(nominal.wheel_radius_m / s.robot.wheel_radius_m - 1) + "  # nominal / built - 1\n"
-         "track_error: " + g(nominal.track_m / s.robot.track_m - 1) + "\n";
+         "wheel_radius_m: " + format_real(s.robot.wheel_radius_m) + "  # both wheels, as built\n"
+         "track_m: " + format_real(s.robot.track_m) + "  # between the wheels' contact points, as built\n"
+         "effective_wheel_radius_m: " + format_real(effective.wheel_radius_m) + "  # measured rolling straight\n"
+         "effective_track_m: " + format_real(effective.track_m) + "  # measured turning on the spot\n"
+         "nominal_wheel_radius_m: " + format_real(nominal.wheel_radius_m) + "\n"
+         "nominal_track_m: " + format_real(nominal.track_m) + "\n"
+         "radius_error: " + format_real(nominal.wheel_radius_m / s.robot.wheel_radius_m - 1) + "  # nominal / built - 1\n"
+         "track_error: " + format_real(nominal.track_m / s.robot.track_m - 1) + "\n";
 }
 
 }  // namespace

@@ -107,6 +107,18 @@ TEST(RecordCli, WritesAConsistentTumSequence) {
   }
 }
 
+// The motion files read back in a second tool: Python's csv and yaml
+// modules (tests/harness/cli/read_motion_files.py checks layouts, periods,
+// counts and plausible readings).
+TEST(RecordCli, MotionFilesReadBackWithPythonsCsvAndYaml) {
+  const std::string& d = station_run();
+  const std::string log = ::testing::TempDir() + "pvb_py_" + std::to_string(::getpid()) + ".txt";
+  const int status = std::system(("python3 " + std::string(PVB_SOURCE_DIR) +
+                                  "/tests/harness/cli/read_motion_files.py " + d + " > " + log + " 2>&1").c_str());
+  EXPECT_EQ(status, 0) << read_file(log);
+  EXPECT_NE(read_file(log).find("all read back"), std::string::npos) << read_file(log);
+}
+
 TEST(RecordCli, SameScenarioSeedAndBackendGiveIdenticalFiles) {
   const std::string& a = station_run();
   const std::string b = fresh("station_b");

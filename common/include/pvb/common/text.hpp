@@ -38,6 +38,10 @@ std::string format_g(double v, int significant_digits = 6);
 /// format_exact(55.0000001) = "55.0000001", format_exact(55) = "55", so a
 /// value just outside a limit is never printed as the limit.
 std::string format_exact(double v);
+/// %.9g with a point, so that YAML 1.1 (Python's yaml, Kalibr) and OpenCV's
+/// FileStorage read it as a real: format_real(170) = "170.0",
+/// format_real(2e-05) = "2.0e-05".
+std::string format_real(double v);
 /// `decimals` digits after the point (%.Nf): format_fixed(2.5, 2) = "2.50".
 std::string format_fixed(double v, int decimals);
 
