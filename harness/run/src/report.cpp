@@ -210,6 +210,10 @@ std::string metrics_json(const RunReport& r) {
   out += run_fields(r, "  ");
   out += slam_fields(r.primary, "  ");
   if (r.closed_loop) out += ",\n  \"closed_loop\": " + closed_loop_json(*r.closed_loop);
+  if (r.motion)
+    out += ",\n  \"wheel_odometry\": {\"distance_m\": " + json_number(r.motion->distance_driven_m(), 9) +
+           ", \"end_error_m\": " + json_number(r.motion->end_drift_m(), 9) +
+           ", \"mean_abs_slip\": " + json_number(r.motion->mean_abs_slip, 9) + "}";
   if (r.baseline) {
     out += ",\n  \"baseline\": {\n" + run_fields(r, "    ") + slam_fields(*r.baseline, "    ") + "\n  }";
     const bool both = r.primary.eval && r.baseline->eval;
@@ -263,6 +267,25 @@ std::string comparison_table(const RunReport& r) {
                 r.primary.lost_frames);
   out += line;
   return out + footnote;
+}
+
+/// The IMU's yaw rate against the truth, the wheel odometry's path against
+/// the base's, and the odometry's drift over the distance driven.
+void write_motion_figures(const MotionSensorsReport& m, const std::string& dir, std::vector<std::string>* written) {
+  if (!m.imu_t_s.empty())
+    write_figure(eval::make_line_chart("IMU: the base's yaw rate, measured and true", "time [s]", "yaw rate [rad/s]",
+                                       {{"gyroscope", m.imu_t_s, m.yaw_rate_measured, eval::series_color(0)},
+                                        {"truth", m.imu_t_s, m.yaw_rate_true, eval::series_color(1)}}),
+                 dir, "imu_yaw_rate", written);
+  if (m.odo_t_s.empty()) return;
+  write_figure(eval::make_line_chart("wheel odometry alone against the truth (odometry frame, top view)", "x [m]",
+                                     "y [m]",
+                                     {{"wheel odometry", m.odo_x_m, m.odo_y_m, eval::series_color(0)},
+                                      {"truth", m.true_x_m, m.true_y_m, eval::series_color(1)}}),
+               dir, "odometry_top", written);
+  write_figure(eval::make_line_chart("wheel odometry drift over the distance driven", "distance driven [m]",
+                                     "position error [m]", {{"drift", m.distance_m, m.drift_m, eval::series_color(0)}}),
+               dir, "odometry_drift", written);
 }
 
 std::vector<std::string> write_figures(const RunReport& r, const std::string& dir) {
@@ -339,6 +362,7 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
                                        "path error [m]", {s}),
                  dir, "path_error", &written);
   }
+  if (r.motion) write_motion_figures(*r.motion, dir, &written);
   return written;
 }
 
@@ -434,6 +458,11 @@ std::string accuracy_rows(const RunReport& r) {
       fixed(percentile(ms, 0.5), 2) + " / " + fixed(mean_of(ms), 2) + " / " + fixed(percentile(ms, 0.95), 2));
   h += table_row("realtime factor", fixed(realtime_factor(r.sim_s, r.wall_s), 2) + " (" + fixed(r.sim_s, 2) +
                                         " s simulated in " + fixed(r.wall_s, 2) + " s)");
+  if (r.motion && r.motion->distance_driven_m() > 0)
+    h += table_row("wheel odometry alone", fixed(r.motion->end_drift_m(), 3) + " m off after " +
+                                               fixed(r.motion->distance_driven_m(), 2) + " m (" +
+                                               fixed(100 * r.motion->end_drift_m() / r.motion->distance_driven_m(), 1) +
+                                               " %); mean |slip| " + fixed(r.motion->mean_abs_slip, 3));
   if (r.closed_loop)
     h += table_row("path error rmse / max [m]", fixed(r.closed_loop->path_error_rmse_m, 4) + " / " +
                                                     fixed(r.closed_loop->path_error_max_m, 4) + " (held " +

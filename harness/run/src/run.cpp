@@ -9,6 +9,7 @@
 #include "frame_pipeline.hpp"
 #include "landmark_classes.hpp"
 #include "map_scoring.hpp"
+#include "motion_report.hpp"
 #include "pvb/common/io_paths.hpp"
 #include "pvb/common/output_folder.hpp"
 #include "pvb/common/text.hpp"
@@ -108,7 +109,8 @@ class GroundTruthSink {
         scenario_(scenario),
         file_(dir + "/groundtruth.txt"),
         motion_(dir, robot_calibration_for(scenario)),
-        motion_truth_(dir) {
+        motion_truth_(dir),
+        motion_report_(scenes::T_base_imu(scenario), sim::nominal_description(scenario)) {
     file_.append(
         "# timestamp tx ty tz qx qy qz qw (T_w_c: camera optical frame in the site frame, ground truth)\n");
     trajectory_.source = dir + "/groundtruth.txt";
@@ -119,7 +121,9 @@ class GroundTruthSink {
     trajectory_.poses.push_back(item.gt);
     motion_.write(item.frame);
     motion_truth_.write(item.imu_truth, item.wheel_truth);
+    motion_report_.add(item);
   }
+  const MotionSensorsReport& motion_report() const { return motion_report_.report(); }
   void close() { file_.close(); }
   const eval::Trajectory& trajectory() const { return trajectory_; }
 
@@ -129,6 +133,7 @@ class GroundTruthSink {
   OutputFile file_;
   dataset::MotionFilesWriter motion_;
   MotionTruthWriter motion_truth_;
+  MotionReportBuilder motion_report_;
   eval::Trajectory trajectory_;
 };
 
@@ -464,6 +469,7 @@ RunReport run_scenario(const RunOptions& opt) {
     classify_matched_landmarks(*sinks.front()->system, backend, &*p.map);
   const double map_ms = score_or_skip_maps(opt, scenario, backend, gt.trajectory(), sinks, log);
   if (closed_loop) report.closed_loop = closed_loop->metrics();
+  report.motion = gt.motion_report();
   report.primary = sinks.front()->run;
   if (sinks.size() > 1) report.baseline = sinks[1]->run;
   report.profile = profile_entries(opt, loop, consumer.costs(), sinks, report.primary.frames, eval_ms);

@@ -131,6 +131,18 @@ struct StageTime {
   std::string thread;     ///< "producer", "consumer", "mapping", "main"
 };
 
+/// The motion sensors against the truth: the gyroscope's yaw rate (base
+/// z) and the wheel odometry alone, in the odometry frame (the base's
+/// first pose), with its drift over the distance driven.
+struct MotionSensorsReport {
+  std::vector<double> imu_t_s, yaw_rate_measured, yaw_rate_true;  ///< rad/s
+  std::vector<double> odo_t_s, odo_x_m, odo_y_m, true_x_m, true_y_m;
+  std::vector<double> distance_m, drift_m;  ///< distance driven, odometry's position error
+  double mean_abs_slip = 0;                 ///< over both wheels and every reading on the ground
+  double end_drift_m() const { return drift_m.empty() ? 0.0 : drift_m.back(); }
+  double distance_driven_m() const { return distance_m.empty() ? 0.0 : distance_m.back(); }
+};
+
 struct RunReport {
   std::string scenario;  ///< scenario name
   std::string scenario_file;
@@ -147,6 +159,7 @@ struct RunReport {
   SlamRun primary;
   std::optional<SlamRun> baseline;  ///< --compare
   std::optional<ClosedLoopMetrics> closed_loop;
+  std::optional<MotionSensorsReport> motion;  ///< simulated runs
   /// First and last frame of the scenario's camera cover (a kidnap), if any.
   std::optional<std::pair<int, int>> camera_covered_frames;
   std::vector<StageTime> profile;

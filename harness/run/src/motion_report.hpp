@@ -1,0 +1,27 @@
+#pragma once
+// Gathers a run's motion sensor readings and their truth, frame by frame,
+// into the report's MotionSensorsReport.
+#include "frame_producer.hpp"
+#include "pvb/run/report.hpp"
+#include "pvb/sensor/wheel_odometry.hpp"
+
+namespace pvb::run {
+
+class MotionReportBuilder {
+ public:
+  /// T_b_i: the IMU in the base; drive: the description odometry uses.
+  MotionReportBuilder(const geom::SE3d& T_b_i, const sensor::DriveDescription& drive);
+  void add(const FrameItem& item);
+  const MotionSensorsReport& report() const { return r_; }
+
+ private:
+  Eigen::Matrix3d R_b_i_;
+  sensor::WheelOdometry odometry_;
+  std::optional<geom::SE3d> T_o_w_;  ///< the odometry frame: the base's first pose, level
+  Eigen::Vector2d last_true_ = Eigen::Vector2d::Zero();
+  double slip_sum_ = 0;
+  long slip_count_ = 0;
+  MotionSensorsReport r_;
+};
+
+}  // namespace pvb::run
