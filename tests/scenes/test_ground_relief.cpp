@@ -213,7 +213,7 @@ TEST(GroundRelief, FrictionIsADayKeyAndTheReliefIsNot) {
   EXPECT_EQ(relief_day_error("friction", station, "base: station.yaml\nground: {friction: 0.35}\n"), "");
   const std::string e = relief_day_error("relief", station, "base: station.yaml\nground: {relief: {amplitude_cm: 3}}\n");
   EXPECT_NE(e.find("day.yaml:2: ground.relief: expected a key a derived file may change"), std::string::npos) << e;
-  EXPECT_DOUBLE_EQ(*load_scenario(kReliefScenes + "days/rough_station_wet.yaml").ground.friction, 0.35);
-  EXPECT_DOUBLE_EQ(*load_scenario(kReliefScenes + "days/rough_station_dry.yaml").ground.friction, 0.9);
+  EXPECT_DOUBLE_EQ(*load_scenario(kReliefScenes + "days/rough_station_wet.yaml").ground.friction, 0.4);
+  EXPECT_DOUBLE_EQ(*load_scenario(kReliefScenes + "days/rough_station_dry.yaml").ground.friction, 0.65);
   EXPECT_FALSE(load_scenario(kReliefScenes + "rough_station.yaml").ground.friction);
 }

@@ -414,6 +414,6 @@ TEST(SceneBuilder, SoilFrictionGovernsTheTyresContact) {
     return wheels.empty() ? -1.0 : *std::max_element(wheels.begin(), wheels.end());
   };
   EXPECT_DOUBLE_EQ(contact_friction("rough_station.yaml"), 1.2);
-  EXPECT_DOUBLE_EQ(contact_friction("days/rough_station_dry.yaml"), 0.9);
-  EXPECT_DOUBLE_EQ(contact_friction("days/rough_station_wet.yaml"), 0.35);
+  EXPECT_DOUBLE_EQ(contact_friction("days/rough_station_dry.yaml"), 0.65);
+  EXPECT_DOUBLE_EQ(contact_friction("days/rough_station_wet.yaml"), 0.4);
 }

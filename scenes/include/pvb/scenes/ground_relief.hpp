@@ -120,9 +120,9 @@ struct RouteGradeFault {
   bool across = false;    ///< across the heading (roll) rather than along it (pitch)
 };
 /// The steepest grade the robot is asked to drive: 15 % (8.5 degrees).
-/// With the soil's friction at 0.35 (wet clay) and about two thirds of the
-/// robot's weight on its driven wheels, traction holds to about 23 %; 15 %
-/// leaves a margin for the bumps' own steps.
+/// About 72 % of the robot's weight rests on its driven wheels (the rest on
+/// the caster), so on wet earth (friction 0.4) traction holds up to a grade
+/// of about 0.72 x 0.4 = 29 %; 15 % leaves a margin for bumps and turns.
 inline constexpr double kMaxRouteGrade = 0.15;
 /// The first route point (every 5 cm) where a grade exceeds kMaxRouteGrade.
 std::optional<RouteGradeFault> find_route_grade_fault(const GroundRelief& g, const std::vector<Eigen::Vector2d>& route,
