@@ -42,7 +42,7 @@ struct Relief {
   double scale_m = 1.0;            ///< its correlation length
   double slope_percent = 0.0;      ///< overall grade, rise over run x 100
   double slope_azimuth_deg = 0.0;  ///< direction the ground rises, CCW from world x
-  double cell_m = 0.2;             ///< grid spacing (at most)
+  double cell_m = 0.25;            ///< grid spacing (at most)
 };
 
 struct Ground {
