@@ -469,3 +469,24 @@ TEST(Simulator, SettlesOnTheReliefAndDrivesRoughStationToItsEnd) {
   EXPECT_GT(std_dev(rough.pitch_deg), 5 * std_dev(flat.pitch_deg));
   EXPECT_GT(std_dev(rough.roll_deg), 5 * std_dev(flat.roll_deg));
 }
+
+// The soil's friction is felt: from standstill at full wheel speed, the
+// wheels of the same station spin more on wet earth than on dry.
+TEST(Simulator, WetSoilSlipsMoreThanDryUnderFullThrottle) {
+  std::map<std::string, double> slip;
+  for (const char* day : {"rough_station_dry", "rough_station_wet"}) {
+    const scenes::Scenario s = scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/days/" + day + ".yaml");
+    sim::Simulator sim(s);
+    const int joint = mj_name2id(sim.model(), mjOBJ_JOINT, sim::kLeftActuator);
+    ASSERT_GE(joint, 0);
+    const double angle0 = sim.data()->qpos[sim.model()->jnt_qposadr[joint]];
+    const sim::Pose2d p0 = sim.base_pose();
+    sim.set_wheel_override(Eigen::Vector2d(s.robot.max_wheel_speed_radps, s.robot.max_wheel_speed_radps));
+    for (int i = 0; i < 10; ++i) sim.advance();  // a third of a second
+    const double turned_m = (sim.data()->qpos[sim.model()->jnt_qposadr[joint]] - angle0) * s.robot.wheel_radius_m;
+    const sim::Pose2d p1 = sim.base_pose();
+    slip[day] = 1.0 - std::hypot(p1.x - p0.x, p1.y - p0.y) / turned_m;
+    std::printf("%s: friction %.2f, wheel slip %.3f over %.3f m of tread\n", day, *s.ground.friction, slip[day], turned_m);
+  }
+  EXPECT_GT(slip["rough_station_wet"], slip["rough_station_dry"] + 0.05);
+}
