@@ -69,19 +69,21 @@ int main(int argc, char** argv) {
     std::vector<pvb::eval::Series> series;
     for (const Drive& d : drives) {
       for (std::size_t k = 0; k < d.t_s.size(); ++k)
-        csv += d.label + "," + pvb::format_number("%.4f", d.t_s[k]) + "," + pvb::format_number("%.4f", d.pitch_deg[k]) +
-               "," + pvb::format_number("%.4f", d.roll_deg[k]) + "\n";
+        csv += d.label + "," + pvb::format_number("%.4f", d.t_s[k]) + "," +
+               pvb::format_number("%.4f", d.pitch_deg[k]) + "," + pvb::format_number("%.4f", d.roll_deg[k]) +
+               "\n";
       series.push_back({d.label + " pitch", d.t_s, d.pitch_deg, pvb::eval::series_color(series.size())});
       series.push_back({d.label + " roll", d.t_s, d.roll_deg, pvb::eval::series_color(series.size())});
       double pm = 0, ps = 0, rm = 0, rs = 0;
       mean_std(d.pitch_deg, &pm, &ps);
       mean_std(d.roll_deg, &rm, &rs);
-      std::printf("%s: %zu poses, pitch %.3f +- %.3f deg, roll %.3f +- %.3f deg (mean +- std)\n", d.label.c_str(),
-                  d.t_s.size(), pm, ps, rm, rs);
+      std::printf("%s: %zu poses, pitch %.3f +- %.3f deg, roll %.3f +- %.3f deg (mean +- std)\n",
+                  d.label.c_str(), d.t_s.size(), pm, ps, rm, rs);
     }
     pvb::write_file(out + "/tilt.csv", csv);
-    pvb::plot::write_png(pvb::eval::make_line_chart("camera pitch and roll over the drive", "time, s", "degrees", series),
-                         out + "/tilt.png");
+    pvb::plot::write_png(
+        pvb::eval::make_line_chart("camera pitch and roll over the drive", "time, s", "degrees", series),
+        out + "/tilt.png");
   } catch (const pvb::Error& e) {
     std::fprintf(stderr, "camera_tilt: %s\n", e.what());
     return 1;

@@ -95,12 +95,13 @@ GroundRelief::GroundRelief(const Relief& r, const Eigen::Vector2d& size_m, std::
   for (int row = 0; row < grid_.nrow; ++row)
     for (int c = 0; c < grid_.ncol; ++c) {
       const double x = -grid_.half_x_m + c * dx, y = -grid_.half_y_m + row * dy;
-      grid_.z_m[static_cast<std::size_t>(row) * static_cast<std::size_t>(grid_.ncol) + static_cast<std::size_t>(c)] +=
-          grade * (x * std::cos(az) + y * std::sin(az));
+      grid_.z_m[static_cast<std::size_t>(row) * static_cast<std::size_t>(grid_.ncol) +
+                static_cast<std::size_t>(c)] += grade * (x * std::cos(az) + y * std::sin(az));
     }
 }
 
-std::optional<RouteGradeFault> find_route_grade_fault(const GroundRelief& g, const std::vector<Eigen::Vector2d>& route,
+std::optional<RouteGradeFault> find_route_grade_fault(const GroundRelief& g,
+                                                      const std::vector<Eigen::Vector2d>& route,
                                                       double wheel_base_m, double track_m) {
   for (std::size_t i = 0; i < route.size(); ++i) {
     const Eigen::Vector2d& p = route[i];
@@ -108,7 +109,8 @@ std::optional<RouteGradeFault> find_route_grade_fault(const GroundRelief& g, con
     if (d.norm() < 1e-9) continue;
     const Eigen::Vector2d t = d.normalized(), left(-t.y(), t.x());
     const double pitch = (g.height_m(p) - g.height_m(p - wheel_base_m * t)) / wheel_base_m;
-    const double roll = (g.height_m(p + 0.5 * track_m * left) - g.height_m(p - 0.5 * track_m * left)) / track_m;
+    const double roll =
+        (g.height_m(p + 0.5 * track_m * left) - g.height_m(p - 0.5 * track_m * left)) / track_m;
     if (std::abs(pitch) > kMaxRouteGrade) return RouteGradeFault{p, pitch, false};
     if (std::abs(roll) > kMaxRouteGrade) return RouteGradeFault{p, roll, true};
   }

@@ -1,8 +1,6 @@
 // The ground relief: made from the station's seed, interpolated as MuJoCo
 // interpolates a height field, with the roughness and slope asked for; and
 // the errors of its keys, by file, line and key.
-#include "pvb/scenes/ground_relief.hpp"
-
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -12,6 +10,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/scenes/ground_relief.hpp"
 #include "pvb/scenes/route.hpp"
 #include "pvb/scenes/scenario.hpp"
 
@@ -132,7 +131,7 @@ TEST(GroundRelief, HasTheRoughnessAndSlopeAsked) {
       const double z = h.z_m[static_cast<std::size_t>(r * h.ncol + c)];
       sum += z;
       sum2 += z * z;
-      lag1 += z * h.z_m[static_cast<std::size_t>(r * h.ncol + c + 5)];  // 1 m
+      lag1 += z * h.z_m[static_cast<std::size_t>(r * h.ncol + c + 5)];   // 1 m
       lag4 += z * h.z_m[static_cast<std::size_t>(r * h.ncol + c + 20)];  // 4 m
       ++pairs;
     }
@@ -160,10 +159,11 @@ TEST(GroundRelief, BadKeysAreOneLineWithTheirRange) {
   EXPECT_NE(relief_error(std::string(kReliefStation) + "ground: {relief: {scale_m: 0.5, cell_m: 0.3}}\n")
                 .find("ground.relief.cell_m: expected a cell of at most half of scale_m (0.25 m)"),
             std::string::npos);
-  EXPECT_NE(relief_error(std::string(kReliefStation) + "ground: {size_m: [2000, 2000], relief: {cell_m: 0.05}}\n")
-                .find("ground.relief.cell_m: expected a cell that samples ground.size_m in at most 1000000 points, "
-                      "got 0.05 m (40001 x 40001 points)"),
-            std::string::npos);
+  EXPECT_NE(
+      relief_error(std::string(kReliefStation) + "ground: {size_m: [2000, 2000], relief: {cell_m: 0.05}}\n")
+          .find("ground.relief.cell_m: expected a cell that samples ground.size_m in at most 1000000 points, "
+                "got 0.05 m (40001 x 40001 points)"),
+      std::string::npos);
   EXPECT_NE(relief_error(std::string(kReliefStation) + "ground: {tiling: varied, relief: {}}\n")
                 .find("ground.relief.amplitude_cm: expected no relief under a varied ground"),
             std::string::npos);
@@ -180,20 +180,25 @@ TEST(GroundRelief, BadKeysAreOneLineWithTheirRange) {
 TEST(GroundRelief, TooRoughOrSteepForTheRouteIsRefused) {
   const std::string ok = std::string(kReliefStation) + "ground: {relief: {amplitude_cm: 2, scale_m: 1}}\n";
   EXPECT_EQ(relief_error(ok), "");
-  const std::string rough =
-      relief_error(std::string(kReliefStation) + "ground:\n  relief: {amplitude_cm: 10, scale_m: 0.4, cell_m: 0.1}\n");
-  EXPECT_NE(rough.find("bad.yaml:7: ground.relief.amplitude_cm: expected a relief the robot can drive: grades of at "
-                       "most 15 % along its route, over its wheel base (0.36 m) and across its track (0.42 m), got "),
-            std::string::npos)
+  const std::string rough = relief_error(
+      std::string(kReliefStation) + "ground:\n  relief: {amplitude_cm: 10, scale_m: 0.4, cell_m: 0.1}\n");
+  EXPECT_NE(
+      rough.find(
+          "bad.yaml:7: ground.relief.amplitude_cm: expected a relief the robot can drive: grades of at "
+          "most 15 % along its route, over its wheel base (0.36 m) and across its track (0.42 m), got "),
+      std::string::npos)
       << rough;
   EXPECT_NE(rough.find(" the route at (x, y) = ("), std::string::npos) << rough;
-  const std::string steep = relief_error(std::string(kReliefStation) + "ground: {relief: {amplitude_cm: 0, slope_percent: 20}}\n");
-  EXPECT_NE(steep.find("ground.relief.slope_percent: expected a relief the robot can drive"), std::string::npos)
+  const std::string steep =
+      relief_error(std::string(kReliefStation) + "ground: {relief: {amplitude_cm: 0, slope_percent: 20}}\n");
+  EXPECT_NE(steep.find("ground.relief.slope_percent: expected a relief the robot can drive"),
+            std::string::npos)
       << steep;
   EXPECT_NE(steep.find("got 20.0 % along the route at (x, y) = ("), std::string::npos) << steep;
   // Across the route the same slope is a roll.
   const std::string across =
-      relief_error(std::string(kReliefStation) + "ground: {relief: {amplitude_cm: 0, slope_percent: 20, slope_azimuth_deg: 90}}\n");
+      relief_error(std::string(kReliefStation) +
+                   "ground: {relief: {amplitude_cm: 0, slope_percent: 20, slope_azimuth_deg: 90}}\n");
   EXPECT_NE(across.find("got 20.0 % across the route"), std::string::npos) << across;
   // The criterion itself: a grade just within the limit passes, just beyond it fails.
   const std::vector<Eigen::Vector2d> route = {{-2, 0}, {-1, 0}, {0, 0}, {1, 0}};
@@ -211,8 +216,10 @@ TEST(GroundRelief, TooRoughOrSteepForTheRouteIsRefused) {
 TEST(GroundRelief, FrictionIsADayKeyAndTheReliefIsNot) {
   const std::string station = std::string(kReliefStation) + "ground: {relief: {amplitude_cm: 1}}\n";
   EXPECT_EQ(relief_day_error("friction", station, "base: station.yaml\nground: {friction: 0.35}\n"), "");
-  const std::string e = relief_day_error("relief", station, "base: station.yaml\nground: {relief: {amplitude_cm: 3}}\n");
-  EXPECT_NE(e.find("day.yaml:2: ground.relief: expected a key a derived file may change"), std::string::npos) << e;
+  const std::string e =
+      relief_day_error("relief", station, "base: station.yaml\nground: {relief: {amplitude_cm: 3}}\n");
+  EXPECT_NE(e.find("day.yaml:2: ground.relief: expected a key a derived file may change"), std::string::npos)
+      << e;
   EXPECT_DOUBLE_EQ(*load_scenario(kReliefScenes + "days/rough_station_wet.yaml").ground.friction, 0.4);
   EXPECT_DOUBLE_EQ(*load_scenario(kReliefScenes + "days/rough_station_dry.yaml").ground.friction, 0.65);
   EXPECT_FALSE(load_scenario(kReliefScenes + "rough_station.yaml").ground.friction);

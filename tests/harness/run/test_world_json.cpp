@@ -1,11 +1,11 @@
 // The world a run was made in (meta.json's and metrics.json's "world"):
 // the ground appears only when it is uneven or its friction is the day's.
-#include "pvb/run/world_json.hpp"
-
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
 #include <string>
+
+#include "pvb/run/world_json.hpp"
 
 using namespace pvb;
 

@@ -115,17 +115,19 @@ Eigen::Vector2i relief_samples(const Eigen::Vector2d& size_m, double cell_m);
 /// along the heading over the wheel base (axle to caster), or across it
 /// over the track, beyond kMaxRouteGrade.
 struct RouteGradeFault {
-  Eigen::Vector2d at_m;   ///< the route point
-  double grade = 0;       ///< rise over run, signed
-  bool across = false;    ///< across the heading (roll) rather than along it (pitch)
+  Eigen::Vector2d at_m;  ///< the route point
+  double grade = 0;      ///< rise over run, signed
+  bool across = false;   ///< across the heading (roll) rather than along it (pitch)
 };
 /// The steepest grade the robot is asked to drive: 15 % (8.5 degrees).
 /// About 72 % of the robot's weight rests on its driven wheels (the rest on
 /// the caster), so on wet earth (friction 0.4) traction holds up to a grade
 /// of about 0.72 x 0.4 = 29 %; 15 % leaves a margin for bumps and turns.
 inline constexpr double kMaxRouteGrade = 0.15;
-/// The first route point (every 5 cm) where a grade exceeds kMaxRouteGrade.
-std::optional<RouteGradeFault> find_route_grade_fault(const GroundRelief& g, const std::vector<Eigen::Vector2d>& route,
+/// The first point of `route` (route_polyline gives one every 5 cm) where a
+/// grade exceeds kMaxRouteGrade.
+std::optional<RouteGradeFault> find_route_grade_fault(const GroundRelief& g,
+                                                      const std::vector<Eigen::Vector2d>& route,
                                                       double wheel_base_m, double track_m);
 
 }  // namespace pvb::scenes
