@@ -1,6 +1,8 @@
-// Render + readback speed of the default station at 640x480, per backend.
+// Render + readback speed of the default station (or another scenario) at
+// 640x480, per backend.
 // One process loads one GL backend, so choose it on the command line:
 //   bench_render --gl=egl      (or --gl=osmesa, --gl=auto; default auto)
+//   bench_render --scenario=scenes/rough_station.yaml   (default: the station)
 // Benchmarks: render+readback with and without shadows, the full capture
 // (render, sky mask, Kinect depth model, RGB noise) and one physics frame.
 #include <benchmark/benchmark.h>
@@ -16,6 +18,7 @@
 namespace {
 
 std::string g_backend = "auto";
+std::string g_scenario = PVB_SOURCE_DIR "/scenes/pv_station.yaml";
 
 // CPU time of the whole process (all llvmpipe threads), ms: less sensitive
 // than wall time to other load on a small machine.
@@ -34,7 +37,7 @@ struct World {
 World& world() {
   static World w = [] {
     World x;
-    auto s = pvb::scenes::load_scenario(PVB_SOURCE_DIR "/scenes/pv_station.yaml");
+    auto s = pvb::scenes::load_scenario(g_scenario);
     x.sim = std::make_unique<pvb::sim::Simulator>(s);
     x.camera = std::make_unique<pvb::sim::RgbdCamera>(*x.sim, pvb::sim::parse_gl_backend(g_backend));
     x.renderer = std::make_unique<pvb::sim::Renderer>(x.sim->model(), pvb::sim::parse_gl_backend(g_backend), 640, 480);
@@ -97,7 +100,10 @@ BENCHMARK(BM_PhysicsFrame)->Unit(benchmark::kMillisecond);
 
 int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
-    if (std::strncmp(argv[i], "--gl=", 5) == 0) g_backend = argv[i] + 5;
+    if (std::strncmp(argv[i], "--gl=", 5) == 0)
+      g_backend = argv[i] + 5;
+    else if (std::strncmp(argv[i], "--scenario=", 11) == 0)
+      g_scenario = argv[i] + 11;
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

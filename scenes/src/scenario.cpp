@@ -17,13 +17,7 @@ void read_top(detail::MapReader& top, Scenario& s) {
   s.seed = top.seed("seed", s.seed);
   if (top.has("station_seed")) s.station_seed = top.seed("station_seed", 0);
   s.duration_s = top.number("duration_s", s.duration_s, 0.1, 3600);
-  detail::with_map(top, "ground", [&](detail::MapReader& r) {
-    s.ground.type = r.choice<GroundType>("type", s.ground.type,
-                                         {{"soil", GroundType::kSoil}, {"gravel", GroundType::kGravel}});
-    s.ground.size_m = r.vec2("size_m", s.ground.size_m, 5, 2000);
-    s.ground.tiling = r.choice<GroundTiling>("tiling", s.ground.tiling,
-                                             {{"repeat", GroundTiling::kRepeat}, {"varied", GroundTiling::kVaried}});
-  });
+  detail::with_map(top, "ground", [&](detail::MapReader& r) { detail::read_ground(r, s.ground); });
   detail::read_arrays(top, s.pv_arrays);
   detail::read_walls(top, s.walls);
   detail::with_map(top, "vegetation", [&](detail::MapReader& r) { detail::read_vegetation(r, s.vegetation); });
@@ -49,6 +43,7 @@ Scenario read_scenario(const detail::ScenarioDocument& doc) {
   detail::refuse_station_keys(doc);  // after the reader named any unknown key as one
   detail::check_scene_size(s, ctx);
   detail::check_route(s, ctx);
+  detail::check_ground_relief(s, ctx);
   detail::resolve_day(s, ctx);
   return s;
 }

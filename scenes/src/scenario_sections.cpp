@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "pvb/common/text.hpp"
+#include "pvb/scenes/ground_relief.hpp"
 #include "pvb/scenes/route.hpp"
 
 namespace pvb::scenes::detail {
@@ -384,6 +385,63 @@ void check_route(const Scenario& s, const ReadContext& ctx) {
           "a distance at least 1 m before the route's end (" + format_number("%.2f m", length) + " long)",
           format_exact(rt.start_m));
   }
+}
+
+/// ground.relief: roughness and slope, checked against the ground's
+/// tiling and the samples the height field may have.
+void read_relief(MapReader& q, Ground& g) {
+  Relief rl;
+  rl.amplitude_cm = q.number("amplitude_cm", rl.amplitude_cm, 0, 20);
+  rl.scale_m = q.number("scale_m", rl.scale_m, 0.2, 50);
+  rl.slope_percent = q.number("slope_percent", rl.slope_percent, 0, 30);
+  rl.slope_azimuth_deg = q.number("slope_azimuth_deg", rl.slope_azimuth_deg, -360, 360);
+  rl.cell_m = q.number("cell_m", rl.cell_m, 0.05, 2);
+  if (rl.cell_m > rl.scale_m / 2)
+    q.fail(q.full("cell_m"), YAML::Node(),
+           "a cell of at most half of scale_m (" + format_exact(rl.scale_m / 2) + " m), to draw the bumps",
+           format_exact(rl.cell_m));
+  const Eigen::Vector2i n = relief_samples(g.size_m, rl.cell_m);
+  if (static_cast<long long>(n.x()) * n.y() > kMaxReliefSamples)
+    q.fail(q.full("cell_m"), YAML::Node(),
+           "a cell that samples ground.size_m in at most " + std::to_string(kMaxReliefSamples) + " points",
+           format_exact(rl.cell_m) + " m (" + std::to_string(n.x()) + " x " + std::to_string(n.y()) + " points)");
+  if (g.tiling == GroundTiling::kVaried)
+    q.fail(q.full("amplitude_cm"), YAML::Node(),
+           "no relief under a varied ground (its tiles are flat planes): ground.tiling repeat", "tiling varied");
+  g.relief = rl;
+}
+
+void read_ground(MapReader& r, Ground& g) {
+  g.type = r.choice<GroundType>("type", g.type, {{"soil", GroundType::kSoil}, {"gravel", GroundType::kGravel}});
+  g.size_m = r.vec2("size_m", g.size_m, 5, 2000);
+  g.tiling = r.choice<GroundTiling>("tiling", g.tiling,
+                                    {{"repeat", GroundTiling::kRepeat}, {"varied", GroundTiling::kVaried}});
+  with_map(r, "relief", [&](MapReader& q) { read_relief(q, g); });
+  if (r.has("friction")) g.friction = r.number("friction", 0.0, 0.05, 2);
+}
+
+/// A relief the robot cannot drive: the first route point where a grade
+/// exceeds kMaxRouteGrade, named at the key that makes it (the slope when
+/// the plane alone is too steep there, else the roughness).
+void check_ground_relief(const Scenario& s, const ReadContext& ctx) {
+  if (!s.ground.relief) return;
+  const std::vector<Eigen::Vector2d> route = route_polyline(s);
+  const GroundRelief ground(s);
+  const auto fault = find_route_grade_fault(ground, route, kRobotWheelBaseM, s.robot.track_m);
+  if (!fault) return;
+  Relief plane = *s.ground.relief;
+  plane.amplitude_cm = 0;
+  const bool slope = find_route_grade_fault(GroundRelief(plane, s.ground.size_m, 0), route, kRobotWheelBaseM,
+                                            s.robot.track_m).has_value();
+  const std::string key = std::string("ground.relief.") + (slope ? "slope_percent" : "amplitude_cm");
+  throw ConfigError(ctx.origins->where(key, ctx.file), key,
+                    "a relief the robot can drive: grades of at most " + format_number("%.0f", 100 * kMaxRouteGrade) +
+                        " % along its route, over its wheel base (" + format_number("%.2f", kRobotWheelBaseM) +
+                        " m) and across its track (" + format_number("%.2f", s.robot.track_m) + " m)",
+                    format_number("%.1f", 100 * std::abs(fault->grade)) + " % " +
+                        (fault->across ? "across" : "along") + " the route at (x, y) = (" +
+                        format_number("%.2f", fault->at_m.x()) + ", " + format_number("%.2f", fault->at_m.y()) +
+                        ") m");
 }
 
 }  // namespace pvb::scenes::detail

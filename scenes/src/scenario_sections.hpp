@@ -14,6 +14,8 @@ namespace pvb::scenes::detail {
 /// (617 500 geoms) were not compiled after 5 minutes.
 inline constexpr long long kMaxSceneGeoms = 3800;
 
+/// The ground: section (type, size, tiling, relief, the soil's friction).
+void read_ground(MapReader& r, Ground& g);
 void read_arrays(MapReader& top, std::vector<PvArray>& out);
 void read_walls(MapReader& top, std::vector<Wall>& out);
 void read_vegetation(MapReader& r, Vegetation& v);
@@ -40,5 +42,7 @@ void resolve_day(Scenario& s, const ReadContext& ctx);
 void check_scene_size(const Scenario& s, const ReadContext& ctx);
 /// Checks between fields: the route against the arrays it names.
 void check_route(const Scenario& s, const ReadContext& ctx);
+/// Refuses a ground relief too rough or steep for the robot on its route.
+void check_ground_relief(const Scenario& s, const ReadContext& ctx);
 
 }  // namespace pvb::scenes::detail

@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -16,6 +18,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/scenes/ground_relief.hpp"
 #include "pvb/scenes/route.hpp"
 #include "pvb/sim/simulator.hpp"
 #include "pvb/sim/textures.hpp"
@@ -26,6 +29,11 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 constexpr int kDirtVariants = 4;
 constexpr double kPanelHalfThicknessM = 0.02;
+/// On a relief, posts, walls and trunks reach this far into the ground, so
+/// that no gap shows where the ground under them is uneven.
+constexpr double kIntoReliefM = 0.15;
+/// Depth of the height field's base below its lowest point.
+constexpr double kReliefBaseM = 0.5;
 
 // Fixed-precision number formatting so the XML is byte-identical everywhere.
 std::string f(double v) {
@@ -35,6 +43,12 @@ std::string f(double v) {
 }
 std::string v3(double a, double b, double c) { return f(a) + " " + f(b) + " " + f(c); }
 std::string v3(const Eigen::Vector3d& v) { return v3(v.x(), v.y(), v.z()); }
+/// Ten digits, for the height field's placement and size (to a micrometre).
+std::string exact(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", std::abs(v) < 1e-12 ? 0.0 : v);
+  return buf;
+}
 
 std::vector<unsigned char> png(const cv::Mat& rgb_img) {
   cv::Mat bgr;
@@ -83,8 +97,15 @@ std::string panel_geom(const std::string& name, double pw, double ph, const Eige
          "\" pos=\"" + v3(pos) + "\" xyaxes=\"" + axes + "\" material=\"" + material + "\"/>";
 }
 
+/// Where a post under `top` starts: on flat ground at z = 0, on a relief
+/// kIntoReliefM into the ground.
+double post_foot_m(const scenes::GroundRelief& ground, const Eigen::Vector3d& top) {
+  return ground.flat() ? 0.0 : ground.height_m(top.x(), top.y()) - kIntoReliefM;
+}
+
 /// Fixed tables: each tilted by tilt_deg, facing -v, on rails and four posts.
-void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed) {
+void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed,
+                     const scenes::GroundRelief& ground) {
   const double az = a.azimuth_deg * kDeg, tilt = a.tilt_deg * kDeg;
   const Eigen::Vector3d eu(std::cos(az), std::sin(az), 0), ev(-std::sin(az), std::cos(az), 0);
   const Eigen::Vector3d up_slope = std::cos(tilt) * ev + std::sin(tilt) * Eigen::Vector3d::UnitZ();
@@ -100,10 +121,12 @@ void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uin
       if (a.identical_tables) rng = first_table_rng;
       const double u_start = t * (tl + a.table_gap_m);
       const double v0 = row * a.row_pitch_m;
+      // The table stands on the ground at its centre: its panels keep their heights above it.
+      const double dz = ground.height_m(scenes::array_to_world(a, u_start + tl / 2, v0 + td / 2 * std::cos(tilt)));
       // table centre on the slope: s = td/2
       auto slope_point = [&](double u, double s) {
         const Eigen::Vector2d g = scenes::array_to_world(a, u, v0 + s * std::cos(tilt));
-        return Eigen::Vector3d(g.x(), g.y(), a.clearance_m + s * std::sin(tilt));
+        return Eigen::Vector3d(g.x(), g.y(), a.clearance_m + s * std::sin(tilt) + dz);
       };
       const std::string tname = pre + "r" + std::to_string(row) + "t" + std::to_string(t);
       for (int line = 0; line < a.panel_lines; ++line) {
@@ -131,9 +154,9 @@ void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uin
         for (double uf : {0.12, 0.88}) {
           for (double sf : {0.22, 0.78}) {
             const Eigen::Vector3d top = slope_point(u_start + tl * uf, td * sf) - normal * 0.11;
-            const double h = top.z();
-            x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(0.04, 0.04, h / 2) + "\" pos=\"" +
-                   v3(top.x(), top.y(), h / 2) + "\" euler=\"0 0 " + f(a.azimuth_deg) +
+            const double foot = post_foot_m(ground, top);
+            x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(0.04, 0.04, (top.z() - foot) / 2) +
+                   "\" pos=\"" + v3(top.x(), top.y(), (top.z() + foot) / 2) + "\" euler=\"0 0 " + f(a.azimuth_deg) +
                    "\" material=\"steel\"/>");
           }
         }
@@ -146,7 +169,8 @@ void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uin
 /// row's middle, turned by rotation_deg (right-handed about +u, 0 flat), on
 /// two posts per table.  The panels sit kTrackerPanelAboveAxisM above the
 /// tube's axis along their normal.
-void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed) {
+void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed,
+                       const scenes::GroundRelief& ground) {
   const double az = a.azimuth_deg * kDeg, rot = a.rotation_deg * kDeg;
   const Eigen::Vector3d eu(std::cos(az), std::sin(az), 0), ev(-std::sin(az), std::cos(az), 0);
   const Eigen::Vector3d across = std::cos(rot) * ev + std::sin(rot) * Eigen::Vector3d::UnitZ();
@@ -161,9 +185,10 @@ void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::u
     for (int t = 0; t < a.tables_per_row; ++t) {
       if (a.identical_tables) rng = first_table_rng;
       const double u_start = t * (tl + a.table_gap_m);
+      const double dz = ground.height_m(scenes::array_to_world(a, u_start + tl / 2, row * a.row_pitch_m + td / 2));
       const auto axis_point = [&](double u) {
         const Eigen::Vector2d g = scenes::array_to_world(a, u, row * a.row_pitch_m + td / 2);
-        return Eigen::Vector3d(g.x(), g.y(), h);
+        return Eigen::Vector3d(g.x(), g.y(), h + dz);
       };
       // s from the table's lower (-across) edge, as for fixed tables.
       // Returns a vector, not an Eigen expression: that would refer to
@@ -188,18 +213,21 @@ void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::u
       if (a.posts)
         for (double uf : {0.15, 0.85}) {
           const Eigen::Vector3d top = axis_point(u_start + tl * uf) - Eigen::Vector3d(0, 0, 0.06);
-          x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(0.05, 0.05, top.z() / 2) + "\" pos=\"" +
-                 v3(top.x(), top.y(), top.z() / 2) + "\" euler=\"0 0 " + f(a.azimuth_deg) + "\" material=\"steel\"/>");
+          const double foot = post_foot_m(ground, top);
+          x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(0.05, 0.05, (top.z() - foot) / 2) +
+                 "\" pos=\"" + v3(top.x(), top.y(), (top.z() + foot) / 2) + "\" euler=\"0 0 " + f(a.azimuth_deg) +
+                 "\" material=\"steel\"/>");
         }
     }
   }
 }
 
-void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed) {
+void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed,
+               const scenes::GroundRelief& ground) {
   if (a.mount == scenes::Mount::kSingleAxis)
-    add_tracker_array(x, a, index, day_seed);
+    add_tracker_array(x, a, index, day_seed, ground);
   else
-    add_fixed_array(x, a, index, day_seed);
+    add_fixed_array(x, a, index, day_seed, ground);
 }
 
 }  // namespace
@@ -335,17 +363,45 @@ void write_settings(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& 
   x.close("</default>");
 }
 
-/// Textures and materials.
-void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& out) {
+/// The relief's samples in MuJoCo's own height-field file format: int32
+/// rows, int32 columns, then rows x columns float32 heights, row-major, row
+/// 0 at -y (MuJoCo scales them to [0, 1]; size[2] scales them back).
+std::vector<unsigned char> hfield_file(const scenes::HeightGrid& g) {
+  const std::int32_t dims[2] = {g.nrow, g.ncol};
+  std::vector<unsigned char> out(sizeof dims + g.z_m.size() * sizeof(float));
+  std::memcpy(out.data(), dims, sizeof dims);
+  const double lowest = g.min_m();
+  for (std::size_t i = 0; i < g.z_m.size(); ++i) {
+    const float v = static_cast<float>(g.z_m[i] - lowest);
+    std::memcpy(out.data() + sizeof dims + i * sizeof(float), &v, sizeof v);
+  }
+  return out;
+}
+
+/// The relief's height field: the ground's extent, its height range and a
+/// base kReliefBaseM deep under its lowest point.
+std::string hfield_line(const scenes::Scenario& s, const scenes::GroundRelief& ground) {
+  const double range = std::max(ground.grid().max_m() - ground.grid().min_m(), 1e-6);  // MuJoCo: positive
+  return "<hfield name=\"ground\" file=\"" + std::string(kReliefFile) + "\" size=\"" +
+         exact(s.ground.size_m.x() / 2) + " " + exact(s.ground.size_m.y() / 2) + " " + exact(range) + " " +
+         f(kReliefBaseM) + "\"/>";
+}
+
+/// Textures and materials (and the relief's height field).
+void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& out, const scenes::GroundRelief& ground) {
   x.open("<asset>");
+  if (!ground.flat()) x.line(hfield_line(s, ground));
   x.line("<texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"0.50 0.66 0.90\" rgb2=\"0.93 0.95 0.98\" "
          "width=\"512\" height=\"512\"/>");
+  const auto texture = [](const std::string& path) { return path.rfind("textures/", 0) == 0; };
   for (const auto& file : out.files) {
+    if (!texture(file.first)) continue;
     const std::string name = file.first.substr(9, file.first.size() - 13);  // textures/NAME.png
     x.line("<texture name=\"" + name + "\" type=\"2d\" file=\"" + file.first + "\"/>");
   }
   // The materials after every texture, as a scene without varied ground always had them.
   for (const auto& file : out.files) {
+    if (!texture(file.first)) continue;
     const std::string name = file.first.substr(9, file.first.size() - 13);  // textures/NAME.png
     if (name.rfind("ground", 0) != 0) continue;  // the ground, and a varied ground's tiles
     x.line("<material name=\"" + name + "\" texture=\"" + name + "\" texuniform=\"true\" texrepeat=\"" +
@@ -371,17 +427,35 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
   x.close("</asset>");
 }
 
+/// The lowest ground under a wall's footprint (sampled every 5 cm along
+/// both faces and the centre line), or 0 on flat ground.
+double lowest_ground_under(const scenes::GroundRelief& ground, const scenes::Wall& w) {
+  if (ground.flat()) return 0.0;
+  const Eigen::Vector2d along = w.end_m - w.start_m;
+  const Eigen::Vector2d side = Eigen::Vector2d(-along.y(), along.x()).normalized() * (w.thickness_m / 2);
+  const int n = static_cast<int>(std::ceil(along.norm() / 0.05));
+  double lowest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k <= n; ++k)
+    for (double sf : {-1.0, 0.0, 1.0})
+      lowest = std::min(lowest, ground.height_m(w.start_m + along * (static_cast<double>(k) / n) + sf * side));
+  return lowest;
+}
+
 /// The walls: boxes with local x along the wall and local y up, so that
-/// the brick texture maps onto the face.
-void add_walls(XmlWriter& x, const scenes::Scenario& s) {
+/// the brick texture maps onto the face.  On a relief a wall's top is
+/// height_m above the ground at its middle, and it reaches kIntoReliefM
+/// below the lowest ground under it.
+void add_walls(XmlWriter& x, const scenes::Scenario& s, const scenes::GroundRelief& ground) {
   for (std::size_t i = 0; i < s.walls.size(); ++i) {
     const scenes::Wall& w = s.walls[i];
     const Eigen::Vector2d d = (w.end_m - w.start_m).normalized();
     const Eigen::Vector2d mid = 0.5 * (w.start_m + w.end_m);
     const double len = (w.end_m - w.start_m).norm();
+    const double top = ground.height_m(mid) + w.height_m;
+    const double foot = ground.flat() ? 0.0 : lowest_ground_under(ground, w) - kIntoReliefM;
     const char* material = w.finish == scenes::WallFinish::kPlaster ? "plaster" : "brick";
     x.line("<geom name=\"wall" + std::to_string(i) + "\" class=\"scenery\" type=\"box\" size=\"" +
-           v3(len / 2, w.height_m / 2, w.thickness_m / 2) + "\" pos=\"" + v3(mid.x(), mid.y(), w.height_m / 2) +
+           v3(len / 2, (top - foot) / 2, w.thickness_m / 2) + "\" pos=\"" + v3(mid.x(), mid.y(), (top + foot) / 2) +
            "\" xyaxes=\"" + v3(d.x(), d.y(), 0) + " 0 0 1\" material=\"" + material + "\"/>");
   }
 }
@@ -409,32 +483,35 @@ bool clear_of_everything(const scenes::Scenario& s, const std::vector<Eigen::Vec
 }
 
 /// One plant, `size` at its station size, grown by the day's growth where
-/// it stands (so that it stands in the same place every day).
+/// it stands (so that it stands in the same place every day), on the ground
+/// where it stands (a trunk kIntoReliefM into a relief).
 void add_plant(XmlWriter& x, const std::string& n, bool tree, const Eigen::Vector2d& p, double size,
-               double growth, Placer& rng) {
-  const double grown = size * growth;
+               double growth, Placer& rng, const scenes::GroundRelief& ground) {
+  const double grown = size * growth, z0 = ground.height_m(p);
   if (tree) {
-    const double trunk_h = 0.45 * grown, crown = 0.3 * grown;
-    x.line("<geom name=\"" + n + "_trunk\" class=\"scenery\" type=\"cylinder\" size=\"" + v3(0.06 + 0.02 * grown, trunk_h / 2, 0) +
-           "\" pos=\"" + v3(p.x(), p.y(), trunk_h / 2) + "\" material=\"bark\"/>");
+    const double trunk_h = 0.45 * grown, crown = 0.3 * grown, into = ground.flat() ? 0.0 : kIntoReliefM;
+    x.line("<geom name=\"" + n + "_trunk\" class=\"scenery\" type=\"cylinder\" size=\"" +
+           v3(0.06 + 0.02 * grown, (trunk_h + into) / 2, 0) + "\" pos=\"" +
+           v3(p.x(), p.y(), z0 + (trunk_h - into) / 2) + "\" material=\"bark\"/>");
     x.line("<geom name=\"" + n + "_crown\" class=\"scenery\" type=\"ellipsoid\" size=\"" +
            v3(crown, crown * rng.uniform(0.8, 1.1), 0.55 * grown * 0.6) + "\" pos=\"" +
-           v3(p.x(), p.y(), trunk_h + 0.25 * grown) + "\" euler=\"0 0 " + f(rng.uniform(0, 180)) +
+           v3(p.x(), p.y(), z0 + trunk_h + 0.25 * grown) + "\" euler=\"0 0 " + f(rng.uniform(0, 180)) +
            "\" material=\"foliage\"/>");
     return;
   }
   const double r = grown / 2;
   x.line("<geom name=\"" + n + "\" class=\"scenery\" type=\"ellipsoid\" size=\"" +
-         v3(r, r * rng.uniform(0.7, 1.0), r * rng.uniform(0.6, 0.9)) + "\" pos=\"" + v3(p.x(), p.y(), r * 0.55) +
-         "\" euler=\"0 0 " + f(rng.uniform(0, 180)) + "\" material=\"foliage\"/>");
+         v3(r, r * rng.uniform(0.7, 1.0), r * rng.uniform(0.6, 0.9)) + "\" pos=\"" +
+         v3(p.x(), p.y(), z0 + r * 0.55) + "\" euler=\"0 0 " + f(rng.uniform(0, 180)) + "\" material=\"foliage\"/>");
   const Eigen::Vector2d q = p + Eigen::Vector2d(rng.uniform(-r, r), rng.uniform(-r, r)) * 0.6;
   x.line("<geom name=\"" + n + "b\" class=\"scenery\" type=\"ellipsoid\" size=\"" + v3(r * 0.7, r * 0.6, r * 0.55) +
-         "\" pos=\"" + v3(q.x(), q.y(), r * 0.5) + "\" material=\"foliage\"/>");
+         "\" pos=\"" + v3(q.x(), q.y(), ground.height_m(q) + r * 0.5) + "\" material=\"foliage\"/>");
 }
 
 /// Vegetation: rejection sampling away from the route, walls and arrays;
 /// where the plants stand is the station's.
-void add_vegetation(XmlWriter& x, const scenes::Scenario& s, const std::vector<Eigen::Vector2d>& route) {
+void add_vegetation(XmlWriter& x, const scenes::Scenario& s, const std::vector<Eigen::Vector2d>& route,
+                    const scenes::GroundRelief& ground) {
   const scenes::Vegetation& veg = s.vegetation;
   Placer rng(s.station_seed_or_seed() ^ 0x5EED5EED);
   int placed = 0;
@@ -446,7 +523,7 @@ void add_vegetation(XmlWriter& x, const scenes::Scenario& s, const std::vector<E
     const Eigen::Vector2d p(rng.uniform(veg.area_m[0], veg.area_m[2]), rng.uniform(veg.area_m[1], veg.area_m[3]));
     const double radius = tree ? 0.3 * size : 0.5 * size;
     if (!clear_of_everything(s, route, p, radius)) continue;
-    add_plant(x, (tree ? "tree" : "shrub") + std::to_string(placed), tree, p, size, veg.growth, rng);
+    add_plant(x, (tree ? "tree" : "shrub") + std::to_string(placed), tree, p, size, veg.growth, rng, ground);
     ++placed;
   }
 }
@@ -474,8 +551,10 @@ void add_robot_parts(XmlWriter& x, const scenes::Scenario& s) {
   x.line("<freejoint name=\"robot_free\"/>");
   x.line("<geom name=\"chassis\" type=\"box\" size=\"0.30 " + f(0.5 * rb.track_m - 0.05) + " 0.07\" pos=\"-0.12 0 0.05\" "
          "mass=\"18\" material=\"robot\"/>");
-  x.line("<geom name=\"caster\" type=\"sphere\" size=\"0.04\" pos=\"" + v3(-0.36, 0, 0.04 - r) +
-         "\" mass=\"0.3\" condim=\"1\" priority=\"1\" friction=\"0 0 0\" rgba=\"0.2 0.2 0.2 1\"/>");
+  // Frictionless: its priority above the ground's (1 when the soil's friction is given) makes its own govern.
+  x.line("<geom name=\"caster\" type=\"sphere\" size=\"0.04\" pos=\"" + v3(-scenes::kRobotWheelBaseM, 0, 0.04 - r) +
+         "\" mass=\"0.3\" condim=\"1\" priority=\"" + (s.ground.friction ? "2" : "1") +
+         "\" friction=\"0 0 0\" rgba=\"0.2 0.2 0.2 1\"/>");
   for (int side = 0; side < 2; ++side) {
     const double y = (side == 0 ? 1 : -1) * 0.5 * rb.track_m;
     const std::string n = side == 0 ? kLeftActuator : kRightActuator;
@@ -490,10 +569,30 @@ void add_robot_parts(XmlWriter& x, const scenes::Scenario& s) {
          v3(s.camera.mount_forward_m - 0.05, 0, mast_h / 2) + "\" mass=\"0.5\" rgba=\"0.3 0.3 0.3 1\"/>");
 }
 
+/// The robot's body at its start: on flat ground 2 mm above it, heading
+/// yaw0; on a relief tilted to the plane through the ground under its two
+/// wheels and its caster, 10 mm above it (it settles before frame 0).
+std::string robot_body_line(const scenes::Scenario& s, const scenes::GroundRelief& ground, const Eigen::Vector2d& start,
+                            double yaw0) {
+  const double r = s.robot.wheel_radius_m;
+  const std::string open = "<body name=\"" + std::string(kRobotBody) + "\" pos=\"";
+  if (ground.flat()) return open + v3(start.x(), start.y(), r + 0.002) + "\" euler=\"0 0 " + f(yaw0 / kDeg) + "\">";
+  const Eigen::Vector2d ahead(std::cos(yaw0), std::sin(yaw0)), left(-ahead.y(), ahead.x());
+  const double hl = ground.height_m(start + 0.5 * s.robot.track_m * left);
+  const double hr = ground.height_m(start - 0.5 * s.robot.track_m * left);
+  const double hc = ground.height_m(start - scenes::kRobotWheelBaseM * ahead), axle = 0.5 * (hl + hr);
+  const double pitch = -std::atan2(axle - hc, scenes::kRobotWheelBaseM);  // about +y: positive turns the nose down
+  const double roll = std::atan2(hl - hr, s.robot.track_m);               // about +x: positive lifts the left wheel
+  const Eigen::Quaterniond q = Eigen::AngleAxisd(yaw0, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());
+  return open + v3(start.x(), start.y(), axle + r + 0.010) + "\" quat=\"" + f(q.w()) + " " + v3(q.vec()) + "\">";
+}
+
 /// The robot (differential drive, two driven wheels and a caster) at the
 /// start of the driven route, its camera, and the sun.
 void add_robot_and_sun(XmlWriter& x, const scenes::Scenario& s, const std::vector<Eigen::Vector2d>& driven,
-                       const ShadowMap& shadow) {
+                       const ShadowMap& shadow, const scenes::GroundRelief& ground) {
   const scenes::Camera& cam = s.camera;
   const double r = s.robot.wheel_radius_m;
   const Eigen::Vector2d start = driven.empty() ? Eigen::Vector2d::Zero() : driven.front();
@@ -502,8 +601,7 @@ void add_robot_and_sun(XmlWriter& x, const scenes::Scenario& s, const std::vecto
     const Eigen::Vector2d d = driven[std::min<std::size_t>(10, driven.size() - 1)] - driven.front();
     yaw0 = std::atan2(d.y(), d.x());
   }
-  x.open("<body name=\"" + std::string(kRobotBody) + "\" pos=\"" + v3(start.x(), start.y(), r + 0.002) +
-         "\" euler=\"0 0 " + f(yaw0 / kDeg) + "\">");
+  x.open(robot_body_line(s, ground, start, yaw0));
   add_robot_parts(x, s);
   const double mast_h = cam.mount_height_m - r;
   // Camera: MuJoCo cameras look along -z with y up.  Forward direction from
@@ -521,15 +619,32 @@ void add_robot_and_sun(XmlWriter& x, const scenes::Scenario& s, const std::vecto
                     Eigen::Vector3d(shadow.centre_xy_m.x(), shadow.centre_xy_m.y(), 0) + to_sun(s.light) * 20.0));
 }
 
+/// The ground's contact: MuJoCo's default combination with the tyres (the
+/// larger friction) unless the soil's friction is given; then it governs
+/// (a priority above the tyres').
+std::string ground_friction(const scenes::Ground& g) {
+  if (!g.friction) return "friction=\"1 0.005 0.0001\"";
+  return "priority=\"1\" friction=\"" + f(*g.friction) + " 0.005 0.0001\"";
+}
+
 /// The ground: one plane that the robot drives on, with the soil image
 /// repeated every kGroundTileM.  A varied ground hides that plane (group 3,
 /// still colliding) and draws its tiles, each with its own image, over a
-/// copy of the repeated plane 5 mm lower for the distance.
-void add_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<GroundTile>& tiles) {
+/// copy of the repeated plane 5 mm lower for the distance.  A relief is a
+/// height field instead, at the height of its lowest sample, with the same
+/// soil image (MuJoCo maps a 2-D texture onto a height field as onto a
+/// plane: by x and y, texrepeat per metre with texuniform).
+void add_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<GroundTile>& tiles,
+                const scenes::GroundRelief& ground) {
+  if (!ground.flat()) {
+    x.line("<geom name=\"ground\" type=\"hfield\" hfield=\"ground\" pos=\"0 0 " + exact(ground.grid().min_m()) +
+           "\" material=\"ground\" condim=\"3\" " + ground_friction(s.ground) + "/>");
+    return;
+  }
   const std::string size = v3(s.ground.size_m.x() / 2, s.ground.size_m.y() / 2, 1);
   const bool varied = s.ground.tiling == scenes::GroundTiling::kVaried;
   x.line("<geom name=\"ground\" type=\"plane\" size=\"" + size + "\" material=\"ground\" condim=\"3\" " +
-         std::string(varied ? "group=\"3\" " : "") + "friction=\"1 0.005 0.0001\"/>");
+         std::string(varied ? "group=\"3\" " : "") + ground_friction(s.ground) + "/>");
   if (!varied) return;
   x.line("<geom class=\"scenery\" type=\"plane\" size=\"" + size + "\" pos=\"0 0 -0.005\" material=\"ground\"/>");
   for (std::size_t k = 0; k < tiles.size(); ++k)
@@ -561,17 +676,20 @@ SceneAssets build_scene(const scenes::Scenario& s) {
   }
   const std::vector<GroundTile> tiles = varied_ground_tiles(s, route);
   add_textures(s, tiles, &out);
+  const scenes::GroundRelief ground(s);
+  if (!ground.flat()) out.files.emplace_back(kReliefFile, hfield_file(ground.grid()));
 
   XmlWriter x;
   x.open("<mujoco model=\"" + s.name + "\">");
   write_settings(x, s, out, shadow);
-  write_assets(x, s, out);
+  write_assets(x, s, out, ground);
   x.open("<worldbody>");
-  add_ground(x, s, tiles);
-  for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) add_array(x, s.pv_arrays[i], static_cast<int>(i), s.seed);
-  add_walls(x, s);
-  add_vegetation(x, s, route);
-  add_robot_and_sun(x, s, driven, shadow);
+  add_ground(x, s, tiles, ground);
+  for (std::size_t i = 0; i < s.pv_arrays.size(); ++i)
+    add_array(x, s.pv_arrays[i], static_cast<int>(i), s.seed, ground);
+  add_walls(x, s, ground);
+  add_vegetation(x, s, route, ground);
+  add_robot_and_sun(x, s, driven, shadow, ground);
   x.close("</worldbody>");
 
   x.open("<actuator>");

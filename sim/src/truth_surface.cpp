@@ -9,6 +9,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "pvb/scenes/ground_relief.hpp"
 #include "pvb/sim/renderer.hpp"
 #include "pvb/sim/scene_builder.hpp"
 #include "pvb/sim/simulator.hpp"
@@ -54,6 +55,14 @@ Eigen::Vector3d geom_normal(const mjModel* m, const mjData* d, int g, const Eige
       Eigen::Index axis = 0;
       (p.cwiseAbs().cwiseQuotient(size)).maxCoeff(&axis);
       n = Eigen::Vector3d::Unit(axis) * (p[axis] < 0 ? -1.0 : 1.0);
+      break;
+    }
+    case mjGEOM_HFIELD: {  // the ground relief: its triangle's normal, as MuJoCo interpolates it
+      const int h = m->geom_dataid[g];
+      const mjtNum* hs = m->hfield_size + 4 * h;
+      n = scenes::grid_surface(m->hfield_data + m->hfield_adr[h], hs[2], m->hfield_nrow[h], m->hfield_ncol[h], hs[0],
+                               hs[1], p.x(), p.y())
+              .normal;
       break;
     }
     case mjGEOM_SPHERE: n = p; break;

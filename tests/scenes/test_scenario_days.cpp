@@ -268,7 +268,7 @@ TEST(ScenarioDays, TheGroundsTilingIsTheStations) {
   const Folder f("tiling");
   f.write("station.yaml", kStation);
   const std::string e = f.error_of("day.yaml", "base: station.yaml\nground: {tiling: varied}\n");
-  EXPECT_NE(e.find("day.yaml:2: ground: expected a key a derived file may change"), std::string::npos) << e;
+  EXPECT_NE(e.find("day.yaml:2: ground.tiling: expected a key a derived file may change"), std::string::npos) << e;
 }
 
 TEST(ScenarioDays, TrackerKeysAreCheckedWithFileAndLine) {

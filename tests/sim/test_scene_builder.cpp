@@ -2,13 +2,17 @@
 
 #include <cmath>
 #include <algorithm>
+#include <random>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "pvb/scenes/ground_relief.hpp"
+#include "pvb/scenes/route.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/scene_builder.hpp"
+#include "pvb/sim/truth_surface.hpp"
 
 using namespace pvb;
 
@@ -276,4 +280,140 @@ TEST(SceneBuilder, AVariedGroundGivesEveryTileAlongTheRouteAnImageOfItsOwn) {
   for (int g = 0; g < r->ngeom; ++g) planes += r->geom_type[g] == mjGEOM_PLANE ? 1 : 0;
   EXPECT_EQ(planes, 1);
   EXPECT_EQ(r->geom_group[mj_name2id(r.get(), mjOBJ_GEOM, "ground")], 0);
+}
+
+namespace {
+
+scenes::Scenario rough_scene(const std::string& file) {
+  return scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + file);
+}
+
+/// A geom's lowest and highest z (a box or cylinder standing upright).
+std::pair<double, double> upright_z_range(const mjModel* m, const mjData* d, int g) {
+  const double half = m->geom_type[g] == mjGEOM_CYLINDER ? m->geom_size[3 * g + 1] : m->geom_size[3 * g + 2];
+  return {d->geom_xpos[3 * g + 2] - half, d->geom_xpos[3 * g + 2] + half};
+}
+
+}  // namespace
+
+// The relief is a MuJoCo height field whose surface is GroundRelief's:
+// rays cast down onto it at seeded random points land at height_m.
+TEST(SceneBuilder, ReliefIsAHeightFieldThatMujocoAgreesWith) {
+  const scenes::Scenario s = rough_scene("rough_station.yaml");
+  const scenes::GroundRelief relief(s);
+  const sim::ModelPtr m = sim::compile_scene(sim::build_scene(s));
+  sim::DataPtr d(mj_makeData(m.get()));
+  mj_forward(m.get(), d.get());
+  const int ground = mj_name2id(m.get(), mjOBJ_GEOM, "ground");
+  ASSERT_GE(ground, 0);
+  ASSERT_EQ(m->geom_type[ground], mjGEOM_HFIELD);
+  std::mt19937_64 rng(20261128);
+  std::uniform_real_distribution<double> ux(-29.0, 29.0), uy(-19.0, 19.0);
+  double worst = 0;
+  for (int i = 0; i < 300; ++i) {
+    const double x = ux(rng), y = uy(rng);
+    const mjtNum from[3] = {x, y, 10.0}, down[3] = {0, 0, -1};
+    const mjtNum dist = mj_rayHfield(m.get(), d.get(), ground, from, down);
+    ASSERT_GT(dist, 0) << x << " " << y;
+    worst = std::max(worst, std::abs((10.0 - dist) - relief.height_m(x, y)));
+    // The true surface's normal of the height field is GroundRelief's too.
+    const Eigen::Vector3d p(x, y, 10.0 - dist);
+    EXPECT_LT((sim::geom_normal(m.get(), d.get(), ground, p, p + Eigen::Vector3d(0, 0, 1)) - relief.normal(x, y)).norm(),
+              1e-4);
+  }
+  EXPECT_LT(worst, 1e-4);  // within 0.1 mm (MuJoCo keeps the samples as floats)
+  // The relief is not flat: a few centimetres of roughness over the slope.
+  EXPECT_GT(relief.grid().max_m() - relief.grid().min_m(), 1.0);
+}
+
+// Posts reach into the ground under them; tables keep their height above
+// the ground at their centre; walls, shrubs and trees stand on it.
+TEST(SceneBuilder, EverythingStandsOnTheRelief) {
+  const scenes::Scenario rough = rough_scene("rough_station.yaml"), flat = station();
+  const scenes::GroundRelief relief(rough);
+  const sim::ModelPtr mr = sim::compile_scene(sim::build_scene(rough));
+  const sim::ModelPtr mf = sim::compile_scene(sim::build_scene(flat));
+  sim::DataPtr dr(mj_makeData(mr.get())), df(mj_makeData(mf.get()));
+  mj_forward(mr.get(), dr.get());
+  mj_forward(mf.get(), df.get());
+  const auto z_of = [](const mjModel* m, const mjData* d, const char* name) {
+    const int g = mj_name2id(m, mjOBJ_GEOM, name);
+    EXPECT_GE(g, 0) << name;
+    return g < 0 ? 0.0 : d->geom_xpos[3 * g + 2];
+  };
+  const scenes::PvArray& a = rough.pv_arrays[0];
+  const Eigen::Vector2d centre = scenes::array_to_world(a, a.table_length_m() / 2,
+                                                        a.table_depth_m() / 2 * std::cos(a.tilt_deg * M_PI / 180));
+  EXPECT_NEAR(z_of(mr.get(), dr.get(), "a0r0t0p1_3") - z_of(mf.get(), df.get(), "a0r0t0p1_3"),
+              relief.height_m(centre), 1e-5);
+  int posts = 0;
+  for (int g = 0; g < mr->ngeom; ++g) {
+    const int mat = mr->geom_matid[g];
+    if (mat < 0 || std::string(mj_id2name(mr.get(), mjOBJ_MATERIAL, mat)) != "steel" || mr->geom_size[3 * g + 2] < 0.2)
+      continue;
+    const auto [bottom, top] = upright_z_range(mr.get(), dr.get(), g);
+    const double ground = relief.height_m(dr->geom_xpos[3 * g], dr->geom_xpos[3 * g + 1]);
+    EXPECT_NEAR(bottom, ground - 0.15, 1e-5);
+    EXPECT_GT(top, ground + 0.3);
+    ++posts;
+  }
+  EXPECT_EQ(posts, 16);
+  const int wall = mj_name2id(mr.get(), mjOBJ_GEOM, "wall0");
+  const scenes::Wall& w = rough.walls[0];
+  const double lowest = std::min(relief.height_m(w.start_m), relief.height_m(w.end_m));
+  EXPECT_GT(mr->geom_size[3 * wall + 1] * 2, w.height_m + 0.15 - 1e-9);  // a box, local y up
+  EXPECT_LT(dr->geom_xpos[3 * wall + 2] - mr->geom_size[3 * wall + 1], lowest - 0.15 + 1e-9);
+  EXPECT_NEAR(dr->geom_xpos[3 * wall + 2] + mr->geom_size[3 * wall + 1],
+              relief.height_m(0.5 * (w.start_m + w.end_m)) + w.height_m, 1e-5);
+  // Plants stand where they stood on flat ground, on the ground there.
+  for (const char* plant : {"shrub0", "shrub7", "tree11_crown"}) {
+    const int g = mj_name2id(mr.get(), mjOBJ_GEOM, plant);
+    ASSERT_GE(g, 0) << plant;
+    EXPECT_NEAR(dr->geom_xpos[3 * g + 2] - relief.height_m(dr->geom_xpos[3 * g], dr->geom_xpos[3 * g + 1]),
+                z_of(mf.get(), df.get(), plant), 1e-5)
+        << plant;
+  }
+  const int trunk = mj_name2id(mr.get(), mjOBJ_GEOM, "tree11_trunk");
+  EXPECT_NEAR(upright_z_range(mr.get(), dr.get(), trunk).first,
+              relief.height_m(dr->geom_xpos[3 * trunk], dr->geom_xpos[3 * trunk + 1]) - 0.15, 1e-5);
+}
+
+// rough_station is pv_station on a relief: without it, the same scene.
+TEST(SceneBuilder, RoughStationIsPvStationOnARelief) {
+  scenes::Scenario rough = rough_scene("rough_station.yaml");
+  const scenes::Scenario flat = station();
+  ASSERT_TRUE(rough.ground.relief);
+  rough.ground.relief.reset();
+  rough.name = flat.name;
+  rough.source_file = flat.source_file;
+  rough.station_seed.reset();
+  EXPECT_EQ(sim::build_scene(rough).xml, sim::build_scene(flat).xml);
+}
+
+// The soil's friction, when the day gives it, governs the tyres' contact
+// (the ground's priority); without it MuJoCo takes the larger, the tyres'
+// 1.2.  The caster stays frictionless either way.
+TEST(SceneBuilder, SoilFrictionGovernsTheTyresContact) {
+  const auto contact_friction = [](const std::string& file) {
+    const sim::ModelPtr m = sim::compile_scene(sim::build_scene(rough_scene(file)));
+    sim::DataPtr d(mj_makeData(m.get()));
+    for (int i = 0; i < 200; ++i) mj_step(m.get(), d.get());  // settled on its wheels and caster
+    const int ground = mj_name2id(m.get(), mjOBJ_GEOM, "ground"), caster = mj_name2id(m.get(), mjOBJ_GEOM, "caster");
+    std::vector<double> wheels;
+    double caster_mu = -1;
+    for (int c = 0; c < d->ncon; ++c) {
+      const mjContact& k = d->contact[c];
+      if (k.geom1 != ground && k.geom2 != ground) continue;
+      if (k.geom1 == caster || k.geom2 == caster)
+        caster_mu = k.dim == 1 ? 0.0 : k.friction[0];
+      else
+        wheels.push_back(k.friction[0]);
+    }
+    EXPECT_GE(wheels.size(), 2u) << file;
+    EXPECT_EQ(caster_mu, 0.0) << file;
+    return wheels.empty() ? -1.0 : *std::max_element(wheels.begin(), wheels.end());
+  };
+  EXPECT_DOUBLE_EQ(contact_friction("rough_station.yaml"), 1.2);
+  EXPECT_DOUBLE_EQ(contact_friction("days/rough_station_dry.yaml"), 0.65);
+  EXPECT_DOUBLE_EQ(contact_friction("days/rough_station_wet.yaml"), 0.4);
 }

@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <optional>
 #include <thread>
 #include <vector>
 
 #include "pvb/common/error.hpp"
+#include "pvb/scenes/ground_relief.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sensor/depth_encoding.hpp"
 #include "pvb/geometry/time.hpp"
@@ -424,4 +426,78 @@ TEST(SimFrameSource, KidnapCoversTheCameraAndTheGroundTruthFollowsTheCarry) {
   EXPECT_GT((gt[k.cover_begin].T_w_c.translation() - gt[k.teleport].T_w_c.translation()).norm(), 0.4);
   for (int i = k.cover_begin + 1; i <= k.teleport; ++i)
     EXPECT_LT((gt[i].T_w_c.translation() - gt[i - 1].T_w_c.translation()).norm(), 0.25) << i;
+}
+
+namespace {
+
+/// The camera's pitch (its optical axis above the horizontal) and roll (the
+/// image's x axis above it), degrees, at every frame of a physics-only drive.
+struct TiltTrace {
+  std::vector<double> pitch_deg, roll_deg;
+};
+
+double std_dev(const std::vector<double>& v) {
+  double mean = 0, sq = 0;
+  for (double x : v) mean += x / static_cast<double>(v.size());
+  for (double x : v) sq += (x - mean) * (x - mean) / static_cast<double>(v.size());
+  return std::sqrt(sq);
+}
+
+}  // namespace
+
+// The robot settles on the relief on its wheels and caster, drives the
+// whole route of rough_station, and pitches and rolls with the ground: far
+// more than on pv_station's flat ground, the same route.
+TEST(Simulator, SettlesOnTheReliefAndDrivesRoughStationToItsEnd) {
+  std::map<std::string, TiltTrace> traces;
+  for (const char* name : {"pv_station", "rough_station"}) {
+    const scenes::Scenario s = scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + name + ".yaml");
+    const scenes::GroundRelief relief(s);
+    sim::Simulator sim(s);
+    const int body = mj_name2id(sim.model(), mjOBJ_BODY, sim::kRobotBody);
+    const mjtNum* axle = sim.data()->xpos + 3 * body;
+    EXPECT_NEAR(axle[2] - relief.height_m(axle[0], axle[1]), s.robot.wheel_radius_m, 0.01) << name << ": settled";
+    EXPECT_LT(mju_norm3(sim.data()->cvel + 6 * body + 3), 0.01) << name << ": at rest before it drives";
+    double worst = 0;
+    TiltTrace& trace = traces[name];
+    for (int i = 1; i < sim.frame_count(); ++i) {
+      sim.advance();
+      worst = std::max(worst, sim.follower().cross_track_error_m(sim.base_pose()));
+      const Eigen::Matrix3d R = sim.T_w_c().linear();
+      trace.pitch_deg.push_back(std::asin(R(2, 2)) * 180 / M_PI);
+      trace.roll_deg.push_back(std::asin(R(2, 0)) * 180 / M_PI);
+    }
+    EXPECT_TRUE(sim.follower().finished()) << name << ": route not finished in time";
+    EXPECT_LT(worst, 0.3) << name;
+    const sim::Pose2d end = sim.base_pose();
+    EXPECT_LT((Eigen::Vector2d(end.x, end.y) - sim.follower().path().back()).norm(), 0.2) << name;
+    std::printf("%s: camera pitch std %.3f deg, roll std %.3f deg, worst cross-track error %.3f m\n", name,
+                std_dev(trace.pitch_deg), std_dev(trace.roll_deg), worst);
+  }
+  const TiltTrace &flat = traces["pv_station"], &rough = traces["rough_station"];
+  EXPECT_GT(std_dev(rough.pitch_deg), 0.3);
+  EXPECT_GT(std_dev(rough.roll_deg), 0.3);
+  EXPECT_GT(std_dev(rough.pitch_deg), 5 * std_dev(flat.pitch_deg));
+  EXPECT_GT(std_dev(rough.roll_deg), 5 * std_dev(flat.roll_deg));
+}
+
+// The soil's friction is felt: from standstill at full wheel speed, the
+// wheels of the same station spin more on wet earth than on dry.
+TEST(Simulator, WetSoilSlipsMoreThanDryUnderFullThrottle) {
+  std::map<std::string, double> slip;
+  for (const char* day : {"rough_station_dry", "rough_station_wet"}) {
+    const scenes::Scenario s = scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/days/" + day + ".yaml");
+    sim::Simulator sim(s);
+    const int joint = mj_name2id(sim.model(), mjOBJ_JOINT, sim::kLeftActuator);
+    ASSERT_GE(joint, 0);
+    const double angle0 = sim.data()->qpos[sim.model()->jnt_qposadr[joint]];
+    const sim::Pose2d p0 = sim.base_pose();
+    sim.set_wheel_override(Eigen::Vector2d(s.robot.max_wheel_speed_radps, s.robot.max_wheel_speed_radps));
+    for (int i = 0; i < 10; ++i) sim.advance();  // a third of a second
+    const double turned_m = (sim.data()->qpos[sim.model()->jnt_qposadr[joint]] - angle0) * s.robot.wheel_radius_m;
+    const sim::Pose2d p1 = sim.base_pose();
+    slip[day] = 1.0 - std::hypot(p1.x - p0.x, p1.y - p0.y) / turned_m;
+    std::printf("%s: friction %.2f, wheel slip %.3f over %.3f m of tread\n", day, *s.ground.friction, slip[day], turned_m);
+  }
+  EXPECT_GT(slip["rough_station_wet"], slip["rough_station_dry"] + 0.05);
 }

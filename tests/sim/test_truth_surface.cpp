@@ -3,6 +3,8 @@
 // one per voxel, and the same on every run.
 #include "pvb/sim/truth_surface.hpp"
 
+#include "pvb/scenes/ground_relief.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -61,4 +63,32 @@ TEST(TruthSurface, WallPassSeesTheWall) {
   ASSERT_GT(classes.count(pvb::sim::SurfaceClass::kWall), 0u);
   EXPECT_GT(classes.at(pvb::sim::SurfaceClass::kWall), 1000);
   EXPECT_EQ(classes.count(pvb::sim::SurfaceClass::kOther), 0u) << "every seen geom has a class";
+}
+
+// On a relief the ground's samples lie on GroundRelief's surface, labelled
+// ground, with its triangles' normals (not the direction to the camera).
+TEST(TruthSurface, RoughStationGroundLiesOnTheRelief) {
+  pvb::sim::TruthSurfaceOptions o;
+  o.frames = 60;
+  o.every = 30;
+  const pvb::scenes::Scenario rough = scenario("rough_station");
+  const pvb::scenes::GroundRelief relief(rough);
+  const auto s = pvb::sim::sample_truth_surface(rough, pvb::sim::GlBackend::kAuto, o);
+  const auto classes = count_classes(s);
+  ASSERT_GT(classes.count(pvb::sim::SurfaceClass::kGround), 0u);
+  EXPECT_GT(classes.at(pvb::sim::SurfaceClass::kGround), 20000);
+  EXPECT_EQ(classes.count(pvb::sim::SurfaceClass::kOther), 0u) << "every seen geom has a class";
+  double worst = 0, worst_normal = 0;
+  int tilted = 0, ground = 0;
+  for (const auto& t : s) {
+    if (t.cls != pvb::sim::SurfaceClass::kGround) continue;
+    ++ground;
+    worst = std::max(worst, std::abs(t.p_w.z() - relief.height_m(t.p_w.x(), t.p_w.y())));
+    // A sample near a triangle's edge may take its neighbour's normal: judged by the median below.
+    worst_normal = std::max(worst_normal, (t.n_w - relief.normal(t.p_w.x(), t.p_w.y())).norm());
+    tilted += t.n_w.z() < 1.0 - 1e-6 ? 1 : 0;
+  }
+  EXPECT_LT(worst, 0.002) << "ground samples must lie on the relief";
+  EXPECT_LT(worst_normal, 0.2);
+  EXPECT_EQ(tilted, ground) << "every ground normal is the relief's, none the plane's";
 }

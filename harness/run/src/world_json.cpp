@@ -40,6 +40,19 @@ std::string array_json(const scenes::PvArray& a) {
   return out + ", \"dirt\": " + number8(a.dirt) + "}";
 }
 
+/// The ground, only when it is not the flat default: its relief (the
+/// station's) and the soil's friction (the day's, or null).
+std::string ground_json(const scenes::Ground& g) {
+  std::string relief = "null";
+  if (g.relief)
+    relief = "{\"amplitude_cm\": " + number8(g.relief->amplitude_cm) + ", \"scale_m\": " + number8(g.relief->scale_m) +
+             ", \"slope_percent\": " + number8(g.relief->slope_percent) +
+             ", \"slope_azimuth_deg\": " + number8(g.relief->slope_azimuth_deg) +
+             ", \"cell_m\": " + number8(g.relief->cell_m) + "}";
+  return ", \"ground\": {\"relief\": " + relief +
+         ", \"friction\": " + (g.friction ? number8(*g.friction) : std::string("null")) + "}";
+}
+
 }  // namespace
 
 std::string world_json(const scenes::Scenario& s) {
@@ -57,7 +70,8 @@ std::string world_json(const scenes::Scenario& s) {
          ", \"elevation_deg\": " + number8(s.sun.elevation_deg) +
          ", \"scene_azimuth_deg\": " + number8(s.light.sun_azimuth_deg) +
          ", \"intensity\": " + number8(s.light.intensity) + ", \"ambient\": " + number8(s.light.ambient) +
-         "}, \"vegetation_growth\": " + number8(s.vegetation.growth) + ", \"arrays\": " + arrays + "}";
+         "}, \"vegetation_growth\": " + number8(s.vegetation.growth) + ", \"arrays\": " + arrays +
+         (s.ground.relief || s.ground.friction ? ground_json(s.ground) : std::string()) + "}";
 }
 
 }  // namespace pvb::run

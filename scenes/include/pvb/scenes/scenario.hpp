@@ -37,10 +37,25 @@ struct TrackerMount {
   std::optional<double> fixed_rotation_deg;
 };
 
+/// Uneven ground (`ground.relief`): roughness over an overall slope, from
+/// the station's seed (pvb/scenes/ground_relief.hpp says how it is made).
+struct Relief {
+  double amplitude_cm = 2.0;       ///< standard deviation of the roughness
+  double scale_m = 1.0;            ///< its correlation length
+  double slope_percent = 0.0;      ///< overall grade, rise over run x 100
+  double slope_azimuth_deg = 0.0;  ///< direction the ground rises, CCW from world x
+  double cell_m = 0.25;            ///< grid spacing (at most)
+};
+
 struct Ground {
   GroundType type = GroundType::kSoil;
   Eigen::Vector2d size_m{60.0, 60.0};  ///< extent along x and y, centred at origin
   GroundTiling tiling = GroundTiling::kRepeat;
+  std::optional<Relief> relief;  ///< none: the flat plane z = 0
+  /// Sliding friction of the soil against the tyres (the day's: wet soil
+  /// slips).  None: MuJoCo's default combination (the larger of soil 1 and
+  /// tyre 1.2).  Given: the ground's friction governs every contact with it.
+  std::optional<double> friction;
 };
 
 /// Trackers: the panels sit this far above the torque tube's axis, along
@@ -218,6 +233,9 @@ struct Camera {
   /// height pixels, so tan(fovy / 2) = (height / 2) / fy.
   double fovy_deg() const;
 };
+
+/// The robot's caster is this far behind the wheels' axle: its wheel base.
+inline constexpr double kRobotWheelBaseM = 0.36;
 
 /// The robot as built (the simulated one).  The description a SLAM core or
 /// an odometry gets (robot.yaml) has nominal values that differ from these

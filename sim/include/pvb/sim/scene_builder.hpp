@@ -14,7 +14,9 @@ namespace pvb::sim {
 /// A generated scene: scene.xml plus the texture files it names.
 struct SceneAssets {
   std::string xml;
-  std::vector<std::pair<std::string, std::vector<unsigned char>>> files;  ///< path relative to scene.xml, PNG bytes
+  /// Path relative to scene.xml and bytes: the textures' PNGs, and with a
+  /// ground relief its height field (kReliefFile).
+  std::vector<std::pair<std::string, std::vector<unsigned char>>> files;
   double timestep_s = 0.002;   ///< physics step; an exact divisor of the frame period
   int substeps = 17;           ///< physics steps per camera frame
   double max_scene_depth_m = 100;  ///< anything farther than this is sky
@@ -61,7 +63,7 @@ using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 /// carrying MuJoCo's message on failure.
 ModelPtr compile_scene(const SceneAssets& assets);
 
-/// Writes scene.xml and the texture files under `dir` (created if needed).
+/// Writes scene.xml and the files it names under `dir` (created if needed).
 void write_scene(const SceneAssets& assets, const std::string& dir);
 
 /// Names used in the generated model.
@@ -69,5 +71,7 @@ inline constexpr const char* kCameraName = "rgbd";
 inline constexpr const char* kRobotBody = "robot";
 inline constexpr const char* kLeftActuator = "wheel_left";
 inline constexpr const char* kRightActuator = "wheel_right";
+/// The ground relief's height field, in MuJoCo's binary hfield format.
+inline constexpr const char* kReliefFile = "ground_relief.bin";
 
 }  // namespace pvb::sim

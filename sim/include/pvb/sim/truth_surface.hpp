@@ -45,7 +45,7 @@ std::vector<TruthSample> sample_truth_surface(const scenes::Scenario& scenario, 
 SurfaceClass classify_geom(const mjModel* model, int geom_id);
 
 /// The outward unit normal of geom `geom_id` at the world point `p_w` on
-/// its surface (plane, box, sphere, ellipsoid, cylinder; others: the
+/// its surface (plane, height field, box, sphere, ellipsoid, cylinder; others: the
 /// direction to `eye_w`).
 Eigen::Vector3d geom_normal(const mjModel* model, const mjData* data, int geom_id, const Eigen::Vector3d& p_w,
                             const Eigen::Vector3d& eye_w);
