@@ -418,6 +418,7 @@ void read_ground(MapReader& r, Ground& g) {
                                     {{"repeat", GroundTiling::kRepeat}, {"varied", GroundTiling::kVaried}});
   with_map(r, "relief", [&](MapReader& q) { read_relief(q, g); });
   if (r.has("friction")) g.friction = r.number("friction", 0.0, 0.05, 2);
+  g.softness = r.number("softness", g.softness, 0, 1);
 }
 
 /// A relief the robot cannot drive: the first route point where a grade

@@ -553,7 +553,7 @@ void add_robot_parts(XmlWriter& x, const scenes::Scenario& s) {
          "mass=\"18\" material=\"robot\"/>");
   // Frictionless: its priority above the ground's (1 when the soil's friction is given) makes its own govern.
   x.line("<geom name=\"caster\" type=\"sphere\" size=\"0.04\" pos=\"" + v3(-scenes::kRobotWheelBaseM, 0, 0.04 - r) +
-         "\" mass=\"0.3\" condim=\"1\" priority=\"" + (s.ground.friction ? "2" : "1") +
+         "\" mass=\"0.3\" condim=\"1\" priority=\"" + (s.ground.governs_contact() ? "2" : "1") +
          "\" friction=\"0 0 0\" rgba=\"0.2 0.2 0.2 1\"/>");
   for (int side = 0; side < 2; ++side) {
     const double y = (side == 0 ? 1 : -1) * 0.5 * rb.track_m;
@@ -620,11 +620,19 @@ void add_robot_and_sun(XmlWriter& x, const scenes::Scenario& s, const std::vecto
 }
 
 /// The ground's contact: MuJoCo's default combination with the tyres (the
-/// larger friction) unless the soil's friction is given; then it governs
-/// (a priority above the tyres').
+/// larger friction) unless the day gives the soil's friction or softness;
+/// then the ground's govern (a priority above the tyres'): its friction
+/// (the tyres' 1.2 when only the softness is given) and, for a soft soil,
+/// a softer, slower contact in which the tyres sink and creep.
 std::string ground_friction(const scenes::Ground& g) {
-  if (!g.friction) return "friction=\"1 0.005 0.0001\"";
-  return "priority=\"1\" friction=\"" + f(*g.friction) + " 0.005 0.0001\"";
+  if (!g.governs_contact()) return "friction=\"1 0.005 0.0001\"";
+  std::string out = "priority=\"1\" friction=\"" + f(g.friction.value_or(1.2)) + " 0.005 0.0001\"";
+  if (g.softness > 0) {  // MuJoCo's defaults at 0: solref 0.02 1, solimp 0.9 0.95 0.001
+    const double k = g.softness;
+    out += " solref=\"" + f(0.02 + 0.08 * k) + " 1\" solimp=\"" + f(0.9 - 0.4 * k) + " " + f(0.95 - 0.25 * k) + " " +
+           f(0.001 + 0.009 * k) + "\"";
+  }
+  return out;
 }
 
 /// The ground: one plane that the robot drives on, with the soil image

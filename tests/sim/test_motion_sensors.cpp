@@ -66,16 +66,14 @@ struct Strapdown {
   }
 };
 
-}  // namespace
 
-// With noise and biases off, integrating the IMU from the true initial state
-// gives back the true pose after 10 s of driving: within 1 cm and 0.1 deg.
-TEST(MotionSensors, ImuIntegratesBackToTheTruePose) {
-  scenes::Scenario s = drive_scenario(0.5, 12);
+/// Integrates the noise-free IMU of `s` over 10 s of driving from the true
+/// initial state; the position and rotation errors at the end.
+std::pair<double, double> imu_integration_error(scenes::Scenario s) {
   perfect_imu(&s);
   sim::Simulator sim(s);
   const sim::MotionBatch b = drive(sim, 301);
-  ASSERT_GE(b.imu.size(), 2001u);
+  EXPECT_GE(b.imu.size(), 2001u);
   EXPECT_EQ(b.imu[0].t_ns, 5'000'000);  // 200 Hz from frame 0
   Strapdown sd{b.imu_truth[0].T_w_i.linear(), b.imu_truth[0].T_w_i.translation(), b.imu_truth[0].v_w_i};
   const Eigen::Vector3d g(0, 0, -9.81);
@@ -83,8 +81,24 @@ TEST(MotionSensors, ImuIntegratesBackToTheTruePose) {
   const sim::ImuTruth& end = b.imu_truth[2000];
   EXPECT_NEAR(geom::ns_to_seconds(end.t_ns - b.imu_truth[0].t_ns), 10.0, 1e-9);
   EXPECT_GT((end.T_w_i.translation() - b.imu_truth[0].T_w_i.translation()).norm(), 3.5) << "it drove";
-  EXPECT_LT((sd.p - end.T_w_i.translation()).norm(), 0.01);
-  EXPECT_LT(Eigen::AngleAxisd(sd.R.transpose() * end.T_w_i.linear()).angle() * 180 / M_PI, 0.1);
+  const double dp = (sd.p - end.T_w_i.translation()).norm();
+  const double dr = Eigen::AngleAxisd(sd.R.transpose() * end.T_w_i.linear()).angle() * 180 / M_PI;
+  std::printf("%s: IMU integrated over 10 s: %.2f mm, %.4f deg from the truth\n", s.name.c_str(), dp * 1000, dr);
+  return {dp, dr};
+}
+
+}  // namespace
+
+// With noise and biases off, integrating the IMU from the true initial state
+// gives back the true pose after 10 s of driving: within 1 cm and 0.1 deg,
+// on flat ground and on rough_station's bumps and slope.
+TEST(MotionSensors, ImuIntegratesBackToTheTruePose) {
+  for (const scenes::Scenario& s :
+       {drive_scenario(0.5, 12), scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/rough_station.yaml")}) {
+    const auto [dp, dr] = imu_integration_error(s);
+    EXPECT_LT(dp, 0.01) << s.name;
+    EXPECT_LT(dr, 0.1) << s.name;
+  }
 }
 
 // On flat ground at low speed, odometry from the encoders with the true
@@ -348,4 +362,52 @@ TEST(MotionSensors, MountPosesAgreeWithTheModel) {
   const geom::SE3d i = sim.motion_sensors().T_b_i(), j = scenes::T_base_imu(s);
   EXPECT_LT((i.translation() - j.translation()).norm(), 1e-6);
   EXPECT_LT((i.translation() - a.translation()).norm(), 0.05) << "near the camera";
+}
+
+namespace {
+
+struct OdometryOutcome {
+  double drift_m = 0, distance_m = 0, mean_abs_slip = 0, max_abs_slip = 0;
+};
+
+/// Drives a day's scenario and integrates its encoders with the robot's
+/// description: the odometry's position error at the end, and the slip.
+OdometryOutcome drive_day(const std::string& file) {
+  const scenes::Scenario s = scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + file);
+  sim::Simulator sim(s);
+  const sim::MotionBatch b = drive(sim, sim.frame_count() - 1);
+  sensor::WheelOdometry odo(sim::nominal_description(s));
+  OdometryOutcome out;
+  const geom::SE3d T_w_b0 = b.wheel_truth.front().T_w_b;
+  const Eigen::Vector3d x0 = T_w_b0.linear().col(0);
+  const double yaw0 = std::atan2(x0.y(), x0.x());
+  for (std::size_t k = 0; k < b.ticks.size(); ++k) {
+    odo.add(b.ticks[k]);
+    if (k > 0)
+      out.distance_m +=
+          (b.wheel_truth[k].T_w_b.translation() - b.wheel_truth[k - 1].T_w_b.translation()).head<2>().norm();
+    out.mean_abs_slip += (std::abs(b.wheel_truth[k].slip.x()) + std::abs(b.wheel_truth[k].slip.y())) / 2;
+    out.max_abs_slip = std::max(out.max_abs_slip, b.wheel_truth[k].slip.cwiseAbs().maxCoeff());
+  }
+  out.mean_abs_slip /= b.ticks.size();
+  const Eigen::Vector2d d = (b.wheel_truth.back().T_w_b.translation() - T_w_b0.translation()).head<2>();
+  const Eigen::Vector2d p_true(std::cos(yaw0) * d.x() + std::sin(yaw0) * d.y(),
+                               -std::sin(yaw0) * d.x() + std::cos(yaw0) * d.y());
+  out.drift_m = (Eigen::Vector2d(odo.state().x_m, odo.state().y_m) - p_true).norm();
+  std::printf("%s: odometry %.4f m off after %.2f m; mean |slip| %.4f, max %.3f\n", file.c_str(), out.drift_m,
+              out.distance_m, out.mean_abs_slip, out.max_abs_slip);
+  return out;
+}
+
+}  // namespace
+
+// The same station on a wet and a dry day: the wheels slip more on wet
+// earth (MuJoCo's contact, not a random draw), and the odometry alone
+// drifts further.
+TEST(MotionSensors, WetDaySlipsAndDriftsMoreThanDryDay) {
+  const OdometryOutcome dry = drive_day("days/rough_station_dry.yaml");
+  const OdometryOutcome wet = drive_day("days/rough_station_wet.yaml");
+  EXPECT_GT(wet.mean_abs_slip, dry.mean_abs_slip);
+  EXPECT_GT(wet.drift_m, dry.drift_m);
+  EXPECT_GT(dry.distance_m, 8.0);
 }

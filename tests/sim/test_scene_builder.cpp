@@ -384,9 +384,12 @@ TEST(SceneBuilder, RoughStationIsPvStationOnARelief) {
   const scenes::Scenario flat = station();
   ASSERT_TRUE(rough.ground.relief);
   rough.ground.relief.reset();
+  EXPECT_NE(rough.physics.rate_hz, flat.physics.rate_hz);
   rough.name = flat.name;
   rough.source_file = flat.source_file;
   rough.station_seed.reset();
+  rough.physics = flat.physics;  // its body: the 600 Hz step and the ramped wheels
+  rough.robot = flat.robot;
   EXPECT_EQ(sim::build_scene(rough).xml, sim::build_scene(flat).xml);
 }
 

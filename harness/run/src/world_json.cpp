@@ -50,7 +50,8 @@ std::string ground_json(const scenes::Ground& g) {
              ", \"slope_azimuth_deg\": " + number8(g.relief->slope_azimuth_deg) +
              ", \"cell_m\": " + number8(g.relief->cell_m) + "}";
   return ", \"ground\": {\"relief\": " + relief +
-         ", \"friction\": " + (g.friction ? number8(*g.friction) : std::string("null")) + "}";
+         ", \"friction\": " + (g.friction ? number8(*g.friction) : std::string("null")) +
+         ", \"softness\": " + number8(g.softness) + "}";
 }
 
 }  // namespace
@@ -71,7 +72,7 @@ std::string world_json(const scenes::Scenario& s) {
          ", \"scene_azimuth_deg\": " + number8(s.light.sun_azimuth_deg) +
          ", \"intensity\": " + number8(s.light.intensity) + ", \"ambient\": " + number8(s.light.ambient) +
          "}, \"vegetation_growth\": " + number8(s.vegetation.growth) + ", \"arrays\": " + arrays +
-         (s.ground.relief || s.ground.friction ? ground_json(s.ground) : std::string()) + "}";
+         (s.ground.relief || s.ground.governs_contact() ? ground_json(s.ground) : std::string()) + "}";
 }
 
 }  // namespace pvb::run

@@ -56,6 +56,12 @@ struct Ground {
   /// slips).  None: MuJoCo's default combination (the larger of soil 1 and
   /// tyre 1.2).  Given: the ground's friction governs every contact with it.
   std::optional<double> friction;
+  /// How soft the soil is under the tyres (the day's: wet earth gives):
+  /// 0 is MuJoCo's default contact, 1 a soft contact (solref 0.1 s, solimp
+  /// 0.5 0.7 0.01) in which the tyres sink and creep under traction.
+  double softness = 0;
+  /// Whether the ground's contact parameters govern its contacts.
+  bool governs_contact() const { return friction.has_value() || softness > 0; }
 };
 
 /// Trackers: the panels sit this far above the torque tube's axis, along
