@@ -39,8 +39,6 @@ Day drive(const std::string& label, const std::string& file) {
       truth.push_back(b.wheel_truth[k]);
     }
   }
-  const Eigen::Vector3d x0 = truth.front().T_w_b.linear().col(0);
-  const double yaw0 = std::atan2(x0.y(), x0.x());
   for (std::size_t k = 0; k < truth.size(); ++k) {
     d.t_s.push_back(pvb::geom::ns_to_seconds(truth[k].t_ns));
     d.slip_left.push_back(truth[k].slip.x());
@@ -48,8 +46,7 @@ Day drive(const std::string& label, const std::string& file) {
     d.commanded_left.push_back(truth[k].commanded_radps.x());
     if (k > 0) d.distance_m += (truth[k].T_w_b.translation() - truth[k - 1].T_w_b.translation()).head<2>().norm();
   }
-  const Eigen::Vector2d p = (truth.back().T_w_b.translation() - truth.front().T_w_b.translation()).head<2>();
-  const Eigen::Vector2d p_o(std::cos(yaw0) * p.x() + std::sin(yaw0) * p.y(), -std::sin(yaw0) * p.x() + std::cos(yaw0) * p.y());
+  const Eigen::Vector2d p_o = pvb::sensor::odometry_frame_position(truth.front().T_w_b, truth.back().T_w_b);
   d.drift_m = (Eigen::Vector2d(odo.state().x_m, odo.state().y_m) - p_o).norm();
   return d;
 }

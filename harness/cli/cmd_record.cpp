@@ -59,7 +59,7 @@ class FakenectDump {
         max_m_(s.camera.depth_range_m[1]),
         registration_(sensor::kinect::Calibration{}),
         writer_(dir, registration_.calibration()),
-        R_c_i_((scenes::T_base_camera(s).inverse() * scenes::T_base_imu(s)).linear()) {
+        R_c_i_(scenes::T_camera_imu(s.imu).linear()) {
     if (s.camera.width != sensor::kinect::kWidth || s.camera.height != sensor::kinect::kHeight)
       throw ConfigError(s.name, "camera.width/height", "640x480 for a fakenect dump (a Kinect v1's frames)",
                         std::to_string(s.camera.width) + "x" + std::to_string(s.camera.height));

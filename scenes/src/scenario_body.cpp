@@ -58,14 +58,16 @@ geom::SE3d T_base_camera(const Scenario& s) {
   return geom::make_se3(R_b_c, Eigen::Vector3d(cam.mount_forward_m, 0, cam.mount_height_m - s.robot.wheel_radius_m));
 }
 
-geom::SE3d T_base_imu(const Scenario& s) {
-  const Eigen::Vector3d rpy = s.imu.rpy_c_i_deg * kPartDegToRad;
+geom::SE3d T_camera_imu(const Imu& imu) {
+  const Eigen::Vector3d rpy = imu.rpy_c_i_deg * kPartDegToRad;
   const Eigen::Matrix3d R_c_i = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
                                  Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
                                  Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
                                     .toRotationMatrix();
-  return T_base_camera(s) * geom::make_se3(R_c_i, s.imu.p_c_i_m);
+  return geom::make_se3(R_c_i, imu.p_c_i_m);
 }
+
+geom::SE3d T_base_imu(const Scenario& s) { return T_base_camera(s) * T_camera_imu(s.imu); }
 
 bool divides(double rate_hz, double physics_hz) {
   if (rate_hz <= 0) return false;

@@ -4,6 +4,13 @@
 
 namespace pvb::sensor {
 
+Eigen::Vector2d odometry_frame_position(const geom::SE3d& T_w_b0, const geom::SE3d& T_w_b) {
+  const Eigen::Vector3d x = T_w_b0.linear().col(0);
+  const double yaw = std::atan2(x.y(), x.x());
+  const Eigen::Vector2d d = (T_w_b.translation() - T_w_b0.translation()).head<2>();
+  return {std::cos(yaw) * d.x() + std::sin(yaw) * d.y(), -std::sin(yaw) * d.x() + std::cos(yaw) * d.y()};
+}
+
 double WheelOdometry::metres_per_tick() const { return 2.0 * M_PI * d_.wheel_radius_m / d_.ticks_per_rev; }
 
 void WheelOdometry::add(const WheelTicks& t) {

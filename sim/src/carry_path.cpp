@@ -1,5 +1,9 @@
 #include "carry_path.hpp"
 
+#include <mujoco/mujoco.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 namespace pvb::sim {
@@ -24,6 +28,26 @@ struct Hermite {
 };
 
 }  // namespace
+
+FreeState free_state(const mjData* d, int qpos, int dof) {
+  FreeState f;
+  f.p_w = Eigen::Vector3d(d->qpos + qpos);
+  const mjtNum* q = d->qpos + qpos + 3;
+  f.R_w_b = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
+  f.v_w = Eigen::Vector3d(d->qvel + dof);
+  f.w_b = Eigen::Vector3d(d->qvel + dof + 3);
+  return f;
+}
+
+void set_free_state(mjData* d, int qpos, int dof, const FreeState& f) {
+  const Eigen::Quaterniond q(f.R_w_b);
+  const mjtNum values[7] = {f.p_w.x(), f.p_w.y(), f.p_w.z(), q.w(), q.x(), q.y(), q.z()};
+  std::copy(values, values + 7, d->qpos + qpos);
+  for (int i = 0; i < 3; ++i) {
+    d->qvel[dof + i] = f.v_w[i];
+    d->qvel[dof + 3 + i] = f.w_b[i];
+  }
+}
 
 Eigen::Matrix3d so3_right_jacobian(const Eigen::Vector3d& phi) {
   const double th = phi.norm();

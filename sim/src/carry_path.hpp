@@ -6,6 +6,8 @@
 
 #include "pvb/geometry/se3.hpp"
 
+typedef struct mjData_ mjData;
+
 namespace pvb::sim {
 
 /// A free body's state: origin position and linear velocity in the world,
@@ -16,6 +18,12 @@ struct FreeState {
   Eigen::Vector3d v_w = Eigen::Vector3d::Zero();
   Eigen::Vector3d w_b = Eigen::Vector3d::Zero();
 };
+
+/// The free body's state in `d`: its free joint's positions start at
+/// `qpos`, its velocities at `dof`.
+FreeState free_state(const mjData* d, int qpos, int dof);
+/// Sets that state in `d` (positions and velocities of the free joint).
+void set_free_state(mjData* d, int qpos, int dof, const FreeState& f);
 
 /// Position: a quintic Hermite curve between the two states' positions and
 /// velocities with no acceleration at either end, plus a lift of

@@ -8,16 +8,11 @@
 #include "pvb/common/error.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/sim/scene_builder.hpp"
+#include "carry_path.hpp"
 #include "splitmix.hpp"
 
 namespace pvb::sim {
 namespace {
-
-Eigen::Matrix3d rotation_of(const Eigen::Vector4d& q_wxyz) {
-  return Eigen::Quaterniond(q_wxyz[0], q_wxyz[1], q_wxyz[2], q_wxyz[3]).normalized().toRotationMatrix();
-}
-
-Eigen::Vector4d quat_at(const mjtNum* q) { return {q[0], q[1], q[2], q[3]}; }
 
 int joint_id(const mjModel* m, const char* name) {
   const int id = mj_name2id(m, mjOBJ_JOINT, name);
@@ -78,7 +73,7 @@ sensor::DriveDescription nominal_description(const scenes::Scenario& s) {
 }
 
 MotionSensors::MotionSensors(const mjModel* m, const scenes::Scenario& s, int robot_body, const geom::SE3d& T_b_c)
-    : T_b_i_(T_b_c * scenes::T_base_camera(s).inverse() * scenes::T_base_imu(s)),
+    : T_b_i_(T_b_c * scenes::T_camera_imu(s.imu)),
       dt_s_(m->opt.timestep),
       imu_rate_hz_(scenes::imu_rate_hz(s)),
       wheel_rate_hz_(scenes::wheel_rate_hz(s)),
@@ -101,9 +96,8 @@ MotionSensors::MotionSensors(const mjModel* m, const scenes::Scenario& s, int ro
 }
 
 void MotionSensors::before_step(const mjData* d) {
-  pre_.quat = quat_at(d->qpos + free_qpos_ + 3);
-  pre_.v_w = Eigen::Vector3d(d->qvel + free_dof_);
-  pre_.w_b = Eigen::Vector3d(d->qvel + free_dof_ + 3);
+  const FreeState f = free_state(d, free_qpos_, free_dof_);
+  pre_ = {f.R_w_b, f.v_w, f.w_b};
 }
 
 void MotionSensors::after_step(const mjModel* m, const mjData* d, bool carried) {
@@ -123,10 +117,11 @@ void MotionSensors::after_step(const mjModel* m, const mjData* d, bool carried) 
 // point adds the angular acceleration's and the centripetal terms.  The
 // specific force is that acceleration less gravity, in the IMU's axes.
 void MotionSensors::accumulate_imu(const mjModel* m, const mjData* d) {
-  const Eigen::Vector3d v1(d->qvel + free_dof_), w1(d->qvel + free_dof_ + 3);
-  const Eigen::Vector3d a_origin_w = (v1 - pre_.v_w) / dt_s_;
+  const FreeState now = free_state(d, free_qpos_, free_dof_);
+  const Eigen::Vector3d& w1 = now.w_b;
+  const Eigen::Vector3d a_origin_w = (now.v_w - pre_.v_w) / dt_s_;
   const Eigen::Vector3d alpha_b = (w1 - pre_.w_b) / dt_s_;
-  const Eigen::Matrix3d R_mid = rotation_of(pre_.quat) * geom::so3_exp(0.5 * dt_s_ * w1);
+  const Eigen::Matrix3d R_mid = pre_.R_w_b * geom::so3_exp(0.5 * dt_s_ * w1);
   const Eigen::Vector3d r = T_b_i_.translation();
   const Eigen::Vector3d a_w = a_origin_w + R_mid * (alpha_b.cross(r) + w1.cross(w1.cross(r)));
   const Eigen::Vector3d g_w(m->opt.gravity[0], m->opt.gravity[1], m->opt.gravity[2]);
@@ -142,10 +137,9 @@ void MotionSensors::emit_imu(const mjData* d) {
   truth.accel_mps2 = sum_accel_ / imu_steps_;
   sum_gyro_.setZero();
   sum_accel_.setZero();
-  const Eigen::Matrix3d R_w_b = rotation_of(quat_at(d->qpos + free_qpos_ + 3));
-  const Eigen::Vector3d p_w_b(d->qpos + free_qpos_), v_w_b(d->qvel + free_dof_), w_b(d->qvel + free_dof_ + 3);
-  truth.T_w_i = geom::make_se3(R_w_b, p_w_b) * T_b_i_;
-  truth.v_w_i = v_w_b + R_w_b * w_b.cross(T_b_i_.translation());
+  const FreeState f = free_state(d, free_qpos_, free_dof_);
+  truth.T_w_i = geom::make_se3(f.R_w_b, f.p_w) * T_b_i_;
+  truth.v_w_i = f.v_w + f.R_w_b * f.w_b.cross(T_b_i_.translation());
   sensor::ImuSample sample;
   sample.t_ns = truth.t_ns;
   sample.gyro_radps = gyro_noise_.apply(truth.gyro_radps, &truth.gyro_bias);
@@ -161,9 +155,8 @@ double MotionSensors::wheel_angle(const mjData* d, int side) const {
 void MotionSensors::emit_wheels(const mjData* d) {
   WheelTruth truth;
   truth.t_ns = geom::frame_time_ns(0, steps_ / wheel_steps_, wheel_rate_hz_);
-  const Eigen::Matrix3d R_w_b = rotation_of(quat_at(d->qpos + free_qpos_ + 3));
-  const Eigen::Vector3d p_w_b(d->qpos + free_qpos_), v_w_b(d->qvel + free_dof_), w_b(d->qvel + free_dof_ + 3);
-  truth.T_w_b = geom::make_se3(R_w_b, p_w_b);
+  const FreeState f = free_state(d, free_qpos_, free_dof_);
+  truth.T_w_b = geom::make_se3(f.R_w_b, f.p_w);
   sensor::WheelTicks ticks;
   ticks.t_ns = truth.t_ns;
   for (int side = 0; side < 2; ++side) {
@@ -171,7 +164,7 @@ void MotionSensors::emit_wheels(const mjData* d) {
     const auto count = static_cast<std::int64_t>(std::floor(revs * ticks_per_rev_));
     (side == 0 ? ticks.left : ticks.right) = count;
     const Eigen::Vector3d centre_b(0.0, (side == 0 ? 0.5 : -0.5) * track_m_, 0.0);
-    const Eigen::Vector3d v_centre_b = R_w_b.transpose() * v_w_b + w_b.cross(centre_b);
+    const Eigen::Vector3d v_centre_b = f.R_w_b.transpose() * f.v_w + f.w_b.cross(centre_b);
     const double wheel = d->qvel[wheel_dof_[side]], ground = v_centre_b.x();
     truth.wheel_radps[side] = wheel;
     truth.ground_mps[side] = ground;

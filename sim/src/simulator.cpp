@@ -21,26 +21,6 @@ double yaw_of(const mjtNum* q) {  // MuJoCo quaternion w, x, y, z
   return std::atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]));
 }
 
-FreeState free_state(const mjData* d, int qpos, int dof) {
-  FreeState f;
-  f.p_w = Eigen::Vector3d(d->qpos + qpos);
-  const mjtNum* q = d->qpos + qpos + 3;
-  f.R_w_b = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
-  f.v_w = Eigen::Vector3d(d->qvel + dof);
-  f.w_b = Eigen::Vector3d(d->qvel + dof + 3);
-  return f;
-}
-
-void set_free_state(mjData* d, int qpos, int dof, const FreeState& f) {
-  const Eigen::Quaterniond q(f.R_w_b);
-  const mjtNum values[7] = {f.p_w.x(), f.p_w.y(), f.p_w.z(), q.w(), q.x(), q.y(), q.z()};
-  std::copy(values, values + 7, d->qpos + qpos);
-  for (int i = 0; i < 3; ++i) {
-    d->qvel[dof + i] = f.v_w[i];
-    d->qvel[dof + 3 + i] = f.w_b[i];
-  }
-}
-
 int actuator(const mjModel* m, const char* name) {
   const int id = mj_name2id(m, mjOBJ_ACTUATOR, name);
   if (id < 0) throw Error(std::string("generated model lacks actuator ") + name);

@@ -379,8 +379,6 @@ OdometryOutcome drive_day(const std::string& file) {
   sensor::WheelOdometry odo(sim::nominal_description(s));
   OdometryOutcome out;
   const geom::SE3d T_w_b0 = b.wheel_truth.front().T_w_b;
-  const Eigen::Vector3d x0 = T_w_b0.linear().col(0);
-  const double yaw0 = std::atan2(x0.y(), x0.x());
   for (std::size_t k = 0; k < b.ticks.size(); ++k) {
     odo.add(b.ticks[k]);
     if (k > 0)
@@ -390,9 +388,7 @@ OdometryOutcome drive_day(const std::string& file) {
     out.max_abs_slip = std::max(out.max_abs_slip, b.wheel_truth[k].slip.cwiseAbs().maxCoeff());
   }
   out.mean_abs_slip /= b.ticks.size();
-  const Eigen::Vector2d d = (b.wheel_truth.back().T_w_b.translation() - T_w_b0.translation()).head<2>();
-  const Eigen::Vector2d p_true(std::cos(yaw0) * d.x() + std::sin(yaw0) * d.y(),
-                               -std::sin(yaw0) * d.x() + std::cos(yaw0) * d.y());
+  const Eigen::Vector2d p_true = sensor::odometry_frame_position(T_w_b0, b.wheel_truth.back().T_w_b);
   out.drift_m = (Eigen::Vector2d(odo.state().x_m, odo.state().y_m) - p_true).norm();
   std::printf("%s: odometry %.4f m off after %.2f m; mean |slip| %.4f, max %.3f\n", file.c_str(), out.drift_m,
               out.distance_m, out.mean_abs_slip, out.max_abs_slip);

@@ -54,8 +54,7 @@ std::string robot_yaml(const RobotCalibration& c) {
 }
 
 MotionFilesWriter::MotionFilesWriter(const std::string& dir, const RobotCalibration& c)
-    : imu_csv_(),
-      odometry_(c.drive) {
+    : odometry_(c.drive) {
   make_dirs(dir + "/imu0");
   imu_csv_ = open_with(dir + "/imu0/data.csv",
                        "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"

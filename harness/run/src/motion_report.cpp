@@ -1,6 +1,5 @@
 #include "motion_report.hpp"
 
-#include <Eigen/Geometry>
 #include <cmath>
 
 #include "pvb/geometry/time.hpp"
@@ -18,14 +17,9 @@ void MotionReportBuilder::add(const FrameItem& item) {
   }
   for (std::size_t k = 0; k < item.frame.wheel_ticks.size() && k < item.wheel_truth.size(); ++k) {
     const sim::WheelTruth& truth = item.wheel_truth[k];
-    if (!T_o_w_) {  // the base's first pose, turned by its heading only
-      const Eigen::Vector3d x = truth.T_w_b.linear().col(0);
-      T_o_w_ = geom::make_se3(Eigen::Matrix3d(Eigen::AngleAxisd(std::atan2(x.y(), x.x()), Eigen::Vector3d::UnitZ())),
-                              truth.T_w_b.translation())
-                   .inverse();
-    }
+    if (!T_w_b0_) T_w_b0_ = truth.T_w_b;
     odometry_.add(item.frame.wheel_ticks[k]);
-    const Eigen::Vector2d p_true = (*T_o_w_ * truth.T_w_b.translation()).head<2>();
+    const Eigen::Vector2d p_true = sensor::odometry_frame_position(*T_w_b0_, truth.T_w_b);
     const sensor::OdometryState& o = odometry_.state();
     const double step = r_.distance_m.empty() ? 0.0 : (p_true - last_true_).norm();
     last_true_ = p_true;

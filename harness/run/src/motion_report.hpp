@@ -17,7 +17,7 @@ class MotionReportBuilder {
  private:
   Eigen::Matrix3d R_b_i_;
   sensor::WheelOdometry odometry_;
-  std::optional<geom::SE3d> T_o_w_;  ///< the odometry frame: the base's first pose, level
+  std::optional<geom::SE3d> T_w_b0_;  ///< the base's first pose: the odometry frame's origin
   Eigen::Vector2d last_true_ = Eigen::Vector2d::Zero();
   double slip_sum_ = 0;
   long slip_count_ = 0;

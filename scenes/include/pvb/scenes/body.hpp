@@ -61,8 +61,9 @@ struct Scenario;
 /// forward, z up.  The camera sits on the mast at camera.mount_forward_m,
 /// camera.mount_height_m above the ground, turned by yaw_deg and pitch_deg.
 geom::SE3d T_base_camera(const Scenario& s);
-/// The IMU's frame in the base: the camera's composed with imu.p_c_i_m
-/// and imu.rpy_c_i_deg.
+/// The IMU's frame in the camera's: imu.p_c_i_m and imu.rpy_c_i_deg.
+geom::SE3d T_camera_imu(const Imu& imu);
+/// The IMU's frame in the base: T_base_camera * T_camera_imu.
 geom::SE3d T_base_imu(const Scenario& s);
 
 /// The divisor of `physics_hz` (physics_hz / k for a whole k) nearest to

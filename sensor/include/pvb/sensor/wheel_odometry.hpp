@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "pvb/geometry/se3.hpp"
 #include "pvb/sensor/motion.hpp"
 
 namespace pvb::sensor {
@@ -24,6 +25,11 @@ struct OdometryState {
   double v_mps = 0;     ///< forward speed over the last interval
   double w_radps = 0;   ///< turn rate over the last interval
 };
+
+/// Where the base at T_w_b is in the odometry frame that starts at T_w_b0
+/// (origin there, x along its heading, z up): the planar position that
+/// odometry from T_w_b0 should give.
+Eigen::Vector2d odometry_frame_position(const geom::SE3d& T_w_b0, const geom::SE3d& T_w_b);
 
 /// Integrates encoder counts: each wheel's arc from its count change, the
 /// base moving along the arc's chord at the mean heading of the interval.

@@ -81,6 +81,8 @@ sensor::DriveDescription nominal_description(const scenes::Scenario& s);
 /// counted from the first step.
 class MotionSensors {
  public:
+  /// T_b_c: the camera in the base as the model has it; the IMU is at the
+  /// scenario's offset from it (scenes::T_camera_imu).
   MotionSensors(const mjModel* m, const scenes::Scenario& s, int robot_body, const geom::SE3d& T_b_c);
   void before_step(const mjData* d);
   void after_step(const mjModel* m, const mjData* d, bool carried);
@@ -93,8 +95,8 @@ class MotionSensors {
   double wheel_rate_hz() const { return wheel_rate_hz_; }
 
  private:
-  struct Pre {
-    Eigen::Vector4d quat;
+  struct Pre {  ///< the free body before a step
+    Eigen::Matrix3d R_w_b;
     Eigen::Vector3d v_w, w_b;
   };
   void accumulate_imu(const mjModel* m, const mjData* d);
