@@ -89,6 +89,37 @@ class Reader {
     if (!n.isString()) throw ConfigError(path_, key, "a string (a file path, or none)");
     return static_cast<std::string>(n);
   }
+  /// A 4x4 rigid transform written as an opencv-matrix (ORB-SLAM3's
+  /// IMU.T_b_c1); `fallback` when absent.  Its rotation must be orthonormal
+  /// to 1e-3 and its last row 0 0 0 1.
+  geom::SE3d pose(const std::string& key, bool required, const geom::SE3d& fallback) {
+    seen_.insert(key);
+    const cv::FileNode n = fs_[key];
+    const std::string expected = "a 4x4 rigid transform (opencv-matrix, rows 4, cols 4)";
+    if (n.empty()) {
+      if (required) throw ConfigError(path_, key, expected + " (required key is missing)");
+      return fallback;
+    }
+    cv::Mat m;
+    try {
+      n >> m;
+    } catch (const cv::Exception&) {
+      throw ConfigError(path_, key, expected);
+    }
+    if (m.rows != 4 || m.cols != 4 || m.channels() != 1) throw ConfigError(path_, key, expected);
+    m.convertTo(m, CV_64F);
+    Eigen::Matrix4d T;
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) T(r, c) = m.at<double>(r, c);
+    const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+    const bool finite = T.allFinite();
+    if (!finite || (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-3 ||
+        R.determinant() < 0 || (T.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > 1e-9 ||
+        T.topRightCorner<3, 1>().norm() > 10)
+      throw ConfigError(path_, key, expected + " with an orthonormal rotation and a translation under 10 m");
+    const Eigen::Quaterniond q(R);
+    return geom::make_se3(q, Eigen::Vector3d(T.topRightCorner<3, 1>()));
+  }
   /// Checks a value read before against a range known only later.
   void check(const std::string& key, double v, const Range& range, const std::string& what) const {
     if (!range.contains(v)) throw ConfigError(path_, key, what + " in " + range.text(), number_text(v));
@@ -124,10 +155,44 @@ class Reader {
 
 // Keys ORB-SLAM2 files carry that the RGB-D core does not use.
 bool ignored_key(const std::string& key) {
-  // IMU.* and Robot.*: a recording's motion sensors (ORB-SLAM3's IMU keys,
-  // the robot's description), which this RGB-D core does not read.
-  return key.rfind("Viewer.", 0) == 0 || key == "Camera.type" || key == "Camera.bFishEye" ||
-         key.rfind("IMU.", 0) == 0 || key.rfind("Robot.", 0) == 0;
+  return key.rfind("Viewer.", 0) == 0 || key == "Camera.type" || key == "Camera.bFishEye";
+}
+
+/// IMU.* (ORB-SLAM3's keys): noise densities, rate and the camera's pose
+/// in the IMU frame.  All or none.
+void read_imu(Reader& r, const cv::FileStorage& fs, ImuSettings* imu) {
+  imu->present = !fs["IMU.NoiseGyro"].empty() || !fs["IMU.T_b_c1"].empty();
+  const bool req = imu->present;
+  ImuNoise& n = imu->noise;
+  n.gyro_noise_density = r.real("IMU.NoiseGyro", req, n.gyro_noise_density, above(0, 1), "rad/s/sqrt(Hz)");
+  n.accel_noise_density = r.real("IMU.NoiseAcc", req, n.accel_noise_density, above(0, 10), "m/s^2/sqrt(Hz)");
+  n.gyro_random_walk = r.real("IMU.GyroWalk", req, n.gyro_random_walk, above(0, 1), "rad/s^2/sqrt(Hz)");
+  n.accel_random_walk = r.real("IMU.AccWalk", req, n.accel_random_walk, above(0, 10), "m/s^3/sqrt(Hz)");
+  imu->rate_hz = r.real("IMU.Frequency", req, imu->rate_hz, closed(1, 10000), "readings per second");
+  imu->T_b_c = r.pose("IMU.T_b_c1", req, imu->T_b_c);
+}
+
+/// Robot.* (ours): the wheel drive and the camera's and IMU's poses on the base.
+void read_robot(Reader& r, const cv::FileStorage& fs, RobotSettings* robot) {
+  robot->present = !fs["Robot.WheelRadius"].empty();
+  const bool req = robot->present;
+  WheelDrive& d = robot->drive;
+  d.wheel_radius_m = r.real("Robot.WheelRadius", req, d.wheel_radius_m, above(0, 5), "metres");
+  d.track_m = r.real("Robot.Track", req, d.track_m, above(0, 10), "metres");
+  d.ticks_per_rev = r.integer("Robot.TicksPerRev", req, d.ticks_per_rev, 1, 1 << 24);
+  robot->encoder_rate_hz = r.real("Robot.EncoderFrequency", req, robot->encoder_rate_hz, closed(1, 10000), "readings per second");
+  robot->T_base_c = r.pose("Robot.T_base_c1", req, robot->T_base_c);
+  robot->T_base_imu = r.pose("Robot.T_base_imu", req, robot->T_base_imu);
+}
+
+/// System.Sensors, checked against the sections the setup needs.
+SensorSetup read_sensors(Reader& r, const Settings& s) {
+  const std::string text = r.text("System.Sensors", "camera");
+  const std::optional<SensorSetup> setup = parse_sensor_setup(text);
+  if (!setup)
+    throw ConfigError(r.path(), "System.Sensors", "camera, camera+imu, camera+imu+wheels or camera+accel", text);
+  check_sensor_setup(s, *setup);
+  return *setup;
 }
 
 /// Smallest side, in pixels, of the coarsest ORB pyramid level.
@@ -316,6 +381,9 @@ Settings settings_from(const cv::FileStorage& fs, const std::string& text, const
   read_keyframe(r, &s.keyframe);
   read_point_cloud(r, &s.dense);
   read_loop_closing(r, &s.loop);
+  read_imu(r, fs, &s.imu);
+  read_robot(r, fs, &s.robot);
+  s.sensors = read_sensors(r, s);
   s.vocabulary_path = vocabulary_path(path, r.text("Vocabulary.path", ""));
   const cv::FileNode root = fs.root();
   for (auto it = root.begin(); it != root.end(); ++it) {
@@ -353,6 +421,36 @@ Settings read_settings_text(const std::string& text, const std::string& name) {
     throw parse_error(name, e);
   }
   return settings_from(fs, text, name);
+}
+
+const char* to_string(SensorSetup s) {
+  switch (s) {
+    case SensorSetup::kCamera: return "camera";
+    case SensorSetup::kCameraImu: return "camera+imu";
+    case SensorSetup::kCameraImuWheels: return "camera+imu+wheels";
+    case SensorSetup::kCameraAccel: return "camera+accel";
+  }
+  return "?";
+}
+
+std::optional<SensorSetup> parse_sensor_setup(std::string_view text) {
+  for (SensorSetup s : {SensorSetup::kCamera, SensorSetup::kCameraImu, SensorSetup::kCameraImuWheels,
+                        SensorSetup::kCameraAccel})
+    if (text == to_string(s)) return s;
+  return std::nullopt;
+}
+
+bool uses_imu(SensorSetup s) { return s == SensorSetup::kCameraImu || s == SensorSetup::kCameraImuWheels; }
+bool uses_accel(SensorSetup s) { return s != SensorSetup::kCamera; }
+bool uses_wheels(SensorSetup s) { return s == SensorSetup::kCameraImuWheels; }
+
+void check_sensor_setup(const Settings& s, SensorSetup setup) {
+  if (uses_accel(setup) && !s.imu.present)
+    throw ConfigError(s.source, "IMU.NoiseGyro",
+                      std::string("the IMU.* keys (sensors ") + to_string(setup) + " need them; required key is missing)");
+  if (uses_wheels(setup) && !s.robot.present)
+    throw ConfigError(s.source, "Robot.WheelRadius",
+                      std::string("the Robot.* keys (sensors ") + to_string(setup) + " need them; required key is missing)");
 }
 
 }  // namespace pvb::slam

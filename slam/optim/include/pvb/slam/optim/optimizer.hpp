@@ -13,6 +13,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "pvb/geometry/se3.hpp"
@@ -74,10 +75,13 @@ struct BaEdge {
   std::size_t point = 0;     ///< index into BaProblem::points
   Observation obs;
 };
+struct BaInertial;  // inertial_ba.hpp
 struct BaProblem {
   std::vector<BaKeyframe> keyframes;
   std::vector<BaPoint> points;
   std::vector<BaEdge> edges;
+  /// Optional inertial and wheel terms (null: visual only, as before).
+  std::shared_ptr<BaInertial> inertial;
 };
 
 struct BaOptions {

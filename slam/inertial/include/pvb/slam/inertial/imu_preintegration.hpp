@@ -1,0 +1,109 @@
+#pragma once
+// IMU preintegration on the manifold (Forster, Carlone, Dellaert and
+// Scaramuzza, "On-Manifold Preintegration for Real-Time Visual-Inertial
+// Odometry", T-RO 2017): the rotation, velocity and position increments
+// between two instants from the readings between them, their covariance,
+// and their first-order Jacobians with respect to the biases, so that a
+// bias update corrects the increments without integrating again.
+//
+// Frames: b is the IMU's frame, w a world frame whose gravity is g_w.
+// Readings are means over their period (sensor::ImuSample): one reading is
+// held constant over its dt.
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+namespace pvb::slam {
+
+/// Kalibr's continuous-time noise model of an IMU.
+struct ImuNoise {
+  double gyro_noise_density = 1.7e-4;   ///< rad/s/sqrt(Hz)   (IMU.NoiseGyro)
+  double accel_noise_density = 2.0e-3;  ///< m/s^2/sqrt(Hz)   (IMU.NoiseAcc)
+  double gyro_random_walk = 2.0e-5;     ///< rad/s^2/sqrt(Hz) (IMU.GyroWalk)
+  double accel_random_walk = 4.0e-4;    ///< m/s^3/sqrt(Hz)   (IMU.AccWalk)
+};
+
+struct ImuBias {
+  Eigen::Vector3d gyro_radps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();
+};
+
+/// The IMU's navigation state: attitude, velocity and position of the IMU
+/// frame in the world.
+struct NavState {
+  Eigen::Matrix3d R_w_b = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d v_w_mps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d p_w_m = Eigen::Vector3d::Zero();
+};
+
+class ImuPreintegration {
+ public:
+  /// One reading as integrated: held over dt_s.
+  struct Reading {
+    Eigen::Vector3d gyro_radps = Eigen::Vector3d::Zero();
+    Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();
+    double dt_s = 0;
+  };
+
+  ImuPreintegration() = default;
+  /// Empty: identity increments at linearisation bias `bias`.
+  ImuPreintegration(const ImuBias& bias, const ImuNoise& noise);
+
+  /// Adds one reading held constant over dt_s (> 0) and propagates the
+  /// covariance (discrete noise: density^2 / dt) and the bias Jacobians.
+  void integrate(const Eigen::Vector3d& gyro_radps, const Eigen::Vector3d& accel_mps2, double dt_s);
+  /// Appends the readings of `next` (which starts where this one ends),
+  /// integrated at this one's bias.
+  void append(const ImuPreintegration& next);
+  /// Integrates every reading again at a new linearisation bias.
+  void reintegrate(const ImuBias& bias);
+
+  double dt_s() const { return dt_s_; }
+  std::size_t size() const { return readings_.size(); }
+  const std::vector<Reading>& readings() const { return readings_; }
+  const ImuBias& bias() const { return bias_; }
+  const ImuNoise& noise() const { return noise_; }
+
+  /// Increments at the linearisation bias.
+  const Eigen::Matrix3d& delta_R() const { return dR_; }
+  const Eigen::Vector3d& delta_v() const { return dv_; }
+  const Eigen::Vector3d& delta_p() const { return dp_; }
+  /// Increments corrected to first order for bias b (Forster eq. 44):
+  /// dR Exp(J_R_bg dbg), dv + J_v_bg dbg + J_v_ba dba, dp + ...
+  Eigen::Matrix3d delta_R(const ImuBias& b) const;
+  Eigen::Vector3d delta_v(const ImuBias& b) const;
+  Eigen::Vector3d delta_p(const ImuBias& b) const;
+
+  /// Bias Jacobians of the increments at the linearisation bias.
+  const Eigen::Matrix3d& J_R_bg() const { return J_R_bg_; }
+  const Eigen::Matrix3d& J_v_bg() const { return J_v_bg_; }
+  const Eigen::Matrix3d& J_v_ba() const { return J_v_ba_; }
+  const Eigen::Matrix3d& J_p_bg() const { return J_p_bg_; }
+  const Eigen::Matrix3d& J_p_ba() const { return J_p_ba_; }
+
+  /// Covariance of the increment errors, order [rotation, velocity, position].
+  const Eigen::Matrix<double, 9, 9>& covariance() const { return cov_; }
+
+  /// The state at the end from the state at the start, gravity g_w and
+  /// bias b (Forster eq. 33 with the corrected increments).
+  NavState predict(const NavState& start, const Eigen::Vector3d& g_w, const ImuBias& b) const;
+
+ private:
+  ImuBias bias_;
+  ImuNoise noise_;
+  std::vector<Reading> readings_;
+  double dt_s_ = 0;
+  Eigen::Matrix3d dR_ = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d dv_ = Eigen::Vector3d::Zero(), dp_ = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d J_R_bg_ = Eigen::Matrix3d::Zero(), J_v_bg_ = Eigen::Matrix3d::Zero(),
+                  J_v_ba_ = Eigen::Matrix3d::Zero(), J_p_bg_ = Eigen::Matrix3d::Zero(),
+                  J_p_ba_ = Eigen::Matrix3d::Zero();
+  Eigen::Matrix<double, 9, 9> cov_ = Eigen::Matrix<double, 9, 9>::Zero();
+};
+
+/// The right Jacobian of SO(3) and its inverse (Forster eq. 8); the
+/// exponential and logarithm are geom::so3_exp and geom::so3_log.
+Eigen::Matrix3d so3_right_jacobian(const Eigen::Vector3d& phi);
+Eigen::Matrix3d so3_right_jacobian_inverse(const Eigen::Vector3d& phi);
+
+}  // namespace pvb::slam
