@@ -1,6 +1,7 @@
 #include "system_sink.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -23,7 +24,12 @@ void record_state_change(SlamRun& run, slam::TrackingState prev_state, const sla
   std::snprintf(head_buf, sizeof head_buf, "frame %d (t = %.3f s): %s ", index, t_s, run.mode.c_str());
   const std::string head = head_buf;
   const std::string reason = r.tracking.failure.empty() ? "no reason given" : r.tracking.failure;
-  if (r.state == slam::TrackingState::kLost && prev_state != slam::TrackingState::kLost) {
+  const auto kDead = slam::TrackingState::kDeadReckoning;
+  if (r.state == kDead && prev_state != kDead) {
+    log.line(head + "vision lost, the motion sensors carry the pose: " + reason);
+  } else if (r.state == slam::TrackingState::kOk && prev_state == kDead) {
+    log.line(head + "vision back: tracking resumed against the local map");
+  } else if (r.state == slam::TrackingState::kLost && prev_state != slam::TrackingState::kLost) {
     run.loss_events.push_back({index, t_s, reason, std::nullopt});
     log.line(head + std::string("lost tracking: ") + reason);
   } else if (r.state == slam::TrackingState::kOk && prev_state == slam::TrackingState::kLost) {
@@ -80,9 +86,22 @@ slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log)
   record_state_change(run, prev_state, r, index, t_s, log);
   if (prev_provisional && r.T_w_c)
     log.line("frame " + std::to_string(index) + ": the provisional map was merged into the loaded map");
+  if (system->sensors() != slam::SensorSetup::kCamera && !inertial_logged) log_inertial_state(index, log);
   prev_state = r.state;
   prev_provisional = r.provisional;
   return r;
+}
+
+void SystemSink::log_inertial_state(int index, RunLog& log) {
+  const slam::MapGravity g = system->gravity();
+  if (!g.ready) return;
+  inertial_logged = true;
+  const double tilt_deg = std::acos(std::clamp(-g.g_w.normalized().z(), -1.0, 1.0)) * 180.0 / M_PI;
+  log.line("frame " + std::to_string(index) + ": inertial state trusted (" + slam::to_string(system->sensors()) +
+           ", keyframe " + std::to_string(g.ready_keyframe_id) + " at t = " +
+           format_fixed(geom::ns_to_seconds(g.ready_t_ns), 3) + " s): gravity " + format_fixed(tilt_deg, 3) +
+           " deg off the map's -z, gyro bias " + format_fixed(g.bias.gyro_radps.norm(), 5) + " rad/s, accel bias " +
+           format_fixed(g.bias.accel_mps2.norm(), 4) + " m/s^2, whitened RMS " + format_fixed(g.init_rms, 2));
 }
 
 void SystemSink::count(const slam::FrameResult& r, int index, double t_s) {
@@ -105,7 +124,7 @@ void SystemSink::write_lines(const slam::FrameResult& r, int index) {
     est.poses.push_back({r.t_ns, *r.T_w_c});
     if (r.tracking.new_keyframe) kf_traj.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
   }
-  static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc"};
+  static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc", "dead_reckoning", "after_blind"};
   std::ostringstream line;
   line << index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
        << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","

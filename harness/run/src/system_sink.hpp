@@ -28,6 +28,7 @@ struct SystemSink {
   eval::Trajectory refined;  ///< filled by finish()
   slam::TrackingState prev_state = slam::TrackingState::kNotInitialized;
   bool prev_provisional = false;  ///< the last frame was tracked in a provisional map
+  bool inertial_logged = false;   ///< run.log has said when the inertial state became trusted
   double tracking_ms = 0, orb_ms = 0, inline_mapping_ms = 0;
   std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made, for the revisit labels
   /// The dense maps written by finish(), by name (corrected, live, and
@@ -58,6 +59,8 @@ struct SystemSink {
  private:
   /// The dense maps into `clouds` and their PLY files; run.dense_map.
   void save_dense_maps();
+  /// Once the inertial state is trusted: a line in run.log saying when and what was found.
+  void log_inertial_state(int index, RunLog& log);
   /// The counters and the per-frame record.
   void count(const slam::FrameResult& r, int index, double t_s);
   /// The frame's lines in CameraTrajectory, KeyFrameTrajectory and timing.csv.

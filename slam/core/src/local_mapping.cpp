@@ -148,6 +148,7 @@ void LocalMapping::process(const std::shared_ptr<KeyFrame>& kf) {
     std::lock_guard<std::mutex> lock(map_.mutex());
     cull_keyframes(kf);
   }
+  if (options_.sensors != SensorSetup::kCamera) initialize_inertial(kf);
   if (options_.align_patches) {
     std::lock_guard<std::mutex> lock(map_.mutex());
     release_pyramids(kf);
@@ -355,6 +356,7 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
         if (it == kf_index.end()) continue;
         problem.edges.push_back({it->second, p, kfs[it->second]->frame().observation(o.idx)});
       }
+    if (options_.sensors != SensorSetup::kCamera) add_motion_terms(&problem, &kfs);
   }
   if (problem.edges.empty()) return;
   // Optimise without holding the map: tracking goes on with the old poses.
@@ -372,6 +374,7 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
   erase_outlier_observations(problem, result.outlier_edges, kfs, pts);
   for (std::size_t k = 0; k < kfs.size(); ++k)
     if (!problem.keyframes[k].fixed && !kfs[k]->bad()) kfs[k]->set_T_c_w(problem.keyframes[k].T_c_w);
+  if (problem.inertial) write_motion_states(problem, kfs);
   for (std::size_t p = 0; p < pts.size(); ++p)
     if (!pts[p]->bad()) {
       pts[p]->set_p_w(problem.points[p].p_w);
@@ -382,7 +385,7 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
 
 void LocalMapping::cull_keyframes(const std::shared_ptr<KeyFrame>& kf) {
   for (const auto& n : kf->best_covisibles(-1)) {
-    if (n->id() == 0 || n->root() || n->bad()) continue;
+    if (n->id() == 0 || n->root() || n->bad() || !may_cull_in_time(*n)) continue;
     if (is_redundant_keyframe(*n, cam_->th_depth_m, options_.redundant_ratio, options_.redundant_observers))
       map_.erase_keyframe(n);
   }

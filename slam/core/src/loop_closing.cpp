@@ -531,7 +531,7 @@ MovedGroup move_neighbourhood(const KeyFramePtr& kf, const geom::SE3d& T_cur_w) 
       g.corrected_by[mp->id()] = k->id();
     }
   }
-  for (const auto& k : g.keyframes) k->set_T_c_w(corrected.at(k->id()));
+  for (const auto& k : g.keyframes) k->correct_T_c_w(corrected.at(k->id()));
   for (const auto& k : g.keyframes)
     for (const auto& mp : k->map_points())
       if (mp && !mp->bad()) mp->update_normal_and_depth();
@@ -718,7 +718,7 @@ void write_back(Map& map, const EssentialGraph& g, const KeyFramePtr& kf, const 
     mp->set_p_w(it1->second.inverse() * (it0->second * mp->p_w()));
   }
   for (const auto& [id, k] : map.keyframes())
-    if (!k->bad() && final_pose.count(id)) k->set_T_c_w(final_pose.at(id));
+    if (!k->bad() && final_pose.count(id)) k->correct_T_c_w(final_pose.at(id));
   for (const auto& [id, mp] : map.points())
     if (!mp->bad()) mp->update_normal_and_depth();
 }
@@ -736,7 +736,7 @@ void merge_into(Map& map, const KeyFramePtr& kf, const KeyFramePtr& loop_kf, con
     if (k->bad() || map.map_of(*k) != from) continue;
     for (const auto& mp : k->map_points())
       if (mp && !mp->bad() && seen.insert(mp->id()).second) moved.push_back(mp);
-    k->set_T_c_w(k->T_c_w() * T_from_into);
+    k->correct_T_c_w(k->T_c_w() * T_from_into);
   }
   for (const auto& mp : moved) mp->set_p_w(T_into_from * mp->p_w());
   map.merge_provisional(from, into);

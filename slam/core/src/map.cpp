@@ -386,8 +386,36 @@ void Map::erase_point(const std::shared_ptr<MapPoint>& mp) {
   points_.erase(mp->id());
 }
 
+void unlink_in_time(KeyFrame& kf) {
+  KeyFrameMotion& m = kf.motion();
+  const auto prev = m.prev.lock();
+  const auto next = m.next.lock();
+  if (next) {
+    KeyframeInterval& n = next->motion().from_prev;
+    if (n.imu && m.from_prev.imu) {
+      auto joined = std::make_shared<ImuPreintegration>(*m.from_prev.imu);
+      joined->append(*n.imu);
+      n.imu = std::move(joined);
+    } else {
+      n.imu.reset();
+    }
+    if (n.wheels && m.from_prev.wheels) {
+      auto joined = std::make_shared<WheelPreintegration>(*m.from_prev.wheels);
+      joined->append(*n.wheels);
+      n.wheels = std::move(joined);
+    } else {
+      n.wheels.reset();
+    }
+    next->motion().prev = prev;
+  }
+  if (prev) prev->motion().next = next;
+  m.prev.reset();
+  m.next.reset();
+}
+
 bool Map::erase_keyframe(const std::shared_ptr<KeyFrame>& kf) {
   if (!kf->set_bad()) return false;
+  unlink_in_time(*kf);
   keyframes_.erase(kf->id());
   remove_bad_points();
   return true;

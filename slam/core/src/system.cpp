@@ -49,9 +49,14 @@ System::System(const Settings& settings, const SystemOptions& options)
     place_ = std::make_unique<PlaceRecognizer>(std::move(vocabulary));
   }
   tracking_ = std::make_unique<Tracking>(map_, cam_, topt, place_.get());
+  check_sensor_setup(settings, settings.sensors);
+  tracking_->use_motion_sensors(settings.sensors, settings.imu, settings.robot);
   LocalMappingOptions mopt;
   mopt.align_patches = settings.align_patches;
   mopt.patch_align = topt.patch_align;
+  mopt.sensors = settings.sensors;
+  mopt.imu = settings.imu;
+  mopt.robot = settings.robot;
   mapping_ = std::make_unique<LocalMapping>(map_, cam_, mopt);
   if (settings.loop.enabled) loop_ = std::make_unique<LoopClosing>(map_, settings.loop, place_.get());
   // After local mapping: the keyframe's bag of words, loop detection
@@ -97,13 +102,14 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
   out.orb_ms = ms_since(t0);
   Frame frame(next_frame_id_++, in.t_ns, std::move(features), in.depth_m, cam_);
   if (settings_.align_patches) frame.pyramid = std::make_shared<const ImagePyramid>(copy_pyramid(extractor_.pyramid()));
+  tracking_->add_motion(in.t_ns, in.imu, in.wheel_ticks);
   std::shared_ptr<KeyFrame> kf = tracking_->track(std::move(frame), mapping_->idle(), mapping_->queue_size());
   if (auto hint = tracking_->take_merge_hint(); hint && loop_)
     loop_->suggest_merge(hint->from, hint->T_into_from, hint->anchor);
   out.tracking_ms = ms_since(t0);
   out.state = tracking_->state();
   out.tracking = tracking_->stats();
-  if (out.state == TrackingState::kOk) {
+  if (out.state == TrackingState::kOk || out.state == TrackingState::kDeadReckoning) {
     const auto ref = tracking_->reference_keyframe();
     std::lock_guard<std::mutex> lock(map_.mutex());
     out.provisional = ref && map_.map_of(*ref) != 0;
@@ -341,6 +347,19 @@ std::vector<System::LandmarkUse> System::landmark_uses() {
   out.reserve(map_.num_points());
   for (const auto& [id, mp] : map_.points())
     if (!mp->bad()) out.push_back({id, mp->p_w(), mp->found()});
+  return out;
+}
+
+MapGravity System::gravity() {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  return map_.gravity();
+}
+
+std::vector<System::KeyFrameState> System::keyframe_states() {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::vector<KeyFrameState> out;
+  for (const auto& [id, kf] : map_.keyframes())
+    if (kf->motion().has_state) out.push_back({id, kf->t_ns(), kf->motion().v_w_mps, kf->motion().bias});
   return out;
 }
 

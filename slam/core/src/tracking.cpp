@@ -16,6 +16,7 @@ const char* to_string(TrackingState s) {
     case TrackingState::kNotInitialized: return "not_initialized";
     case TrackingState::kOk: return "ok";
     case TrackingState::kLost: return "lost";
+    case TrackingState::kDeadReckoning: return "dead_reckoning";
   }
   return "?";
 }
@@ -64,6 +65,7 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
       stats_.new_keyframe = true;
       state_ = TrackingState::kOk;
       last_kf_frame_id_ = f.id;
+      update_motion_state(f, false);
       last_is_keyframe_ = true;
       T_last_ref_ = geom::SE3d::Identity();
       last_ = f;
@@ -72,9 +74,14 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
   }
 
   bool ok = false;
-  if (state_ == TrackingState::kOk) {
+  const bool was_tracking = state_ == TrackingState::kOk || state_ == TrackingState::kDeadReckoning;
+  if (state_ == TrackingState::kDeadReckoning) {
     replace_in_last_frame();
-    if (velocity_ && f.id >= last_reloc_frame_id_ + 2) {
+    ok = track_after_blind(f);
+    if (ok) stats_.method = TrackingMethod::kAfterBlind;
+  } else if (state_ == TrackingState::kOk) {
+    replace_in_last_frame();
+    if ((velocity_ || inertial_ready()) && f.id >= last_reloc_frame_id_ + 2) {
       ok = track_with_motion_model(f);
       if (ok) stats_.method = TrackingMethod::kMotionModel;
     }
@@ -89,8 +96,12 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
   if (ok) ok = track_local_map(f);
   if (ok) probe_merge(f);
   if (ok && stats_.method == TrackingMethod::kRelocalization) record_relocalisation(f);
-  state_ = ok ? TrackingState::kOk : TrackingState::kLost;
-  lost_in_row_ = ok ? 0 : lost_in_row_ + 1;
+  const bool dead = !ok && was_tracking && motion_ && dead_reckon(f);
+  if (dead) stats_.method = TrackingMethod::kDeadReckoning;
+  if (!dead) blind_.reset();
+  state_ = ok ? TrackingState::kOk : dead ? TrackingState::kDeadReckoning : TrackingState::kLost;
+  lost_in_row_ = ok || dead ? 0 : lost_in_row_ + 1;
+  update_motion_state(f, ok);
 
   if (ok) {
     if (last_.has_pose) velocity_ = f.T_c_w * last_.T_c_w.inverse();
@@ -113,9 +124,9 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
     velocity_.reset();
   }
   last_is_keyframe_ = static_cast<bool>(new_kf);
-  if (ok && ref_kf_) T_last_ref_ = f.T_c_w * ref_kf_->T_c_w().inverse();
+  if ((ok || dead) && ref_kf_) T_last_ref_ = f.T_c_w * ref_kf_->T_c_w().inverse();
   last_ = std::move(f);
-  if (!ok) last_.has_pose = false;
+  if (!ok && !dead) last_.has_pose = false;
   return new_kf;
 }
 
@@ -144,9 +155,10 @@ bool Tracking::initialize(Frame& f) {
   if (with_depth <= options_.min_init_points)
     return fail("initialisation: only " + std::to_string(with_depth) + " keypoints with depth (need more than " +
                 std::to_string(options_.min_init_points) + ")");
-  f.T_c_w = geom::SE3d::Identity();
+  f.T_c_w = first_pose();
   f.has_pose = true;
   auto kf = map_.create_keyframe(f);
+  attach_motion(kf);
   if (provisional_ > 0) {  // its own frame until merged: a root like keyframe 0
     kf->set_provisional(provisional_);
     kf->make_root();
@@ -205,7 +217,8 @@ void Tracking::discard_outliers(Frame& f, int* map_matches) {
 
 bool Tracking::track_with_motion_model(Frame& f) {
   update_last_frame();
-  f.T_c_w = *velocity_ * last_.T_c_w;
+  // The IMU's prediction once its state is trusted, else constant velocity.
+  f.T_c_w = inertial_ready() ? predicted_pose(nullptr) : *velocity_ * last_.T_c_w;
   std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
   std::vector<IndexMatch> m = search_by_projection(f, last_, options_.motion_th, options_.motion_ratio);
   if (m.size() < 20) {
@@ -231,7 +244,7 @@ bool Tracking::track_with_motion_model(Frame& f) {
   }
 
   if (options_.use_pe_match && options_.pe_skip_low_parallax) {
-    stats_.translation_parallax_px = translation_parallax_px(m, *velocity_);
+    stats_.translation_parallax_px = translation_parallax_px(m, velocity_ ? *velocity_ : f.T_c_w * last_.T_c_w.inverse());
     stats_.pe_skipped = stats_.translation_parallax_px < options_.pe_match.inlier_threshold_px;
   }
   if (options_.use_pe_match && !stats_.pe_skipped) {
@@ -627,6 +640,7 @@ void Tracking::add_point_from_depth(Frame& f, const std::shared_ptr<KeyFrame>& k
 std::shared_ptr<KeyFrame> Tracking::create_keyframe(Frame& f) {
   auto kf = map_.create_keyframe(f);
   if (ref_kf_) kf->set_provisional(ref_kf_->provisional());
+  attach_motion(kf);
   ref_kf_ = kf;
   // New points from depth: the closest keypoints first, all nearer than the
   // close/far threshold and at least 100 (ORB-SLAM2 CreateNewKeyFrame).

@@ -19,6 +19,7 @@
 
 #include "pvb/common/closable_queue.hpp"
 #include "pvb/slam/core/map.hpp"
+#include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/features/patch_align.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
 
@@ -43,6 +44,17 @@ struct LocalMappingOptions {
   /// Local BA iterations and gates; its abort_flag is local mapping's own
   /// (set on the worker thread only), whatever is given here.
   BaOptions ba;
+  /// The motion sensors fused (inertial initialisation, inertial and wheel
+  /// terms in local BA; docs/slam_inertial.md).
+  SensorSetup sensors = SensorSetup::kCamera;
+  ImuSettings imu;
+  RobotSettings robot;
+  /// Inertial initialisation: keyframes in the chain and seconds it spans.
+  int init_min_keyframes = 10;
+  double init_min_span_s = 3.0;
+  /// A keyframe is not culled when its neighbours in time would be this
+  /// far apart (their IMU interval would grow too long).
+  double max_inertial_gap_s = 3.0;
 };
 
 /// Map-point culling rule (ORB-SLAM2 MapPointCulling, RGB-D): returns
@@ -121,6 +133,17 @@ class LocalMapping {
   void local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf);
   void cull_keyframes(const std::shared_ptr<KeyFrame>& kf);
   void release_pyramids(const std::shared_ptr<KeyFrame>& kf);
+  // Motion sensors (local_mapping_inertial.cpp)
+  /// Estimates gravity, velocities and biases from the keyframes so far,
+  /// once there are enough of them (MapGravity::ready).
+  void initialize_inertial(const std::shared_ptr<KeyFrame>& kf);
+  /// Adds the inertial, wheel and tilt terms of the keyframes in `problem`
+  /// (kfs index for index); keyframes the chain needs are appended fixed.
+  void add_motion_terms(BaProblem* problem, std::vector<std::shared_ptr<KeyFrame>>* kfs);
+  /// Writes the optimised velocities and biases back.
+  void write_motion_states(const BaProblem& problem, const std::vector<std::shared_ptr<KeyFrame>>& kfs);
+  /// Culling kf keeps the IMU chain's intervals short enough.
+  bool may_cull_in_time(const KeyFrame& kf) const;
 
   Map& map_;
   std::shared_ptr<const CameraModel> cam_;

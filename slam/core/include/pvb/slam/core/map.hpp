@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "pvb/slam/core/frame.hpp"
+#include "pvb/slam/core/keyframe_motion.hpp"
 #include "pvb/slam/place/vocabulary.hpp"
 
 namespace pvb::slam {
@@ -142,6 +143,12 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   void release_pyramid() { frame_.pyramid.reset(); }
   const geom::SE3d& T_c_w() const { return frame_.T_c_w; }
   void set_T_c_w(const geom::SE3d& T) { frame_.T_c_w = T; }
+  /// A correction (loop, merge) moves the keyframe to T: its velocity
+  /// in the world turns with it.
+  void correct_T_c_w(const geom::SE3d& T) {
+    motion_.v_w_mps = T.linear().transpose() * frame_.T_c_w.linear() * motion_.v_w_mps;
+    frame_.T_c_w = T;
+  }
   Eigen::Vector3d camera_center_w() const { return frame_.camera_center_w(); }
   bool bad() const { return bad_; }
   /// The mapping session the keyframe was made in (0: the map's first).
@@ -234,6 +241,10 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   /// What this keyframe holds, by structure.
   KeyFrameMemory memory() const;
 
+  // Motion sensors (under the map's mutex) -------------------------------------
+  KeyFrameMotion& motion() { return motion_; }
+  const KeyFrameMotion& motion() const { return motion_; }
+
  private:
   void update_order();
 
@@ -254,6 +265,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   bool root_ = false;
   std::shared_ptr<KeyFrame> removed_parent_;          ///< parent at removal (kept alive for trajectories)
   geom::SE3d T_c_parent_ = geom::SE3d::Identity();  ///< pose relative to it at removal
+  KeyFrameMotion motion_;
 };
 
 /// All keyframes and map points of a run.
@@ -300,6 +312,11 @@ class Map {
   /// The map a keyframe belongs to now: 0 for the map's own frame.
   std::uint32_t map_of(const KeyFrame& kf) const;
 
+  // Motion sensors -----------------------------------------------------------------
+  /// Gravity in the map's frame and whether the inertial state is trusted.
+  MapGravity& gravity() { return gravity_; }
+  const MapGravity& gravity() const { return gravity_; }
+
  private:
   std::mutex mutex_;
   std::map<std::uint64_t, std::shared_ptr<KeyFrame>> keyframes_;
@@ -309,6 +326,12 @@ class Map {
   std::uint32_t session_ = 0;
   std::uint32_t next_provisional_ = 1;
   std::map<std::uint32_t, std::uint32_t> merged_;  ///< provisional map -> the map it was merged into
+  MapGravity gravity_;
 };
+
+/// Takes kf out of the chain in time: its next keyframe's interval then
+/// begins at kf's predecessor (the readings appended), or is dropped when
+/// a part is missing.
+void unlink_in_time(KeyFrame& kf);
 
 }  // namespace pvb::slam

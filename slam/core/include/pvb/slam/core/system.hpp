@@ -134,6 +134,20 @@ class System {
   /// What the map, the culled keyframes and the dense mapper hold now (call
   /// from the thread that calls track(); after shutdown() for the final figures).
   SystemMemory memory();
+  /// Gravity in the map's frame and when the inertial state became
+  /// trusted (MapGravity::ready false: not yet, or a camera-only setup).
+  MapGravity gravity();
+  /// The sensors this system fuses.
+  SensorSetup sensors() const { return settings_.sensors; }
+  /// Each keyframe in the map with an inertial state: its time, velocity
+  /// and biases (for reports against the true biases).
+  struct KeyFrameState {
+    std::uint64_t id = 0;
+    std::int64_t t_ns = 0;
+    Eigen::Vector3d v_w_mps = Eigen::Vector3d::Zero();
+    ImuBias bias;
+  };
+  std::vector<KeyFrameState> keyframe_states();
   /// Every relocalisation so far (call from the thread that calls track()).
   const std::vector<RelocEvent>& relocalisations() const { return tracking_->relocalisations(); }
 

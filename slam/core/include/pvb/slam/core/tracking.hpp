@@ -13,17 +13,28 @@
 
 #include "pvb/slam/core/map.hpp"
 #include "pvb/slam/core/matcher.hpp"
+#include "pvb/slam/core/motion_integrator.hpp"
 #include "pvb/slam/core/place_recognition.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/pematch/pe_match.hpp"
 
 namespace pvb::slam {
 
-enum class TrackingState { kNotInitialized, kOk, kLost };
+/// kDeadReckoning: vision has failed and the IMU (and wheels) carry the
+/// pose, for at most TrackingOptions::blind_max_s / blind_max_m.
+enum class TrackingState { kNotInitialized, kOk, kLost, kDeadReckoning };
 const char* to_string(TrackingState s);
 
 /// How the pose of a frame was found.
-enum class TrackingMethod { kNone, kInitialization, kMotionModel, kReferenceKeyFrame, kRelocalization };
+enum class TrackingMethod {
+  kNone,
+  kInitialization,
+  kMotionModel,
+  kReferenceKeyFrame,
+  kRelocalization,
+  kDeadReckoning,  ///< the pose predicted by the motion sensors alone
+  kAfterBlind,     ///< the local map found again from the dead-reckoned pose
+};
 
 /// Per-frame figures for timing.csv and the tests.
 struct TrackingStats {
@@ -131,6 +142,19 @@ struct TrackingOptions {
   /// loaded map's keyframes alone (with the look-alike checks); a success
   /// is a merge hypothesis for loop closing (take_merge_hint).  0: never.
   int merge_reloc_every = 5;
+  /// With an IMU whose state is trusted: how long, and how far, the motion
+  /// sensors may carry the pose while vision fails before tracking
+  /// declares itself lost and relocalises globally.
+  double blind_max_s = 5.0;
+  double blind_max_m = 3.0;
+  /// A blind stretch is a kidnap (lost at once) when the IMU says the robot
+  /// rose more than this (a ground robot does not), or with wheels when
+  /// the IMU's and the wheels' positions part by more than kidnap_disagree_m.
+  double kidnap_lift_m = 0.15;
+  double kidnap_disagree_m = 0.25;
+  /// Search radius (px at level 0) for the local map's points in the
+  /// first frame after a blind stretch, around the dead-reckoned pose.
+  double after_blind_radius_px = 12.0;
 };
 
 /// A provisional map's frame in the map's own, from one frame tracked in
@@ -167,6 +191,14 @@ class Tracking {
   /// `place` (may be null) gives relocalisation candidates anywhere in the map.
   Tracking(Map& map, std::shared_ptr<const CameraModel> cam, const TrackingOptions& options,
            const PlaceRecognizer* place = nullptr);
+
+  /// Fuses the motion sensors of `setup` (not kCamera); before the first frame.
+  void use_motion_sensors(SensorSetup setup, const ImuSettings& imu, const RobotSettings& robot);
+  /// The readings that came with the next frame (before track()).
+  void add_motion(std::int64_t t_ns, const std::vector<sensor::ImuSample>& imu,
+                  const std::vector<sensor::WheelTicks>& ticks);
+  /// The motion sensors' state (null for a camera-only setup).
+  const MotionIntegrator* motion() const { return motion_.get(); }
 
   /// Tracks one frame (features extracted).  `mapping_idle` and
   /// `mapping_queue` describe the local mapper for the keyframe decision.
@@ -246,6 +278,41 @@ class Tracking {
   void replace_in_last_frame();
   /// Appends one step's failure to stats_.failure; returns false.
   bool fail(const std::string& why);
+
+  // Motion sensors (motion_tracking.cpp) ------------------------------------------
+  /// The IMU's state is trusted: predictions and dead reckoning may use it.
+  bool inertial_ready() const;
+  /// The first frame's pose: levelled by the accelerometer (z against
+  /// gravity, the camera's heading kept) when the setup has one.
+  geom::SE3d first_pose() const;
+  /// The pose the motion sensors predict for f from the last frame.
+  geom::SE3d predicted_pose(Eigen::Vector3d* v_w) const;
+  /// After a frame is tracked or dead-reckoned: the last frame's IMU
+  /// velocity, and the bias the readings are integrated at.
+  void update_motion_state(const Frame& f, bool tracked);
+  /// Links kf in time after the previous keyframe and hands it the
+  /// readings since, and its inertial state when known.
+  void attach_motion(const std::shared_ptr<KeyFrame>& kf);
+  /// Vision failed on f: carries the pose by the motion sensors when it
+  /// may (true), or says why not.
+  bool dead_reckon(Frame& f);
+  /// The first frames after a blind stretch: the local map's points
+  /// searched around the dead-reckoned pose, then the local map tracked.
+  bool track_after_blind(Frame& f);
+
+  std::unique_ptr<MotionIntegrator> motion_;  ///< null: camera only
+  Eigen::Vector3d v_last_ = Eigen::Vector3d::Zero();  ///< the IMU's velocity at the last frame
+  bool v_last_known_ = false;
+  std::shared_ptr<KeyFrame> last_kf_;         ///< the newest keyframe in time (the chain's end)
+  /// The blind stretch so far: its start, the distance carried, and
+  /// the IMU-only and wheel-only positions of the base (kidnap check).
+  struct Blind {
+    std::int64_t start_t_ns = 0;
+    double distance_m = 0;
+    Eigen::Vector3d p_start_w = Eigen::Vector3d::Zero();
+    Eigen::Vector3d p_imu_w = Eigen::Vector3d::Zero(), v_imu_w = Eigen::Vector3d::Zero();
+  };
+  std::optional<Blind> blind_;
 
   Map& map_;
   std::shared_ptr<const CameraModel> cam_;

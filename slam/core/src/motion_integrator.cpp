@@ -1,0 +1,118 @@
+#include "pvb/slam/core/motion_integrator.hpp"
+
+#include <cmath>
+
+namespace pvb::slam {
+
+MotionIntegrator::MotionIntegrator(SensorSetup setup, const ImuSettings& imu, const RobotSettings& robot)
+    : setup_(setup),
+      imu_(imu),
+      robot_(robot),
+      imu_frame_(ImuBias{}, imu.noise),
+      imu_kf_(ImuBias{}, imu.noise),
+      wheel_frame_(robot.drive, wheel_noise_),
+      wheel_kf_(robot.drive, wheel_noise_) {}
+
+void MotionIntegrator::add_frame(std::int64_t t_ns, const std::vector<sensor::ImuSample>& imu,
+                                 const std::vector<sensor::WheelTicks>& ticks) {
+  imu_frame_ = ImuPreintegration(bias_, imu_.noise);
+  wheel_frame_ = WheelPreintegration(robot_.drive, wheel_noise_);
+  if (uses_accel(setup_))
+    for (const auto& s : imu) add_imu(s);
+  if (uses_wheels(setup_))
+    for (const auto& t : ticks) add_ticks(t);
+  // The tilt window ends at the frame.
+  const auto window_ns = static_cast<std::int64_t>(kTiltWindowS * 1e9);
+  while (!recent_f_c_.empty() && recent_f_c_.front().first < t_ns - window_ns) recent_f_c_.pop_front();
+}
+
+void MotionIntegrator::add_imu(const sensor::ImuSample& s) {
+  const double period_s = 1.0 / imu_.rate_hz;
+  const double dt_s = last_imu_t_ns_ ? static_cast<double>(s.t_ns - *last_imu_t_ns_) * 1e-9 : period_s;
+  last_imu_t_ns_ = s.t_ns;
+  if (!(dt_s > 0) || !s.accel_mps2.allFinite()) return;  // a repeated or broken reading
+  ++imu_count_;
+  const Eigen::Matrix3d R_c_b = imu_.T_b_c.linear().transpose();
+  recent_f_c_.emplace_back(s.t_ns, R_c_b * (s.accel_mps2 - bias_.accel_mps2));
+  if (!uses_imu(setup_) || !s.gyro_radps.allFinite()) return;
+  // A gap (a dropped stretch) is integrated as one reading of at most
+  // ten periods: the rest is not known.
+  const double step_s = std::min(dt_s, 10 * period_s);
+  imu_frame_.integrate(s.gyro_radps, s.accel_mps2, step_s);
+  imu_kf_.integrate(s.gyro_radps, s.accel_mps2, step_s);
+}
+
+void MotionIntegrator::add_ticks(const sensor::WheelTicks& t) {
+  if (last_ticks_ && t.t_ns > last_ticks_->t_ns) {
+    const std::int64_t dl = t.left - last_ticks_->left, dr = t.right - last_ticks_->right;
+    wheel_frame_.add(dl, dr);
+    wheel_kf_.add(dl, dr);
+  }
+  last_ticks_ = t;
+}
+
+KeyframeInterval MotionIntegrator::take_keyframe_interval() {
+  KeyframeInterval out;
+  if (uses_imu(setup_) && imu_kf_.size() > 0) out.imu = std::make_shared<ImuPreintegration>(imu_kf_);
+  if (uses_wheels(setup_) && has_wheels()) out.wheels = std::make_shared<WheelPreintegration>(wheel_kf_);
+  if (!recent_f_c_.empty()) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& [t, f] : recent_f_c_) mean += f;
+    mean /= static_cast<double>(recent_f_c_.size());
+    double var = 0;
+    for (const auto& [t, f] : recent_f_c_) var += (f - mean).squaredNorm();
+    out.f_c_mps2 = mean;
+    out.f_spread_mps2 = std::sqrt(var / static_cast<double>(recent_f_c_.size()));
+  }
+  imu_kf_ = ImuPreintegration(bias_, imu_.noise);
+  wheel_kf_ = WheelPreintegration(robot_.drive, wheel_noise_);
+  return out;
+}
+
+void MotionIntegrator::set_bias(const ImuBias& b) {
+  bias_ = b;
+  imu_frame_.reintegrate(b);
+  imu_kf_.reintegrate(b);
+}
+
+std::optional<Eigen::Vector3d> MotionIntegrator::recent_specific_force_c() const {
+  if (recent_f_c_.empty()) return std::nullopt;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& [t, f] : recent_f_c_) mean += f;
+  return mean / static_cast<double>(recent_f_c_.size());
+}
+
+NavState MotionIntegrator::nav_state(const geom::SE3d& T_c_w, const Eigen::Vector3d& v_w) const {
+  const geom::SE3d T_w_b = T_c_w.inverse() * imu_.T_b_c.inverse();
+  NavState s;
+  s.R_w_b = T_w_b.linear();
+  s.p_w_m = T_w_b.translation();
+  s.v_w_mps = v_w;
+  return s;
+}
+
+geom::SE3d MotionIntegrator::camera_pose(const NavState& s) const {
+  return (geom::make_se3(s.R_w_b, s.p_w_m) * imu_.T_b_c).inverse();
+}
+
+geom::SE3d MotionIntegrator::predict(const geom::SE3d& T_c_w_last, const Eigen::Vector3d& v_w_last,
+                                     const Eigen::Vector3d& g_w, Eigen::Vector3d* v_w_out) const {
+  const NavState start = nav_state(T_c_w_last, v_w_last);
+  const NavState end = imu_frame_.size() > 0 ? imu_frame_.predict(start, g_w, bias_) : start;
+  if (v_w_out) *v_w_out = end.v_w_mps;
+  if (!uses_wheels(setup_) || !has_wheels()) return camera_pose(end);
+  // Wheels: the base moves by the encoders' planar increment in its own
+  // frame, turned as the gyro says.
+  const geom::SE3d T_base_b = robot_.T_base_c * imu_.T_b_c.inverse();
+  const geom::SE3d T_w_base0 = T_c_w_last.inverse() * robot_.T_base_c.inverse();
+  const Eigen::Matrix3d R_b0_b1 = start.R_w_b.transpose() * end.R_w_b;
+  const Eigen::Matrix3d R_base0_base1 = T_base_b.linear() * R_b0_b1 * T_base_b.linear().transpose();
+  const Eigen::Vector3d& d = wheel_frame_.delta();
+  const geom::SE3d T_base0_base1 = geom::make_se3(R_base0_base1, Eigen::Vector3d(d.x(), d.y(), 0));
+  const geom::SE3d T_w_c1 = T_w_base0 * T_base0_base1 * robot_.T_base_c;
+  if (v_w_out && imu_frame_.dt_s() > 0)
+    *v_w_out = ((T_w_c1 * imu_.T_b_c.inverse()).translation() - start.p_w_m) / imu_frame_.dt_s();
+  return T_w_c1.inverse();
+}
+
+}  // namespace pvb::slam
