@@ -14,6 +14,7 @@
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/matcher.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
+#include "pvb/slam/core/frame_pose.hpp"
 
 namespace pvb::slam {
 namespace {

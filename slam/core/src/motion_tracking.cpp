@@ -6,6 +6,7 @@
 
 #include "pvb/common/text.hpp"
 #include "pvb/slam/core/tracking.hpp"
+#include "pvb/slam/core/frame_pose.hpp"
 
 namespace pvb::slam {
 

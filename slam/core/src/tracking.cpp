@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "pvb/slam/core/patch_refine.hpp"
+#include "pvb/slam/core/frame_pose.hpp"
 
 namespace pvb::slam {
 

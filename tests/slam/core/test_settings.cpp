@@ -481,5 +481,69 @@ TEST(Settings, MissingVocabularyIsOneIoErrorNamingIt) {
   }
 }
 
+
+/// ORB-SLAM3's IMU keys and our Robot keys, as a recording writes them.
+const std::string kImuKeys =
+    "\nIMU.NoiseGyro: 0.00017\nIMU.NoiseAcc: 0.002\nIMU.GyroWalk: 2.0e-05\nIMU.AccWalk: 0.0004\nIMU.Frequency: 200.0\n"
+    "IMU.T_b_c1: !!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: f\n"
+    "  data: [0.0, 0.0, 1.0, 0.05, -1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.1, 0.0, 0.0, 0.0, 1.0]\n";
+const std::string kRobotKeys =
+    "Robot.WheelRadius: 0.1\nRobot.Track: 0.42\nRobot.TicksPerRev: 1024\nRobot.EncoderFrequency: 50.0\n"
+    "Robot.T_base_c1: !!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: f\n"
+    "  data: [0.0, 0.0, 1.0, 0.2, -1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.5, 0.0, 0.0, 0.0, 1.0]\n"
+    "Robot.T_base_imu: !!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: f\n"
+    "  data: [1.0, 0.0, 0.0, 0.1, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.4, 0.0, 0.0, 0.0, 1.0]\n";
+
+TEST(Settings, ReadsImuAndRobotKeysAndTheSensorSetup) {
+  const Settings plain = read_settings(tum1());
+  EXPECT_EQ(plain.sensors, SensorSetup::kCamera);
+  EXPECT_FALSE(plain.imu.present);
+  EXPECT_FALSE(plain.robot.present);
+  const Settings s = read_settings(
+      temp_copy("imu", read_file(tum1()) + kImuKeys + kRobotKeys + "System.Sensors: \"camera+imu+wheels\"\n"));
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+  EXPECT_EQ(s.sensors, SensorSetup::kCameraImuWheels);
+  ASSERT_TRUE(s.imu.present);
+  EXPECT_DOUBLE_EQ(s.imu.noise.gyro_noise_density, 0.00017);
+  EXPECT_DOUBLE_EQ(s.imu.noise.accel_random_walk, 0.0004);
+  EXPECT_DOUBLE_EQ(s.imu.rate_hz, 200.0);
+  // The camera's optical z looks along the IMU's x; its centre 5 cm ahead, 10 cm up.
+  EXPECT_NEAR((s.imu.T_b_c.linear() * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitX()).norm(), 0, 1e-6);
+  EXPECT_NEAR((s.imu.T_b_c.translation() - Eigen::Vector3d(0.05, 0, 0.1)).norm(), 0, 1e-6);
+  ASSERT_TRUE(s.robot.present);
+  EXPECT_EQ(s.robot.drive.ticks_per_rev, 1024);
+  EXPECT_DOUBLE_EQ(s.robot.drive.track_m, 0.42);
+  EXPECT_NEAR(s.robot.T_base_imu.translation().z(), 0.4, 1e-6);
+  for (const char* name : {"camera", "camera+imu", "camera+imu+wheels", "camera+accel"})
+    EXPECT_STREQ(to_string(*parse_sensor_setup(name)), name);
+  EXPECT_FALSE(parse_sensor_setup("imu"));
+}
+
+TEST(Settings, SensorSetupWithoutItsKeysOrWithABadExtrinsicIsOneConfigError) {
+  const auto error_of = [](const std::string& name, const std::string& text) -> std::string {
+    try {
+      read_settings(temp_copy(name, text));
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  const std::string base = read_file(tum1());
+  EXPECT_NE(error_of("s1", base + "System.Sensors: \"camera+imu\"\n").find("IMU.NoiseGyro"), std::string::npos);
+  EXPECT_NE(error_of("s2", base + kImuKeys + "System.Sensors: \"camera+imu+wheels\"\n").find("Robot.WheelRadius"),
+            std::string::npos);
+  EXPECT_NE(error_of("s3", base + "System.Sensors: \"lidar\"\n").find("System.Sensors"), std::string::npos);
+  std::string skewed = kImuKeys;
+  skewed.replace(skewed.find("[0.0, 0.0, 1.0"), 14, "[0.5, 0.0, 1.0");
+  EXPECT_NE(error_of("s4", base + skewed).find("IMU.T_b_c1"), std::string::npos);
+  std::string partial = kImuKeys;
+  partial.replace(partial.find("IMU.AccWalk"), 3, "XMU");
+  EXPECT_NE(error_of("s5", base + partial).find("IMU.AccWalk"), std::string::npos);
+  // With a setup that needs them, a flag's choice is checked the same way.
+  const Settings plain = read_settings(tum1());
+  EXPECT_THROW(check_sensor_setup(plain, SensorSetup::kCameraAccel), ConfigError);
+  EXPECT_NO_THROW(check_sensor_setup(plain, SensorSetup::kCamera));
+}
+
 }  // namespace
 }  // namespace pvb::slam

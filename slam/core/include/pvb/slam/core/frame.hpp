@@ -191,10 +191,6 @@ class Frame {
   KeypointGrid grid_;  ///< keypoints by cell (CameraModel::kGridCols x kGridRows), as detected
 };
 
-/// Pose-only optimisation of `f` against its matched map points (robust,
-/// ORB-SLAM2's four rounds): sets f.T_c_w and has_pose, and marks f.outlier
-/// (cleared first).  Returns the inlier count (0 with fewer than 3 matches).
-int optimize_frame_pose(Frame& f);
 
 /// Hamming distance of two 32-byte descriptors.
 int descriptor_distance(const cv::Mat& a, const cv::Mat& b);

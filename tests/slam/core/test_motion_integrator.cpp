@@ -1,0 +1,119 @@
+// The motion sensors on the tracking side: intervals, predictions and the
+// accelerometer's tilt, on readings of known motion.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pvb/slam/core/motion_integrator.hpp"
+
+namespace pvb::slam {
+namespace {
+
+constexpr double kG = 9.81;
+constexpr std::int64_t kImuPeriodNs = 5'000'000;  // 200 Hz
+constexpr std::int64_t kFramePeriodNs = 33'333'333;
+
+/// A camera looking along the IMU's x (forward), 10 cm above it.
+Settings robot_settings(SensorSetup setup) {
+  Settings s;
+  s.sensors = setup;
+  s.imu.present = true;
+  s.imu.rate_hz = 200;
+  s.imu.T_b_c = geom::make_se3(geom::R_body_optical(), Eigen::Vector3d(0.05, 0, 0.1));
+  s.robot.present = true;
+  s.robot.T_base_imu = geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 0.3));
+  s.robot.T_base_c = s.robot.T_base_imu * s.imu.T_b_c;
+  return s;
+}
+
+/// Readings of an IMU on a level robot driving straight at constant speed
+/// and turning at w_radps, from t0 (exclusive) to t1 (inclusive).
+std::vector<sensor::ImuSample> level_readings(std::int64_t t0_ns, std::int64_t t1_ns, double w_radps,
+                                              const Eigen::Vector3d& accel_extra = Eigen::Vector3d::Zero()) {
+  std::vector<sensor::ImuSample> out;
+  for (std::int64_t t = t0_ns + kImuPeriodNs; t <= t1_ns; t += kImuPeriodNs) {
+    sensor::ImuSample s;
+    s.t_ns = t;
+    s.gyro_radps = Eigen::Vector3d(0, 0, w_radps);
+    s.accel_mps2 = Eigen::Vector3d(0, 0, kG) + accel_extra;
+    out.push_back(s);
+  }
+  return out;
+}
+
+TEST(MotionIntegrator, PredictsAStraightDriveAtConstantSpeed) {
+  const Settings s = robot_settings(SensorSetup::kCameraImu);
+  MotionIntegrator m(s.sensors, s.imu, s.robot);
+  m.add_frame(0, level_readings(-kFramePeriodNs, 0, 0), {});
+  m.add_frame(kFramePeriodNs, level_readings(0, kFramePeriodNs, 0), {});
+  EXPECT_NEAR(m.imu_since_frame().dt_s(), kFramePeriodNs * 1e-9, 1e-6);
+  // The camera pose whose IMU stands at the origin, level, heading along x.
+  const geom::SE3d T_c_w0 = m.camera_pose(NavState{});
+  const Eigen::Vector3d v_w(0.5, 0, 0);
+  Eigen::Vector3d v_out;
+  const geom::SE3d T_c_w1 = m.predict(T_c_w0, v_w, Eigen::Vector3d(0, 0, -kG), &v_out);
+  const NavState at1 = m.nav_state(T_c_w1, v_out);
+  const double dt_s = m.imu_since_frame().dt_s();
+  EXPECT_NEAR((at1.p_w_m - Eigen::Vector3d(0.5 * dt_s, 0, 0)).norm(), 0, 1e-9);
+  EXPECT_NEAR((v_out - v_w).norm(), 0, 1e-9);
+  EXPECT_NEAR((at1.R_w_b - Eigen::Matrix3d::Identity()).norm(), 0, 1e-9);
+}
+
+TEST(MotionIntegrator, WheelsCarryTheTranslationAndTheGyroTheTurn) {
+  const Settings s = robot_settings(SensorSetup::kCameraImuWheels);
+  MotionIntegrator m(s.sensors, s.imu, s.robot);
+  // An accelerometer bias of 0.5 m/s^2 forward that the IMU alone would
+  // integrate; the wheels say 0.2 m/s straight on.
+  const Eigen::Vector3d bias_like(0.5, 0, 0);
+  const double metres_per_tick = 2 * M_PI * s.robot.drive.wheel_radius_m / s.robot.drive.ticks_per_rev;
+  std::vector<sensor::WheelTicks> ticks;
+  for (int k = 0; k <= 10; ++k) {
+    const auto count = static_cast<std::int64_t>(std::lround(0.2 * 0.1 * k / metres_per_tick));
+    ticks.push_back({k * 100'000'000LL, count, count});
+  }
+  m.add_frame(0, level_readings(-kImuPeriodNs, 0, 0), {ticks.front()});
+  m.add_frame(1'000'000'000, level_readings(0, 1'000'000'000, 0.1, bias_like),
+              std::vector<sensor::WheelTicks>(ticks.begin() + 1, ticks.end()));
+  const geom::SE3d T_c_w0 = m.camera_pose(NavState{});
+  const geom::SE3d T_c_w1 = m.predict(T_c_w0, Eigen::Vector3d(0.2, 0, 0), Eigen::Vector3d(0, 0, -kG), nullptr);
+  const geom::SE3d T_w_base0 = T_c_w0.inverse() * s.robot.T_base_c.inverse();
+  const geom::SE3d T_w_base1 = T_c_w1.inverse() * s.robot.T_base_c.inverse();
+  const geom::SE3d T_b0_b1 = T_w_base0.inverse() * T_w_base1;
+  // 0.2 m ahead within one count, turned 0.1 rad by the gyro, no height.
+  EXPECT_NEAR(T_b0_b1.translation().x(), 0.2, metres_per_tick);
+  EXPECT_NEAR(T_b0_b1.translation().y(), 0, 1e-9);
+  EXPECT_NEAR(T_b0_b1.translation().z(), 0, 1e-9);
+  EXPECT_NEAR(geom::so3_log(T_b0_b1.linear()).z(), 0.1, 1e-6);
+}
+
+TEST(MotionIntegrator, KeyframeIntervalsSplitTheReadingsAndGiveTheTilt) {
+  const Settings s = robot_settings(SensorSetup::kCameraImu);
+  MotionIntegrator m(s.sensors, s.imu, s.robot);
+  for (int f = 0; f < 10; ++f) m.add_frame(f * kFramePeriodNs, level_readings((f - 1) * kFramePeriodNs, f * kFramePeriodNs, 0), {});
+  const KeyframeInterval a = m.take_keyframe_interval();
+  ASSERT_TRUE(a.imu);
+  ASSERT_TRUE(a.f_c_mps2);
+  // Up (the specific force) in the optical frame is -y.
+  EXPECT_NEAR((a.f_c_mps2->normalized() - Eigen::Vector3d(0, -1, 0)).norm(), 0, 1e-12);
+  EXPECT_NEAR(a.f_spread_mps2, 0, 1e-12);
+  for (int f = 10; f < 15; ++f) m.add_frame(f * kFramePeriodNs, level_readings((f - 1) * kFramePeriodNs, f * kFramePeriodNs, 0), {});
+  const KeyframeInterval b = m.take_keyframe_interval();
+  ASSERT_TRUE(b.imu);
+  EXPECT_NEAR(a.imu->dt_s() + b.imu->dt_s(), 14 * kFramePeriodNs * 1e-9 + 0.005, 1e-6);
+  EXPECT_EQ(m.imu_since_keyframe().size(), 0u);
+}
+
+TEST(MotionIntegrator, AccelerometerOnlyReadingsGiveTiltButNoIntervals) {
+  const Settings s = robot_settings(SensorSetup::kCameraAccel);
+  MotionIntegrator m(s.sensors, s.imu, s.robot);
+  auto readings = level_readings(-kFramePeriodNs, 0, 0);
+  for (auto& r : readings) r.gyro_radps = Eigen::Vector3d::Constant(std::nan(""));
+  m.add_frame(0, readings, {});
+  const KeyframeInterval k = m.take_keyframe_interval();
+  EXPECT_FALSE(k.imu);
+  ASSERT_TRUE(k.f_c_mps2);
+  EXPECT_NEAR(k.f_c_mps2->norm(), kG, 1e-9);
+}
+
+}  // namespace
+}  // namespace pvb::slam
