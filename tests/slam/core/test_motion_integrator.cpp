@@ -31,7 +31,9 @@ Settings robot_settings(SensorSetup setup) {
 std::vector<sensor::ImuSample> level_readings(std::int64_t t0_ns, std::int64_t t1_ns, double w_radps,
                                               const Eigen::Vector3d& accel_extra = Eigen::Vector3d::Zero()) {
   std::vector<sensor::ImuSample> out;
-  for (std::int64_t t = t0_ns + kImuPeriodNs; t <= t1_ns; t += kImuPeriodNs) {
+  // On the IMU's own clock: every multiple of its period in (t0, t1].
+  const std::int64_t first = (t0_ns >= 0 ? t0_ns / kImuPeriodNs + 1 : -((-t0_ns) / kImuPeriodNs)) * kImuPeriodNs;
+  for (std::int64_t t = first; t <= t1_ns; t += kImuPeriodNs) {
     sensor::ImuSample s;
     s.t_ns = t;
     s.gyro_radps = Eigen::Vector3d(0, 0, w_radps);
@@ -99,7 +101,9 @@ TEST(MotionIntegrator, KeyframeIntervalsSplitTheReadingsAndGiveTheTilt) {
   for (int f = 10; f < 15; ++f) m.add_frame(f * kFramePeriodNs, level_readings((f - 1) * kFramePeriodNs, f * kFramePeriodNs, 0), {});
   const KeyframeInterval b = m.take_keyframe_interval();
   ASSERT_TRUE(b.imu);
-  EXPECT_NEAR(a.imu->dt_s() + b.imu->dt_s(), 14 * kFramePeriodNs * 1e-9 + 0.005, 1e-6);
+  // Readings from -30 ms to 465 ms, the first counted one period.
+  EXPECT_NEAR(a.imu->dt_s() + b.imu->dt_s(), 0.500, 1e-9);
+  EXPECT_EQ(a.imu->size() + b.imu->size(), 100u);
   EXPECT_EQ(m.imu_since_keyframe().size(), 0u);
 }
 
