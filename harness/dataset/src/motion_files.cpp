@@ -1,9 +1,15 @@
 #include "pvb/dataset/motion_files.hpp"
 
+#include <unistd.h>
+
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 
+#include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/time.hpp"
@@ -90,6 +96,73 @@ void MotionFilesWriter::write(const std::vector<sensor::ImuSample>& imu_samples,
   accel_txt_.append(accel);
   wheels_csv_.append(wheels);
   odom_txt_.append(odom);
+}
+
+namespace {
+
+/// The comma-separated numbers of one line, or an IoError naming it.
+std::vector<double> csv_numbers(const std::string& line, std::size_t count, const std::string& file, int n,
+                                const char* expected) {
+  std::vector<double> v;
+  std::stringstream in(line);
+  std::string cell;
+  while (std::getline(in, cell, ',')) {
+    char* end = nullptr;
+    const double x = std::strtod(cell.c_str(), &end);
+    if (end == cell.c_str() || !std::isfinite(x)) throw IoError(file, std::string("expected ") + expected, n);
+    v.push_back(x);
+  }
+  if (v.size() != count) throw IoError(file, std::string("expected ") + expected, n);
+  return v;
+}
+
+/// Calls f(numbers, line number) for each data line of a CSV file with a '#' header.
+template <typename F>
+void for_each_csv_line(const std::string& file, std::size_t count, const char* expected, F&& f) {
+  std::ifstream in(file);
+  if (!in) throw IoError(file, "cannot open");
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    f(csv_numbers(line, count, file, n, expected), n);
+  }
+}
+
+}  // namespace
+
+MotionReadings read_motion_readings(const std::string& dir) {
+  MotionReadings m;
+  const std::string imu_file = dir + "/imu0/data.csv", wheels_file = dir + "/wheels.csv";
+  if (::access(imu_file.c_str(), R_OK) == 0)
+    for_each_csv_line(imu_file, 7, "t_ns,wx,wy,wz,ax,ay,az (7 numbers)", [&](const std::vector<double>& v, int n) {
+      sensor::ImuSample s;
+      s.t_ns = static_cast<std::int64_t>(v[0]);
+      if (!m.imu.empty() && s.t_ns <= m.imu.back().t_ns) throw IoError(imu_file, "expected a time after the line before", n);
+      s.gyro_radps = Eigen::Vector3d(v[1], v[2], v[3]);
+      s.accel_mps2 = Eigen::Vector3d(v[4], v[5], v[6]);
+      m.imu.push_back(s);
+    });
+  if (::access(wheels_file.c_str(), R_OK) == 0)
+    for_each_csv_line(wheels_file, 3, "t_ns,left,right (3 integers)", [&](const std::vector<double>& v, int n) {
+      sensor::WheelTicks t;
+      t.t_ns = static_cast<std::int64_t>(v[0]);
+      if (!m.ticks.empty() && t.t_ns <= m.ticks.back().t_ns)
+        throw IoError(wheels_file, "expected a time after the line before", n);
+      t.left = static_cast<std::int64_t>(v[1]);
+      t.right = static_cast<std::int64_t>(v[2]);
+      m.ticks.push_back(t);
+    });
+  return m;
+}
+
+void attach_readings(const MotionReadings& m, std::int64_t t0_ns, std::int64_t t1_ns, sensor::RgbdFrame* frame) {
+  const auto in_range = [&](const auto& v, auto* out) {
+    auto it = std::upper_bound(v.begin(), v.end(), t0_ns, [](std::int64_t t, const auto& r) { return t < r.t_ns; });
+    for (; it != v.end() && it->t_ns <= t1_ns; ++it) out->push_back(*it);
+  };
+  in_range(m.imu, &frame->imu);
+  in_range(m.ticks, &frame->wheel_ticks);
 }
 
 }  // namespace pvb::dataset

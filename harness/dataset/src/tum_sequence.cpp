@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -206,7 +207,8 @@ std::vector<std::pair<int, std::vector<std::string>>> list_lines(const std::stri
 std::vector<std::string> sequence_files(const std::string& dir) {
   std::vector<std::string> out;
   for (const char* name :
-       {"associations.txt", "rgb.txt", "depth.txt", "groundtruth.txt", "meta.json", "camera.yaml"})
+       {"associations.txt", "rgb.txt", "depth.txt", "groundtruth.txt", "meta.json", "camera.yaml", "imu0/data.csv",
+        "wheels.csv"})
     out.push_back(dir + "/" + name);
   for (const char* images : {"rgb", "depth"}) {
     std::error_code ec;
@@ -308,6 +310,8 @@ TumSequenceReader::TumSequenceReader(const std::string& dir, double depth_factor
   if (::access(assoc.c_str(), R_OK) == 0) entries_ = read_associations(assoc);
   if (entries_.empty()) entries_ = associate_lists(dir, max_diff_s);
   max_skipped_ = std::max<std::size_t>(10, entries_.size() / 10);
+  motion_ = read_motion_readings(dir);
+  last_delivered_t_ns_ = std::numeric_limits<std::int64_t>::min();
 }
 
 sensor::RgbdFrame TumSequenceReader::load(std::size_t i) const {
@@ -323,6 +327,8 @@ sensor::RgbdFrame TumSequenceReader::load(std::size_t i) const {
   if (d16.type() != CV_16UC1) throw IoError(depth_path, "expected a 16-bit single-channel depth image");
   if (d16.size() != f.rgb.size()) throw IoError(depth_path, "depth and colour images differ in size");
   f.depth_m = sensor::depth_from_u16(d16, depth_factor_);
+  const std::int64_t t0_ns = i > 0 ? entries_[i - 1].t_ns : std::numeric_limits<std::int64_t>::min();
+  attach_readings(motion_, t0_ns, e.t_ns, &f);
   return f;
 }
 
@@ -330,7 +336,13 @@ std::optional<sensor::RgbdFrame> TumSequenceReader::next() {
   while (pos_ < entries_.size() && !skip_limit_reached()) {
     const std::size_t i = pos_++;
     try {
-      return load(i);
+      sensor::RgbdFrame f = load(i);
+      // The readings of frames skipped before this one go with it.
+      f.imu.clear();
+      f.wheel_ticks.clear();
+      attach_readings(motion_, last_delivered_t_ns_, f.t_ns, &f);
+      last_delivered_t_ns_ = f.t_ns;
+      return f;
     } catch (const IoError& e) {
       ++skipped_;
       std::fprintf(stderr, "pvbench: warning: skipping frame %zu: %s\n", i, e.what());

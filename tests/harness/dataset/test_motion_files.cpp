@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 #include <sstream>
 
+#include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/motion_files.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
@@ -99,4 +100,45 @@ TEST(MotionFiles, ReadingsAndOdometryAreWrittenPerFrame) {
   EXPECT_GT(x, 2 * M_PI * 0.1);  // the straight metre and part of the arc
   EXPECT_NE(read_file(dir + "/imu.yaml").find("gyroscope_random_walk: 2.0e-05"), std::string::npos);
   EXPECT_NE(read_file(dir + "/robot.yaml").find("ticks_per_rev: 1024"), std::string::npos);
+}
+
+// What a recording wrote reads back reading for reading, split between
+// frames by time; a damaged line names its file and line.
+TEST(MotionFiles, ReadingsReadBackAndGoWithTheirFrames) {
+  const std::string dir = ::testing::TempDir() + "motion_read_" + std::to_string(::getpid());
+  {
+    dataset::MotionFilesWriter w(dir, calibration());
+    std::vector<sensor::ImuSample> imu;
+    std::vector<sensor::WheelTicks> ticks;
+    for (int k = 1; k <= 40; ++k) {
+      imu.push_back({k * 5'000'000LL, Eigen::Vector3d(0.01 * k, -0.02, 1e-7), Eigen::Vector3d(0.1, -9.8, 0.25 * k)});
+      if (k % 4 == 0) ticks.push_back({k * 5'000'000LL, 3 * k, -k});
+    }
+    w.write(imu, ticks);
+  }
+  const dataset::MotionReadings m = dataset::read_motion_readings(dir);
+  ASSERT_EQ(m.imu.size(), 40u);
+  ASSERT_EQ(m.ticks.size(), 10u);
+  EXPECT_EQ(m.imu[6].t_ns, 35'000'000);
+  EXPECT_DOUBLE_EQ(m.imu[6].gyro_radps.x(), 0.07);
+  EXPECT_DOUBLE_EQ(m.imu[6].gyro_radps.z(), 1e-7);
+  EXPECT_DOUBLE_EQ(m.imu[6].accel_mps2.z(), 1.75);
+  EXPECT_EQ(m.ticks[9].left, 120);
+  EXPECT_EQ(m.ticks[9].right, -40);
+  // A frame at 100 ms after one at 50 ms takes the readings in (50, 100] ms.
+  sensor::RgbdFrame f;
+  dataset::attach_readings(m, 50'000'000, 100'000'000, &f);
+  ASSERT_EQ(f.imu.size(), 10u);
+  EXPECT_EQ(f.imu.front().t_ns, 55'000'000);
+  EXPECT_EQ(f.imu.back().t_ns, 100'000'000);
+  EXPECT_EQ(f.wheel_ticks.size(), 3u);  // at 60, 80 and 100 ms
+
+  write_file(dir + "/wheels.csv", "#timestamp [ns],left [ticks],right [ticks]\n20000000,1,2\n40000000,x,3\n");
+  try {
+    dataset::read_motion_readings(dir);
+    FAIL() << "expected an IoError";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("wheels.csv"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(":3"), std::string::npos) << e.what();
+  }
 }

@@ -50,4 +50,20 @@ class MotionFilesWriter {
   sensor::WheelOdometry odometry_;
 };
 
+/// A recording's motion readings, read back: imu0/data.csv (EuRoC layout)
+/// and wheels.csv, each sorted by time (empty when the file is absent).
+struct MotionReadings {
+  std::vector<sensor::ImuSample> imu;
+  std::vector<sensor::WheelTicks> ticks;
+  bool empty() const { return imu.empty() && ticks.empty(); }
+};
+
+/// Reads the motion files in `dir` that are there.  A malformed line, a
+/// non-finite value or a time that does not increase is an IoError naming
+/// the file and line.
+MotionReadings read_motion_readings(const std::string& dir);
+
+/// The readings with time in (t0_ns, t1_ns] appended to `frame` (binary search).
+void attach_readings(const MotionReadings& m, std::int64_t t0_ns, std::int64_t t1_ns, sensor::RgbdFrame* frame);
+
 }  // namespace pvb::dataset

@@ -100,7 +100,8 @@ class TumSequenceReader : public sensor::FrameSource {
   std::size_t size_hint() const override { return entries_.size(); }
   std::string describe() const override { return "tum:" + dir_; }
   const std::vector<Entry>& entries() const { return entries_; }
-  /// Loads frame i (throws IoError for a missing, damaged or unreadable image).
+  /// Loads frame i (throws IoError for a missing, damaged or unreadable
+  /// image), with the motion readings since frame i - 1.
   sensor::RgbdFrame load(std::size_t i) const;
   /// Number of frames skipped because an image was missing or corrupt.
   std::size_t skipped() const { return skipped_; }
@@ -109,6 +110,8 @@ class TumSequenceReader : public sensor::FrameSource {
   std::string dir_;
   double depth_factor_;
   std::vector<Entry> entries_;
+  MotionReadings motion_;             ///< imu0/data.csv and wheels.csv, when the folder has them
+  std::int64_t last_delivered_t_ns_;  ///< the last frame next() returned (readings up to it went with it)
   std::size_t pos_ = 0;
   std::size_t skipped_ = 0;
   std::size_t max_skipped_ = 0;
@@ -116,7 +119,8 @@ class TumSequenceReader : public sensor::FrameSource {
 
 /// The files of a TUM RGB-D folder that a reader of it may read: its lists
 /// (associations.txt, rgb.txt, depth.txt, groundtruth.txt), meta.json,
-/// camera.yaml, and the images in rgb/ and depth/.  Other files in the
+/// camera.yaml, the motion readings (imu0/data.csv, wheels.csv) and the
+/// images in rgb/ and depth/.  Other files in the
 /// folder (a map saved beside the sequence) are not among them.
 std::vector<std::string> sequence_files(const std::string& dir);
 
