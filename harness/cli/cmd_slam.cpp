@@ -12,6 +12,7 @@
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/run/offline_slam.hpp"
+#include "sensor_options.hpp"
 #include "stop_signals.hpp"
 
 namespace pvb::cli {
@@ -21,10 +22,12 @@ struct SlamArgs {
   run::OfflineSlamOptions options;
   std::optional<std::uint32_t> seed;  ///< --seed; else the recording's own, else the default
   std::string map_mode;
+  std::string sensors;  ///< --sensors
 };
 
 int run_slam(SlamArgs a) {
   run::OfflineSlamOptions& o = a.options;
+  o.sensors = sensors_from_flag(a.sensors);
   if (!a.map_mode.empty()) o.map.use = run::parse_map_use(a.map_mode, "--map-mode");
   run::resolve_offline_seed(a.seed, &o);
   // A map of another station than the recording's is used after a warning.
@@ -81,6 +84,7 @@ Command add_slam_command(CLI::App& app) {
          "frames are missing or corrupt")
       ->capture_default_str();
   add_map_options(sub, &args->options.map, &args->map_mode);
+  add_sensors_option(sub, &args->sensors);
   return {sub, [args] { return run_slam(*args); }};
 }
 

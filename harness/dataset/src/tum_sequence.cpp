@@ -206,7 +206,8 @@ std::vector<std::pair<int, std::vector<std::string>>> list_lines(const std::stri
 std::vector<std::string> sequence_files(const std::string& dir) {
   std::vector<std::string> out;
   for (const char* name :
-       {"associations.txt", "rgb.txt", "depth.txt", "groundtruth.txt", "meta.json", "camera.yaml"})
+       {"associations.txt", "rgb.txt", "depth.txt", "groundtruth.txt", "meta.json", "camera.yaml",
+        "accelerometer.txt", "imu0/data.csv"})
     out.push_back(dir + "/" + name);
   for (const char* images : {"rgb", "depth"}) {
     std::error_code ec;
@@ -308,6 +309,7 @@ TumSequenceReader::TumSequenceReader(const std::string& dir, double depth_factor
   if (::access(assoc.c_str(), R_OK) == 0) entries_ = read_associations(assoc);
   if (entries_.empty()) entries_ = associate_lists(dir, max_diff_s);
   max_skipped_ = std::max<std::size_t>(10, entries_.size() / 10);
+  imu_ = read_tum_imu(dir);
 }
 
 sensor::RgbdFrame TumSequenceReader::load(std::size_t i) const {
@@ -330,7 +332,9 @@ std::optional<sensor::RgbdFrame> TumSequenceReader::next() {
   while (pos_ < entries_.size() && !skip_limit_reached()) {
     const std::size_t i = pos_++;
     try {
-      return load(i);
+      sensor::RgbdFrame frame = load(i);
+      while (imu_pos_ < imu_.size() && imu_[imu_pos_].t_ns <= frame.t_ns) frame.imu.push_back(imu_[imu_pos_++]);
+      return frame;
     } catch (const IoError& e) {
       ++skipped_;
       std::fprintf(stderr, "pvbench: warning: skipping frame %zu: %s\n", i, e.what());

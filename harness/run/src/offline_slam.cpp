@@ -17,10 +17,12 @@
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/evaluate.hpp"
+#include "pvb/eval/gravity.hpp"
 #include "pvb/eval/metrics.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/run/map_eval.hpp"
 #include "pvb/run/place_recognition.hpp"
+#include "pvb/run/sensor_setup.hpp"
 #include "pvb/slam/core/system.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"
 #include "pvb/suite/metrics_file.hpp"
@@ -165,6 +167,9 @@ class OfflineSlam::Impl {
   std::string stats_json(StopReason stop, const std::string& dense_json);
   void print_loop_closing(std::ostringstream* js);
   void evaluate(std::ostringstream* js);
+  /// Gravity error per frame and the keyframes' pitch and roll error (docs/evaluation.md).
+  void evaluate_gravity(const eval::Trajectory& gt, const eval::Trajectory& est, const eval::Sim3Transform& alignment,
+                        std::ostringstream* js);
   void evaluate_refined(const eval::Trajectory& gt, const eval::EvalOptions& eo, std::ostringstream* js);
   /// Labels the loops and relocalisations against `gt` and prints them.
   void label_places(const eval::Trajectory& gt);
@@ -189,6 +194,12 @@ slam::Settings OfflineSlam::Impl::read_settings() const {
   for (const std::string& w : settings.warnings) warn("warning: " + w);
   if (a_.no_pe_match) settings.pe_match.enabled = false;
   if (a_.no_dense) settings.dense.enabled = false;
+  if (a_.sensors) settings.sensors = *a_.sensors;
+  if (settings.sensors == slam::SensorSetup::kCameraAccel && supply_kinect_accelerometer(&settings, a_.sequence))
+    warn(std::string("note: sensors ") + slam::to_string(settings.sensors) +
+         ": the settings have no IMU.* keys; the Kinect v1 accelerometer's description is used "
+         "(docs/sensors.md)");
+  apply_sensor_setup(&settings, settings.sensors);
   return settings;
 }
 
@@ -375,6 +386,7 @@ void OfflineSlam::Impl::evaluate(std::ostringstream* js) {
     while (!ev.empty() && (ev.back() == '\n' || ev.back() == ' ')) ev.pop_back();
     *js << "," << ev;
     evaluate_refined(gt, eo, js);
+    evaluate_gravity(gt, est, res.alignment, js);
   } catch (const Error& e) {
     warn(std::string("warning: no evaluation: ") + e.what());
   }
@@ -391,6 +403,22 @@ void OfflineSlam::Impl::evaluate_refined(const eval::Trajectory& gt, const eval:
   } catch (const Error& e) {
     warn(std::string("warning: refined trajectory not evaluated: ") + e.what());
   }
+}
+
+void OfflineSlam::Impl::evaluate_gravity(const eval::Trajectory& gt, const eval::Trajectory& est,
+                                         const eval::Sim3Transform& alignment, std::ostringstream* js) {
+  // A pvbench recording's world is the site frame (z up); a TUM download's
+  // the mocap world, whose up was measured from the Kinect's accelerometer.
+  const bool site = std::ifstream(a_.sequence + "/meta.json").good();
+  const geom::Vec3d down_w = site ? geom::Vec3d(0, 0, -1) : geom::Vec3d(-dataset::tum_world_up());
+  const eval::GravityError g = eval::gravity_error(gt, est, down_w, gravity_map_frame(settings_.sensors));
+  const eval::TiltDrift t =
+      eval::tilt_drift(gt, eval::read_tum(a_.out + "/KeyFrameTrajectory.txt"), alignment);
+  text(strf("gravity error (map frame: %s): median %.2f deg, p95 %.2f, final %.2f; keyframe pitch error "
+            "%+.4f deg/keyframe, roll %+.4f\n",
+            g.map_frame.c_str(), g.median_deg, g.p95_deg, g.final_deg, t.pitch_slope_deg_per_kf,
+            t.roll_slope_deg_per_kf));
+  *js << ",\n  \"gravity\": " << eval::gravity_json(g) << ",\n  \"tilt\": " << eval::tilt_json(t);
 }
 
 void OfflineSlam::Impl::finish_map(std::ostringstream* js) {
@@ -422,6 +450,7 @@ std::string OfflineSlam::Impl::stats_json(StopReason stop, const std::string& de
   std::ostringstream js;
   js << "{\n  \"sequence\": \"" << json_escape(a_.sequence)
      << "\",\n  \"pe_match\": " << (settings_.pe_match.enabled ? "true" : "false")
+     << ",\n  \"sensors\": \"" << slam::to_string(settings_.sensors) << "\""
      << ",\n  \"sync\": " << (a_.sync ? "true" : "false") << ",\n  \"seed\": " << a_.seed
      << ",\n  \"seed_source\": \"" << json_escape(a_.seed_source) << "\""
      << ",\n  \"interrupted\": " << (stop == StopReason::kSignal ? "true" : "false") << ",\n  \"stop\": \""

@@ -32,6 +32,7 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
   const std::vector<double> ms = tracking_times(run);
   std::string out;
   out += in + "\"mode\": " + json_string(run.mode) + ",\n";
+  out += in + "\"sensors\": " + json_string(run.sensors) + ",\n";
   out += in + "\"frames\": " + std::to_string(run.frames) + ",\n";
   out += in + "\"lost_frames\": " + std::to_string(run.lost_frames) + ",\n";
   out += in + "\"not_initialized_frames\": " + std::to_string(run.not_initialized_frames) + ",\n";

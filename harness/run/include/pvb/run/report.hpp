@@ -92,6 +92,7 @@ std::string dense_map_json(const DenseMapReport& d, const std::string& in);
 /// One SLAM system's run (PE-SLAM, or the baseline: PE-match off, ORB-SLAM2's motion model).
 struct SlamRun {
   std::string mode;  ///< eval::kPeSlamMode or eval::kBaselineMode ("pe-slam", "baseline")
+  std::string sensors = "camera";  ///< slam::to_string(SensorSetup): the sensors the system fused
   std::size_t frames = 0;
   std::size_t lost_frames = 0;  ///< frames in state Lost
   std::size_t not_initialized_frames = 0;
