@@ -44,6 +44,7 @@
 #include "pvb/sim/simulator.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
+#include "sensor_options.hpp"
 #include "stop_signals.hpp"
 #include "trajectory_output.hpp"
 
@@ -64,6 +65,7 @@ struct CameraArgs {
   std::string timeout_ms = "10000";  ///< checked by parse_count
   run::MapOptions map;
   std::string map_mode;
+  std::string sensors;  ///< --sensors
 };
 
 /// Files written into --out (a recording must not land on one of them).
@@ -173,6 +175,8 @@ CameraSettings read_camera_settings(const CameraArgs& a, const std::optional<sce
   for (const std::string& w : s.slam.warnings)
     std::fprintf(stderr, "pvbench camera: warning: %s\n", w.c_str());
   if (a.no_pe_match) s.slam.pe_match.enabled = false;
+  if (const std::optional<slam::SensorSetup> setup = sensors_from_flag(a.sensors))
+    run::apply_sensor_setup(&s.slam, *setup);
   return s;
 }
 
@@ -395,6 +399,7 @@ void report_run(const CameraArgs& a, const slam::Settings& settings, openni::Ope
   std::ostringstream js;
   js << "{\n  \"source\": \"" << json_escape(source.describe())
      << "\",\n  \"pe_match\": " << (settings.pe_match.enabled ? "true" : "false")
+     << ",\n  \"sensors\": \"" << slam::to_string(settings.sensors) << "\""
      << ",\n  \"sync\": " << (a.sync ? "true" : "false") << ",\n  \"seed\": " << a.seed
      << ",\n  \"frames\": " << c.frames << ",\n  \"lost_frames\": " << c.lost
      << ",\n  \"not_initialized_frames\": " << c.not_initialized
@@ -509,6 +514,7 @@ Command add_camera_command(CLI::App& app) {
       "is never replaced)");
   sub->add_option("--frames", args->frames, "stop after N frames (0: until the stream ends)")
       ->capture_default_str();
+  add_sensors_option(sub, &args->sensors);
   sub->add_flag("--sync", args->sync, "synchronous mode: no worker threads, bit-identical runs");
   sub->add_option("--seed", args->seed, "PE-match seed")
       ->capture_default_str()

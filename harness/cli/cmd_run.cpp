@@ -13,6 +13,7 @@
 #include "pvb/common/error.hpp"
 #include "pvb/common/progress.hpp"
 #include "pvb/run/run.hpp"
+#include "sensor_options.hpp"
 #include "stop_signals.hpp"
 
 namespace pvb::cli {
@@ -29,12 +30,20 @@ struct RunArgs {
   bool check = false;
   bool no_pace = false;
   std::string map_mode;
+  std::string sensors;          ///< --sensors
+  std::string compare_sensors;  ///< --compare-sensors A,B
 };
 
 int run_run(RunArgs& a) {
   if (a.baseline && a.compare)
     throw ConfigError("pvbench run", "--baseline/--compare", "at most one of them");
   run::RunOptions& o = a.options;
+  o.sensors = sensors_from_flag(a.sensors);
+  if (!a.compare_sensors.empty()) {
+    if (a.compare || o.sensors)
+      throw ConfigError("pvbench run", "--compare-sensors", "without --compare and --sensors");
+    o.compare_sensors = run::parse_sensor_pair_option(a.compare_sensors, "--compare-sensors");
+  }
   if (!a.frames.empty())
     o.max_frames = static_cast<int>(parse_count("run", "--frames", a.frames, 1, 10'000'000));
   o.seed = a.seed;
@@ -93,6 +102,10 @@ Command add_run_command(CLI::App& app) {
   sub->add_flag("--baseline", args->baseline,
                 "run the baseline (PE-match off: ORB-SLAM2's motion model) instead of PE-SLAM");
   sub->add_flag("--compare", args->compare, "run PE-SLAM and the baseline on the same rendered frames");
+  add_sensors_option(sub, &args->sensors);
+  sub->add_option("--compare-sensors", args->compare_sensors,
+                  "A,B: two sensor setups on the same rendered frames; B is the primary run, A the reference "
+                  "(in baseline/)");
   sub->add_flag("--closed-loop", args->options.closed_loop,
                 "the route follower steers from the SLAM pose instead of ground truth");
   sub->add_option("--gl", args->options.gl, "rendering backend")

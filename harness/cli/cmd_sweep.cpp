@@ -3,7 +3,8 @@
 // DIR/seed_S` (`pvbench campaign ...` with --campaign)
 // (this same binary, through /proc/self/exe), at most --jobs at once, then
 // aggregates DIR/seed_*/metrics.json into DIR/aggregate.{md,csv,json,svg,png}
-// and, with --compare, prints the paired PE-SLAM − baseline ATE line last.
+// and, with --compare, prints the paired PE-SLAM − baseline ATE line last
+// (with --compare-sensors A,B the paired B − A line).
 //
 // Every seed's command is self-contained (--print-commands prints them), so
 // a cluster scheduler can run them anywhere and `--aggregate-only` collects
@@ -41,6 +42,7 @@
 #include "pvb/suite/check.hpp"
 #include "pvb/suite/metrics_file.hpp"
 #include "pvb/suite/seeds.hpp"
+#include "sensor_options.hpp"
 
 namespace pvb::cli {
 namespace {
@@ -63,6 +65,8 @@ struct SweepArgs {
   std::string frames_text;  ///< --frames, checked by parse_count
   int frames = 0;
   bool compare = false;
+  std::string compare_sensors;  ///< --compare-sensors A,B, passed on to every run
+  std::string sensors;          ///< --sensors, passed on to every run
   bool baseline = false;
   bool sync = false;
   bool no_map_eval = false;
@@ -94,6 +98,8 @@ std::vector<std::string> run_args(const SweepArgs& a, std::uint64_t seed) {
     v.push_back(std::to_string(a.frames));
   }
   if (a.compare) v.push_back("--compare");
+  if (!a.compare_sensors.empty()) v.insert(v.end(), {"--compare-sensors", a.compare_sensors});
+  if (!a.sensors.empty()) v.insert(v.end(), {"--sensors", a.sensors});
   if (a.baseline) v.push_back("--baseline");
   if (a.sync) v.push_back("--sync");
   if (a.no_map_eval) v.push_back("--no-map-eval");
@@ -342,7 +348,7 @@ suite::SweepAggregate write_aggregate(const SweepArgs& a, const std::string& sce
   plot::write_png(fig, (out / "aggregate.png").string());
   std::printf("\n%s\nwrote %s/aggregate.{md,csv,json,svg,png}\n", suite::format_markdown(agg).c_str(),
               a.out.c_str());
-  // With --compare, the paired PE-SLAM − baseline figure is the sweep's answer: last.
+  // With --compare (--compare-sensors), the paired figure is the sweep's answer: last.
   if (agg.has_baseline) std::printf("%s\n", suite::format_paired_line(agg.paired).c_str());
   std::fflush(stdout);
   return agg;
@@ -407,10 +413,22 @@ void check_sweep_paths(const SweepArgs& a, IoPlan* plan, const std::vector<std::
   plan->check();
 }
 
+/// --sensors and --compare-sensors, checked before any seed runs (each run
+/// checks them again).
+void check_sensor_flags(const SweepArgs& a) {
+  if (!a.sensors.empty()) run::parse_sensors_option(a.sensors, "--sensors");
+  if (a.compare_sensors.empty()) return;
+  if (a.compare || !a.sensors.empty())
+    throw ConfigError("command line", "--compare-sensors", "without --compare and --sensors");
+  run::parse_sensor_pair_option(a.compare_sensors, "--compare-sensors");
+}
+
 /// A sweep of a campaign: each seed a `pvbench campaign` child process.
 int run_campaign_sweep(const SweepArgs& a) {
-  if (!a.scenario.empty() || a.compare || a.baseline || a.check)
-    throw ConfigError("command line", "--campaign", "no --scenario, --compare, --baseline or --check with it");
+  if (!a.scenario.empty() || a.compare || a.baseline || a.check || !a.sensors.empty() ||
+      !a.compare_sensors.empty())
+    throw ConfigError("command line", "--campaign",
+                      "no --scenario, --compare, --compare-sensors, --sensors, --baseline or --check with it");
   // Validates the file early: every session's scenario, before any seed runs.
   const run::Campaign campaign = run::load_campaign(a.campaign);
   const suite::ExpectedCampaign expected = expected_campaign(campaign);
@@ -446,6 +464,7 @@ int run_sweep(SweepArgs a) {
     a.frames = static_cast<int>(parse_count("sweep", "--frames", a.frames_text, 1, 10'000'000));
   if (a.compare && a.baseline)
     throw ConfigError("command line", "--baseline", "either --compare or --baseline, not both");
+  check_sensor_flags(a);
   if (!a.campaign.empty()) return run_campaign_sweep(a);
   std::string scenario_name;
   IoPlan plan;
@@ -513,6 +532,9 @@ Command add_sweep_command(CLI::App& app) {
   sub->add_option("--frames", args->frames_text, "passed to pvbench run: at most N frames");
   sub->add_flag("--compare", args->compare, "passed to pvbench run: PE-SLAM and the baseline (PE-match off)");
   sub->add_flag("--baseline", args->baseline, "passed to pvbench run: the baseline alone (PE-match off)");
+  sub->add_option("--compare-sensors", args->compare_sensors,
+                  "passed to pvbench run: A,B, two sensor setups on the same frames; paired B − A per seed");
+  add_sensors_option(sub, &args->sensors);
   sub->add_flag("--sync", args->sync, "passed to pvbench run: synchronous, bit-reproducible SLAM");
   sub->add_flag("--no-map-eval", args->no_map_eval, "passed to pvbench run: dense maps written, not scored");
   sub->add_option("--gl", args->gl, "passed to pvbench run: rendering backend")

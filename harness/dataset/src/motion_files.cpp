@@ -11,6 +11,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/dataset/tum_imu.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/time.hpp"
 
@@ -133,16 +134,8 @@ void for_each_csv_line(const std::string& file, std::size_t count, const char* e
 
 MotionReadings read_motion_readings(const std::string& dir) {
   MotionReadings m;
-  const std::string imu_file = dir + "/imu0/data.csv", wheels_file = dir + "/wheels.csv";
-  if (::access(imu_file.c_str(), R_OK) == 0)
-    for_each_csv_line(imu_file, 7, "t_ns,wx,wy,wz,ax,ay,az (7 numbers)", [&](const std::vector<double>& v, int n) {
-      sensor::ImuSample s;
-      s.t_ns = static_cast<std::int64_t>(v[0]);
-      if (!m.imu.empty() && s.t_ns <= m.imu.back().t_ns) throw IoError(imu_file, "expected a time after the line before", n);
-      s.gyro_radps = Eigen::Vector3d(v[1], v[2], v[3]);
-      s.accel_mps2 = Eigen::Vector3d(v[4], v[5], v[6]);
-      m.imu.push_back(s);
-    });
+  const std::string wheels_file = dir + "/wheels.csv";
+  m.imu = read_tum_imu(dir);
   if (::access(wheels_file.c_str(), R_OK) == 0)
     for_each_csv_line(wheels_file, 3, "t_ns,left,right (3 integers)", [&](const std::vector<double>& v, int n) {
       sensor::WheelTicks t;

@@ -207,8 +207,8 @@ std::vector<std::pair<int, std::vector<std::string>>> list_lines(const std::stri
 std::vector<std::string> sequence_files(const std::string& dir) {
   std::vector<std::string> out;
   for (const char* name :
-       {"associations.txt", "rgb.txt", "depth.txt", "groundtruth.txt", "meta.json", "camera.yaml", "imu0/data.csv",
-        "wheels.csv"})
+       {"associations.txt", "rgb.txt", "depth.txt", "groundtruth.txt", "meta.json", "camera.yaml",
+        "accelerometer.txt", "imu0/data.csv", "wheels.csv"})
     out.push_back(dir + "/" + name);
   for (const char* images : {"rgb", "depth"}) {
     std::error_code ec;

@@ -25,15 +25,14 @@ std::vector<double> tracking_times(const SlamRun& run) {
   return v;
 }
 
-double mean_of(const std::vector<double>& v) {
-  return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-}
+using eval::mean_of;
 
 /// The keys one SLAM system contributes (shared by the top level and "baseline").
 std::string slam_fields(const SlamRun& run, const std::string& in) {
   const std::vector<double> ms = tracking_times(run);
   std::string out;
   out += in + "\"mode\": " + json_string(run.mode) + ",\n";
+  out += in + "\"sensors\": " + json_string(run.sensors) + ",\n";
   out += in + "\"frames\": " + std::to_string(run.frames) + ",\n";
   out += in + "\"lost_frames\": " + std::to_string(run.lost_frames) + ",\n";
   out += in + "\"not_initialized_frames\": " + std::to_string(run.not_initialized_frames) + ",\n";
@@ -192,15 +191,6 @@ double distance_to_polyline(const Eigen::Vector2d& p, const std::vector<Eigen::V
     best = std::min(best, (p - (a + s * ab)).norm());
   }
   return best;
-}
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const double pos = std::clamp(p, 0.0, 1.0) * static_cast<double>(v.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(pos);
-  const std::size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
 double realtime_factor(double sim_s, double wall_s) { return wall_s > 0 ? sim_s / wall_s : 0.0; }

@@ -24,6 +24,7 @@
 #include "pvb/slam/core/settings.hpp"
 #include "run_log.hpp"
 #include "system_sink.hpp"
+#include "pvb/run/sensor_setup.hpp"
 
 namespace pvb::run {
 namespace {
@@ -83,6 +84,14 @@ RunReport new_report(const scenes::Scenario& scenario, const RunOptions& opt) {
   return report;
 }
 
+/// ", sensors S" (--sensors) or ", sensors B against A" (--compare-sensors); "" otherwise.
+std::string sensors_part(const RunOptions& opt) {
+  if (opt.compare_sensors)
+    return std::string(", sensors ") + slam::to_string(opt.compare_sensors->second) + " against " +
+           slam::to_string(opt.compare_sensors->first);
+  return opt.sensors ? std::string(", sensors ") + slam::to_string(*opt.sensors) : std::string();
+}
+
 std::string start_line(const RunOptions& opt, const scenes::Scenario& scenario, int frames,
                        const std::string& mode) {
   const bool compare = opt.mode == SlamMode::kCompare;
@@ -94,7 +103,7 @@ std::string start_line(const RunOptions& opt, const scenes::Scenario& scenario, 
               ? ", closed loop (on loss: " +
                     std::string(scenario.route.on_loss == scenes::OnLoss::kAbort ? "abort" : "wait") + ")"
               : ", open loop") +
-         (opt.sync ? ", synchronous" : ", pipelined");
+         (opt.sync ? ", synchronous" : ", pipelined") + sensors_part(opt);
 }
 
 // --- The consumer side of each frame ---
@@ -438,7 +447,10 @@ RunReport run_scenario(const RunOptions& opt) {
   const int n = scenes::frame_count(scenario, opt.max_frames);
   opt.map.check();
   check_run_paths(opt, scenario);
-  const RunSettings settings = slam_settings(scenario, opt.out_dir);
+  RunSettings settings = slam_settings(scenario, opt.out_dir);
+  if (opt.compare_sensors && opt.mode == SlamMode::kCompare)
+    throw ConfigError("pvbench run", "--compare/--compare-sensors", "at most one of them");
+  if (opt.sensors) apply_sensor_setup(&settings.slam, *opt.sensors);
   MapOptions map = opt.map;
   map.station = station_of(scenario);
   SystemSinks sinks = make_systems(settings.slam, opt, static_cast<std::uint32_t>(scenario.seed), map);

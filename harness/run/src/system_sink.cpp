@@ -1,5 +1,7 @@
 #include "system_sink.hpp"
 
+#include "pvb/run/sensor_setup.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -55,6 +57,7 @@ SystemSink::SystemSink(const std::string& mode, const slam::Settings& settings, 
                        const std::string& out_dir, const MapOptions& map)
     : map_options(map), dir(out_dir) {
   run.mode = mode;
+  run.sensors = slam::to_string(settings.sensors);
   slam::SystemOptions options;
   options.synchronous = sync;
   options.seed = seed;
@@ -217,6 +220,7 @@ SystemSinks make_systems(const slam::Settings& settings, const RunOptions& opt, 
   slam::Settings s = settings;
   s.loop.enabled = s.loop.enabled && opt.loop_closing;
   s.pe_match.enabled = opt.mode != SlamMode::kBaseline;
+  if (opt.compare_sensors) apply_sensor_setup(&s, opt.compare_sensors->second);
   sinks.push_back(std::make_unique<SystemSink>(s.pe_match.enabled ? eval::kPeSlamMode : eval::kBaselineMode,
                                                s, opt.sync, seed, opt.out_dir, map));
   if (opt.mode == SlamMode::kCompare) {
@@ -225,6 +229,12 @@ SystemSinks make_systems(const slam::Settings& settings, const RunOptions& opt, 
     baseline_map.save_path.clear();
     sinks.push_back(std::make_unique<SystemSink>(eval::kBaselineMode, s, opt.sync, seed,
                                                  opt.out_dir + "/baseline", baseline_map));
+  } else if (opt.compare_sensors) {
+    apply_sensor_setup(&s, opt.compare_sensors->first);  // the reference setup, same PE-match
+    MapOptions reference_map = map;
+    reference_map.save_path.clear();
+    sinks.push_back(std::make_unique<SystemSink>(sinks.front()->run.mode, s, opt.sync, seed,
+                                                 opt.out_dir + "/baseline", reference_map));
   }
   return sinks;
 }

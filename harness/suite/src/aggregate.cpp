@@ -102,7 +102,8 @@ std::string paired_json(const PairedComparison& p) {
          ", \"sign_test_p\": " + json_num(p.sign_test_p) +
          ", \"baseline_mean_m\": " + json_num(p.baseline_mean_m) + ", \"margin_m\": " + json_num(p.margin_m) +
          ", \"not_significantly_worse\": " + (p.has_ci ? (p.not_worse ? "true" : "false") : "null") +
-         ", \"verdict\": \"" + json_escape(verdict_text(p.verdict)) + "\"}";
+         ", \"verdict\": \"" + json_escape(verdict_text(p)) + "\", \"primary\": " + json_string(p.primary_label) +
+         ", \"reference\": " + json_string(p.reference_label) + "}";
 }
 
 std::string csv_field(const std::string& s) {
@@ -180,6 +181,12 @@ const char* verdict_text(PairedVerdict v) {
   return "too few seeds";
 }
 
+std::string verdict_text(const PairedComparison& p) {
+  if (p.verdict == PairedVerdict::kPeBetter) return p.primary_label + " better";
+  if (p.verdict == PairedVerdict::kBaselineBetter) return p.reference_label + " better";
+  return verdict_text(p.verdict);
+}
+
 std::optional<double> paired_ate_difference_m(const SeedRun& r) {
   if (!r.metrics || !r.metrics->baseline || !r.metrics->primary.ate_rmse_m ||
       !r.metrics->baseline->ate_rmse_m)
@@ -216,6 +223,10 @@ PairedComparison compare_paired(const std::vector<SeedRun>& runs) {
     if (*diff <= 0.0) ++p.pe_not_worse;
     if (*diff < 0.0) ++p.pe_better;
     if (*diff > 0.0) ++p.pe_worse;
+    if (r.metrics->primary.sensors != r.metrics->baseline->sensors) {  // --compare-sensors
+      p.primary_label = r.metrics->primary.sensors;
+      p.reference_label = r.metrics->baseline->sensors;
+    }
   }
   const Summary s = summarize(d);
   p.count = s.count;
@@ -239,16 +250,19 @@ PairedComparison compare_paired(const std::vector<SeedRun>& runs) {
 }
 
 std::string format_paired_line(const PairedComparison& p) {
-  std::string out = "PE-SLAM − baseline ATE: ";
-  if (p.count == 0) return out + "no seed with both ATEs; " + verdict_text(p.verdict);
+  // "PE ≤ baseline" in a --compare sweep; the setups' names in a --compare-sensors one.
+  const bool pe = p.primary_label == "PE-SLAM";
+  const std::string le = (pe ? std::string("PE") : p.primary_label) + " ≤ " + p.reference_label;
+  std::string out = p.primary_label + " − " + p.reference_label + " ATE: ";
+  if (p.count == 0) return out + "no seed with both ATEs; " + verdict_text(p);
   out += "mean " + mm2(p.mean_m) + " mm";
   if (p.has_ci) out += ", 95 % CI [" + mm2(p.ci_low_m) + ", " + mm2(p.ci_high_m) + "] mm";
   out += " over " + std::to_string(p.count) + (p.count == 1 ? " seed" : " seeds");
   if (!p.has_ci)
-    return out + " (PE ≤ baseline on " + std::to_string(p.pe_not_worse) + "); " + verdict_text(p.verdict);
-  out += " (effect size d_z " + format_number("%.2f", p.effect_size_dz) + "; PE ≤ baseline on " +
+    return out + " (" + le + " on " + std::to_string(p.pe_not_worse) + "); " + verdict_text(p);
+  out += " (effect size d_z " + format_number("%.2f", p.effect_size_dz) + "; " + le + " on " +
          std::to_string(p.pe_not_worse) + ", sign test p = " + format_number("%.2f", p.sign_test_p) + "); " +
-         verdict_text(p.verdict);
+         verdict_text(p);
   return out + "; not significantly worse: " + (p.not_worse ? "yes (upper end " : "no (upper end ") +
          mm2(p.ci_high_m) + (p.not_worse ? " mm ≤ margin " : " mm > margin ") + mm2(p.margin_m) + " mm)";
 }
@@ -339,10 +353,14 @@ std::string format_markdown(const SweepAggregate& a) {
       if (r.metrics->primary.mode == eval::kBaselineMode) primary_name = eval::kBaselineLabel;
       break;
     }
+  // --compare-sensors: the rows are named by the setups.
+  const bool by_sensors = a.has_baseline && a.paired.primary_label != "PE-SLAM";
+  if (by_sensors) primary_name = a.paired.primary_label;
+  const std::string reference_name = by_sensors ? a.paired.reference_label : std::string(eval::kBaselineLabel);
   // The table's rows first, together, then the lines about them: a line
   // between two rows would end the table in a Markdown viewer.
   row(primary_name.c_str(), a.primary);
-  if (a.has_baseline) row(eval::kBaselineLabel, a.baseline);
+  if (a.has_baseline) row(reference_name.c_str(), a.baseline);
   if (a.primary.refined_ate_rmse_m.count > 0)
     out += "\nRefined trajectory (frames re-anchored on the final keyframe poses, after loop closing): ATE RMSE " +
            pm(a.primary.refined_ate_rmse_m, "%.2f", 1000.0) + " mm, max " +
@@ -350,11 +368,12 @@ std::string format_markdown(const SweepAggregate& a) {
   if (a.primary_place.seeds > 0) out += "\n" + place_totals_line(a.primary_place);
   out += map_line(primary_name, a.primary);
   if (a.has_baseline) {
-    out += map_line(eval::kBaselineLabel, a.baseline);
+    out += map_line(reference_name, a.baseline);
     // The paired figure (docs/sweeps.md): per seed d = PE − baseline on the same frames.
     out += "\n" + format_paired_line(a.paired) + "\n";
     if (a.paired.count > 0)
-      out += "\nPaired per seed (both runs track the same frames): d = PE-SLAM − baseline ATE RMSE, SD " +
+      out += "\nPaired per seed (both runs track the same frames): d = " + a.paired.primary_label + " − " +
+             a.paired.reference_label + " ATE RMSE, SD " +
              mm2(a.paired.sd_m) + " mm, standard error " + mm2(a.paired.se_m) +
              " mm; the interval is mean ± t(0.975, n − 1) · SE. Not significantly worse: the upper end is at "
              "most max(0.5 mm, 10 % of the baseline's mean " +

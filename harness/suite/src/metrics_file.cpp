@@ -72,6 +72,7 @@ class Reader : public detail::JsonFields {
     if (!obj.IsMap()) fail(obj, "(top level)", "a JSON object");
     RunMetrics r;
     if (obj["mode"].IsDefined()) r.mode = eval::normalized_mode(text(obj, "mode"));
+    if (obj["sensors"].IsDefined()) r.sensors = text(obj, "sensors");
     r.status = text(obj, "status");
     if (r.status != "completed" && r.status != "interrupted" && r.status != "aborted" && r.status != "failed")
       fail(obj["status"], "status", "completed, interrupted, aborted or failed", r.status);

@@ -358,3 +358,25 @@ TEST(SweepAggregate, FigureShowsEverySeedAndBothModes) {
   ASSERT_EQ(dot_y.size(), 2u);
   EXPECT_GT(dot_y[0], dot_y[1]);
 }
+
+TEST(PairedComparison, TwoSensorSetupsAreNamedByTheSetups) {
+  // --compare-sensors camera,camera+imu+wheels: the same figures as ClearLoss,
+  // with B = camera+imu+wheels the primary run and A = camera the reference.
+  std::vector<suite::SeedRun> runs = {compare_run(1, 9, 6), compare_run(2, 10, 5), compare_run(3, 12, 8)};
+  for (suite::SeedRun& r : runs) {
+    r.metrics->primary.sensors = "camera+imu+wheels";
+    r.metrics->baseline->mode = "pe-slam";
+    r.metrics->baseline->sensors = "camera";
+  }
+  const suite::PairedComparison p = suite::compare_paired(runs);
+  EXPECT_EQ(p.verdict, suite::PairedVerdict::kBaselineBetter);
+  EXPECT_EQ(suite::verdict_text(p), "camera better");
+  EXPECT_EQ(suite::format_paired_line(p),
+            "camera+imu+wheels − camera ATE: mean 4.00 mm, 95 % CI [1.52, 6.48] mm over 3 seeds "
+            "(effect size d_z 4.00; camera+imu+wheels ≤ camera on 0, sign test p = 0.25); camera better; "
+            "not significantly worse: no (upper end 6.48 mm > margin 0.63 mm)");
+  const suite::SweepAggregate a = suite::aggregate("s", runs);
+  EXPECT_NE(suite::format_markdown(a).find("| camera | 3 |"), std::string::npos) << suite::format_markdown(a);
+  EXPECT_NE(suite::format_json(a).find("\"primary\": \"camera+imu+wheels\", \"reference\": \"camera\""),
+            std::string::npos);
+}

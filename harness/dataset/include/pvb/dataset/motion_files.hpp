@@ -50,8 +50,9 @@ class MotionFilesWriter {
   sensor::WheelOdometry odometry_;
 };
 
-/// A recording's motion readings, read back: imu0/data.csv (EuRoC layout)
-/// and wheels.csv, each sorted by time (empty when the file is absent).
+/// A folder's motion readings, read back: the IMU's (read_tum_imu:
+/// imu0/data.csv, else a Kinect's accelerometer.txt) and the encoders'
+/// (wheels.csv), each sorted by time (empty when the files are absent).
 struct MotionReadings {
   std::vector<sensor::ImuSample> imu;
   std::vector<sensor::WheelTicks> ticks;

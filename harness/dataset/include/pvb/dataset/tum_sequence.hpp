@@ -11,6 +11,7 @@
 
 #include "pvb/common/output_file.hpp"
 #include "pvb/dataset/motion_files.hpp"
+#include "pvb/dataset/tum_imu.hpp"
 #include "pvb/geometry/pinhole.hpp"
 #include "pvb/geometry/se3.hpp"
 #include "pvb/sensor/depth_encoding.hpp"
@@ -77,6 +78,11 @@ void make_dirs(const std::string& dir);
 /// +-geom::kMaxAbsTimeS.  associations.txt is tracked in its own order, so
 /// its colour time stamps must increase (IoError naming the line otherwise);
 /// rgb.txt and depth.txt are sorted by time (a repeated stamp is an error).
+/// The motion readings (imu0/data.csv, else a Kinect's accelerometer.txt:
+/// tum_imu.hpp; and wheels.csv) are read by the constructor; next() attaches to each frame
+/// those since the frame it returned before (up to and with its t_ns; the
+/// first frame gets every reading up to its time, a skipped frame's go to
+/// the next one).
 class TumSequenceReader : public sensor::FrameSource {
  public:
   struct Entry {
@@ -105,12 +111,14 @@ class TumSequenceReader : public sensor::FrameSource {
   sensor::RgbdFrame load(std::size_t i) const;
   /// Number of frames skipped because an image was missing or corrupt.
   std::size_t skipped() const { return skipped_; }
+  /// Every motion reading of the folder, by time (empty without any).
+  const MotionReadings& motion() const { return motion_; }
 
  private:
   std::string dir_;
   double depth_factor_;
   std::vector<Entry> entries_;
-  MotionReadings motion_;             ///< imu0/data.csv and wheels.csv, when the folder has them
+  MotionReadings motion_;             ///< the IMU's (tum_imu.hpp) and the encoders' readings, when there
   std::int64_t last_delivered_t_ns_;  ///< the last frame next() returned (readings up to it went with it)
   std::size_t pos_ = 0;
   std::size_t skipped_ = 0;
@@ -119,8 +127,8 @@ class TumSequenceReader : public sensor::FrameSource {
 
 /// The files of a TUM RGB-D folder that a reader of it may read: its lists
 /// (associations.txt, rgb.txt, depth.txt, groundtruth.txt), meta.json,
-/// camera.yaml, the motion readings (imu0/data.csv, wheels.csv) and the
-/// images in rgb/ and depth/.  Other files in the
+/// camera.yaml, the motion readings (imu0/data.csv, else accelerometer.txt;
+/// wheels.csv) and the images in rgb/ and depth/.  Other files in the
 /// folder (a map saved beside the sequence) are not among them.
 std::vector<std::string> sequence_files(const std::string& dir);
 

@@ -27,6 +27,14 @@ struct Stats {
 /// Computes Stats over `values` (not modified).
 Stats compute_stats(const std::vector<double>& values);
 
+/// p-quantile (p in 0..1, clamped) with linear interpolation between the
+/// sorted values (numpy.percentile's default); 0 for no values.  The one
+/// quantile of the harness's timing, gravity and map summaries.
+double percentile(std::vector<double> values, double p);
+
+/// Arithmetic mean; 0 for no values.
+double mean_of(const std::vector<double>& values);
+
 /// ATE per pose: |t(gt_i) - t(est_i)| in metres, for already aligned,
 /// associated pose lists of equal length (EvalError otherwise).
 std::vector<double> ate_errors_m(const std::vector<geom::SE3d>& est, const std::vector<geom::SE3d>& gt);

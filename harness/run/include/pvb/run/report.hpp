@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "pvb/eval/evaluate.hpp"
+#include "pvb/eval/metrics.hpp"
 #include "pvb/eval/place_labels.hpp"
 #include "pvb/plot/contact_sheet.hpp"
 #include "pvb/run/map_session.hpp"
@@ -91,6 +92,7 @@ std::string dense_map_json(const DenseMapReport& d, const std::string& in);
 /// One SLAM system's run (PE-SLAM, or the baseline: PE-match off, ORB-SLAM2's motion model).
 struct SlamRun {
   std::string mode;  ///< eval::kPeSlamMode or eval::kBaselineMode ("pe-slam", "baseline")
+  std::string sensors = "camera";  ///< slam::to_string(SensorSetup): the sensors the system fused
   std::size_t frames = 0;
   std::size_t lost_frames = 0;  ///< frames in state Lost
   std::size_t not_initialized_frames = 0;
@@ -171,8 +173,8 @@ struct RunReport {
 /// distance to the single point for a one-point line; +inf for an empty one.
 double distance_to_polyline(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& polyline);
 
-/// p-quantile (0..1) with linear interpolation; 0 for no values.
-double percentile(std::vector<double> values, double p);
+/// p-quantile (0..1) with linear interpolation; 0 for no values (eval/metrics.hpp).
+using eval::percentile;
 
 /// The realtime factor: simulated seconds per wall second (0 when wall_s is 0).
 double realtime_factor(double sim_s, double wall_s);

@@ -15,12 +15,14 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/se3.hpp"
 #include "pvb/run/map_session.hpp"
 #include "pvb/run/report.hpp"
 #include "pvb/scenes/scenario.hpp"
+#include "pvb/slam/core/settings.hpp"
 #include "pvb/sim/robot.hpp"
 
 namespace pvb::run {
@@ -45,6 +47,14 @@ struct RunOptions {
   std::optional<double> start_m;
   bool sync = false;                  ///< no threads: bit-identical runs
   SlamMode mode = SlamMode::kPeSlam;
+  /// Overrides the settings' sensor setup (camera.yaml's System.Sensors,
+  /// absent: camera) for every system (--sensors).
+  std::optional<slam::SensorSetup> sensors;
+  /// Two setups on the same rendered frames (--compare-sensors A,B): the
+  /// primary run fuses B, the reference run (report.baseline, folder
+  /// baseline/) fuses A; both with PE-match unless mode is kBaseline.
+  /// Not with kCompare.
+  std::optional<std::pair<slam::SensorSetup, slam::SensorSetup>> compare_sensors;
   bool closed_loop = false;        ///< steer from the SLAM pose instead of ground truth
   bool loop_closing = true;        ///< false: LoopClosing.enabled = 0 for every system (--no-loop-closing)
   /// Score the dense maps against the scenario's true surface

@@ -85,7 +85,15 @@ struct PairedComparison {
   double margin_m = 0.0;         ///< not_worse_margin_m(baseline_mean_m)
   bool not_worse = false;        ///< has_ci and ci_high_m <= margin_m
   PairedVerdict verdict = PairedVerdict::kTooFewSeeds;
+  /// Who is compared: "PE-SLAM" against "baseline" (--compare), or with
+  /// --compare-sensors the primary run's sensor setup against the
+  /// reference's (e.g. "camera+imu+wheels" against "camera").
+  std::string primary_label = "PE-SLAM";
+  std::string reference_label = "baseline";
 };
+
+/// The verdict in the comparison's own names, e.g. "camera better".
+std::string verdict_text(const PairedComparison& p);
 
 /// PE-SLAM − baseline ATE of one seed, when both are present.
 std::optional<double> paired_ate_difference_m(const SeedRun& r);

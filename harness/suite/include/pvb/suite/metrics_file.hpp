@@ -37,6 +37,7 @@ struct MapMetrics {
 /// One SLAM run's figures (the top level, or the "baseline" object).
 struct RunMetrics {
   std::string mode;    ///< "pe-slam" or "baseline" ("orb-slam2" in version 1 files is read as "baseline")
+  std::string sensors = "camera";  ///< the sensor setup the run fused (absent in older files: camera)
   std::string status;  ///< "completed", "interrupted" or "aborted"
   int frames = 0;
   int lost_frames = 0;

@@ -1,0 +1,26 @@
+#pragma once
+// --sensors SETUP, shared by slam, run, camera and sweep: overrides the
+// settings' System.Sensors (docs/slam.md, "Sensor setups").  The text is
+// checked when the command runs (run::parse_sensors_option: one error line
+// naming the flag and the accepted values).
+#include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+
+#include "pvb/run/sensor_setup.hpp"
+
+namespace pvb::cli {
+
+inline void add_sensors_option(CLI::App* sub, std::string* text) {
+  sub->add_option("--sensors", *text,
+                  std::string("sensors the SLAM system fuses: ") + run::kSensorSetupValues +
+                      " (default: the settings' System.Sensors, else camera)");
+}
+
+/// The setup --sensors names; nullopt when the flag was not given.
+inline std::optional<slam::SensorSetup> sensors_from_flag(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  return run::parse_sensors_option(text, "--sensors");
+}
+
+}  // namespace pvb::cli

@@ -1,0 +1,40 @@
+#pragma once
+// The sensor setup of a run (slam::SensorSetup) as the commands take it:
+// the --sensors and --compare-sensors flags, and the IMU description the
+// harness supplies when a TUM folder's accelerometer has none in the
+// settings (docs/sensors.md, "The Kinect v1's accelerometer").
+#include <string>
+#include <utility>
+
+#include "pvb/slam/core/settings.hpp"
+
+namespace pvb::run {
+
+/// The values --sensors accepts, for messages and help.
+inline constexpr const char* kSensorSetupValues = "camera, camera+imu, camera+imu+wheels or camera+accel";
+
+/// `text` as a sensor setup; ConfigError naming `option` and the accepted
+/// values otherwise.
+slam::SensorSetup parse_sensors_option(const std::string& text, const std::string& option);
+
+/// "A,B" of --compare-sensors: two different setups, the reference A first.
+std::pair<slam::SensorSetup, slam::SensorSetup> parse_sensor_pair_option(const std::string& text,
+                                                                          const std::string& option);
+
+/// Sets settings->sensors to `setup` and checks that the settings hold the
+/// sections it needs (slam::check_sensor_setup: ConfigError otherwise).
+void apply_sensor_setup(slam::Settings* settings, slam::SensorSetup setup);
+
+/// The gravity metric's label of the map frame: "first_camera" for camera
+/// alone, "gravity_aligned" for the setups with an accelerometer.
+const char* gravity_map_frame(slam::SensorSetup setup);
+
+/// The Kinect v1's accelerometer as an IMU.* section: readings already in
+/// the camera's optical frame (IMU.T_b_c1 the identity), noise from its
+/// resolution (dataset/kinect_accelerometer.hpp), 500 Hz.  Sets
+/// settings->imu when the settings have no IMU.* keys and `sequence` holds
+/// a Kinect accelerometer.txt; returns whether it did.  For camera+accel
+/// only (the setups with a gyroscope still need the settings' IMU.*).
+bool supply_kinect_accelerometer(slam::Settings* settings, const std::string& sequence);
+
+}  // namespace pvb::run
