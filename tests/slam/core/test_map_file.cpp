@@ -547,7 +547,8 @@ std::vector<ImpossibleMap> impossible_inertial_maps() {
       {"inertial_setup_camera", edit([](std::string& b) { put_u32(b, 0, 0); }),
        "sensor setup camera has no inertial state"},
       {"inertial_gravity_12", edit([](std::string& b) { put_f64(b, kInerGravity + 16, -12); }),
-       "gravity (0.1, -0.2, -12) m/s^2 of magnitude 12.0021, expected 9 to 10.6 m/s^2"},
+       "INER section at byte 40 (file byte 2976): gravity (0.1, -0.2, -12) m/s^2 of magnitude 12.0021, expected 9 "
+       "to 10.6 m/s^2"},  // as docs/map_file.md shows it
       {"inertial_t_b_c_not_a_rotation", edit([](std::string& b) { put_f64(b, kInerTbc, 2.0); }),
        "IMU.T_b_c1 is not a rigid transform within 10 m"},
       {"inertial_t_base_c_20m", edit([](std::string& b) { put_f64(b, kInerTbaseC + 72, 20.0); }),
@@ -564,7 +565,8 @@ std::vector<ImpossibleMap> impossible_inertial_maps() {
       {"inertial_predecessor_newer", edit([&](std::string& b) { put_u64(b, prev(1), 2); }),
        "keyframe 1: its predecessor in time 2 is not older (at 2000000000 ns, it at 1000000000 ns)"},
       {"inertial_predecessor_shared", edit([&](std::string& b) { put_u64(b, prev(2), 0); }),
-       "keyframe 2: its predecessor in time 0 is already keyframe 1's"},
+       "INER section at byte 579 (file byte 3515): keyframe 2: its predecessor in time 0 is already keyframe "
+       "1's"},  // as docs/map_file.md shows it
       {"inertial_has_state_2", edit([&](std::string& b) { b[state(1)] = 2; }),
        "keyframe 1: has_state 2, expected 0 or 1"},
       {"inertial_stateless_velocity", edit([&](std::string& b) { put_f64(b, velocity(0), 0.5); }),
