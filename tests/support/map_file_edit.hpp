@@ -5,6 +5,7 @@
 // reader's checks behind the checksums (the impossible maps).
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -39,11 +40,12 @@ inline std::uint64_t get_u64(const std::string& b, std::size_t at) {
 }
 
 /// The payloads of a well-formed map file's sections, in file order
-/// (HEAD, KEYF, POIN, GRAP, BOWV, META).
+/// (HEAD, KEYF, POIN, GRAP, BOWV, META; version 2 with INER before META).
 inline std::vector<std::string> map_sections(const std::string& file) {
   std::vector<std::string> out;
   std::size_t at = 16;  // magic, version, section count
-  for (int s = 0; s < 6; ++s) {
+  const std::uint64_t count = get_u64(file, 8) >> 32;  // the u32 after the version
+  for (std::uint64_t s = 0; s < count; ++s) {
     const std::uint64_t length = get_u64(file, at + 4);
     out.push_back(file.substr(at + 12, length));
     at += 12 + length + 8;
@@ -52,16 +54,19 @@ inline std::vector<std::string> map_sections(const std::string& file) {
 }
 
 /// The map file of `payloads` (as map_sections gives them), each section
-/// with its length and checksum.
+/// with its length and checksum: version 1 of 6 sections, version 2 of 7
+/// (INER before META).
 inline std::string map_file_of(const std::vector<std::string>& payloads) {
-  static const char* const kTags[] = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "META"};
+  static const char* const kTagsV1[] = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "META"};
+  static const char* const kTagsV2[] = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "INER", "META"};
+  const bool v2 = payloads.size() == 7;
   std::string out("PVBMAP\r\n", 8);
   out.append(8, '\0');
-  put_u32(out, 8, slam::kMapFileVersion);
-  put_u32(out, 12, 6);
+  put_u32(out, 8, v2 ? slam::kMapFileVersion : slam::kMapFileVersionVisual);
+  put_u32(out, 12, static_cast<std::uint32_t>(payloads.size()));
   for (std::size_t s = 0; s < payloads.size(); ++s) {
     std::string head(12, '\0');
-    std::memcpy(head.data(), kTags[s], 4);
+    std::memcpy(head.data(), (v2 ? kTagsV2 : kTagsV1)[s], 4);
     put_u64(head, 4, payloads[s].size());
     std::string sum(8, '\0');
     put_u64(sum, 0, fnv1a64(payloads[s].data(), payloads[s].size()));
@@ -101,9 +106,11 @@ inline std::size_t keyf_translation(int k) { return keyf_keyframe(k) + 28 + 72; 
 inline std::size_t keyf_keypoint(int k, int i) { return keyf_keyframe(k) + 128 + i * 73; }
 inline std::size_t poin_point(int p) { return 8 + p * 56; }  // id, x y z, ref, first, visible, found
 
-/// The tiny map, through the writer, with `app_json` as its META.
+/// The tiny map, through the writer, with `app_json` as its META; `edit`
+/// changes the map (under its mutex) before it is written.
 inline std::string tiny_map(const slam::MapSettings& settings = tiny_settings(),
-                            const std::string& app_json = "{}") {
+                            const std::string& app_json = "{}",
+                            const std::function<void(slam::Map&)>& edit = nullptr) {
   const auto cam = slam::camera_for(settings);
   slam::Map map;
   std::lock_guard<std::mutex> lock(map.mutex());
@@ -135,8 +142,59 @@ inline std::string tiny_map(const slam::MapSettings& settings = tiny_settings(),
     }
   }
   for (const auto& kf : kfs) kf->update_connections();
+  if (edit) edit(map);
   return slam::encode_map(map, settings, 1, app_json);
 }
+
+/// The tiny map's settings with an IMU and wheels: the camera 5 cm ahead
+/// of the IMU, turned 90 degrees about z, and 0.4 m above the base.
+inline slam::MapSettings tiny_inertial_settings() {
+  slam::MapSettings s = tiny_settings();
+  s.sensors = slam::SensorSetup::kCameraImuWheels;
+  s.T_b_c = geom::make_se3(Eigen::Matrix3d(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())),
+                           Eigen::Vector3d(0.05, 0, 0.01));
+  s.T_base_c = geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.1, 0, 0.4));
+  return s;
+}
+
+/// Makes the tiny map's inertial state: gravity trusted at keyframe 1,
+/// keyframes chained 0 -> 1 -> 2 in time, 1 and 2 with a velocity and bias.
+inline void give_tiny_inertial_state(slam::Map& map) {
+  slam::MapGravity& g = map.gravity();
+  g.ready = true;
+  g.g_w = Eigen::Vector3d(0.1, -0.2, -9.8);
+  g.bias.gyro_radps = Eigen::Vector3d(0.001, -0.002, 0.003);
+  g.bias.accel_mps2 = Eigen::Vector3d(0.02, 0.01, -0.03);
+  g.ready_keyframe_id = 1;
+  g.ready_t_ns = 1000000000;
+  g.init_rms = 0.75;
+  std::shared_ptr<slam::KeyFrame> prev;
+  for (const auto& [id, kf] : map.keyframes()) {
+    if (prev) {
+      kf->motion().prev = prev;
+      prev->motion().next = kf;
+    }
+    if (id > 0) {
+      kf->motion().has_state = true;
+      kf->motion().v_w_mps = Eigen::Vector3d(0.1 * static_cast<double>(id), 0.05, -0.01);
+      kf->motion().bias = g.bias;
+    }
+    prev = kf;
+  }
+}
+
+/// The tiny map with its inertial state (a version-2 file).
+inline std::string tiny_inertial_map() {
+  return tiny_map(tiny_inertial_settings(), "{}", give_tiny_inertial_state);
+}
+
+/// Byte offsets in the tiny inertial map's INER payload: setup, gravity,
+/// T_b_c (rotation, translation), T_base_c, the map's bias, the keyframe
+/// and time gravity was trusted at, the RMS, the count; then per keyframe
+/// 89 bytes: id, predecessor, has_state, velocity, bias.
+constexpr std::size_t kInerGravity = 4, kInerTbc = 28, kInerTbaseC = 124, kInerBias = 220, kInerReadyId = 268,
+                      kInerRms = 284, kInerCount = 292;
+inline std::size_t iner_keyframe(int k) { return 300 + static_cast<std::size_t>(k) * 89; }
 
 /// A GRAP payload: per keyframe (ids 0, 1, ...) its parent (kNone: the
 /// root), its covisibility edges and its loop edges, as given.

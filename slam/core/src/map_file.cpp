@@ -9,6 +9,7 @@
 #include "map_file_bytes.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/fnv.hpp"
+#include "pvb/common/text.hpp"
 
 namespace pvb::slam {
 namespace {
@@ -135,11 +136,79 @@ void put_bow(ByteWriter& w, const KeyFrame& kf, const BagOf& bag_of) {
   }
 }
 
+void put_vector(ByteWriter& w, const Eigen::Vector3d& v) {
+  for (int i = 0; i < 3; ++i) w.f64(v(i));
+}
+
+void put_bias(ByteWriter& w, const ImuBias& b) {
+  put_vector(w, b.gyro_radps);
+  put_vector(w, b.accel_mps2);
+}
+
+/// The keyframe before `kf` in time when the file can name it: saved, of
+/// `kf`'s session, older (id and time) and naming `kf` as its next; else
+/// kNone (the chain breaks there).
+std::uint64_t saved_prev(const KeyFrame& kf, const SortedIds& kf_ids) {
+  const auto prev = kf.motion().prev.lock();
+  const bool named = prev && !prev->bad() && has(kf_ids, prev->id()) && prev->id() < kf.id() &&
+                     prev->t_ns() < kf.t_ns() && prev->session() == kf.session() &&
+                     prev->motion().next.lock().get() == &kf;
+  return named ? prev->id() : kNone;
+}
+
+/// INER: the setup, gravity, the extrinsics, then per keyframe its
+/// predecessor in time and its state (a state the reader would refuse is
+/// written as none).
+void put_inertial(ByteWriter& w, const Map& map, const MapSettings& s,
+                  const std::vector<std::shared_ptr<KeyFrame>>& kfs, const SortedIds& kf_ids) {
+  const MapGravity& g = map.gravity();
+  w.u32(sensor_code(s.sensors));
+  put_vector(w, g.g_w);
+  put_pose(w, s.T_b_c);
+  if (uses_wheels(s.sensors)) put_pose(w, s.T_base_c);
+  put_bias(w, bias_in_range(g.bias) ? g.bias : ImuBias{});
+  w.u64(g.ready_keyframe_id);
+  w.i64(g.ready_t_ns);
+  w.f64(std::isfinite(g.init_rms) && g.init_rms >= 0 ? g.init_rms : 0.0);
+  w.u64(kfs.size());
+  for (const auto& kf : kfs) {
+    const KeyFrameMotion& m = kf->motion();
+    const bool state = m.has_state && speed_in_range(m.v_w_mps) && bias_in_range(m.bias);
+    w.u64(kf->id());
+    w.u64(saved_prev(*kf, kf_ids));
+    w.u8(state ? 1 : 0);
+    put_vector(w, state ? m.v_w_mps : Eigen::Vector3d::Zero());
+    put_bias(w, state ? m.bias : ImuBias{});
+  }
+}
+
+/// Whether the map's inertial state goes into the file (version 2).
+bool saves_inertial(const Map& map, const MapSettings& s) {
+  if (!map.gravity().ready || !uses_accel(s.sensors) || !gravity_in_range(map.gravity().g_w)) return false;
+  if (!rigid_in_range(s.T_b_c) || (uses_wheels(s.sensors) && !rigid_in_range(s.T_base_c)))
+    throw std::logic_error("encode_map: an extrinsic transform that is not rigid or lies beyond 10 m");
+  return true;
+}
+
 void put_section(ByteWriter& out, const char* tag, const std::string& payload) {
   out.bytes(tag, 4);
   out.u64(payload.size());
   out.bytes(payload.data(), payload.size());
   out.u64(fnv1a64(payload.data(), payload.size()));
+}
+
+/// "NAME: the map's and this run's differ by X mm and Y deg (...)" when
+/// they differ by more than kMaxExtrinsicShiftM or kMaxExtrinsicTurnDeg;
+/// empty when they agree.
+std::string extrinsic_difference(const char* name, const char* sensor, const geom::SE3d& in_map,
+                                 const geom::SE3d& in_run) {
+  const double shift_m = (in_map.translation() - in_run.translation()).norm();
+  const Eigen::Matrix3d dR = in_map.linear().transpose() * in_run.linear();
+  const double turn_deg = Eigen::AngleAxisd(dR).angle() * 180.0 / M_PI;
+  if (shift_m <= kMaxExtrinsicShiftM && turn_deg <= kMaxExtrinsicTurnDeg) return {};
+  return std::string(name) + ": the map's and this run's differ by " + format_fixed(shift_m * 1e3, 2) +
+         " mm and " + format_fixed(turn_deg, 3) + " deg (at most " + format_g(kMaxExtrinsicShiftM * 1e3) +
+         " mm and " + format_g(kMaxExtrinsicTurnDeg) + " deg when both use the " + sensor + ")";
 }
 
 }  // namespace
@@ -165,7 +234,7 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   for (const auto& [id, mp] : map.points())
     if (!mp->bad() && saved_observer(*mp, kf_ids, kNone) != kNone) point_ids.push_back(id);
 
-  ByteWriter head, keyf, poin, grap, bowv;
+  ByteWriter head, keyf, poin, grap, bowv, iner;
   put_settings(head, settings, sessions);
   keyf.reserve(8 + kfs.size() * kKeyframeHeadBytes + keypoints * kKeypointBytes);
   keyf.u64(kfs.size());
@@ -175,16 +244,25 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   grap.u64(kfs.size());
   for (const auto& kf : kfs) put_graph(grap, *kf, kf_ids);
   for (const auto& kf : kfs) put_bow(bowv, *kf, bag_of);
+  std::vector<const std::string*> payloads = {&head.data(), &keyf.data(), &poin.data(), &grap.data(),
+                                              &bowv.data()};
+  const bool inertial = saves_inertial(map, settings);
+  if (inertial) {
+    put_inertial(iner, map, settings, kfs, kf_ids);
+    payloads.push_back(&iner.data());
+  }
+  payloads.push_back(&app_json);
 
-  const std::string* payloads[] = {&head.data(), &keyf.data(), &poin.data(), &grap.data(), &bowv.data(), &app_json};
+  const std::uint32_t version = inertial ? kMapFileVersion : kMapFileVersionVisual;
+  const std::vector<const char*> tags = section_tags(version);
   std::size_t total = kMagicBytes + 8;
   for (const std::string* p : payloads) total += 4 + 8 + p->size() + 8;  // tag, size, payload, checksum
   ByteWriter out;
   out.reserve(total);
   out.bytes(kMagic, kMagicBytes);
-  out.u32(kMapFileVersion);
-  out.u32(static_cast<std::uint32_t>(kSections.size()));
-  for (std::size_t s = 0; s < kSections.size(); ++s) put_section(out, kSections[s], *payloads[s]);
+  out.u32(version);
+  out.u32(static_cast<std::uint32_t>(tags.size()));
+  for (std::size_t s = 0; s < tags.size(); ++s) put_section(out, tags[s], *payloads[s]);
   return out.data();
 }
 
@@ -216,6 +294,13 @@ std::string MapSettings::difference(const MapSettings& run) const {
       << " in this run (another vocabulary)";
     return o.str();
   }
+  // The setup is not compared: either side without the sensor leaves the
+  // other's state unused.  Extrinsics are, where both use them.
+  if (uses_accel(sensors) && uses_accel(run.sensors))
+    if (std::string d = extrinsic_difference("IMU.T_b_c1", "IMU", T_b_c, run.T_b_c); !d.empty()) return d;
+  if (uses_wheels(sensors) && uses_wheels(run.sensors))
+    if (std::string d = extrinsic_difference("Robot.T_base_c1", "wheels", T_base_c, run.T_base_c); !d.empty())
+      return d;
   return {};
 }
 

@@ -3,16 +3,28 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "pvb/common/error.hpp"
+#include "pvb/slam/core/map_file.hpp"
 
 namespace pvb::slam::mapfile {
 
 constexpr char kMagic[] = "PVBMAP\r\n";  // 8 bytes, without the NUL
 constexpr std::size_t kMagicBytes = 8;
 constexpr std::uint64_t kNone = ~std::uint64_t(0);  ///< no keyframe, no point
-constexpr std::array<const char*, 6> kSections = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "META"};
+/// The sections of a version-1 file, in order.
+constexpr std::array<const char*, 6> kSectionsV1 = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "META"};
+/// The sections of a version-2 file: INER (the inertial state) before META.
+constexpr std::array<const char*, 7> kSectionsV2 = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "INER", "META"};
+constexpr std::size_t kInerSection = 5;  ///< INER's place in a version-2 file
+/// The sections of a file of `version` (1 or 2), in order.
+inline std::vector<const char*> section_tags(std::uint32_t version) {
+  if (version == 1) return {kSectionsV1.begin(), kSectionsV1.end()};
+  return {kSectionsV2.begin(), kSectionsV2.end()};
+}
 /// Bytes of one keypoint in KEYF: 7 f32, the octave, depth, point id, descriptor.
 constexpr std::size_t kKeypointBytes = 7 * 4 + 1 + 4 + 8 + 32;
 /// Bytes of a keyframe in KEYF before its keypoints: id, frame id, time,
@@ -29,6 +41,47 @@ constexpr std::uint64_t kMaxId = std::uint64_t(1) << 48;
 /// of frames at 30 Hz is 0.88 * 2^30.  Counting on from there cannot
 /// overflow an int.
 constexpr std::int32_t kMaxVisible = std::int32_t(1) << 30;
+
+/// A sensor setup's code in INER (fixed, whatever the enum's order).
+inline std::uint32_t sensor_code(SensorSetup s) {
+  switch (s) {
+    case SensorSetup::kCamera:
+      return 0;
+    case SensorSetup::kCameraImu:
+      return 1;
+    case SensorSetup::kCameraImuWheels:
+      return 2;
+    case SensorSetup::kCameraAccel:
+      return 3;
+  }
+  return 0;
+}
+inline std::optional<SensorSetup> sensor_of_code(std::uint32_t code) {
+  for (SensorSetup s : {SensorSetup::kCamera, SensorSetup::kCameraImu, SensorSetup::kCameraImuWheels,
+                        SensorSetup::kCameraAccel})
+    if (sensor_code(s) == code) return s;
+  return std::nullopt;
+}
+
+/// What INER may hold (the reader refuses the rest; the writer leaves it out).
+inline bool gravity_in_range(const Eigen::Vector3d& g_w) {
+  return g_w.allFinite() && g_w.norm() >= kMinGravityMps2 && g_w.norm() <= kMaxGravityMps2;
+}
+inline bool bias_in_range(const ImuBias& b) {
+  return b.gyro_radps.allFinite() && b.accel_mps2.allFinite() && b.gyro_radps.norm() <= kMaxGyroBiasRadps &&
+         b.accel_mps2.norm() <= kMaxAccelBiasMps2;
+}
+inline bool speed_in_range(const Eigen::Vector3d& v_w) {
+  return v_w.allFinite() && v_w.norm() <= kMaxSpeedMps;
+}
+/// Finite, a rotation (orthonormal within 1e-6, determinant +1) and a
+/// translation within kMaxExtrinsicM.
+inline bool rigid_in_range(const geom::SE3d& T) {
+  const Eigen::Matrix3d R = T.linear();
+  return T.matrix().allFinite() &&
+         (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-6 &&
+         R.determinant() > 0 && T.translation().norm() <= kMaxExtrinsicM;
+}
 
 class ByteWriter {
  public:

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <unordered_map>
 #include <utility>
@@ -38,8 +39,8 @@ std::uint64_t le64(const std::string& b, std::size_t at) {
   return v;
 }
 
-/// The file header: magic, version, section count.
-void check_file_header(const std::string& head, const std::string& file) {
+/// The file header: magic, version, section count; returns the version.
+std::uint32_t check_file_header(const std::string& head, const std::string& file) {
   if (head.size() < kMagicBytes || head.compare(0, kMagicBytes, kMagic, kMagicBytes) != 0)
     throw IoError(file, "not a map file (it does not start with PVBMAP)");
   ByteReader r(head.data() + kMagicBytes, head.size() - kMagicBytes, file, "file header", kMagicBytes,
@@ -50,19 +51,31 @@ void check_file_header(const std::string& head, const std::string& file) {
                             std::to_string(kMapFileVersion) + ")");
   if (version == 0) throw IoError(file, "map file version 0 does not exist");
   const std::uint32_t count = r.u32();
-  if (count != kSections.size())
-    r.fail(std::to_string(count) + " sections, expected " + std::to_string(kSections.size()));
+  const std::size_t expected = section_tags(version).size();
+  if (count != expected)
+    r.fail(std::to_string(count) + " sections, expected " + std::to_string(expected) + " in a version-" +
+           std::to_string(version) + " file");
+  return version;
 }
+
+/// A file's version and where each section's payload lies.
+struct Framing {
+  std::uint32_t version = 0;
+  Sections sections;
+};
 
 /// The sections of a file of `size` bytes, from the file header and each
 /// section's tag and length alone (16 bytes, then 12 a section): their
 /// lengths must add up to the file's size.
-Sections frame_sections(const ReadAt& read_at, std::uint64_t size, const std::string& file) {
-  check_file_header(read_at(0, kMagicBytes + 8), file);
-  Sections out(kSections.size());
+Framing frame_sections(const ReadAt& read_at, std::uint64_t size, const std::string& file) {
+  Framing framing;
+  framing.version = check_file_header(read_at(0, kMagicBytes + 8), file);
+  const std::vector<const char*> tags = section_tags(framing.version);
+  Sections& out = framing.sections;
+  out.resize(tags.size());
   std::uint64_t at = kMagicBytes + 8;  // where the section begins
-  for (std::size_t s = 0; s < kSections.size(); ++s) {
-    const std::string label = std::string(kSections[s]) + " section";
+  for (std::size_t s = 0; s < tags.size(); ++s) {
+    const std::string label = std::string(tags[s]) + " section";
     const auto fail = [&](std::uint64_t offset, const std::string& what) {
       throw IoError(file, ByteReader::where(label, offset, at + offset) + what);
     };
@@ -70,8 +83,8 @@ Sections frame_sections(const ReadAt& read_at, std::uint64_t size, const std::st
       fail(0, at == size ? "missing (the file ends before it)"
                          : "its tag and length are cut short (the file is truncated)");
     const std::string head = read_at(at, kSectionHeadBytes);
-    if (head.compare(0, 4, kSections[s]) != 0)
-      fail(0, "tag \"" + printable(head.substr(0, 4)) + "\", expected " + kSections[s]);
+    if (head.compare(0, 4, tags[s]) != 0)
+      fail(0, "tag \"" + printable(head.substr(0, 4)) + "\", expected " + tags[s]);
     const std::uint64_t length = le64(head, 4);
     const std::uint64_t left = size - at - kSectionHeadBytes;
     if (length > left || left - length < kSectionTailBytes)
@@ -83,26 +96,29 @@ Sections frame_sections(const ReadAt& read_at, std::uint64_t size, const std::st
   if (at != size)
     throw IoError(file, std::to_string(size - at) + " bytes after the last section (from file byte " +
                             std::to_string(at) + ")");
-  return out;
+  return framing;
 }
 
-Sections split_sections(const std::string& b, const std::string& file) {
+Framing split_sections(const std::string& b, const std::string& file) {
   const ReadAt in_memory = [&](std::uint64_t offset, std::uint64_t n) { return b.substr(offset, n); };
-  const Sections out = frame_sections(in_memory, b.size(), file);
-  for (std::size_t s = 0; s < kSections.size(); ++s) {
-    const auto [payload, length] = out[s];
+  const Framing framing = frame_sections(in_memory, b.size(), file);
+  const std::vector<const char*> tags = section_tags(framing.version);
+  for (std::size_t s = 0; s < tags.size(); ++s) {
+    const auto [payload, length] = framing.sections[s];
     if (le64(b, payload + length) != fnv1a64(b.data() + payload, length))
-      throw IoError(file, ByteReader::where(std::string(kSections[s]) + " section",
-                                            kSectionHeadBytes + length, payload + length) +
+      throw IoError(file, ByteReader::where(std::string(tags[s]) + " section", kSectionHeadBytes + length,
+                                            payload + length) +
                               "checksum does not match its " + std::to_string(length) +
                               "-byte payload (the file is damaged)");
   }
-  return out;
+  return framing;
 }
 
-ByteReader reader_for(const std::string& b, const Sections& s, std::size_t i, const std::string& file) {
-  return ByteReader(b.data() + s[i].first, s[i].second, file, std::string(kSections[i]) + " section",
-                    kSectionHeadBytes, s[i].first);
+/// A reader of section `i` of a file of `version`.
+ByteReader reader_for(const std::string& b, const Sections& s, std::size_t i, const std::string& file,
+                      std::uint32_t version) {
+  return ByteReader(b.data() + s[i].first, s[i].second, file,
+                    std::string(section_tags(version)[i]) + " section", kSectionHeadBytes, s[i].first);
 }
 
 void check_settings(ByteReader& r, const MapSettings& s) {
@@ -121,7 +137,6 @@ void check_settings(ByteReader& r, const MapSettings& s) {
 
 MapFileHeader parse_head(ByteReader r) {
   MapFileHeader h;
-  h.version = kMapFileVersion;
   MapSettings& s = h.settings;
   for (double* v : {&s.fx, &s.fy, &s.cx, &s.cy, &s.bf}) *v = r.f64();
   s.width = r.u32();
@@ -448,6 +463,141 @@ void read_bows(ByteReader r, Map* map) {
   if (!r.at_end()) r.fail("longer than its bags of words");
 }
 
+std::string vector_text(const Eigen::Vector3d& v) {
+  return "(" + format_g(v.x()) + ", " + format_g(v.y()) + ", " + format_g(v.z()) + ")";
+}
+
+Eigen::Vector3d read_vector(ByteReader& r) {
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) v(i) = r.f64();
+  return v;
+}
+
+ImuBias read_bias(ByteReader& r) {
+  ImuBias b;
+  b.gyro_radps = read_vector(r);
+  b.accel_mps2 = read_vector(r);
+  return b;
+}
+
+/// "gyro bias (..) rad/s and accelerometer bias (..) m/s^2"
+std::string bias_text(const ImuBias& b) {
+  return "gyro bias " + vector_text(b.gyro_radps) + " rad/s and accelerometer bias " +
+         vector_text(b.accel_mps2) + " m/s^2";
+}
+
+void check_bias(ByteReader& r, const std::string& whose, const ImuBias& b) {
+  if (!bias_in_range(b))
+    r.fail(whose + " " + bias_text(b) + ": not finite or beyond " + format_g(kMaxGyroBiasRadps) +
+           " rad/s and " + format_g(kMaxAccelBiasMps2) + " m/s^2");
+}
+
+/// An extrinsic transform (12 f64: the rotation row by row, the translation).
+geom::SE3d read_extrinsic(ByteReader& r, const char* name) {
+  Eigen::Matrix3d R;
+  Eigen::Vector3d t;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) R(i, j) = r.f64();
+  t = read_vector(r);
+  const geom::SE3d T = geom::make_se3(R, t);
+  if (!rigid_in_range(T))
+    r.fail(std::string(name) + " is not a rigid transform within " + format_g(kMaxExtrinsicM) +
+           " m (finite, its rotation orthonormal within 1e-6 with determinant +1)");
+  return T;
+}
+
+/// INER up to its keyframes: the setup and extrinsics into *s, gravity and
+/// the map's bias, when it became trusted, into *g (ready).
+void read_inertial_head(ByteReader& r, MapSettings* s, MapGravity* g) {
+  const std::uint32_t code = r.u32();
+  const std::optional<SensorSetup> setup = sensor_of_code(code);
+  if (!setup) r.fail("sensor setup " + std::to_string(code) + " is not known (0 to 3)");
+  if (!uses_accel(*setup))
+    r.fail(std::string("sensor setup ") + to_string(*setup) + " has no inertial state");
+  s->sensors = *setup;
+  g->ready = true;
+  g->g_w = read_vector(r);
+  if (!gravity_in_range(g->g_w))
+    r.fail("gravity " + vector_text(g->g_w) + " m/s^2 of magnitude " + format_g(g->g_w.norm()) +
+           ", expected " + format_g(kMinGravityMps2) + " to " + format_g(kMaxGravityMps2) + " m/s^2");
+  s->T_b_c = read_extrinsic(r, "IMU.T_b_c1");
+  s->T_base_c = uses_wheels(*setup) ? read_extrinsic(r, "Robot.T_base_c1") : geom::SE3d::Identity();
+  g->bias = read_bias(r);
+  check_bias(r, "the map's", g->bias);
+  g->ready_keyframe_id = r.u64();
+  if (g->ready_keyframe_id >= kMaxId)
+    r.fail("gravity trusted at keyframe " + std::to_string(g->ready_keyframe_id) + ", an id not below 2^48");
+  g->ready_t_ns = r.i64();
+  g->init_rms = r.f64();
+  if (!(std::isfinite(g->init_rms) && g->init_rms >= 0))
+    r.fail("initialisation RMS " + format_g(g->init_rms) + ", expected a finite value >= 0");
+}
+
+/// A keyframe's inertial state: none (all zero) or a speed and biases in range.
+void check_state(ByteReader& r, std::uint64_t id, std::uint8_t has_state, const Eigen::Vector3d& v_w,
+                 const ImuBias& b) {
+  const std::string what = "keyframe " + std::to_string(id);
+  if (has_state > 1) r.fail(what + ": has_state " + std::to_string(has_state) + ", expected 0 or 1");
+  if (has_state == 0) {
+    if (!v_w.isZero(0) || !b.gyro_radps.isZero(0) || !b.accel_mps2.isZero(0))
+      r.fail(what + " has no inertial state but a velocity or bias other than 0");
+    return;
+  }
+  if (!speed_in_range(v_w))
+    r.fail(what + ": velocity " + vector_text(v_w) + " m/s, not finite or faster than " +
+           format_g(kMaxSpeedMps) + " m/s");
+  check_bias(r, what + "'s", b);
+}
+
+/// Links keyframe `kf` after `prev_id` in time (kNone: it starts a chain).
+/// The predecessor is another keyframe of the map, older (a smaller id and
+/// an earlier time), of the same session, and no other keyframe's.
+void link_in_time(ByteReader& r, const std::shared_ptr<KeyFrame>& kf, std::uint64_t prev_id, const Map& map) {
+  if (prev_id == kNone) return;
+  const std::string what =
+      "keyframe " + std::to_string(kf->id()) + ": its predecessor in time " + std::to_string(prev_id);
+  const auto it = map.keyframes().find(prev_id);
+  if (it == map.keyframes().end()) r.fail(what + " is not in the map");
+  const std::shared_ptr<KeyFrame>& prev = it->second;
+  if (!(prev_id < kf->id() && prev->t_ns() < kf->t_ns()))
+    r.fail(what + " is not older (at " + std::to_string(prev->t_ns()) + " ns, it at " +
+           std::to_string(kf->t_ns()) + " ns)");
+  if (prev->session() != kf->session())
+    r.fail(what + " is of session " + std::to_string(prev->session()) + ", it of session " +
+           std::to_string(kf->session()));
+  if (const auto next = prev->motion().next.lock())
+    r.fail(what + " is already keyframe " + std::to_string(next->id()) + "'s");
+  kf->motion().prev = prev;
+  prev->motion().next = kf;
+}
+
+/// INER: the map's gravity, each keyframe's state and its link in time.
+void read_inertial(ByteReader r, Map* map) {
+  MapSettings unused;
+  MapGravity g;
+  read_inertial_head(r, &unused, &g);
+  const auto& kfs = map->keyframes();
+  const std::uint64_t n = r.count(8 + 8 + 1 + 72, "keyframe states");
+  if (n != kfs.size())
+    r.fail(std::to_string(n) + " keyframe states for " + std::to_string(kfs.size()) + " keyframes");
+  for (const auto& [id, kf] : kfs) {
+    const std::uint64_t entry = r.u64();
+    if (entry != id) r.fail("keyframe state for keyframe " + std::to_string(entry) + " out of order");
+    const std::uint64_t prev_id = r.u64();
+    const std::uint8_t has_state = r.u8();
+    const Eigen::Vector3d v_w = read_vector(r);
+    const ImuBias bias = read_bias(r);
+    check_state(r, id, has_state, v_w, bias);
+    link_in_time(r, kf, prev_id, *map);
+    KeyFrameMotion& m = kf->motion();
+    m.has_state = has_state == 1;
+    m.v_w_mps = v_w;
+    m.bias = bias;
+  }
+  if (!r.at_end()) r.fail("longer than its keyframe states");
+  map->gravity() = g;
+}
+
 }  // namespace
 
 std::string read_map_file(const std::string& path) {
@@ -473,9 +623,16 @@ std::string read_map_file(const std::string& path) {
 }
 
 MapFileHeader read_map_header(const std::string& bytes, const std::string& file) {
-  const Sections s = split_sections(bytes, file);
-  MapFileHeader h = parse_head(reader_for(bytes, s, 0, file));
-  h.app_json.assign(bytes, s[5].first, s[5].second);
+  const Framing framing = split_sections(bytes, file);
+  const Sections& s = framing.sections;
+  MapFileHeader h = parse_head(reader_for(bytes, s, 0, file, framing.version));
+  h.version = framing.version;
+  if (h.version >= 2) {
+    ByteReader iner = reader_for(bytes, s, kInerSection, file, h.version);
+    MapGravity unused;
+    read_inertial_head(iner, &h.settings, &unused);
+  }
+  h.app_json.assign(bytes, s.back().first, s.back().second);
   h.sections = s;
   return h;
 }
@@ -483,8 +640,10 @@ MapFileHeader read_map_header(const std::string& bytes, const std::string& file)
 void decode_map(const std::string& bytes, const std::string& file, const MapFileHeader& h,
                 const std::shared_ptr<const CameraModel>& cam, Map* map) {
   const Sections& s = h.sections;
-  if (s.size() != kSections.size()) throw std::logic_error("decode_map: a header not from read_map_header");
-  const PointIdsByKf ids = read_keyframes(reader_for(bytes, s, 1, file), cam, h.sessions, map);
+  if ((h.version != 1 && h.version != 2) || s.size() != section_tags(h.version).size())
+    throw std::logic_error("decode_map: a header not from read_map_header");
+  const auto reader = [&](std::size_t i) { return reader_for(bytes, s, i, file, h.version); };
+  const PointIdsByKf ids = read_keyframes(reader(1), cam, h.sessions, map);
   if (map->keyframes().empty()) throw IoError(file, "the map has no keyframes");
   if (h.sessions > map->keyframes().size())  // every session counted made a keyframe that is kept
     throw IoError(
@@ -492,10 +651,11 @@ void decode_map(const std::string& bytes, const std::string& file, const MapFile
         ByteReader::where("HEAD section", kSectionHeadBytes + s[0].second - 4, s[0].first + s[0].second - 4) +
             std::to_string(h.sessions) + " sessions in a map of " + std::to_string(map->keyframes().size()) +
             " keyframes (each session holds one at least)");
-  const auto saved = read_points(reader_for(bytes, s, 2, file), *map);
-  link_points(reader_for(bytes, s, 2, file), ids, saved, map);
-  read_graph(reader_for(bytes, s, 3, file), map);
-  read_bows(reader_for(bytes, s, 4, file), map);
+  const auto saved = read_points(reader(2), *map);
+  link_points(reader(2), ids, saved, map);
+  read_graph(reader(3), map);
+  read_bows(reader(4), map);
+  if (h.version >= 2) read_inertial(reader(kInerSection), map);
 }
 
 }  // namespace pvb::slam

@@ -158,6 +158,9 @@ MapSettings System::map_settings() const {
   m.num_levels = static_cast<std::uint32_t>(settings_.orb.num_levels);
   m.num_features = static_cast<std::uint32_t>(settings_.orb.num_features);
   m.vocabulary = vocabulary_fingerprint_;
+  m.sensors = settings_.sensors;  // extrinsics only where the setup uses them (docs/map_file.md)
+  if (uses_accel(m.sensors)) m.T_b_c = settings_.imu.T_b_c;
+  if (uses_wheels(m.sensors)) m.T_base_c = settings_.robot.T_base_c;
   return m;
 }
 
@@ -172,7 +175,9 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
   MapLoadInfo info;
   {
     std::lock_guard<std::mutex> lock(map_.mutex());
-    decode_map(bytes, path, head, cam_, &map_);
+    decode_map(bytes, path, head, cam_, &map_);  // with a version-2 file, gravity ready and the chain
+    if (!uses_accel(settings_.sensors))
+      map_.gravity() = MapGravity{};  // a camera-only run keeps no inertial state
     std::size_t words = 0;
     for (const auto& [id, kf] : map_.keyframes()) words += kf->bow().size();
     place_->reserve(map_.num_keyframes(), words);  // an upper bound on the distinct words

@@ -169,8 +169,13 @@ TEST_F(MapFile, ADamagedByteInAnySectionFailsItsChecksum) {
 TEST_F(MapFile, ForeignAndFutureFilesSaySo) {
   EXPECT_NE(load_error("PVBVOC1\nnot a map", "foreign.pvbmap").find("not a map file"), std::string::npos);
   std::string future = bytes_;
-  future[8] = 2;  // version, little-endian u32 after the magic
-  EXPECT_NE(load_error(future, "future.pvbmap").find("version 2 is newer"), std::string::npos);
+  future[8] = 3;  // version, little-endian u32 after the magic
+  EXPECT_NE(load_error(future, "future.pvbmap").find("version 3 is newer than this build reads (2)"),
+            std::string::npos);
+  std::string unframed = bytes_;
+  unframed[8] = 2;  // a version-2 file has an INER section
+  EXPECT_NE(load_error(unframed, "v2.pvbmap").find("6 sections, expected 7 in a version-2 file"),
+            std::string::npos);
 }
 
 TEST_F(MapFile, AMapOfOtherSettingsIsRefused) {
@@ -203,6 +208,69 @@ TEST_F(MapFile, LocaliseStartsLostRelocalisesAndNeverAddsKeyframes) {
   EXPECT_EQ(system.num_keyframes(), info.keyframes);
   EXPECT_EQ(system.relocalisations().size(), 1u);
   EXPECT_THROW(system.save_map(tmp_path("localised.pvbmap"), "{}"), ConfigError);
+}
+
+/// The pair's map with inertial state (test::give_tiny_inertial_state), as
+/// a run with an IMU whose camera sits at T_b_c saves it.
+std::string inertial_pair_map(const std::string& bytes, const std::string& file, const geom::SE3d& T_b_c) {
+  const MapFileHeader h = read_map_header(bytes, file);
+  Map map;
+  decode_map(bytes, file, h, camera_for(h.settings), &map);
+  std::lock_guard<std::mutex> lock(map.mutex());
+  test::give_tiny_inertial_state(map);
+  MapSettings s = h.settings;
+  s.sensors = SensorSetup::kCameraImu;
+  s.T_b_c = T_b_c;
+  return encode_map(map, s, h.sessions, h.app_json);
+}
+
+Settings imu_settings(const geom::SE3d& T_b_c) {
+  Settings s = read_settings(kTum3);
+  s.sensors = SensorSetup::kCameraImu;
+  s.imu.present = true;
+  s.imu.T_b_c = T_b_c;
+  return s;
+}
+
+// A run with an IMU that loads a map with inertial state has its gravity
+// and keyframe states at once, and saves the map again byte for byte; one
+// whose IMU sits elsewhere is refused in one line; a camera-only run
+// localises in the map and keeps no inertial state.
+TEST_F(MapFile, ARunWithAnImuHasTheMapsGravityAtOnce) {
+  const geom::SE3d T_b_c = test::tiny_inertial_settings().T_b_c;
+  const std::string p = tmp_path("inertial_pair.pvbmap");
+  const std::string bytes = inertial_pair_map(bytes_, path_, T_b_c);
+  write_file(p, bytes);
+  {
+    System system(imu_settings(T_b_c), sync_options());
+    system.load_map(p, MapStart::kExtend);
+    const MapGravity g = system.gravity();
+    EXPECT_TRUE(g.ready);
+    EXPECT_EQ(g.g_w, Eigen::Vector3d(0.1, -0.2, -9.8));
+    EXPECT_EQ(system.keyframe_states().size(), system.num_keyframes() - 1);  // all but the first
+    system.shutdown();
+    const std::string again = tmp_path("inertial_again.pvbmap");
+    system.save_map(again, R"({"station": "fr3"})");
+    EXPECT_TRUE(read_file(again) == bytes);
+  }
+  System moved(imu_settings(T_b_c * geom::SE3d(Eigen::Translation3d(0.002, 0, 0))), sync_options());
+  try {
+    moved.load_map(p, MapStart::kLocalise);
+    ADD_FAILURE() << "loaded";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("IMU.T_b_c1: the map's and this run's differ by 2.00 mm and 0.000 deg"),
+              std::string::npos)
+        << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+  const Settings s = read_settings(kTum3);
+  System camera(s, sync_options());
+  camera.load_map(p, MapStart::kLocalise);
+  EXPECT_FALSE(camera.gravity().ready);
+  const FrameResult r = camera.track(pair_frames(s).front());
+  ASSERT_TRUE(r.T_w_c) << r.tracking.failure;
+  EXPECT_LT(r.T_w_c->translation().norm(), 0.01);
 }
 
 /// The pair's map with a look-alike place added: its first keyframe again
@@ -460,6 +528,60 @@ std::vector<ImpossibleMap> impossible_maps() {
   };
 }
 
+/// The tiny inertial map made impossible one way at a time (in its INER).
+std::vector<ImpossibleMap> impossible_inertial_maps() {
+  using namespace test;
+  const std::string tiny = tiny_inertial_map();
+  const auto edit = [&](const std::function<void(std::string&)>& change) {
+    std::vector<std::string> p = map_sections(tiny);
+    change(p[5]);
+    return map_file_of(p);
+  };
+  const auto prev = [](int k) { return iner_keyframe(k) + 8; };
+  const auto state = [](int k) { return iner_keyframe(k) + 16; };
+  const auto velocity = [](int k) { return iner_keyframe(k) + 17; };
+  const auto bias = [](int k) { return iner_keyframe(k) + 41; };
+  return {
+      {"inertial_setup_9", edit([](std::string& b) { put_u32(b, 0, 9); }),
+       "sensor setup 9 is not known (0 to 3)"},
+      {"inertial_setup_camera", edit([](std::string& b) { put_u32(b, 0, 0); }),
+       "sensor setup camera has no inertial state"},
+      {"inertial_gravity_12", edit([](std::string& b) { put_f64(b, kInerGravity + 16, -12); }),
+       "INER section at byte 40 (file byte 2976): gravity (0.1, -0.2, -12) m/s^2 of magnitude 12.0021, expected 9 "
+       "to 10.6 m/s^2"},  // as docs/map_file.md shows it
+      {"inertial_t_b_c_not_a_rotation", edit([](std::string& b) { put_f64(b, kInerTbc, 2.0); }),
+       "IMU.T_b_c1 is not a rigid transform within 10 m"},
+      {"inertial_t_base_c_20m", edit([](std::string& b) { put_f64(b, kInerTbaseC + 72, 20.0); }),
+       "Robot.T_base_c1 is not a rigid transform within 10 m"},
+      {"inertial_map_bias_nan",
+       edit([](std::string& b) { put_f64(b, kInerBias, std::numeric_limits<double>::quiet_NaN()); }),
+       "the map's gyro bias ("},
+      {"inertial_rms_negative", edit([](std::string& b) { put_f64(b, kInerRms, -1.0); }),
+       "initialisation RMS -1, expected a finite value >= 0"},
+      {"inertial_count_2", edit([](std::string& b) { put_u64(b, kInerCount, 2); }),
+       "2 keyframe states for 3 keyframes"},
+      {"inertial_predecessor_missing", edit([&](std::string& b) { put_u64(b, prev(1), 7); }),
+       "keyframe 1: its predecessor in time 7 is not in the map"},
+      {"inertial_predecessor_newer", edit([&](std::string& b) { put_u64(b, prev(1), 2); }),
+       "keyframe 1: its predecessor in time 2 is not older (at 2000000000 ns, it at 1000000000 ns)"},
+      {"inertial_predecessor_shared", edit([&](std::string& b) { put_u64(b, prev(2), 0); }),
+       "INER section at byte 579 (file byte 3515): keyframe 2: its predecessor in time 0 is already keyframe "
+       "1's"},  // as docs/map_file.md shows it
+      {"inertial_has_state_2", edit([&](std::string& b) { b[state(1)] = 2; }),
+       "keyframe 1: has_state 2, expected 0 or 1"},
+      {"inertial_stateless_velocity", edit([&](std::string& b) { put_f64(b, velocity(0), 0.5); }),
+       "keyframe 0 has no inertial state but a velocity or bias other than 0"},
+      {"inertial_speed_1000", edit([&](std::string& b) { put_f64(b, velocity(2), 1000.0); }),
+       "keyframe 2: velocity (1000, 0.05, -0.01) m/s, not finite or faster than 100 m/s"},
+      {"inertial_speed_inf",
+       edit([&](std::string& b) { put_f64(b, velocity(1) + 8, std::numeric_limits<double>::infinity()); }),
+       "keyframe 1: velocity (0.1, inf, -0.01) m/s, not finite or faster than 100 m/s"},
+      {"inertial_gyro_bias_2", edit([&](std::string& b) { put_f64(b, bias(1), 2.0); }),
+       "keyframe 1's gyro bias (2, -0.002, 0.003) rad/s and accelerometer bias (0.02, 0.01, -0.03) m/s^2: "
+       "not finite or beyond 1 rad/s and 5 m/s^2"},
+  };
+}
+
 const std::string kCorpus = std::string(PVB_SOURCE_DIR) + "/tests/fuzz/corpus/map_file";
 
 TEST(MapFileChecks, TheTinyMapIsWhatItsOffsetsSay) {
@@ -480,13 +602,19 @@ TEST(MapFileChecks, TheTinyMapIsWhatItsOffsetsSay) {
 TEST(MapFileChecks, EveryImpossibleMapIsRefusedForItsReason) {
   const char* out = std::getenv("PVB_WRITE_MAP_CORPUS");
   if (out) write_file(std::string(out) + "/tiny.pvbmap", test::tiny_map());
-  for (const ImpossibleMap& m : impossible_maps()) {
+  if (out) write_file(std::string(out) + "/tiny_inertial.pvbmap", test::tiny_inertial_map());
+  std::vector<ImpossibleMap> maps = impossible_maps();
+  for (ImpossibleMap& m : impossible_inertial_maps()) maps.push_back(std::move(m));
+  for (const ImpossibleMap& m : maps) {
     const std::string what = decode_error(m.bytes, "m.pvbmap");
     EXPECT_NE(what.find(m.reason), std::string::npos) << m.name << ": " << what;
     const std::string seed = "impossible_" + m.name + ".pvbmap";
     if (out) write_file(std::string(out) + "/" + seed, m.bytes);
     std::ifstream in(kCorpus + "/" + seed, std::ios::binary);
-    ASSERT_TRUE(in.good()) << seed << " is not in " << kCorpus;
+    if (!in.good()) {
+      ADD_FAILURE() << seed << " is not in " << kCorpus;
+      continue;
+    }
     const std::string committed((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     EXPECT_NE(decode_error(committed, seed).find(m.reason), std::string::npos) << seed;
   }
@@ -507,7 +635,7 @@ void write_pair_seeds(const std::string& dir) {
 // The seeds that are whole maps are maps the reader reads.
 TEST(MapFileChecks, TheWholeMapsOfTheCorpusAreRead) {
   if (const char* out = std::getenv("PVB_WRITE_MAP_CORPUS")) write_pair_seeds(out);
-  for (const char* seed : {"tiny.pvbmap", "fr3_pair_600.pvbmap"}) {
+  for (const char* seed : {"tiny.pvbmap", "tiny_inertial.pvbmap", "fr3_pair_600.pvbmap"}) {
     std::ifstream in(kCorpus + "/" + seed, std::ios::binary);
     ASSERT_TRUE(in.good()) << seed;
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -543,6 +671,186 @@ TEST(MapFileChecks, TheWriterNeverWritesWhatTheReaderRefuses) {
   EXPECT_EQ(again.points().count(unseen->id()), 0u);
   EXPECT_THROW(encode_map(map, h.settings, 0, "{}"), std::logic_error);
   EXPECT_THROW(encode_map(map, h.settings, 4, "{}"), std::logic_error);  // more sessions than keyframes
+}
+
+// --- Inertial state (version 2) ------------------------------------------------
+
+/// The file's version (the u32 after the magic).
+std::uint32_t version_of(const std::string& bytes) {
+  return static_cast<std::uint32_t>(test::get_u64(bytes, 8));
+}
+
+std::string corpus_file(const std::string& name) {
+  std::ifstream in(kCorpus + "/" + name, std::ios::binary);
+  EXPECT_TRUE(in.good()) << name;
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// A map without a trusted inertial state, or saved by a run without an
+// accelerometer, is the version-1 file it always was: the tiny map as
+// committed to the corpus before version 2 existed.
+TEST(MapFileInertial, AMapWithoutInertialStateIsVersion1ByteForByte) {
+  const std::string tiny = test::tiny_map();
+  EXPECT_EQ(version_of(tiny), 1u);
+  EXPECT_TRUE(tiny == corpus_file("tiny.pvbmap"));
+  // Sensors with an IMU but gravity not yet trusted: nothing to save.
+  EXPECT_TRUE(test::tiny_map(test::tiny_inertial_settings()) == tiny);
+  // Gravity trusted, but the run saving the map has no accelerometer.
+  EXPECT_TRUE(test::tiny_map(test::tiny_settings(), "{}", test::give_tiny_inertial_state) == tiny);
+}
+
+// Version-1 files (the corpus's, made before version 2) are read, as
+// camera-only maps without inertial state, and written again unchanged.
+TEST(MapFileInertial, AVersion1FileIsReadAndWrittenAgainByteForByte) {
+  for (const char* seed : {"tiny.pvbmap", "fr3_pair_600.pvbmap"}) {
+    const std::string bytes = corpus_file(seed);
+    const MapFileHeader h = read_map_header(bytes, seed);
+    EXPECT_EQ(h.version, 1u) << seed;
+    EXPECT_EQ(h.settings.sensors, SensorSetup::kCamera) << seed;
+    Map map;
+    decode_map(bytes, seed, h, camera_for(h.settings), &map);
+    std::lock_guard<std::mutex> lock(map.mutex());
+    EXPECT_FALSE(map.gravity().ready) << seed;
+    for (const auto& [id, kf] : map.keyframes()) {
+      EXPECT_FALSE(kf->motion().has_state) << seed << " keyframe " << id;
+      EXPECT_FALSE(kf->motion().prev.lock()) << seed << " keyframe " << id;
+    }
+    EXPECT_TRUE(encode_map(map, h.settings, h.sessions, h.app_json) == bytes) << seed;
+  }
+}
+
+TEST(MapFileInertial, TheTinyInertialMapIsWhatItsOffsetsSay) {
+  const std::string tiny = test::tiny_inertial_map();
+  EXPECT_EQ(version_of(tiny), 2u);
+  const auto p = test::map_sections(tiny);
+  ASSERT_EQ(p.size(), 7u);
+  EXPECT_EQ(p[5].size(), test::iner_keyframe(3));
+  EXPECT_EQ(test::get_u64(p[5], test::kInerReadyId), 1u);
+  EXPECT_EQ(test::get_u64(p[5], test::kInerCount), 3u);
+  EXPECT_EQ(test::get_u64(p[5], test::iner_keyframe(0) + 8), ~std::uint64_t(0));  // the chain's start
+  EXPECT_EQ(test::get_u64(p[5], test::iner_keyframe(2) + 8), 1u);
+  EXPECT_EQ(test::map_file_of(p), tiny);
+  // The visual sections and META are the camera-only map's.
+  const auto visual = test::map_sections(test::tiny_map());
+  for (std::size_t s = 0; s < 5; ++s) EXPECT_TRUE(p[s] == visual[s]) << s;
+  EXPECT_EQ(p[6], visual[5]);
+  EXPECT_EQ(decode_error(tiny), "");
+  // An error in INER names it and the byte.
+  std::vector<std::string> bad = p;
+  test::put_u32(bad[5], 0, 9);
+  std::size_t iner = 16;  // where INER's tag lies in the file
+  for (std::size_t s = 0; s < 5; ++s) iner += 12 + p[s].size() + 8;
+  const std::string what = decode_error(test::map_file_of(bad));
+  EXPECT_NE(what.find("INER section at byte 16 (file byte " + std::to_string(iner + 16) +
+                      "): sensor setup 9 is not known (0 to 3)"),
+            std::string::npos)
+      << what;
+}
+
+// Save -> load -> save of a map with inertial state: the same bytes, and
+// the loaded map holds the state (gravity ready, velocities, biases, the
+// chain in time without its readings).
+TEST(MapFileInertial, AMapWithInertialStateRoundTripsAsVersion2) {
+  const std::string bytes = test::tiny_inertial_map();
+  const MapFileHeader h = read_map_header(bytes, "tiny_inertial.pvbmap");
+  const MapSettings want = test::tiny_inertial_settings();
+  EXPECT_EQ(h.version, 2u);
+  EXPECT_EQ(h.settings.sensors, SensorSetup::kCameraImuWheels);
+  EXPECT_TRUE(h.settings.T_b_c.isApprox(want.T_b_c, 0));
+  EXPECT_TRUE(h.settings.T_base_c.isApprox(want.T_base_c, 0));
+  EXPECT_EQ(h.settings.difference(want), "");
+  Map map;
+  decode_map(bytes, "tiny_inertial.pvbmap", h, camera_for(h.settings), &map);
+  std::lock_guard<std::mutex> lock(map.mutex());
+  const MapGravity& g = map.gravity();
+  EXPECT_TRUE(g.ready);
+  EXPECT_EQ(g.g_w, Eigen::Vector3d(0.1, -0.2, -9.8));
+  EXPECT_EQ(g.bias.gyro_radps, Eigen::Vector3d(0.001, -0.002, 0.003));
+  EXPECT_EQ(g.bias.accel_mps2, Eigen::Vector3d(0.02, 0.01, -0.03));
+  EXPECT_EQ(g.ready_keyframe_id, 1u);
+  EXPECT_EQ(g.ready_t_ns, 1000000000);
+  EXPECT_EQ(g.init_rms, 0.75);
+  const auto& kfs = map.keyframes();
+  ASSERT_EQ(kfs.size(), 3u);
+  EXPECT_FALSE(kfs.at(0)->motion().has_state);
+  EXPECT_FALSE(kfs.at(0)->motion().prev.lock());
+  for (std::uint64_t id : {1, 2}) {
+    const KeyFrameMotion& m = kfs.at(id)->motion();
+    EXPECT_TRUE(m.has_state) << id;
+    EXPECT_EQ(m.v_w_mps, Eigen::Vector3d(0.1 * static_cast<double>(id), 0.05, -0.01)) << id;
+    EXPECT_EQ(m.bias.accel_mps2, g.bias.accel_mps2) << id;
+    EXPECT_EQ(m.prev.lock(), kfs.at(id - 1)) << id;
+    EXPECT_EQ(kfs.at(id - 1)->motion().next.lock(), kfs.at(id)) << id;
+    EXPECT_FALSE(m.from_prev.imu) << id;  // the readings are not saved
+    EXPECT_FALSE(m.from_prev.wheels) << id;
+  }
+  EXPECT_FALSE(kfs.at(2)->motion().next.lock());
+  EXPECT_TRUE(encode_map(map, h.settings, h.sessions, h.app_json) == bytes);
+}
+
+// What the reader would refuse is not written: a keyframe state beyond
+// range is saved as none, a link in time that the reader would refuse as
+// the chain's start, and a gravity beyond range leaves the section out.
+TEST(MapFileInertial, TheWriterLeavesOutWhatTheReaderWouldRefuse) {
+  const auto bad_state = [](Map& m) {
+    test::give_tiny_inertial_state(m);
+    m.keyframes().at(2)->motion().v_w_mps.x() = 1e3;  // faster than 100 m/s
+    m.keyframes().at(1)->motion().next.reset();       // 1 no longer names 2 as its next
+  };
+  const std::string bytes = test::tiny_map(test::tiny_inertial_settings(), "{}", bad_state);
+  ASSERT_EQ(decode_error(bytes), "");
+  const MapFileHeader h = read_map_header(bytes, "m.pvbmap");
+  Map map;
+  decode_map(bytes, "m.pvbmap", h, camera_for(h.settings), &map);
+  EXPECT_FALSE(map.keyframes().at(2)->motion().has_state);
+  EXPECT_EQ(map.keyframes().at(2)->motion().v_w_mps, Eigen::Vector3d::Zero());
+  EXPECT_FALSE(map.keyframes().at(2)->motion().prev.lock());
+  EXPECT_EQ(map.keyframes().at(1)->motion().prev.lock(), map.keyframes().at(0));
+  const auto heavy = [](Map& m) {
+    test::give_tiny_inertial_state(m);
+    m.gravity().g_w = Eigen::Vector3d(0, 0, -12);
+  };
+  EXPECT_TRUE(test::tiny_map(test::tiny_inertial_settings(), "{}", heavy) == test::tiny_map());
+}
+
+// The setup is not compared (either side without a sensor leaves the
+// other's state unused); extrinsics are where both use them, to 1 mm and
+// 0.1 degrees, in one line.
+TEST(MapFileInertial, ExtrinsicsAreComparedWhereMapAndRunBothUseThem) {
+  const MapSettings map = test::tiny_inertial_settings();
+  MapSettings run = map;
+  const auto moved = [](const geom::SE3d& T, double shift_m, double turn_deg) {
+    return T *
+           geom::make_se3(Eigen::Matrix3d(Eigen::AngleAxisd(turn_deg * M_PI / 180, Eigen::Vector3d::UnitY())),
+                          Eigen::Vector3d(shift_m, 0, 0));
+  };
+  run.T_b_c = moved(map.T_b_c, 0.0009, 0.09);
+  run.T_base_c = moved(map.T_base_c, 0.0009, 0.09);
+  EXPECT_EQ(map.difference(run), "");
+  run.T_b_c = moved(map.T_b_c, 0.002, 0);
+  EXPECT_EQ(
+      map.difference(run),
+      "IMU.T_b_c1: the map's and this run's differ by 2.00 mm and 0.000 deg (at most 1 mm and 0.1 deg when "
+      "both use the IMU)");
+  run.T_b_c = moved(map.T_b_c, 0, 0.2);
+  EXPECT_NE(map.difference(run).find("IMU.T_b_c1: the map's and this run's differ by 0.00 mm and 0.200 deg"),
+            std::string::npos)
+      << map.difference(run);
+  run.T_b_c = map.T_b_c;
+  run.T_base_c = moved(map.T_base_c, 0.01, 0);
+  EXPECT_NE(map.difference(run).find("Robot.T_base_c1: the map's and this run's differ by 10.00 mm"),
+            std::string::npos)
+      << map.difference(run);
+  run.sensors = SensorSetup::kCameraImu;  // the run has no wheels: the base is not compared
+  EXPECT_EQ(map.difference(run), "");
+  run.T_b_c = moved(map.T_b_c, 0.05, 5);
+  run.sensors = SensorSetup::kCamera;  // a camera-only run uses the visual map alone
+  EXPECT_EQ(map.difference(run), "");
+  EXPECT_EQ(run.difference(map), "");       // and a camera-only map serves a run with an IMU
+  run.sensors = SensorSetup::kCameraAccel;  // an accelerometer's frame is compared
+  EXPECT_NE(map.difference(run).find("IMU.T_b_c1"), std::string::npos);
+  run.num_features += 1;  // the visual settings first
+  EXPECT_NE(map.difference(run).find("ORBextractor.nFeatures"), std::string::npos);
 }
 
 }  // namespace

@@ -3,7 +3,10 @@
 // A versioned binary format: the magic "PVBMAP\r\n", a version, then
 // sections (HEAD settings, KEYF keyframes, POIN points, GRAP graph, BOWV
 // bags of words, META the application's JSON), each with its length and an
-// FNV-1a checksum.
+// FNV-1a checksum.  A map with a trusted inertial state (MapGravity::ready)
+// is written as version 2, with an INER section (gravity, the IMU's
+// extrinsics, the keyframes' velocities, biases and chain in time) before
+// META; any other as version 1.  Both versions are read.
 // What is saved is the map's own state (poses, keypoints, descriptors,
 // point positions and statistics, the graph); what follows from it (point
 // descriptors, normals, scale ranges) is recomputed on load, so save ->
@@ -17,12 +20,14 @@
 #include <vector>
 
 #include "pvb/slam/core/map.hpp"
+#include "pvb/slam/core/settings.hpp"
 
 namespace pvb::slam {
 
 /// What a map was made with.  A map is used only by a run whose settings
 /// match, and never with another vocabulary.
 struct MapSettings {
+  // The camera and ORB settings: in HEAD.
   double fx = 0, fy = 0, cx = 0, cy = 0, bf = 0;
   std::uint32_t width = 0, height = 0;
   std::array<double, 5> distortion{};  ///< k1 k2 p1 p2 k3
@@ -32,17 +37,32 @@ struct MapSettings {
   std::uint32_t num_levels = 0;
   std::uint32_t num_features = 0;
   std::uint64_t vocabulary = 0;  ///< place::Vocabulary::fingerprint()
+  // The motion sensors: in INER, so only in a map with a trusted inertial
+  // state; a map without one reads back as kCamera (its visual map is all
+  // it holds).
+  SensorSetup sensors = SensorSetup::kCamera;
+  /// IMU.T_b_c1, the camera in the IMU (body) frame; used when
+  /// uses_accel(sensors), the identity otherwise.
+  geom::SE3d T_b_c = geom::SE3d::Identity();
+  /// Robot.T_base_c1, the camera in the base frame; used when
+  /// uses_wheels(sensors), the identity otherwise.
+  geom::SE3d T_base_c = geom::SE3d::Identity();
 
   /// The first setting that differs from `run`'s, as "NAME: VALUE in the
   /// map, VALUE in this run"; empty when they agree.  The depth factor is
-  /// not compared (a source's raw units; the map holds metres).
+  /// not compared (a source's raw units; the map holds metres), nor the
+  /// sensor setup: a camera-only map serves a run with an IMU (which finds
+  /// gravity itself) and a map with inertial state serves a camera-only run
+  /// (the visual map is the same).  When both the map and the run use an
+  /// accelerometer, T_b_c must agree within kMaxExtrinsicShiftM and
+  /// kMaxExtrinsicTurnDeg, and T_base_c too when both use the wheels.
   std::string difference(const MapSettings& run) const;
 };
 
 /// The file's header and application data, without the map itself.
 struct MapFileHeader {
-  std::uint32_t version = 0;
-  MapSettings settings;
+  std::uint32_t version = 0;   ///< 1 (no inertial state) or 2 (INER)
+  MapSettings settings;        ///< from HEAD, and the sensors from INER
   std::uint32_t sessions = 0;  ///< mapping sessions the map holds
   std::string app_json;        ///< the META section (the caller's JSON, "" when none)
   /// Where each section's payload lies in the file (offset, length), in
@@ -50,7 +70,11 @@ struct MapFileHeader {
   std::vector<std::pair<std::uint64_t, std::uint64_t>> sections;
 };
 
-constexpr std::uint32_t kMapFileVersion = 1;
+/// The newest version written and read; a map without inertial state is
+/// still written as version 1 (kMapFileVersionVisual), byte for byte as
+/// before version 2 existed.
+constexpr std::uint32_t kMapFileVersion = 2;
+constexpr std::uint32_t kMapFileVersionVisual = 1;
 /// The largest map file read: 4 GiB, about 30 000 keyframes (a
 /// 709-keyframe lawnmower map is 103 MB).  Reading one takes its size in
 /// memory, and the map about as much again.
@@ -59,6 +83,17 @@ constexpr std::uint64_t kMaxMapFileBytes = std::uint64_t(4) << 30;
 /// metres of the map's origin on each axis, and no keypoint's depth is
 /// larger: 1000 km, far beyond any station.
 constexpr double kMaxMapCoordinateM = 1e6;
+/// Extrinsics (T_b_c, T_base_c) of a map and a run that both use them
+/// agree when they differ by at most 1 mm and 0.1 degrees.
+constexpr double kMaxExtrinsicShiftM = 1e-3, kMaxExtrinsicTurnDeg = 0.1;
+/// What INER may hold: gravity's magnitude within 9.0-10.6 m/s^2 (the
+/// Earth's is 9.78-9.83); extrinsic translations within 10 m (as the
+/// settings); a keyframe's speed up to 100 m/s, its gyro bias up to
+/// 1 rad/s and accelerometer bias up to 5 m/s^2 (norms: far beyond any
+/// MEMS IMU's).  The writer leaves out what lies beyond (docs/map_file.md).
+constexpr double kMinGravityMps2 = 9.0, kMaxGravityMps2 = 10.6;
+constexpr double kMaxExtrinsicM = 10;
+constexpr double kMaxSpeedMps = 100, kMaxGyroBiasRadps = 1, kMaxAccelBiasMps2 = 5;
 
 /// Reads a map file whole, once its size and framing allow: a file larger
 /// than kMaxMapFileBytes, or whose sections' lengths (read from their
@@ -73,7 +108,9 @@ using BagOf = std::function<place::BowVector(const KeyFrame&)>;
 /// The map file's bytes for every keyframe and point in `map` (bad ones
 /// are not in it, nor a provisional map that was never merged: it lies in
 /// a frame of its own); bags of words from `bag_of`, or each keyframe's own
-/// when it is empty.  Call with the map's mutex held.
+/// when it is empty.  Version 2 with INER when the map's gravity is ready
+/// (within kMinGravityMps2..kMaxGravityMps2) and `settings.sensors` uses
+/// an accelerometer, else version 1.  Call with the map's mutex held.
 std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
                        const std::string& app_json, const BagOf& bag_of = nullptr);
 
@@ -89,7 +126,10 @@ std::shared_ptr<const CameraModel> camera_for(const MapSettings& settings);
 
 /// Reads the keyframes, points and graph of the file whose header
 /// read_map_header gave into `map` (empty), with frames on camera `cam`
-/// (the checksums are not checked again).  Every reference is checked
+/// (the checksums are not checked again); from a version-2 file also the
+/// inertial state: the map's gravity (ready), each keyframe's velocity and
+/// bias and its links to its neighbours in time (without the readings
+/// between them: a loaded chain has no intervals).  Every reference is checked
 /// (ids, keypoint indices, the spanning tree) and every value against what
 /// a camera of the map's settings could have made (docs/map_file.md, "Bad
 /// files"); a bad one throws IoError naming `file`, the section and the
