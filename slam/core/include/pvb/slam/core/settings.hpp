@@ -99,7 +99,7 @@ struct ImuSettings {
   bool present = false;  ///< the section was in the file
   ImuNoise noise;        ///< IMU.NoiseGyro, NoiseAcc, GyroWalk, AccWalk
   double rate_hz = 200;  ///< IMU.Frequency
-  geom::SE3d T_b_c;      ///< IMU.T_b_c1: the camera in the IMU (body) frame
+  geom::SE3d T_b_c = geom::SE3d::Identity();  ///< IMU.T_b_c1: the camera in the IMU (body) frame
 };
 
 /// Robot.* section (ours, optional; needed by camera+imu+wheels).
@@ -107,8 +107,8 @@ struct RobotSettings {
   bool present = false;
   WheelDrive drive;                ///< Robot.WheelRadius, Track, TicksPerRev
   double encoder_rate_hz = 50;     ///< Robot.EncoderFrequency
-  geom::SE3d T_base_c;             ///< Robot.T_base_c1: the camera in the base frame
-  geom::SE3d T_base_imu;           ///< Robot.T_base_imu
+  geom::SE3d T_base_c = geom::SE3d::Identity();    ///< Robot.T_base_c1: the camera in the base frame
+  geom::SE3d T_base_imu = geom::SE3d::Identity();  ///< Robot.T_base_imu
 };
 
 /// The default vocabulary, trained by the build (docs/place_recognition.md).

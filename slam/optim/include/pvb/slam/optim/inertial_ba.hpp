@@ -41,8 +41,8 @@ struct BaGravityEdge {
 };
 
 struct BaInertial {
-  geom::SE3d T_b_c;       ///< the camera in the IMU frame (ORB-SLAM3's IMU.T_b_c1)
-  geom::SE3d T_base_c;    ///< the camera in the wheel base frame
+  geom::SE3d T_b_c = geom::SE3d::Identity();     ///< the camera in the IMU frame (ORB-SLAM3's IMU.T_b_c1)
+  geom::SE3d T_base_c = geom::SE3d::Identity();  ///< the camera in the wheel base frame
   Eigen::Vector3d g_w = Eigen::Vector3d(0, 0, -9.81);  ///< gravity in the world (map) frame
   /// One per BaProblem::keyframes entry; in and out.  A fixed keyframe
   /// keeps its state constant too.
@@ -59,7 +59,7 @@ struct BaInertial {
 struct InertialInitProblem {
   std::vector<geom::SE3d> T_c_w;                                   ///< keyframes in time order
   std::vector<std::shared_ptr<const ImuPreintegration>> pre;       ///< pre[k]: keyframe k to k + 1
-  geom::SE3d T_b_c;
+  geom::SE3d T_b_c = geom::SE3d::Identity();
   Eigen::Vector3d g_w_guess = Eigen::Vector3d(0, 0, -9.81);
   ImuBias bias_guess;
   double gyro_bias_prior_radps = 0.01;  ///< sigma of a zero-mean prior on the gyro bias
