@@ -15,6 +15,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "inertial_costs.hpp"
+#include "pvb/slam/optim/inertial_ba.hpp"
 #include "residuals.hpp"
 
 namespace pvb::slam {
@@ -240,6 +242,7 @@ class LocalBa {
     for (std::size_t e = 0; e < ba.edges.size(); ++e) active_[e] = std::isfinite(edge_chi2(e)) ? 1 : 0;
     keyframe_used_.assign(ba.keyframes.size(), 0);
     point_used_.assign(ba.points.size(), 0);
+    if (ba.inertial) init_inertial(*ba.inertial);
   }
 
   /// Two passes as ORB-SLAM2 runs them: all edges with the Huber loss, then
@@ -266,6 +269,14 @@ class LocalBa {
       if (keyframe_used_[k] && !ba_.keyframes[k].fixed) ba_.keyframes[k].T_c_w = poses_[k].to_se3();
     for (std::size_t p = 0; p < ba_.points.size(); ++p)
       if (point_used_[p]) ba_.points[p].p_w = points_[p];
+    if (!ba_.inertial) return;
+    for (std::size_t k = 0; k < ba_.keyframes.size(); ++k) {
+      if (!has_imu_state_[k] || !keyframe_used_[k] || ba_.keyframes[k].fixed) continue;
+      BaInertialState& st = ba_.inertial->states[k];
+      st.v_w_mps = velocities_[k];
+      st.bias.gyro_radps = biases_[k].head<3>();
+      st.bias.accel_mps2 = biases_[k].tail<3>();
+    }
   }
 
  private:
@@ -304,6 +315,8 @@ class LocalBa {
     ceres::Problem prob(borrowed_problem_options());
     std::vector<std::uint8_t> kf_in(ba_.keyframes.size(), 0), pt_in(ba_.points.size(), 0);
     add_residuals(&prob, robust, &kf_in, &pt_in);
+    std::vector<std::uint8_t> state_in;  // velocity and bias blocks added (inertial only)
+    if (ba_.inertial) add_inertial_residuals(&prob, &kf_in, &state_in);
     if (prob.NumResidualBlocks() == 0) return;
     // Schur ordering: points (group 0) are eliminated first, then poses.
     // Every block must be listed, the constant ones included.
@@ -312,6 +325,11 @@ class LocalBa {
       if (pt_in[p]) ordering->AddElementToGroup(points_[p].data(), 0);
     for (std::size_t k = 0; k < poses_.size(); ++k)
       if (kf_in[k]) ordering->AddElementToGroup(poses_[k].pose, 1);
+    for (std::size_t k = 0; k < state_in.size(); ++k) {
+      if (!state_in[k]) continue;
+      ordering->AddElementToGroup(velocities_[k].data(), 1);
+      ordering->AddElementToGroup(biases_[k].data(), 1);
+    }
 
     ceres::Solver::Options solver_options;
     solver_options.linear_solver_type = options_.sparse_schur ? ceres::SPARSE_SCHUR : ceres::DENSE_SCHUR;
@@ -332,6 +350,80 @@ class LocalBa {
     for (std::size_t p = 0; p < pt_in.size(); ++p) point_used_[p] |= pt_in[p];
   }
 
+  /// The inertial terms' costs and the velocity and bias blocks of every
+  /// keyframe that an IMU edge names.
+  void init_inertial(const BaInertial& in) {
+    const std::size_t n = ba_.keyframes.size();
+    velocities_.resize(n);
+    biases_.resize(n);
+    has_imu_state_.assign(n, 0);
+    for (std::size_t k = 0; k < n; ++k) {
+      velocities_[k] = in.states[k].v_w_mps;
+      biases_[k] << in.states[k].bias.gyro_radps, in.states[k].bias.accel_mps2;
+    }
+    for (const BaImuEdge& e : in.imu_edges) {
+      has_imu_state_[e.i] = has_imu_state_[e.j] = 1;
+      imu_costs_.emplace_back(new optim_detail::ImuCost(*e.pre, in.T_b_c, in.g_w));
+      walk_costs_.emplace_back(new optim_detail::BiasWalkCost(*e.pre));
+    }
+    for (const BaWheelEdge& e : in.wheel_edges) {
+      wheel_costs_.emplace_back(new optim_detail::WheelPlanarCost(*e.pre, in.T_base_c));
+      wheel_costs_.emplace_back(new optim_detail::WheelTiltCost(*e.pre, in.T_base_c));
+    }
+    for (const BaGravityEdge& e : in.gravity_edges)
+      gravity_costs_.emplace_back(new optim_detail::GravityCost(e.f_c, in.g_w, e.sigma_rad));
+    if (in.wheel_huber > 0) wheel_loss_ = std::make_unique<ceres::HuberLoss>(in.wheel_huber);
+  }
+
+  /// A keyframe's pose block, once; constant for a fixed keyframe.
+  void add_pose_block(ceres::Problem* prob, std::size_t k, std::vector<std::uint8_t>* kf_in) {
+    if ((*kf_in)[k]) return;
+    prob->AddParameterBlock(poses_[k].pose, optim_detail::kPoseSize, &se3_manifold_);
+    if (ba_.keyframes[k].fixed) prob->SetParameterBlockConstant(poses_[k].pose);
+    (*kf_in)[k] = 1;
+  }
+
+  /// A keyframe's pose, velocity and bias blocks, once; constant for a fixed keyframe.
+  void add_state_blocks(ceres::Problem* prob, std::size_t k, std::vector<std::uint8_t>* kf_in,
+                        std::vector<std::uint8_t>* state_in) {
+    add_pose_block(prob, k, kf_in);
+    if ((*state_in)[k]) return;
+    prob->AddParameterBlock(velocities_[k].data(), 3);
+    prob->AddParameterBlock(biases_[k].data(), 6);
+    if (ba_.keyframes[k].fixed) {
+      prob->SetParameterBlockConstant(velocities_[k].data());
+      prob->SetParameterBlockConstant(biases_[k].data());
+    }
+    (*state_in)[k] = 1;
+  }
+
+  /// IMU edges with their bias walks, wheel edges (Huber), gravity edges.
+  void add_inertial_residuals(ceres::Problem* prob, std::vector<std::uint8_t>* kf_in,
+                              std::vector<std::uint8_t>* state_in) {
+    const BaInertial& in = *ba_.inertial;
+    state_in->assign(ba_.keyframes.size(), 0);
+    for (std::size_t e = 0; e < in.imu_edges.size(); ++e) {
+      const std::size_t i = in.imu_edges[e].i, j = in.imu_edges[e].j;
+      add_state_blocks(prob, i, kf_in, state_in);
+      add_state_blocks(prob, j, kf_in, state_in);
+      prob->AddResidualBlock(imu_costs_[e].get(), nullptr, {poses_[i].pose, velocities_[i].data(), biases_[i].data(),
+                                                             poses_[j].pose, velocities_[j].data()});
+      prob->AddResidualBlock(walk_costs_[e].get(), nullptr, biases_[i].data(), biases_[j].data());
+    }
+    for (std::size_t e = 0; e < in.wheel_edges.size(); ++e) {
+      const std::size_t i = in.wheel_edges[e].i, j = in.wheel_edges[e].j;
+      add_pose_block(prob, i, kf_in);
+      add_pose_block(prob, j, kf_in);
+      for (int part = 0; part < 2; ++part)
+        prob->AddResidualBlock(wheel_costs_[2 * e + part].get(), wheel_loss_.get(), poses_[i].pose, poses_[j].pose);
+    }
+    for (std::size_t e = 0; e < in.gravity_edges.size(); ++e) {
+      const std::size_t k = in.gravity_edges[e].keyframe;
+      add_pose_block(prob, k, kf_in);
+      prob->AddResidualBlock(gravity_costs_[e].get(), nullptr, poses_[k].pose);
+    }
+  }
+
   BaProblem& ba_;
   const StereoIntrinsics& K_;
   const BaOptions& options_;
@@ -342,7 +434,32 @@ class LocalBa {
   optim_detail::SE3LeftManifold se3_manifold_;
   std::vector<std::uint8_t> active_, keyframe_used_, point_used_;
   AbortCallback abort_callback_;
+  // Inertial terms (BaProblem::inertial set), indexed like the keyframes / the edges.
+  std::vector<Eigen::Vector3d> velocities_;               ///< velocity blocks
+  std::vector<Eigen::Matrix<double, 6, 1>> biases_;       ///< bias blocks [b_g, b_a]
+  std::vector<std::uint8_t> has_imu_state_;               ///< keyframe named by an IMU edge
+  std::vector<std::unique_ptr<ceres::CostFunction>> imu_costs_, walk_costs_;  ///< per IMU edge
+  std::vector<std::unique_ptr<ceres::CostFunction>> wheel_costs_;   ///< planar and tilt per wheel edge
+  std::vector<std::unique_ptr<ceres::CostFunction>> gravity_costs_; ///< per gravity edge
+  std::unique_ptr<ceres::HuberLoss> wheel_loss_;          ///< Huber of the wheel edges (null: none)
 };
+
+/// Checks the inertial part of a problem: one state per keyframe, edges
+/// naming two different existing keyframes, non-empty increments.
+void check_inertial(const BaProblem& ba) {
+  const BaInertial& in = *ba.inertial;
+  const std::size_t n = ba.keyframes.size();
+  const auto fail = [](const std::string& what) {
+    throw std::invalid_argument("local_bundle_adjustment: " + what);
+  };
+  if (in.states.size() != n) fail("inertial states must be one per keyframe");
+  for (const BaImuEdge& e : in.imu_edges)
+    if (e.i >= n || e.j >= n || e.i == e.j || !e.pre || !(e.pre->dt_s() > 0)) fail("bad IMU edge");
+  for (const BaWheelEdge& e : in.wheel_edges)
+    if (e.i >= n || e.j >= n || e.i == e.j || !e.pre) fail("bad wheel edge");
+  for (const BaGravityEdge& e : in.gravity_edges)
+    if (e.keyframe >= n || !(e.sigma_rad > 0) || !(e.f_c.norm() > 0)) fail("bad gravity edge");
+}
 
 }  // namespace
 
@@ -356,8 +473,11 @@ BaResult local_bundle_adjustment(BaProblem* problem, const StereoIntrinsics& K, 
                                   " refers to a missing keyframe or point");
     }
   }
+  if (ba.inertial) check_inertial(ba);
+  const bool inertial_terms = ba.inertial && (!ba.inertial->imu_edges.empty() || !ba.inertial->wheel_edges.empty() ||
+                                              !ba.inertial->gravity_edges.empty());
   BaResult result;
-  if (num_edges == 0) {
+  if (num_edges == 0 && !inertial_terms) {
     result.converged = true;  // nothing to optimise
     return result;
   }

@@ -51,6 +51,9 @@ class ImuPreintegration {
 
   /// Adds one reading held constant over dt_s (> 0) and propagates the
   /// covariance (discrete noise: density^2 / dt) and the bias Jacobians.
+  /// The specific force is rotated by the attitude at the middle of the
+  /// period (the reading is a mean over it).  Throws std::invalid_argument
+  /// for dt_s <= 0.
   void integrate(const Eigen::Vector3d& gyro_radps, const Eigen::Vector3d& accel_mps2, double dt_s);
   /// Appends the readings of `next` (which starts where this one ends),
   /// integrated at this one's bias.

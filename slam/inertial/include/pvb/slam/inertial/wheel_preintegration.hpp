@@ -28,6 +28,17 @@ struct WheelNoise {
   double planar_floor = 1e-3;               ///< m / rad added so standing still is not infinitely stiff
 };
 
+/// Composition of planar poses [x, y, yaw]: b expressed in a's frame,
+///   a (+) b = [a_xy + R(a_yaw) b_xy, a_yaw + b_yaw],
+/// with its Jacobians with respect to a and b (either may be null).
+Eigen::Vector3d planar_compose(const Eigen::Vector3d& a, const Eigen::Vector3d& b, Eigen::Matrix3d* J_a = nullptr,
+                               Eigen::Matrix3d* J_b = nullptr);
+
+/// The increment [x, y, yaw] of one encoder interval from the arcs the left
+/// and right wheel rolled (m): ds = (l + r) / 2 along the chord at half the
+/// turn dyaw = (r - l) / track.
+Eigen::Vector3d wheel_step(double left_m, double right_m, double track_m);
+
 class WheelPreintegration {
  public:
   WheelPreintegration() = default;
@@ -49,6 +60,9 @@ class WheelPreintegration {
   /// [z (m), roll (rad), pitch (rad)].
   Eigen::Vector3d planar_sigma() const;
   const WheelDrive& drive() const { return drive_; }
+  const WheelNoise& noise() const { return noise_; }
+  /// Distance a wheel rolls per encoder count, metres.
+  double metres_per_tick() const;
 
  private:
   WheelDrive drive_;
