@@ -2,6 +2,8 @@
 // the inertial, wheel and tilt terms of local BA (docs/slam_inertial.md).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 
 #include "pvb/slam/core/local_mapping.hpp"
@@ -21,6 +23,33 @@ std::vector<std::shared_ptr<KeyFrame>> chain_to(const std::shared_ptr<KeyFrame>&
 }
 
 double seconds_between(const KeyFrame& a, const KeyFrame& b) { return static_cast<double>(b.t_ns() - a.t_ns()) * 1e-9; }
+
+/// The IMU's position at a keyframe.
+Eigen::Vector3d imu_position(const KeyFrame& k, const geom::SE3d& T_b_c) {
+  return (k.T_c_w().inverse() * T_b_c.inverse()).translation();
+}
+
+/// Gravity's direction from the run's increments (ORB-SLAM3's first
+/// guess): the velocity increments turned into the map add up to the
+/// change of velocity less g times the time, and vision gives that change.
+Eigen::Vector3d gravity_guess(const std::vector<std::shared_ptr<KeyFrame>>& run, const geom::SE3d& T_b_c,
+                              const Eigen::Vector3d& fallback) {
+  Eigen::Vector3d sum_dv = Eigen::Vector3d::Zero();
+  double total_s = 0;
+  for (std::size_t k = 1; k < run.size(); ++k) {
+    const ImuPreintegration& pre = *run[k]->motion().from_prev.imu;
+    const Eigen::Matrix3d R_w_b = (run[k - 1]->T_c_w().inverse() * T_b_c.inverse()).linear();
+    sum_dv += R_w_b * pre.delta_v();
+    total_s += pre.dt_s();
+  }
+  const std::size_t n = run.size();
+  const auto velocity = [&](std::size_t a, std::size_t b) {
+    return (imu_position(*run[b], T_b_c) - imu_position(*run[a], T_b_c)) / seconds_between(*run[a], *run[b]);
+  };
+  const Eigen::Vector3d dv_w = velocity(n - 2, n - 1) - velocity(0, 1);
+  const Eigen::Vector3d g = (dv_w - sum_dv) / total_s;
+  return g.norm() > 1.0 ? Eigen::Vector3d(g.normalized() * kGravityMps2) : fallback;
+}
 
 /// Camera + accelerometer: gravity is the mean of the keyframes'
 /// specific forces turned into the map, pointing down.
@@ -70,12 +99,19 @@ void LocalMapping::initialize_inertial(const std::shared_ptr<KeyFrame>& kf) {
     return;
   InertialInitProblem problem;
   problem.T_b_c = options_.imu.T_b_c;
-  problem.g_w_guess = g.g_w;
+  problem.g_w_guess = gravity_guess(run, options_.imu.T_b_c, g.g_w);
+  problem.gyro_bias_prior_radps = options_.init_gyro_bias_sigma_radps;
+  problem.accel_bias_prior_mps2 = options_.init_accel_bias_sigma_mps2;
   for (std::size_t k = 0; k < run.size(); ++k) {
     problem.T_c_w.push_back(run[k]->T_c_w());
     if (k > 0) problem.pre.push_back(run[k]->motion().from_prev.imu);
   }
   const InertialInitResult r = slam::initialize_inertial(problem);
+  if (std::getenv("PVB_DEBUG_INERTIAL"))
+    std::fprintf(stderr, "inertial init at kf %llu (%zu kfs): ok %d g %.4f %.4f %.4f bg %.5f %.5f %.5f ba %.4f %.4f %.4f rms %.3f\n",
+                 (unsigned long long)kf->id(), run.size(), r.ok, r.g_w.x(), r.g_w.y(), r.g_w.z(), r.bias.gyro_radps.x(),
+                 r.bias.gyro_radps.y(), r.bias.gyro_radps.z(), r.bias.accel_mps2.x(), r.bias.accel_mps2.y(),
+                 r.bias.accel_mps2.z(), r.rms_whitened);
   if (!r.ok) return;
   g.ready = true;
   g.g_w = r.g_w;
@@ -106,6 +142,8 @@ void LocalMapping::add_motion_terms(BaProblem* problem, std::vector<std::shared_
   in->T_b_c = options_.imu.T_b_c;
   in->T_base_c = options_.robot.T_base_c;
   in->g_w = g.g_w;
+  if (imu) in->gravity_sigma_rad = options_.gravity_sigma_rad;
+  in->fixed_states_free = true;
   std::map<std::uint64_t, std::size_t> index;
   for (std::size_t k = 0; k < kfs->size(); ++k) index[(*kfs)[k]->id()] = k;
   const auto index_of = [&](const std::shared_ptr<KeyFrame>& k) {
@@ -146,6 +184,7 @@ void LocalMapping::add_motion_terms(BaProblem* problem, std::vector<std::shared_
 
 void LocalMapping::write_motion_states(const BaProblem& problem, const std::vector<std::shared_ptr<KeyFrame>>& kfs) {
   MapGravity& g = map_.gravity();
+  if (g.ready && problem.inertial->gravity_sigma_rad > 0) g.g_w = problem.inertial->g_w;
   std::uint64_t newest = 0;
   for (std::size_t k = 0; k < kfs.size(); ++k) {
     KeyFrameMotion& m = kfs[k]->motion();

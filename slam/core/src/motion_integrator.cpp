@@ -1,13 +1,24 @@
 #include "pvb/slam/core/motion_integrator.hpp"
 
 #include <cmath>
+#include <cstdlib>
 
 namespace pvb::slam {
+
+namespace {
+WheelNoise env_wheel_noise() {
+  WheelNoise n;
+  if (const char* v = std::getenv("PVB_WHEEL_YAW")) n.yaw_per_sqrt_m = std::atof(v);
+  if (const char* v = std::getenv("PVB_WHEEL_TRANS")) n.translation_per_sqrt_m = std::atof(v);
+  return n;
+}
+}  // namespace
 
 MotionIntegrator::MotionIntegrator(SensorSetup setup, const ImuSettings& imu, const RobotSettings& robot)
     : setup_(setup),
       imu_(imu),
       robot_(robot),
+      wheel_noise_(env_wheel_noise()),
       imu_frame_(ImuBias{}, imu.noise),
       imu_kf_(ImuBias{}, imu.noise),
       wheel_frame_(robot.drive, wheel_noise_),
@@ -19,6 +30,7 @@ void MotionIntegrator::add_frame(std::int64_t t_ns, const std::vector<sensor::Im
   wheel_frame_ = WheelPreintegration(robot_.drive, wheel_noise_);
   if (uses_accel(setup_))
     for (const auto& s : imu) add_imu(s);
+  if (uses_imu(setup_)) integrate_up_to(t_ns);
   if (uses_wheels(setup_))
     for (const auto& t : ticks) add_ticks(t);
   // The tilt window ends at the frame.
@@ -27,19 +39,36 @@ void MotionIntegrator::add_frame(std::int64_t t_ns, const std::vector<sensor::Im
 }
 
 void MotionIntegrator::add_imu(const sensor::ImuSample& s) {
-  const double period_s = 1.0 / imu_.rate_hz;
-  const double dt_s = last_imu_t_ns_ ? static_cast<double>(s.t_ns - *last_imu_t_ns_) * 1e-9 : period_s;
+  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / imu_.rate_hz));
+  if (last_imu_t_ns_ && s.t_ns <= *last_imu_t_ns_) return;  // a repeated reading
   last_imu_t_ns_ = s.t_ns;
-  if (!(dt_s > 0) || !s.accel_mps2.allFinite()) return;  // a repeated or broken reading
+  if (!s.accel_mps2.allFinite()) return;
   ++imu_count_;
   const Eigen::Matrix3d R_c_b = imu_.T_b_c.linear().transpose();
   recent_f_c_.emplace_back(s.t_ns, R_c_b * (s.accel_mps2 - bias_.accel_mps2));
   if (!uses_imu(setup_) || !s.gyro_radps.allFinite()) return;
-  // A gap (a dropped stretch) is integrated as one reading of at most
-  // ten periods: the rest is not known.
-  const double step_s = std::min(dt_s, 10 * period_s);
-  imu_frame_.integrate(s.gyro_radps, s.accel_mps2, step_s);
-  imu_kf_.integrate(s.gyro_radps, s.accel_mps2, step_s);
+  // The reading is the mean over its period; the part of it before the
+  // time already integrated (a frame's time inside the period) was
+  // counted with the frame.  A gap (a dropped stretch) is integrated as at
+  // most ten periods: the rest is not known.
+  const std::int64_t start_ns = covered_t_ns_ ? *covered_t_ns_ : s.t_ns - period_ns;
+  covered_t_ns_ = s.t_ns;
+  last_reading_ = s;
+  const double dt_s = static_cast<double>(std::min(s.t_ns - start_ns, 10 * period_ns)) * 1e-9;
+  if (!(dt_s > 0)) return;
+  imu_frame_.integrate(s.gyro_radps, s.accel_mps2, dt_s);
+  imu_kf_.integrate(s.gyro_radps, s.accel_mps2, dt_s);
+}
+
+void MotionIntegrator::integrate_up_to(std::int64_t t_ns) {
+  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / imu_.rate_hz));
+  if (!last_reading_ || !covered_t_ns_ || *covered_t_ns_ >= t_ns || t_ns - *covered_t_ns_ > period_ns) return;
+  // The interval ends at the frame: the newest reading is held up to it
+  // (the next reading, which covers this stretch too, begins there).
+  const double dt_s = static_cast<double>(t_ns - *covered_t_ns_) * 1e-9;
+  imu_frame_.integrate(last_reading_->gyro_radps, last_reading_->accel_mps2, dt_s);
+  imu_kf_.integrate(last_reading_->gyro_radps, last_reading_->accel_mps2, dt_s);
+  covered_t_ns_ = t_ns;
 }
 
 void MotionIntegrator::add_ticks(const sensor::WheelTicks& t) {
@@ -55,15 +84,8 @@ KeyframeInterval MotionIntegrator::take_keyframe_interval() {
   KeyframeInterval out;
   if (uses_imu(setup_) && imu_kf_.size() > 0) out.imu = std::make_shared<ImuPreintegration>(imu_kf_);
   if (uses_wheels(setup_) && has_wheels()) out.wheels = std::make_shared<WheelPreintegration>(wheel_kf_);
-  if (!recent_f_c_.empty()) {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const auto& [t, f] : recent_f_c_) mean += f;
-    mean /= static_cast<double>(recent_f_c_.size());
-    double var = 0;
-    for (const auto& [t, f] : recent_f_c_) var += (f - mean).squaredNorm();
-    out.f_c_mps2 = mean;
-    out.f_spread_mps2 = std::sqrt(var / static_cast<double>(recent_f_c_.size()));
-  }
+  out.f_c_mps2 = recent_specific_force_c();
+  out.f_spread_mps2 = recent_spread_mps2();
   imu_kf_ = ImuPreintegration(bias_, imu_.noise);
   wheel_kf_ = WheelPreintegration(robot_.drive, wheel_noise_);
   return out;
@@ -80,6 +102,14 @@ std::optional<Eigen::Vector3d> MotionIntegrator::recent_specific_force_c() const
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const auto& [t, f] : recent_f_c_) mean += f;
   return mean / static_cast<double>(recent_f_c_.size());
+}
+
+double MotionIntegrator::recent_spread_mps2() const {
+  const std::optional<Eigen::Vector3d> mean = recent_specific_force_c();
+  if (!mean) return 0;
+  double sum = 0;
+  for (const auto& [t, f] : recent_f_c_) sum += (f - *mean).squaredNorm();
+  return std::sqrt(sum / static_cast<double>(recent_f_c_.size()));
 }
 
 NavState MotionIntegrator::nav_state(const geom::SE3d& T_c_w, const Eigen::Vector3d& v_w) const {

@@ -34,6 +34,16 @@ bool Tracking::inertial_ready() const {
   return motion_ && uses_imu(motion_->setup()) && motion_->has_imu() && map_.gravity().ready && provisional_ == 0;
 }
 
+bool Tracking::waiting_for_accelerometer(const Frame& f) {
+  if (!motion_ || !uses_accel(motion_->setup())) return false;
+  if (!first_frame_t_ns_) first_frame_t_ns_ = f.t_ns;
+  if (f.t_ns - *first_frame_t_ns_ >= kAccelWaitNs) return false;
+  // Level only on a quiet accelerometer: the robot not jolted (a start
+  // rocks it on its caster for a moment).
+  const std::optional<Eigen::Vector3d> f_c = motion_->recent_specific_force_c();
+  return !f_c || std::abs(f_c->norm() - 9.81) > kQuietMps2 || motion_->recent_spread_mps2() > kQuietMps2;
+}
+
 geom::SE3d Tracking::first_pose() const {
   if (!motion_ || !uses_accel(motion_->setup())) return geom::SE3d::Identity();
   const std::optional<Eigen::Vector3d> f_c = motion_->recent_specific_force_c();

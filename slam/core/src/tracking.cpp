@@ -156,6 +156,7 @@ bool Tracking::initialize(Frame& f) {
   if (with_depth <= options_.min_init_points)
     return fail("initialisation: only " + std::to_string(with_depth) + " keypoints with depth (need more than " +
                 std::to_string(options_.min_init_points) + ")");
+  if (waiting_for_accelerometer(f)) return fail("initialisation: waiting for the accelerometer's first readings");
   f.T_c_w = first_pose();
   f.has_pose = true;
   auto kf = map_.create_keyframe(f);

@@ -101,6 +101,37 @@ class ImuCost final : public TangentJetCost<ImuCost, 9, kPoseSize, 3, 6, kPoseSi
   Eigen::Vector3d g_w_;  ///< gravity in the world
 };
 
+/// IMU factor with gravity estimated (9 rows).  Blocks: pose i, v_i,
+/// bias i, pose j, v_j, g_w (3, on a sphere of radius |g|).
+class ImuCostFreeGravity final : public TangentJetCost<ImuCostFreeGravity, 9, kPoseSize, 3, 6, kPoseSize, 3, 3> {
+ public:
+  ImuCostFreeGravity(const ImuPreintegration& pre, const geom::SE3d& T_b_c) : factor_(pre, T_b_c) {}
+  template <typename T>
+  void residual(const T* const* b, T* r) const {
+    factor_.residual(b[0], b[1], b[2], b[3], b[4], b[5], r);
+  }
+
+ private:
+  ImuFactor factor_;
+};
+
+/// Prior on gravity's direction (3 rows): (g - g0) / (|g0| sigma).
+class GravityPriorCost final : public ceres::SizedCostFunction<3, 3> {
+ public:
+  GravityPriorCost(const Eigen::Vector3d& g0, double sigma_rad) : g0_(g0), w_(1.0 / (g0.norm() * sigma_rad)) {}
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    for (int k = 0; k < 3; ++k) residuals[k] = w_ * (parameters[0][k] - g0_[k]);
+    if (jacobians != nullptr && jacobians[0] != nullptr)
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) jacobians[0][r * 3 + c] = r == c ? w_ : 0.0;
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d g0_;
+  double w_;
+};
+
 /// Bias random walk (6 rows).  Blocks: bias i, bias j.
 class BiasWalkCost final : public TangentJetCost<BiasWalkCost, 6, 6, 6> {
  public:

@@ -270,6 +270,7 @@ class LocalBa {
     for (std::size_t p = 0; p < ba_.points.size(); ++p)
       if (point_used_[p]) ba_.points[p].p_w = points_[p];
     if (!ba_.inertial) return;
+    if (free_gravity_) ba_.inertial->g_w = gravity_;
     for (std::size_t k = 0; k < ba_.keyframes.size(); ++k) {
       if (!has_imu_state_[k] || !keyframe_used_[k] || ba_.keyframes[k].fixed) continue;
       BaInertialState& st = ba_.inertial->states[k];
@@ -330,6 +331,7 @@ class LocalBa {
       ordering->AddElementToGroup(velocities_[k].data(), 1);
       ordering->AddElementToGroup(biases_[k].data(), 1);
     }
+    if (ba_.inertial && free_gravity_) ordering->AddElementToGroup(gravity_.data(), 1);
 
     ceres::Solver::Options solver_options;
     solver_options.linear_solver_type = options_.sparse_schur ? ceres::SPARSE_SCHUR : ceres::DENSE_SCHUR;
@@ -361,9 +363,13 @@ class LocalBa {
       velocities_[k] = in.states[k].v_w_mps;
       biases_[k] << in.states[k].bias.gyro_radps, in.states[k].bias.accel_mps2;
     }
+    gravity_ = in.g_w;
+    free_gravity_ = in.gravity_sigma_rad > 0 && !in.imu_edges.empty();
+    if (free_gravity_) gravity_prior_ = std::make_unique<optim_detail::GravityPriorCost>(in.g_w, in.gravity_sigma_rad);
     for (const BaImuEdge& e : in.imu_edges) {
       has_imu_state_[e.i] = has_imu_state_[e.j] = 1;
-      imu_costs_.emplace_back(new optim_detail::ImuCost(*e.pre, in.T_b_c, in.g_w));
+      if (free_gravity_) imu_costs_.emplace_back(new optim_detail::ImuCostFreeGravity(*e.pre, in.T_b_c));
+      else imu_costs_.emplace_back(new optim_detail::ImuCost(*e.pre, in.T_b_c, in.g_w));
       walk_costs_.emplace_back(new optim_detail::BiasWalkCost(*e.pre));
     }
     for (const BaWheelEdge& e : in.wheel_edges) {
@@ -375,6 +381,7 @@ class LocalBa {
     if (in.wheel_huber > 0) wheel_loss_ = std::make_unique<ceres::HuberLoss>(in.wheel_huber);
   }
 
+  bool free_fixed_states() const { return ba_.inertial->fixed_states_free; }
   /// A keyframe's pose block, once; constant for a fixed keyframe.
   void add_pose_block(ceres::Problem* prob, std::size_t k, std::vector<std::uint8_t>* kf_in) {
     if ((*kf_in)[k]) return;
@@ -390,7 +397,7 @@ class LocalBa {
     if ((*state_in)[k]) return;
     prob->AddParameterBlock(velocities_[k].data(), 3);
     prob->AddParameterBlock(biases_[k].data(), 6);
-    if (ba_.keyframes[k].fixed) {
+    if (ba_.keyframes[k].fixed && !free_fixed_states()) {
       prob->SetParameterBlockConstant(velocities_[k].data());
       prob->SetParameterBlockConstant(biases_[k].data());
     }
@@ -406,9 +413,15 @@ class LocalBa {
       const std::size_t i = in.imu_edges[e].i, j = in.imu_edges[e].j;
       add_state_blocks(prob, i, kf_in, state_in);
       add_state_blocks(prob, j, kf_in, state_in);
-      prob->AddResidualBlock(imu_costs_[e].get(), nullptr, {poses_[i].pose, velocities_[i].data(), biases_[i].data(),
-                                                             poses_[j].pose, velocities_[j].data()});
+      std::vector<double*> blocks{poses_[i].pose, velocities_[i].data(), biases_[i].data(), poses_[j].pose,
+                                  velocities_[j].data()};
+      if (free_gravity_) blocks.push_back(gravity_.data());
+      prob->AddResidualBlock(imu_costs_[e].get(), nullptr, blocks);
       prob->AddResidualBlock(walk_costs_[e].get(), nullptr, biases_[i].data(), biases_[j].data());
+    }
+    if (free_gravity_) {
+      prob->SetManifold(gravity_.data(), &sphere_manifold_);
+      prob->AddResidualBlock(gravity_prior_.get(), nullptr, gravity_.data());
     }
     for (std::size_t e = 0; e < in.wheel_edges.size(); ++e) {
       const std::size_t i = in.wheel_edges[e].i, j = in.wheel_edges[e].j;
@@ -442,6 +455,10 @@ class LocalBa {
   std::vector<std::unique_ptr<ceres::CostFunction>> wheel_costs_;   ///< planar and tilt per wheel edge
   std::vector<std::unique_ptr<ceres::CostFunction>> gravity_costs_; ///< per gravity edge
   std::unique_ptr<ceres::HuberLoss> wheel_loss_;          ///< Huber of the wheel edges (null: none)
+  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();     ///< g_w's block (BaInertial::gravity_sigma_rad > 0)
+  bool free_gravity_ = false;
+  std::unique_ptr<ceres::CostFunction> gravity_prior_;
+  ceres::SphereManifold<3> sphere_manifold_;
 };
 
 /// Checks the inertial part of a problem: one state per keyframe, edges

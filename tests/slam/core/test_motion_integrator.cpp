@@ -48,8 +48,8 @@ TEST(MotionIntegrator, PredictsAStraightDriveAtConstantSpeed) {
   MotionIntegrator m(s.sensors, s.imu, s.robot);
   m.add_frame(0, level_readings(-kFramePeriodNs, 0, 0), {});
   m.add_frame(kFramePeriodNs, level_readings(0, kFramePeriodNs, 0), {});
-  // The readings at 5 ... 30 ms: the one at 35 ms comes with the next frame.
-  EXPECT_NEAR(m.imu_since_frame().dt_s(), 0.030, 1e-12);
+  // The readings at 5 ... 30 ms, the one at 30 ms held to the frame's time.
+  EXPECT_NEAR(m.imu_since_frame().dt_s(), kFramePeriodNs * 1e-9, 1e-12);
   // The camera pose whose IMU stands at the origin, level, heading along x.
   const geom::SE3d T_c_w0 = m.camera_pose(NavState{});
   const Eigen::Vector3d v_w(0.5, 0, 0);
@@ -102,9 +102,10 @@ TEST(MotionIntegrator, KeyframeIntervalsSplitTheReadingsAndGiveTheTilt) {
   for (int f = 10; f < 15; ++f) m.add_frame(f * kFramePeriodNs, level_readings((f - 1) * kFramePeriodNs, f * kFramePeriodNs, 0), {});
   const KeyframeInterval b = m.take_keyframe_interval();
   ASSERT_TRUE(b.imu);
-  // Readings from -30 ms to 465 ms, the first counted one period.
-  EXPECT_NEAR(a.imu->dt_s() + b.imu->dt_s(), 0.500, 1e-9);
-  EXPECT_EQ(a.imu->size() + b.imu->size(), 100u);
+  // The intervals end at the frames: the first reading (at -30 ms) counts
+  // one period, and the last frame is at 14 frame periods.
+  EXPECT_NEAR(a.imu->dt_s(), (9 * kFramePeriodNs + 35'000'000) * 1e-9, 1e-12);
+  EXPECT_NEAR(b.imu->dt_s(), 5 * kFramePeriodNs * 1e-9, 1e-12);
   EXPECT_EQ(m.imu_since_keyframe().size(), 0u);
 }
 

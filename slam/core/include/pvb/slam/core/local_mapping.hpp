@@ -55,6 +55,13 @@ struct LocalMappingOptions {
   /// A keyframe is not culled when its neighbours in time would be this
   /// far apart (their IMU interval would grow too long).
   double max_inertial_gap_s = 3.0;
+  /// Zero-mean priors of the initialisation on the biases (an IMU's
+  /// turn-on biases: BMI088's datasheet gives 1 deg/s and 20 mg per axis).
+  double init_gyro_bias_sigma_radps = 0.02;
+  double init_accel_bias_sigma_mps2 = 0.3;
+  /// Local BA refines gravity's direction under a prior of this standard
+  /// deviation about the last estimate (0: gravity held after initialisation).
+  double gravity_sigma_rad = 0.005;
 };
 
 /// Map-point culling rule (ORB-SLAM2 MapPointCulling, RGB-D): returns

@@ -46,10 +46,12 @@ class MotionIntegrator {
   const ImuBias& bias() const { return bias_; }
   void set_bias(const ImuBias& b);
 
-  /// The mean accelerometer direction of the first frame's readings in the
-  /// camera frame (specific force, pointing up), if any: the map's first
-  /// frame is levelled with it.
+  /// The accelerometer's mean over the last kTiltWindowS in the camera
+  /// frame (specific force, pointing up), if any: the map's first frame is
+  /// levelled with it.
   std::optional<Eigen::Vector3d> recent_specific_force_c() const;
+  /// RMS distance of those readings from their mean (0 without readings).
+  double recent_spread_mps2() const;
 
   /// The frame after `last` (IMU state of the last frame: attitude and
   /// position from its camera pose, velocity v_w) by the readings since it,
@@ -81,7 +83,12 @@ class MotionIntegrator {
   ImuBias bias_;
   ImuPreintegration imu_frame_, imu_kf_;
   WheelPreintegration wheel_frame_, wheel_kf_;
-  std::optional<std::int64_t> last_imu_t_ns_;
+  /// Holds the newest reading from its time up to the frame's t_ns.
+  void integrate_up_to(std::int64_t t_ns);
+
+  std::optional<std::int64_t> last_imu_t_ns_;  ///< the newest reading's time
+  std::optional<std::int64_t> covered_t_ns_;   ///< integrated up to here
+  std::optional<sensor::ImuSample> last_reading_;
   std::optional<sensor::WheelTicks> last_ticks_;
   std::size_t imu_count_ = 0;
   /// Accelerometer readings of the last kTiltWindowS (time, camera frame).

@@ -282,6 +282,13 @@ class Tracking {
   // Motion sensors (motion_tracking.cpp) ------------------------------------------
   /// The IMU's state is trusted: predictions and dead reckoning may use it.
   bool inertial_ready() const;
+  /// A setup with an accelerometer whose readings have not come yet or
+  /// are not quiet (for at most kAccelWaitNs after the first frame): the
+  /// map waits for them, to begin level.
+  bool waiting_for_accelerometer(const Frame& f);
+  static constexpr std::int64_t kAccelWaitNs = 1'000'000'000;
+  static constexpr double kQuietMps2 = 0.5;  ///< spread and departure from g of a quiet accelerometer
+  std::optional<std::int64_t> first_frame_t_ns_;
   /// The first frame's pose: levelled by the accelerometer (z against
   /// gravity, the camera's heading kept) when the setup has one.
   geom::SE3d first_pose() const;

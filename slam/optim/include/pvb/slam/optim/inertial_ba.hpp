@@ -45,12 +45,20 @@ struct BaInertial {
   geom::SE3d T_base_c = geom::SE3d::Identity();  ///< the camera in the wheel base frame
   Eigen::Vector3d g_w = Eigen::Vector3d(0, 0, -9.81);  ///< gravity in the world (map) frame
   /// One per BaProblem::keyframes entry; in and out.  A fixed keyframe
-  /// keeps its state constant too.
+  /// keeps its state constant too, unless fixed_states_free.
   std::vector<BaInertialState> states;
   std::vector<BaImuEdge> imu_edges;
   std::vector<BaWheelEdge> wheel_edges;
   std::vector<BaGravityEdge> gravity_edges;
+  /// A fixed keyframe's velocity and bias are estimated (its pose held):
+  /// the window's biases then follow the data instead of the oldest
+  /// keyframe's estimate, which the bias random walk would pin them to.
+  bool fixed_states_free = false;
   double wheel_huber = 2.0;  ///< Huber delta of the whitened wheel residual (slip)
+  /// > 0: gravity's direction is estimated with the IMU edges (its
+  /// magnitude kept), under a prior of this standard deviation about g_w,
+  /// and written back to g_w; 0: g_w is held.
+  double gravity_sigma_rad = 0;
 };
 
 /// Inertial initialisation: keyframe poses from vision (fixed), the IMU
