@@ -107,6 +107,38 @@ TEST(RunInertialCli, CameraImuRunReportsGravityTiltAndBiases) {
   EXPECT_NE(read_file(d + "/index.html").find("<tr><th>dead-reckoned frames</th>"), std::string::npos);
 }
 
+// pvbench slam on a recording: the same keys in stats.json, the biases
+// against the recording's imu0/truth.csv.
+TEST(RunInertialCli, SlamOnARecordingComparesTheBiasesWithItsTruth) {
+  const std::string rec = fresh("rec"), out = fresh("slam");
+  ASSERT_EQ(test::run_pvbench("record --scenario " + kStation + " --out " + rec + " --frames 120").code, 0);
+  const test::RunResult r =
+      test::run_pvbench("slam --sequence " + rec + " --settings " + rec + "/camera.yaml --out " + out +
+                        " --sync --no-dense --sensors camera+imu");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("inertial state trusted at t = "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("bias error RMS over "), std::string::npos) << r.output;
+  const YAML::Node s = YAML::Load(read_file(out + "/stats.json"));
+  EXPECT_EQ(s["dead_reckoned_frames"].as<int>(), frames_in_state(out, "dead_reckoning"));
+  EXPECT_EQ(s["gravity"]["map_frame"].as<std::string>(), "gravity_aligned");
+  ASSERT_TRUE(s["inertial"]["trusted"].as<bool>());
+  const YAML::Node b = s["inertial"]["biases"];
+  ASSERT_TRUE(b && b.IsMap());
+  EXPECT_GT(b["keyframes"].as<int>(), 1);
+  EXPECT_LT(b["gyro_rms_radps"].as<double>(), 0.005);
+  const std::vector<double> truth = true_gyro_bias_near(rec, b["t_s"][0].as<double>());
+  ASSERT_EQ(truth.size(), 3u);
+  EXPECT_NEAR(b["gyro_true_radps"][0][2].as<double>(), truth[2], 4e-7);
+  // Camera alone: no inertial state.
+  const std::string cam = fresh("slam_cam");
+  ASSERT_EQ(test::run_pvbench("slam --sequence " + rec + " --settings " + rec + "/camera.yaml --out " + cam +
+                              " --sync --no-dense --max-frames 10 --sensors camera")
+                .code,
+            0);
+  EXPECT_FALSE(YAML::Load(read_file(cam + "/stats.json"))["inertial"]);
+  EXPECT_EQ(YAML::Load(read_file(cam + "/stats.json"))["dead_reckoned_frames"].as<int>(), 0);
+}
+
 TEST(RunInertialCli, CompareSensorsNamesTheSystemsBySetup) {
   const std::string d = fresh("compare");
   const test::RunResult r =
