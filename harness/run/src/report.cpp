@@ -346,7 +346,7 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
   // Tracking time histogram, one per run.
   for (const SlamRun* run : runs) {
     const std::vector<double> ms = tracking_times(*run);
-    write_figure(eval::make_histogram("tracking time per frame: " + eval::mode_label(run->mode),
+    write_figure(eval::make_histogram("tracking time per frame: " + system_label(r, *run),
                                       "tracking time [ms]", ms, 40),
                  dir, run == &r.primary ? "tracking_time_hist" : "tracking_time_hist_" + run->mode, &written);
   }
@@ -354,7 +354,7 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
   {
     std::vector<eval::Series> series;
     for (const SlamRun* run : runs) {
-      const std::string label = eval::mode_label(run->mode);
+      const std::string label = system_label(r, *run);
       eval::Series coarse{label + " coarse", {}, {}, eval::series_color(series.size())};
       eval::Series kept{label + " kept", {}, {}, eval::series_color(series.size() + 1)};
       for (const FrameRecord& f : run->per_frame) {
@@ -497,10 +497,10 @@ std::string loss_section(const RunReport& r) {
   std::string h = "<h2>Tracking loss</h2>\n";
   for (const SlamRun* run : runs) {
     if (run->loss_events.empty()) {
-      h += "<p>" + html_escape(eval::mode_label(run->mode)) + ": tracking was never lost.</p>\n";
+      h += "<p>" + html_escape(system_label(r, *run)) + ": tracking was never lost.</p>\n";
       continue;
     }
-    h += "<p>" + html_escape(eval::mode_label(run->mode)) +
+    h += "<p>" + html_escape(system_label(r, *run)) +
          ":</p>\n<table><tr><th>frame</th><th>t [s]</th><th>reason</th>"
          "<th>recovered at frame</th></tr>\n";
     for (const LossEvent& e : run->loss_events)
