@@ -20,6 +20,7 @@
 #include "pvb/eval/gravity.hpp"
 #include "pvb/eval/metrics.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
+#include "pvb/run/inertial_eval.hpp"
 #include "pvb/run/map_eval.hpp"
 #include "pvb/run/place_recognition.hpp"
 #include "pvb/run/sensor_setup.hpp"
@@ -56,6 +57,7 @@ const char* stop_name(StopReason r) {
 /// Counts and per-frame series of one run.
 struct Tally {
   std::size_t frames = 0, lost = 0, not_init = 0, poses = 0;
+  std::size_t dead_reckoned = 0;  ///< frames carried by the motion sensors (TrackingState::kDeadReckoning)
   std::vector<double> tracking_ms, pe_ms;
   std::vector<double> cpu_ms;  ///< caller-thread CPU per frame: tracking, plus inline mapping in sync mode
   std::string init_failure;    ///< why the last frame failed to initialise
@@ -171,6 +173,9 @@ class OfflineSlam::Impl {
   void evaluate_gravity(const eval::Trajectory& gt, const eval::Trajectory& est, const eval::Sim3Transform& alignment,
                         std::ostringstream* js);
   void evaluate_refined(const eval::Trajectory& gt, const eval::EvalOptions& eo, std::ostringstream* js);
+  /// A setup with an accelerometer: stats.json's "inertial", the keyframes'
+  /// biases against the folder's imu0/truth.csv when it has one.
+  void evaluate_inertial(std::ostringstream* js);
   /// Labels the loops and relocalisations against `gt` and prints them.
   void label_places(const eval::Trajectory& gt);
   void fail_if_incomplete(StopReason stop) const;
@@ -279,6 +284,7 @@ slam::TrackingState OfflineSlam::Impl::track_one(const sensor::RgbdFrame& frame)
   tally_.frame_t_ns.push_back(frame.t_ns);
   ++tally_.frames;
   if (r.state == slam::TrackingState::kLost) ++tally_.lost;
+  if (r.state == slam::TrackingState::kDeadReckoning) ++tally_.dead_reckoned;
   if (r.state == slam::TrackingState::kNotInitialized) {
     ++tally_.not_init;
     tally_.init_failure = r.tracking.failure;
@@ -301,7 +307,8 @@ slam::TrackingState OfflineSlam::Impl::track_one(const sensor::RgbdFrame& frame)
 
 void OfflineSlam::Impl::write_timing_line(const sensor::RgbdFrame& frame, const slam::FrameResult& r,
                                           double cpu_ms) {
-  static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc"};
+  static const char* kMethods[] = {"none",  "init",           "motion",     "refkf",
+                                   "reloc", "dead_reckoning", "after_blind"};
   std::ostringstream line;
   line << frame.index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
        << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","
@@ -421,6 +428,33 @@ void OfflineSlam::Impl::evaluate_gravity(const eval::Trajectory& gt, const eval:
   *js << ",\n  \"gravity\": " << eval::gravity_json(g) << ",\n  \"tilt\": " << eval::tilt_json(t);
 }
 
+void OfflineSlam::Impl::evaluate_inertial(std::ostringstream* js) {
+  if (!slam::uses_accel(settings_.sensors) || tally_.frame_t_ns.empty()) return;
+  const std::int64_t t0_ns = tally_.frame_t_ns.front();
+  InertialReport r = inertial_report(system_->gravity(), t0_ns);
+  std::vector<KeyframeBias> kfs;
+  for (const slam::System::KeyFrameState& k : system_->keyframe_states())
+    kfs.push_back({k.id, k.t_ns, k.bias});
+  const std::string truth_path = a_.sequence + "/imu0/truth.csv";
+  if (!kfs.empty() && std::ifstream(truth_path)) {
+    try {
+      const std::vector<BiasTruth> truth = read_bias_truth(truth_path);
+      if (!truth.empty())
+        r.biases = compare_biases(std::move(kfs), truth, t0_ns, slam::uses_imu(settings_.sensors));
+    } catch (const IoError& e) {
+      warn(std::string("warning: biases not compared: ") + e.what());
+    }
+  }
+  text(r.trusted
+           ? strf("inertial state trusted at t = %.2f s (keyframe %llu): gravity %.2f deg off the map's -z\n",
+                  r.trusted_t_s, static_cast<unsigned long long>(r.trusted_keyframe), r.gravity_tilt_deg)
+           : std::string("inertial state not trusted by the end\n"));
+  if (r.biases)
+    text(strf("bias error RMS over %zu keyframes: gyro %.5f rad/s, accel %.4f m/s^2\n", r.biases->t_s.size(),
+              r.biases->gyro_rms_radps, r.biases->accel_rms_mps2));
+  *js << ",\n  \"inertial\": " << inertial_json(r);
+}
+
 void OfflineSlam::Impl::finish_map(std::ostringstream* js) {
   if (!map_) return;
   const std::string gt_path = a_.sequence + "/groundtruth.txt";
@@ -455,7 +489,9 @@ std::string OfflineSlam::Impl::stats_json(StopReason stop, const std::string& de
      << ",\n  \"seed_source\": \"" << json_escape(a_.seed_source) << "\""
      << ",\n  \"interrupted\": " << (stop == StopReason::kSignal ? "true" : "false") << ",\n  \"stop\": \""
      << stop_name(stop) << "\",\n  \"frames\": " << t.frames << ",\n  \"lost_frames\": " << t.lost
-     << ",\n  \"not_initialized_frames\": " << t.not_init << ",\n  \"skipped_frames\": " << reader_.skipped()
+     << ",\n  \"not_initialized_frames\": " << t.not_init
+     << ",\n  \"dead_reckoned_frames\": " << t.dead_reckoned
+     << ",\n  \"skipped_frames\": " << reader_.skipped()
      << ",\n  \"keyframes\": " << system_->num_keyframes()
      << ",\n  \"map_points\": " << system_->num_map_points()
      << ",\n  \"tracking_ms\": {\"median\": " << format_g(percentile(t.tracking_ms, 0.5))
@@ -526,6 +562,7 @@ int OfflineSlam::Impl::run() {
   js << stats_json(stop, dense);
   place_ = collect_place_recognition(*system_, tally_.keyframe_t_ns);
   evaluate(&js);
+  evaluate_inertial(&js);
   finish_map(&js);
   js << ",\n  \"place_recognition\": " << place_json(place_);
   if (scorer_) js << ",\n  " << scorer_->json();

@@ -11,6 +11,7 @@
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/plot/png.hpp"
+#include "report_inertial.hpp"
 
 namespace pvb::run {
 namespace {
@@ -38,6 +39,7 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
   out += in + "\"not_initialized_frames\": " + std::to_string(run.not_initialized_frames) + ",\n";
   out += in + "\"keyframes\": " + std::to_string(run.keyframes) + ",\n";
   out += in + "\"map_points\": " + std::to_string(run.map_points) + ",\n";
+  out += gravity_inertial_fields(run, in);
   if (run.eval) {
     out += in + "\"ate\": " + eval::stats_json(run.eval->ate) + ",\n";
     out += in + "\"rpe\": " + eval::rpe_json(*run.eval) + ",\n";
@@ -195,6 +197,35 @@ double distance_to_polyline(const Eigen::Vector2d& p, const std::vector<Eigen::V
 
 double realtime_factor(double sim_s, double wall_s) { return wall_s > 0 ? sim_s / wall_s : 0.0; }
 
+namespace {
+
+/// How metrics.json's comparison names a system: its setup under
+/// --compare-sensors, else its mode ("pe-slam", "baseline").
+std::string comparison_key(const RunReport& r, const SlamRun& run) {
+  return compares_sensors(r) ? run.sensors : run.mode;
+}
+
+/// metrics.json's "comparison": the primary's reductions against the
+/// reference (the baseline or the reference setup) and per system figures.
+std::string comparison_json(const RunReport& r) {
+  const SlamRun &p = r.primary, &b = *r.baseline;
+  const bool both = p.eval && b.eval;
+  const std::string kp = json_string(comparison_key(r, p)), kb = json_string(comparison_key(r, b));
+  const auto pair = [&](const std::string& vp, const std::string& vb) {
+    return "{" + kp + ": " + vp + ", " + kb + ": " + vb + "}";
+  };
+  return "{\"primary\": " + kp + ", \"reference\": " + kb + ", \"ate_rmse_reduction_pct\": " +
+         (both ? num(eval::reduction_percent(b.eval->ate.rmse, p.eval->ate.rmse)) : "null") +
+         ", \"rpe_trans_rmse_reduction_pct\": " +
+         (both ? num(eval::reduction_percent(b.eval->rpe_trans_m.rmse, p.eval->rpe_trans_m.rmse)) : "null") +
+         ", \"tracking_ms_median\": " +
+         pair(num(percentile(tracking_times(p), 0.5)), num(percentile(tracking_times(b), 0.5))) +
+         ", \"dead_reckoned_frames\": " +
+         pair(std::to_string(p.dead_reckoned_frames), std::to_string(b.dead_reckoned_frames)) + "}";
+}
+
+}  // namespace
+
 std::string metrics_json(const RunReport& r) {
   std::string out = "{\n  \"metrics_version\": " + std::to_string(eval::kMetricsVersion) + ",\n";
   out += run_fields(r, "  ");
@@ -206,17 +237,7 @@ std::string metrics_json(const RunReport& r) {
            ", \"mean_abs_slip\": " + json_number(r.motion->mean_abs_slip, 9) + "}";
   if (r.baseline) {
     out += ",\n  \"baseline\": {\n" + run_fields(r, "    ") + slam_fields(*r.baseline, "    ") + "\n  }";
-    const bool both = r.primary.eval && r.baseline->eval;
-    const std::vector<double> pe_ms = tracking_times(r.primary), base_ms = tracking_times(r.baseline.value());
-    out +=
-        ",\n  \"comparison\": {\"ate_rmse_reduction_pct\": " +
-        (both ? num(eval::reduction_percent(r.baseline->eval->ate.rmse, r.primary.eval->ate.rmse)) : "null") +
-        ", \"rpe_trans_rmse_reduction_pct\": " +
-        (both ? num(eval::reduction_percent(r.baseline->eval->rpe_trans_m.rmse,
-                                            r.primary.eval->rpe_trans_m.rmse))
-              : "null") +
-        ", \"tracking_ms_median\": {\"" + eval::kPeSlamMode + "\": " + num(percentile(pe_ms, 0.5)) + ", \"" +
-        eval::kBaselineMode + "\": " + num(percentile(base_ms, 0.5)) + "}}";
+    out += ",\n  \"comparison\": " + comparison_json(r);
   }
   out += ",\n  \"profile\": {";
   const double frames = std::max<double>(1.0, static_cast<double>(r.primary.frames));
@@ -234,9 +255,11 @@ std::string metrics_json(const RunReport& r) {
 std::string comparison_table(const RunReport& r) {
   if (!r.baseline || !r.baseline->eval || !r.primary.eval) return {};
   eval::EvalResult base = *r.baseline->eval, pe = *r.primary.eval;
-  // Short column names: the heading above the table names the baseline in full.
-  base.est_source = eval::kBaselineMode;
-  pe.est_source = eval::kPeSlamLabel;
+  // Short column names: the heading above the table names the baseline in
+  // full; the sensor setups under --compare-sensors.
+  const bool by_setup = compares_sensors(r);
+  base.est_source = by_setup ? r.baseline->sensors : eval::kBaselineMode;
+  pe.est_source = by_setup ? r.primary.sensors : eval::kPeSlamLabel;
   std::string out = eval::format_comparison({base, pe});
   // Tracking time and lost frames go above format_comparison's footnote.
   std::string footnote;
@@ -255,6 +278,9 @@ std::string comparison_table(const RunReport& r) {
   out += line;
   std::snprintf(line, sizeof line, "%-22s%24zu%24zu\n", "lost frames", r.baseline->lost_frames,
                 r.primary.lost_frames);
+  out += line;
+  std::snprintf(line, sizeof line, "%-22s%24zu%24zu\n", "dead-reckoned frames",
+                r.baseline->dead_reckoned_frames, r.primary.dead_reckoned_frames);
   out += line;
   return out + footnote;
 }
@@ -285,14 +311,14 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
   // Trajectory with error (top view + ATE over time), one per run.
   for (const SlamRun* run : runs)
     if (run->eval)
-      write_figure(eval::make_error_figure(*run->eval, r.scenario + ": " + eval::mode_label(run->mode)), dir,
+      write_figure(eval::make_error_figure(*run->eval, r.scenario + ": " + system_label(r, *run)), dir,
                    run == &r.primary ? "trajectory_error" : "trajectory_error_" + run->mode, &written);
   // ATE over time, every run on one chart.
   {
     std::vector<eval::Series> series;
     for (const SlamRun* run : runs) {
       if (!run->eval) continue;
-      eval::Series s{eval::mode_label(run->mode), {}, {}, eval::series_color(series.size())};
+      eval::Series s{system_label(r, *run), {}, {}, eval::series_color(series.size())};
       for (std::size_t i = 0; i < run->eval->t_ns.size(); ++i) {
         s.x.push_back(geom::ns_to_seconds(run->eval->t_ns[i]));
         s.y.push_back(run->eval->ate_m[i]);
@@ -320,7 +346,7 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
   // Tracking time histogram, one per run.
   for (const SlamRun* run : runs) {
     const std::vector<double> ms = tracking_times(*run);
-    write_figure(eval::make_histogram("tracking time per frame: " + eval::mode_label(run->mode),
+    write_figure(eval::make_histogram("tracking time per frame: " + system_label(r, *run),
                                       "tracking time [ms]", ms, 40),
                  dir, run == &r.primary ? "tracking_time_hist" : "tracking_time_hist_" + run->mode, &written);
   }
@@ -328,7 +354,7 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
   {
     std::vector<eval::Series> series;
     for (const SlamRun* run : runs) {
-      const std::string label = eval::mode_label(run->mode);
+      const std::string label = system_label(r, *run);
       eval::Series coarse{label + " coarse", {}, {}, eval::series_color(series.size())};
       eval::Series kept{label + " kept", {}, {}, eval::series_color(series.size() + 1)};
       for (const FrameRecord& f : run->per_frame) {
@@ -352,6 +378,7 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
                                        "path error [m]", {s}),
                  dir, "path_error", &written);
   }
+  write_inertial_figures(r, dir, &written);
   if (r.motion) write_motion_figures(*r.motion, dir, &written);
   return written;
 }
@@ -405,7 +432,9 @@ std::string run_rows(const RunReport& r) {
   h += table_row(
       "mode",
       eval::mode_label(p.mode) +
-          (r.baseline ? " (compared with the " + eval::mode_label(r.baseline->mode) + ")" : std::string()) +
+          (!r.baseline           ? std::string()
+           : compares_sensors(r) ? " (compared with the same system fusing " + r.baseline->sensors + ")"
+                                 : " (compared with the " + eval::mode_label(r.baseline->mode) + ")") +
           (r.closed_loop ? ", closed loop" : ", open loop") + (r.sync ? ", synchronous" : ", pipelined"));
   h += table_row("renderer", r.renderer);
   h += table_row("frames", std::to_string(p.frames) + " (" + fixed(r.sim_s, 2) + " s simulated)");
@@ -446,6 +475,7 @@ std::string accuracy_rows(const RunReport& r) {
   h += table_row(
       "tracking ms median / mean / p95",
       fixed(percentile(ms, 0.5), 2) + " / " + fixed(mean_of(ms), 2) + " / " + fixed(percentile(ms, 0.95), 2));
+  h += inertial_summary_rows(p);
   h += table_row("realtime factor", fixed(realtime_factor(r.sim_s, r.wall_s), 2) + " (" + fixed(r.sim_s, 2) +
                                         " s simulated in " + fixed(r.wall_s, 2) + " s)");
   if (r.motion && r.motion->distance_driven_m() > 0)
@@ -467,10 +497,10 @@ std::string loss_section(const RunReport& r) {
   std::string h = "<h2>Tracking loss</h2>\n";
   for (const SlamRun* run : runs) {
     if (run->loss_events.empty()) {
-      h += "<p>" + html_escape(eval::mode_label(run->mode)) + ": tracking was never lost.</p>\n";
+      h += "<p>" + html_escape(system_label(r, *run)) + ": tracking was never lost.</p>\n";
       continue;
     }
-    h += "<p>" + html_escape(eval::mode_label(run->mode)) +
+    h += "<p>" + html_escape(system_label(r, *run)) +
          ":</p>\n<table><tr><th>frame</th><th>t [s]</th><th>reason</th>"
          "<th>recovered at frame</th></tr>\n";
     for (const LossEvent& e : run->loss_events)
@@ -584,8 +614,8 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
   h += loss_section(r);
   const std::string table = comparison_table(r);
   if (!table.empty())
-    h += "<h2>PE-SLAM against the " + std::string(eval::kBaselineLabel) + "</h2>\n<pre>" +
-         html_escape(table) + "</pre>\n";
+    h += "<h2>" + html_escape(comparison_heading(r)) + "</h2>\n<pre>" + html_escape(table) + "</pre>\n";
+  h += inertial_section(r);
   h += figures_section(figures);
   h += dense_map_section(r);
   h += profile_section(r);

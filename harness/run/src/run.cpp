@@ -131,7 +131,10 @@ class GroundTruthSink {
     motion_.write(item.frame);
     motion_truth_.write(item.imu_truth, item.wheel_truth);
     motion_report_.add(item);
+    for (const sim::ImuTruth& t : item.imu_truth) bias_truth_.push_back({t.t_ns, t.gyro_bias, t.accel_bias});
   }
+  /// The biases in every IMU reading so far (imu0/truth.csv's).
+  const std::vector<BiasTruth>& bias_truth() const { return bias_truth_; }
   const MotionSensorsReport& motion_report() const { return motion_report_.report(); }
   void close() { file_.close(); }
   const eval::Trajectory& trajectory() const { return trajectory_; }
@@ -144,6 +147,7 @@ class GroundTruthSink {
   MotionTruthWriter motion_truth_;
   MotionReportBuilder motion_report_;
   eval::Trajectory trajectory_;
+  std::vector<BiasTruth> bias_truth_;
 };
 
 /// Stage times the consumer adds up: the producer's, from each frame, and
@@ -375,7 +379,7 @@ void log_summary(const RunReport& report, RunLog& log) {
              std::to_string(report.closed_loop->hold_frames) + " frames");
   const std::string table = comparison_table(report);
   if (table.empty()) return;
-  log.line(std::string("PE-SLAM against the ") + eval::kBaselineLabel + " on the same frames:");
+  log.line(comparison_heading(report) + " on the same frames:");
   for (std::size_t a = 0, b; a < table.size(); a = b + 1) {
     b = table.find('\n', a);
     if (b == std::string::npos) b = table.size();
@@ -475,6 +479,7 @@ RunReport run_scenario(const RunOptions& opt) {
   fail_if_never_initialised(sinks.front()->run, report, log);
   gt.close();
   const double eval_ms = evaluate_systems(sinks, gt.trajectory());
+  for (auto& sink : sinks) sink->evaluate_inertial(gt.bias_truth());
   if (!opt.map.save_path.empty()) log.line("saving the map to " + opt.map.save_path);
   for (auto& sink : sinks) sink->finish_map(gt.trajectory(), scenario.name, opt.scenario_file);
   if (SlamRun& p = sinks.front()->run; p.map && p.map->localisation)

@@ -1,7 +1,5 @@
 #include "system_sink.hpp"
 
-#include "pvb/run/sensor_setup.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,10 +7,12 @@
 
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
+#include "pvb/eval/gravity.hpp"
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/run/place_recognition.hpp"
+#include "pvb/run/sensor_setup.hpp"
 
 namespace pvb::run {
 namespace {
@@ -81,6 +81,7 @@ void SystemSink::open_outputs() {
 
 slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log) {
   const slam::FrameResult r = system->track(frame);
+  if (!first_t_ns) first_t_ns = frame.t_ns;
   const int index = static_cast<int>(frame.index);
   const double t_s = geom::ns_to_seconds(frame.t_ns);
   count(r, index, t_s);
@@ -110,6 +111,7 @@ void SystemSink::log_inertial_state(int index, RunLog& log) {
 void SystemSink::count(const slam::FrameResult& r, int index, double t_s) {
   ++run.frames;
   if (r.state == slam::TrackingState::kLost) ++run.lost_frames;
+  if (r.state == slam::TrackingState::kDeadReckoning) ++run.dead_reckoned_frames;
   if (r.state == slam::TrackingState::kNotInitialized) {
     ++run.not_initialized_frames;
     run.init_failure = r.tracking.failure;
@@ -140,9 +142,11 @@ void SystemSink::write_lines(const slam::FrameResult& r, int index) {
 void SystemSink::finish() {
   system->shutdown();
   kf_traj.close();
-  write_tum(dir + "/KeyFrameTrajectory.txt",
+  keyframes.source = dir + "/KeyFrameTrajectory.txt";
+  keyframes.poses = system->keyframe_trajectory();
+  write_tum(keyframes.source,
             "# timestamp tx ty tz qx qy qz qw (T_w_c, refined by local BA; culled keyframes left out)\n",
-            system->keyframe_trajectory());
+            keyframes.poses);
   // Each frame re-anchored on its reference keyframe's final pose (local
   // BA, loop closing), as ORB-SLAM2 saves its trajectory.
   refined.source = dir + "/CameraTrajectoryRefined.txt";
@@ -212,6 +216,26 @@ void SystemSink::evaluate(const eval::Trajectory& gt) {
       // left out of the report: the primary evaluation stands
     }
   }
+  if (run.eval) evaluate_gravity(gt);
+}
+
+void SystemSink::evaluate_gravity(const eval::Trajectory& gt) {
+  // The run's ground truth is in the site frame: z up.
+  run.gravity = eval::gravity_error(gt, est, geom::Vec3d(0, 0, -1), gravity_map_frame(system->sensors()));
+  run.tilt = eval::tilt_drift(gt, keyframes, run.eval->alignment);
+}
+
+void SystemSink::evaluate_inertial(const std::vector<BiasTruth>& truth) {
+  const slam::SensorSetup setup = system->sensors();
+  if (!slam::uses_accel(setup)) return;
+  const std::int64_t t0_ns = first_t_ns.value_or(0);
+  InertialReport r = inertial_report(system->gravity(), t0_ns);
+  std::vector<KeyframeBias> kfs;
+  for (const slam::System::KeyFrameState& k : system->keyframe_states())
+    kfs.push_back({k.id, k.t_ns, k.bias});
+  if (!truth.empty() && !kfs.empty())
+    r.biases = compare_biases(std::move(kfs), truth, t0_ns, slam::uses_imu(setup));
+  run.inertial = std::move(r);
 }
 
 SystemSinks make_systems(const slam::Settings& settings, const RunOptions& opt, std::uint32_t seed,

@@ -4,11 +4,13 @@
 // and recovery events, finished and evaluated at the end.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "pvb/common/output_file.hpp"
 #include "pvb/eval/trajectory.hpp"
+#include "pvb/run/inertial_eval.hpp"
 #include "pvb/run/report.hpp"
 #include "pvb/run/run.hpp"
 #include "pvb/slam/core/settings.hpp"
@@ -26,6 +28,8 @@ struct SystemSink {
   OutputFile cam_traj, kf_traj, timing;
   eval::Trajectory est;
   eval::Trajectory refined;  ///< filled by finish()
+  eval::Trajectory keyframes;  ///< filled by finish(): the keyframes' final poses (KeyFrameTrajectory.txt)
+  std::optional<std::int64_t> first_t_ns;  ///< the first frame's time: the inertial report's t = 0
   slam::TrackingState prev_state = slam::TrackingState::kNotInitialized;
   bool prev_provisional = false;  ///< the last frame was tracked in a provisional map
   bool inertial_logged = false;   ///< run.log has said when the inertial state became trusted
@@ -50,8 +54,12 @@ struct SystemSink {
   /// writes the dense maps.
   void finish();
 
-  /// ATE/RPE of the trajectory (and of the refined one) against `gt`.
+  /// ATE/RPE of the trajectory (and of the refined one) against `gt`,
+  /// the gravity error and the keyframes' tilt drift.
   void evaluate(const eval::Trajectory& gt);
+  /// A setup with an IMU: the inertial state (run.inertial) after finish(),
+  /// its keyframes' biases against `truth` when it is not empty.
+  void evaluate_inertial(const std::vector<BiasTruth>& truth);
   /// The localisation in a loaded map against `gt`, and the final map
   /// saved when the options say so (run::finish_map).
   void finish_map(const eval::Trajectory& gt, const std::string& scenario, const std::string& scenario_file);
@@ -59,6 +67,8 @@ struct SystemSink {
  private:
   /// The dense maps into `clouds` and their PLY files; run.dense_map.
   void save_dense_maps();
+  /// run.gravity and run.tilt against `gt` (site frame, z up) after run.eval.
+  void evaluate_gravity(const eval::Trajectory& gt);
   /// Once the inertial state is trusted: a line in run.log saying when and what was found.
   void log_inertial_state(int index, RunLog& log);
   /// The counters and the per-frame record.

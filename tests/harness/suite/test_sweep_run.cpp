@@ -78,3 +78,35 @@ TEST(SweepRun, TwoSeedsThenASlurmTaskThenAggregateOnly) {
   EXPECT_NE(agg.output.find(" mm over 3 seeds (effect size d_z "), std::string::npos) << agg.output;
   fs::remove_all(out);
 }
+
+// --sensors and --compare-sensors reach every seed's run: each metrics.json
+// says the setup it fused, and the aggregate names the two setups.
+TEST(SweepRun, SensorSetupsReachEverySeedsRun) {
+  const fs::path out = fs::path(::testing::TempDir()) / ("pvb_sweep_sensors_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const std::string scenario = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
+  const std::string common = " --frames " + std::to_string(kFrames) + " --sync --seeds 1";
+
+  const auto pair = run_pvbench("sweep --scenario " + scenario + " --out " + (out / "pair").string() + common +
+                                " --compare-sensors camera,camera+imu");
+  ASSERT_EQ(pair.code, 0) << pair.output;
+  const std::string m = pvb::read_file((out / "pair" / "seed_1" / "metrics.json").string());
+  EXPECT_NE(m.find("\"sensors\": \"camera+imu\""), std::string::npos) << m.substr(0, 600);
+  EXPECT_NE(m.find("    \"sensors\": \"camera\""), std::string::npos);  // the reference, under "baseline"
+  EXPECT_NE(m.find("\"primary\": \"camera+imu\", \"reference\": \"camera\""), std::string::npos);
+  EXPECT_NE(m.find("\"inertial\": {\"trusted\": "), std::string::npos);
+  const std::string md = pvb::read_file((out / "pair" / "aggregate.md").string());
+  EXPECT_NE(md.find("| camera+imu | 1 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| camera | 1 |"), std::string::npos) << md;
+
+  const auto one = run_pvbench("sweep --scenario " + scenario + " --out " + (out / "one").string() + common +
+                               " --sensors camera+imu+wheels");
+  ASSERT_EQ(one.code, 0) << one.output;
+  const std::string m1 = pvb::read_file((out / "one" / "seed_1" / "metrics.json").string());
+  EXPECT_NE(m1.find("\"sensors\": \"camera+imu+wheels\""), std::string::npos) << m1.substr(0, 600);
+  EXPECT_NE(m1.find("\"dead_reckoned_frames\": "), std::string::npos);
+  EXPECT_EQ(m1.find("\"baseline\""), std::string::npos);
+  EXPECT_NE(pvb::read_file((out / "one" / "seed_1" / "run.log").string()).find("sensors camera+imu+wheels"),
+            std::string::npos);
+  fs::remove_all(out);
+}

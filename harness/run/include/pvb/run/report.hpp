@@ -10,9 +10,11 @@
 #include <vector>
 
 #include "pvb/eval/evaluate.hpp"
+#include "pvb/eval/gravity.hpp"
 #include "pvb/eval/metrics.hpp"
 #include "pvb/eval/place_labels.hpp"
 #include "pvb/plot/contact_sheet.hpp"
+#include "pvb/run/inertial_eval.hpp"
 #include "pvb/run/map_session.hpp"
 #include "pvb/run/map_eval.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
@@ -96,6 +98,9 @@ struct SlamRun {
   std::size_t frames = 0;
   std::size_t lost_frames = 0;  ///< frames in state Lost
   std::size_t not_initialized_frames = 0;
+  /// Frames whose pose the motion sensors carried while vision failed
+  /// (slam::TrackingState::kDeadReckoning).
+  std::size_t dead_reckoned_frames = 0;
   std::string init_failure;  ///< why the last frame not initialised failed to initialise
   std::size_t keyframes = 0;
   std::size_t map_points = 0;
@@ -113,6 +118,11 @@ struct SlamRun {
   std::optional<DenseMapReport> dense_map;  ///< nullopt when dense mapping is off
   /// A saved map loaded or the final map saved (nullopt: neither).
   std::optional<MapReport> map;
+  /// Gravity error per frame and the keyframes' pitch and roll error
+  /// (docs/evaluation.md, "Gravity and tilt"); with an evaluation.
+  std::optional<eval::GravityError> gravity;
+  std::optional<eval::TiltDrift> tilt;
+  std::optional<InertialReport> inertial;  ///< a setup with an IMU (not camera alone)
 };
 
 /// Closed loop: distance of the ground-truth robot (axle centre) from the
@@ -182,8 +192,26 @@ double realtime_factor(double sim_s, double wall_s);
 /// The metrics.json document (plain JSON that yaml-cpp parses).
 std::string metrics_json(const RunReport& report);
 
-/// The paper-style comparison table (PE-SLAM vs baseline): ATE and RPE
-/// statistics with reductions, plus tracking time and lost frames.  Empty
+/// The two systems differ only in their sensor setup (--compare-sensors).
+bool compares_sensors(const RunReport& report);
+
+/// How the report names one of its systems: by its sensor setup when the
+/// two systems differ only in it (--compare-sensors), else by its mode
+/// ("PE-SLAM", "baseline (ORB-SLAM2 motion model)").
+std::string system_label(const RunReport& report, const SlamRun& run);
+
+/// The comparison's heading, the reference named second: "PE-SLAM against
+/// the baseline (ORB-SLAM2 motion model)", or with --compare-sensors e.g.
+/// "camera+imu+wheels against camera".
+std::string comparison_heading(const RunReport& report);
+
+/// The gravity, tilt, inertial and dead-reckoning keys of one system in
+/// metrics.json, each line ending in ",\n" (as the other system keys).
+std::string gravity_inertial_fields(const SlamRun& run, const std::string& indent);
+
+/// The paper-style comparison table (PE-SLAM vs baseline, or the two
+/// sensor setups, columns named by system_label): ATE and RPE statistics
+/// with reductions, plus tracking time, lost and dead-reckoned frames.  Empty
 /// when there is no baseline or either run has no evaluation.
 std::string comparison_table(const RunReport& report);
 

@@ -1,0 +1,158 @@
+#include "pvb/run/inertial_eval.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+
+#include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
+
+namespace pvb::run {
+namespace {
+
+constexpr double kInertialDegPerRad = 57.29577951308232;
+constexpr std::size_t kTruthColumns = 13;
+
+/// One number of a CSV field; false when it is not one whole number.
+bool parse_field(const std::string& s, double* v) {
+  char* end = nullptr;
+  *v = std::strtod(s.c_str(), &end);
+  return !s.empty() && end == s.c_str() + s.size() && std::isfinite(*v);
+}
+
+BiasTruth parse_truth_line(const std::vector<std::string>& f, const std::string& path, int line) {
+  if (f.size() != kTruthColumns)
+    throw IoError(path, std::to_string(f.size()) + " columns, expected " + std::to_string(kTruthColumns),
+                  line);
+  double v[kTruthColumns];
+  for (std::size_t i = 0; i < kTruthColumns; ++i)
+    if (!parse_field(f[i], &v[i])) throw IoError(path, "not a number: '" + f[i] + "'", line);
+  BiasTruth t;
+  t.t_ns = std::strtoll(f[0].c_str(), nullptr, 10);
+  t.gyro_radps = Eigen::Vector3d(v[7], v[8], v[9]);
+  t.accel_mps2 = Eigen::Vector3d(v[10], v[11], v[12]);
+  return t;
+}
+
+double seconds_since_ns(std::int64_t t0_ns, std::int64_t t_ns) {
+  return static_cast<double>(t_ns - t0_ns) * 1e-9;
+}
+
+void push_axes(Axes* a, const Eigen::Vector3d& v) {
+  for (int k = 0; k < 3; ++k) (*a)[k].push_back(v[k]);
+}
+
+double rms_of(double sum_sq, std::size_t n) { return n ? std::sqrt(sum_sq / static_cast<double>(n)) : 0.0; }
+
+std::string bias_num(double v) { return json_number(v, 9); }
+
+/// [[x, y, z], ...] of one series.
+std::string axes_json(const Axes& a) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < a[0].size(); ++i)
+    out += std::string(i ? ", " : "") + "[" + bias_num(a[0][i]) + ", " + bias_num(a[1][i]) + ", " +
+           bias_num(a[2][i]) + "]";
+  return out + "]";
+}
+
+std::string biases_json(const BiasComparison& b) {
+  const auto gyro = [&](const std::string& v) { return b.has_gyro ? v : std::string("null"); };
+  std::string out = "{\"keyframes\": " + std::to_string(b.t_s.size()) +
+                    ", \"gyro_rms_radps\": " + gyro(bias_num(b.gyro_rms_radps)) +
+                    ", \"accel_rms_mps2\": " + bias_num(b.accel_rms_mps2) +
+                    ", \"gyro_final_radps\": " + gyro(bias_num(b.gyro_final_radps)) +
+                    ", \"accel_final_mps2\": " + bias_num(b.accel_final_mps2) + ", \"keyframe_id\": [";
+  for (std::size_t i = 0; i < b.keyframe_id.size(); ++i)
+    out += (i ? ", " : "") + std::to_string(b.keyframe_id[i]);
+  out += "], \"t_s\": [";
+  for (std::size_t i = 0; i < b.t_s.size(); ++i) out += (i ? ", " : "") + bias_num(b.t_s[i]);
+  out += "], \"gyro_est_radps\": " + gyro(axes_json(b.gyro_est_radps)) +
+         ", \"gyro_true_radps\": " + gyro(axes_json(b.gyro_true_radps)) +
+         ", \"accel_est_mps2\": " + axes_json(b.accel_est_mps2) +
+         ", \"accel_true_mps2\": " + axes_json(b.accel_true_mps2) + "}";
+  return out;
+}
+
+}  // namespace
+
+std::vector<BiasTruth> read_bias_truth(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path, "cannot read the IMU truth");
+  std::vector<BiasTruth> out;
+  std::string text;
+  for (int line = 1; std::getline(in, text); ++line) {
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    if (text.empty() || text[0] == '#') continue;
+    out.push_back(parse_truth_line(split_ws(text, ","), path, line));
+    if (out.size() > 1 && out.back().t_ns < out[out.size() - 2].t_ns)
+      throw IoError(path, "readings out of time order", line);
+  }
+  return out;
+}
+
+BiasTruth bias_truth_at(const std::vector<BiasTruth>& truth, std::int64_t t_ns) {
+  const auto after = std::lower_bound(truth.begin(), truth.end(), t_ns,
+                                      [](const BiasTruth& b, std::int64_t t) { return b.t_ns < t; });
+  if (after == truth.begin()) return {t_ns, truth.front().gyro_radps, truth.front().accel_mps2};
+  if (after == truth.end()) return {t_ns, truth.back().gyro_radps, truth.back().accel_mps2};
+  const BiasTruth& a = *(after - 1);
+  const BiasTruth& b = *after;
+  const double s =
+      b.t_ns > a.t_ns ? static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns) : 0.0;
+  return {t_ns, a.gyro_radps + s * (b.gyro_radps - a.gyro_radps),
+          a.accel_mps2 + s * (b.accel_mps2 - a.accel_mps2)};
+}
+
+BiasComparison compare_biases(std::vector<KeyframeBias> keyframes, const std::vector<BiasTruth>& truth,
+                              std::int64_t t0_ns, bool has_gyro) {
+  std::sort(keyframes.begin(), keyframes.end(),
+            [](const KeyframeBias& a, const KeyframeBias& b) { return a.t_ns < b.t_ns; });
+  BiasComparison c;
+  c.has_gyro = has_gyro;
+  double gyro_sq = 0, accel_sq = 0;
+  for (const KeyframeBias& k : keyframes) {
+    const BiasTruth t = bias_truth_at(truth, k.t_ns);
+    c.keyframe_id.push_back(k.id);
+    c.t_s.push_back(seconds_since_ns(t0_ns, k.t_ns));
+    push_axes(&c.gyro_est_radps, k.bias.gyro_radps);
+    push_axes(&c.gyro_true_radps, t.gyro_radps);
+    push_axes(&c.accel_est_mps2, k.bias.accel_mps2);
+    push_axes(&c.accel_true_mps2, t.accel_mps2);
+    c.gyro_final_radps = (k.bias.gyro_radps - t.gyro_radps).norm();
+    c.accel_final_mps2 = (k.bias.accel_mps2 - t.accel_mps2).norm();
+    gyro_sq += c.gyro_final_radps * c.gyro_final_radps;
+    accel_sq += c.accel_final_mps2 * c.accel_final_mps2;
+  }
+  c.gyro_rms_radps = rms_of(gyro_sq, keyframes.size());
+  c.accel_rms_mps2 = rms_of(accel_sq, keyframes.size());
+  return c;
+}
+
+double gravity_tilt_deg(const Eigen::Vector3d& g_w) {
+  if (!(g_w.norm() > 0)) return 0.0;
+  return std::acos(std::clamp(-g_w.normalized().z(), -1.0, 1.0)) * kInertialDegPerRad;
+}
+
+InertialReport inertial_report(const slam::MapGravity& g, std::int64_t t0_ns) {
+  InertialReport r;
+  r.trusted = g.ready;
+  if (!g.ready) return r;
+  r.trusted_t_s = seconds_since_ns(t0_ns, g.ready_t_ns);
+  r.trusted_keyframe = g.ready_keyframe_id;
+  r.gravity_tilt_deg = gravity_tilt_deg(g.g_w);
+  r.init_rms = g.init_rms;
+  return r;
+}
+
+std::string inertial_json(const InertialReport& r) {
+  const auto when = [&](const std::string& v) { return r.trusted ? v : std::string("null"); };
+  return std::string("{\"trusted\": ") + (r.trusted ? "true" : "false") +
+         ", \"trusted_t_s\": " + when(bias_num(r.trusted_t_s)) +
+         ", \"trusted_keyframe\": " + when(std::to_string(r.trusted_keyframe)) +
+         ", \"gravity_tilt_deg\": " + when(bias_num(r.gravity_tilt_deg)) +
+         ", \"init_rms\": " + when(bias_num(r.init_rms)) +
+         ", \"biases\": " + (r.biases ? biases_json(*r.biases) : std::string("null")) + "}";
+}
+
+}  // namespace pvb::run

@@ -1,0 +1,171 @@
+// pvbench run with motion sensors, end to end: the gravity, tilt, inertial
+// and dead-reckoning keys of metrics.json on a short camera+imu run (the
+// biases against the run's own imu0/truth.csv), their figures, and
+// --compare-sensors naming the two systems by their setups.
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+
+#include "cli_output.hpp"
+#include "pvb/common/text.hpp"
+#include "run_pvbench.hpp"
+
+using namespace pvb;
+
+namespace {
+
+const std::string kStation = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
+
+std::string fresh(const std::string& name) {
+  const std::string d = ::testing::TempDir() + "pvb_run_inertial_" + name + "_" + std::to_string(::getpid());
+  std::system(("rm -rf " + d).c_str());
+  return d;
+}
+
+bool exists(const std::string& path) { return std::ifstream(path).good(); }
+
+YAML::Node metrics(const std::string& dir) { return YAML::Load(read_file(dir + "/metrics.json")); }
+
+/// Rows of timing.csv in tracking state `state`.
+int frames_in_state(const std::string& dir, const std::string& state) {
+  int n = 0;
+  for (const std::string& line : test::data_lines(dir + "/timing.csv")) {
+    const std::vector<std::string> f = split_ws(line, ",");
+    n += f.size() > 2 && f[2] == state;
+  }
+  return n;
+}
+
+/// imu0/truth.csv's gyro bias (bw_x..z) of the reading nearest t_s.
+std::vector<double> true_gyro_bias_near(const std::string& dir, double t_s) {
+  std::vector<double> best;
+  double best_dt = std::numeric_limits<double>::infinity();
+  for (const std::string& line : test::data_lines(dir + "/imu0/truth.csv")) {
+    const std::vector<std::string> f = split_ws(line, ",");
+    if (f.size() != 13 || f[0][0] == '#') continue;
+    const double dt = std::abs(std::stod(f[0]) * 1e-9 - t_s);
+    if (dt < best_dt) best_dt = dt, best = {std::stod(f[7]), std::stod(f[8]), std::stod(f[9])};
+  }
+  return best;
+}
+
+// 120 frames: the inertial state is trusted after about 3 s of the station's drive.
+TEST(RunInertialCli, CameraImuRunReportsGravityTiltAndBiases) {
+  const std::string d = fresh("imu");
+  const test::RunResult r = test::run_pvbench("run --scenario " + kStation + " --out " + d +
+                                              " --sync --frames 120 --no-map-eval --sensors camera+imu");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const YAML::Node m = metrics(d);
+  EXPECT_EQ(m["sensors"].as<std::string>(), "camera+imu");
+  EXPECT_EQ(m["dead_reckoned_frames"].as<int>(), frames_in_state(d, "dead_reckoning"));
+  // Gravity: every tracked frame; tilt: every keyframe of KeyFrameTrajectory.txt.
+  EXPECT_EQ(m["gravity"]["map_frame"].as<std::string>(), "gravity_aligned");
+  EXPECT_EQ(m["gravity"]["frames"].as<int>(),
+            static_cast<int>(test::data_lines(d + "/CameraTrajectory.txt").size()));
+  EXPECT_EQ(m["gravity"]["angle_deg"].size(), m["gravity"]["t_s"].size());
+  EXPECT_LE(m["gravity"]["median_deg"].as<double>(), m["gravity"]["p95_deg"].as<double>());
+  EXPECT_EQ(m["tilt"]["keyframes"].as<int>(),
+            static_cast<int>(test::data_lines(d + "/KeyFrameTrajectory.txt").size()));
+  EXPECT_TRUE(std::isfinite(m["tilt"]["pitch_slope_deg_per_keyframe"].as<double>()));
+  // The inertial state: trusted within the run, its biases against the run's truth.
+  const YAML::Node in = m["inertial"];
+  ASSERT_TRUE(in["trusted"].as<bool>()) << r.output;
+  EXPECT_GT(in["trusted_t_s"].as<double>(), 0.0);
+  EXPECT_LT(in["trusted_t_s"].as<double>(), 120 / 30.0);
+  EXPECT_GT(in["trusted_keyframe"].as<int>(), 0);
+  EXPECT_GE(in["gravity_tilt_deg"].as<double>(), 0.0);
+  EXPECT_NE(r.output.find("inertial state trusted (camera+imu, keyframe " +
+                          in["trusted_keyframe"].as<std::string>()),
+            std::string::npos)
+      << r.output;
+  const YAML::Node b = in["biases"];
+  ASSERT_TRUE(b && b.IsMap());
+  const int kfs = b["keyframes"].as<int>();
+  EXPECT_GT(kfs, 1);
+  EXPECT_EQ(static_cast<int>(b["t_s"].size()), kfs);
+  EXPECT_EQ(static_cast<int>(b["gyro_true_radps"].size()), kfs);
+  // The true series are imu0/truth.csv's biases at the keyframes' times (the
+  // sim's bias walks slowly: the nearest reading is within 4e-7 rad/s).
+  for (int k : {0, kfs - 1}) {
+    const std::vector<double> truth = true_gyro_bias_near(d, b["t_s"][k].as<double>());
+    ASSERT_EQ(truth.size(), 3u);
+    for (int a = 0; a < 3; ++a)
+      EXPECT_NEAR(b["gyro_true_radps"][k][a].as<double>(), truth[a], 4e-7) << k << a;
+  }
+  // The gyro bias (about 0.016 rad/s in the station's IMU) is estimated well; zero would not pass.
+  EXPECT_LT(b["gyro_rms_radps"].as<double>(), 0.005);
+  EXPECT_GT(b["accel_rms_mps2"].as<double>(), 0.0);
+  for (const char* f : {"gravity_error", "tilt_error", "imu_gyro_bias", "imu_accel_bias"}) {
+    EXPECT_TRUE(exists(d + "/" + f + ".png")) << f;
+    EXPECT_NE(read_file(d + "/index.html").find(std::string(f) + ".png"), std::string::npos) << f;
+  }
+  EXPECT_NE(read_file(d + "/index.html").find("<tr><th>dead-reckoned frames</th>"), std::string::npos);
+}
+
+// pvbench slam on a recording: the same keys in stats.json, the biases
+// against the recording's imu0/truth.csv.
+TEST(RunInertialCli, SlamOnARecordingComparesTheBiasesWithItsTruth) {
+  const std::string rec = fresh("rec"), out = fresh("slam");
+  ASSERT_EQ(test::run_pvbench("record --scenario " + kStation + " --out " + rec + " --frames 120").code, 0);
+  const test::RunResult r =
+      test::run_pvbench("slam --sequence " + rec + " --settings " + rec + "/camera.yaml --out " + out +
+                        " --sync --no-dense --sensors camera+imu");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("inertial state trusted at t = "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("bias error RMS over "), std::string::npos) << r.output;
+  const YAML::Node s = YAML::Load(read_file(out + "/stats.json"));
+  EXPECT_EQ(s["dead_reckoned_frames"].as<int>(), frames_in_state(out, "dead_reckoning"));
+  EXPECT_EQ(s["gravity"]["map_frame"].as<std::string>(), "gravity_aligned");
+  ASSERT_TRUE(s["inertial"]["trusted"].as<bool>());
+  const YAML::Node b = s["inertial"]["biases"];
+  ASSERT_TRUE(b && b.IsMap());
+  EXPECT_GT(b["keyframes"].as<int>(), 1);
+  EXPECT_LT(b["gyro_rms_radps"].as<double>(), 0.005);
+  const std::vector<double> truth = true_gyro_bias_near(rec, b["t_s"][0].as<double>());
+  ASSERT_EQ(truth.size(), 3u);
+  EXPECT_NEAR(b["gyro_true_radps"][0][2].as<double>(), truth[2], 4e-7);
+  // Camera alone: no inertial state.
+  const std::string cam = fresh("slam_cam");
+  ASSERT_EQ(test::run_pvbench("slam --sequence " + rec + " --settings " + rec + "/camera.yaml --out " + cam +
+                              " --sync --no-dense --max-frames 10 --sensors camera")
+                .code,
+            0);
+  EXPECT_FALSE(YAML::Load(read_file(cam + "/stats.json"))["inertial"]);
+  EXPECT_EQ(YAML::Load(read_file(cam + "/stats.json"))["dead_reckoned_frames"].as<int>(), 0);
+}
+
+TEST(RunInertialCli, CompareSensorsNamesTheSystemsBySetup) {
+  const std::string d = fresh("compare");
+  const test::RunResult r =
+      test::run_pvbench("run --scenario " + kStation + " --out " + d +
+                        " --sync --frames 30 --no-map-eval --compare-sensors camera,camera+imu");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("camera+imu against camera on the same frames:"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("PE-SLAM against"), std::string::npos) << r.output;
+  const YAML::Node m = metrics(d);
+  EXPECT_EQ(m["sensors"].as<std::string>(), "camera+imu");
+  EXPECT_EQ(m["baseline"]["sensors"].as<std::string>(), "camera");
+  EXPECT_EQ(m["baseline"]["mode"].as<std::string>(), "pe-slam");
+  const YAML::Node c = m["comparison"];
+  EXPECT_EQ(c["primary"].as<std::string>(), "camera+imu");
+  EXPECT_EQ(c["reference"].as<std::string>(), "camera");
+  EXPECT_TRUE(c["tracking_ms_median"]["camera+imu"].IsScalar());
+  EXPECT_TRUE(c["tracking_ms_median"]["camera"].IsScalar());
+  EXPECT_EQ(c["dead_reckoned_frames"]["camera+imu"].as<int>(), m["dead_reckoned_frames"].as<int>());
+  // 30 frames: too early for the inertial state; camera alone has none.
+  EXPECT_FALSE(m["inertial"]["trusted"].as<bool>());
+  EXPECT_TRUE(m["inertial"]["trusted_t_s"].IsNull());
+  EXPECT_TRUE(m["inertial"]["biases"].IsNull());
+  EXPECT_FALSE(m["baseline"]["inertial"]);
+  EXPECT_EQ(m["baseline"]["gravity"]["map_frame"].as<std::string>(), "first_camera");
+  const std::string html = read_file(d + "/index.html");
+  EXPECT_NE(html.find("<h2>camera+imu against camera</h2>"), std::string::npos);
+  EXPECT_NE(html.find("<h2>Gravity and inertial state</h2>"), std::string::npos);
+}
+
+}  // namespace
