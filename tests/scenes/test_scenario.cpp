@@ -24,7 +24,7 @@ const char* kMinimal = "route: {waypoints_m: [[0, 0], [5, 0]]}\n";
 TEST(Scenario, ShippedScenariosLoad) {
   for (const char* name : {"pv_station", "along_row", "lawnmower", "loop", "wall_pass", "dusty_panels",
                            "low_sun_glare", "high_noise", "fast_turns", "tracking_failure", "kidnapped",
-                           "kidnapped_short", "aliasing", "lawnmower_return"}) {
+                           "kidnapped_short", "aliasing", "lawnmower_return", "blind"}) {
     const Scenario s = load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + name + ".yaml");
     EXPECT_EQ(s.name, name);
     EXPECT_GE(s.duration_s, 20.0) << name;
