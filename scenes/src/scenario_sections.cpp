@@ -293,7 +293,8 @@ void read_expect(MapReader& r, Expectations& e) {
     e.blind_after_error_m_max = r.number("blind_after_error_m_max", 0.0, 1e-6, 100);
   if (r.has("blind_after_error_deg_max"))
     e.blind_after_error_deg_max = r.number("blind_after_error_deg_max", 0.0, 1e-6, 180);
-  e.blind_no_global_relocalisation = r.boolean("blind_no_global_relocalisation", e.blind_no_global_relocalisation);
+  e.blind_no_global_relocalisation =
+      r.boolean("blind_no_global_relocalisation", e.blind_no_global_relocalisation);
   if (r.has("pe_not_worse_than_baseline"))
     r.fail(r.full("pe_not_worse_than_baseline"), r.child("pe_not_worse_than_baseline"),
            "expect.sweep.pe_not_significantly_worse instead (PE-SLAM against the baseline is judged over "
@@ -333,18 +334,21 @@ Cover read_cover_times(MapReader& r) {
 /// one frame and ends before duration_s.
 void check_cover_times(const MapReader& r, const YAML::Node& n, const Cover& c, const Scenario& s) {
   const double frame_s = 1.0 / s.camera.fps;
-  const std::string one_frame = "at least one frame period (1 / camera.fps = " + format_number("%g", frame_s) + " s)";
+  const std::string one_frame =
+      "at least one frame period (1 / camera.fps = " + format_number("%g", frame_s) + " s)";
   if (!(c.at_s < s.duration_s))
-    r.fail(r.full("at_s"), node_of(n, "at_s"), "a time before duration_s (" + format_exact(s.duration_s) + " s)",
-           format_exact(c.at_s));
+    r.fail(r.full("at_s"), node_of(n, "at_s"),
+           "a time before duration_s (" + format_exact(s.duration_s) + " s)", format_exact(c.at_s));
   // At least one frame period (1e-9 s: a period written in decimals).
-  if (c.covered_s < frame_s - 1e-9) r.fail(r.full("covered_s"), node_of(n, "covered_s"), one_frame, format_exact(c.covered_s));
+  if (c.covered_s < frame_s - 1e-9)
+    r.fail(r.full("covered_s"), node_of(n, "covered_s"), one_frame, format_exact(c.covered_s));
   if (!(c.at_s + c.covered_s < s.duration_s))
     r.fail(r.full("covered_s"), node_of(n, "covered_s"),
            "at_s + covered_s before duration_s (" + format_exact(s.duration_s) + " s)",
            format_exact(c.at_s + c.covered_s) + " s");
   const CoverFrames f = cover_frames(c, s.camera.fps);
-  if (f.end <= f.begin) r.fail(r.full("covered_s"), node_of(n, "covered_s"), one_frame, format_exact(c.covered_s));
+  if (f.end <= f.begin)
+    r.fail(r.full("covered_s"), node_of(n, "covered_s"), one_frame, format_exact(c.covered_s));
 }
 
 }  // namespace
@@ -388,10 +392,10 @@ void read_cover(MapReader& top, Scenario& s) {
 void check_blind_bounds(const Scenario& s, const ReadContext& ctx) {
   if (!s.expect.any_blind_bound() || s.cover || s.kidnap) return;
   const Expectations& e = s.expect;
-  const char* key = e.blind_poses_all                  ? "blind_poses_all"
-                    : e.blind_after_error_m_max        ? "blind_after_error_m_max"
-                    : e.blind_after_error_deg_max      ? "blind_after_error_deg_max"
-                                                       : "blind_no_global_relocalisation";
+  const char* key = e.blind_poses_all             ? "blind_poses_all"
+                    : e.blind_after_error_m_max   ? "blind_after_error_m_max"
+                    : e.blind_after_error_deg_max ? "blind_after_error_deg_max"
+                                                  : "blind_no_global_relocalisation";
   throw ConfigError(ctx.origins->where(std::string("expect.") + key, ctx.file), std::string("expect.") + key,
                     "a scenario with a cover: or kidnap: section (the bound is on its covered frames)",
                     "no covered frames");

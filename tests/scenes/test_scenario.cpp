@@ -485,23 +485,28 @@ TEST(Scenario, CoverIsValidatedWithFileAndLine) {
   std::string e = err("  at_s: 10\n  to_route_s: 3\n");  // a kidnap's key
   EXPECT_NE(e.find("bad.yaml:5: cover.to_route_s: expected a known key"), std::string::npos) << e;
   e = err("  covered_s: 2\n");
-  EXPECT_NE(e.find("bad.yaml:3: cover.at_s: expected a time in seconds (required in cover)"), std::string::npos)
+  EXPECT_NE(e.find("bad.yaml:3: cover.at_s: expected a time in seconds (required in cover)"),
+            std::string::npos)
       << e;
   e = err("  at_s: 25\n");
-  EXPECT_NE(e.find("bad.yaml:4: cover.at_s: expected a time before duration_s (20 s), got 25"), std::string::npos)
+  EXPECT_NE(e.find("bad.yaml:4: cover.at_s: expected a time before duration_s (20 s), got 25"),
+            std::string::npos)
       << e;
   e = err("  at_s: -1\n");
   EXPECT_NE(e.find("bad.yaml:4: cover.at_s: expected a value in [0, 3600], got -1"), std::string::npos) << e;
   e = err("  at_s: 17\n  covered_s: 3\n");
-  EXPECT_NE(e.find("bad.yaml:5: cover.covered_s: expected at_s + covered_s before duration_s (20 s), got 20 s"),
-            std::string::npos)
+  EXPECT_NE(
+      e.find("bad.yaml:5: cover.covered_s: expected at_s + covered_s before duration_s (20 s), got 20 s"),
+      std::string::npos)
       << e;
   e = err("  at_s: 19\n");  // the default cover of 2 s
   EXPECT_NE(e.find("cover.covered_s: expected at_s + covered_s before duration_s"), std::string::npos) << e;
   e = err("  at_s: 10\n  covered_s: 0.01\n");
-  EXPECT_NE(e.find("bad.yaml:5: cover.covered_s: expected at least one frame period (1 / camera.fps = 0.0333333 s), "
-                   "got 0.01"),
-            std::string::npos)
+  EXPECT_NE(
+      e.find(
+          "bad.yaml:5: cover.covered_s: expected at least one frame period (1 / camera.fps = 0.0333333 s), "
+          "got 0.01"),
+      std::string::npos)
       << e;
   e = err("  at_s: 10.001\n  covered_s: 0.02\n");  // no frame between 10.001 and 10.021 s
   EXPECT_NE(e.find("cover.covered_s: expected at least one frame period"), std::string::npos) << e;
@@ -524,9 +529,8 @@ TEST(Scenario, BlindBoundsAreReadAndNeedCoveredFrames) {
       "  blind_no_global_relocalisation: true\n";
   const Scenario none = parse_scenario(kMinimal, "min.yaml");
   EXPECT_FALSE(none.expect.any_blind_bound());
-  const Scenario s = parse_scenario(std::string(kMinimal) + "duration_s: 30\ncover: {at_s: 12, covered_s: 3}\n" +
-                                        bounds,
-                                    "b.yaml");
+  const Scenario s = parse_scenario(
+      std::string(kMinimal) + "duration_s: 30\ncover: {at_s: 12, covered_s: 3}\n" + bounds, "b.yaml");
   EXPECT_TRUE(s.expect.blind_poses_all);
   EXPECT_TRUE(s.expect.blind_no_global_relocalisation);
   ASSERT_TRUE(s.expect.blind_after_error_m_max);
@@ -535,14 +539,17 @@ TEST(Scenario, BlindBoundsAreReadAndNeedCoveredFrames) {
   EXPECT_DOUBLE_EQ(*s.expect.blind_after_error_deg_max, 1.0);
   EXPECT_TRUE(s.expect.any_run_bound());
   // A kidnap's covered frames are a blind stretch too.
-  EXPECT_EQ(error_of(std::string(kMinimal) + "duration_s: 30\nkidnap: {at_s: 12, to_route_s: 3}\n" + bounds), "");
+  EXPECT_EQ(error_of(std::string(kMinimal) + "duration_s: 30\nkidnap: {at_s: 12, to_route_s: 3}\n" + bounds),
+            "");
   // Without covered frames there is nothing to bound.
   std::string e = error_of(std::string(kMinimal) + "expect:\n  blind_after_error_deg_max: 1\n");
-  EXPECT_NE(e.find("bad.yaml:3: expect.blind_after_error_deg_max: expected a scenario with a cover: or kidnap: "
-                   "section"),
-            std::string::npos)
+  EXPECT_NE(
+      e.find("bad.yaml:3: expect.blind_after_error_deg_max: expected a scenario with a cover: or kidnap: "
+             "section"),
+      std::string::npos)
       << e;
-  e = error_of(std::string(kMinimal) + "duration_s: 30\ncover: {at_s: 12}\nexpect: {blind_after_error_m_max: 0}\n");
+  e = error_of(std::string(kMinimal) +
+               "duration_s: 30\ncover: {at_s: 12}\nexpect: {blind_after_error_m_max: 0}\n");
   EXPECT_NE(e.find("expect.blind_after_error_m_max: expected a value in"), std::string::npos) << e;
   e = error_of(std::string(kMinimal) + "duration_s: 30\ncover: {at_s: 12}\nexpect: {blind_poses_all: 3}\n");
   EXPECT_NE(e.find("expect.blind_poses_all: expected"), std::string::npos) << e;

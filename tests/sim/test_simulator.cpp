@@ -65,7 +65,8 @@ scenes::Scenario cover_scenario(bool covered) {
 
 /// Every frame of a scenario on the pipeline's path, and the ground truth.
 std::vector<sensor::RgbdFrame> all_frames(const scenes::Scenario& s, std::vector<geom::StampedPose>* gt) {
-  sim::SimFrameSource src(s, sim::GlBackend::kAuto, 0, [gt](const geom::StampedPose& p) { gt->push_back(p); });
+  sim::SimFrameSource src(s, sim::GlBackend::kAuto, 0,
+                          [gt](const geom::StampedPose& p) { gt->push_back(p); });
   const sim::SensorModel model = src.sensor_model();
   std::vector<sensor::RgbdFrame> frames;
   while (auto r = src.next_rendered()) frames.push_back(model.apply(std::move(*r)).frame);
@@ -543,7 +544,8 @@ TEST(SimFrameSource, CoverBlindsTheCameraWhileTheRobotDrivesOn) {
     EXPECT_TRUE(gt_cover[i].T_w_c.matrix() == gt_plain[i].T_w_c.matrix()) << "frame " << i;
     if (c.covered(static_cast<std::int64_t>(i))) {
       EXPECT_EQ(cv::countNonZero(cover[i].depth_m), 0) << "frame " << i;
-      EXPECT_EQ(cv::norm(cover[i].rgb, kidnap[i].rgb, cv::NORM_INF), 0.0) << "frame " << i << ": a kidnap's cover";
+      EXPECT_EQ(cv::norm(cover[i].rgb, kidnap[i].rgb, cv::NORM_INF), 0.0)
+          << "frame " << i << ": a kidnap's cover";
       EXPECT_GT(cv::norm(cover[i].rgb, plain[i].rgb, cv::NORM_INF), 100.0) << "frame " << i;
     } else {
       EXPECT_EQ(cv::norm(cover[i].rgb, plain[i].rgb, cv::NORM_INF), 0.0) << "frame " << i;

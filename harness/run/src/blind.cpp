@@ -52,7 +52,8 @@ std::optional<PoseError> aligned_error(int after, double fps, const eval::EvalRe
 
 std::string error_json(const std::optional<PoseError>& e) {
   if (!e) return "null";
-  return "{\"trans_m\": " + json_number(e->trans_m, 10) + ", \"rot_deg\": " + json_number(e->rot_deg, 10) + "}";
+  return "{\"trans_m\": " + json_number(e->trans_m, 10) + ", \"rot_deg\": " + json_number(e->rot_deg, 10) +
+         "}";
 }
 
 std::string optional_int_json(const std::optional<int>& v) { return v ? std::to_string(*v) : "null"; }
@@ -66,9 +67,9 @@ PoseError pose_error(const geom::SE3d& T_w_c_true, const geom::SE3d& T_w_c_est) 
   return e;
 }
 
-BlindStretch blind_stretch(const scenes::CoverFrames& cover, double fps, const std::vector<FrameRecord>& frames,
-                           const eval::Trajectory& est, const eval::Trajectory& gt,
-                           const std::optional<eval::EvalResult>& eval) {
+BlindStretch blind_stretch(const scenes::CoverFrames& cover, double fps,
+                           const std::vector<FrameRecord>& frames, const eval::Trajectory& est,
+                           const eval::Trajectory& gt, const std::optional<eval::EvalResult>& eval) {
   BlindStretch b;
   b.first_covered = cover.begin;
   b.last_covered = cover.end - 1;

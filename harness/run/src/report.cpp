@@ -500,9 +500,10 @@ std::string blind_section(const RunReport& r) {
   for (const SlamRun* run : {&r.primary, r.baseline ? &*r.baseline : nullptr})
     if (run && run->blind) runs.push_back(run);
   if (runs.empty()) return {};
-  std::string h = "<h2>Blind stretch</h2>\n<table><tr><th></th><th>covered frames</th><th>with a pose</th>"
-                  "<th>first frame after</th><th>tracked (method)</th>"
-                  "<th>error across the stretch [m / deg]</th><th>error, ATE-aligned [m / deg]</th></tr>\n";
+  std::string h =
+      "<h2>Blind stretch</h2>\n<table><tr><th></th><th>covered frames</th><th>with a pose</th>"
+      "<th>first frame after</th><th>tracked (method)</th>"
+      "<th>error across the stretch [m / deg]</th><th>error, ATE-aligned [m / deg]</th></tr>\n";
   const auto error_cell = [](const std::optional<PoseError>& e) {
     return e ? fixed(e->trans_m, 4) + " / " + fixed(e->rot_deg, 3) : std::string("-");
   };
@@ -511,9 +512,9 @@ std::string blind_section(const RunReport& r) {
     const std::string tracked = !b.first_after          ? "-"
                                 : b.first_after_tracked ? "yes (" + b.first_after_method + ")"
                                                         : "no (" + b.first_after_state + ")";
-    h += "<tr><td>" + html_escape(eval::mode_label(run->mode)) + "</td><td>" + std::to_string(b.first_covered) +
-         "-" + std::to_string(b.last_covered) + "</td><td>" + std::to_string(b.covered_with_pose) + " of " +
-         std::to_string(b.covered_frames()) + "</td><td>" +
+    h += "<tr><td>" + html_escape(eval::mode_label(run->mode)) + "</td><td>" +
+         std::to_string(b.first_covered) + "-" + std::to_string(b.last_covered) + "</td><td>" +
+         std::to_string(b.covered_with_pose) + " of " + std::to_string(b.covered_frames()) + "</td><td>" +
          (b.first_after ? std::to_string(*b.first_after) : std::string("not reached")) + "</td><td>" +
          html_escape(tracked) + "</td><td>" + error_cell(b.first_after_error) + "</td><td>" +
          error_cell(b.first_after_ate) + "</td></tr>\n";

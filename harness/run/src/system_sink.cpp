@@ -102,7 +102,8 @@ void SystemSink::count(const slam::FrameResult& r, int index, double t_s) {
   orb_ms += r.orb_ms;
   inline_mapping_ms += r.mapping_ms;
   run.per_frame.push_back({index, t_s, r.T_w_c.has_value(), r.tracking_ms, r.tracking.coarse_matches,
-                           r.tracking.matches_kept, slam::to_string(r.state), method_name(r.tracking.method)});
+                           r.tracking.matches_kept, slam::to_string(r.state),
+                           method_name(r.tracking.method)});
 }
 
 void SystemSink::write_lines(const slam::FrameResult& r, int index) {

@@ -86,15 +86,15 @@ void check_blind_relocalisation(const BlindMetrics& b, std::vector<Violation>* o
     out->push_back({key, frame + " was tracked by a global relocalisation"});
   if (b.relocalised_frames > 0 && b.first_after_method != "reloc")
     out->push_back({key, std::to_string(b.relocalised_frames) + " covered frames were tracked by a global "
-                         "relocalisation"});
+                                                                "relocalisation"});
 }
 
 /// The bounds on the blind stretch (a cover, or a kidnap's covered frames).
 void check_blind(const scenes::Expectations& expect, const RunMetrics& run, std::vector<Violation>* out) {
   if (!expect.any_blind_bound()) return;
   if (!run.blind) {
-    const std::string key = expect.blind_poses_all           ? "blind_poses_all"
-                            : expect.blind_after_error_m_max ? "blind_after_error_m_max"
+    const std::string key = expect.blind_poses_all             ? "blind_poses_all"
+                            : expect.blind_after_error_m_max   ? "blind_after_error_m_max"
                             : expect.blind_after_error_deg_max ? "blind_after_error_deg_max"
                                                                : "blind_no_global_relocalisation";
     out->push_back({key, "no blind stretch in the metrics (blind is absent)"});
@@ -103,23 +103,26 @@ void check_blind(const scenes::Expectations& expect, const RunMetrics& run, std:
   const BlindMetrics& b = *run.blind;
   if (expect.blind_poses_all && b.covered_with_pose < b.covered_frames())
     out->push_back({"blind_poses_all", std::to_string(b.covered_with_pose) + " of " +
-                                           std::to_string(b.covered_frames()) + " covered frames have a pose"});
-  const std::string no_error = "no error across the stretch in the metrics (the first frame after it or the "
-                               "last before it has no pose)";
+                                           std::to_string(b.covered_frames()) +
+                                           " covered frames have a pose"});
+  const std::string no_error =
+      "no error across the stretch in the metrics (the first frame after it or the "
+      "last before it has no pose)";
   if (expect.blind_after_error_m_max) {
     if (!b.first_after_error_m)
       out->push_back({"blind_after_error_m_max", no_error});
     else if (!(*b.first_after_error_m <= *expect.blind_after_error_m_max))
-      out->push_back({"blind_after_error_m_max", "error across the stretch " + metres(*b.first_after_error_m) +
-                                                     " > " + metres(*expect.blind_after_error_m_max)});
+      out->push_back({"blind_after_error_m_max", "error across the stretch " +
+                                                     metres(*b.first_after_error_m) + " > " +
+                                                     metres(*expect.blind_after_error_m_max)});
   }
   if (expect.blind_after_error_deg_max) {
     if (!b.first_after_error_deg)
       out->push_back({"blind_after_error_deg_max", no_error});
     else if (!(*b.first_after_error_deg <= *expect.blind_after_error_deg_max))
       out->push_back({"blind_after_error_deg_max",
-                      "error across the stretch " + format_number("%.4g deg", *b.first_after_error_deg) + " > " +
-                          format_number("%.4g deg", *expect.blind_after_error_deg_max)});
+                      "error across the stretch " + format_number("%.4g deg", *b.first_after_error_deg) +
+                          " > " + format_number("%.4g deg", *expect.blind_after_error_deg_max)});
   }
   if (expect.blind_no_global_relocalisation) check_blind_relocalisation(b, out);
 }

@@ -108,7 +108,8 @@ class Reader : public detail::JsonFields {
     if (!cover.IsSequence() || cover.size() != 2) in.fail(cover, "covered_frames", "[first, last]");
     b.first_covered = in.integer_at(cover[0], "covered_frames[0]", 0);
     b.last_covered = in.integer_at(cover[1], "covered_frames[1]", b.first_covered, INT_MAX, "first");
-    b.covered_with_pose = in.integer(n, "covered_frames_with_pose", 0, b.covered_frames(), "the covered frames");
+    b.covered_with_pose =
+        in.integer(n, "covered_frames_with_pose", 0, b.covered_frames(), "the covered frames");
     b.relocalised_frames = in.integer(n, "relocalised_frames", 0);
     if (!absent(n, "first_after_frame")) b.first_after = in.integer(n, "first_after_frame", 0);
     b.first_after_tracked = boolean(in, n, "first_after_tracked");

@@ -463,7 +463,8 @@ TEST(RunCli, ACoverIsDrivenThroughAndReportedAsABlindStretch) {
   const std::vector<std::string> timing = data_lines(d + "/timing.csv");
   ASSERT_EQ(timing.size(), 91u);  // the header and 90 frames
   std::set<std::string> posed_times;
-  for (const std::string& line : data_lines(d + "/CameraTrajectory.txt")) posed_times.insert(split_ws(line)[0]);
+  for (const std::string& line : data_lines(d + "/CameraTrajectory.txt"))
+    posed_times.insert(split_ws(line)[0]);
   int covered_with_pose = 0;
   for (int i = 60; i <= 74; ++i)
     covered_with_pose += posed_times.count(split_ws(timing[static_cast<std::size_t>(i) + 1])[1]) > 0 ? 1 : 0;

@@ -593,10 +593,11 @@ TEST(SuiteCheckBlind, EachBoundHoldsAndFailsOnItsOwn) {
   m = blind_run();
   m.primary.blind->first_after_method = "reloc";
   m.primary.blind->relocalised_frames = 1;
-  EXPECT_EQ(lines_of(suite::check_expectations(e, m)),
-            std::vector<std::string>{
-                "blind_no_global_relocalisation: the first frame after the cover (540) was tracked by a global "
-                "relocalisation"});
+  EXPECT_EQ(
+      lines_of(suite::check_expectations(e, m)),
+      std::vector<std::string>{
+          "blind_no_global_relocalisation: the first frame after the cover (540) was tracked by a global "
+          "relocalisation"});
 }
 
 // What a camera-only SLAM does: no pose while covered, lost on the first
@@ -612,12 +613,13 @@ TEST(SuiteCheckBlind, ACameraOnlyRunViolatesEveryBlindBound) {
   b.first_after_error_deg.reset();
   const std::vector<std::string> lines = lines_of(suite::check_expectations(blind_bounds(), m));
   const std::string no_error =
-      "no error across the stretch in the metrics (the first frame after it or the last before it has no pose)";
-  EXPECT_EQ(lines, (std::vector<std::string>{"blind_poses_all: 0 of 90 covered frames have a pose",
-                                             "blind_after_error_m_max: " + no_error,
-                                             "blind_after_error_deg_max: " + no_error,
-                                             "blind_no_global_relocalisation: the first frame after the cover "
-                                             "(540) has no pose (state lost)"}));
+      "no error across the stretch in the metrics (the first frame after it or the last before it has no "
+      "pose)";
+  EXPECT_EQ(lines, (std::vector<std::string>{
+                       "blind_poses_all: 0 of 90 covered frames have a pose",
+                       "blind_after_error_m_max: " + no_error, "blind_after_error_deg_max: " + no_error,
+                       "blind_no_global_relocalisation: the first frame after the cover "
+                       "(540) has no pose (state lost)"}));
   // A run that ended inside the cover, and one with no blind object at all.
   b.first_after.reset();
   scenes::Expectations only_reloc;
@@ -646,8 +648,9 @@ TEST(SuiteCheckBlind, BadBlindObjectsAreRefusedNamingFileLineAndKey) {
     return std::string("(no error)");
   };
   const std::string f = path + ":";
-  EXPECT_EQ(message("\"covered_frames_with_pose\": 90", "\"covered_frames_with_pose\": 91"),
-            f + "10: blind.covered_frames_with_pose: expected an integer in [0, the covered frames = 90], got 91");
+  EXPECT_EQ(
+      message("\"covered_frames_with_pose\": 90", "\"covered_frames_with_pose\": 91"),
+      f + "10: blind.covered_frames_with_pose: expected an integer in [0, the covered frames = 90], got 91");
   EXPECT_EQ(message("\"first_after_tracked\": true", "\"first_after_tracked\": \"yes\""),
             f + "12: blind.first_after_tracked: expected true or false, got the string \"yes\"");
   EXPECT_EQ(message("\"covered_frames\": [450, 539]", "\"covered_frames\": [450, 439]"),

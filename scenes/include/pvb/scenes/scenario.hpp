@@ -325,13 +325,14 @@ struct Expectations {
   SweepExpectations sweep;                     ///< judged over a seed sweep only
   /// True when a bound on a single run is set.
   bool any_run_bound() const {
-    return ate_rmse_m_max || rpe_trans_rmse_m_max || lost_frames_max || keyframes_max || tracking_loss_expected ||
-           refined_ate_rmse_m_max || false_loops_max || relocalised_within_frames || loops_min ||
-           map_accuracy_m_max || map_completeness_min || any_blind_bound();
+    return ate_rmse_m_max || rpe_trans_rmse_m_max || lost_frames_max || keyframes_max ||
+           tracking_loss_expected || refined_ate_rmse_m_max || false_loops_max || relocalised_within_frames ||
+           loops_min || map_accuracy_m_max || map_completeness_min || any_blind_bound();
   }
   /// True when a bound on the blind stretch is set.
   bool any_blind_bound() const {
-    return blind_poses_all || blind_after_error_m_max || blind_after_error_deg_max || blind_no_global_relocalisation;
+    return blind_poses_all || blind_after_error_m_max || blind_after_error_deg_max ||
+           blind_no_global_relocalisation;
   }
   /// True when any bound or flag is set.
   bool any() const { return any_run_bound() || sweep.any(); }

@@ -20,8 +20,8 @@ PoseError pose_error(const geom::SE3d& T_w_c_true, const geom::SE3d& T_w_c_est);
 /// The blind stretch of one system: `frames` its per-frame records (frame
 /// i at geom::frame_time_ns(0, i, fps)), `est` its trajectory, `gt` the
 /// ground truth and `eval` its evaluation against it (nullopt: none).
-BlindStretch blind_stretch(const scenes::CoverFrames& cover, double fps, const std::vector<FrameRecord>& frames,
-                           const eval::Trajectory& est, const eval::Trajectory& gt,
-                           const std::optional<eval::EvalResult>& eval);
+BlindStretch blind_stretch(const scenes::CoverFrames& cover, double fps,
+                           const std::vector<FrameRecord>& frames, const eval::Trajectory& est,
+                           const eval::Trajectory& gt, const std::optional<eval::EvalResult>& eval);
 
 }  // namespace pvb::run

@@ -62,14 +62,14 @@ struct PoseError {
 /// frames) as one SLAM system came through it.
 struct BlindStretch {
   int first_covered = 0, last_covered = 0;  ///< the covered frames
-  int covered_processed = 0;  ///< covered frames the run processed (fewer when it ended early)
-  int covered_with_pose = 0;  ///< covered frames with a pose in the trajectory
+  int covered_processed = 0;                ///< covered frames the run processed (fewer when it ended early)
+  int covered_with_pose = 0;                ///< covered frames with a pose in the trajectory
   /// Frames of the cover and the first frame after it tracked by a global
   /// relocalisation (method "reloc").
   int relocalised_frames = 0;
-  std::optional<int> last_before;  ///< the last frame before the cover with a pose
-  std::optional<int> first_after;  ///< the first frame after the cover, when the run processed it
-  bool first_after_tracked = false;                   ///< it has a pose
+  std::optional<int> last_before;    ///< the last frame before the cover with a pose
+  std::optional<int> first_after;    ///< the first frame after the cover, when the run processed it
+  bool first_after_tracked = false;  ///< it has a pose
   std::string first_after_state, first_after_method;  ///< as timing.csv writes them
   /// The motion across the stretch, T_c(before)_c(after), estimated against
   /// true: with a pose of last_before and of first_after.

@@ -42,7 +42,7 @@ struct BlindMetrics {
   int relocalised_frames = 0;               ///< of the cover and the first frame after it
   std::optional<int> first_after;           ///< absent when the run ended before it
   bool first_after_tracked = false;
-  std::string first_after_method;           ///< "" when the run ended before it
+  std::string first_after_method;  ///< "" when the run ended before it
   std::string first_after_state;
   /// The motion across the stretch against the truth ("first_after_error"),
   /// absent when it could not be measured.
