@@ -71,8 +71,9 @@ void check_relocalisation(const scenes::Expectations& expect, const RunMetrics& 
   }
 }
 
-/// blind_no_global_relocalisation: the first frame after the cover tracked,
-/// and neither it nor a covered frame by a global relocalisation.
+/// blind_no_global_relocalisation: tracking resumes on the first frame
+/// after the cover (state ok) in the same map, and neither it nor a covered
+/// frame was tracked by a global relocalisation.
 void check_blind_relocalisation(const BlindMetrics& b, std::vector<Violation>* out) {
   const std::string key = "blind_no_global_relocalisation";
   if (!b.first_after) {
@@ -84,6 +85,10 @@ void check_blind_relocalisation(const BlindMetrics& b, std::vector<Violation>* o
     out->push_back({key, frame + " has no pose (state " + b.first_after_state + ")"});
   else if (b.first_after_method == "reloc")
     out->push_back({key, frame + " was tracked by a global relocalisation"});
+  else if (b.first_after_method == "init")
+    out->push_back({key, frame + " began a new map"});
+  else if (b.first_after_state != "ok")
+    out->push_back({key, frame + " has a pose but tracking has not resumed (state " + b.first_after_state + ")"});
   if (b.relocalised_frames > 0 && b.first_after_method != "reloc")
     out->push_back({key, std::to_string(b.relocalised_frames) + " covered frames were tracked by a global "
                                                                 "relocalisation"});

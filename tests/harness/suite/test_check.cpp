@@ -598,6 +598,21 @@ TEST(SuiteCheckBlind, EachBoundHoldsAndFailsOnItsOwn) {
       std::vector<std::string>{
           "blind_no_global_relocalisation: the first frame after the cover (540) was tracked by a global "
           "relocalisation"});
+  m = blind_run();
+  m.primary.blind->first_after_method = "init";
+  EXPECT_EQ(lines_of(suite::check_expectations(e, m)),
+            std::vector<std::string>{
+                "blind_no_global_relocalisation: the first frame after the cover (540) began a new map"});
+  m = blind_run();
+  m.primary.blind->first_after_state = "dead_reckoning";
+  EXPECT_EQ(lines_of(suite::check_expectations(e, m)),
+            std::vector<std::string>{"blind_no_global_relocalisation: the first frame after the cover (540) has a "
+                                     "pose but tracking has not resumed (state dead_reckoning)"});
+  m = blind_run();
+  m.primary.blind->relocalised_frames = 2;
+  EXPECT_EQ(lines_of(suite::check_expectations(e, m)),
+            std::vector<std::string>{
+                "blind_no_global_relocalisation: 2 covered frames were tracked by a global relocalisation"});
 }
 
 // What a camera-only SLAM does: no pose while covered, lost on the first

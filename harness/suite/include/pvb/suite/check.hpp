@@ -37,8 +37,9 @@ struct Violation {
 /// - blind_poses_all, blind_after_error_m_max / _deg_max,
 ///   blind_no_global_relocalisation: on the run's "blind" object (absent:
 ///   a violation): every covered frame has a pose; the motion across the
-///   stretch within the bounds of the truth; the first frame after the
-///   cover tracked, and neither it nor a covered frame by a relocalisation;
+///   stretch within the bounds of the truth; tracking resumes on the first
+///   frame after the cover (state "ok", method neither "reloc" nor "init")
+///   and no covered frame was tracked by a relocalisation;
 /// - tracking_loss_expected: the run must report at least one loss event,
 ///   each with a frame and a non-empty reason, and must not be "interrupted".
 /// PE-SLAM against the baseline is never judged on one run: when both ATEs
