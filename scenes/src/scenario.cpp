@@ -29,6 +29,7 @@ void read_top(detail::MapReader& top, Scenario& s) {
   detail::read_body(top, s);
   detail::with_map(top, "slam", [&](detail::MapReader& r) { detail::read_slam(r, s.slam); });
   detail::read_kidnap(top, s);
+  detail::read_cover(top, s);
   detail::with_map(top, "expect", [&](detail::MapReader& r) { detail::read_expect(r, s.expect); });
 }
 
@@ -43,6 +44,7 @@ Scenario read_scenario(const detail::ScenarioDocument& doc) {
   detail::refuse_station_keys(doc);  // after the reader named any unknown key as one
   detail::check_scene_size(s, ctx);
   detail::check_route(s, ctx);
+  detail::check_blind_bounds(s, ctx);
   detail::check_ground_relief(s, ctx);
   detail::resolve_day(s, ctx);
   return s;
@@ -88,16 +90,27 @@ int frame_count(const Scenario& s, int max_frames) {
   return max_frames > 0 ? std::min(n, max_frames) : n;
 }
 
-KidnapFrames kidnap_frames(const Kidnap& k, double fps) {
+CoverFrames cover_frames(const Cover& c, double fps) {
   // Frame i is at i / fps; the small tolerance keeps a time that is a whole
   // number of frames (40 s at 30 fps) on that frame.
   const auto at_or_after = [fps](double t_s) { return static_cast<int>(std::ceil(t_s * fps - 1e-6)); };
+  return {at_or_after(c.at_s), at_or_after(c.at_s + c.covered_s)};
+}
+
+KidnapFrames kidnap_frames(const Kidnap& k, double fps) {
+  const CoverFrames c = cover_frames(Cover{k.at_s, k.covered_s}, fps);
   KidnapFrames f;
-  f.cover_begin = at_or_after(k.at_s);
-  f.cover_end = at_or_after(k.at_s + k.covered_s);
+  f.cover_begin = c.begin;
+  f.cover_end = c.end;
   f.teleport = f.cover_begin + (f.cover_end - f.cover_begin) / 2;
   f.target = static_cast<int>(std::floor(k.to_route_s * fps + 1e-6));
   return f;
+}
+
+std::optional<CoverFrames> camera_cover_frames(const Scenario& s) {
+  if (s.cover) return cover_frames(*s.cover, s.camera.fps);
+  if (s.kidnap) return cover_frames(Cover{s.kidnap->at_s, s.kidnap->covered_s}, s.camera.fps);
+  return std::nullopt;
 }
 
 const char* to_string(RoutePattern p) {

@@ -288,6 +288,13 @@ void read_expect(MapReader& r, Expectations& e) {
   if (r.has("loops_min")) e.loops_min = r.integer("loops_min", 0, 1, 1000000);
   if (r.has("map_accuracy_m_max")) e.map_accuracy_m_max = r.number("map_accuracy_m_max", 0.0, 1e-6, 100);
   if (r.has("map_completeness_min")) e.map_completeness_min = r.number("map_completeness_min", 0.0, 0.0, 1.0);
+  e.blind_poses_all = r.boolean("blind_poses_all", e.blind_poses_all);
+  if (r.has("blind_after_error_m_max"))
+    e.blind_after_error_m_max = r.number("blind_after_error_m_max", 0.0, 1e-6, 100);
+  if (r.has("blind_after_error_deg_max"))
+    e.blind_after_error_deg_max = r.number("blind_after_error_deg_max", 0.0, 1e-6, 180);
+  e.blind_no_global_relocalisation =
+      r.boolean("blind_no_global_relocalisation", e.blind_no_global_relocalisation);
   if (r.has("pe_not_worse_than_baseline"))
     r.fail(r.full("pe_not_worse_than_baseline"), r.child("pe_not_worse_than_baseline"),
            "expect.sweep.pe_not_significantly_worse instead (PE-SLAM against the baseline is judged over "
@@ -313,6 +320,39 @@ YAML::Node node_of(const YAML::Node& n, const char* key) {
   return v.IsDefined() ? v : n;
 }
 
+namespace {
+
+/// A covered lens's at_s and covered_s (of kidnap: or cover:).
+Cover read_cover_times(MapReader& r) {
+  Cover c;
+  c.at_s = r.number("at_s", c.at_s, 0, 3600);
+  c.covered_s = r.number("covered_s", c.covered_s, 1e-3, 3600);
+  return c;
+}
+
+/// The cover against the run: it starts before duration_s, lasts at least
+/// one frame and ends before duration_s.
+void check_cover_times(const MapReader& r, const YAML::Node& n, const Cover& c, const Scenario& s) {
+  const double frame_s = 1.0 / s.camera.fps;
+  const std::string one_frame =
+      "at least one frame period (1 / camera.fps = " + format_number("%g", frame_s) + " s)";
+  if (!(c.at_s < s.duration_s))
+    r.fail(r.full("at_s"), node_of(n, "at_s"),
+           "a time before duration_s (" + format_exact(s.duration_s) + " s)", format_exact(c.at_s));
+  // At least one frame period (1e-9 s: a period written in decimals).
+  if (c.covered_s < frame_s - 1e-9)
+    r.fail(r.full("covered_s"), node_of(n, "covered_s"), one_frame, format_exact(c.covered_s));
+  if (!(c.at_s + c.covered_s < s.duration_s))
+    r.fail(r.full("covered_s"), node_of(n, "covered_s"),
+           "at_s + covered_s before duration_s (" + format_exact(s.duration_s) + " s)",
+           format_exact(c.at_s + c.covered_s) + " s");
+  const CoverFrames f = cover_frames(c, s.camera.fps);
+  if (f.end <= f.begin)
+    r.fail(r.full("covered_s"), node_of(n, "covered_s"), one_frame, format_exact(c.covered_s));
+}
+
+}  // namespace
+
 /// The kidnap: section.  Read after duration_s and camera, which bound it.
 void read_kidnap(MapReader& top, Scenario& s) {
   const YAML::Node n = top.child("kidnap");
@@ -320,34 +360,45 @@ void read_kidnap(MapReader& top, Scenario& s) {
   MapReader r(n, top.context(), "kidnap");
   for (const char* key : {"at_s", "to_route_s"})
     if (!r.has(key)) r.fail(r.full(key), n, "a time in seconds (required in kidnap)");
-  Kidnap k;
-  k.at_s = r.number("at_s", k.at_s, 0, 3600);
-  k.covered_s = r.number("covered_s", k.covered_s, 1e-3, 3600);
+  const Cover c = read_cover_times(r);
+  Kidnap k{c.at_s, c.covered_s, 0};
   k.to_route_s = r.number("to_route_s", k.to_route_s, 0, 3600);
   r.finish();
-  const double frame_s = 1.0 / s.camera.fps;
-  if (!(k.at_s < s.duration_s))
-    r.fail(r.full("at_s"), node_of(n, "at_s"),
-           "a time before duration_s (" + format_exact(s.duration_s) + " s)", format_exact(k.at_s));
-  // At least one frame period (1e-9 s: a period written in decimals).
-  if (k.covered_s < frame_s - 1e-9)
-    r.fail(r.full("covered_s"), node_of(n, "covered_s"),
-           "at least one frame period (1 / camera.fps = " + format_number("%g", frame_s) + " s)",
-           format_exact(k.covered_s));
+  check_cover_times(r, n, c, s);
   const KidnapFrames f = kidnap_frames(k, s.camera.fps);
   if (!(k.to_route_s < k.at_s) || f.target >= f.cover_begin)
     r.fail(r.full("to_route_s"), node_of(n, "to_route_s"),
            "a time at least one frame before kidnap.at_s (" + format_exact(k.at_s) + " s)",
            format_exact(k.to_route_s));
-  if (!(k.at_s + k.covered_s < s.duration_s))
-    r.fail(r.full("covered_s"), node_of(n, "covered_s"),
-           "at_s + covered_s before duration_s (" + format_exact(s.duration_s) + " s)",
-           format_exact(k.at_s + k.covered_s) + " s");
-  if (f.cover_end <= f.cover_begin)
-    r.fail(r.full("covered_s"), node_of(n, "covered_s"),
-           "at least one frame period (1 / camera.fps = " + format_number("%g", 1.0 / s.camera.fps) + " s)",
-           format_exact(k.covered_s));
   s.kidnap = k;
+}
+
+/// The cover: section.  Read after kidnap:, duration_s and camera.
+void read_cover(MapReader& top, Scenario& s) {
+  const YAML::Node n = top.child("cover");
+  if (!n) return;
+  MapReader r(n, top.context(), "cover");
+  if (!r.has("at_s")) r.fail(r.full("at_s"), n, "a time in seconds (required in cover)");
+  const Cover c = read_cover_times(r);
+  r.finish();
+  if (s.kidnap)
+    r.fail("cover", n, "either kidnap or cover, not both (a kidnap covers the camera itself)",
+           "both sections");
+  check_cover_times(r, n, c, s);
+  s.cover = c;
+}
+
+/// Bounds on the blind stretch need a stretch: a cover: or a kidnap:.
+void check_blind_bounds(const Scenario& s, const ReadContext& ctx) {
+  if (!s.expect.any_blind_bound() || s.cover || s.kidnap) return;
+  const Expectations& e = s.expect;
+  const char* key = e.blind_poses_all             ? "blind_poses_all"
+                    : e.blind_after_error_m_max   ? "blind_after_error_m_max"
+                    : e.blind_after_error_deg_max ? "blind_after_error_deg_max"
+                                                  : "blind_no_global_relocalisation";
+  throw ConfigError(ctx.origins->where(std::string("expect.") + key, ctx.file), std::string("expect.") + key,
+                    "a scenario with a cover: or kidnap: section (the bound is on its covered frames)",
+                    "no covered frames");
 }
 
 /// Checks between fields: the route against the arrays it names.

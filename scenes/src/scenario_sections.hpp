@@ -27,6 +27,9 @@ void read_slam(MapReader& r, SlamTuning& t);
 void read_expect(MapReader& r, Expectations& e);
 /// The kidnap: section.  Read after duration_s and camera, which bound it.
 void read_kidnap(MapReader& top, Scenario& s);
+/// The cover: section.  Read after kidnap: (a scenario has one or the
+/// other), duration_s and camera.
+void read_cover(MapReader& top, Scenario& s);
 /// The physics:, imu: and wheels: sections.  Read after camera (the
 /// physics rate is a multiple of its frame rate).
 void read_body(MapReader& top, Scenario& s);
@@ -42,6 +45,8 @@ void resolve_day(Scenario& s, const ReadContext& ctx);
 void check_scene_size(const Scenario& s, const ReadContext& ctx);
 /// Checks between fields: the route against the arrays it names.
 void check_route(const Scenario& s, const ReadContext& ctx);
+/// Refuses bounds on the blind stretch in a scenario without covered frames.
+void check_blind_bounds(const Scenario& s, const ReadContext& ctx);
 /// Refuses a ground relief too rough or steep for the robot on its route.
 void check_ground_relief(const Scenario& s, const ReadContext& ctx);
 

@@ -237,14 +237,14 @@ SensorModel::SensorModel(const Simulator& sim)
     : camera_(sim.scenario().camera),
       K_(sim.intrinsics()),
       seed_(sim.scenario().seed),
-      kidnap_(sim.kidnap_frames()) {}
+      cover_(scenes::camera_cover_frames(sim.scenario())) {}
 
 Capture SensorModel::apply(RenderedFrame rendered) const {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   Capture out;
   out.depth_gt_m = std::move(rendered.depth_gt_m);
-  const bool covered = kidnap_ && kidnap_->covered(static_cast<std::int64_t>(rendered.index));
+  const bool covered = cover_ && cover_->covered(static_cast<std::int64_t>(rendered.index));
   if (covered) {  // no light reaches the colour sensor, no infrared pattern comes back
     rendered.rgb.setTo(cv::Scalar::all(0));
     out.frame.depth_m = cv::Mat::zeros(out.depth_gt_m.size(), CV_32FC1);

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "pvb/geometry/time.hpp"
@@ -331,6 +332,39 @@ TEST(MotionSensors, KidnapShowsInTheImuAndNotInTheWheels) {
   std::printf("kidnap: lift %.3f m, largest step of the accelerometer at the carry's ends %.2f m/s^2, "
               "elsewhere %.2f m/s^2\n", lift, jump_ends, jump_drive);
   EXPECT_LT(jump_ends, std::max(1.0, jump_drive));
+}
+
+// A cover only blinds the camera: the IMU and the encoders read what they
+// read without it, bit for bit, and the wheels turn on through it.
+TEST(MotionSensors, CoverLeavesTheImuAndTheWheelsAsTheyAre) {
+  scenes::Scenario plain = drive_scenario(0.5, 5);
+  scenes::Scenario covered = plain;
+  covered.cover = scenes::Cover{1.5, 2.0};
+  sim::Simulator a(plain), b(covered);
+  const sim::MotionBatch ra = drive(a, 150), rb = drive(b, 150);
+  ASSERT_EQ(ra.imu.size(), rb.imu.size());
+  ASSERT_EQ(ra.ticks.size(), rb.ticks.size());
+  for (std::size_t i = 0; i < ra.imu.size(); ++i) {
+    ASSERT_EQ(ra.imu[i].t_ns, rb.imu[i].t_ns) << i;
+    ASSERT_TRUE(ra.imu[i].gyro_radps == rb.imu[i].gyro_radps) << i;
+    ASSERT_TRUE(ra.imu[i].accel_mps2 == rb.imu[i].accel_mps2) << i;
+  }
+  const scenes::CoverFrames c = *scenes::camera_cover_frames(covered);
+  const std::int64_t from_ns = geom::frame_time_ns(0, c.begin, 30), to_ns = geom::frame_time_ns(0, c.end, 30);
+  std::optional<sensor::WheelTicks> first, last;
+  for (std::size_t i = 0; i < rb.ticks.size(); ++i) {
+    ASSERT_EQ(ra.ticks[i].left, rb.ticks[i].left) << i;
+    ASSERT_EQ(ra.ticks[i].right, rb.ticks[i].right) << i;
+    if (rb.ticks[i].t_ns < from_ns || rb.ticks[i].t_ns > to_ns) continue;
+    EXPECT_FALSE(rb.wheel_truth[i].carried) << i;
+    if (!first) first = rb.ticks[i];
+    last = rb.ticks[i];
+  }
+  ASSERT_TRUE(first && last);
+  EXPECT_GE(last->t_ns - first->t_ns, 1'900'000'000);  // 50 Hz over the 2 s
+  // 0.5 m/s over about 2 s: a metre, far more than a few ticks on each wheel
+  EXPECT_GT(last->left - first->left, 100);
+  EXPECT_GT(last->right - first->right, 100);
 }
 
 // Two simulators of one scenario give the same readings, bit for bit.

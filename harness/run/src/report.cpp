@@ -56,6 +56,7 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
   if (run.place) out += in + "\"place_recognition\": " + place_json(*run.place) + ",\n";
   if (run.dense_map) out += in + "\"dense_map\": " + dense_map_json(*run.dense_map, in) + ",\n";
   if (run.map) out += in + "\"map\": " + map_report_json(*run.map) + ",\n";
+  if (run.blind) out += in + "\"blind\": " + blind_json(*run.blind) + ",\n";
   out += in + "\"tracking_ms\": {\"median\": " + num(percentile(ms, 0.5)) +
          ", \"mean\": " + num(mean_of(ms)) + ", \"p95\": " + num(percentile(ms, 0.95)) + "},\n";
   out += in + "\"loss_events\": [";
@@ -512,6 +513,35 @@ std::string loss_section(const RunReport& r) {
   return h;
 }
 
+/// The blind stretch of every system: the covered frames, their poses, and
+/// the first frame after them.
+std::string blind_section(const RunReport& r) {
+  std::vector<const SlamRun*> runs;
+  for (const SlamRun* run : {&r.primary, r.baseline ? &*r.baseline : nullptr})
+    if (run && run->blind) runs.push_back(run);
+  if (runs.empty()) return {};
+  std::string h =
+      "<h2>Blind stretch</h2>\n<table><tr><th></th><th>covered frames</th><th>with a pose</th>"
+      "<th>first frame after</th><th>tracked (method)</th>"
+      "<th>error across the stretch [m / deg]</th><th>error, ATE-aligned [m / deg]</th></tr>\n";
+  const auto error_cell = [](const std::optional<PoseError>& e) {
+    return e ? fixed(e->trans_m, 4) + " / " + fixed(e->rot_deg, 3) : std::string("-");
+  };
+  for (const SlamRun* run : runs) {
+    const BlindStretch& b = *run->blind;
+    const std::string tracked = !b.first_after          ? "-"
+                                : b.first_after_tracked ? "yes (" + b.first_after_method + ")"
+                                                        : "no (" + b.first_after_state + ")";
+    h += "<tr><td>" + html_escape(eval::mode_label(run->mode)) + "</td><td>" +
+         std::to_string(b.first_covered) + "-" + std::to_string(b.last_covered) + "</td><td>" +
+         std::to_string(b.covered_with_pose) + " of " + std::to_string(b.covered_frames()) + "</td><td>" +
+         (b.first_after ? std::to_string(*b.first_after) : std::string("not reached")) + "</td><td>" +
+         html_escape(tracked) + "</td><td>" + error_cell(b.first_after_error) + "</td><td>" +
+         error_cell(b.first_after_ate) + "</td></tr>\n";
+  }
+  return h + "</table>\n";
+}
+
 /// The figures (PNG linking to the SVG) and the contact sheet.
 std::string figures_section(const std::vector<std::string>& figures) {
   std::string h = "<h2>Figures</h2>\n";
@@ -612,6 +642,7 @@ std::string index_html(const RunReport& r, const std::vector<std::string>& figur
   std::string h = html_head(r);
   h += "<table>\n" + run_rows(r) + accuracy_rows(r) + "</table>\n";
   h += loss_section(r);
+  h += blind_section(r);
   const std::string table = comparison_table(r);
   if (!table.empty())
     h += "<h2>" + html_escape(comparison_heading(r)) + "</h2>\n<pre>" + html_escape(table) + "</pre>\n";

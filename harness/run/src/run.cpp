@@ -17,6 +17,7 @@
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
+#include "pvb/run/blind.hpp"
 #include "pvb/run/motion_truth.hpp"
 #include "pvb/run/world_json.hpp"
 #include "pvb/scenes/route.hpp"
@@ -77,10 +78,8 @@ RunReport new_report(const scenes::Scenario& scenario, const RunOptions& opt) {
   report.world = world_json(scenario);
   report.sync = opt.sync;
   report.fps = scenario.camera.fps;
-  if (scenario.kidnap) {
-    const scenes::KidnapFrames k = scenes::kidnap_frames(*scenario.kidnap, scenario.camera.fps);
-    report.camera_covered_frames = std::make_pair(k.cover_begin, k.cover_end - 1);
-  }
+  if (const auto cover = scenes::camera_cover_frames(scenario))
+    report.camera_covered_frames = std::make_pair(cover->begin, cover->end - 1);
   return report;
 }
 
@@ -283,6 +282,19 @@ double evaluate_systems(SystemSinks& sinks, const eval::Trajectory& gt) {
   return ms_since(t_eval);
 }
 
+/// The blind stretch of every system, in a scenario whose camera is
+/// covered for a while; its summary in the log.
+void evaluate_blind_stretch(const scenes::Scenario& scenario, SystemSinks& sinks, const eval::Trajectory& gt,
+                            RunLog& log) {
+  const std::optional<scenes::CoverFrames> cover = scenes::camera_cover_frames(scenario);
+  if (!cover || sinks.front()->run.frames <= static_cast<std::size_t>(cover->begin)) return;
+  for (auto& sink : sinks) {
+    SlamRun& run = sink->run;
+    run.blind = blind_stretch(*cover, scenario.camera.fps, run.per_frame, sink->est, gt, run.eval);
+    log.line(eval::mode_label(run.mode) + ": " + blind_summary(*run.blind));
+  }
+}
+
 /// The dense maps scored against the true surface, unless the options say
 /// not to; returns the time it took (ms).
 double score_or_skip_maps(const RunOptions& opt, const scenes::Scenario& scenario, sim::GlBackend backend,
@@ -480,6 +492,7 @@ RunReport run_scenario(const RunOptions& opt) {
   gt.close();
   const double eval_ms = evaluate_systems(sinks, gt.trajectory());
   for (auto& sink : sinks) sink->evaluate_inertial(gt.bias_truth());
+  evaluate_blind_stretch(scenario, sinks, gt.trajectory(), log);
   if (!opt.map.save_path.empty()) log.line("saving the map to " + opt.map.save_path);
   for (auto& sink : sinks) sink->finish_map(gt.trajectory(), scenario.name, opt.scenario_file);
   if (SlamRun& p = sinks.front()->run; p.map && p.map->localisation)

@@ -46,6 +46,12 @@ void record_state_change(SlamRun& run, slam::TrackingState prev_state, const sla
   }
 }
 
+/// The tracking method as timing.csv writes it.
+const char* method_name(slam::TrackingMethod m) {
+  static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc", "dead_reckoning", "after_blind"};
+  return kMethods[static_cast<int>(m)];
+}
+
 void write_tum(const std::string& path, const std::string& header,
                const std::vector<geom::StampedPose>& poses) {
   write_file(path, geom::format_tum(poses, header));
@@ -119,8 +125,9 @@ void SystemSink::count(const slam::FrameResult& r, int index, double t_s) {
   tracking_ms += r.tracking_ms;
   orb_ms += r.orb_ms;
   inline_mapping_ms += r.mapping_ms;
-  run.per_frame.push_back(
-      {index, t_s, r.T_w_c.has_value(), r.tracking_ms, r.tracking.coarse_matches, r.tracking.matches_kept});
+  run.per_frame.push_back({index, t_s, r.T_w_c.has_value(), r.tracking_ms, r.tracking.coarse_matches,
+                           r.tracking.matches_kept, slam::to_string(r.state),
+                           method_name(r.tracking.method)});
 }
 
 void SystemSink::write_lines(const slam::FrameResult& r, int index) {
@@ -129,10 +136,9 @@ void SystemSink::write_lines(const slam::FrameResult& r, int index) {
     est.poses.push_back({r.t_ns, *r.T_w_c});
     if (r.tracking.new_keyframe) kf_traj.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
   }
-  static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc", "dead_reckoning", "after_blind"};
   std::ostringstream line;
   line << index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
-       << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","
+       << method_name(r.tracking.method) << "," << r.num_features << ","
        << format_g(r.tracking_ms) << "," << format_g(r.orb_ms) << "," << format_g(r.tracking.pe_match_ms)
        << "," << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers
        << "," << (r.tracking.new_keyframe ? 1 : 0) << "," << format_g(r.mapping_ms) << "\n";

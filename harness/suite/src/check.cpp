@@ -71,6 +71,67 @@ void check_relocalisation(const scenes::Expectations& expect, const RunMetrics& 
   }
 }
 
+/// blind_no_global_relocalisation: tracking resumes on the first frame
+/// after the cover (state ok) in the same map, and neither it nor a covered
+/// frame was tracked by a global relocalisation.
+void check_blind_relocalisation(const BlindMetrics& b, std::vector<Violation>* out) {
+  const std::string key = "blind_no_global_relocalisation";
+  if (!b.first_after) {
+    out->push_back({key, "the run ended before the first frame after the cover"});
+    return;
+  }
+  const std::string frame = "the first frame after the cover (" + std::to_string(*b.first_after) + ")";
+  if (!b.first_after_tracked)
+    out->push_back({key, frame + " has no pose (state " + b.first_after_state + ")"});
+  else if (b.first_after_method == "reloc")
+    out->push_back({key, frame + " was tracked by a global relocalisation"});
+  else if (b.first_after_method == "init")
+    out->push_back({key, frame + " began a new map"});
+  else if (b.first_after_state != "ok")
+    out->push_back({key, frame + " has a pose but tracking has not resumed (state " + b.first_after_state + ")"});
+  if (b.relocalised_frames > 0 && b.first_after_method != "reloc")
+    out->push_back({key, std::to_string(b.relocalised_frames) + " covered frames were tracked by a global "
+                                                                "relocalisation"});
+}
+
+/// The bounds on the blind stretch (a cover, or a kidnap's covered frames).
+void check_blind(const scenes::Expectations& expect, const RunMetrics& run, std::vector<Violation>* out) {
+  if (!expect.any_blind_bound()) return;
+  if (!run.blind) {
+    const std::string key = expect.blind_poses_all             ? "blind_poses_all"
+                            : expect.blind_after_error_m_max   ? "blind_after_error_m_max"
+                            : expect.blind_after_error_deg_max ? "blind_after_error_deg_max"
+                                                               : "blind_no_global_relocalisation";
+    out->push_back({key, "no blind stretch in the metrics (blind is absent)"});
+    return;
+  }
+  const BlindMetrics& b = *run.blind;
+  if (expect.blind_poses_all && b.covered_with_pose < b.covered_frames())
+    out->push_back({"blind_poses_all", std::to_string(b.covered_with_pose) + " of " +
+                                           std::to_string(b.covered_frames()) +
+                                           " covered frames have a pose"});
+  const std::string no_error =
+      "no error across the stretch in the metrics (the first frame after it or the "
+      "last before it has no pose)";
+  if (expect.blind_after_error_m_max) {
+    if (!b.first_after_error_m)
+      out->push_back({"blind_after_error_m_max", no_error});
+    else if (!(*b.first_after_error_m <= *expect.blind_after_error_m_max))
+      out->push_back({"blind_after_error_m_max", "error across the stretch " +
+                                                     metres(*b.first_after_error_m) + " > " +
+                                                     metres(*expect.blind_after_error_m_max)});
+  }
+  if (expect.blind_after_error_deg_max) {
+    if (!b.first_after_error_deg)
+      out->push_back({"blind_after_error_deg_max", no_error});
+    else if (!(*b.first_after_error_deg <= *expect.blind_after_error_deg_max))
+      out->push_back({"blind_after_error_deg_max",
+                      "error across the stretch " + format_number("%.4g deg", *b.first_after_error_deg) +
+                          " > " + format_number("%.4g deg", *expect.blind_after_error_deg_max)});
+  }
+  if (expect.blind_no_global_relocalisation) check_blind_relocalisation(b, out);
+}
+
 /// The dense-map bounds, on the corrected map's scores.
 void check_map(const scenes::Expectations& expect, const RunMetrics& run, std::vector<Violation>* out) {
   if (!expect.map_accuracy_m_max && !expect.map_completeness_min) return;
@@ -152,6 +213,7 @@ std::vector<Violation> check_expectations(const scenes::Expectations& expect, co
   check_place(expect, run, &out);
   check_relocalisation(expect, run, &out);
   check_map(expect, run, &out);
+  check_blind(expect, run, &out);
 
   if (notes != nullptr && metrics.baseline && metrics.baseline->ate_rmse_m && run.ate_rmse_m)
     notes->push_back(pe_against_baseline_note(*run.ate_rmse_m, *metrics.baseline->ate_rmse_m));

@@ -87,6 +87,7 @@ class Reader : public detail::JsonFields {
     r.refined_ate_rmse_m = optional_number(obj, "refined", "ate_rmse");
     r.place = place(obj);
     r.maps = maps(obj);
+    r.blind = blind(obj);
     const YAML::Node cover = obj["camera_covered_frames"];
     if (cover.IsDefined() && !cover.IsNull()) {
       if (!cover.IsSequence() || cover.size() != 2) fail(cover, "camera_covered_frames", "[first, last]");
@@ -95,6 +96,42 @@ class Reader : public detail::JsonFields {
                                  integer_at(cover[1], "camera_covered_frames[1]", first, INT_MAX, "first")};
     }
     return r;
+  }
+
+  /// "blind": the covered frames, their poses and the first frame after them.
+  std::optional<BlindMetrics> blind(const YAML::Node& obj) const {
+    const YAML::Node n = obj["blind"];
+    if (!n.IsDefined() || n.IsNull()) return std::nullopt;
+    if (!n.IsMap()) fail(n, "blind", "an object or null");
+    const JsonFields in = nested("blind.");
+    BlindMetrics b;
+    const YAML::Node cover = in.required(n, "covered_frames");
+    if (!cover.IsSequence() || cover.size() != 2) in.fail(cover, "covered_frames", "[first, last]");
+    b.first_covered = in.integer_at(cover[0], "covered_frames[0]", 0);
+    b.last_covered = in.integer_at(cover[1], "covered_frames[1]", b.first_covered, INT_MAX, "first");
+    b.covered_with_pose =
+        in.integer(n, "covered_frames_with_pose", 0, b.covered_frames(), "the covered frames");
+    b.relocalised_frames = in.integer(n, "relocalised_frames", 0);
+    if (!absent(n, "first_after_frame")) b.first_after = in.integer(n, "first_after_frame", 0);
+    b.first_after_tracked = boolean(in, n, "first_after_tracked");
+    if (!absent(n, "first_after_method")) b.first_after_method = in.text(n, "first_after_method");
+    if (!absent(n, "first_after_state")) b.first_after_state = in.text(n, "first_after_state");
+    const YAML::Node err = n["first_after_error"];
+    if (err.IsDefined() && !err.IsNull()) {
+      if (!err.IsMap()) in.fail(err, "first_after_error", "an object or null");
+      const JsonFields e = in.nested("first_after_error.");
+      b.first_after_error_m = e.number(err, "trans_m", 0.0);
+      b.first_after_error_deg = e.number(err, "rot_deg", 0.0, 180.0);
+    }
+    return b;
+  }
+
+  /// true or false under obj[key] (required).
+  static bool boolean(const JsonFields& in, const YAML::Node& obj, const std::string& key) {
+    const YAML::Node v = in.required(obj, key);
+    if (!is_plain_scalar(v) || (v.Scalar() != "true" && v.Scalar() != "false"))
+      in.fail(v, key, "true or false", shown(v));
+    return v.Scalar() == "true";
   }
 
   /// "dense_map.maps": each map's whole-map scores (tau 1, 2, 5, 10 cm).

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <set>
 
 #include "pvb/common/text.hpp"
 #include "cli_output.hpp"
@@ -435,6 +436,51 @@ TEST(RunCli, ARunThatNeverInitialisesFailsAndSavesNoMap) {
   EXPECT_EQ(metrics(d)["status"].as<std::string>(), "failed");
   EXPECT_TRUE(exists(d + "/index.html"));
   EXPECT_FALSE(exists(map));
+}
+
+// A cover on the default station: the run goes through it whatever the
+// SLAM core does while blind, and its blind object says what the files
+// say (the covered frames with a pose, the first frame after the cover and
+// its tracking as timing.csv has them); the robot drives on meanwhile.
+TEST(RunCli, ACoverIsDrivenThroughAndReportedAsABlindStretch) {
+  const std::string d = fresh("cover");
+  const std::string scenario = d + "_cover.yaml";
+  write_file(scenario, read_file(kStation) + "cover: {at_s: 2, covered_s: 0.5}\n");
+  const test::RunResult r =
+      test::run_pvbench("run --scenario " + scenario + " --out " + d + " --frames 90 --sync --no-map-eval");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const YAML::Node m = metrics(d);
+  EXPECT_EQ(m["status"].as<std::string>(), "completed");
+  EXPECT_EQ(m["camera_covered_frames"][0].as<int>(), 60);
+  EXPECT_EQ(m["camera_covered_frames"][1].as<int>(), 74);
+  const YAML::Node b = m["blind"];
+  ASSERT_TRUE(b.IsMap()) << read_file(d + "/metrics.json");
+  EXPECT_EQ(b["covered_frames"][0].as<int>(), 60);
+  EXPECT_EQ(b["covered_frames"][1].as<int>(), 74);
+  EXPECT_EQ(b["covered_frames_processed"].as<int>(), 15);
+  EXPECT_EQ(b["first_after_frame"].as<int>(), 75);
+  // timing.csv: frame,t_s,state,method,...; CameraTrajectory.txt: one line a pose.
+  const std::vector<std::string> timing = data_lines(d + "/timing.csv");
+  ASSERT_EQ(timing.size(), 91u);  // the header and 90 frames
+  std::set<std::string> posed_times;
+  for (const std::string& line : data_lines(d + "/CameraTrajectory.txt"))
+    posed_times.insert(split_ws(line)[0]);
+  int covered_with_pose = 0;
+  for (int i = 60; i <= 74; ++i)
+    covered_with_pose += posed_times.count(split_ws(timing[static_cast<std::size_t>(i) + 1])[1]) > 0 ? 1 : 0;
+  EXPECT_EQ(b["covered_frames_with_pose"].as<int>(), covered_with_pose);
+  const std::vector<std::string> after = split_ws(timing[76]);
+  ASSERT_EQ(after[0], "75");
+  EXPECT_EQ(b["first_after_state"].as<std::string>(), after[2]);
+  EXPECT_EQ(b["first_after_method"].as<std::string>(), after[3]);
+  EXPECT_EQ(b["first_after_tracked"].as<bool>(), posed_times.count(after[1]) > 0);
+  EXPECT_EQ(b["first_after_error"].IsNull(), !b["first_after_tracked"].as<bool>());
+  EXPECT_NE(r.output.find("blind stretch (frames 60-74): "), std::string::npos) << r.output;
+  EXPECT_NE(read_file(d + "/index.html").find("<h2>Blind stretch</h2>"), std::string::npos);
+  // The robot drove on: 0.45 m/s over the half second of the cover.
+  const std::vector<std::string> gt = data_lines(d + "/groundtruth.txt");
+  const std::vector<std::string> g0 = split_ws(gt[59]), g1 = split_ws(gt[75]);
+  EXPECT_GT(std::hypot(std::stod(g1[1]) - std::stod(g0[1]), std::stod(g1[2]) - std::stod(g0[2])), 0.15);
 }
 
 TEST(RunCli, BadInputIsOneClearError) {

@@ -49,7 +49,8 @@ SlamRun slam_run(const std::string& mode, double lateral_error_m) {
   r.keyframes = 7;
   r.map_points = 900;
   for (int i = 0; i < 50; ++i)
-    r.per_frame.push_back({i, i / 30.0, i != 20 && i != 21, 10.0 + i % 5, i > 0 ? 300 : 0, i > 0 ? 290 : 0});
+    r.per_frame.push_back({i, i / 30.0, i != 20 && i != 21, 10.0 + i % 5, i > 0 ? 300 : 0, i > 0 ? 290 : 0,
+                           i != 20 && i != 21 ? "ok" : "lost", i != 20 && i != 21 ? "motion" : "none"});
   r.loss_events.push_back(
       {20, 20 / 30.0, "local map: only 21 inliers after pose optimisation (need 30)", 22});
   r.eval = synthetic_eval(lateral_error_m);

@@ -534,3 +534,145 @@ TEST(SuiteCheckMap, SweepsAggregateTheMaps) {
   const std::string md = suite::format_markdown(a);
   EXPECT_NE(md.find("dense map over 2 seeds: median accuracy 14.0 ± 2.8 mm"), std::string::npos) << md;
 }
+
+namespace {
+
+suite::MetricsFile blind_run() { return suite::read_metrics_file(suite_fixture("blind.json")); }
+
+scenes::Expectations blind_bounds() {
+  scenes::Expectations e;
+  e.blind_poses_all = true;
+  e.blind_after_error_m_max = 0.05;
+  e.blind_after_error_deg_max = 1.0;
+  e.blind_no_global_relocalisation = true;
+  return e;
+}
+
+std::vector<std::string> lines_of(const std::vector<suite::Violation>& v) {
+  std::vector<std::string> out;
+  for (const suite::Violation& x : v) out.push_back(x.line());
+  return out;
+}
+
+}  // namespace
+
+TEST(SuiteCheckBlind, ReadsTheBlindStretch) {
+  const suite::MetricsFile m = blind_run();
+  ASSERT_TRUE(m.primary.blind.has_value());
+  const suite::BlindMetrics& b = *m.primary.blind;
+  EXPECT_EQ(b.first_covered, 450);
+  EXPECT_EQ(b.last_covered, 539);
+  EXPECT_EQ(b.covered_frames(), 90);
+  EXPECT_EQ(b.covered_with_pose, 90);
+  EXPECT_EQ(b.first_after.value_or(-1), 540);
+  EXPECT_TRUE(b.first_after_tracked);
+  EXPECT_EQ(b.first_after_method, "motion");
+  EXPECT_EQ(b.first_after_state, "ok");
+  EXPECT_DOUBLE_EQ(b.first_after_error_m.value_or(-1), 0.031);
+  EXPECT_DOUBLE_EQ(b.first_after_error_deg.value_or(-1), 0.42);
+  EXPECT_FALSE(kidnapped().primary.blind.has_value());
+}
+
+// A stretch driven on dead reckoning meets every bound; each bound fails
+// on its own when its figure is past it.
+TEST(SuiteCheckBlind, EachBoundHoldsAndFailsOnItsOwn) {
+  const scenes::Expectations e = blind_bounds();
+  EXPECT_TRUE(suite::check_expectations(e, blind_run()).empty());
+  suite::MetricsFile m = blind_run();
+  m.primary.blind->covered_with_pose = 89;
+  EXPECT_EQ(lines_of(suite::check_expectations(e, m)),
+            std::vector<std::string>{"blind_poses_all: 89 of 90 covered frames have a pose"});
+  m = blind_run();
+  m.primary.blind->first_after_error_m = 0.0501;
+  EXPECT_EQ(lines_of(suite::check_expectations(e, m)),
+            std::vector<std::string>{"blind_after_error_m_max: error across the stretch 0.0501 m > 0.05 m"});
+  m = blind_run();
+  m.primary.blind->first_after_error_deg = 1.5;
+  EXPECT_EQ(lines_of(suite::check_expectations(e, m)),
+            std::vector<std::string>{"blind_after_error_deg_max: error across the stretch 1.5 deg > 1 deg"});
+  m = blind_run();
+  m.primary.blind->first_after_method = "reloc";
+  m.primary.blind->relocalised_frames = 1;
+  EXPECT_EQ(
+      lines_of(suite::check_expectations(e, m)),
+      std::vector<std::string>{
+          "blind_no_global_relocalisation: the first frame after the cover (540) was tracked by a global "
+          "relocalisation"});
+  m = blind_run();
+  m.primary.blind->first_after_method = "init";
+  EXPECT_EQ(lines_of(suite::check_expectations(e, m)),
+            std::vector<std::string>{
+                "blind_no_global_relocalisation: the first frame after the cover (540) began a new map"});
+  m = blind_run();
+  m.primary.blind->first_after_state = "dead_reckoning";
+  EXPECT_EQ(lines_of(suite::check_expectations(e, m)),
+            std::vector<std::string>{"blind_no_global_relocalisation: the first frame after the cover (540) has a "
+                                     "pose but tracking has not resumed (state dead_reckoning)"});
+  m = blind_run();
+  m.primary.blind->relocalised_frames = 2;
+  EXPECT_EQ(lines_of(suite::check_expectations(e, m)),
+            std::vector<std::string>{
+                "blind_no_global_relocalisation: 2 covered frames were tracked by a global relocalisation"});
+}
+
+// What a camera-only SLAM does: no pose while covered, lost on the first
+// frame after, relocalised later.  Every blind bound is violated and says why.
+TEST(SuiteCheckBlind, ACameraOnlyRunViolatesEveryBlindBound) {
+  suite::MetricsFile m = blind_run();
+  suite::BlindMetrics& b = *m.primary.blind;
+  b.covered_with_pose = 0;
+  b.first_after_tracked = false;
+  b.first_after_state = "lost";
+  b.first_after_method = "none";
+  b.first_after_error_m.reset();
+  b.first_after_error_deg.reset();
+  const std::vector<std::string> lines = lines_of(suite::check_expectations(blind_bounds(), m));
+  const std::string no_error =
+      "no error across the stretch in the metrics (the first frame after it or the last before it has no "
+      "pose)";
+  EXPECT_EQ(lines, (std::vector<std::string>{
+                       "blind_poses_all: 0 of 90 covered frames have a pose",
+                       "blind_after_error_m_max: " + no_error, "blind_after_error_deg_max: " + no_error,
+                       "blind_no_global_relocalisation: the first frame after the cover "
+                       "(540) has no pose (state lost)"}));
+  // A run that ended inside the cover, and one with no blind object at all.
+  b.first_after.reset();
+  scenes::Expectations only_reloc;
+  only_reloc.blind_no_global_relocalisation = true;
+  EXPECT_EQ(lines_of(suite::check_expectations(only_reloc, m)),
+            std::vector<std::string>{
+                "blind_no_global_relocalisation: the run ended before the first frame after the cover"});
+  m.primary.blind.reset();
+  EXPECT_EQ(lines_of(suite::check_expectations(only_reloc, m)),
+            std::vector<std::string>{
+                "blind_no_global_relocalisation: no blind stretch in the metrics (blind is absent)"});
+}
+
+TEST(SuiteCheckBlind, BadBlindObjectsAreRefusedNamingFileLineAndKey) {
+  const std::string path = ::testing::TempDir() + "pvb_metrics_blind_" + std::to_string(::getpid()) + ".json";
+  auto message = [&path](const std::string& from, const std::string& to) {
+    std::string text = read_file(suite_fixture("blind.json"));
+    const std::size_t at = text.find(from);
+    if (at == std::string::npos) return "(" + from + " not in blind.json)";
+    write_file(path, text.replace(at, from.size(), to));
+    try {
+      suite::read_metrics_file(path);
+    } catch (const IoError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  const std::string f = path + ":";
+  EXPECT_EQ(
+      message("\"covered_frames_with_pose\": 90", "\"covered_frames_with_pose\": 91"),
+      f + "10: blind.covered_frames_with_pose: expected an integer in [0, the covered frames = 90], got 91");
+  EXPECT_EQ(message("\"first_after_tracked\": true", "\"first_after_tracked\": \"yes\""),
+            f + "12: blind.first_after_tracked: expected true or false, got the string \"yes\"");
+  EXPECT_EQ(message("\"covered_frames\": [450, 539]", "\"covered_frames\": [450, 439]"),
+            f + "10: blind.covered_frames[1]: expected an integer >= first = 450, got 439");
+  EXPECT_EQ(message("\"rot_deg\": 0.42", "\"rot_deg\": 270"),
+            f + "13: blind.first_after_error.rot_deg: expected a number in [0, 180], got 270");
+  EXPECT_EQ(message("{\"trans_m\": 0.031, \"rot_deg\": 0.42}", "0.031"),
+            f + "13: blind.first_after_error: expected an object or null");
+  std::remove(path.c_str());
+}

@@ -311,14 +311,28 @@ struct Expectations {
   /// and at least this share (0-1) of the surface within 5 cm of the map.
   std::optional<double> map_accuracy_m_max;
   std::optional<double> map_completeness_min;
+  /// The blind stretch (a `cover:` or a kidnap's covered frames): every
+  /// covered frame has a pose; the first frame after the cover, relative to
+  /// the last pose before it, within these bounds of the truth; and that
+  /// frame tracked without a global relocalisation (none during the cover
+  /// either).
+  bool blind_poses_all = false;
+  std::optional<double> blind_after_error_m_max;
+  std::optional<double> blind_after_error_deg_max;
+  bool blind_no_global_relocalisation = false;
   bool tracking_loss_expected = false;         ///< the run must report a loss with a reason
   int ci_frames = 0;                           ///< frames of the fast CI run; 0 = not in the fast subset
   SweepExpectations sweep;                     ///< judged over a seed sweep only
   /// True when a bound on a single run is set.
   bool any_run_bound() const {
-    return ate_rmse_m_max || rpe_trans_rmse_m_max || lost_frames_max || keyframes_max || tracking_loss_expected ||
-           refined_ate_rmse_m_max || false_loops_max || relocalised_within_frames || loops_min ||
-           map_accuracy_m_max || map_completeness_min;
+    return ate_rmse_m_max || rpe_trans_rmse_m_max || lost_frames_max || keyframes_max ||
+           tracking_loss_expected || refined_ate_rmse_m_max || false_loops_max || relocalised_within_frames ||
+           loops_min || map_accuracy_m_max || map_completeness_min || any_blind_bound();
+  }
+  /// True when a bound on the blind stretch is set.
+  bool any_blind_bound() const {
+    return blind_poses_all || blind_after_error_m_max || blind_after_error_deg_max ||
+           blind_no_global_relocalisation;
   }
   /// True when any bound or flag is set.
   bool any() const { return any_run_bound() || sweep.any(); }
@@ -334,6 +348,21 @@ struct Kidnap {
   double at_s = 0;        ///< the lens is covered from this time
   double covered_s = 2;   ///< for this long
   double to_route_s = 0;  ///< the robot is carried to its state at this earlier time
+};
+
+/// The camera is covered for a while, as in a kidnap, but the robot drives
+/// on along its route (the `cover:` section): its IMU and wheel encoders
+/// read as usual.
+struct Cover {
+  double at_s = 0;       ///< the lens is covered from this time
+  double covered_s = 2;  ///< for this long
+};
+
+/// The frames a covered lens spans (frame i is at i / fps).
+struct CoverFrames {
+  int begin = 0;  ///< first covered frame: the first at or after at_s
+  int end = 0;    ///< first frame after the cover: the first at or after at_s + covered_s
+  bool covered(std::int64_t frame) const { return frame >= begin && frame < end; }
 };
 
 /// A kidnap in frame indices (frame i is at i / fps).
@@ -375,6 +404,7 @@ struct Scenario {
   Wheels wheels;
   SlamTuning slam;
   std::optional<Kidnap> kidnap;  ///< none unless the file has a kidnap: section
+  std::optional<Cover> cover;    ///< none unless the file has a cover: section (never with a kidnap)
   Expectations expect;
 };
 
@@ -408,6 +438,11 @@ double wheel_rate_hz(const Scenario& s);
 
 /// The kidnap's frames at the scenario's frame rate.
 KidnapFrames kidnap_frames(const Kidnap& k, double fps);
+/// The cover's frames at the scenario's frame rate.
+CoverFrames cover_frames(const Cover& c, double fps);
+/// The frames the scenario's camera is covered: its cover's, or its
+/// kidnap's; nullopt with neither.
+std::optional<CoverFrames> camera_cover_frames(const Scenario& s);
 
 const char* to_string(RoutePattern p);
 

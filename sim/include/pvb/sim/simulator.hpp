@@ -40,7 +40,8 @@ class Simulator {
   /// state kept at frame kidnap_frames()->target, which it reaches at frame
   /// kidnap_frames()->teleport with that state's velocities; from there it
   /// is that state (pose, velocities, the route follower's progress) and
-  /// drives on; time goes on.
+  /// drives on; time goes on.  A cover (scenario `cover:`) only covers
+  /// the lens: the robot drives on along its route.
   void advance();
   /// The IMU and encoder readings (and their truth) since the last call.
   MotionBatch take_motion() { return motion_ ? motion_->take() : MotionBatch{}; }
@@ -140,15 +141,16 @@ class SensorModel {
   explicit SensorModel(const Simulator& sim);
   /// Applies the sensor model; the result does not depend on the thread
   /// or on which frames were processed before.  A frame the scenario's
-  /// kidnap covers is what a covered lens gives: black colour with the
-  /// sensor's noise, and no depth (0 everywhere).
+  /// cover or kidnap covers (scenes::camera_cover_frames) is what a covered
+  /// lens gives: black colour with the sensor's noise, and no depth (0
+  /// everywhere).
   Capture apply(RenderedFrame rendered) const;
 
  private:
   scenes::Camera camera_;
   geom::PinholeIntrinsics K_;
   std::uint64_t seed_;
-  std::optional<scenes::KidnapFrames> kidnap_;
+  std::optional<scenes::CoverFrames> cover_;
 };
 
 /// Renders the simulator's camera and applies the sensor model.

@@ -50,6 +50,37 @@ struct FrameRecord {
   double tracking_ms = 0;
   int coarse_matches = 0;
   int matches_kept = 0;
+  std::string state;   ///< the tracking state, as timing.csv writes it ("ok", "lost", ...)
+  std::string method;  ///< how the pose was found, as timing.csv writes it ("motion", "reloc", ...)
+};
+
+/// One pose against the truth: the distance between the positions and the
+/// angle of the rotation between them.
+struct PoseError {
+  double trans_m = 0;
+  double rot_deg = 0;
+};
+
+/// The stretch the camera was covered (a cover, or a kidnap's covered
+/// frames) as one SLAM system came through it.
+struct BlindStretch {
+  int first_covered = 0, last_covered = 0;  ///< the covered frames
+  int covered_processed = 0;                ///< covered frames the run processed (fewer when it ended early)
+  int covered_with_pose = 0;                ///< covered frames with a pose in the trajectory
+  /// Frames of the cover and the first frame after it tracked by a global
+  /// relocalisation (method "reloc").
+  int relocalised_frames = 0;
+  std::optional<int> last_before;    ///< the last frame before the cover with a pose
+  std::optional<int> first_after;    ///< the first frame after the cover, when the run processed it
+  bool first_after_tracked = false;  ///< it has a pose
+  std::string first_after_state, first_after_method;  ///< as timing.csv writes them
+  /// The motion across the stretch, T_c(before)_c(after), estimated against
+  /// true: with a pose of last_before and of first_after.
+  std::optional<PoseError> first_after_error;
+  /// The first frame after the cover in the ATE-aligned frame of the whole
+  /// trajectory: with a pose of it and an evaluation.
+  std::optional<PoseError> first_after_ate;
+  int covered_frames() const { return last_covered - first_covered + 1; }
 };
 
 /// Place recognition of one run (loop closing on): what the detectors
@@ -66,6 +97,13 @@ struct PlaceRecognition {
 
 /// The place-recognition object of metrics.json.
 std::string place_json(const PlaceRecognition& p);
+
+/// The blind object of metrics.json (docs/evaluation.md, "The blind stretch").
+std::string blind_json(const BlindStretch& b);
+
+/// One line of the run's log on the blind stretch: how many covered frames
+/// have a pose and how tracking went on after it.
+std::string blind_summary(const BlindStretch& b);
 
 /// One SLAM system's dense map: how it was built and, with ground truth,
 /// how each of its versions scored against the true surface.
@@ -123,6 +161,7 @@ struct SlamRun {
   std::optional<eval::GravityError> gravity;
   std::optional<eval::TiltDrift> tilt;
   std::optional<InertialReport> inertial;  ///< a setup with an IMU (not camera alone)
+  std::optional<BlindStretch> blind;  ///< a scenario whose camera is covered for a while
 };
 
 /// Closed loop: distance of the ground-truth robot (axle centre) from the

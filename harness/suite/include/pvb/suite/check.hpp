@@ -34,6 +34,12 @@ struct Violation {
 /// - relocalised_within_frames: every loss recovered, by a relocalisation,
 ///   within the bound of the camera's return (the loss's frame, or the
 ///   last covered frame + 1 when camera_covered_frames overlaps the loss);
+/// - blind_poses_all, blind_after_error_m_max / _deg_max,
+///   blind_no_global_relocalisation: on the run's "blind" object (absent:
+///   a violation): every covered frame has a pose; the motion across the
+///   stretch within the bounds of the truth; tracking resumes on the first
+///   frame after the cover (state "ok", method neither "reloc" nor "init")
+///   and no covered frame was tracked by a relocalisation;
 /// - tracking_loss_expected: the run must report at least one loss event,
 ///   each with a frame and a non-empty reason, and must not be "interrupted".
 /// PE-SLAM against the baseline is never judged on one run: when both ATEs

@@ -34,6 +34,22 @@ struct MapMetrics {
   double ghosting = 0;          ///< share of the judged surface mapped twice
 };
 
+/// metrics.json's "blind": the stretch the camera was covered (a cover or
+/// a kidnap) as the run came through it.
+struct BlindMetrics {
+  int first_covered = 0, last_covered = 0;  ///< "covered_frames"
+  int covered_with_pose = 0;                ///< covered frames with a pose
+  int relocalised_frames = 0;               ///< of the cover and the first frame after it
+  std::optional<int> first_after;           ///< absent when the run ended before it
+  bool first_after_tracked = false;
+  std::string first_after_method;  ///< "" when the run ended before it
+  std::string first_after_state;
+  /// The motion across the stretch against the truth ("first_after_error"),
+  /// absent when it could not be measured.
+  std::optional<double> first_after_error_m, first_after_error_deg;
+  int covered_frames() const { return last_covered - first_covered + 1; }
+};
+
 /// One SLAM run's figures (the top level, or the "baseline" object).
 struct RunMetrics {
   std::string mode;    ///< "pe-slam" or "baseline" ("orb-slam2" in version 1 files is read as "baseline")
@@ -48,6 +64,7 @@ struct RunMetrics {
   std::optional<PlaceMetrics> place;       ///< absent when loop closing was off
   /// "camera_covered_frames": [first, last] of a scenario's camera cover.
   std::optional<std::pair<int, int>> camera_covered_frames;
+  std::optional<BlindMetrics> blind;  ///< absent in runs whose camera was never covered
   std::optional<double> tracking_ms_median;
   std::optional<double> realtime_factor;
   std::vector<LossEvent> loss_events;
