@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -147,6 +148,16 @@ MotionReadings read_motion_readings(const std::string& dir) {
       m.ticks.push_back(t);
     });
   return m;
+}
+
+void round_as_written(sensor::RgbdFrame* frame) {
+  const auto round = [](Eigen::Vector3d* v) {
+    for (int k = 0; k < 3; ++k) (*v)[k] = std::strtod(g((*v)[k]).c_str(), nullptr);
+  };
+  for (sensor::ImuSample& s : frame->imu) {
+    round(&s.gyro_radps);
+    round(&s.accel_mps2);
+  }
 }
 
 void attach_readings(const MotionReadings& m, std::int64_t t0_ns, std::int64_t t1_ns, sensor::RgbdFrame* frame) {

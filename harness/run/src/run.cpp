@@ -183,6 +183,7 @@ class RunConsumer : public FrameConsumer {
     costs_.render_ms += item.times.render_ms;
     costs_.sensor_ms += item.times.sensor_ms;
     std::vector<slam::FrameResult> results;
+    dataset::round_as_written(&item.frame);  // as a replay of the recording reads them
     for (auto& sink : sinks_) results.push_back(sink->track(item.frame, log_));
     const auto t0 = Clock::now();
     gt_.add(item);

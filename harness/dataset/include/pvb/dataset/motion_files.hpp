@@ -64,6 +64,11 @@ struct MotionReadings {
 /// the file and line.
 MotionReadings read_motion_readings(const std::string& dir);
 
+/// The frame's IMU readings as a recording holds them: each value rounded
+/// to the nine significant digits the files keep, so that SLAM on a live
+/// run sees what SLAM on its recording reads back.
+void round_as_written(sensor::RgbdFrame* frame);
+
 /// The readings with time in (t0_ns, t1_ns] appended to `frame` (binary search).
 void attach_readings(const MotionReadings& m, std::int64_t t0_ns, std::int64_t t1_ns, sensor::RgbdFrame* frame);
 
