@@ -24,33 +24,6 @@ std::vector<std::shared_ptr<KeyFrame>> chain_to(const std::shared_ptr<KeyFrame>&
 
 double seconds_between(const KeyFrame& a, const KeyFrame& b) { return static_cast<double>(b.t_ns() - a.t_ns()) * 1e-9; }
 
-/// The IMU's position at a keyframe.
-Eigen::Vector3d imu_position(const KeyFrame& k, const geom::SE3d& T_b_c) {
-  return (k.T_c_w().inverse() * T_b_c.inverse()).translation();
-}
-
-/// Gravity's direction from the run's increments (ORB-SLAM3's first
-/// guess): the velocity increments turned into the map add up to the
-/// change of velocity less g times the time, and vision gives that change.
-Eigen::Vector3d gravity_guess(const std::vector<std::shared_ptr<KeyFrame>>& run, const geom::SE3d& T_b_c,
-                              const Eigen::Vector3d& fallback) {
-  Eigen::Vector3d sum_dv = Eigen::Vector3d::Zero();
-  double total_s = 0;
-  for (std::size_t k = 1; k < run.size(); ++k) {
-    const ImuPreintegration& pre = *run[k]->motion().from_prev.imu;
-    const Eigen::Matrix3d R_w_b = (run[k - 1]->T_c_w().inverse() * T_b_c.inverse()).linear();
-    sum_dv += R_w_b * pre.delta_v();
-    total_s += pre.dt_s();
-  }
-  const std::size_t n = run.size();
-  const auto velocity = [&](std::size_t a, std::size_t b) {
-    return (imu_position(*run[b], T_b_c) - imu_position(*run[a], T_b_c)) / seconds_between(*run[a], *run[b]);
-  };
-  const Eigen::Vector3d dv_w = velocity(n - 2, n - 1) - velocity(0, 1);
-  const Eigen::Vector3d g = (dv_w - sum_dv) / total_s;
-  return g.norm() > 1.0 ? Eigen::Vector3d(g.normalized() * kGravityMps2) : fallback;
-}
-
 /// Camera + accelerometer: gravity is the mean of the keyframes'
 /// specific forces turned into the map, pointing down.
 bool initialize_tilt(const std::vector<std::shared_ptr<KeyFrame>>& chain, int min_keyframes, MapGravity* g) {
@@ -99,7 +72,7 @@ void LocalMapping::initialize_inertial(const std::shared_ptr<KeyFrame>& kf) {
     return;
   InertialInitProblem problem;
   problem.T_b_c = options_.imu.T_b_c;
-  problem.g_w_guess = gravity_guess(run, options_.imu.T_b_c, g.g_w);
+  problem.g_w_guess = g.g_w;  // its magnitude; the direction comes from the increments
   problem.gyro_bias_prior_radps = options_.init_gyro_bias_sigma_radps;
   problem.accel_bias_prior_mps2 = options_.init_accel_bias_sigma_mps2;
   for (std::size_t k = 0; k < run.size(); ++k) {
