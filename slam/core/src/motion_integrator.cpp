@@ -1,6 +1,7 @@
 #include "pvb/slam/core/motion_integrator.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 namespace pvb::slam {
@@ -122,7 +123,8 @@ NavState MotionIntegrator::nav_state(const geom::SE3d& T_c_w, const Eigen::Vecto
 }
 
 geom::SE3d MotionIntegrator::camera_pose(const NavState& s) const {
-  return (geom::make_se3(s.R_w_b, s.p_w_m) * imu_.T_b_c).inverse();
+  const geom::SE3d T_w_c = geom::make_se3(s.R_w_b, s.p_w_m) * imu_.T_b_c;
+  return geom::make_se3(Eigen::Quaterniond(T_w_c.linear()), T_w_c.translation()).inverse();
 }
 
 geom::SE3d MotionIntegrator::predict(const geom::SE3d& T_c_w_last, const Eigen::Vector3d& v_w_last,
@@ -135,11 +137,16 @@ geom::SE3d MotionIntegrator::predict(const geom::SE3d& T_c_w_last, const Eigen::
   // frame, turned as the gyro says.
   const geom::SE3d T_base_b = robot_.T_base_c * imu_.T_b_c.inverse();
   const geom::SE3d T_w_base0 = T_c_w_last.inverse() * robot_.T_base_c.inverse();
-  const Eigen::Matrix3d R_b0_b1 = start.R_w_b.transpose() * end.R_w_b;
+  const Eigen::Matrix3d R_b0_b1 =
+      imu_frame_.size() > 0 ? imu_frame_.delta_R(bias_) : Eigen::Matrix3d(Eigen::Matrix3d::Identity());
   const Eigen::Matrix3d R_base0_base1 = T_base_b.linear() * R_b0_b1 * T_base_b.linear().transpose();
   const Eigen::Vector3d& d = wheel_frame_.delta();
-  const geom::SE3d T_base0_base1 = geom::make_se3(R_base0_base1, Eigen::Vector3d(d.x(), d.y(), 0));
-  const geom::SE3d T_w_c1 = T_w_base0 * T_base0_base1 * robot_.T_base_c;
+  const geom::SE3d T_base0_base1 =
+      geom::make_se3(Eigen::Quaterniond(R_base0_base1), Eigen::Vector3d(d.x(), d.y(), 0));
+  geom::SE3d T_w_c1 = T_w_base0 * T_base0_base1 * robot_.T_base_c;
+  // Kept a rotation: Isometry3d's inverse transposes, so a drift from
+  // orthonormality would grow from frame to frame of a blind stretch.
+  T_w_c1 = geom::make_se3(Eigen::Quaterniond(T_w_c1.linear()), T_w_c1.translation());
   if (v_w_out && imu_frame_.dt_s() > 0)
     *v_w_out = ((T_w_c1 * imu_.T_b_c.inverse()).translation() - start.p_w_m) / imu_frame_.dt_s();
   return T_w_c1.inverse();
