@@ -123,3 +123,38 @@ TEST(MotionIntegrator, AccelerometerOnlyReadingsGiveTiltButNoIntervals) {
 
 }  // namespace
 }  // namespace pvb::slam
+
+namespace pvb::slam {
+namespace {
+
+// A blind stretch feeds each prediction back as the next start: ninety
+// frames with wheels stay a rotation and follow the encoders.
+TEST(MotionIntegrator, ChainedPredictionsStayRigidAndFollowTheWheels) {
+  Settings s = robot_settings(SensorSetup::kCameraImuWheels);
+  // A mount with a tilt, as a real one (the camera pitched down 15 degrees).
+  s.robot.T_base_c = geom::make_se3(Eigen::Matrix3d(Eigen::AngleAxisd(0.26, Eigen::Vector3d::UnitY())) *
+                                        geom::R_body_optical(),
+                                    Eigen::Vector3d(0.15, 0, 1.0));
+  s.imu.T_b_c = s.robot.T_base_imu.inverse() * s.robot.T_base_c;
+  MotionIntegrator m(s.sensors, s.imu, s.robot);
+  const double metres_per_tick = 2 * M_PI * s.robot.drive.wheel_radius_m / s.robot.drive.ticks_per_rev;
+  geom::SE3d T_c_w = s.robot.T_base_c.inverse();  // the base at the origin
+  const Eigen::Vector3d g(0, 0, -kG);
+  m.add_frame(0, level_readings(-kFramePeriodNs, 0, 0), {{0, 0, 0}});
+  for (int f = 1; f <= 90; ++f) {
+    const std::int64_t t = f * kFramePeriodNs;
+    const auto count = static_cast<std::int64_t>(std::lround(0.5 * t * 1e-9 / metres_per_tick));
+    m.add_frame(t, level_readings(t - kFramePeriodNs, t, 0), {{t, count, count}});
+    T_c_w = m.predict(T_c_w, Eigen::Vector3d(0.5, 0, 0), g, nullptr);
+    const Eigen::Matrix3d R = T_c_w.linear();
+    ASSERT_NEAR((R * R.transpose() - Eigen::Matrix3d::Identity()).norm(), 0, 1e-12) << "frame " << f;
+  }
+  // 3 s at 0.5 m/s straight ahead, within a count, the mount's height kept.
+  const geom::SE3d T_w_base = T_c_w.inverse() * s.robot.T_base_c.inverse();
+  EXPECT_NEAR(T_w_base.translation().x(), 1.5, 2 * metres_per_tick);
+  EXPECT_NEAR(T_w_base.translation().y(), 0, 1e-9);
+  EXPECT_NEAR(T_w_base.translation().z(), 0, 1e-9);
+}
+
+}  // namespace
+}  // namespace pvb::slam
