@@ -238,7 +238,10 @@ class RunConsumer : public FrameConsumer {
 /// interruption noted in the status.
 void finish_loop(const RunOptions& opt, const LoopTimes& loop, bool aborted, int frames, SystemSinks& sinks,
                  RunReport& report, RunLog& log) {
-  for (auto& sink : sinks) sink->finish();  // waits for local mapping
+  for (auto& sink : sinks) {
+    sink->end_losses(log);
+    sink->finish();  // waits for local mapping
+  }
   report.wall_s = ms_since(loop.start) / 1000.0;
   report.cpu_s = process_cpu_s() - loop.start_cpu_s;
   report.sim_s = static_cast<double>(sinks.front()->run.frames) / report.fps;

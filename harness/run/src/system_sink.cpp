@@ -70,6 +70,7 @@ SystemSink::SystemSink(const std::string& mode, const slam::Settings& settings, 
   system = std::make_unique<slam::System>(settings, options);
   if (!map.load_path.empty() || !map.save_path.empty()) run.map = start_map(*system, map);
   prev_state = system->state();  // lost in a loaded map until it relocalises
+  loss_log = LossLog(mode, prev_state == slam::TrackingState::kLost);
 }
 
 void SystemSink::open_outputs() {
@@ -93,6 +94,9 @@ slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log)
   count(r, index, t_s);
   if (r.tracking.new_keyframe) keyframe_t_ns.push_back(r.t_ns);
   write_lines(r, index);
+  for (const std::string& l : loss_log.frame(index, t_s, r.state == slam::TrackingState::kLost, r.tracking.failure,
+                                             slam::to_string(r.tracking.reloc_failure)))
+    log.line(l);
   record_state_change(run, prev_state, r, index, t_s, log);
   if (prev_provisional && r.T_w_c)
     log.line("frame " + std::to_string(index) + ": the provisional map was merged into the loaded map");
@@ -143,6 +147,10 @@ void SystemSink::write_lines(const slam::FrameResult& r, int index) {
        << "," << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers
        << "," << (r.tracking.new_keyframe ? 1 : 0) << "," << format_g(r.mapping_ms) << "\n";
   timing.append(line.str());
+}
+
+void SystemSink::end_losses(RunLog& log) {
+  for (const std::string& l : loss_log.finish()) log.line(l);
 }
 
 void SystemSink::finish() {

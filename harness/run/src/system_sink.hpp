@@ -11,6 +11,7 @@
 #include "pvb/common/output_file.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/run/inertial_eval.hpp"
+#include "pvb/run/loss_log.hpp"
 #include "pvb/run/report.hpp"
 #include "pvb/run/run.hpp"
 #include "pvb/slam/core/settings.hpp"
@@ -33,6 +34,7 @@ struct SystemSink {
   slam::TrackingState prev_state = slam::TrackingState::kNotInitialized;
   bool prev_provisional = false;  ///< the last frame was tracked in a provisional map
   bool inertial_logged = false;   ///< run.log has said when the inertial state became trusted
+  LossLog loss_log{""};           ///< why each lost frame stayed lost (run.log)
   double tracking_ms = 0, orb_ms = 0, inline_mapping_ms = 0;
   std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made, for the revisit labels
   /// The dense maps written by finish(), by name (corrected, live, and
@@ -49,6 +51,9 @@ struct SystemSink {
 
   /// Tracks one frame, writes its lines and records loss and recovery.
   slam::FrameResult track(const sensor::RgbdFrame& frame, RunLog& log);
+
+  /// Writes the lines of a loss that lasts to the end of the run.
+  void end_losses(RunLog& log);
 
   /// Stops mapping, rewrites the keyframe trajectory with refined poses,
   /// writes the dense maps.

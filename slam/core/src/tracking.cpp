@@ -22,6 +22,51 @@ const char* to_string(TrackingState s) {
   return "?";
 }
 
+const char* to_string(TrackingStats::RelocFailure f) {
+  using F = TrackingStats::RelocFailure;
+  switch (f) {
+    case F::kNone: return "none";
+    case F::kNoCandidates: return "no candidates";
+    case F::kFewMatches: return "too few descriptor matches";
+    case F::kPnp: return "no PnP pose";
+    case F::kFewInliers: return "too few pose inliers";
+    case F::kAmbiguous: return "ambiguous";
+    case F::kLookalike: return "look-alike place";
+    case F::kLocalMap: return "local map after relocalisation";
+  }
+  return "?";
+}
+
+namespace {
+
+/// Why no relocalisation candidate matched, at the furthest step any got to.
+std::string no_match_reason(std::size_t candidates, bool with_place, int best_matches, int with_matches,
+                            int best_pnp, int with_pnp, int best_inliers, int min_inliers,
+                            TrackingStats::RelocFailure* kind) {
+  using F = TrackingStats::RelocFailure;
+  const std::string n = std::to_string(candidates);
+  if (candidates == 0) {
+    *kind = F::kNoCandidates;
+    return with_place ? "relocalisation: 0 candidates from place recognition"
+                      : "relocalisation: no keyframe to try";
+  }
+  std::string why = "relocalisation: " + n + (candidates == 1 ? " candidate, " : " candidates, ");
+  if (with_matches == 0) {
+    *kind = F::kFewMatches;
+    return why + "best " + std::to_string(best_matches) + " descriptor matches (need 15)";
+  }
+  why += std::to_string(with_matches) + " with 15+ descriptor matches (best " + std::to_string(best_matches) + "), ";
+  if (with_pnp == 0) {
+    *kind = F::kPnp;
+    return why + "no PnP RANSAC pose (best " + std::to_string(best_pnp) + " inliers, need 10)";
+  }
+  *kind = F::kFewInliers;
+  return why + std::to_string(with_pnp) + " with a PnP pose, best " + std::to_string(best_inliers) +
+         " pose inliers (need " + std::to_string(min_inliers) + ")";
+}
+
+}  // namespace
+
 void IdMarks::new_pass() {
   ++pass_;
   if (pass_ == 0) {  // wrapped: clear the stamps once every 2^32 passes
@@ -95,6 +140,10 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
     if (ok) stats_.method = TrackingMethod::kRelocalization;
   }
   if (ok) ok = track_local_map(f);
+  if (!ok && stats_.method == TrackingMethod::kRelocalization) {
+    stats_.reloc_failure = TrackingStats::RelocFailure::kLocalMap;
+    stats_.failure = "relocalisation: keyframe " + std::to_string(reloc_kf_->id()) + " matched; " + stats_.failure;
+  }
   if (ok) probe_merge(f);
   if (ok && stats_.method == TrackingMethod::kRelocalization) record_relocalisation(f);
   const bool dead = !ok && was_tracking && motion_ && dead_reckon(f);
@@ -339,12 +388,14 @@ std::vector<std::shared_ptr<KeyFrame>> Tracking::recent_keyframes() const {
 }
 
 int Tracking::relocalize_against(Frame& f, const KeyFrame& kf, const place::FeatureVector* f_features,
-                                 int* matches) {
+                                 int* matches, int* pnp) {
   std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
   *matches = f_features ? search_keyframe_by_bow(kf, f, *f_features, kThLow, 0.75)
                         : search_keyframe_bruteforce(kf, f, kThLow, 0.75);
   if (*matches < 15) return 0;
-  if (pnp_ransac_on_matches(f, 10) < 10) return 0;
+  const int pnp_inliers = pnp_ransac_on_matches(f, 10);
+  if (pnp) *pnp = pnp_inliers;
+  if (pnp_inliers < 10) return 0;
   int good = optimize_frame_pose(f);
   if (good < 10) return 0;
   int map_matches = 0;
@@ -368,7 +419,8 @@ int Tracking::relocalize_against(Frame& f, const KeyFrame& kf, const place::Feat
 bool Tracking::relocalize(Frame& f) {
   std::shared_ptr<KeyFrame> kf;
   int candidates = 0;
-  if (std::string why = relocalise_in(f, std::nullopt, &kf, &candidates); !why.empty()) return fail(why);
+  if (std::string why = relocalise_in(f, std::nullopt, &kf, &candidates, &stats_.reloc_failure); !why.empty())
+    return fail(why);
   last_reloc_frame_id_ = f.id;
   reloc_kf_ = std::move(kf);
   reloc_candidates_ = candidates;
@@ -376,7 +428,10 @@ bool Tracking::relocalize(Frame& f) {
 }
 
 std::string Tracking::relocalise_in(Frame& f, std::optional<std::uint32_t> only_map, std::shared_ptr<KeyFrame>* kf_out,
-                                    int* candidates) {
+                                    int* candidates, TrackingStats::RelocFailure* kind) {
+  using F = TrackingStats::RelocFailure;
+  F no_kind = F::kNone;
+  if (!kind) kind = &no_kind;
   // Candidates from the bag of words anywhere in the map (ORB-SLAM2
   // DetectRelocalizationCandidates), or the recent keyframes without one.
   place::FeatureVector f_features;
@@ -392,15 +447,19 @@ std::string Tracking::relocalise_in(Frame& f, std::optional<std::uint32_t> only_
   } else {
     cands = recent_keyframes();
   }
-  int best_matches = 0, best_inliers = 0;  // over the candidates, for the failure reason
+  // over the candidates, for the failure reason
+  int best_matches = 0, with_matches = 0, best_pnp = 0, with_pnp = 0, best_inliers = 0;
   std::vector<std::pair<Frame, std::shared_ptr<KeyFrame>>> found;
   std::vector<int> found_inliers;
   for (const auto& kf : cands) {
     if (kf->bad()) continue;
     Frame trial = f;
-    int matches = 0;
-    const int good = relocalize_against(trial, *kf, place_ ? &f_features : nullptr, &matches);
+    int matches = 0, pnp = 0;
+    const int good = relocalize_against(trial, *kf, place_ ? &f_features : nullptr, &matches, &pnp);
     best_matches = std::max(best_matches, matches);
+    with_matches += matches >= 15;
+    best_pnp = std::max(best_pnp, pnp);
+    with_pnp += pnp >= 10;
     best_inliers = std::max(best_inliers, good);
     if (good < kRelocMinInliers) continue;
     found.emplace_back(std::move(trial), kf);
@@ -409,9 +468,9 @@ std::string Tracking::relocalise_in(Frame& f, std::optional<std::uint32_t> only_
   }
   std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
   if (found.empty())
-    return "relocalisation: no candidate keyframe matched (" + std::to_string(cands.size()) + " candidates, best " +
-           std::to_string(best_matches) + " descriptor matches (need 15), best " + std::to_string(best_inliers) +
-           " pose inliers (need " + std::to_string(kRelocMinInliers) + "))";
+    return no_match_reason(cands.size(), place_ != nullptr, best_matches, with_matches, best_pnp, with_pnp,
+                           best_inliers, kRelocMinInliers, kind);
+  *kind = F::kAmbiguous;
   for (std::size_t i = 0; i < found.size(); ++i)
     for (std::size_t j = i + 1; j < found.size(); ++j)
       if ((found[i].first.camera_center_w() - found[j].first.camera_center_w()).norm() >
@@ -423,9 +482,11 @@ std::string Tracking::relocalise_in(Frame& f, std::optional<std::uint32_t> only_
   const std::size_t best = static_cast<std::size_t>(
       std::max_element(found_inliers.begin(), found_inliers.end()) - found_inliers.begin());
   if (place_ && options_.reloc_ambiguity_check && options_.reloc_lookalikes > 0) {
+    *kind = F::kLookalike;
     std::string why = lookalike(f, found[best].first, bow, f_features, cands, only_map);
     if (!why.empty()) return why;
   }
+  *kind = F::kNone;
   f = std::move(found[best].first);
   *kf_out = found[best].second;
   *candidates = static_cast<int>(cands.size());

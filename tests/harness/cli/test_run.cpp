@@ -289,6 +289,18 @@ TEST(RunCli, ClosedLoopWaitsOnLossHoldingTheRobot) {
   if (m["loss_events"][m["loss_events"].size() - 1]["recovered_frame"].IsNull()) {
     EXPECT_LT(std::hypot(std::stod(b[1]) - std::stod(a[1]), std::stod(b[2]) - std::stod(a[2])), 0.01);
   }
+  // run.log explains the lost frames after the loss: why relocalisation
+  // failed on each, and a summary of the stretch.
+  const std::string log = read_file(d + "/run.log");
+  const int lost_at = m["loss_events"][0]["frame"].as<int>();
+  const std::size_t attempt = log.find("pe-slam still lost");
+  ASSERT_NE(attempt, std::string::npos) << log;
+  const std::string attempt_line = log.substr(attempt, log.find('\n', attempt) - attempt);
+  EXPECT_NE(attempt_line.find(": relocalisation: "), std::string::npos) << attempt_line;
+  const std::size_t summary = log.find("frames " + std::to_string(lost_at) + "-");
+  ASSERT_NE(summary, std::string::npos) << log;
+  const std::string line = log.substr(summary, log.find('\n', summary) - summary);
+  EXPECT_NE(line.find("relocalisation attempts failed ("), std::string::npos) << line;
 }
 
 // The pipelined run (the default): render thread, sensor-model thread and

@@ -110,10 +110,16 @@ TEST(KinectPairs, LostOnABlankFrameThenRelocalised) {
   const FrameResult rb2 = system.track(blank2);
   EXPECT_EQ(rb2.state, TrackingState::kLost);
   EXPECT_EQ(rb2.tracking.failure.rfind("relocalisation: ", 0), 0u) << rb2.tracking.failure;
+  // Relocalisation was tried on the second lost frame only, and says where
+  // it stopped: a blank frame gives place recognition nothing to look up.
+  EXPECT_EQ(rb.tracking.reloc_failure, TrackingStats::RelocFailure::kNone);
+  EXPECT_EQ(rb2.tracking.reloc_failure, TrackingStats::RelocFailure::kNoCandidates);
+  EXPECT_EQ(rb2.tracking.failure, "relocalisation: 0 candidates from place recognition");
   const FrameResult r2 = system.track(f2);
   ASSERT_EQ(r2.state, TrackingState::kOk);
   EXPECT_TRUE(r2.tracking.failure.empty()) << r2.tracking.failure;
   EXPECT_EQ(r2.tracking.method, TrackingMethod::kRelocalization);
+  EXPECT_EQ(r2.tracking.reloc_failure, TrackingStats::RelocFailure::kNone);
   const eval::Trajectory gt = eval::read_tum(tum(name) + "/groundtruth.txt");
   const auto off = static_cast<std::int64_t>(-0.02 * 1e9);
   const geom::SE3d gt_rel = gt_at(gt, f1.t_ns + off).inverse() * gt_at(gt, f2.t_ns + off);

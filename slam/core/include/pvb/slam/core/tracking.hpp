@@ -77,11 +77,27 @@ struct TrackingStats {
     std::vector<std::uint8_t> pose_inlier;
   };
   MotionMatches motion;
+  /// On a lost frame where relocalisation was tried: the step at which it
+  /// failed (kNone when it was not tried or the frame was tracked).
+  enum class RelocFailure {
+    kNone,
+    kNoCandidates,   ///< no keyframe to try (place recognition returned none)
+    kFewMatches,     ///< no candidate had 15 descriptor matches
+    kPnp,            ///< no candidate gave a PnP RANSAC pose with 10 inliers
+    kFewInliers,     ///< no candidate reached 50 pose inliers
+    kAmbiguous,      ///< two candidates matched at places apart
+    kLookalike,      ///< a look-alike keyframe matched at another place
+    kLocalMap,       ///< relocalised, then the local map gave too few inliers
+  };
+  RelocFailure reloc_failure = RelocFailure::kNone;
   /// Why the frame was not tracked (empty when it was): each attempted
   /// step's failure, "; "-separated, e.g. "motion model: only 7 map matches
   /// after pose optimisation (need 10); reference keyframe: only 9 matches (need 15)".
   std::string failure;
 };
+
+/// A short name of the step, e.g. "no candidates", "too few pose inliers".
+const char* to_string(TrackingStats::RelocFailure f);
 
 /// One relocalisation: a frame tracked again after a loss, and the
 /// keyframe whose points found it.
@@ -237,9 +253,10 @@ class Tracking {
   /// Global relocalisation of f among the keyframes of map `only_map` (of
   /// any map without one), with the ambiguity and look-alike checks:
   /// empty with f at its pose, *kf the keyframe matched and *candidates
-  /// the candidates tried, or why it failed (f's matches cleared).
+  /// the candidates tried, or why it failed (f's matches cleared) with
+  /// the step in *kind (when given).
   std::string relocalise_in(Frame& f, std::optional<std::uint32_t> only_map, std::shared_ptr<KeyFrame>* kf,
-                            int* candidates);
+                            int* candidates, TrackingStats::RelocFailure* kind = nullptr);
   /// While tracking in a provisional map: relocalises a copy of f in the
   /// loaded map every merge_reloc_every frames; a success is kept as
   /// merge_hint_.
@@ -249,7 +266,9 @@ class Tracking {
   /// Matches f against kf (through the direct index when f_features is
   /// given), PnP RANSAC and pose optimisation; returns the pose inliers
   /// (0 when a step failed) and the descriptor matches in *matches.
-  int relocalize_against(Frame& f, const KeyFrame& kf, const place::FeatureVector* f_features, int* matches);
+  /// *pnp (when given) receives PnP RANSAC's inliers (0 when not run).
+  int relocalize_against(Frame& f, const KeyFrame& kf, const place::FeatureVector* f_features, int* matches,
+                         int* pnp = nullptr);
   /// After a relocalisation to `found`: why it is ambiguous against the
   /// best-scoring keyframes not among `tried` (and the best covisibles of
   /// those at another place), or empty.
