@@ -2,8 +2,6 @@
 // the inertial, wheel and tilt terms of local BA (docs/slam_inertial.md).
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <map>
 
 #include "pvb/slam/core/local_mapping.hpp"
@@ -80,11 +78,6 @@ void LocalMapping::initialize_inertial(const std::shared_ptr<KeyFrame>& kf) {
     if (k > 0) problem.pre.push_back(run[k]->motion().from_prev.imu);
   }
   const InertialInitResult r = slam::initialize_inertial(problem);
-  if (std::getenv("PVB_DEBUG_INERTIAL"))
-    std::fprintf(stderr, "inertial init at kf %llu (%zu kfs): ok %d g %.4f %.4f %.4f bg %.5f %.5f %.5f ba %.4f %.4f %.4f rms %.3f\n",
-                 (unsigned long long)kf->id(), run.size(), r.ok, r.g_w.x(), r.g_w.y(), r.g_w.z(), r.bias.gyro_radps.x(),
-                 r.bias.gyro_radps.y(), r.bias.gyro_radps.z(), r.bias.accel_mps2.x(), r.bias.accel_mps2.y(),
-                 r.bias.accel_mps2.z(), r.rms_whitened);
   if (!r.ok) return;
   g.ready = true;
   g.g_w = r.g_w;

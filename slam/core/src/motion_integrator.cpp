@@ -1,25 +1,13 @@
 #include "pvb/slam/core/motion_integrator.hpp"
 
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 namespace pvb::slam {
-
-namespace {
-WheelNoise env_wheel_noise() {
-  WheelNoise n;
-  if (const char* v = std::getenv("PVB_WHEEL_YAW")) n.yaw_per_sqrt_m = std::atof(v);
-  if (const char* v = std::getenv("PVB_WHEEL_TRANS")) n.translation_per_sqrt_m = std::atof(v);
-  return n;
-}
-}  // namespace
 
 MotionIntegrator::MotionIntegrator(SensorSetup setup, const ImuSettings& imu, const RobotSettings& robot)
     : setup_(setup),
       imu_(imu),
       robot_(robot),
-      wheel_noise_(env_wheel_noise()),
       imu_frame_(ImuBias{}, imu.noise),
       imu_kf_(ImuBias{}, imu.noise),
       wheel_frame_(robot.drive, wheel_noise_),

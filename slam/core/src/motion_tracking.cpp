@@ -3,8 +3,6 @@
 // reckoning through blind stretches and finding the local map again after
 // one (docs/slam_inertial.md).
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "pvb/common/text.hpp"
 #include "pvb/slam/core/tracking.hpp"
@@ -132,21 +130,6 @@ bool Tracking::dead_reckon(Frame& f) {
   const double blind_s = static_cast<double>(f.t_ns - blind_->start_t_ns) * 1e-9;
   const double rise_m = (blind_->p_imu_w - blind_->p_start_w).dot(-g_w.normalized());
   const double apart_m = (blind_->p_imu_w - predicted.p_w_m).norm();
-  if (std::getenv("PVB_DEBUG_INERTIAL"))
-    std::fprintf(stderr, "DR f%llu t %.3f dist %.3f rise %.3f apart %.3f |v_imu| %.3f |v| %.3f v_imu %.3f %.3f %.3f v %.3f %.3f %.3f wheels %.4f imu_n %zu\n",
-                 (unsigned long long)f.id, blind_s, blind_->distance_m, rise_m, apart_m, blind_->v_imu_w.norm(), v_w.norm(),
-                 blind_->v_imu_w.x(), blind_->v_imu_w.y(), blind_->v_imu_w.z(), v_w.x(), v_w.y(), v_w.z(),
-                 motion_->wheels_since_frame().delta().x(), motion_->imu_since_frame().size());
-  if (std::getenv("PVB_DEBUG_INERTIAL"))
-    std::fprintf(stderr, "   last p %.4f %.4f %.4f pred %.4f %.4f %.4f d %.5f %.5f %.5f\n", last_state.p_w_m.x(), last_state.p_w_m.y(),
-                 last_state.p_w_m.z(), predicted.p_w_m.x(), predicted.p_w_m.y(), predicted.p_w_m.z(),
-                 motion_->wheels_since_frame().delta().x(), motion_->wheels_since_frame().delta().y(),
-                 motion_->wheels_since_frame().delta().z());
-  if (std::getenv("PVB_DEBUG_INERTIAL"))
-    std::fprintf(stderr, "   rot step %.4f deg  dR %.4f deg dt %.4f bias_g %.4f %.4f %.4f\n",
-                 geom::rotation_angle_rad(T_c_w.linear() * last_.T_c_w.linear().transpose()) * 57.2958,
-                 geom::rotation_angle_rad(motion_->imu_since_frame().delta_R()) * 57.2958, motion_->imu_since_frame().dt_s(),
-                 motion_->bias().gyro_radps.x(), motion_->bias().gyro_radps.y(), motion_->bias().gyro_radps.z());
   if (blind_s > options_.blind_max_s)
     return fail("dead reckoning: blind for " + format_fixed(blind_s, 2) + " s (limit " +
                 format_fixed(options_.blind_max_s, 2) + " s)");
