@@ -272,6 +272,12 @@ void read_slam(MapReader& r, SlamTuning& t) {
     t.keyframe_min_tracked_close = r.integer("keyframe_min_tracked_close", 0, 1, 100000);
   if (r.has("keyframe_ref_overlap"))
     t.keyframe_ref_overlap = r.number("keyframe_ref_overlap", 0.0, 0.01, 0.99);
+  if (r.has("sensors")) {
+    static const std::vector<std::pair<std::string, std::string>> kSetups = {
+        {"camera", "camera"}, {"camera+imu", "camera+imu"}, {"camera+imu+wheels", "camera+imu+wheels"},
+        {"camera+accel", "camera+accel"}};
+    t.sensors = r.choice<std::string>("sensors", "camera", kSetups);
+  }
 }
 
 void read_expect(MapReader& r, Expectations& e) {

@@ -216,6 +216,13 @@ TEST(Scenario, SlamSectionIsReadAndOptional) {
   EXPECT_NE(error_of(base + "  keyframe_ref_overlap: 1.5\n").find("slam.keyframe_ref_overlap"),
             std::string::npos);
   EXPECT_NE(error_of(base + "  nFeatures: 2000\n").find("slam.nFeatures: expected a known key"), std::string::npos);
+  EXPECT_FALSE(none.slam.sensors);
+  const Scenario fused = parse_scenario(std::string(kMinimal) + "slam: {sensors: camera+imu+wheels}\n", "f.yaml");
+  ASSERT_TRUE(fused.slam.sensors);
+  EXPECT_EQ(*fused.slam.sensors, "camera+imu+wheels");
+  const std::string bad_setup = error_of(base + "  sensors: camera+gps\n");
+  EXPECT_NE(bad_setup.find("slam.sensors"), std::string::npos) << bad_setup;
+  EXPECT_NE(bad_setup.find("camera+imu+wheels"), std::string::npos) << bad_setup;
 }
 
 TEST(Scenario, WallFinish) {

@@ -111,6 +111,8 @@ std::string orbslam_settings_text(const OrbSlamSettings& s) {
     std::snprintf(ov, sizeof ov, "%.6g", *s.kf_ref_overlap);  // as given, not rounded to a grid
     text += std::string("KeyFrame.refOverlap: ") + ov + "\n";
   }
+  if (s.sensors)
+    text += "\n# The sensors the SLAM core fuses (pvbench's own key)\nSystem.Sensors: \"" + *s.sensors + "\"\n";
   if (s.robot) text += robot_settings_text(*s.robot);
   return text;
 }

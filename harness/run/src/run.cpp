@@ -432,6 +432,7 @@ dataset::OrbSlamSettings orbslam_settings_for(const scenes::Scenario& s) {
   o.n_features = s.slam.orb_features;
   o.kf_min_tracked_close = s.slam.keyframe_min_tracked_close;
   o.kf_ref_overlap = s.slam.keyframe_ref_overlap;
+  o.sensors = s.slam.sensors;
   o.robot = robot_calibration_for(s);
   return o;
 }

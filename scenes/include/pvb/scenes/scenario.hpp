@@ -268,6 +268,10 @@ struct SlamTuning {
   std::optional<int> keyframe_min_tracked_close;
   /// KeyFrame.refOverlap (pvbench's own key; unset: ORB-SLAM2's 75 % rule)
   std::optional<double> keyframe_ref_overlap;
+  /// System.Sensors (pvbench's own key; unset: camera): the sensors the
+  /// SLAM core fuses, "camera", "camera+imu", "camera+imu+wheels" or
+  /// "camera+accel".
+  std::optional<std::string> sensors;
 };
 
 /// What a seed sweep of this scenario must show (`expect.sweep:`), judged by
