@@ -8,6 +8,7 @@ MotionIntegrator::MotionIntegrator(SensorSetup setup, const ImuSettings& imu, co
     : setup_(setup),
       imu_(imu),
       robot_(robot),
+      period_ns_(static_cast<std::int64_t>(std::llround(1e9 / imu.rate_hz))),
       imu_frame_(ImuBias{}, imu.noise),
       imu_kf_(ImuBias{}, imu.noise),
       wheel_frame_(robot.drive, wheel_noise_),
@@ -28,7 +29,6 @@ void MotionIntegrator::add_frame(std::int64_t t_ns, const std::vector<sensor::Im
 }
 
 void MotionIntegrator::add_imu(const sensor::ImuSample& s) {
-  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / imu_.rate_hz));
   if (last_imu_t_ns_ && s.t_ns <= *last_imu_t_ns_) return;  // a repeated reading
   last_imu_t_ns_ = s.t_ns;
   if (!s.accel_mps2.allFinite()) return;
@@ -40,18 +40,17 @@ void MotionIntegrator::add_imu(const sensor::ImuSample& s) {
   // time already integrated (a frame's time inside the period) was
   // counted with the frame.  A gap (a dropped stretch) is integrated as at
   // most ten periods: the rest is not known.
-  const std::int64_t start_ns = covered_t_ns_ ? *covered_t_ns_ : s.t_ns - period_ns;
+  const std::int64_t start_ns = covered_t_ns_ ? *covered_t_ns_ : s.t_ns - period_ns_;
   covered_t_ns_ = s.t_ns;
   last_reading_ = s;
-  const double dt_s = static_cast<double>(std::min(s.t_ns - start_ns, 10 * period_ns)) * 1e-9;
+  const double dt_s = static_cast<double>(std::min(s.t_ns - start_ns, 10 * period_ns_)) * 1e-9;
   if (!(dt_s > 0)) return;
   imu_frame_.integrate(s.gyro_radps, s.accel_mps2, dt_s);
   imu_kf_.integrate(s.gyro_radps, s.accel_mps2, dt_s);
 }
 
 void MotionIntegrator::integrate_up_to(std::int64_t t_ns) {
-  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / imu_.rate_hz));
-  if (!last_reading_ || !covered_t_ns_ || *covered_t_ns_ >= t_ns || t_ns - *covered_t_ns_ > period_ns) return;
+  if (!last_reading_ || !covered_t_ns_ || *covered_t_ns_ >= t_ns || t_ns - *covered_t_ns_ > period_ns_) return;
   // The interval ends at the frame: the newest reading is held up to it
   // (the next reading, which covers this stretch too, begins there).
   const double dt_s = static_cast<double>(t_ns - *covered_t_ns_) * 1e-9;

@@ -24,8 +24,7 @@ void Tracking::add_motion(std::int64_t t_ns, const std::vector<sensor::ImuSample
   std::lock_guard<std::mutex> lock(map_.mutex());
   const MapGravity& g = map_.gravity();
   if (g.ready && uses_imu(motion_->setup()) &&
-      ((g.bias.gyro_radps - motion_->bias().gyro_radps).norm() > 0 ||
-       (g.bias.accel_mps2 - motion_->bias().accel_mps2).norm() > 0))
+      (g.bias.gyro_radps != motion_->bias().gyro_radps || g.bias.accel_mps2 != motion_->bias().accel_mps2))
     motion_->set_bias(g.bias);
   motion_->add_frame(t_ns, imu, ticks);
 }

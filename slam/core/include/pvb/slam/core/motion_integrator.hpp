@@ -79,6 +79,7 @@ class MotionIntegrator {
   SensorSetup setup_;
   ImuSettings imu_;
   RobotSettings robot_;
+  std::int64_t period_ns_;  ///< the IMU's reading period
   WheelNoise wheel_noise_;
   ImuBias bias_;
   ImuPreintegration imu_frame_, imu_kf_;
