@@ -17,6 +17,13 @@ double seconds_between(std::int64_t from_ns, std::int64_t to_ns) {
   return static_cast<double>(to_ns - from_ns) * 1e-9;
 }
 
+geom::Vec3d estimated_down(const GravityEstimates& estimates, std::int64_t t_ns) {
+  constexpr std::int64_t kTolNs = 1000000;  // trajectory files keep microseconds
+  auto it = estimates.lower_bound(t_ns - kTolNs);
+  if (it != estimates.end() && it->first <= t_ns + kTolNs && it->second.norm() > 0) return it->second.normalized();
+  return geom::Vec3d(0, 0, -1);
+}
+
 int sign_of(double v) { return v > 0 ? 1 : v < 0 ? -1 : 0; }
 
 std::string json_list(const std::vector<double>& v) {
@@ -28,16 +35,15 @@ std::string json_list(const std::vector<double>& v) {
 }  // namespace
 
 GravityError gravity_error(const Trajectory& gt, const Trajectory& est, const geom::Vec3d& down_w,
-                           const std::string& map_frame) {
+                           const std::string& map_frame, const GravityEstimates& estimates) {
   GravityError g;
   g.map_frame = map_frame;
   const geom::Vec3d down = down_w.normalized();
-  const geom::Vec3d map_down(0, 0, -1);
   const std::vector<IndexPair> pairs = associate(gt, est);
   for (const IndexPair& p : pairs) {
     const geom::Mat3d R_c_w = gt.poses[p.gt].T_w_c.linear().transpose();
     const geom::Mat3d R_c_map = est.poses[p.est].T_w_c.linear().transpose();
-    const geom::Vec3d true_c = R_c_w * down, est_c = R_c_map * map_down;
+    const geom::Vec3d true_c = R_c_w * down, est_c = R_c_map * estimated_down(estimates, est.poses[p.est].t_ns);
     const double angle = std::atan2(true_c.cross(est_c).norm(), true_c.dot(est_c));
     g.t_s.push_back(seconds_between(est.poses[pairs.front().est].t_ns, est.poses[p.est].t_ns));
     g.angle_deg.push_back(angle * kDegPerRad);

@@ -63,6 +63,7 @@ struct Tally {
   std::string init_failure;    ///< why the last frame failed to initialise
   std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made
   std::vector<std::int64_t> frame_t_ns;     ///< every frame tracked
+  eval::GravityEstimates gravity;           ///< the core's gravity per frame, once trusted
 };
 
 }  // namespace offline_detail
@@ -292,6 +293,7 @@ slam::TrackingState OfflineSlam::Impl::track_one(const sensor::RgbdFrame& frame)
   tally_.tracking_ms.push_back(r.tracking_ms);
   if (settings_.pe_match.enabled && r.tracking.method == slam::TrackingMethod::kMotionModel)
     tally_.pe_ms.push_back(r.tracking.pe_match_ms);
+  if (r.g_w) tally_.gravity[r.t_ns] = *r.g_w;
   if (r.T_w_c) {
     cam_traj_.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
     ++tally_.poses;
@@ -418,7 +420,7 @@ void OfflineSlam::Impl::evaluate_gravity(const eval::Trajectory& gt, const eval:
   // the mocap world, whose up was measured from the Kinect's accelerometer.
   const bool site = std::ifstream(a_.sequence + "/meta.json").good();
   const geom::Vec3d down_w = site ? geom::Vec3d(0, 0, -1) : geom::Vec3d(-dataset::tum_world_up());
-  const eval::GravityError g = eval::gravity_error(gt, est, down_w, gravity_map_frame(settings_.sensors));
+  const eval::GravityError g = eval::gravity_error(gt, est, down_w, gravity_map_frame(settings_.sensors), tally_.gravity);
   const eval::TiltDrift t =
       eval::tilt_drift(gt, eval::read_tum(a_.out + "/KeyFrameTrajectory.txt"), alignment);
   text(strf("gravity error (map frame: %s): median %.2f deg, p95 %.2f, final %.2f; keyframe pitch error "

@@ -93,6 +93,7 @@ slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log)
   const double t_s = geom::ns_to_seconds(frame.t_ns);
   count(r, index, t_s);
   if (r.tracking.new_keyframe) keyframe_t_ns.push_back(r.t_ns);
+  if (r.g_w) gravity_estimates[r.t_ns] = *r.g_w;
   write_lines(r, index);
   for (const std::string& l : loss_log.frame(index, t_s, r.state == slam::TrackingState::kLost, r.tracking.failure,
                                              slam::to_string(r.tracking.reloc_failure)))
@@ -235,7 +236,8 @@ void SystemSink::evaluate(const eval::Trajectory& gt) {
 
 void SystemSink::evaluate_gravity(const eval::Trajectory& gt) {
   // The run's ground truth is in the site frame: z up.
-  run.gravity = eval::gravity_error(gt, est, geom::Vec3d(0, 0, -1), gravity_map_frame(system->sensors()));
+  run.gravity = eval::gravity_error(gt, est, geom::Vec3d(0, 0, -1), gravity_map_frame(system->sensors()),
+                                   gravity_estimates);
   run.tilt = eval::tilt_drift(gt, keyframes, run.eval->alignment);
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "pvb/common/output_file.hpp"
+#include "pvb/eval/gravity.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/run/inertial_eval.hpp"
 #include "pvb/run/loss_log.hpp"
@@ -28,6 +29,7 @@ struct SystemSink {
   std::string dir;
   OutputFile cam_traj, kf_traj, timing;
   eval::Trajectory est;
+  eval::GravityEstimates gravity_estimates;  ///< the core's gravity per frame, once trusted
   eval::Trajectory refined;  ///< filled by finish()
   eval::Trajectory keyframes;  ///< filled by finish(): the keyframes' final poses (KeyFrameTrajectory.txt)
   std::optional<std::int64_t> first_t_ns;  ///< the first frame's time: the inertial report's t = 0

@@ -114,6 +114,7 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
     std::lock_guard<std::mutex> lock(map_.mutex());
     out.provisional = ref && map_.map_of(*ref) != 0;
     if (!out.provisional) out.T_w_c = tracking_->last_frame().T_c_w.inverse();
+    if (!out.provisional && map_.gravity().ready) out.g_w = map_.gravity().g_w;
     if (ref) records_.push_back({in.t_ns, ref, tracking_->last_frame().T_c_w * ref->T_c_w().inverse()});
   }
   if (kf && dense_) {

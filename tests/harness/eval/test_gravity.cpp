@@ -51,6 +51,25 @@ TEST(Gravity, APitchDriftIsTheGravityErrorInAGravityAlignedMap) {
   EXPECT_EQ(g.map_frame, "gravity_aligned");
 }
 
+TEST(Gravity, TheCoresOwnGravityCountsWhereItHasOne) {
+  // A map tilted 3 degrees about world y: its -z is 3 degrees off, but a
+  // core that estimated gravity in that map is judged by its estimate.
+  eval::Trajectory gt, est;
+  drifting(4, 0.0, 0.0, &gt, &est);
+  const geom::Mat3d R_map_w = Eigen::AngleAxisd(rad(3.0), geom::Vec3d::UnitY()).toRotationMatrix();
+  for (auto& p : est.poses) p.T_w_c.linear() = R_map_w * p.T_w_c.linear();
+  eval::GravityEstimates g_map;
+  const geom::Vec3d true_down_map = R_map_w * geom::Vec3d(0, 0, -9.81);
+  g_map[est.poses[2].t_ns + 400'000] = true_down_map;  // within a millisecond: a trajectory file's rounding
+  g_map[est.poses[3].t_ns] = Eigen::AngleAxisd(rad(0.5), geom::Vec3d::UnitY()) * true_down_map;
+  const eval::GravityError g = eval::gravity_error(gt, est, geom::Vec3d(0, 0, -1), "gravity_aligned", g_map);
+  ASSERT_EQ(g.angle_deg.size(), 4u);
+  EXPECT_NEAR(g.angle_deg[0], 3.0, 1e-9);  // no estimate yet: the map's -z
+  EXPECT_NEAR(g.angle_deg[1], 3.0, 1e-9);
+  EXPECT_NEAR(g.angle_deg[2], 0.0, 1e-6);
+  EXPECT_NEAR(g.angle_deg[3], 0.5, 1e-9);
+}
+
 TEST(Gravity, AMapInTheFirstCameraFrameIsNinetyDegreesOffForALevelCamera) {
   eval::Trajectory gt, est;
   drifting(3, 0.0, 0.0, &gt, &est);

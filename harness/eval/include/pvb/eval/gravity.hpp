@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include <map>
+
 #include "pvb/eval/align.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/geometry/se3.hpp"
@@ -30,11 +32,18 @@ struct GravityError {
   double median_deg = 0, p95_deg = 0, final_deg = 0;
 };
 
+/// The core's gravity per frame: at each time (ns), gravity's direction
+/// in the map's frame as the core held it.  A frame without an entry
+/// within a millisecond takes the map's -z (before the inertial state is
+/// trusted, the map's frame is all the core says about gravity).
+using GravityEstimates = std::map<std::int64_t, geom::Vec3d>;
+
 /// The gravity error of `est` (T_map_c) against `gt` (T_w_c) with gravity
-/// down_w in gt's world (normalised here); frames associated as the ATE
-/// associates them.  Empty when nothing associates.
+/// down_w in gt's world (normalised here): per frame, the angle between the
+/// true and the estimated down seen from the camera.  Frames associated as
+/// the ATE associates them.  Empty when nothing associates.
 GravityError gravity_error(const Trajectory& gt, const Trajectory& est, const geom::Vec3d& down_w,
-                           const std::string& map_frame);
+                           const std::string& map_frame, const GravityEstimates& estimates = {});
 
 struct TiltDrift {
   std::vector<double> t_s;  ///< keyframe time from the first associated keyframe

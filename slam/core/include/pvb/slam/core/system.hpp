@@ -59,6 +59,9 @@ struct FrameResult {
   /// begun while lost): its pose in the map's frame is not known, so
   /// T_w_c is empty although state == kOk.
   bool provisional = false;
+  /// Gravity in the map's frame as the core held it for this frame, once
+  /// the inertial state is trusted (empty before, and without an IMU).
+  std::optional<Eigen::Vector3d> g_w;
   TrackingStats tracking;
   double tracking_ms = 0;           ///< extraction + tracking (not inline mapping)
   double orb_ms = 0;                ///< of which ORB extraction
