@@ -73,6 +73,8 @@ void LocalMapping::initialize_inertial(const std::shared_ptr<KeyFrame>& kf) {
   problem.g_w_guess = g.g_w;  // its magnitude; the direction comes from the increments
   problem.gyro_bias_prior_radps = options_.init_gyro_bias_sigma_radps;
   problem.accel_bias_prior_mps2 = options_.init_accel_bias_sigma_mps2;
+  problem.pose_sigma_m = options_.init_pose_sigma_m;
+  problem.pose_sigma_rad = options_.init_pose_sigma_rad;
   for (std::size_t k = 0; k < run.size(); ++k) {
     problem.T_c_w.push_back(run[k]->T_c_w());
     if (k > 0) problem.pre.push_back(run[k]->motion().from_prev.imu);

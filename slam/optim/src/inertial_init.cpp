@@ -38,6 +38,22 @@ void check(const InertialInitProblem& p) {
   if (!(p.gyro_bias_prior_radps > 0) || !(p.accel_bias_prior_mps2 > 0)) fail("bias priors must be positive");
 }
 
+/// An interval's covariance with the noise of its two fixed poses added:
+/// rotation 2 s_R^2; velocity 2 (|g| dt s_R)^2 (gravity turned by a rotation
+/// error); position 2 s_p^2 + 2 (|g| dt^2 s_R / 2)^2.
+Eigen::Matrix<double, 9, 9> interval_covariance(const ImuPreintegration& pre, const InertialInitProblem& p) {
+  Eigen::Matrix<double, 9, 9> cov = pre.covariance();
+  const double dt = pre.dt_s(), g = p.g_w_guess.norm(), s_R = p.pose_sigma_rad, s_p = p.pose_sigma_m;
+  const double var_R = 2 * s_R * s_R, var_v = 2 * std::pow(g * dt * s_R, 2);
+  const double var_p = 2 * s_p * s_p + 2 * std::pow(0.5 * g * dt * dt * s_R, 2);
+  for (int k = 0; k < 3; ++k) {
+    cov(k, k) += var_R;
+    cov(3 + k, 3 + k) += var_v;
+    cov(6 + k, 6 + k) += var_p;
+  }
+  return cov;
+}
+
 /// Whitened rotation residual of one interval as a function of the gyro
 /// bias alone: W_R Log(dR(b_g)^T R_i^T R_j) (3).
 struct GyroBiasResidual {
@@ -122,7 +138,7 @@ Eigen::Vector3d solve_gyro_bias(const InertialInitProblem& p, const std::vector<
     Vec3T<double> unused;
     CameraPoseT<double>(poses[k].data()).attached(f.q_c_b, f.p_c_b, &q_i, &unused);
     CameraPoseT<double>(poses[k + 1].data()).attached(f.q_c_b, f.p_c_b, &q_j, &unused);
-    const Eigen::Matrix3d W = sqrt_information<3>(p.pre[k]->covariance().topLeftCorner<3, 3>());
+    const Eigen::Matrix3d W = sqrt_information<3>(interval_covariance(*p.pre[k], p).topLeftCorner<3, 3>());
     prob.AddResidualBlock(new ceres::AutoDiffCostFunction<GyroBiasResidual, 3, 3>(
                               new GyroBiasResidual{&f, q_i.conjugate() * q_j, W}),
                           nullptr, bg.data());
@@ -214,10 +230,13 @@ double rms_whitened(const std::vector<ImuFactor>& factors, const std::vector<Pos
 }
 
 std::vector<ImuFactor> factors_of(const std::vector<std::shared_ptr<const ImuPreintegration>>& pre,
-                                  const geom::SE3d& T_b_c) {
+                                  const InertialInitProblem& problem) {
   std::vector<ImuFactor> f;
   f.reserve(pre.size());
-  for (const auto& p : pre) f.emplace_back(*p, T_b_c);
+  for (const auto& p : pre) {
+    f.emplace_back(*p, problem.T_b_c);
+    f.back().sqrt_info = sqrt_information<9>(interval_covariance(*p, problem));
+  }
   return f;
 }
 
@@ -229,7 +248,7 @@ InertialInitResult initialize_inertial(const InertialInitProblem& problem) {
   for (const geom::SE3d& T : problem.T_c_w) poses.push_back(to_block(T));
   InertialInitResult result;
   // 1. The gyro bias from the rotations alone, at the given linearisation.
-  const Eigen::Vector3d bg = solve_gyro_bias(problem, factors_of(problem.pre, problem.T_b_c), poses);
+  const Eigen::Vector3d bg = solve_gyro_bias(problem, factors_of(problem.pre, problem), poses);
   // 2. Velocities, gravity and both biases, the increments integrated again
   // at the current bias until it settles (at most three rounds).
   Eigen::Matrix<double, 6, 1> bias;
@@ -245,7 +264,7 @@ InertialInitResult initialize_inertial(const InertialInitProblem& problem) {
       copy->reintegrate(lin);
       pre.push_back(copy);
     }
-    factors = factors_of(pre, problem.T_b_c);
+    factors = factors_of(pre, problem);
     if (round == 0) {
       result.v_w_mps = initial_velocities(factors, poses);
       result.g_w = initial_gravity(problem, factors, poses, result.v_w_mps);

@@ -59,6 +59,11 @@ struct LocalMappingOptions {
   /// turn-on biases: BMI088's datasheet gives 1 deg/s and 20 mg per axis).
   double init_gyro_bias_sigma_radps = 0.02;
   double init_accel_bias_sigma_mps2 = 0.3;
+  /// Noise of vision's keyframe poses in the initialisation, which holds
+  /// them fixed (about a keyframe pair's RPE over the square root of two
+  /// on the shipped scenes).
+  double init_pose_sigma_m = 0.002;
+  double init_pose_sigma_rad = 0.0005;
   /// Local BA refines gravity's direction under a prior of this standard
   /// deviation about the last estimate (0: gravity held after initialisation).
   double gravity_sigma_rad = 0.005;

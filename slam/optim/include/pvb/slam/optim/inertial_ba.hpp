@@ -72,6 +72,13 @@ struct InertialInitProblem {
   ImuBias bias_guess;
   double gyro_bias_prior_radps = 0.01;  ///< sigma of a zero-mean prior on the gyro bias
   double accel_bias_prior_mps2 = 0.1;   ///< sigma of a zero-mean prior on the accelerometer bias
+  /// Noise of the fixed keyframe poses (vision's), per pose: position in
+  /// metres and rotation in radians.  It is added to each interval's
+  /// covariance; without it a millimetre of visual noise over an interval
+  /// of a few frames reads as a metre per second squared of acceleration,
+  /// which gravity's direction and the biases then absorb.
+  double pose_sigma_m = 0;
+  double pose_sigma_rad = 0;
 };
 struct InertialInitResult {
   bool ok = false;
