@@ -58,48 +58,10 @@
 #include <vector>
 
 #include "pvb/slam/core/map.hpp"
+#include "pvb/slam/core/options.hpp"
 #include "pvb/slam/core/place_recognition.hpp"
 
 namespace pvb::slam {
-
-/// LoopClosing.* settings (docs/slam.md, "Loop closing").
-struct LoopClosingOptions {
-  bool enabled = true;             ///< LoopClosing.enabled (0/1)
-  double search_radius_m = 3.0;    ///< LoopClosing.searchRadius: camera centre distance, metres
-  double max_angle_deg = 30.0;     ///< LoopClosing.maxAngle: angle between the optical axes
-  int min_keyframe_gap = 30;       ///< LoopClosing.minKeyFrameGap: candidate this many keyframe ids older
-  int max_candidates = 5;          ///< LoopClosing.maxCandidates: closest first
-  int min_matches = 20;            ///< LoopClosing.minMatches: appearance check, descriptor matches
-  int consistency = 2;             ///< LoopClosing.consistency: consecutive consistent detections needed
-  int min_inliers = 40;            ///< LoopClosing.minInliers: after the guided search
-  double max_correction_m = 0.5;   ///< LoopClosing.maxCorrection: larger corrections are refused, metres
-  double max_correction_deg = 10;  ///< LoopClosing.maxCorrectionAngle, degrees
-  int essential_weight = 100;      ///< LoopClosing.essentialWeight: covisibility edges in the essential graph
-  int keyframes_between_loops = 10;  ///< no detection for this many keyframes after a loop (ORB-SLAM2: 10)
-  double rotation_weight = 1.0;    ///< LoopClosing.rotationWeight: pose-graph rotation rows (rad) against translation (m)
-  bool global_ba = false;          ///< LoopClosing.globalBA (0/1): bundle adjustment of the whole map after a loop
-  /// LoopClosing.poseProximity (0/1): candidates by pose proximity (step 1
-  /// above) instead of the bag of words.  Off by default: it cannot find a
-  /// loop after a drift larger than searchRadius.
-  bool pose_proximity = false;
-  /// Beyond ORB-SLAM2, against look-alike places (docs/place_recognition.md):
-  /// LoopClosing.maxDriftRate / driftFloor: a correction moving the camera
-  /// centre further than driftFloor + maxDriftRate x the path driven between
-  /// the two keyframes (as estimated) + the swing of the correction's own
-  /// turn about the keyframe's scene (2 sin(angle / 2) x its median depth)
-  /// is implausible and refused; 0 turns the check off.
-  double max_drift_rate = 0.01;
-  double drift_floor_m = 0.05;
-  /// LoopClosing.ambiguityCheck (0/1) / ambiguityDistance: when two
-  /// candidates verify at camera positions more than ambiguityDistance
-  /// apart, the place is ambiguous (a repeated structure) and the loop is refused.
-  bool ambiguity_check = true;
-  double ambiguity_distance_m = 0.3;
-  /// LoopClosing.mergeConfirmations: keyframes of a provisional map in a
-  /// row (the first match included) verified at the pose the merge
-  /// transform predicts before the maps are merged.
-  int merge_confirmations = 3;
-};
 
 /// One closed loop.
 struct LoopEvent {

@@ -16,6 +16,7 @@
 #include "pvb/slam/core/loop_closing.hpp"
 #include "pvb/slam/core/map_file.hpp"
 #include "pvb/slam/core/map_snapshot.hpp"
+#include "pvb/slam/core/options.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/tracking.hpp"
 #include "pvb/slam/dense/dense_mapper.hpp"
@@ -43,11 +44,6 @@ struct MapSaveInfo {
   /// (they lie in frames of their own).
   std::size_t unmerged_keyframes = 0;
   double save_ms = 0;          ///< encoding and the atomic write
-};
-
-struct SystemOptions {
-  bool synchronous = false;    ///< no worker threads: bit-identical runs
-  std::uint32_t seed = 1;      ///< PE-match seed (and any other randomness)
 };
 
 /// What track() reports for one frame.

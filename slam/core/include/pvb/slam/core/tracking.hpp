@@ -14,6 +14,7 @@
 #include "pvb/slam/core/map.hpp"
 #include "pvb/slam/core/matcher.hpp"
 #include "pvb/slam/core/motion_integrator.hpp"
+#include "pvb/slam/core/options.hpp"
 #include "pvb/slam/core/place_recognition.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/pematch/pe_match.hpp"
@@ -111,66 +112,6 @@ struct RelocEvent {
   /// The frame's pose relative to the keyframe's, as estimated when it was
   /// found (T_f_w * T_kf_w^-1): what ground truth can judge.
   geom::SE3d T_f_kf;
-};
-
-struct TrackingOptions {
-  bool use_pe_match = true;    ///< false: ORB-SLAM2 baseline motion model
-  PeMatchParams pe_match = PeMatchParams::for_slam();
-  /// Beyond the paper: skip PE-match when the predicted translation moves
-  /// the matched points by less than its own inlier threshold (median over
-  /// the matches with depth).  There the epipole is not determined by the
-  /// matches (the motion is a homography within the noise), so an F from
-  /// eight of them says little about the others.  Off by default: on
-  /// fast_turns it changed neither the turn-frame errors nor the ATE
-  /// (docs/experiments/2026-11-21-pe-match-on-fast-turns.md).
-  bool pe_skip_low_parallax = false;
-  double motion_th = 7.0;      ///< ORB-SLAM2 window for stereo / RGB-D, x scale of the octave
-  double motion_ratio = 0.9;   ///< paper sec. 3 step 1
-  int min_init_points = 500;   ///< keypoints with depth needed to initialise
-  int max_frames = 30;         ///< keyframe spacing limit (= fps)
-  int min_frames = 0;
-  int kf_min_tracked_close = 200;    ///< KeyFrame.minTrackedClose (ORB-SLAM2: 100)
-  int kf_min_untracked_close = 70;   ///< KeyFrame.minUntrackedClose
-  double kf_ref_overlap = 0.0;       ///< KeyFrame.refOverlap (0: ORB-SLAM2's 75 % rule)
-  /// Beyond ORB-SLAM2: before the local-map pose optimisation, move each
-  /// map-point match to where the point's reference-keyframe patch,
-  /// warped by the predicted pose, aligns (needs Frame::pyramid; frames
-  /// without one are not aligned).  docs/slam.md, "Patch alignment".
-  bool align_patches = true;
-  PatchAlignParams patch_align;
-  /// Relocalisation against look-alike places: every candidate is tried,
-  /// and when two match at camera positions more than this apart the frame
-  /// stays lost (LoopClosing.ambiguityCheck / ambiguityDistance).
-  bool reloc_ambiguity_check = true;
-  double reloc_ambiguity_distance_m = 0.3;
-  /// Tracking.relocLookalikes: with the ambiguity check, a relocalisation
-  /// is also tried against this many best-scoring keyframes one by one
-  /// (not grouped), and refused when one of them matches at another place;
-  /// 0 turns it off.
-  int reloc_lookalikes = 10;
-  /// Tracking.newMapAfter: in a loaded map that is being extended, after
-  /// this many frames lost in a row a provisional map begins at the next
-  /// frame (the robot started or went outside the map); loop closing
-  /// merges it into the map when it finds the map.  0: never.
-  int new_map_after_lost = 30;
-  /// Tracking.mergeRelocEvery: while tracking in a provisional map, every
-  /// this many frames tracked the frame is also relocalised among the
-  /// loaded map's keyframes alone (with the look-alike checks); a success
-  /// is a merge hypothesis for loop closing (take_merge_hint).  0: never.
-  int merge_reloc_every = 5;
-  /// With an IMU whose state is trusted: how long, and how far, the motion
-  /// sensors may carry the pose while vision fails before tracking
-  /// declares itself lost and relocalises globally.
-  double blind_max_s = 5.0;
-  double blind_max_m = 3.0;
-  /// A blind stretch is a kidnap (lost at once) when the IMU says the robot
-  /// rose more than this (a ground robot does not), or with wheels when
-  /// the IMU's and the wheels' positions part by more than kidnap_disagree_m.
-  double kidnap_lift_m = 0.15;
-  double kidnap_disagree_m = 0.25;
-  /// Search radius (px at level 0) for the local map's points in the
-  /// first frame after a blind stretch, around the dead-reckoned pose.
-  double after_blind_radius_px = 12.0;
 };
 
 /// A provisional map's frame in the map's own, from one frame tracked in
