@@ -20,6 +20,7 @@
 #include "pvb/common/closable_queue.hpp"
 #include "pvb/slam/core/map.hpp"
 #include "pvb/slam/core/options.hpp"
+#include "pvb/slam/core/reports.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/features/patch_align.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
@@ -46,16 +47,6 @@ bool is_redundant_keyframe(const KeyFrame& kf, double th_depth_m, double ratio =
 void erase_outlier_observations(const BaProblem& problem, const std::vector<std::size_t>& outlier_edges,
                                 const std::vector<std::shared_ptr<KeyFrame>>& kfs,
                                 const std::vector<std::shared_ptr<MapPoint>>& pts);
-
-/// What local mapping has done so far (for stats and reports).
-struct LocalMappingStats {
-  std::int64_t keyframes = 0;         ///< keyframes processed
-  std::int64_t local_ba = 0;          ///< local bundle adjustments started
-  std::int64_t local_ba_stopped = 0;  ///< of which cut short by a new keyframe (worker mode only)
-  double busy_ms = 0;                 ///< time spent processing keyframes
-};
-/// {"keyframes", "local_ba", "local_ba_stopped", "busy_ms"} for stats.json and metrics.json.
-std::string to_json(const LocalMappingStats& stats);
 
 class LocalMapping {
  public:

@@ -16,103 +16,11 @@
 #include "pvb/slam/core/motion_integrator.hpp"
 #include "pvb/slam/core/options.hpp"
 #include "pvb/slam/core/place_recognition.hpp"
+#include "pvb/slam/core/reports.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/pematch/pe_match.hpp"
 
 namespace pvb::slam {
-
-/// kDeadReckoning: vision has failed and the IMU (and wheels) carry the
-/// pose, for at most TrackingOptions::blind_max_s / blind_max_m.
-enum class TrackingState { kNotInitialized, kOk, kLost, kDeadReckoning };
-const char* to_string(TrackingState s);
-
-/// How the pose of a frame was found.
-enum class TrackingMethod {
-  kNone,
-  kInitialization,
-  kMotionModel,
-  kReferenceKeyFrame,
-  kRelocalization,
-  kDeadReckoning,  ///< the pose predicted by the motion sensors alone
-  kAfterBlind,     ///< the local map found again from the dead-reckoned pose
-};
-
-/// Per-frame figures for timing.csv and the tests.
-struct TrackingStats {
-  TrackingMethod method = TrackingMethod::kNone;
-  int coarse_matches = 0;       ///< motion-model matches after the orientation check
-  int matches_kept = 0;         ///< after PE-match (== coarse without it)
-  double pe_match_ms = 0;       ///< time in PE-match
-  /// With TrackingOptions::pe_skip_low_parallax on (else 0 / false): the
-  /// median pixel displacement that the predicted translation alone causes
-  /// at the motion model's matches with depth (+inf when unknown), and
-  /// whether PE-match was skipped because it is below the epipolar threshold.
-  double translation_parallax_px = 0;
-  bool pe_skipped = false;
-  int inliers = 0;              ///< map-point inliers after the local-map optimisation
-  int align_tried = 0;          ///< map-point matches patch alignment was tried on
-  int aligned = 0;              ///< of those, the ones it moved (the others keep the keypoint)
-  double align_ms = 0;          ///< time in patch alignment
-  bool new_keyframe = false;
-  /// Inputs of the keyframe decision (ORB-SLAM2 NeedNewKeyFrame), filled
-  /// whenever the frame was tracked: close keypoints (depth under ThDepth)
-  /// tracked and not tracked, and the reference keyframe's points with at
-  /// least 3 observations (2 while the map has at most 2 keyframes).
-  int kf_tracked_close = 0;
-  int kf_untracked_close = 0;
-  int kf_ref_points = 0;
-  /// The reference keyframe's map points (any number of observations) and
-  /// how many of them this frame tracks.
-  int kf_ref_all = 0;
-  int kf_ref_shared = 0;
-  /// The motion model's coarse matches (empty when it did not run), for
-  /// scoring PE-match against ground truth: pixel pairs (last frame,
-  /// this frame), undistorted and as detected, the octaves of both
-  /// keypoints, PE-match's keep mask (all 1 in baseline mode or with no
-  /// model) and whether the pose optimisation kept the match as an inlier.
-  struct MotionMatches {
-    std::vector<PointMatch> undistorted;
-    std::vector<PointMatch> raw;
-    std::vector<std::array<int, 2>> octaves;
-    std::vector<std::uint8_t> pe_keep;
-    std::vector<std::uint8_t> pose_inlier;
-  };
-  MotionMatches motion;
-  /// On a lost frame where relocalisation was tried: the step at which it
-  /// failed (kNone when it was not tried or the frame was tracked).
-  enum class RelocFailure {
-    kNone,
-    kNoCandidates,   ///< no keyframe to try (place recognition returned none)
-    kFewMatches,     ///< no candidate had 15 descriptor matches
-    kPnp,            ///< no candidate gave a PnP RANSAC pose with 10 inliers
-    kFewInliers,     ///< no candidate reached 50 pose inliers
-    kAmbiguous,      ///< two candidates matched at places apart
-    kLookalike,      ///< a look-alike keyframe matched at another place
-    kLocalMap,       ///< relocalised, then the local map gave too few inliers
-  };
-  RelocFailure reloc_failure = RelocFailure::kNone;
-  /// Why the frame was not tracked (empty when it was): each attempted
-  /// step's failure, "; "-separated, e.g. "motion model: only 7 map matches
-  /// after pose optimisation (need 10); reference keyframe: only 9 matches (need 15)".
-  std::string failure;
-};
-
-/// A short name of the step, e.g. "no candidates", "too few pose inliers".
-const char* to_string(TrackingStats::RelocFailure f);
-
-/// One relocalisation: a frame tracked again after a loss, and the
-/// keyframe whose points found it.
-struct RelocEvent {
-  std::uint64_t frame_id = 0;
-  std::int64_t t_ns = 0;
-  std::uint64_t keyframe_id = 0, keyframe_frame_id = 0;
-  std::int64_t keyframe_t_ns = 0;
-  int candidates = 0;  ///< keyframes tried
-  int inliers = 0;     ///< after the local-map optimisation
-  /// The frame's pose relative to the keyframe's, as estimated when it was
-  /// found (T_f_w * T_kf_w^-1): what ground truth can judge.
-  geom::SE3d T_f_kf;
-};
 
 /// A provisional map's frame in the map's own, from one frame tracked in
 /// the provisional map and relocalised in the map (a merge hypothesis,
