@@ -8,11 +8,23 @@
 #include "pvb/common/clock.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/slam/core/frame.hpp"
+#include "pvb/slam/core/local_mapping.hpp"
+#include "pvb/slam/core/loop_closing.hpp"
+#include "pvb/slam/core/map.hpp"
+#include "pvb/slam/core/map_file.hpp"
+#include "pvb/slam/core/place_recognition.hpp"
+#include "pvb/slam/core/tracking.hpp"
+#include "pvb/slam/dense/dense_mapper.hpp"
+#include "pvb/slam/features/orb_extractor.hpp"
 
 namespace pvb::slam {
 
 System::System(const Settings& settings, const SystemOptions& options)
-    : settings_(settings), options_(options), extractor_(settings.orb) {
+    : settings_(settings),
+      options_(options),
+      extractor_(std::make_unique<OrbExtractor>(settings.orb)),
+      map_(std::make_unique<Map>()) {
   StereoIntrinsics K;
   K.fx = settings.K.fx;
   K.fy = settings.K.fy;
@@ -48,7 +60,7 @@ System::System(const Settings& settings, const SystemOptions& options)
     vocabulary_fingerprint_ = vocabulary->fingerprint();
     place_ = std::make_unique<PlaceRecognizer>(std::move(vocabulary));
   }
-  tracking_ = std::make_unique<Tracking>(map_, cam_, topt, place_.get());
+  tracking_ = std::make_unique<Tracking>(*map_, cam_, topt, place_.get());
   check_sensor_setup(settings, settings.sensors);
   tracking_->use_motion_sensors(settings.sensors, settings.imu, settings.robot);
   LocalMappingOptions mopt;
@@ -57,8 +69,8 @@ System::System(const Settings& settings, const SystemOptions& options)
   mopt.sensors = settings.sensors;
   mopt.imu = settings.imu;
   mopt.robot = settings.robot;
-  mapping_ = std::make_unique<LocalMapping>(map_, cam_, mopt);
-  if (settings.loop.enabled) loop_ = std::make_unique<LoopClosing>(map_, settings.loop, place_.get());
+  mapping_ = std::make_unique<LocalMapping>(*map_, cam_, mopt);
+  if (settings.loop.enabled) loop_ = std::make_unique<LoopClosing>(*map_, settings.loop, place_.get());
   // After local mapping: the keyframe's bag of words, loop detection
   // against the older keyframes, then the keyframe joins the database.
   mapping_->set_after_keyframe([this](const std::shared_ptr<KeyFrame>& kf) {
@@ -90,6 +102,14 @@ void System::shutdown() {
   if (dense_) dense_->stop();
 }
 
+LocalMappingStats System::mapping_stats() const { return mapping_->stats(); }
+
+TrackingState System::state() const { return tracking_->state(); }
+
+LoopClosingStats System::loop_stats() const { return loop_ ? loop_->stats() : LoopClosingStats{}; }
+
+const std::vector<RelocEvent>& System::relocalisations() const { return tracking_->relocalisations(); }
+
 FrameResult System::track(const sensor::RgbdFrame& in) {
   FrameResult out;
   out.t_ns = in.t_ns;
@@ -97,11 +117,11 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
   cv::Mat grey;
   if (in.rgb.channels() == 3) cv::cvtColor(in.rgb, grey, cv::COLOR_RGB2GRAY);  // RgbdFrame is R,G,B
   else grey = in.rgb;
-  OrbFeatures features = extractor_.extract(grey);
+  OrbFeatures features = extractor_->extract(grey);
   out.num_features = static_cast<int>(features.keypoints.size());
   out.orb_ms = ms_since(t0);
   Frame frame(next_frame_id_++, in.t_ns, std::move(features), in.depth_m, cam_);
-  if (settings_.align_patches) frame.pyramid = std::make_shared<const ImagePyramid>(copy_pyramid(extractor_.pyramid()));
+  if (settings_.align_patches) frame.pyramid = std::make_shared<const ImagePyramid>(copy_pyramid(extractor_->pyramid()));
   tracking_->add_motion(in.t_ns, in.imu, in.wheel_ticks);
   std::shared_ptr<KeyFrame> kf = tracking_->track(std::move(frame), mapping_->idle(), mapping_->queue_size());
   if (auto hint = tracking_->take_merge_hint(); hint && loop_)
@@ -111,10 +131,10 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
   out.tracking = tracking_->stats();
   if (out.state == TrackingState::kOk || out.state == TrackingState::kDeadReckoning) {
     const auto ref = tracking_->reference_keyframe();
-    std::lock_guard<std::mutex> lock(map_.mutex());
-    out.provisional = ref && map_.map_of(*ref) != 0;
+    std::lock_guard<std::mutex> lock(map_->mutex());
+    out.provisional = ref && map_->map_of(*ref) != 0;
     if (!out.provisional) out.T_w_c = tracking_->last_frame().T_c_w.inverse();
-    if (!out.provisional && map_.gravity().ready) out.g_w = map_.gravity().g_w;
+    if (!out.provisional && map_->gravity().ready) out.g_w = map_->gravity().g_w;
     if (ref) records_.push_back({in.t_ns, ref, tracking_->last_frame().T_c_w * ref->T_c_w().inverse()});
   }
   if (kf && dense_) {
@@ -126,7 +146,7 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
     dkf.rgb = dense_->running() ? in.rgb.clone() : in.rgb;
     dkf.depth_m = dense_->running() ? in.depth_m.clone() : in.depth_m;
     {
-      std::lock_guard<std::mutex> lock(map_.mutex());
+      std::lock_guard<std::mutex> lock(map_->mutex());
       dkf.T_w_c = kf->T_c_w().inverse();
     }
     {
@@ -175,21 +195,21 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
   if (!diff.empty()) throw ConfigError(path, "settings", "a map made with this run's settings", diff);
   MapLoadInfo info;
   {
-    std::lock_guard<std::mutex> lock(map_.mutex());
-    decode_map(bytes, path, head, cam_, &map_);  // with a version-2 file, gravity ready and the chain
+    std::lock_guard<std::mutex> lock(map_->mutex());
+    decode_map(bytes, path, head, cam_, map_.get());  // with a version-2 file, gravity ready and the chain
     if (!uses_accel(settings_.sensors))
-      map_.gravity() = MapGravity{};  // a camera-only run keeps no inertial state
+      map_->gravity() = MapGravity{};  // a camera-only run keeps no inertial state
     std::size_t words = 0;
-    for (const auto& [id, kf] : map_.keyframes()) words += kf->bow().size();
-    place_->reserve(map_.num_keyframes(), words);  // an upper bound on the distinct words
-    for (const auto& [id, kf] : map_.keyframes()) {
+    for (const auto& [id, kf] : map_->keyframes()) words += kf->bow().size();
+    place_->reserve(map_->num_keyframes(), words);  // an upper bound on the distinct words
+    for (const auto& [id, kf] : map_->keyframes()) {
       kf->set_fixed(start == MapStart::kExtend);
       if (kf->bow().empty()) place_->compute_bow(*kf);  // saved with the map (the same vocabulary)
       place_->add(*kf);
     }
-    map_.set_session(head.sessions);
-    info.keyframes = map_.num_keyframes();
-    info.points = map_.num_points();
+    map_->set_session(head.sessions);
+    info.keyframes = map_->num_keyframes();
+    info.points = map_->num_points();
   }
   tracking_->start_in_map(start == MapStart::kLocalise);
   map_start_ = start;
@@ -208,17 +228,17 @@ MapSaveInfo System::save_map(const std::string& path, const std::string& app_jso
   MapSaveInfo info;
   std::string bytes;
   {
-    std::lock_guard<std::mutex> lock(map_.mutex());
+    std::lock_guard<std::mutex> lock(map_->mutex());
     // The sessions loaded, and this one when it made a keyframe.
-    if (map_.num_keyframes() == 0) throw ConfigError(path, "map", "a map with keyframes (this run made none)");
+    if (map_->num_keyframes() == 0) throw ConfigError(path, "map", "a map with keyframes (this run made none)");
     std::uint64_t sessions = loaded_sessions_;  // counted on in 64 bits: no wrap to 0
-    for (const auto& [id, kf] : map_.keyframes()) {
-      if (map_.map_of(*kf) != 0) {  // a provisional map never merged: not saved
+    for (const auto& [id, kf] : map_->keyframes()) {
+      if (map_->map_of(*kf) != 0) {  // a provisional map never merged: not saved
         ++info.unmerged_keyframes;
         continue;
       }
       ++info.keyframes;
-      if (kf->session() == map_.session()) sessions = std::uint64_t(map_.session()) + 1;
+      if (kf->session() == map_->session()) sessions = std::uint64_t(map_->session()) + 1;
     }
     if (sessions > info.keyframes)  // the reader refuses more sessions than keyframes
       throw IoError(path, std::to_string(sessions) + " sessions in a map of " +
@@ -226,8 +246,8 @@ MapSaveInfo System::save_map(const std::string& path, const std::string& app_jso
                               " keyframes (each session holds one at least)");
     info.sessions = static_cast<std::uint32_t>(sessions);
     const BagOf bag_of = [this](const KeyFrame& kf) { return place_ ? place_->bag_of(kf) : kf.bow(); };
-    bytes = encode_map(map_, map_settings(), info.sessions, app_json, bag_of);
-    info.points = map_.num_points();
+    bytes = encode_map(*map_, map_settings(), info.sessions, app_json, bag_of);
+    info.points = map_->num_points();
   }
   write_file(path, bytes);
   info.bytes = bytes.size();
@@ -236,24 +256,24 @@ MapSaveInfo System::save_map(const std::string& path, const std::string& app_jso
 }
 
 std::vector<geom::StampedPose> System::keyframe_trajectory() {
-  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::lock_guard<std::mutex> lock(map_->mutex());
   std::vector<geom::StampedPose> out;
-  for (const auto& [id, kf] : map_.keyframes())
-    if (!kf->bad() && map_.map_of(*kf) == 0) out.push_back({kf->t_ns(), kf->T_c_w().inverse()});
+  for (const auto& [id, kf] : map_->keyframes())
+    if (!kf->bad() && map_->map_of(*kf) == 0) out.push_back({kf->t_ns(), kf->T_c_w().inverse()});
   return out;
 }
 
 MapSnapshot System::map_snapshot() {
-  std::lock_guard<std::mutex> lock(map_.mutex());
-  return snapshot_map(map_, cam_->K, settings_.orb.scale_factor);
+  std::lock_guard<std::mutex> lock(map_->mutex());
+  return snapshot_map(*map_, cam_->K, settings_.orb.scale_factor);
 }
 
 std::vector<geom::StampedPose> System::refined_trajectory() {
-  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::lock_guard<std::mutex> lock(map_->mutex());
   std::vector<geom::StampedPose> out;
   out.reserve(records_.size());
   for (const FrameRecord& r : records_)
-    if (map_.map_of(*r.ref) == 0) out.push_back({r.t_ns, (r.T_c_r * r.ref->T_c_w_via_tree()).inverse()});
+    if (map_->map_of(*r.ref) == 0) out.push_back({r.t_ns, (r.T_c_r * r.ref->T_c_w_via_tree()).inverse()});
   return out;
 }
 
@@ -263,7 +283,7 @@ void System::post_dense_poses(bool loop_correction, bool exact) {
   update.exact = exact;
   {
     std::lock_guard<std::mutex> kf_lock(dense_keyframes_mutex_);
-    std::lock_guard<std::mutex> lock(map_.mutex());
+    std::lock_guard<std::mutex> lock(map_->mutex());
     for (const auto& [id, kf] : dense_keyframes_) update.T_w_c_by_id[id] = kf->T_c_w_via_tree().inverse();
   }
   dense_->update_poses(std::move(update));
@@ -286,8 +306,8 @@ dense::DenseMapperStats System::dense_stats() const { return dense_ ? dense_->st
 SystemMemory System::memory() {
   SystemMemory m;
   {
-    std::lock_guard<std::mutex> lock(map_.mutex());
-    m.map = map_.memory();
+    std::lock_guard<std::mutex> lock(map_->mutex());
+    m.map = map_->memory();
     // Every keyframe was the reference keyframe of the frame that made it.
     std::set<const KeyFrame*> culled;
     for (const FrameRecord& r : records_)
@@ -329,42 +349,42 @@ std::string to_json(const SystemMemory& m) {
 }
 
 std::size_t System::num_keyframes() {
-  std::lock_guard<std::mutex> lock(map_.mutex());
-  return map_.num_keyframes();
+  std::lock_guard<std::mutex> lock(map_->mutex());
+  return map_->num_keyframes();
 }
 
 std::size_t System::num_map_points() {
-  std::lock_guard<std::mutex> lock(map_.mutex());
-  return map_.num_points();
+  std::lock_guard<std::mutex> lock(map_->mutex());
+  return map_->num_points();
 }
 
 std::vector<Eigen::Vector3d> System::map_point_positions() {
-  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::lock_guard<std::mutex> lock(map_->mutex());
   std::vector<Eigen::Vector3d> out;
-  out.reserve(map_.num_points());
-  for (const auto& [id, mp] : map_.points())
+  out.reserve(map_->num_points());
+  for (const auto& [id, mp] : map_->points())
     if (!mp->bad()) out.push_back(mp->p_w());
   return out;
 }
 
 std::vector<System::LandmarkUse> System::landmark_uses() {
-  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::lock_guard<std::mutex> lock(map_->mutex());
   std::vector<LandmarkUse> out;
-  out.reserve(map_.num_points());
-  for (const auto& [id, mp] : map_.points())
+  out.reserve(map_->num_points());
+  for (const auto& [id, mp] : map_->points())
     if (!mp->bad()) out.push_back({id, mp->p_w(), mp->found()});
   return out;
 }
 
 MapGravity System::gravity() {
-  std::lock_guard<std::mutex> lock(map_.mutex());
-  return map_.gravity();
+  std::lock_guard<std::mutex> lock(map_->mutex());
+  return map_->gravity();
 }
 
 std::vector<System::KeyFrameState> System::keyframe_states() {
-  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::lock_guard<std::mutex> lock(map_->mutex());
   std::vector<KeyFrameState> out;
-  for (const auto& [id, kf] : map_.keyframes())
+  for (const auto& [id, kf] : map_->keyframes())
     if (kf->motion().has_state) out.push_back({id, kf->t_ns(), kf->motion().v_w_mps, kf->motion().bias});
   return out;
 }

@@ -17,7 +17,7 @@
 #include "pvb/run/inertial_eval.hpp"
 #include "pvb/run/map_session.hpp"
 #include "pvb/run/map_eval.hpp"
-#include "pvb/slam/core/local_mapping.hpp"
+#include "pvb/slam/core/reports.hpp"
 
 namespace pvb::run {
 

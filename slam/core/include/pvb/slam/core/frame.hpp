@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "pvb/geometry/se3.hpp"
+#include "pvb/slam/core/reports.hpp"
 #include "pvb/slam/features/orb_extractor.hpp"
 #include "pvb/slam/features/patch_align.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
@@ -58,20 +59,6 @@ struct CameraModel {
   Eigen::Vector2d undistort(const Eigen::Vector2d& px) const;
   /// Predicted pyramid level of a point at `dist_m` with max distance `max_dist_m`.
   int predict_scale(double dist_m, double max_dist_m) const;
-};
-
-/// Bytes a frame holds, by structure: heap blocks as malloc sizes them
-/// (pvb/common/memory.hpp) plus the object itself.  The pyramid is shared
-/// by the frame and the keyframe made from it; each counts it.
-struct FrameMemory {
-  std::size_t pyramid = 0;       ///< grey image pyramid (patch alignment)
-  std::size_t keypoints = 0;     ///< keys and keys_un
-  std::size_t descriptors = 0;
-  std::size_t per_keypoint = 0;  ///< depth, u_right, map-point links, outlier flags, aligned_for
-  std::size_t grid = 0;          ///< the area-search index
-  std::size_t object = 0;        ///< sizeof(Frame)
-  std::size_t total() const { return pyramid + keypoints + descriptors + per_keypoint + grid + object; }
-  FrameMemory& operator+=(const FrameMemory& o);
 };
 
 /// A keypoint as SLAM keeps it after extraction: cv::KeyPoint's position,

@@ -19,55 +19,13 @@
 
 #include "pvb/common/closable_queue.hpp"
 #include "pvb/slam/core/map.hpp"
+#include "pvb/slam/core/options.hpp"
+#include "pvb/slam/core/reports.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/features/patch_align.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
 
 namespace pvb::slam {
-
-struct LocalMappingOptions {
-  int covisible_for_triangulation = 10;  ///< neighbours searched for new points (RGB-D: 10)
-  double redundant_ratio = 0.9;          ///< keyframe culling: share of points seen by >= 3 others
-  int redundant_observers = 3;
-  bool local_ba = true;
-  /// Before local BA, align the observations of the new keyframe and its
-  /// covisible keyframes not yet aligned (those that fusion and
-  /// triangulation added) to their points' reference patches
-  /// (patch_refine.hpp); the tracker aligns the rest.
-  bool align_patches = true;
-  PatchAlignParams patch_align;
-  /// A keyframe's grey pyramid (about 1 MB at 640 x 480) is kept while it
-  /// is in the local map, that is among the newest `pyramid_window`
-  /// keyframes or covisible with the newest; then it is released, and its
-  /// points are no longer aligned to its patches (release_pyramids).
-  int pyramid_window = 10;
-  /// Local BA iterations and gates; its abort_flag is local mapping's own
-  /// (set on the worker thread only), whatever is given here.
-  BaOptions ba;
-  /// The motion sensors fused (inertial initialisation, inertial and wheel
-  /// terms in local BA; docs/slam_inertial.md).
-  SensorSetup sensors = SensorSetup::kCamera;
-  ImuSettings imu;
-  RobotSettings robot;
-  /// Inertial initialisation: keyframes in the chain and seconds it spans.
-  int init_min_keyframes = 10;
-  double init_min_span_s = 3.0;
-  /// A keyframe is not culled when its neighbours in time would be this
-  /// far apart (their IMU interval would grow too long).
-  double max_inertial_gap_s = 3.0;
-  /// Zero-mean priors of the initialisation on the biases (an IMU's
-  /// turn-on biases: BMI088's datasheet gives 1 deg/s and 20 mg per axis).
-  double init_gyro_bias_sigma_radps = 0.02;
-  double init_accel_bias_sigma_mps2 = 0.3;
-  /// Noise of vision's keyframe poses in the initialisation, which holds
-  /// them fixed (about a keyframe pair's RPE over the square root of two
-  /// on the shipped scenes).
-  double init_pose_sigma_m = 0.002;
-  double init_pose_sigma_rad = 0.0005;
-  /// Local BA refines gravity's direction under a prior of this standard
-  /// deviation about the last estimate (0: gravity held after initialisation).
-  double gravity_sigma_rad = 0.005;
-};
 
 /// Map-point culling rule (ORB-SLAM2 MapPointCulling, RGB-D): returns
 /// kErase for a point to remove, kKeep to keep watching, kDone when it has
@@ -89,16 +47,6 @@ bool is_redundant_keyframe(const KeyFrame& kf, double th_depth_m, double ratio =
 void erase_outlier_observations(const BaProblem& problem, const std::vector<std::size_t>& outlier_edges,
                                 const std::vector<std::shared_ptr<KeyFrame>>& kfs,
                                 const std::vector<std::shared_ptr<MapPoint>>& pts);
-
-/// What local mapping has done so far (for stats and reports).
-struct LocalMappingStats {
-  std::int64_t keyframes = 0;         ///< keyframes processed
-  std::int64_t local_ba = 0;          ///< local bundle adjustments started
-  std::int64_t local_ba_stopped = 0;  ///< of which cut short by a new keyframe (worker mode only)
-  double busy_ms = 0;                 ///< time spent processing keyframes
-};
-/// {"keyframes", "local_ba", "local_ba_stopped", "busy_ms"} for stats.json and metrics.json.
-std::string to_json(const LocalMappingStats& stats);
 
 class LocalMapping {
  public:

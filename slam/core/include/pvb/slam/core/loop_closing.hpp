@@ -58,100 +58,11 @@
 #include <vector>
 
 #include "pvb/slam/core/map.hpp"
+#include "pvb/slam/core/options.hpp"
 #include "pvb/slam/core/place_recognition.hpp"
+#include "pvb/slam/core/reports.hpp"
 
 namespace pvb::slam {
-
-/// LoopClosing.* settings (docs/slam.md, "Loop closing").
-struct LoopClosingOptions {
-  bool enabled = true;             ///< LoopClosing.enabled (0/1)
-  double search_radius_m = 3.0;    ///< LoopClosing.searchRadius: camera centre distance, metres
-  double max_angle_deg = 30.0;     ///< LoopClosing.maxAngle: angle between the optical axes
-  int min_keyframe_gap = 30;       ///< LoopClosing.minKeyFrameGap: candidate this many keyframe ids older
-  int max_candidates = 5;          ///< LoopClosing.maxCandidates: closest first
-  int min_matches = 20;            ///< LoopClosing.minMatches: appearance check, descriptor matches
-  int consistency = 2;             ///< LoopClosing.consistency: consecutive consistent detections needed
-  int min_inliers = 40;            ///< LoopClosing.minInliers: after the guided search
-  double max_correction_m = 0.5;   ///< LoopClosing.maxCorrection: larger corrections are refused, metres
-  double max_correction_deg = 10;  ///< LoopClosing.maxCorrectionAngle, degrees
-  int essential_weight = 100;      ///< LoopClosing.essentialWeight: covisibility edges in the essential graph
-  int keyframes_between_loops = 10;  ///< no detection for this many keyframes after a loop (ORB-SLAM2: 10)
-  double rotation_weight = 1.0;    ///< LoopClosing.rotationWeight: pose-graph rotation rows (rad) against translation (m)
-  bool global_ba = false;          ///< LoopClosing.globalBA (0/1): bundle adjustment of the whole map after a loop
-  /// LoopClosing.poseProximity (0/1): candidates by pose proximity (step 1
-  /// above) instead of the bag of words.  Off by default: it cannot find a
-  /// loop after a drift larger than searchRadius.
-  bool pose_proximity = false;
-  /// Beyond ORB-SLAM2, against look-alike places (docs/place_recognition.md):
-  /// LoopClosing.maxDriftRate / driftFloor: a correction moving the camera
-  /// centre further than driftFloor + maxDriftRate x the path driven between
-  /// the two keyframes (as estimated) + the swing of the correction's own
-  /// turn about the keyframe's scene (2 sin(angle / 2) x its median depth)
-  /// is implausible and refused; 0 turns the check off.
-  double max_drift_rate = 0.01;
-  double drift_floor_m = 0.05;
-  /// LoopClosing.ambiguityCheck (0/1) / ambiguityDistance: when two
-  /// candidates verify at camera positions more than ambiguityDistance
-  /// apart, the place is ambiguous (a repeated structure) and the loop is refused.
-  bool ambiguity_check = true;
-  double ambiguity_distance_m = 0.3;
-  /// LoopClosing.mergeConfirmations: keyframes of a provisional map in a
-  /// row (the first match included) verified at the pose the merge
-  /// transform predicts before the maps are merged.
-  int merge_confirmations = 3;
-};
-
-/// One closed loop.
-struct LoopEvent {
-  std::uint64_t keyframe_id = 0, frame_id = 0;            ///< the new keyframe
-  std::uint64_t loop_keyframe_id = 0, loop_frame_id = 0;  ///< the old keyframe it matched
-  std::int64_t t_ns = 0, loop_t_ns = 0;                   ///< their frames' times
-  /// The new keyframe's pose relative to the old one as the verification
-  /// found it (T_cur_w' * T_loop_w^-1, before the correction): what ground
-  /// truth can judge.
-  geom::SE3d T_cur_loop;
-  int inliers = 0;            ///< after the guided search
-  double correction_m = 0;    ///< how far the new keyframe moved
-  double correction_deg = 0;
-  int fused_points = 0;       ///< current-side points replaced or joined by loop-side ones
-  int graph_keyframes = 0;    ///< nodes of the essential graph
-  int graph_edges = 0;
-  double detect_ms = 0;       ///< detection and verification for this keyframe
-  double correct_ms = 0;      ///< correction (fusion, pose graph, points)
-  double global_ba_ms = 0;    ///< global bundle adjustment afterwards (0 when off)
-  int global_ba_outliers = 0; ///< observations it removed
-  bool merge = false;         ///< a provisional map merged into the map (correction_m: how far it moved)
-};
-
-/// Running totals (all keyframes).
-struct LoopClosingStats {
-  std::vector<LoopEvent> loops;
-  int keyframes = 0;              ///< keyframes examined
-  int candidates = 0;             ///< pose candidates that passed the appearance check
-  int consistent = 0;             ///< keyframes with a consistent candidate
-  int rejected = 0;               ///< consistent detections refused by geometry or the correction bound
-  int refused_drift = 0;          ///< of those, verified but implausible against the drift bound
-  int refused_ambiguous = 0;      ///< of those, verified at two places apart
-  int merge_confirmed = 0;        ///< keyframes that confirmed a held-back merge transform
-  int merge_unconfirmed = 0;      ///< held-back merge transforms the next keyframe did not confirm (dropped)
-  int merge_suggested = 0;        ///< merge transforms held back from a relocalisation (suggest_merge)
-  /// Per candidate verified (step 3), the stage that refused it.
-  int verified = 0;               ///< candidates verified
-  int refused_matches = 0;        ///< fewer than min_matches descriptor matches
-  int refused_ransac = 0;         ///< too few EPnP RANSAC / pose-optimisation inliers
-  int refused_inliers = 0;        ///< fewer than min_inliers after the guided search
-  int refused_correction = 0;     ///< a correction over max_correction_m / max_correction_deg
-  double verify_ms_total = 0;     ///< the part of detect_ms_total spent in step 3
-  double detect_ms_total = 0;     ///< all detection work
-  std::vector<double> detect_ms;  ///< detection and verification per keyframe examined
-};
-
-/// The stats as one JSON object for stats.json / metrics.json:
-/// {"loops": n, "events": [{keyframe, frame, loop_keyframe, loop_frame,
-/// inliers, correction_m, correction_deg, fused_points, graph_keyframes,
-/// graph_edges, detect_ms, correct_ms}], "keyframes", "candidates",
-/// "consistent", "rejected", "detect_ms_total"}.
-std::string to_json(const LoopClosingStats& stats);
 
 /// Result of the geometric verification of one candidate.
 struct LoopMatch {

@@ -18,34 +18,12 @@
 
 #include "pvb/slam/core/frame.hpp"
 #include "pvb/slam/core/keyframe_motion.hpp"
+#include "pvb/slam/core/reports.hpp"
 #include "pvb/slam/place/vocabulary.hpp"
 
 namespace pvb::slam {
 
 class KeyFrame;
-
-/// Bytes a keyframe holds, by structure (heap blocks as malloc sizes them,
-/// plus the objects themselves); docs/slam.md, "Keyframe memory".
-struct KeyFrameMemory {
-  FrameMemory frame;       ///< its frame's data
-  std::size_t bow = 0;     ///< bag of words and the direct index
-  std::size_t graph = 0;   ///< covisibility, spanning tree, loop edges
-  std::size_t object = 0;  ///< the KeyFrame beyond its Frame, with make_shared's control block
-  std::size_t total() const { return frame.total() + bow + graph + object; }
-  KeyFrameMemory& operator+=(const KeyFrameMemory& o);
-};
-
-/// What the map holds: its keyframes (by structure, summed) and points.
-struct MapMemory {
-  std::size_t keyframes = 0;
-  KeyFrameMemory keyframe_bytes;
-  /// Keyframes outside the local map (their pyramid released) and what
-  /// they hold: the part of keyframe_bytes that grows with the route.
-  std::size_t keyframes_outside = 0;
-  KeyFrameMemory outside_bytes;
-  std::size_t points = 0;
-  std::size_t point_bytes = 0;
-};
 
 /// A 3-D landmark.
 class MapPoint {

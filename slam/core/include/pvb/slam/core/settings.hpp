@@ -3,17 +3,13 @@
 // ThDepth, DepthMapFactor, ORBextractor.*) plus optional PEMatch.*,
 // PointCloudMapping.* and LoopClosing.* sections.  A missing required key is a pvb::ConfigError naming it; an
 // unknown key is a warning (returned, not printed: the app prints it).
-#include <optional>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "pvb/geometry/pinhole.hpp"
-#include "pvb/geometry/se3.hpp"
-#include "pvb/slam/core/loop_closing.hpp"
+#include "pvb/slam/core/options.hpp"
+#include "pvb/slam/core/sensor_settings.hpp"
 #include "pvb/slam/features/orb_extractor.hpp"
-#include "pvb/slam/inertial/imu_preintegration.hpp"
-#include "pvb/slam/inertial/wheel_preintegration.hpp"
 
 namespace pvb::slam {
 
@@ -75,41 +71,10 @@ struct PointCloudMappingSettings {
   bool reassemble = true;
 };
 
-/// Which sensors the core fuses (System.Sensors, or a flag of the apps).
-enum class SensorSetup {
-  kCamera,           ///< "camera": RGB-D only (ORB-SLAM2's RGB-D)
-  kCameraImu,        ///< "camera+imu": RGB-D and a 6-axis IMU
-  kCameraImuWheels,  ///< "camera+imu+wheels": and the wheel encoders
-  kCameraAccel,      ///< "camera+accel": RGB-D and an accelerometer without gyro (the Kinect v1)
-};
-const char* to_string(SensorSetup s);
-/// "camera", "camera+imu", "camera+imu+wheels" or "camera+accel"; nullopt otherwise.
-std::optional<SensorSetup> parse_sensor_setup(std::string_view text);
-bool uses_imu(SensorSetup s);     ///< gyro and accelerometer
-bool uses_accel(SensorSetup s);   ///< the accelerometer (all but kCamera)
-bool uses_wheels(SensorSetup s);
 struct Settings;
 /// Throws ConfigError when `s` lacks a section that `setup` needs (an app
 /// calls it after a flag changed Settings::sensors).
 void check_sensor_setup(const Settings& s, SensorSetup setup);
-
-/// IMU.* section, ORB-SLAM3's keys read as ORB-SLAM3 reads them (optional;
-/// needed by the setups with an IMU or accelerometer).
-struct ImuSettings {
-  bool present = false;  ///< the section was in the file
-  ImuNoise noise;        ///< IMU.NoiseGyro, NoiseAcc, GyroWalk, AccWalk
-  double rate_hz = 200;  ///< IMU.Frequency
-  geom::SE3d T_b_c = geom::SE3d::Identity();  ///< IMU.T_b_c1: the camera in the IMU (body) frame
-};
-
-/// Robot.* section (ours, optional; needed by camera+imu+wheels).
-struct RobotSettings {
-  bool present = false;
-  WheelDrive drive;                ///< Robot.WheelRadius, Track, TicksPerRev
-  double encoder_rate_hz = 50;     ///< Robot.EncoderFrequency
-  geom::SE3d T_base_c = geom::SE3d::Identity();    ///< Robot.T_base_c1: the camera in the base frame
-  geom::SE3d T_base_imu = geom::SE3d::Identity();  ///< Robot.T_base_imu
-};
 
 /// The default vocabulary, trained by the build (docs/place_recognition.md).
 inline constexpr const char* kDefaultVocabularyPath = PVB_DEFAULT_VOCABULARY;

@@ -1,7 +1,10 @@
 #pragma once
 // The PE-SLAM RGB-D system: ORB extraction and tracking on the caller's
 // thread, local mapping and dense point-cloud mapping inline (synchronous
-// mode) or on worker threads.
+// mode) or on worker threads.  The parts are only declared here: their
+// headers (tracking.hpp, local_mapping.hpp, loop_closing.hpp, map.hpp,
+// dense_mapper.hpp) are for code that works with them directly.
+#include <Eigen/Core>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -10,17 +13,31 @@
 #include <string>
 #include <vector>
 
+#include "pvb/geometry/se3.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/sensor/rgbd_frame.hpp"
-#include "pvb/slam/core/local_mapping.hpp"
-#include "pvb/slam/core/loop_closing.hpp"
-#include "pvb/slam/core/map_file.hpp"
+#include "pvb/slam/core/keyframe_motion.hpp"
+#include "pvb/slam/core/map_settings.hpp"
 #include "pvb/slam/core/map_snapshot.hpp"
+#include "pvb/slam/core/options.hpp"
+#include "pvb/slam/core/reports.hpp"
 #include "pvb/slam/core/settings.hpp"
-#include "pvb/slam/core/tracking.hpp"
-#include "pvb/slam/dense/dense_mapper.hpp"
+#include "pvb/slam/dense/point_cloud.hpp"
+#include "pvb/slam/dense/reports.hpp"
 
 namespace pvb::slam {
+
+struct CameraModel;
+class KeyFrame;
+class LocalMapping;
+class LoopClosing;
+class Map;
+class OrbExtractor;
+class PlaceRecognizer;
+class Tracking;
+namespace dense {
+class DenseMapper;
+}  // namespace dense
 
 /// How a run starts from a saved map (System::load_map).
 enum class MapStart {
@@ -43,11 +60,6 @@ struct MapSaveInfo {
   /// (they lie in frames of their own).
   std::size_t unmerged_keyframes = 0;
   double save_ms = 0;          ///< encoding and the atomic write
-};
-
-struct SystemOptions {
-  bool synchronous = false;    ///< no worker threads: bit-identical runs
-  std::uint32_t seed = 1;      ///< PE-match seed (and any other randomness)
 };
 
 /// What track() reports for one frame.
@@ -129,10 +141,10 @@ class System {
   std::vector<LandmarkUse> landmark_uses();
   /// Keyframes processed, local BAs started (and cut short) and the time
   /// spent so far (inline or on its worker).
-  LocalMappingStats mapping_stats() const { return mapping_->stats(); }
-  TrackingState state() const { return tracking_->state(); }
+  LocalMappingStats mapping_stats() const;
+  TrackingState state() const;
   /// Loops closed so far and detection totals (empty when LoopClosing.enabled is 0).
-  LoopClosingStats loop_stats() const { return loop_ ? loop_->stats() : LoopClosingStats{}; }
+  LoopClosingStats loop_stats() const;
   bool loop_closing_enabled() const { return loop_ != nullptr; }
   /// What the map, the culled keyframes and the dense mapper hold now (call
   /// from the thread that calls track(); after shutdown() for the final figures).
@@ -152,7 +164,7 @@ class System {
   };
   std::vector<KeyFrameState> keyframe_states();
   /// Every relocalisation so far (call from the thread that calls track()).
-  const std::vector<RelocEvent>& relocalisations() const { return tracking_->relocalisations(); }
+  const std::vector<RelocEvent>& relocalisations() const;
 
   // Dense point-cloud mapping (Settings::dense; off: the functions below
   // return empty results) ----------------------------------------------------
@@ -174,8 +186,8 @@ class System {
   Settings settings_;
   SystemOptions options_;
   std::shared_ptr<const CameraModel> cam_;
-  OrbExtractor extractor_;
-  Map map_;
+  std::unique_ptr<OrbExtractor> extractor_;
+  std::unique_ptr<Map> map_;
   std::unique_ptr<PlaceRecognizer> place_;  ///< null with Vocabulary.path none
   std::uint64_t vocabulary_fingerprint_ = 0;
   std::optional<MapStart> map_start_;       ///< set when the run started from a saved map

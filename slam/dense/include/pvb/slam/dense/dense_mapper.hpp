@@ -32,6 +32,7 @@
 #include "pvb/geometry/pinhole.hpp"
 #include "pvb/geometry/se3.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"
+#include "pvb/slam/dense/reports.hpp"
 #include "pvb/slam/dense/voxel_map.hpp"
 
 namespace pvb::slam::dense {
@@ -62,31 +63,6 @@ struct PoseUpdate {
   std::map<std::uint64_t, geom::SE3d> T_w_c_by_id;
   bool loop_correction = false;  ///< the first one keeps the map before and after it
   bool exact = false;            ///< re-bin every keyframe whose pose changed at all
-};
-
-/// The corrected map just before and just after the first loop correction.
-struct LoopSnapshot {
-  PointCloud before, after;
-  std::size_t keyframes_moved = 0;
-};
-
-/// Figures for reports.
-struct DenseMapperStats {
-  std::size_t keyframes = 0;  ///< keyframes processed
-  std::size_t points = 0;     ///< points over all keyframe clouds (before the global filter)
-  double total_ms = 0;        ///< back-projection + voxel filter, summed over keyframes
-  std::size_t pose_updates = 0;    ///< update_poses() applied
-  std::size_t keyframes_moved = 0; ///< keyframes re-binned, over all updates
-  std::vector<double> update_ms;   ///< per update: the re-binning time
-  std::vector<double> loop_update_ms;  ///< the same for the loop corrections
-};
-
-/// Bytes the mapper holds (heap blocks as malloc sizes them).
-struct DenseMemory {
-  std::size_t keyframes = 0;        ///< keyframes kept
-  std::size_t keyframe_bytes = 0;   ///< their clouds (camera frame), voxel handles and entries
-  std::size_t map_bytes = 0;        ///< the live and the corrected voxel maps
-  std::size_t total() const { return keyframe_bytes + map_bytes; }
 };
 
 class DenseMapper {
