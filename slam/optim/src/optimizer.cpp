@@ -320,7 +320,11 @@ class LocalBa {
     if (ba_.inertial) add_inertial_residuals(&prob, &kf_in, &state_in);
     if (prob.NumResidualBlocks() == 0) return;
     // Schur ordering: points (group 0) are eliminated first, then poses.
-    // Every block must be listed, the constant ones included.
+    // Every block must be listed, the constant ones included.  Ceres
+    // orders the blocks of one group by address, so each kind has a group
+    // of its own and lies in one array: blocks in separate allocations
+    // would be ordered by where the heap put them, which another thread's
+    // allocations change from run to run.
     auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
     for (std::size_t p = 0; p < points_.size(); ++p)
       if (pt_in[p]) ordering->AddElementToGroup(points_[p].data(), 0);
@@ -328,10 +332,10 @@ class LocalBa {
       if (kf_in[k]) ordering->AddElementToGroup(poses_[k].pose, 1);
     for (std::size_t k = 0; k < state_in.size(); ++k) {
       if (!state_in[k]) continue;
-      ordering->AddElementToGroup(velocities_[k].data(), 1);
-      ordering->AddElementToGroup(biases_[k].data(), 1);
+      ordering->AddElementToGroup(velocities_[k].data(), 2);
+      ordering->AddElementToGroup(biases_[k].data(), 3);
     }
-    if (ba_.inertial && free_gravity_) ordering->AddElementToGroup(gravity_.data(), 1);
+    if (ba_.inertial && free_gravity_) ordering->AddElementToGroup(gravity_.data(), 4);
 
     ceres::Solver::Options solver_options;
     solver_options.linear_solver_type = options_.sparse_schur ? ceres::SPARSE_SCHUR : ceres::DENSE_SCHUR;
