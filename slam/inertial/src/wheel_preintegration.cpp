@@ -47,9 +47,9 @@ double WheelPreintegration::metres_per_tick() const {
   return 2.0 * M_PI * drive_.wheel_radius_m / drive_.ticks_per_rev;
 }
 
-void WheelPreintegration::add(std::int64_t d_left_ticks, std::int64_t d_right_ticks) {
-  const double left_m = static_cast<double>(d_left_ticks) * metres_per_tick();
-  const double right_m = static_cast<double>(d_right_ticks) * metres_per_tick();
+void WheelPreintegration::add(double d_left_ticks, double d_right_ticks) {
+  const double left_m = d_left_ticks * metres_per_tick();
+  const double right_m = d_right_ticks * metres_per_tick();
   const Eigen::Vector3d step = wheel_step(left_m, right_m, drive_.track_m);
   const double ds = std::abs(0.5 * (left_m + right_m)), dyaw = std::abs(step.z());
   // Noise of this step in its own frame: isotropic in the plane (along and

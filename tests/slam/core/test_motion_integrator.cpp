@@ -89,6 +89,45 @@ TEST(MotionIntegrator, WheelsCarryTheTranslationAndTheGyroTheTurn) {
   EXPECT_NEAR(geom::so3_log(T_b0_b1.linear()).z(), 0.1, 1e-6);
 }
 
+/// Encoder readings at 50 Hz of a robot driving straight at speed_mps,
+/// from t0 (exclusive) to t1 (inclusive), counts rounded down as an encoder
+/// counts them.
+std::vector<sensor::WheelTicks> straight_ticks(std::int64_t t0_ns, std::int64_t t1_ns, double speed_mps,
+                                               double metres_per_tick) {
+  constexpr std::int64_t kEncoderPeriodNs = 20'000'000;
+  std::vector<sensor::WheelTicks> out;
+  for (std::int64_t t = (t0_ns / kEncoderPeriodNs + 1) * kEncoderPeriodNs; t <= t1_ns; t += kEncoderPeriodNs) {
+    const auto count = static_cast<std::int64_t>(std::floor(speed_mps * static_cast<double>(t) * 1e-9 / metres_per_tick));
+    out.push_back({t, count, count});
+  }
+  return out;
+}
+
+TEST(MotionIntegrator, WheelIntervalsEndAtTheFramesBetweenEncoderReadings) {
+  Settings s = robot_settings(SensorSetup::kCameraImuWheels);
+  s.robot.encoder_rate_hz = 50;
+  MotionIntegrator m(s.sensors, s.imu, s.robot);
+  const double speed = 0.45, metres_per_tick = 2 * M_PI * s.robot.drive.wheel_radius_m / s.robot.drive.ticks_per_rev;
+  // Keyframes 1, 2, 3 and 4 frames apart: their ends fall 0, 6.7 and 13.3 ms
+  // after the last encoder reading, in turn.
+  const int keyframe_at[] = {0, 3, 5, 6, 10, 14, 15, 18};
+  int next = 0;
+  for (int f = 0; f <= 18; ++f) {
+    const std::int64_t t0 = (f - 1) * kFramePeriodNs, t1 = f * kFramePeriodNs;
+    const std::vector<sensor::WheelTicks> ticks =
+        f == 0 ? std::vector<sensor::WheelTicks>{{0, 0, 0}} : straight_ticks(t0, t1, speed, metres_per_tick);
+    m.add_frame(t1, level_readings(t0, t1, 0), ticks);
+    if (f != keyframe_at[next]) continue;
+    const KeyframeInterval in = m.take_keyframe_interval();
+    if (next++ == 0) continue;
+    ASSERT_TRUE(in.wheels);
+    const double span_s = (keyframe_at[next - 1] - keyframe_at[next - 2]) * kFramePeriodNs * 1e-9;
+    // Within the counts' rounding at both ends; unaligned, the error would
+    // reach 13.3 ms of driving (6 mm).
+    EXPECT_NEAR(in.wheels->delta().x(), speed * span_s, 2.5 * metres_per_tick) << "keyframe at frame " << f;
+  }
+}
+
 TEST(MotionIntegrator, KeyframeIntervalsSplitTheReadingsAndGiveTheTilt) {
   const Settings s = robot_settings(SensorSetup::kCameraImu);
   MotionIntegrator m(s.sensors, s.imu, s.robot);

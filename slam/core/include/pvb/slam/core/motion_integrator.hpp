@@ -91,6 +91,12 @@ class MotionIntegrator {
   std::optional<std::int64_t> covered_t_ns_;   ///< integrated up to here
   std::optional<sensor::ImuSample> last_reading_;
   std::optional<sensor::WheelTicks> last_ticks_;
+  /// Counts per nanosecond of the last encoder interval, and the counts
+  /// already credited past last_ticks_ (up to a frame between readings).
+  std::optional<Eigen::Vector2d> tick_rate_per_ns_;
+  Eigen::Vector2d ticks_ahead_ = Eigen::Vector2d::Zero();
+  /// Credits the wheels up to the frame at the last interval's rate.
+  void wheels_up_to(std::int64_t t_ns);
   std::size_t imu_count_ = 0;
   /// Accelerometer readings of the last kTiltWindowS (time, camera frame).
   std::deque<std::pair<std::int64_t, Eigen::Vector3d>> recent_f_c_;

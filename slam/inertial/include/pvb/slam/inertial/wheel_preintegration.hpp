@@ -45,8 +45,9 @@ class WheelPreintegration {
   WheelPreintegration(const WheelDrive& drive, const WheelNoise& noise);
 
   /// Adds one encoder interval: the count changes of the left and right
-  /// wheel (positive forward).
-  void add(std::int64_t d_left_ticks, std::int64_t d_right_ticks);
+  /// wheel (positive forward), with a fraction where the interval is a
+  /// reading's share of the time up to a frame between two readings.
+  void add(double d_left_ticks, double d_right_ticks);
   /// Appends `next`, which starts where this one ends.
   void append(const WheelPreintegration& next);
 
