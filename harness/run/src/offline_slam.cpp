@@ -420,7 +420,8 @@ void OfflineSlam::Impl::evaluate_gravity(const eval::Trajectory& gt, const eval:
   // the mocap world, whose up was measured from the Kinect's accelerometer.
   const bool site = std::ifstream(a_.sequence + "/meta.json").good();
   const geom::Vec3d down_w = site ? geom::Vec3d(0, 0, -1) : geom::Vec3d(-dataset::tum_world_up());
-  const eval::GravityError g = eval::gravity_error(gt, est, down_w, gravity_map_frame(settings_.sensors), tally_.gravity);
+  const eval::GravityError g =
+      eval::gravity_error(gt, est, down_w, gravity_map_frame(settings_.sensors), tally_.gravity);
   const eval::TiltDrift t =
       eval::tilt_drift(gt, eval::read_tum(a_.out + "/KeyFrameTrajectory.txt"), alignment);
   text(strf("gravity error (map frame: %s): median %.2f deg, p95 %.2f, final %.2f; keyframe pitch error "

@@ -9,6 +9,7 @@ MotionIntegrator::MotionIntegrator(SensorSetup setup, const ImuSettings& imu, co
       imu_(imu),
       robot_(robot),
       period_ns_(static_cast<std::int64_t>(std::llround(1e9 / imu.rate_hz))),
+      encoder_period_ns_(static_cast<std::int64_t>(std::llround(1e9 / robot.encoder_rate_hz))),
       imu_frame_(ImuBias{}, imu.noise),
       imu_kf_(ImuBias{}, imu.noise),
       wheel_frame_(robot.drive, wheel_noise_),
@@ -82,8 +83,7 @@ void MotionIntegrator::wheels_up_to(std::int64_t t_ns) {
   // (a dropped stretch) nothing is guessed.
   if (!last_ticks_ || !tick_rate_per_ns_ || t_ns <= last_ticks_->t_ns) return;
   const std::int64_t ahead_ns = t_ns - last_ticks_->t_ns;
-  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / robot_.encoder_rate_hz));
-  if (ahead_ns > 2 * period_ns) return;
+  if (ahead_ns > 2 * encoder_period_ns_) return;
   const Eigen::Vector2d step = *tick_rate_per_ns_ * static_cast<double>(ahead_ns) - ticks_ahead_;
   wheel_frame_.add(step.x(), step.y());
   wheel_kf_.add(step.x(), step.y());

@@ -96,8 +96,10 @@ std::vector<sensor::WheelTicks> straight_ticks(std::int64_t t0_ns, std::int64_t 
                                                double metres_per_tick) {
   constexpr std::int64_t kEncoderPeriodNs = 20'000'000;
   std::vector<sensor::WheelTicks> out;
-  for (std::int64_t t = (t0_ns / kEncoderPeriodNs + 1) * kEncoderPeriodNs; t <= t1_ns; t += kEncoderPeriodNs) {
-    const auto count = static_cast<std::int64_t>(std::floor(speed_mps * static_cast<double>(t) * 1e-9 / metres_per_tick));
+  for (std::int64_t t = (t0_ns / kEncoderPeriodNs + 1) * kEncoderPeriodNs; t <= t1_ns;
+       t += kEncoderPeriodNs) {
+    const auto count =
+        static_cast<std::int64_t>(std::floor(speed_mps * static_cast<double>(t) * 1e-9 / metres_per_tick));
     out.push_back({t, count, count});
   }
   return out;
@@ -107,7 +109,8 @@ TEST(MotionIntegrator, WheelIntervalsEndAtTheFramesBetweenEncoderReadings) {
   Settings s = robot_settings(SensorSetup::kCameraImuWheels);
   s.robot.encoder_rate_hz = 50;
   MotionIntegrator m(s.sensors, s.imu, s.robot);
-  const double speed = 0.45, metres_per_tick = 2 * M_PI * s.robot.drive.wheel_radius_m / s.robot.drive.ticks_per_rev;
+  const double speed = 0.45,
+               metres_per_tick = 2 * M_PI * s.robot.drive.wheel_radius_m / s.robot.drive.ticks_per_rev;
   // Keyframes 1, 2, 3 and 4 frames apart: their ends fall 0, 6.7 and 13.3 ms
   // after the last encoder reading, in turn.
   const int keyframe_at[] = {0, 3, 5, 6, 10, 14, 15, 18};
@@ -131,14 +134,16 @@ TEST(MotionIntegrator, WheelIntervalsEndAtTheFramesBetweenEncoderReadings) {
 TEST(MotionIntegrator, KeyframeIntervalsSplitTheReadingsAndGiveTheTilt) {
   const Settings s = robot_settings(SensorSetup::kCameraImu);
   MotionIntegrator m(s.sensors, s.imu, s.robot);
-  for (int f = 0; f < 10; ++f) m.add_frame(f * kFramePeriodNs, level_readings((f - 1) * kFramePeriodNs, f * kFramePeriodNs, 0), {});
+  for (int f = 0; f < 10; ++f)
+    m.add_frame(f * kFramePeriodNs, level_readings((f - 1) * kFramePeriodNs, f * kFramePeriodNs, 0), {});
   const KeyframeInterval a = m.take_keyframe_interval();
   ASSERT_TRUE(a.imu);
   ASSERT_TRUE(a.f_c_mps2);
   // Up (the specific force) in the optical frame is -y.
   EXPECT_NEAR((a.f_c_mps2->normalized() - Eigen::Vector3d(0, -1, 0)).norm(), 0, 1e-12);
   EXPECT_NEAR(a.f_spread_mps2, 0, 1e-12);
-  for (int f = 10; f < 15; ++f) m.add_frame(f * kFramePeriodNs, level_readings((f - 1) * kFramePeriodNs, f * kFramePeriodNs, 0), {});
+  for (int f = 10; f < 15; ++f)
+    m.add_frame(f * kFramePeriodNs, level_readings((f - 1) * kFramePeriodNs, f * kFramePeriodNs, 0), {});
   const KeyframeInterval b = m.take_keyframe_interval();
   ASSERT_TRUE(b.imu);
   // The intervals end at the frames: the first reading (at -30 ms) counts

@@ -410,8 +410,9 @@ TEST(InertialInitialisation, VisionsPoseNoiseDoesNotTiltGravity) {
     worst_modelled = std::max(worst_modelled, gravity_error_with_noisy_poses(0.002, 0.0005, seed));
     worst_ignored = std::max(worst_ignored, gravity_error_with_noisy_poses(0.0, 0.0, seed));
   }
-  std::printf("init on noisy keyframe poses: gravity error %.3f deg with their noise modelled, %.3f deg without\n",
-              worst_modelled, worst_ignored);
+  std::printf(
+      "init on noisy keyframe poses: gravity error %.3f deg with their noise modelled, %.3f deg without\n",
+      worst_modelled, worst_ignored);
   EXPECT_LT(worst_modelled, 0.3);
   EXPECT_LT(worst_modelled, worst_ignored);
 }

@@ -14,10 +14,9 @@
 //    up, towards -y), roll = w_z (about the optical axis; positive: x turned
 //    towards +y, down); degrees.  Their least-squares slope over the
 //    keyframe index, in degrees per keyframe, and its sign.
+#include <map>
 #include <string>
 #include <vector>
-
-#include <map>
 
 #include "pvb/eval/align.hpp"
 #include "pvb/eval/trajectory.hpp"

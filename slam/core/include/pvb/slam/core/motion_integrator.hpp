@@ -75,11 +75,14 @@ class MotionIntegrator {
  private:
   void add_imu(const sensor::ImuSample& s);
   void add_ticks(const sensor::WheelTicks& t);
+  /// Credits the wheels up to the frame at the last interval's rate.
+  void wheels_up_to(std::int64_t t_ns);
 
   SensorSetup setup_;
   ImuSettings imu_;
   RobotSettings robot_;
-  std::int64_t period_ns_;  ///< the IMU's reading period
+  std::int64_t period_ns_;          ///< the IMU's reading period
+  std::int64_t encoder_period_ns_;  ///< the encoders' reading period
   WheelNoise wheel_noise_;
   ImuBias bias_;
   ImuPreintegration imu_frame_, imu_kf_;
@@ -95,8 +98,6 @@ class MotionIntegrator {
   /// already credited past last_ticks_ (up to a frame between readings).
   std::optional<Eigen::Vector2d> tick_rate_per_ns_;
   Eigen::Vector2d ticks_ahead_ = Eigen::Vector2d::Zero();
-  /// Credits the wheels up to the frame at the last interval's rate.
-  void wheels_up_to(std::int64_t t_ns);
   std::size_t imu_count_ = 0;
   /// Accelerometer readings of the last kTiltWindowS (time, camera frame).
   std::deque<std::pair<std::int64_t, Eigen::Vector3d>> recent_f_c_;
