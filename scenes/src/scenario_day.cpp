@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/scenes/solar_position.hpp"
 #include "pvb/scenes/tracker.hpp"

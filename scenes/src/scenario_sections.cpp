@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/scenes/ground_relief.hpp"
 #include "pvb/scenes/route.hpp"
