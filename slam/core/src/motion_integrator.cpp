@@ -10,14 +10,14 @@ MotionIntegrator::MotionIntegrator(SensorSetup setup, const ImuSettings& imu, co
       robot_(robot),
       period_ns_(static_cast<std::int64_t>(std::llround(1e9 / imu.rate_hz))),
       encoder_period_ns_(static_cast<std::int64_t>(std::llround(1e9 / robot.encoder_rate_hz))),
-      imu_frame_(ImuBias{}, imu.noise),
-      imu_kf_(ImuBias{}, imu.noise),
+      imu_frame_(ImuBias{}, imu.fused_noise()),
+      imu_kf_(ImuBias{}, imu.fused_noise()),
       wheel_frame_(robot.drive, wheel_noise_),
       wheel_kf_(robot.drive, wheel_noise_) {}
 
 void MotionIntegrator::add_frame(std::int64_t t_ns, const std::vector<sensor::ImuSample>& imu,
                                  const std::vector<sensor::WheelTicks>& ticks) {
-  imu_frame_ = ImuPreintegration(bias_, imu_.noise);
+  imu_frame_ = ImuPreintegration(bias_, imu_.fused_noise());
   wheel_frame_ = WheelPreintegration(robot_.drive, wheel_noise_);
   if (uses_accel(setup_))
     for (const auto& s : imu) add_imu(s);
@@ -96,7 +96,7 @@ KeyframeInterval MotionIntegrator::take_keyframe_interval() {
   if (uses_wheels(setup_) && has_wheels()) out.wheels = std::make_shared<WheelPreintegration>(wheel_kf_);
   out.f_c_mps2 = recent_specific_force_c();
   out.f_spread_mps2 = recent_spread_mps2();
-  imu_kf_ = ImuPreintegration(bias_, imu_.noise);
+  imu_kf_ = ImuPreintegration(bias_, imu_.fused_noise());
   wheel_kf_ = WheelPreintegration(robot_.drive, wheel_noise_);
   return out;
 }

@@ -170,6 +170,8 @@ void read_imu(Reader& r, const cv::FileStorage& fs, ImuSettings* imu) {
   n.accel_random_walk = r.real("IMU.AccWalk", req, n.accel_random_walk, above(0, 10), "m/s^3/sqrt(Hz)");
   imu->rate_hz = r.real("IMU.Frequency", req, imu->rate_hz, closed(1, 10000), "readings per second");
   imu->T_b_c = r.pose("IMU.T_b_c1", req, imu->T_b_c);
+  imu->accel_noise_inflation =
+      r.real("IMU.AccNoiseInflation", false, imu->accel_noise_inflation, closed(1, 100), "a factor from 1 to 100");
 }
 
 /// Robot.* (ours): the wheel drive and the camera's and IMU's poses on the base.

@@ -33,6 +33,18 @@ struct ImuSettings {
   ImuNoise noise;        ///< IMU.NoiseGyro, NoiseAcc, GyroWalk, AccWalk
   double rate_hz = 200;  ///< IMU.Frequency
   geom::SE3d T_b_c = geom::SE3d::Identity();  ///< IMU.T_b_c1: the camera in the IMU (body) frame
+  /// IMU.AccNoiseInflation (ours, optional): the factor on IMU.NoiseAcc
+  /// the core weighs the accelerometer with. A noise density describes the
+  /// sensor at rest; on a robot driving rough ground the readings carry
+  /// more (docs/slam_inertial.md, "Accelerometer noise on a moving robot").
+  double accel_noise_inflation = 3.0;
+  /// The noise the core's preintegration uses: `noise` with the
+  /// accelerometer's density times accel_noise_inflation.
+  ImuNoise fused_noise() const {
+    ImuNoise n = noise;
+    n.accel_noise_density *= accel_noise_inflation;
+    return n;
+  }
 };
 
 /// Robot.* section (ours, optional; needed by camera+imu+wheels).
