@@ -199,6 +199,8 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
     decode_map(bytes, path, head, cam_, map_.get());  // with a version-2 file, gravity ready and the chain
     if (!uses_accel(settings_.sensors))
       map_->gravity() = MapGravity{};  // a camera-only run keeps no inertial state
+    else if (start == MapStart::kExtend && uses_imu(settings_.sensors) && !uses_imu(head.settings.sensors))
+      map_->gravity().ready = false;  // a tilt alone (camera+accel): the new keyframes initialise the IMU
     std::size_t words = 0;
     for (const auto& [id, kf] : map_->keyframes()) words += kf->bow().size();
     place_->reserve(map_->num_keyframes(), words);  // an upper bound on the distinct words

@@ -212,14 +212,15 @@ TEST_F(MapFile, LocaliseStartsLostRelocalisesAndNeverAddsKeyframes) {
 
 /// The pair's map with inertial state (test::give_tiny_inertial_state), as
 /// a run with an IMU whose camera sits at T_b_c saves it.
-std::string inertial_pair_map(const std::string& bytes, const std::string& file, const geom::SE3d& T_b_c) {
+std::string inertial_pair_map(const std::string& bytes, const std::string& file, const geom::SE3d& T_b_c,
+                              SensorSetup setup = SensorSetup::kCameraImu) {
   const MapFileHeader h = read_map_header(bytes, file);
   Map map;
   decode_map(bytes, file, h, camera_for(h.settings), &map);
   std::lock_guard<std::mutex> lock(map.mutex());
   test::give_tiny_inertial_state(map);
   MapSettings s = h.settings;
-  s.sensors = SensorSetup::kCameraImu;
+  s.sensors = setup;
   s.T_b_c = T_b_c;
   return encode_map(map, s, h.sessions, h.app_json);
 }
@@ -271,6 +272,23 @@ TEST_F(MapFile, ARunWithAnImuHasTheMapsGravityAtOnce) {
   const FrameResult r = camera.track(pair_frames(s).front());
   ASSERT_TRUE(r.T_w_c) << r.tracking.failure;
   EXPECT_LT(r.T_w_c->translation().norm(), 0.01);
+}
+
+// A map made with an accelerometer alone holds a tilt, not the IMU's full
+// state: a run with an IMU that extends it initialises the IMU again from
+// its new keyframes (gravity not trusted yet, the tilt kept as the guess);
+// one that localises in it uses the tilt at once.
+TEST_F(MapFile, AnImuRunExtendingATiltOnlyMapInitialisesItsImu) {
+  const geom::SE3d T_b_c = test::tiny_inertial_settings().T_b_c;
+  const std::string p = tmp_path("tilt_pair.pvbmap");
+  write_file(p, inertial_pair_map(bytes_, path_, T_b_c, SensorSetup::kCameraAccel));
+  System extend(imu_settings(T_b_c), sync_options());
+  extend.load_map(p, MapStart::kExtend);
+  EXPECT_FALSE(extend.gravity().ready);
+  EXPECT_EQ(extend.gravity().g_w, Eigen::Vector3d(0.1, -0.2, -9.8));
+  System localise(imu_settings(T_b_c), sync_options());
+  localise.load_map(p, MapStart::kLocalise);
+  EXPECT_TRUE(localise.gravity().ready);
 }
 
 /// The pair's map with a look-alike place added: its first keyframe again
