@@ -7,17 +7,18 @@ namespace pvb::slam {
 MotionIntegrator::MotionIntegrator(SensorSetup setup, const ImuSettings& imu, const RobotSettings& robot)
     : setup_(setup),
       imu_(imu),
+      imu_noise_(imu.fused_noise()),
       robot_(robot),
       period_ns_(static_cast<std::int64_t>(std::llround(1e9 / imu.rate_hz))),
       encoder_period_ns_(static_cast<std::int64_t>(std::llround(1e9 / robot.encoder_rate_hz))),
-      imu_frame_(ImuBias{}, imu.fused_noise()),
-      imu_kf_(ImuBias{}, imu.fused_noise()),
+      imu_frame_(ImuBias{}, imu_noise_),
+      imu_kf_(ImuBias{}, imu_noise_),
       wheel_frame_(robot.drive, wheel_noise_),
       wheel_kf_(robot.drive, wheel_noise_) {}
 
 void MotionIntegrator::add_frame(std::int64_t t_ns, const std::vector<sensor::ImuSample>& imu,
                                  const std::vector<sensor::WheelTicks>& ticks) {
-  imu_frame_ = ImuPreintegration(bias_, imu_.fused_noise());
+  imu_frame_ = ImuPreintegration(bias_, imu_noise_);
   wheel_frame_ = WheelPreintegration(robot_.drive, wheel_noise_);
   if (uses_accel(setup_))
     for (const auto& s : imu) add_imu(s);
@@ -53,7 +54,8 @@ void MotionIntegrator::add_imu(const sensor::ImuSample& s) {
 }
 
 void MotionIntegrator::integrate_up_to(std::int64_t t_ns) {
-  if (!last_reading_ || !covered_t_ns_ || *covered_t_ns_ >= t_ns || t_ns - *covered_t_ns_ > period_ns_) return;
+  if (!last_reading_ || !covered_t_ns_ || *covered_t_ns_ >= t_ns || t_ns - *covered_t_ns_ > period_ns_)
+    return;
   // The interval ends at the frame: the newest reading is held up to it
   // (the next reading, which covers this stretch too, begins there).
   const double dt_s = static_cast<double>(t_ns - *covered_t_ns_) * 1e-9;
@@ -96,7 +98,7 @@ KeyframeInterval MotionIntegrator::take_keyframe_interval() {
   if (uses_wheels(setup_) && has_wheels()) out.wheels = std::make_shared<WheelPreintegration>(wheel_kf_);
   out.f_c_mps2 = recent_specific_force_c();
   out.f_spread_mps2 = recent_spread_mps2();
-  imu_kf_ = ImuPreintegration(bias_, imu_.fused_noise());
+  imu_kf_ = ImuPreintegration(bias_, imu_noise_);
   wheel_kf_ = WheelPreintegration(robot_.drive, wheel_noise_);
   return out;
 }

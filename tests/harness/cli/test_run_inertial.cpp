@@ -109,8 +109,6 @@ TEST(RunInertialCli, CameraImuRunReportsGravityTiltAndBiases) {
   EXPECT_NE(read_file(d + "/index.html").find("<tr><th>dead-reckoned frames</th>"), std::string::npos);
 }
 
-// pvbench slam on a recording: the same keys in stats.json, the biases
-// against the recording's imu0/truth.csv.
 // Two live synchronous runs with the IMU write the same trajectory bit for
 // bit, well past the inertial initialisation (about 4 s): local BA's
 // velocity and bias blocks once took their order from the heap, which the
@@ -129,6 +127,8 @@ TEST(RunInertialCli, LiveRunsWithAnImuAreBitIdentical) {
   EXPECT_EQ(trajectories[0], trajectories[1]);
 }
 
+// pvbench slam on a recording: the same keys in stats.json, the biases
+// against the recording's imu0/truth.csv.
 TEST(RunInertialCli, SlamOnARecordingComparesTheBiasesWithItsTruth) {
   const std::string rec = fresh("rec"), out = fresh("slam");
   ASSERT_EQ(test::run_pvbench("record --scenario " + kStation + " --out " + rec + " --frames 120").code, 0);

@@ -511,7 +511,8 @@ TEST(Settings, ReadsImuAndRobotKeysAndTheSensorSetup) {
   EXPECT_DOUBLE_EQ(s.imu.noise.accel_noise_density, 0.002);
   EXPECT_DOUBLE_EQ(s.imu.fused_noise().accel_noise_density, 0.006);
   EXPECT_DOUBLE_EQ(s.imu.fused_noise().gyro_noise_density, 0.00017);
-  const Settings one = read_settings(temp_copy("imu1", read_file(tum1()) + kImuKeys + "IMU.AccNoiseInflation: 1.0\n"));
+  const Settings one =
+      read_settings(temp_copy("imu1", read_file(tum1()) + kImuKeys + "IMU.AccNoiseInflation: 1.0\n"));
   EXPECT_DOUBLE_EQ(one.imu.fused_noise().accel_noise_density, 0.002);
   // The camera's optical z looks along the IMU's x; its centre 5 cm ahead, 10 cm up.
   EXPECT_NEAR((s.imu.T_b_c.linear() * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitX()).norm(), 0, 1e-6);

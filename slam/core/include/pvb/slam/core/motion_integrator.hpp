@@ -80,6 +80,7 @@ class MotionIntegrator {
 
   SensorSetup setup_;
   ImuSettings imu_;
+  ImuNoise imu_noise_;  ///< imu_.fused_noise(): what the preintegrations weigh
   RobotSettings robot_;
   std::int64_t period_ns_;          ///< the IMU's reading period
   std::int64_t encoder_period_ns_;  ///< the encoders' reading period
