@@ -381,7 +381,7 @@ void OfflineSlam::Impl::evaluate(std::ostringstream* js) {
       res = eval::evaluate(gt, est, eo);
     } catch (const eval::EvalError& e) {
       // Only a numerically degenerate set lands here (a robot that never
-      // moved, fewer than 3 poses); nearly straight drives align with se3.
+      // moved, fewer than 3 poses); straight drives align with se3.
       // The SLAM estimate starts at its first frame, so align that instead.
       warn(std::string("note: se3 alignment impossible (") + e.what() + "); using origin alignment");
       eo.alignment = eval::Alignment::kOrigin;

@@ -214,8 +214,9 @@ void SystemSink::evaluate(const eval::Trajectory& gt) {
   try {
     run.eval = eval::evaluate(gt, est, eo);
   } catch (const eval::EvalError& e) {
-    // A numerically degenerate set (a robot that did not move): the SLAM
-    // world is its first camera frame, so align that instead.
+    // A numerically degenerate set (a robot that did not move; straight
+    // drives align with se3): the SLAM world is its first camera frame, so
+    // align that instead.
     eo.alignment = eval::Alignment::kOrigin;
     try {
       run.eval = eval::evaluate(gt, est, eo);

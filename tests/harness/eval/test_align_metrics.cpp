@@ -147,6 +147,45 @@ TEST(Align, DegenerateSetsAreErrors) {
   EXPECT_THROW(evaluate(gt, gt, {}), EvalError);
 }
 
+// A simulated robot driving exactly straight on flat ground: the true
+// positions lie on a line, and the turn about it comes from the orientations.
+TEST(Align, AStraightDriveTakesTheTurnAboutItsLineFromTheOrientations) {
+  Trajectory gt;
+  gt.source = "gt";
+  for (int i = 0; i < 60; ++i) {
+    geom::StampedPose p;
+    p.t_ns = 1000000000LL + i * 100000000LL;
+    p.T_w_c = geom::make_se3(geom::so3_exp(Vec3d(1.8 + 0.01 * std::sin(i), 0.02 * std::cos(0.3 * i), 0.4)),
+                             Vec3d(-4.1, -10.0 + 0.2 * i, 1.1));
+    gt.poses.push_back(p);
+  }
+  std::vector<Vec3d> line;
+  for (const auto& p : gt.poses) line.push_back(p.T_w_c.translation());
+  EXPECT_THROW(umeyama(line, line, false), EvalError);  // positions alone leave the turn free
+  for (const double scale : {1.0, 2.5}) {
+    const Trajectory est = transformed(gt, kOffset, scale);
+    EvalOptions o;
+    o.alignment = scale == 1.0 ? Alignment::kSe3 : Alignment::kSim3;
+    const EvalResult r = evaluate(gt, est, o);
+    EXPECT_TRUE(r.alignment.R.isApprox(kOffset.linear().transpose(), 1e-9)) << r.alignment.R;
+    EXPECT_NEAR(r.alignment.s, 1.0 / scale, 1e-9);
+    EXPECT_LT(r.ate.max, 1e-9);
+  }
+  // Millimetres of wobble and a milliradian of attitude noise: the turn is
+  // still found to about that milliradian.
+  Trajectory est = transformed(gt, kOffset);
+  for (std::size_t i = 0; i < est.poses.size(); ++i) {
+    const double k = static_cast<double>(i);
+    est.poses[i].T_w_c.translation() += 0.002 * Vec3d(std::sin(k), std::cos(1.7 * k), std::sin(2.3 * k));
+    est.poses[i].T_w_c.linear() =
+        est.poses[i].T_w_c.linear() * geom::so3_exp(1e-3 * Vec3d(std::cos(k), std::sin(1.3 * k), std::cos(0.7 * k)));
+  }
+  const EvalResult r = evaluate(gt, est, {});
+  const Mat3d dR = r.alignment.R * kOffset.linear();
+  EXPECT_LT(Eigen::AngleAxisd(dR).angle(), 2e-3);
+  EXPECT_LT(r.ate.rmse, 0.004);
+}
+
 // One estimated position at 1e300 (or NaN) is named as such, not reported
 // as "all estimated positions are the same point".
 TEST(Align, AbsurdPositionIsNamed) {

@@ -47,9 +47,12 @@ Sim3Transform umeyama(const std::vector<geom::Vec3d>& est, const std::vector<geo
                       bool with_scale);
 
 /// Computes the alignment of kind `kind` from associated poses (est[i] goes
-/// with gt[i]).  kSe3/kSim3 use umeyama() on the positions (and need at least
-/// 3 non-collinear pairs); kOrigin uses the first pair; kNone returns the
-/// identity.  Throws EvalError when there are too few pairs.
+/// with gt[i]).  kSe3/kSim3 use umeyama() on the positions and need at least
+/// 3 pairs; when one position set lies on a line (a robot driving exactly
+/// straight) the positions leave the turn about that line free and it is
+/// taken from the orientations (the turn that best maps the estimated
+/// orientations onto the true ones).  kOrigin uses the first pair; kNone
+/// returns the identity.  Throws EvalError when there are too few pairs.
 Sim3Transform compute_alignment(const std::vector<geom::SE3d>& est, const std::vector<geom::SE3d>& gt,
                                 Alignment kind);
 
