@@ -163,6 +163,10 @@ double sun_intensity_for(double elevation_deg) {
   return std::clamp(0.8 * detail::beam_share(elevation_deg) / detail::beam_share(45.0), 0.05, 1.0);
 }
 
+double clear_sky_beam_share(double elevation_deg) {
+  return elevation_deg > 0 ? detail::beam_share(std::min(elevation_deg, 90.0)) : 0.0;
+}
+
 double sky_ambient_for(double elevation_deg) {
   const double sin_el = std::sin(std::clamp(elevation_deg, 0.0, 90.0) * detail::kDeg);
   return std::clamp(0.35 * (0.45 + 0.55 * sin_el / std::sin(45.0 * detail::kDeg)), 0.1, 0.6);

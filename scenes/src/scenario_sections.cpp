@@ -257,6 +257,9 @@ void read_camera(MapReader& r, Camera& c) {
     d.lateral_sigma_px = n.number("lateral_sigma_px", d.lateral_sigma_px, 0, 5);
     d.axial_scale = n.number("axial_scale", d.axial_scale, 0, 100);
     d.max_incidence_deg = n.number("max_incidence_deg", d.max_incidence_deg, 1, 90);
+    d.sunlight.on = n.boolean("sunlight", d.sunlight.on);
+    d.sunlight.filter_width_nm = n.number("sunlight_filter_nm", d.sunlight.filter_width_nm, 1, 100);
+    d.sunlight.min_contrast = n.number("sunlight_min_contrast", d.sunlight.min_contrast, 1e-5, 1);
   });
   with_map(r, "rgb", [&](MapReader& n) {
     RgbNoise& g = c.rgb;

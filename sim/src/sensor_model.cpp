@@ -35,11 +35,41 @@ const std::array<float, 4096>& normal_table() {
   return table;
 }
 
+/// Whether the projected pattern stands out against the sun and sky at a
+/// surface point at depth z, with normal n (unnormalised, either side)
+/// seen along ray (x, y, 1); dot = n . ray.
+bool pattern_survives(const SunlightFrame& sun, const Eigen::Vector3f& n, const Eigen::Vector3f& ray, float dot,
+                      float z, bool lit) {
+  const float n_norm = n.norm(), ray2 = ray.squaredNorm();
+  const float cos_projector = std::abs(dot) / (n_norm * std::sqrt(ray2));
+  const float pattern = sun.pattern_w_sr * cos_projector / (z * z * ray2);
+  const float cos_sun = (dot > 0 ? -n : n).dot(sun.to_sun_c) / n_norm;  // the normal turned to the camera
+  const float ambient = sun.beam_w_m2 * (lit ? std::max(cos_sun, 0.0f) : 0.0f) + sun.sky_w_m2;
+  return pattern >= sun.min_contrast * ambient;
+}
+
 }  // namespace
 
+SunlightFrame sunlight_frame(const scenes::Sunlight& params, double sun_elevation_deg,
+                             const Eigen::Vector3f& to_sun_c, cv::Mat lit) {
+  constexpr double kAirMass15ElevationDeg = 41.81;  // air mass 1.5, ASTM G173's sun
+  const double beam = params.filter_width_nm * params.sun_w_m2_nm * scenes::clear_sky_beam_share(sun_elevation_deg) /
+                      scenes::clear_sky_beam_share(kAirMass15ElevationDeg);
+  SunlightFrame f;
+  f.to_sun_c = to_sun_c.normalized();
+  f.beam_w_m2 = static_cast<float>(beam);
+  f.sky_w_m2 = static_cast<float>(params.sky_share * beam);
+  f.pattern_w_sr = static_cast<float>(params.projector_power_w / params.projector_solid_angle_sr);
+  f.min_contrast = static_cast<float>(params.min_contrast);
+  f.lit = std::move(lit);
+  return f;
+}
+
 cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, const scenes::Camera& cam,
-                          std::uint64_t seed, std::uint64_t frame) {
+                          std::uint64_t seed, std::uint64_t frame, const SunlightFrame* sun) {
   CV_Assert(gt.type() == CV_32FC1);
+  if (sun && !(sun->beam_w_m2 > 0 || sun->sky_w_m2 > 0)) sun = nullptr;  // no sun, no change
+  CV_Assert(!sun || (sun->lit.type() == CV_8UC1 && sun->lit.size() == gt.size()));
   const float zmin = static_cast<float>(cam.depth_range_m.x()), zmax = static_cast<float>(cam.depth_range_m.y());
   cv::Mat out(gt.size(), CV_32FC1, cv::Scalar(0));
   const int W = gt.cols, H = gt.rows;
@@ -92,6 +122,7 @@ cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, c
       const Eigen::Vector3f ray(xc, yc, 1.0f);
       const float dot = n.dot(ray);
       if (dot * dot < cos2_max * n.squaredNorm() * ray.squaredNorm()) continue;
+      if (sun && !pattern_survives(*sun, n, ray, dot, z, sun->lit.ptr<std::uint8_t>(rr)[cc] != 0)) continue;
       // axial noise, then disparity quantisation
       double zn = z + nt[(bits >> 24) & 4095] * kinect_axial_sigma_m(z) * p.axial_scale;
       if (p.disparity_step_px > 0 && zn > 0) {

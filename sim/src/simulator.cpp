@@ -10,6 +10,7 @@
 #include "pvb/geometry/time.hpp"
 #include "pvb/scenes/route.hpp"
 #include "pvb/sim/sensor_model.hpp"
+#include "pvb/sim/sun_shadow.hpp"
 #include "carry_path.hpp"
 
 namespace pvb::sim {
@@ -200,10 +201,13 @@ geom::PinholeIntrinsics Simulator::intrinsics() const {
   return {c.fx, c.fy, c.cx(), c.cy(), c.width, c.height};
 }
 
-std::optional<cv::Point2d> Simulator::sun_pixel() const {
+Eigen::Vector3d Simulator::to_sun_w() const {
   const double az = scenario_.light.sun_azimuth_deg * M_PI / 180, el = scenario_.light.sun_elevation_deg * M_PI / 180;
-  const Eigen::Vector3d to_sun_w(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
-  const Eigen::Vector3d d = T_w_c().linear().transpose() * to_sun_w;
+  return {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
+}
+
+std::optional<cv::Point2d> Simulator::sun_pixel() const {
+  const Eigen::Vector3d d = T_w_c().linear().transpose() * to_sun_w();
   if (d.z() <= 0.05) return std::nullopt;
   const auto K = intrinsics();
   return cv::Point2d(K.fx * d.x() / d.z() + K.cx, K.fy * d.y() / d.z() + K.cy);
@@ -222,8 +226,18 @@ RenderedFrame RgbdCamera::render(Simulator& sim) {
   // Sky: beyond every scene distance (the skybox is drawn far away).
   const float sky = static_cast<float>(sim.assets().max_scene_depth_m);
   out.depth_gt_m.setTo(0.0f, out.depth_gt_m > sky);
-  out.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   out.sun_px = sim.sun_pixel();
+  const scenes::Camera& cam = sim.scenario().camera;
+  if (cam.depth_noise.model == scenes::DepthNoiseModel::kKinect && cam.depth_noise.sunlight.on &&
+      sim.scenario().light.sun_elevation_deg > 0) {
+    out.to_sun_c = sim.T_w_c().linear().transpose() * sim.to_sun_w();
+    const float shade_range_m = sunlight_frame(cam.depth_noise.sunlight, sim.scenario().light.sun_elevation_deg,
+                                               out.to_sun_c.cast<float>(), cv::Mat())
+                                    .shade_range_m();
+    const SunShadowCaster caster(sim.model(), sim.data(), sim.to_sun_w());
+    out.sun_lit = sun_visibility(caster, out.depth_gt_m, sim.intrinsics(), sim.T_w_c(), 16, shade_range_m);
+  }
+  out.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   out.index = static_cast<std::uint64_t>(sim.frame_index());
   out.t_ns = sim.t_ns();
   out.T_w_c = sim.T_w_c();
@@ -236,6 +250,7 @@ Capture RgbdCamera::capture(Simulator& sim) { return sensor_.apply(render(sim));
 SensorModel::SensorModel(const Simulator& sim)
     : camera_(sim.scenario().camera),
       K_(sim.intrinsics()),
+      sun_elevation_deg_(sim.scenario().light.sun_elevation_deg),
       seed_(sim.scenario().seed),
       cover_(scenes::camera_cover_frames(sim.scenario())) {}
 
@@ -249,7 +264,11 @@ Capture SensorModel::apply(RenderedFrame rendered) const {
     rendered.rgb.setTo(cv::Scalar::all(0));
     out.frame.depth_m = cv::Mat::zeros(out.depth_gt_m.size(), CV_32FC1);
   } else {
-    out.frame.depth_m = apply_depth_model(out.depth_gt_m, K_, camera_, seed_, rendered.index);
+    std::optional<SunlightFrame> sun;
+    if (!rendered.sun_lit.empty())
+      sun = sunlight_frame(camera_.depth_noise.sunlight, sun_elevation_deg_, rendered.to_sun_c.cast<float>(),
+                           std::move(rendered.sun_lit));
+    out.frame.depth_m = apply_depth_model(out.depth_gt_m, K_, camera_, seed_, rendered.index, sun ? &*sun : nullptr);
   }
   apply_rgb_model(&rendered.rgb, camera_.rgb, covered ? std::nullopt : rendered.sun_px, seed_,
                   rendered.index);

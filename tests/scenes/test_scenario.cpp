@@ -438,6 +438,19 @@ TEST(Scenario, NestedMistakesNameTheFullKeyAndItsLine) {
   EXPECT_NE(e.find("got unknown key"), std::string::npos) << e;
 }
 
+TEST(Scenario, SunlightOnTheDepthPatternIsOffUnlessAsked) {
+  EXPECT_FALSE(parse_scenario(kMinimal, "min.yaml").camera.depth_noise.sunlight.on);
+  const Scenario s = parse_scenario(std::string(kMinimal) +
+                                        "camera:\n  depth_noise: {sunlight: on, sunlight_filter_nm: 20, "
+                                        "sunlight_min_contrast: 0.01}\n",
+                                    "sun.yaml");
+  EXPECT_TRUE(s.camera.depth_noise.sunlight.on);
+  EXPECT_DOUBLE_EQ(s.camera.depth_noise.sunlight.filter_width_nm, 20.0);
+  EXPECT_DOUBLE_EQ(s.camera.depth_noise.sunlight.min_contrast, 0.01);
+  const std::string e = error_of(std::string(kMinimal) + "camera:\n  depth_noise: {sunlight: bright}\n");
+  EXPECT_NE(e.find("bad.yaml:3: camera.depth_noise.sunlight:"), std::string::npos) << e;
+}
+
 TEST(Scenario, KidnapTimesAreJudgedByTheKeyThatIsWrong) {
   const std::string base = std::string(kMinimal) + "duration_s: 20\nkidnap:\n";
   // A cover shorter than one frame period is refused even where it happens

@@ -139,3 +139,45 @@ TEST(SensorModel, AutoExposureMetersTheCentreAndScalesTheNoise) {
   // The gain stays within [1/4, 8].
   EXPECT_DOUBLE_EQ(sim::auto_exposure_gain(cv::Mat(100, 100, CV_8UC3, cv::Scalar(1, 1, 1))), 8.0);
 }
+
+namespace {
+// A Kinect with the sunlight model and a plane facing it at z metres, lit
+// head-on by a sun `elevation_deg` up, or shaded when !lit.
+sim::SunlightFrame sun_on_plane(double elevation_deg, bool lit) {
+  scenes::Sunlight params;
+  params.on = true;
+  return sim::sunlight_frame(params, elevation_deg, Eigen::Vector3f(0, 0, -1),
+                             cv::Mat(480, 640, CV_8UC1, cv::Scalar(lit ? 1 : 0)));
+}
+}  // namespace
+
+TEST(SensorModel, SunlightBelowTheHorizonChangesNothing) {
+  const cv::Mat gt(480, 640, CV_32FC1, cv::Scalar(3.0));
+  const cv::Mat without = sim::apply_depth_model(gt, K(), kinect(), 1, 0);
+  for (const double elevation : {0.0, -10.0}) {
+    const sim::SunlightFrame night = sun_on_plane(elevation, true);
+    const cv::Mat with = sim::apply_depth_model(gt, K(), kinect(), 1, 0, &night);
+    EXPECT_EQ(cv::countNonZero(with != without), 0) << elevation;
+  }
+}
+
+TEST(SensorModel, SunlightDrownsTheFarPatternAndShadeKeepsIt) {
+  const cv::Rect centre(220, 140, 200, 200);  // rays within 11 degrees of the axis
+  const auto valid_share = [&](double z, const sim::SunlightFrame& sun) {
+    const cv::Mat gt(480, 640, CV_32FC1, cv::Scalar(z));
+    return cv::countNonZero(sim::apply_depth_model(gt, K(), kinect(), 1, 0, &sun)(centre)) / 40000.0;
+  };
+  const sim::SunlightFrame noon = sun_on_plane(60, true), shade = sun_on_plane(60, false);
+  EXPECT_EQ(valid_share(3.0, noon), 0.0);   // a sunlit far surface: no depth
+  EXPECT_EQ(valid_share(1.0, noon), 1.0);   // close, the pattern still wins
+  EXPECT_EQ(valid_share(3.0, shade), 1.0);  // shaded: the sky alone
+  // The calibration: in shade at air mass 1.5, a surface facing the camera
+  // keeps depth to the rated 4.0 m.
+  const sim::SunlightFrame am15 = sun_on_plane(41.81, false);
+  EXPECT_EQ(valid_share(3.6, am15), 1.0);  // 4.0 m on the axis, less 11 degrees off it
+  EXPECT_EQ(valid_share(4.3, am15), 0.0);
+  // A surface turned away from the sun has only the sky on it.
+  sim::SunlightFrame behind = noon;
+  behind.to_sun_c = Eigen::Vector3f(0, 0, 1);
+  EXPECT_EQ(valid_share(3.0, behind), 1.0);
+}

@@ -199,8 +199,26 @@ struct Route {
   OnLoss on_loss = OnLoss::kWait;            ///< closed loop: what to do when tracking is lost
 };
 
+/// Sunlight on a structured-light camera's projected pattern
+/// (docs/sensors.md, "Sunlight"): a depth pixel survives while the pattern's
+/// irradiance on the surface, P cos(theta_p) / (Omega r^2), is at least
+/// `min_contrast` times the ambient near-infrared in the camera's band, the
+/// sun's beam on the surface (where no geom shadows it) plus the sky's.
+struct Sunlight {
+  bool on = false;
+  double projector_power_w = 0.06;         ///< Kinect v1's 830 nm laser at its output (OpenKinect)
+  double projector_solid_angle_sr = 0.70;  ///< the pattern's 58 x 45 degree field
+  double filter_width_nm = 10.0;           ///< the infrared camera's band-pass (not published)
+  double sun_w_m2_nm = 0.85;               ///< direct normal at 830 nm, ASTM G173 (air mass 1.5)
+  double sky_share = 0.10;                 ///< the sky's irradiance on any surface, share of the beam's
+  /// Pattern over ambient below which the pattern is lost: a shaded surface
+  /// facing the camera keeps depth to the Kinect's rated 4.0 m at air mass 1.5.
+  double min_contrast = 0.0063;
+};
+
 struct DepthNoise {
   DepthNoiseModel model = DepthNoiseModel::kKinect;
+  Sunlight sunlight;                 ///< applies to the kinect model
   double baseline_m = 0.075;         ///< IR projector-camera baseline
   double disparity_step_px = 0.125;  ///< disparity quantisation (1/8 px)
   double lateral_sigma_px = 0.5;     ///< pixel jitter of the depth sampling
@@ -418,6 +436,10 @@ struct Scenario {
 /// ground, 0.7^(AM^0.678) (Meinel and Meinel 1976) with the air mass of
 /// Kasten and Young (1989); in [0.05, 1].
 double sun_intensity_for(double elevation_deg);
+/// The share of the sun's beam that reaches the ground through a clear sky,
+/// 0.7^(AM^0.678) (Meinel and Meinel 1976; Kasten and Young's air mass); 0
+/// for a sun at or below the horizon.
+double clear_sky_beam_share(double elevation_deg);
 /// The sky's light (light.ambient) likewise: the default 0.35 at 45
 /// degrees, 0.45 + 0.55 sin(elevation) / sin(45) of it; in [0.1, 0.6].
 double sky_ambient_for(double elevation_deg);

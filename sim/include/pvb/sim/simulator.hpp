@@ -61,6 +61,8 @@ class Simulator {
   /// The sun's projection in the image (may lie outside it) when it is in
   /// front of the camera.
   std::optional<cv::Point2d> sun_pixel() const;
+  /// The unit direction towards the sun in the world (scenario light).
+  Eigen::Vector3d to_sun_w() const;
 
   /// Steer from this pose instead of ground truth (closed loop), or from
   /// ground truth again with nullopt.
@@ -127,6 +129,10 @@ struct RenderedFrame {
   cv::Mat rgb;                        ///< noise-free colour, R, G, B order
   cv::Mat depth_gt_m;                 ///< rendered depth, exact, sky = 0
   std::optional<cv::Point2d> sun_px;  ///< the sun's projection (Simulator::sun_pixel)
+  /// With the Kinect model's sunlight: 1 where the sun reaches the point a
+  /// pixel sees (sun_visibility), and the sun's direction in the camera.
+  cv::Mat sun_lit;
+  Eigen::Vector3d to_sun_c = Eigen::Vector3d::UnitZ();
   std::uint64_t index = 0;            ///< frame index
   std::int64_t t_ns = 0;
   geom::SE3d T_w_c;                   ///< ground-truth camera pose
@@ -149,6 +155,7 @@ class SensorModel {
  private:
   scenes::Camera camera_;
   geom::PinholeIntrinsics K_;
+  double sun_elevation_deg_;
   std::uint64_t seed_;
   std::optional<scenes::CoverFrames> cover_;
 };

@@ -1,0 +1,76 @@
+#include <gtest/gtest.h>
+
+#include <array>
+#include <memory>
+#include <string>
+
+#include "pvb/sim/sun_shadow.hpp"
+
+using namespace pvb;
+
+namespace {
+
+// A ground plane, a 2 x 2 m roof 1 m up and a ball hidden from drawing
+// (group 3), from MuJoCo's own parser.
+struct Scene {
+  std::unique_ptr<mjModel, void (*)(mjModel*)> m{nullptr, mj_deleteModel};
+  std::unique_ptr<mjData, void (*)(mjData*)> d{nullptr, mj_deleteData};
+};
+
+Scene roof_scene() {
+  static const std::string xml = R"(<mujoco><worldbody>
+    <geom type="plane" size="10 10 1"/>
+    <geom type="box" pos="0 0 1" size="1 1 0.02"/>
+    <geom type="sphere" pos="4 0 1" size="0.5" group="3"/>
+  </worldbody></mujoco>)";
+  std::array<char, 1000> error{};
+  auto* vfs = new mjVFS;
+  mj_defaultVFS(vfs);
+  mj_makeEmptyFileVFS(vfs, "roof.xml", static_cast<int>(xml.size()));
+  std::copy(xml.begin(), xml.end(), static_cast<char*>(vfs->filedata[0]));
+  Scene s;
+  s.m.reset(mj_loadXML("roof.xml", vfs, error.data(), static_cast<int>(error.size())));
+  mj_deleteVFS(vfs);
+  delete vfs;
+  EXPECT_TRUE(s.m) << error.data();
+  s.d.reset(mj_makeData(s.m.get()));
+  mj_forward(s.m.get(), s.d.get());
+  return s;
+}
+
+}  // namespace
+
+TEST(SunShadow, ARoofShadesTheGroundUnderItAlongTheSunsDirection) {
+  const Scene s = roof_scene();
+  ASSERT_TRUE(s.m);
+  const sim::SunShadowCaster overhead(s.m.get(), s.d.get(), Eigen::Vector3d(0, 0, 1));
+  EXPECT_TRUE(overhead.shadowed({0.5, 0.5, 0}));
+  EXPECT_FALSE(overhead.shadowed({1.5, 0, 0}));
+  EXPECT_FALSE(overhead.shadowed({0, 0, 1.1}));  // on the roof
+  EXPECT_FALSE(overhead.shadowed({4, 0, 0}));    // under the undrawn ball
+  // A sun 45 degrees up in +x: the shadow moves 1 m towards -x.
+  const sim::SunShadowCaster low(s.m.get(), s.d.get(), Eigen::Vector3d(1, 0, 1));
+  EXPECT_TRUE(low.shadowed({-1.5, 0, 0}));
+  EXPECT_FALSE(low.shadowed({0.5, 0, 0}));
+}
+
+TEST(SunShadow, VisibilityOnBlocksEqualsEveryPixelTested) {
+  const Scene s = roof_scene();
+  ASSERT_TRUE(s.m);
+  const sim::SunShadowCaster caster(s.m.get(), s.d.get(), Eigen::Vector3d(0.3, 0.2, 1));
+  // A camera 3 m above the ground looking straight down.
+  const geom::PinholeIntrinsics K{200, 200, 79.5, 59.5, 160, 120};
+  const geom::SE3d T_w_c =
+      geom::make_se3(geom::so3_exp(Eigen::Vector3d(M_PI, 0, 0)), Eigen::Vector3d(0.5, 0, 3));
+  cv::Mat depth(120, 160, CV_32FC1, cv::Scalar(3.0f));
+  depth(cv::Rect(0, 0, 20, 10)).setTo(0.0f);  // a hole: no depth, not lit
+  const cv::Mat blocks = sim::sun_visibility(caster, depth, K, T_w_c);
+  const cv::Mat every = sim::sun_visibility(caster, depth, K, T_w_c, 1);
+  EXPECT_EQ(cv::countNonZero(blocks != every), 0);
+  EXPECT_EQ(cv::countNonZero(blocks(cv::Rect(0, 0, 20, 10))), 0);
+  const int lit = cv::countNonZero(every);
+  EXPECT_GT(lit, 1000);                    // the open ground
+  EXPECT_LT(lit, 160 * 120 - 200 - 1000);  // and the roof's shadow
+  // Points deeper than asked for are not lit.
+  EXPECT_EQ(cv::countNonZero(sim::sun_visibility(caster, depth, K, T_w_c, 16, 2.5f)), 0);
+}
