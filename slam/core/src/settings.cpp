@@ -172,6 +172,8 @@ void read_imu(Reader& r, const cv::FileStorage& fs, ImuSettings* imu) {
   imu->T_b_c = r.pose("IMU.T_b_c1", req, imu->T_b_c);
   imu->accel_noise_inflation =
       r.real("IMU.AccNoiseInflation", false, imu->accel_noise_inflation, closed(1, 100), "a factor from 1 to 100");
+  imu->accel_walk_inflation =
+      r.real("IMU.AccWalkInflation", false, imu->accel_walk_inflation, closed(1, 1000), "a factor from 1 to 1000");
 }
 
 /// Robot.* (ours): the wheel drive and the camera's and IMU's poses on the base.

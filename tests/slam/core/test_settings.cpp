@@ -511,9 +511,13 @@ TEST(Settings, ReadsImuAndRobotKeysAndTheSensorSetup) {
   EXPECT_DOUBLE_EQ(s.imu.noise.accel_noise_density, 0.002);
   EXPECT_DOUBLE_EQ(s.imu.fused_noise().accel_noise_density, 0.006);
   EXPECT_DOUBLE_EQ(s.imu.fused_noise().gyro_noise_density, 0.00017);
-  const Settings one =
-      read_settings(temp_copy("imu1", read_file(tum1()) + kImuKeys + "IMU.AccNoiseInflation: 1.0\n"));
+  // Its bias walks 100x as fast unless set.
+  EXPECT_DOUBLE_EQ(s.imu.fused_noise().accel_random_walk, 0.04);
+  EXPECT_DOUBLE_EQ(s.imu.fused_noise().gyro_random_walk, s.imu.noise.gyro_random_walk);
+  const Settings one = read_settings(temp_copy(
+      "imu1", read_file(tum1()) + kImuKeys + "IMU.AccNoiseInflation: 1.0\nIMU.AccWalkInflation: 1\n"));
   EXPECT_DOUBLE_EQ(one.imu.fused_noise().accel_noise_density, 0.002);
+  EXPECT_DOUBLE_EQ(one.imu.fused_noise().accel_random_walk, 0.0004);
   // The camera's optical z looks along the IMU's x; its centre 5 cm ahead, 10 cm up.
   EXPECT_NEAR((s.imu.T_b_c.linear() * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitX()).norm(), 0, 1e-6);
   EXPECT_NEAR((s.imu.T_b_c.translation() - Eigen::Vector3d(0.05, 0, 0.1)).norm(), 0, 1e-6);
@@ -547,6 +551,8 @@ TEST(Settings, SensorSetupWithoutItsKeysOrWithABadExtrinsicIsOneConfigError) {
   partial.replace(partial.find("IMU.AccWalk"), 3, "XMU");
   EXPECT_NE(error_of("s5", base + partial).find("IMU.AccWalk"), std::string::npos);
   EXPECT_NE(error_of("s6", base + kImuKeys + "IMU.AccNoiseInflation: 0.5\n").find("IMU.AccNoiseInflation"),
+            std::string::npos);
+  EXPECT_NE(error_of("s7", base + kImuKeys + "IMU.AccWalkInflation: 2000\n").find("IMU.AccWalkInflation"),
             std::string::npos);
   // With a setup that needs them, a flag's choice is checked the same way.
   const Settings plain = read_settings(tum1());

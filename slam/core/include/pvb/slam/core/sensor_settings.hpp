@@ -38,11 +38,18 @@ struct ImuSettings {
   /// sensor at rest; on a robot driving rough ground the readings carry
   /// more (docs/slam_inertial.md, "Accelerometer noise on a moving robot").
   double accel_noise_inflation = 3.0;
+  /// IMU.AccWalkInflation (ours, optional): the factor on IMU.AccWalk in
+  /// the bias walk between keyframes. The initialisation cannot tell the
+  /// accelerometer's bias from a tilt on a drive at constant speed; at the
+  /// datasheet's walk the bias it leaves cannot move when a turn shows it
+  /// (docs/slam_inertial.md, "Accelerometer noise on a moving robot").
+  double accel_walk_inflation = 100.0;
   /// The noise the core's preintegration uses: `noise` with the
-  /// accelerometer's density times accel_noise_inflation.
+  /// accelerometer's density and random walk times their inflations.
   ImuNoise fused_noise() const {
     ImuNoise n = noise;
     n.accel_noise_density *= accel_noise_inflation;
+    n.accel_random_walk *= accel_walk_inflation;
     return n;
   }
 };
