@@ -125,8 +125,7 @@ void LocalMapping::add_motion_terms(BaProblem* problem, std::vector<std::shared_
   const auto link = [&](std::size_t i, std::size_t j) {
     const KeyFrameMotion& a = (*kfs)[i]->motion();
     const KeyFrameMotion& b = (*kfs)[j]->motion();
-    if (imu && b.from_prev.imu && b.from_prev.imu_settled && a.has_state && b.has_state)
-      in->imu_edges.push_back({i, j, b.from_prev.imu});
+    if (imu && b.from_prev.imu && a.has_state && b.has_state) in->imu_edges.push_back({i, j, b.from_prev.imu});
     if (wheels && b.from_prev.wheels) in->wheel_edges.push_back({i, j, b.from_prev.wheels});
   };
   const std::size_t window = kfs->size();

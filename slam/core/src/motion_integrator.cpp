@@ -45,12 +45,6 @@ void MotionIntegrator::add_imu(const sensor::ImuSample& s) {
   // counted with the frame.  A gap (a dropped stretch) is integrated as at
   // most ten periods: the rest is not known.
   const std::int64_t start_ns = covered_t_ns_ ? *covered_t_ns_ : s.t_ns - period_ns_;
-  if (taken_tail_held_) {  // the reading after the last keyframe interval's held end
-    settling_ = Settling{};
-    if (s.t_ns - period_ns_ < start_ns) settling_->reading = s;  // its period covers that end
-    taken_tail_held_ = false;
-  }
-  kf_tail_held_ = false;
   covered_t_ns_ = s.t_ns;
   last_reading_ = s;
   const double dt_s = static_cast<double>(std::min(s.t_ns - start_ns, 10 * period_ns_)) * 1e-9;
@@ -68,7 +62,6 @@ void MotionIntegrator::integrate_up_to(std::int64_t t_ns) {
   imu_frame_.integrate(last_reading_->gyro_radps, last_reading_->accel_mps2, dt_s);
   imu_kf_.integrate(last_reading_->gyro_radps, last_reading_->accel_mps2, dt_s);
   covered_t_ns_ = t_ns;
-  kf_tail_held_ = true;
 }
 
 void MotionIntegrator::add_ticks(const sensor::WheelTicks& t) {
@@ -102,20 +95,11 @@ void MotionIntegrator::wheels_up_to(std::int64_t t_ns) {
 KeyframeInterval MotionIntegrator::take_keyframe_interval() {
   KeyframeInterval out;
   if (uses_imu(setup_) && imu_kf_.size() > 0) out.imu = std::make_shared<ImuPreintegration>(imu_kf_);
-  out.imu_settled = !(out.imu && kf_tail_held_);
-  taken_tail_held_ = !out.imu_settled;
-  settling_.reset();
   if (uses_wheels(setup_) && has_wheels()) out.wheels = std::make_shared<WheelPreintegration>(wheel_kf_);
   out.f_c_mps2 = recent_specific_force_c();
   out.f_spread_mps2 = recent_spread_mps2();
   imu_kf_ = ImuPreintegration(bias_, imu_noise_);
   wheel_kf_ = WheelPreintegration(robot_.drive, wheel_noise_);
-  return out;
-}
-
-std::optional<MotionIntegrator::Settling> MotionIntegrator::take_settling() {
-  std::optional<Settling> out = std::move(settling_);
-  settling_.reset();
   return out;
 }
 

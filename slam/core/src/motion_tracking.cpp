@@ -27,18 +27,6 @@ void Tracking::add_motion(std::int64_t t_ns, const std::vector<sensor::ImuSample
       (g.bias.gyro_radps != motion_->bias().gyro_radps || g.bias.accel_mps2 != motion_->bias().accel_mps2))
     motion_->set_bias(g.bias);
   motion_->add_frame(t_ns, imu, ticks);
-  // The newest keyframe's interval, its held end settled by this frame's
-  // first reading.
-  const std::optional<MotionIntegrator::Settling> settling = motion_->take_settling();
-  if (!settling || !last_kf_ || last_kf_->bad()) return;
-  KeyframeInterval& in = last_kf_->motion().from_prev;
-  if (!in.imu || in.imu_settled) return;
-  if (settling->reading) {
-    auto settled = std::make_shared<ImuPreintegration>(*in.imu);
-    settled->replace_last_reading(settling->reading->gyro_radps, settling->reading->accel_mps2);
-    in.imu = std::move(settled);
-  }
-  in.imu_settled = true;
 }
 
 bool Tracking::inertial_ready() const {

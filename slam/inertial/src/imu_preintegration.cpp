@@ -113,13 +113,6 @@ void ImuPreintegration::reintegrate(const ImuBias& bias) {
   for (const Reading& r : all) integrate(r.gyro_radps, r.accel_mps2, r.dt_s);
 }
 
-void ImuPreintegration::replace_last_reading(const Eigen::Vector3d& gyro_radps, const Eigen::Vector3d& accel_mps2) {
-  if (readings_.empty()) return;
-  readings_.back().gyro_radps = gyro_radps;
-  readings_.back().accel_mps2 = accel_mps2;
-  reintegrate(bias_);
-}
-
 Eigen::Matrix3d ImuPreintegration::delta_R(const ImuBias& b) const {
   return orthonormalised(dR_ * geom::so3_exp(J_R_bg_ * (b.gyro_radps - bias_.gyro_radps)));
 }

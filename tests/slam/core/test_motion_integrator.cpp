@@ -153,46 +153,6 @@ TEST(MotionIntegrator, KeyframeIntervalsSplitTheReadingsAndGiveTheTilt) {
   EXPECT_EQ(m.imu_since_keyframe().size(), 0u);
 }
 
-// A keyframe's interval ends by holding the newest reading up to the
-// frame; the reading that covers that stretch, once it comes, settles the
-// interval as if it had been there.
-TEST(MotionIntegrator, AKeyframeIntervalsHeldEndIsSettledByTheNextReading) {
-  const Settings s = robot_settings(SensorSetup::kCameraImu);
-  MotionIntegrator m(s.sensors, s.imu, s.robot);
-  // Jolts: the forward specific force swings by 40 m/s^2 from one reading to the next.
-  const auto jolting = [](std::int64_t t0, std::int64_t t1) {
-    std::vector<sensor::ImuSample> r = level_readings(t0, t1, 0.5);
-    for (auto& x : r) x.accel_mps2.x() = (x.t_ns / kImuPeriodNs) % 2 ? 20.0 : -20.0;
-    return r;
-  };
-  m.add_frame(0, jolting(-kImuPeriodNs, 0), {});
-  EXPECT_TRUE(m.take_keyframe_interval().imu_settled);  // frame 0 is on a reading: nothing held
-  m.add_frame(kFramePeriodNs, jolting(0, kFramePeriodNs), {});
-  EXPECT_FALSE(m.take_settling());
-  const KeyframeInterval k = m.take_keyframe_interval();
-  ASSERT_TRUE(k.imu);
-  EXPECT_FALSE(k.imu_settled);
-  EXPECT_FALSE(m.take_settling());  // its reading has not come
-  m.add_frame(2 * kFramePeriodNs, jolting(kFramePeriodNs, 2 * kFramePeriodNs), {});
-  const auto settling = m.take_settling();
-  ASSERT_TRUE(settling);
-  ASSERT_TRUE(settling->reading);
-  EXPECT_EQ(settling->reading->t_ns, 7 * kImuPeriodNs);  // 35 ms covers 30-35 ms
-  EXPECT_FALSE(m.take_settling());                     // once
-  ImuPreintegration settled = *k.imu;
-  settled.replace_last_reading(settling->reading->gyro_radps, settling->reading->accel_mps2);
-  // The interval from 0 to 33.3 ms with each stretch under its own reading.
-  ImuPreintegration exact(ImuBias{}, s.imu.fused_noise());
-  const std::vector<sensor::ImuSample> r = jolting(0, 7 * kImuPeriodNs);
-  for (int i = 0; i < 6; ++i) exact.integrate(r[i].gyro_radps, r[i].accel_mps2, kImuPeriodNs * 1e-9);
-  exact.integrate(r[6].gyro_radps, r[6].accel_mps2, (kFramePeriodNs - 6 * kImuPeriodNs) * 1e-9);
-  EXPECT_NEAR((settled.delta_v(ImuBias{}) - exact.delta_v(ImuBias{})).norm(), 0, 1e-12);
-  EXPECT_NEAR((settled.delta_p(ImuBias{}) - exact.delta_p(ImuBias{})).norm(), 0, 1e-12);
-  EXPECT_NEAR(settled.dt_s(), k.imu->dt_s(), 1e-15);
-  // Held, the last 3.3 ms took the reading before: 40 m/s^2 x 3.3 ms off.
-  EXPECT_NEAR((k.imu->delta_v(ImuBias{}) - exact.delta_v(ImuBias{})).norm(), 40.0 * 3.333333e-3, 1e-6);
-}
-
 TEST(MotionIntegrator, AccelerometerOnlyReadingsGiveTiltButNoIntervals) {
   const Settings s = robot_settings(SensorSetup::kCameraAccel);
   MotionIntegrator m(s.sensors, s.imu, s.robot);

@@ -17,10 +17,6 @@ class KeyFrame;
 struct KeyframeInterval {
   std::shared_ptr<const ImuPreintegration> imu;       ///< null without gyro readings
   std::shared_ptr<const WheelPreintegration> wheels;  ///< null without encoders
-  /// false while `imu` ends with the newest reading held up to the
-  /// keyframe's time and the reading that covers that stretch has not come
-  /// (until the next frame): local BA leaves such an interval out.
-  bool imu_settled = true;
   /// The accelerometer's mean specific force over a short window before
   /// the keyframe, in the camera frame, and the spread of the readings
   /// about it (RMS, m/s^2); unset without readings.

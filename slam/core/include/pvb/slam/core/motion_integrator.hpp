@@ -41,17 +41,6 @@ class MotionIntegrator {
   /// Ends the keyframe interval at the current frame and begins the next.
   KeyframeInterval take_keyframe_interval();
 
-  /// When the last keyframe interval taken ended by holding the newest
-  /// reading up to the frame: once the next reading has come (the next
-  /// frame's add_frame), the reading that covers that held stretch, or
-  /// nullopt when none came for it; given once.  (A robot's jolts make one
-  /// reading differ from the one before by tens of m/s^2: held for a few
-  /// ms, the wrong one puts centimetres per second into the interval.)
-  struct Settling {
-    std::optional<sensor::ImuSample> reading;
-  };
-  std::optional<Settling> take_settling();
-
   /// The bias the intervals are integrated at; a new one re-integrates
   /// the open intervals.
   const ImuBias& bias() const { return bias_; }
@@ -105,9 +94,6 @@ class MotionIntegrator {
   std::optional<std::int64_t> last_imu_t_ns_;  ///< the newest reading's time
   std::optional<std::int64_t> covered_t_ns_;   ///< integrated up to here
   std::optional<sensor::ImuSample> last_reading_;
-  bool kf_tail_held_ = false;      ///< imu_kf_ ends with a held reading
-  bool taken_tail_held_ = false;   ///< so did the last interval taken, still unsettled
-  std::optional<Settling> settling_;
   std::optional<sensor::WheelTicks> last_ticks_;
   /// Counts per nanosecond of the last encoder interval, and the counts
   /// already credited past last_ticks_ (up to a frame between readings).

@@ -60,11 +60,6 @@ class ImuPreintegration {
   void append(const ImuPreintegration& next);
   /// Integrates every reading again at a new linearisation bias.
   void reintegrate(const ImuBias& bias);
-  /// Gives the last reading new values, keeping its period, and integrates
-  /// again: an interval's end that held a reading up to a frame, once the
-  /// reading whose period covers that stretch has come.  Nothing without
-  /// readings.
-  void replace_last_reading(const Eigen::Vector3d& gyro_radps, const Eigen::Vector3d& accel_mps2);
 
   double dt_s() const { return dt_s_; }
   std::size_t size() const { return readings_.size(); }
