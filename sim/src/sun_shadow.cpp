@@ -23,17 +23,18 @@ SunShadowCaster::SunShadowCaster(const mjModel* m, const mjData* d, const Eigen:
                b1 = std::lround(std::floor((b + r) / cell_m_));
     for (long i = a0; i <= a1; ++i)
       for (long j = b0; j <= b1; ++j)
-        cells_[(static_cast<std::int64_t>(i) << 32) ^ (j & 0xffffffff)].push_back(g);
+        cells_[cell_key(i, j)].push_back(g);
   }
 }
 
-std::int64_t SunShadowCaster::cell_key(double a, double b) const {
-  const long i = std::lround(std::floor(a / cell_m_)), j = std::lround(std::floor(b / cell_m_));
-  return (static_cast<std::int64_t>(i) << 32) ^ (j & 0xffffffff);
+std::uint64_t SunShadowCaster::cell_key(long i, long j) {
+  // Two's complement halves, without shifting a negative value.
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(i)) << 32) | static_cast<std::uint32_t>(j);
 }
 
 bool SunShadowCaster::shadowed(const Eigen::Vector3d& p_w, double start_m) const {
-  const auto it = cells_.find(cell_key(e1_.dot(p_w), e2_.dot(p_w)));
+  const auto it = cells_.find(
+      cell_key(std::lround(std::floor(e1_.dot(p_w) / cell_m_)), std::lround(std::floor(e2_.dot(p_w) / cell_m_))));
   if (it == cells_.end()) return false;
   const Eigen::Vector3d start = p_w + start_m * s_;
   for (const int g : it->second) {

@@ -30,12 +30,13 @@ class SunShadowCaster {
   bool shadowed(const Eigen::Vector3d& p_w, double start_m = 0.02) const;
 
  private:
-  std::int64_t cell_key(double a, double b) const;
+  /// The key of grid cell (i, j), counted in cells across the sun's direction.
+  static std::uint64_t cell_key(long i, long j);
   const mjModel* m_;
   const mjData* d_;
   Eigen::Vector3d s_, e1_, e2_;  ///< towards the sun, and two axes across it
   double cell_m_ = 0.5;
-  std::unordered_map<std::int64_t, std::vector<int>> cells_;  ///< geom ids per cell
+  std::unordered_map<std::uint64_t, std::vector<int>> cells_;  ///< geom ids per cell
 };
 
 /// The sun's reach per pixel of `depth_m` (CV_32FC1, metres along the
