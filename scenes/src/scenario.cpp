@@ -54,6 +54,8 @@ Scenario read_scenario(const detail::ScenarioDocument& doc) {
 
 double Camera::fovy_deg() const { return 2.0 * std::atan(0.5 * height / fy) * 180.0 / M_PI; }
 
+double ActiveStereo::ir_fovy_deg() const { return 2.0 * std::atan(0.5 * ir_height / ir_fx) * 180.0 / M_PI; }
+
 double PvArray::panel_width_m() const {
   // Typical module sizes: 60 cells 1.65 x 0.99 m, 72 cells 1.96 x 0.99 m,
   // 144 half-cut cells 2.27 x 1.13 m (long side x short side).

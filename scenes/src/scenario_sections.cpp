@@ -234,7 +234,34 @@ void read_robot(MapReader& r, Robot& rb) {
   rb.track_error = r.number("track_error", rb.track_error, 0, 0.2);
 }
 
+/// The camera.stereo: section (the d435 model).
+void read_stereo(MapReader& n, ActiveStereo& a) {
+  a.ir_width = n.integer("ir_width", a.ir_width, 32, 4096);
+  a.ir_height = n.integer("ir_height", a.ir_height, 32, 4096);
+  a.ir_fx = n.number("ir_fx", a.ir_fx, 10, 1e5);
+  a.baseline_m = n.number("baseline_m", a.baseline_m, 0.005, 1);
+  a.colour_offset_m = n.number("colour_offset_m", a.colour_offset_m, -0.5, 0.5);
+  a.projector_offset_m = n.number("projector_offset_m", a.projector_offset_m, -0.5, 0.5);
+  a.projector_power_w = n.number("projector_power_w", a.projector_power_w, 0, 100);
+  a.dots = n.integer("dots", a.dots, 0, 1000000);
+  a.pattern_seed = static_cast<std::uint64_t>(n.integer("pattern_seed", static_cast<int>(a.pattern_seed), 0, 1 << 30));
+  a.band_sun_w_m2 = n.number("band_sun_w_m2", a.band_sun_w_m2, 0, 1500);
+  a.disparities = n.integer("disparities", a.disparities, 16, 512);
+  if (a.disparities % 16 != 0) n.fail(n.full("disparities"), n.node()["disparities"], "a multiple of 16 (OpenCV's matcher)");
+  a.block_px = n.integer("block_px", a.block_px, 3, 21);
+  if (a.block_px % 2 == 0) n.fail(n.full("block_px"), n.node()["block_px"], "an odd number of pixels");
+  a.uniqueness_pct = n.integer("uniqueness_pct", a.uniqueness_pct, 0, 100);
+  a.ir_noise_sigma = n.number("ir_noise_sigma", a.ir_noise_sigma, 0, 50);
+}
+
 void read_camera(MapReader& r, Camera& c) {
+  c.model = r.choice<CameraModel>("model", c.model, {{"kinect", CameraModel::kKinect}, {"d435", CameraModel::kD435}});
+  if (c.model == CameraModel::kD435) {  // the D435's colour camera at 640 x 480 and its depth range
+    c.width = 640;
+    c.height = 480;
+    c.fx = c.fy = 615.0;
+    c.depth_range_m = {0.2, 6.0};
+  }
   c.width = r.integer("width", c.width, 32, 4096);
   c.height = r.integer("height", c.height, 32, 4096);
   const bool has_fx = r.has("fx");
@@ -261,6 +288,9 @@ void read_camera(MapReader& r, Camera& c) {
     d.sunlight.filter_width_nm = n.number("sunlight_filter_nm", d.sunlight.filter_width_nm, 1, 100);
     d.sunlight.min_contrast = n.number("sunlight_min_contrast", d.sunlight.min_contrast, 1e-5, 1);
   });
+  with_map(r, "stereo", [&](MapReader& n) { read_stereo(n, c.stereo); });
+  if (c.model != CameraModel::kD435 && r.has("stereo"))
+    r.fail(r.full("stereo"), r.node()["stereo"], "no stereo: section unless model is d435");
   with_map(r, "rgb", [&](MapReader& n) {
     RgbNoise& g = c.rgb;
     g.sigma = n.number("sigma", g.sigma, 0, 100);

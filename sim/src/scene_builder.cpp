@@ -342,8 +342,11 @@ void write_settings(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& 
   x.line("<option timestep=\"" + std::string(step) + "\" integrator=\"implicit\" cone=\"elliptic\"/>");
   x.line("<statistic extent=\"" + f(extent) + "\" center=\"0 0 0\"/>");
   x.open("<visual>");
-  x.line("<global offwidth=\"" + std::to_string(s.camera.width) + "\" offheight=\"" +
-         std::to_string(s.camera.height) + "\" fovy=\"" + f(s.camera.fovy_deg()) + "\"/>");
+  const bool stereo = s.camera.model == scenes::CameraModel::kD435;  // the infrared views may be larger
+  const int off_w = stereo ? std::max(s.camera.width, s.camera.stereo.ir_width) : s.camera.width;
+  const int off_h = stereo ? std::max(s.camera.height, s.camera.stereo.ir_height) : s.camera.height;
+  x.line("<global offwidth=\"" + std::to_string(off_w) + "\" offheight=\"" + std::to_string(off_h) + "\" fovy=\"" +
+         f(s.camera.fovy_deg()) + "\"/>");
   // numquads: box faces drawn as numquads x numquads quads (MuJoCo: 4).
   // The subdivision only serves per-vertex lighting; with a directional sun
   // 1 changes the colour image by 0.004 of 255 on average and saves a
@@ -612,6 +615,13 @@ void add_robot_and_sun(XmlWriter& x, const scenes::Scenario& s, const std::vecto
   const Eigen::Vector3d up = right.cross(fwd);
   x.line("<camera name=\"" + std::string(kCameraName) + "\" pos=\"" + v3(cam.mount_forward_m, 0, mast_h) +
          "\" xyaxes=\"" + v3(right) + " " + v3(up) + "\" fovy=\"" + f(cam.fovy_deg()) + "\"/>");
+  if (cam.model == scenes::CameraModel::kD435) {  // the two infrared imagers, beside the colour camera
+    const Eigen::Vector3d left = Eigen::Vector3d(cam.mount_forward_m, 0, mast_h) - cam.stereo.colour_offset_m * right;
+    const std::string axes = "\" xyaxes=\"" + v3(right) + " " + v3(up) + "\" fovy=\"" + f(cam.stereo.ir_fovy_deg()) + "\"/>";
+    x.line("<camera name=\"" + std::string(kIrLeftCameraName) + "\" pos=\"" + v3(left) + axes);
+    x.line("<camera name=\"" + std::string(kIrRightCameraName) + "\" pos=\"" +
+           v3(left + cam.stereo.baseline_m * right) + axes);
+  }
   if (shadow.follows_robot) x.line(sun_line(s.light, "track", to_sun(s.light) * 20.0));
   x.close("</body>");
   if (!shadow.follows_robot)

@@ -8,14 +8,11 @@
 #include <opencv2/core/utility.hpp>
 
 #include "pvb/sensor/depth_encoding.hpp"
+#include "normal_table.hpp"
 #include "splitmix.hpp"
 
 namespace pvb::sim {
-namespace {
 
-
-// Standard normal quantiles at 4096 evenly spaced probabilities: a table
-// lookup per draw keeps per-pixel noise cheap.
 const std::array<float, 4096>& normal_table() {
   static const std::array<float, 4096> table = [] {
     std::array<float, 4096> t{};
@@ -34,6 +31,8 @@ const std::array<float, 4096>& normal_table() {
   }();
   return table;
 }
+
+namespace {
 
 /// Whether the projected pattern stands out against the sun and sky at a
 /// surface point at depth z, with normal n (unnormalised, either side)

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <opencv2/imgproc.hpp>
 
 #include "pvb/common/error.hpp"
 #include "pvb/geometry/time.hpp"
@@ -216,6 +217,38 @@ std::optional<cv::Point2d> Simulator::sun_pixel() const {
 RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
     : renderer_(sim.model(), backend, sim.scenario().camera.width, sim.scenario().camera.height), sensor_(sim) {
   renderer_.set_shadows(sim.scenario().light.shadows);
+  const scenes::Camera& cam = sim.scenario().camera;
+  if (cam.model != scenes::CameraModel::kD435) return;
+  ir_renderer_ = std::make_unique<Renderer>(sim.model(), renderer_.backend(), cam.stereo.ir_width, cam.stereo.ir_height);
+  ir_renderer_->set_shadows(sim.scenario().light.shadows);
+  ir_left_id_ = mj_name2id(sim.model(), mjOBJ_CAMERA, kIrLeftCameraName);
+  ir_right_id_ = mj_name2id(sim.model(), mjOBJ_CAMERA, kIrRightCameraName);
+  if (ir_left_id_ < 0 || ir_right_id_ < 0)
+    throw ConfigError("model", "camera", "the infrared cameras of the d435 model", "none");
+}
+
+StereoRender RgbdCamera::render_infrared(Simulator& sim) {
+  const scenes::Scenario& s = sim.scenario();
+  const scenes::ActiveStereo& p = s.camera.stereo;
+  StereoRender out;
+  const geom::SE3d T_w_c = sim.T_w_c();
+  out.to_sun_c = (T_w_c.linear().transpose() * sim.to_sun_w()).cast<float>();
+  const float sky = static_cast<float>(sim.assets().max_scene_depth_m);
+  std::optional<SunShadowCaster> caster;
+  if (s.light.sun_elevation_deg > 0) caster.emplace(sim.model(), sim.data(), sim.to_sun_w());
+  const geom::PinholeIntrinsics K_ir = sensor_.stereo_model()->ir_intrinsics();
+  const float pattern_range_m = sensor_.stereo_model()->pattern_range_m();
+  for (int k = 0; k < 2; ++k) {
+    InfraredView& v = k == 0 ? out.left : out.right;
+    cv::Mat rgb;
+    ir_renderer_->render(sim.model(), sim.data(), k == 0 ? ir_left_id_ : ir_right_id_, &rgb, &v.depth_m);
+    v.depth_m.setTo(0.0f, v.depth_m > sky);
+    cv::cvtColor(rgb, v.grey, cv::COLOR_RGB2GRAY);
+    const double x_m = -p.colour_offset_m + (k == 0 ? 0.0 : p.baseline_m);  // along the colour camera's x
+    const geom::SE3d T_w_ir = T_w_c * geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(x_m, 0, 0));
+    if (caster) v.lit = sun_visibility(*caster, v.depth_m, K_ir, T_w_ir, 16, pattern_range_m);
+  }
+  return out;
 }
 
 RenderedFrame RgbdCamera::render(Simulator& sim) {
@@ -237,6 +270,7 @@ RenderedFrame RgbdCamera::render(Simulator& sim) {
     const SunShadowCaster caster(sim.model(), sim.data(), sim.to_sun_w());
     out.sun_lit = sun_visibility(caster, out.depth_gt_m, sim.intrinsics(), sim.T_w_c(), 16, shade_range_m);
   }
+  if (ir_renderer_) out.stereo = render_infrared(sim);
   out.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   out.index = static_cast<std::uint64_t>(sim.frame_index());
   out.t_ns = sim.t_ns();
@@ -252,7 +286,10 @@ SensorModel::SensorModel(const Simulator& sim)
       K_(sim.intrinsics()),
       sun_elevation_deg_(sim.scenario().light.sun_elevation_deg),
       seed_(sim.scenario().seed),
-      cover_(scenes::camera_cover_frames(sim.scenario())) {}
+      cover_(scenes::camera_cover_frames(sim.scenario())) {
+  if (camera_.model == scenes::CameraModel::kD435)
+    stereo_ = std::make_shared<ActiveStereoModel>(camera_, sun_elevation_deg_, seed_);
+}
 
 Capture SensorModel::apply(RenderedFrame rendered) const {
   using Clock = std::chrono::steady_clock;
@@ -263,6 +300,8 @@ Capture SensorModel::apply(RenderedFrame rendered) const {
   if (covered) {  // no light reaches the colour sensor, no infrared pattern comes back
     rendered.rgb.setTo(cv::Scalar::all(0));
     out.frame.depth_m = cv::Mat::zeros(out.depth_gt_m.size(), CV_32FC1);
+  } else if (stereo_ && rendered.stereo) {
+    out.frame.depth_m = stereo_->depth(*rendered.stereo, rendered.index, &out.stereo);
   } else {
     std::optional<SunlightFrame> sun;
     if (!rendered.sun_lit.empty())

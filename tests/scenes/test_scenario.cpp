@@ -451,6 +451,30 @@ TEST(Scenario, SunlightOnTheDepthPatternIsOffUnlessAsked) {
   EXPECT_NE(e.find("bad.yaml:3: camera.depth_noise.sunlight:"), std::string::npos) << e;
 }
 
+TEST(Scenario, TheD435ModelBringsItsColourCameraAndStereoKeys) {
+  const Scenario kinect = parse_scenario(kMinimal, "min.yaml");
+  EXPECT_EQ(kinect.camera.model, CameraModel::kKinect);
+  EXPECT_DOUBLE_EQ(kinect.camera.depth_baseline_m(), 0.075);
+  const Scenario d = parse_scenario(std::string(kMinimal) +
+                                        "camera:\n  model: d435\n  stereo: {disparities: 96, block_px: 5, "
+                                        "projector_power_w: 0}\n",
+                                    "d435.yaml");
+  EXPECT_EQ(d.camera.model, CameraModel::kD435);
+  EXPECT_DOUBLE_EQ(d.camera.fx, 615.0) << "the D435's colour camera unless given";
+  EXPECT_DOUBLE_EQ(d.camera.depth_baseline_m(), 0.050);
+  EXPECT_EQ(d.camera.stereo.disparities, 96);
+  EXPECT_EQ(d.camera.stereo.block_px, 5);
+  EXPECT_DOUBLE_EQ(d.camera.stereo.projector_power_w, 0.0);
+  const Scenario given = parse_scenario(std::string(kMinimal) + "camera:\n  model: d435\n  fy: 500\n", "d.yaml");
+  EXPECT_DOUBLE_EQ(given.camera.fx, 500.0);
+  std::string e = error_of(std::string(kMinimal) + "camera:\n  model: d435\n  stereo: {disparities: 100}\n");
+  EXPECT_NE(e.find("bad.yaml:4: camera.stereo.disparities: expected a multiple of 16"), std::string::npos) << e;
+  e = error_of(std::string(kMinimal) + "camera:\n  stereo: {block_px: 5}\n");
+  EXPECT_NE(e.find("camera.stereo: expected no stereo: section unless model is d435"), std::string::npos) << e;
+  e = error_of(std::string(kMinimal) + "camera:\n  model: zed\n");
+  EXPECT_NE(e.find("bad.yaml:3: camera.model:"), std::string::npos) << e;
+}
+
 TEST(Scenario, KidnapTimesAreJudgedByTheKeyThatIsWrong) {
   const std::string base = std::string(kMinimal) + "duration_s: 20\nkidnap:\n";
   // A cover shorter than one frame period is refused even where it happens

@@ -20,6 +20,9 @@ enum class GroundTiling { kRepeat, kVaried };
 enum class PanelOrientation { kPortrait, kLandscape };
 enum class RoutePattern { kWaypoints, kAlongRow, kLawnmower, kLoop };
 enum class DepthNoiseModel { kNone, kKinect };
+/// The depth camera: a structured-light Kinect v1 (the depth_noise model)
+/// or an active stereo RealSense D435 (ActiveStereo).
+enum class CameraModel { kKinect, kD435 };
 enum class OnLoss { kWait, kAbort };
 enum class WallFinish { kBrick, kPlaster };
 /// How an array's panels are held: fixed tilted tables, or rows of modules
@@ -226,6 +229,37 @@ struct DepthNoise {
   double max_incidence_deg = 80.0;   ///< invalid beyond this view/normal angle
 };
 
+/// An active stereo camera (RealSense D435): two infrared imagers that see
+/// the scene's light and a projected dot pattern, depth from semi-global
+/// matching (docs/sensors.md, "Active stereo").  Figures from Intel's D400
+/// documents and the FRAMOS D435e manual unless marked otherwise.
+struct ActiveStereo {
+  int ir_width = 848;               ///< the D435's best depth resolution
+  int ir_height = 480;
+  double ir_fx = 446.7;             ///< 87 degrees across 848 pixels
+  double baseline_m = 0.050;        ///< between the two imagers
+  double colour_offset_m = 0.015;   ///< from the left imager to the colour camera, along x
+  double projector_offset_m = 0.025;  ///< from the left imager to the projector, along x
+  double projector_power_w = 0.36;  ///< average optical power, 850 nm
+  double projector_hfov_deg = 86.0;
+  double projector_vfov_deg = 57.0;
+  int dots = 5000;                  ///< the pattern's spots
+  std::uint64_t pattern_seed = 435; ///< where the spots lie (a property of the device)
+  /// The sun's beam at air mass 1.5 in the imagers' band (no infrared-cut
+  /// filter: about 400-1000 nm of ASTM G173's direct spectrum).
+  double band_sun_w_m2 = 600.0;
+  double sky_share = 0.12;          ///< the sky's irradiance on any surface, share of the beam's
+  double min_ambient_w_m2 = 1.0;    ///< the ambient floor without sun (dusk, indoors)
+  int disparities = 128;            ///< the D4's 126, rounded up to OpenCV's multiple of 16
+  int block_px = 7;                 ///< the matcher's window
+  int uniqueness_pct = 10;          ///< the matcher's uniqueness ratio
+  double ir_noise_sigma = 2.0;      ///< 8-bit levels, after exposure
+  /// The left imager's intrinsics (square pixels, centred principal point).
+  double ir_cx() const { return 0.5 * ir_width - 0.5; }
+  double ir_cy() const { return 0.5 * ir_height - 0.5; }
+  double ir_fovy_deg() const;
+};
+
 struct RgbNoise {
   double sigma = 1.5;     ///< additive Gaussian noise, 8-bit levels
   double exposure = 1.0;  ///< gain applied before noise
@@ -248,7 +282,9 @@ struct Camera {
   double pitch_deg = -12.0;  ///< negative looks down
   double yaw_deg = 0.0;      ///< relative to the robot's heading, positive left
   Eigen::Vector2d depth_range_m{0.5, 4.5};
-  DepthNoise depth_noise;
+  CameraModel model = CameraModel::kKinect;
+  DepthNoise depth_noise;  ///< the kinect model's depth
+  ActiveStereo stereo;     ///< the d435 model's depth
   RgbNoise rgb;
   // Principal point of MuJoCo's symmetric frustum, pixel-centre convention.
   double cx() const { return 0.5 * width - 0.5; }
@@ -256,6 +292,9 @@ struct Camera {
   /// MuJoCo's vertical field of view giving focal length fy: the image spans
   /// height pixels, so tan(fovy / 2) = (height / 2) / fy.
   double fovy_deg() const;
+  /// The depth sensor's baseline: the Kinect's projector to camera, the
+  /// D435's imager to imager.
+  double depth_baseline_m() const { return model == CameraModel::kD435 ? stereo.baseline_m : depth_noise.baseline_m; }
 };
 
 /// The robot's caster is this far behind the wheels' axle: its wheel base.

@@ -68,6 +68,9 @@ void write_scene(const SceneAssets& assets, const std::string& dir);
 
 /// Names used in the generated model.
 inline constexpr const char* kCameraName = "rgbd";
+/// The d435 model's infrared imagers (scenes::ActiveStereo).
+inline constexpr const char* kIrLeftCameraName = "ir_left";
+inline constexpr const char* kIrRightCameraName = "ir_right";
 inline constexpr const char* kRobotBody = "robot";
 inline constexpr const char* kLeftActuator = "wheel_left";
 inline constexpr const char* kRightActuator = "wheel_right";

@@ -11,6 +11,7 @@
 #include "pvb/geometry/se3.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sensor/rgbd_frame.hpp"
+#include "pvb/sim/active_stereo.hpp"
 #include "pvb/sim/motion_sensors.hpp"
 #include "pvb/sim/renderer.hpp"
 #include "pvb/sim/robot.hpp"
@@ -119,6 +120,7 @@ struct Capture {
   std::vector<WheelTruth> wheel_truth;  ///< the truth behind frame.wheel_ticks
   double render_ms = 0;      ///< time spent rendering (GL + read-back)
   double sensor_ms = 0;      ///< time spent in the sensor model (depth and RGB noise)
+  StereoTimes stereo;        ///< the d435 model's share of sensor_ms
 };
 
 /// One rendered frame before the sensor model: the noise-free images and
@@ -133,6 +135,7 @@ struct RenderedFrame {
   /// pixel sees (sun_visibility), and the sun's direction in the camera.
   cv::Mat sun_lit;
   Eigen::Vector3d to_sun_c = Eigen::Vector3d::UnitZ();
+  std::optional<StereoRender> stereo;  ///< the d435 model's infrared views
   std::uint64_t index = 0;            ///< frame index
   std::int64_t t_ns = 0;
   geom::SE3d T_w_c;                   ///< ground-truth camera pose
@@ -151,6 +154,8 @@ class SensorModel {
   /// lens gives: black colour with the sensor's noise, and no depth (0
   /// everywhere).
   Capture apply(RenderedFrame rendered) const;
+  /// The d435 model (null for the kinect model).
+  const std::shared_ptr<const ActiveStereoModel>& stereo_model() const { return stereo_; }
 
  private:
   scenes::Camera camera_;
@@ -158,6 +163,7 @@ class SensorModel {
   double sun_elevation_deg_;
   std::uint64_t seed_;
   std::optional<scenes::CoverFrames> cover_;
+  std::shared_ptr<const ActiveStereoModel> stereo_;  ///< with camera.model d435
 };
 
 /// Renders the simulator's camera and applies the sensor model.
@@ -173,8 +179,12 @@ class RgbdCamera {
   GlBackend backend() const { return renderer_.backend(); }
 
  private:
+  /// The d435 model's two infrared views of the current state.
+  StereoRender render_infrared(Simulator& sim);
   Renderer renderer_;
   SensorModel sensor_;
+  std::unique_ptr<Renderer> ir_renderer_;  ///< with camera.model d435
+  int ir_left_id_ = -1, ir_right_id_ = -1;
 };
 
 /// Installs MuJoCo's error and warning handlers where none is set: an error
