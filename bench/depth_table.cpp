@@ -79,11 +79,11 @@ void write_sheet(const std::string& dir, const pvb::sim::RenderedFrame& rendered
   cv::Mat bgr;
   cv::cvtColor(cap.frame.rgb, bgr, cv::COLOR_RGB2BGR);
   cv::imwrite(dir + "/colour.png", bgr);
-  cv::Mat mm;
-  cap.frame.depth_m.convertTo(mm, CV_16U, 1000.0);
-  cv::imwrite(dir + "/depth_mm.png", mm);
-  cap.depth_gt_m.convertTo(mm, CV_16U, 1000.0);
-  cv::imwrite(dir + "/truth_mm.png", mm);
+  cv::Mat tum;  // TUM depth PNGs: 5000 steps per metre
+  cap.frame.depth_m.convertTo(tum, CV_16U, 5000.0);
+  cv::imwrite(dir + "/depth.png", tum);
+  cap.depth_gt_m.convertTo(tum, CV_16U, 5000.0);
+  cv::imwrite(dir + "/truth.png", tum);
   if (rendered.stereo && camera.sensor_model().stereo_model()) {
     const auto& m = *camera.sensor_model().stereo_model();
     cv::imwrite(dir + "/ir_left.png", m.infrared_image(rendered.stereo->left, false, rendered.stereo->to_sun_c,

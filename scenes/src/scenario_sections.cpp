@@ -63,6 +63,7 @@ PvArray read_array(MapReader& r) {
   a.clearance_m = r.number("clearance_m", a.clearance_m, 0.1, 5);
   a.posts = r.boolean("posts", a.posts);
   a.dirt = r.number("dirt", a.dirt, 0, 1);
+  a.specular_glass = r.choice<bool>("glass", a.specular_glass, {{"diffuse", false}, {"specular", true}});
   a.identical_tables = r.boolean("identical_tables", a.identical_tables);
   // The row's footprint (a tracker's when flat) and half a metre between rows.
   const double min_pitch = row_footprint_m(a) + 0.5;

@@ -158,6 +158,7 @@ cv::Mat ActiveStereoModel::infrared_image(const InfraredView& view, bool right_i
       }
     }
   });
+  if (!view.glass.face.empty()) apply_glass(&radiance, view.glass, K_ir_, to_sun_c, beam_w_m2_ > 0);
   const double gain = std::clamp(kAutoExposureTargetGrey / std::max(central_mean(radiance), 1.0), 0.25, 8.0);
   const auto& nt = normal_table();
   cv::Mat out(H, W, CV_8UC1);

@@ -394,8 +394,8 @@ std::string hfield_line(const scenes::Scenario& s, const scenes::GroundRelief& g
 void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& out, const scenes::GroundRelief& ground) {
   x.open("<asset>");
   if (!ground.flat()) x.line(hfield_line(s, ground));
-  x.line("<texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"0.50 0.66 0.90\" rgb2=\"0.93 0.95 0.98\" "
-         "width=\"512\" height=\"512\"/>");
+  x.line("<texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"" + v3(kSkyZenithRgb.cast<double>()) +
+         "\" rgb2=\"" + v3(kSkyHorizonRgb.cast<double>()) + "\" width=\"512\" height=\"512\"/>");
   const auto texture = [](const std::string& path) { return path.rfind("textures/", 0) == 0; };
   for (const auto& file : out.files) {
     if (!texture(file.first)) continue;
@@ -417,9 +417,10 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
   for (std::size_t i = 0; i < s.pv_arrays.size(); ++i)
     for (int k = 0; k < kDirtVariants; ++k) {
       const std::string n = "a" + std::to_string(i) + "panel" + std::to_string(k);
-      // glass: strong, tight specular highlight
-      x.line("<material name=\"" + n + "\" texture=\"" + n + "\" specular=\"" + f(0.9 - 0.4 * s.pv_arrays[i].dirt) +
-             "\" shininess=\"0.85\"/>");
+      // Diffuse glass: a strong, tight highlight.  Specular glass: the
+      // cells only; the sensor model mirrors the sky and the sun (glass.hpp).
+      const double specular = s.pv_arrays[i].specular_glass ? 0.0 : 0.9 - 0.4 * s.pv_arrays[i].dirt;
+      x.line("<material name=\"" + n + "\" texture=\"" + n + "\" specular=\"" + f(specular) + "\" shininess=\"0.85\"/>");
     }
   // Plaster: one flat colour, matte (walls with finish: plaster).
   x.line("<material name=\"plaster\" rgba=\"0.78 0.76 0.72 1\" specular=\"0.02\" shininess=\"0.05\"/>");

@@ -38,13 +38,32 @@ namespace {
 /// surface point at depth z, with normal n (unnormalised, either side)
 /// seen along ray (x, y, 1); dot = n . ray.
 bool pattern_survives(const SunlightFrame& sun, const Eigen::Vector3f& n, const Eigen::Vector3f& ray, float dot,
-                      float z, bool lit) {
+                      float z, bool lit, float mirror_w_m2 = 0) {
   const float n_norm = n.norm(), ray2 = ray.squaredNorm();
   const float cos_projector = std::abs(dot) / (n_norm * std::sqrt(ray2));
   const float pattern = sun.pattern_w_sr * cos_projector / (z * z * ray2);
   const float cos_sun = (dot > 0 ? -n : n).dot(sun.to_sun_c) / n_norm;  // the normal turned to the camera
-  const float ambient = sun.beam_w_m2 * (lit ? std::max(cos_sun, 0.0f) : 0.0f) + sun.sky_w_m2;
+  const float ambient = sun.beam_w_m2 * (lit ? std::max(cos_sun, 0.0f) : 0.0f) + sun.sky_w_m2 + mirror_w_m2;
   return pattern >= sun.min_contrast * ambient;
+}
+
+/// A Kinect's depth at a glass pixel: the mirror's image (its path length
+/// along the ray), the cells' own (z) or none (0).
+float glass_depth(const GlassView& glass, const SunlightFrame* sun, const Eigen::Vector3f& n,
+                  const Eigen::Vector3f& ray, float dot, float z, int r, int c, bool lit) {
+  const float mirror = glass.mirror_m.ptr<float>(r)[c];
+  if (mirror > 0) return z + mirror / ray.norm();
+  const float cos_i = std::abs(dot) / (n.norm() * ray.norm());
+  if (z > glass_pattern_range_m(cos_i)) return 0;
+  if (!sun) return z;
+  const float R = static_cast<float>(fresnel_reflectance(cos_i));
+  const Eigen::Vector3f v = ray.normalized(), nf = n.normalized();
+  const Eigen::Vector3f refl = v - 2 * v.dot(nf) * nf;
+  const float glint_rad = 3 * static_cast<float>(kGlintSigmaDeg * M_PI / 180.0);
+  if (sun->beam_w_m2 > 0 && refl.dot(sun->to_sun_c) > std::cos(glint_rad)) return 0;  // the sun's glint
+  // The mirrored sky over the cells' diffuse share of the pattern.
+  const float cells = static_cast<float>(kCellNirReflectance) * (1 - R) * (1 - R);
+  return pattern_survives(*sun, n, ray, dot, z, lit, R / cells * sun->sky_w_m2) ? z : 0.0f;
 }
 
 }  // namespace
@@ -65,10 +84,12 @@ SunlightFrame sunlight_frame(const scenes::Sunlight& params, double sun_elevatio
 }
 
 cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, const scenes::Camera& cam,
-                          std::uint64_t seed, std::uint64_t frame, const SunlightFrame* sun) {
+                          std::uint64_t seed, std::uint64_t frame, const SunlightFrame* sun,
+                          const GlassView* glass) {
   CV_Assert(gt.type() == CV_32FC1);
   if (sun && !(sun->beam_w_m2 > 0 || sun->sky_w_m2 > 0)) sun = nullptr;  // no sun, no change
   CV_Assert(!sun || (sun->lit.type() == CV_8UC1 && sun->lit.size() == gt.size()));
+  CV_Assert(!glass || glass->face.size() == gt.size());
   const float zmin = static_cast<float>(cam.depth_range_m.x()), zmax = static_cast<float>(cam.depth_range_m.y());
   cv::Mat out(gt.size(), CV_32FC1, cv::Scalar(0));
   const int W = gt.cols, H = gt.rows;
@@ -121,9 +142,16 @@ cv::Mat apply_depth_model(const cv::Mat& gt, const geom::PinholeIntrinsics& K, c
       const Eigen::Vector3f ray(xc, yc, 1.0f);
       const float dot = n.dot(ray);
       if (dot * dot < cos2_max * n.squaredNorm() * ray.squaredNorm()) continue;
-      if (sun && !pattern_survives(*sun, n, ray, dot, z, sun->lit.ptr<std::uint8_t>(rr)[cc] != 0)) continue;
+      const bool lit = sun && sun->lit.ptr<std::uint8_t>(rr)[cc] != 0;
+      float zs = z;
+      if (glass && glass->face.ptr<std::uint16_t>(rr)[cc] != 0) {
+        zs = glass_depth(*glass, sun, n, ray, dot, z, rr, cc, lit);
+        if (zs <= 0) continue;
+      } else if (sun && !pattern_survives(*sun, n, ray, dot, z, lit)) {
+        continue;
+      }
       // axial noise, then disparity quantisation
-      double zn = z + nt[(bits >> 24) & 4095] * kinect_axial_sigma_m(z) * p.axial_scale;
+      double zn = zs + nt[(bits >> 24) & 4095] * kinect_axial_sigma_m(zs) * p.axial_scale;
       if (p.disparity_step_px > 0 && zn > 0) {
         const double d = bf / zn;
         const double dq = std::round(d / p.disparity_step_px) * p.disparity_step_px;

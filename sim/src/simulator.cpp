@@ -217,6 +217,10 @@ std::optional<cv::Point2d> Simulator::sun_pixel() const {
 RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
     : renderer_(sim.model(), backend, sim.scenario().camera.width, sim.scenario().camera.height), sensor_(sim) {
   renderer_.set_shadows(sim.scenario().light.shadows);
+  std::vector<bool> specular;
+  for (const auto& a : sim.scenario().pv_arrays) specular.push_back(a.specular_glass);
+  if (std::find(specular.begin(), specular.end(), true) != specular.end())
+    glass_ = std::make_unique<GlassFinder>(sim.model(), specular);
   const scenes::Camera& cam = sim.scenario().camera;
   if (cam.model != scenes::CameraModel::kD435) return;
   ir_renderer_ = std::make_unique<Renderer>(sim.model(), renderer_.backend(), cam.stereo.ir_width, cam.stereo.ir_height);
@@ -247,6 +251,7 @@ StereoRender RgbdCamera::render_infrared(Simulator& sim) {
     const double x_m = -p.colour_offset_m + (k == 0 ? 0.0 : p.baseline_m);  // along the colour camera's x
     const geom::SE3d T_w_ir = T_w_c * geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(x_m, 0, 0));
     if (caster) v.lit = sun_visibility(*caster, v.depth_m, K_ir, T_w_ir, 16, pattern_range_m);
+    if (glass_) v.glass = glass_->find(sim.data(), v.depth_m, K_ir, T_w_ir);
   }
   return out;
 }
@@ -269,6 +274,11 @@ RenderedFrame RgbdCamera::render(Simulator& sim) {
                                     .shade_range_m();
     const SunShadowCaster caster(sim.model(), sim.data(), sim.to_sun_w());
     out.sun_lit = sun_visibility(caster, out.depth_gt_m, sim.intrinsics(), sim.T_w_c(), 16, shade_range_m);
+  }
+  out.sun_up = sim.scenario().light.sun_elevation_deg > 0;
+  if (glass_) {
+    out.glass = glass_->find(sim.data(), out.depth_gt_m, sim.intrinsics(), sim.T_w_c());
+    out.to_sun_c = sim.T_w_c().linear().transpose() * sim.to_sun_w();
   }
   if (ir_renderer_) out.stereo = render_infrared(sim);
   out.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -307,8 +317,11 @@ Capture SensorModel::apply(RenderedFrame rendered) const {
     if (!rendered.sun_lit.empty())
       sun = sunlight_frame(camera_.depth_noise.sunlight, sun_elevation_deg_, rendered.to_sun_c.cast<float>(),
                            std::move(rendered.sun_lit));
-    out.frame.depth_m = apply_depth_model(out.depth_gt_m, K_, camera_, seed_, rendered.index, sun ? &*sun : nullptr);
+    out.frame.depth_m = apply_depth_model(out.depth_gt_m, K_, camera_, seed_, rendered.index, sun ? &*sun : nullptr,
+                                          rendered.glass ? &*rendered.glass : nullptr);
   }
+  if (rendered.glass && !covered)
+    apply_glass(&rendered.rgb, *rendered.glass, K_, rendered.to_sun_c.cast<float>(), rendered.sun_up);
   apply_rgb_model(&rendered.rgb, camera_.rgb, covered ? std::nullopt : rendered.sun_px, seed_,
                   rendered.index);
   out.frame.rgb = std::move(rendered.rgb);

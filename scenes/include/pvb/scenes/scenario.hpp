@@ -92,6 +92,11 @@ struct PvArray {
   bool posts = true;
   bool rails = true;
   double dirt = 0.2;         ///< 0 clean .. 1 very dusty
+  /// The modules' front glass: diffuse (a matte surface with a highlight,
+  /// as the bench always drew it) or specular (the sky mirrored with
+  /// Fresnel's angle dependence, the sun's glint, and what the mirror does
+  /// to depth; docs/sensors.md, "Glass").
+  bool specular_glass = false;
   /// Every table of the array gets the same panels (the same dust variants
   /// in the same places), so its tables and rows look alike.  False: each
   /// panel's variant is drawn on its own.

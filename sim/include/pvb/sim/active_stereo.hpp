@@ -12,6 +12,7 @@
 
 #include "pvb/geometry/pinhole.hpp"
 #include "pvb/scenes/scenario.hpp"
+#include "pvb/sim/glass.hpp"
 
 namespace pvb::sim {
 
@@ -20,6 +21,7 @@ struct InfraredView {
   cv::Mat grey;     ///< CV_8UC1: the rendered scene's luma (its sun, sky and shadows)
   cv::Mat depth_m;  ///< CV_32FC1: exact depth along the optical axis, 0 = sky
   cv::Mat lit;      ///< CV_8UC1: 1 where the sun reaches the point seen (sun_visibility); empty: nowhere
+  GlassView glass;  ///< specular panels' glass (face empty: none)
 };
 
 /// Both imagers' views of one frame.  The imagers and the colour camera
@@ -65,8 +67,9 @@ class ActiveStereoModel {
   /// to a shaded surface: where sun_visibility need not look.
   float pattern_range_m() const;
   /// One imager's 8-bit image: the rendered luma times (1 + projector
-  /// irradiance / ambient irradiance), automatic exposure to middle grey
-  /// over the central region, Gaussian read noise.
+  /// irradiance / ambient irradiance), on specular glass (1 - R) of that
+  /// plus what the glass mirrors (apply_glass), automatic exposure to
+  /// middle grey over the central region, Gaussian read noise.
   cv::Mat infrared_image(const InfraredView& view, bool right_imager, const Eigen::Vector3f& to_sun_c,
                          std::uint64_t frame) const;
   /// The left image's disparity (CV_32FC1, pixels; 0 where the matcher found none).

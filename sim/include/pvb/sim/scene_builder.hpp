@@ -68,6 +68,10 @@ void write_scene(const SceneAssets& assets, const std::string& dir);
 
 /// Names used in the generated model.
 inline constexpr const char* kCameraName = "rgbd";
+/// The sky's gradient (MuJoCo's skybox), linear RGB in [0, 1]: the zenith
+/// and the horizon.  Specular glass mirrors it (glass.hpp).
+inline const Eigen::Vector3f kSkyZenithRgb(0.50f, 0.66f, 0.90f);
+inline const Eigen::Vector3f kSkyHorizonRgb(0.93f, 0.95f, 0.98f);
 /// The d435 model's infrared imagers (scenes::ActiveStereo).
 inline constexpr const char* kIrLeftCameraName = "ir_left";
 inline constexpr const char* kIrRightCameraName = "ir_right";

@@ -10,6 +10,7 @@
 
 #include "pvb/geometry/pinhole.hpp"
 #include "pvb/scenes/scenario.hpp"
+#include "pvb/sim/glass.hpp"
 
 namespace pvb::sim {
 
@@ -43,8 +44,13 @@ SunlightFrame sunlight_frame(const scenes::Sunlight& params, double sun_elevatio
 /// truth cut to the depth range.  Either way the result lies on the 16-bit
 /// grid of TUM PNGs (sensor::kTumDepthFactor, 0.2 mm): a recorded sequence
 /// replays bit for bit the depth a live run saw.
+/// With `glass` (specular panels), a glass pixel returns the depth of what
+/// the mirror shows where GlassView::mirror_m says so, nothing beyond
+/// glass_pattern_range_m, and with `sun` nothing where the mirrored sky
+/// drowns the cells' pattern or the sun glints.
 cv::Mat apply_depth_model(const cv::Mat& depth_gt_m, const geom::PinholeIntrinsics& K, const scenes::Camera& cam,
-                          std::uint64_t seed, std::uint64_t frame, const SunlightFrame* sun = nullptr);
+                          std::uint64_t seed, std::uint64_t frame, const SunlightFrame* sun = nullptr,
+                          const GlassView* glass = nullptr);
 
 /// Exposure gain, sun glare (when `sun_px` is given: the sun's projection,
 /// possibly outside the image) and additive Gaussian noise on an RGB image.

@@ -136,6 +136,8 @@ struct RenderedFrame {
   cv::Mat sun_lit;
   Eigen::Vector3d to_sun_c = Eigen::Vector3d::UnitZ();
   std::optional<StereoRender> stereo;  ///< the d435 model's infrared views
+  std::optional<GlassView> glass;      ///< the colour camera's specular glass
+  bool sun_up = false;                 ///< the sun above the horizon
   std::uint64_t index = 0;            ///< frame index
   std::int64_t t_ns = 0;
   geom::SE3d T_w_c;                   ///< ground-truth camera pose
@@ -184,6 +186,7 @@ class RgbdCamera {
   Renderer renderer_;
   SensorModel sensor_;
   std::unique_ptr<Renderer> ir_renderer_;  ///< with camera.model d435
+  std::unique_ptr<GlassFinder> glass_;     ///< with specular glass on any array
   int ir_left_id_ = -1, ir_right_id_ = -1;
 };
 
