@@ -3,13 +3,15 @@
 // scenario (the robot drives all of them) and compares the sensor's depth
 // with the rendered truth:
 //   depth_table --scenario scenes/days/pv_station_1200.yaml --model d435 --every 25
-// prints one Markdown row per class of surface, "under cover" (something
-// above the point: a panel table, a tree) and "open":
+// prints one Markdown row per class of surface: "panels" (the modules'
+// faces, from the truth's geoms), "under cover" (something above the
+// point: a panel table, a tree) and "open" (the rest):
 //   - the share of pixels whose true depth lies in 0.5-4.5 m that have depth;
 //   - per range bin of the true depth, the median and 95th percentile of
 //     |depth - truth| over the pixels that have depth.
 // --model kinect|d435 and --sunlight on|off override the scenario's camera;
-// --out DIR writes colour, depth and (d435) infrared images of --sheet-frame.
+// --out DIR writes colour, depth, truth (TUM PNGs), sheet.png (the three
+// side by side) and (d435) the infrared images of --sheet-frame.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -25,6 +27,7 @@
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/simulator.hpp"
 #include "pvb/sim/sun_shadow.hpp"
+#include "pvb/sim/truth_surface.hpp"
 
 namespace {
 
@@ -56,7 +59,10 @@ double quantile(std::vector<float> v, double q) {
   return v[k];
 }
 
-void add_frame(pvb::sim::Simulator& sim, const pvb::sim::Capture& cap, std::array<ClassStats, 2>* stats) {
+constexpr int kClasses = 3;
+
+void add_frame(pvb::sim::Simulator& sim, const pvb::sim::Capture& cap, const cv::Mat& geom_id,
+               std::array<ClassStats, kClasses>* stats) {
   const pvb::sim::SunShadowCaster above(sim.model(), sim.data(), Eigen::Vector3d::UnitZ());
   const auto K = sim.intrinsics();
   for (int r = 0; r < cap.depth_gt_m.rows; r += kPixelStep)
@@ -64,7 +70,9 @@ void add_frame(pvb::sim::Simulator& sim, const pvb::sim::Capture& cap, std::arra
       const float zt = cap.depth_gt_m.ptr<float>(r)[c], z = cap.frame.depth_m.ptr<float>(r)[c];
       if (zt <= 0) continue;
       const Eigen::Vector3d p_w = cap.T_w_c * Eigen::Vector3d(zt * (c - K.cx) / K.fx, zt * (r - K.cy) / K.fy, zt);
-      ClassStats& s = (*stats)[above.shadowed(p_w, 0.05) ? 0 : 1];
+      const int g = geom_id.ptr<int>(r)[c];
+      const bool panel = g >= 0 && pvb::sim::classify_geom(sim.model(), g) == pvb::sim::SurfaceClass::kPanel;
+      ClassStats& s = (*stats)[panel ? 0 : above.shadowed(p_w, 0.05) ? 1 : 2];
       if (zt >= 0.5 && zt <= 4.5) {
         ++s.in_range;
         if (z > 0) ++s.valid;
@@ -84,6 +92,17 @@ void write_sheet(const std::string& dir, const pvb::sim::RenderedFrame& rendered
   cv::imwrite(dir + "/depth.png", tum);
   cap.depth_gt_m.convertTo(tum, CV_16U, 5000.0);
   cv::imwrite(dir + "/truth.png", tum);
+  // sheet.png: colour | depth | true depth, depth in jet over 0-6 m, black = none
+  auto jet = [](const cv::Mat& z) {
+    cv::Mat u8, out;
+    z.convertTo(u8, CV_8U, 255.0 / 6.0);
+    cv::applyColorMap(u8, out, cv::COLORMAP_JET);
+    out.setTo(cv::Scalar::all(0), z <= 0);
+    return out;
+  };
+  cv::Mat sheet;
+  cv::hconcat(std::vector<cv::Mat>{bgr, jet(cap.frame.depth_m), jet(cap.depth_gt_m)}, sheet);
+  cv::imwrite(dir + "/sheet.png", sheet);
   if (rendered.stereo && camera.sensor_model().stereo_model()) {
     const auto& m = *camera.sensor_model().stereo_model();
     cv::imwrite(dir + "/ir_left.png", m.infrared_image(rendered.stereo->left, false, rendered.stereo->to_sun_c,
@@ -106,7 +125,8 @@ int run(const Options& o) {
   }
   pvb::sim::Simulator sim(s);
   pvb::sim::RgbdCamera camera(sim, pvb::sim::parse_gl_backend(o.gl));
-  std::array<ClassStats, 2> stats;
+  pvb::sim::Renderer ids(sim.model(), camera.backend(), s.camera.width, s.camera.height);
+  std::array<ClassStats, kClasses> stats;
   double sensor_ms = 0, match_ms = 0;
   int rendered_frames = 0;
   for (int f = 0; f < sim.frame_count(); ++f) {
@@ -118,7 +138,9 @@ int run(const Options& o) {
     const pvb::sim::Capture cap = camera.sensor_model().apply(std::move(rendered));
     if (f == o.sheet_frame && !o.out.empty()) write_sheet(o.out, kept, cap, camera);
     if (f % o.every != 0) continue;
-    add_frame(sim, cap, &stats);
+    cv::Mat geom_id;
+    ids.render_geom_ids(sim.model(), sim.data(), sim.camera_id(), &geom_id);
+    add_frame(sim, cap, geom_id, &stats);
     sensor_ms += cap.sensor_ms;
     match_ms += cap.stereo.match_ms;
     ++rendered_frames;
@@ -128,8 +150,8 @@ int run(const Options& o) {
     std::printf(" %.1f-%.1f m median / p95 |", kBinEdgesM[static_cast<std::size_t>(b)],
                 kBinEdgesM[static_cast<std::size_t>(b) + 1]);
   std::printf("\n");
-  const char* names[2] = {"under cover", "open"};
-  for (int k = 0; k < 2; ++k) {
+  const char* names[kClasses] = {"panels", "under cover", "open"};
+  for (int k = 0; k < kClasses; ++k) {
     const ClassStats& c = stats[static_cast<std::size_t>(k)];
     std::printf("| | | %s | %.1f %% of %ld |", names[k], c.in_range ? 100.0 * c.valid / c.in_range : 0.0, c.in_range);
     for (int b = 0; b < kBins; ++b) {

@@ -394,8 +394,13 @@ std::string hfield_line(const scenes::Scenario& s, const scenes::GroundRelief& g
 void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& out, const scenes::GroundRelief& ground) {
   x.open("<asset>");
   if (!ground.flat()) x.line(hfield_line(s, ground));
-  x.line("<texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"" + v3(kSkyZenithRgb.cast<double>()) +
-         "\" rgb2=\"" + v3(kSkyHorizonRgb.cast<double>()) + "\" width=\"512\" height=\"512\"/>");
+  const auto rgb = [](const Eigen::Vector3f& c) {  // two decimals, as the sky was always written
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "%.2f %.2f %.2f", c.x(), c.y(), c.z());
+    return std::string(buf);
+  };
+  x.line("<texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"" + rgb(kSkyZenithRgb) + "\" rgb2=\"" +
+         rgb(kSkyHorizonRgb) + "\" width=\"512\" height=\"512\"/>");
   const auto texture = [](const std::string& path) { return path.rfind("textures/", 0) == 0; };
   for (const auto& file : out.files) {
     if (!texture(file.first)) continue;
