@@ -101,6 +101,7 @@ struct RecordLoop {
   int frames = 0;  ///< frames written
   bool interrupted = false;
   double capture_ms = 0, write_ms = 0, loop_s = 0;
+  sim::SimFrameSource::StageTimes stages;  ///< summed over the frames
   std::vector<plot::Thumbnail> thumbs;  ///< for the contact sheet
 };
 
@@ -124,6 +125,11 @@ RecordLoop record_frames(sim::SimFrameSource& source, const geom::StampedPose& g
     const std::optional<sensor::RgbdFrame> frame = source.next();
     loop.capture_ms += ms_since(t0);
     if (!frame) break;
+    const sim::SimFrameSource::StageTimes& st = source.last_stage_times();
+    loop.stages.physics_ms += st.physics_ms;
+    loop.stages.render_ms += st.render_ms;
+    loop.stages.sensor_ms += st.sensor_ms;
+    loop.stages.stereo_match_ms += st.stereo_match_ms;
     t0 = Clock::now();
     write(*frame, gt);
     loop.write_ms += ms_since(t0);
@@ -160,7 +166,8 @@ void write_meta(const std::string& path, const RecordOptions& opt, const scenes:
                 "  \"motion_sensors\": {\"imu\": \"%s\", \"imu_rate_hz\": %.9g, \"encoder_rate_hz\": %.9g, "
                 "\"ticks_per_rev\": %d},\n"
                 "  \"timings\": {\"total_s\": %.3f, \"setup_ms\": %.1f, \"capture_ms_per_frame\": %.3f, "
-                "\"write_ms_per_frame\": %.3f, \"frames_per_s\": %.2f}\n"
+                "\"write_ms_per_frame\": %.3f, \"frames_per_s\": %.2f, \"physics_ms_per_frame\": %.3f, "
+                "\"render_ms_per_frame\": %.3f, \"sensor_ms_per_frame\": %.3f, \"stereo_match_ms_per_frame\": %.3f}\n"
                 "}\n",
                 loop.frames, loop.interrupted ? "true" : "false", scenario.camera.fps, pvb::version(),
                 mj_versionString(), sim::to_string(source.camera().backend()),
@@ -169,7 +176,9 @@ void write_meta(const std::string& path, const RecordOptions& opt, const scenes:
                 scenes::imu_rate_hz(scenario), scenes::wheel_rate_hz(scenario), scenario.wheels.ticks_per_rev,
                 total_s, setup_ms,
                 loop.capture_ms * per_frame, loop.write_ms * per_frame,
-                loop.loop_s > 0 ? loop.frames / loop.loop_s : 0.0);
+                loop.loop_s > 0 ? loop.frames / loop.loop_s : 0.0, loop.stages.physics_ms * per_frame,
+                loop.stages.render_ms * per_frame, loop.stages.sensor_ms * per_frame,
+                loop.stages.stereo_match_ms * per_frame);
   meta += rest;
   write_file(path, meta);
 }

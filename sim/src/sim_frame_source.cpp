@@ -19,6 +19,7 @@ std::optional<RenderedFrame> SimFrameSource::next_rendered() {
   RenderedFrame rendered = camera_.render(sim_);
   last_times_.render_ms = rendered.render_ms;
   last_times_.sensor_ms = 0;
+  last_times_.stereo_match_ms = 0;
   if (sink_) sink_({rendered.t_ns, rendered.T_w_c});
   return rendered;
 }
@@ -35,6 +36,7 @@ std::optional<sensor::RgbdFrame> SimFrameSource::next() {
   if (!rendered) return std::nullopt;
   Capture cap = camera_.sensor_model().apply(std::move(*rendered));
   last_times_.sensor_ms = cap.sensor_ms;
+  last_times_.stereo_match_ms = cap.stereo.match_ms;
   last_depth_gt_m_ = cap.depth_gt_m;
   last_imu_truth_ = std::move(cap.imu_truth);
   last_wheel_truth_ = std::move(cap.wheel_truth);

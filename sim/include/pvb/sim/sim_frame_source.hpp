@@ -50,6 +50,7 @@ class SimFrameSource : public sensor::FrameSource {
     double physics_ms = 0;  ///< Simulator::advance (steering + physics steps)
     double render_ms = 0;   ///< GL rendering and read-back
     double sensor_ms = 0;   ///< depth and RGB sensor model
+    double stereo_match_ms = 0;  ///< the d435 model's semi-global matching (part of sensor_ms)
   };
   const StageTimes& last_stage_times() const { return last_times_; }
 
