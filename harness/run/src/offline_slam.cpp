@@ -237,7 +237,7 @@ void OfflineSlam::Impl::open_outputs() {
   timing_.append(
       "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,"
       "inliers,keyframe,mapping_ms,cpu_ms,align_tried,aligned,align_ms,"
-      "kf_tracked_close,kf_untracked_close,kf_ref_points,kf_ref_all,kf_ref_shared\n");
+      "kf_tracked_close,kf_untracked_close,kf_ref_points,kf_ref_all,kf_ref_shared,features_with_depth,depth_valid\n");
   if (a_.dump_matches) {
     const std::string gt = a_.sequence + "/groundtruth.txt";
     if (!std::ifstream(gt)) throw IoError(gt, "--dump-matches needs the sequence's ground truth");
@@ -319,7 +319,13 @@ void OfflineSlam::Impl::write_timing_line(const sensor::RgbdFrame& frame, const 
        << "," << (r.tracking.new_keyframe ? 1 : 0) << "," << format_g(r.mapping_ms) << "," << format_g(cpu_ms)
        << "," << r.tracking.align_tried << "," << r.tracking.aligned << "," << format_g(r.tracking.align_ms)
        << "," << r.tracking.kf_tracked_close << "," << r.tracking.kf_untracked_close << ","
-       << r.tracking.kf_ref_points << "," << r.tracking.kf_ref_all << "," << r.tracking.kf_ref_shared << "\n";
+       << r.tracking.kf_ref_points << "," << r.tracking.kf_ref_all << "," << r.tracking.kf_ref_shared << ","
+       << r.features_with_depth << ","
+       << format_fixed(frame.depth_m.empty() ? 0.0
+                                             : static_cast<double>(cv::countNonZero(frame.depth_m > 0)) /
+                                                   static_cast<double>(frame.depth_m.total()),
+                       4)
+       << "\n";
   timing_.append(line.str());
 }
 

@@ -82,12 +82,15 @@ void SystemSink::open_outputs() {
   kf_traj.append("# timestamp tx ty tz qx qy qz qw (T_w_c)\n");
   timing.append(
       "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,inliers,"
-      "keyframe,mapping_ms\n");
+      "keyframe,mapping_ms,features_with_depth,depth_valid\n");
   est.source = dir + "/CameraTrajectory.txt";
 }
 
 slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log) {
   const slam::FrameResult r = system->track(frame);
+  depth_valid = frame.depth_m.empty() ? 0.0
+                                      : static_cast<double>(cv::countNonZero(frame.depth_m > 0)) /
+                                            static_cast<double>(frame.depth_m.total());
   if (!first_t_ns) first_t_ns = frame.t_ns;
   const int index = static_cast<int>(frame.index);
   const double t_s = geom::ns_to_seconds(frame.t_ns);
@@ -146,7 +149,8 @@ void SystemSink::write_lines(const slam::FrameResult& r, int index) {
        << method_name(r.tracking.method) << "," << r.num_features << ","
        << format_g(r.tracking_ms) << "," << format_g(r.orb_ms) << "," << format_g(r.tracking.pe_match_ms)
        << "," << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers
-       << "," << (r.tracking.new_keyframe ? 1 : 0) << "," << format_g(r.mapping_ms) << "\n";
+       << "," << (r.tracking.new_keyframe ? 1 : 0) << "," << format_g(r.mapping_ms) << ","
+       << r.features_with_depth << "," << format_fixed(depth_valid, 4) << "\n";
   timing.append(line.str());
 }
 

@@ -121,6 +121,8 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
   out.num_features = static_cast<int>(features.keypoints.size());
   out.orb_ms = ms_since(t0);
   Frame frame(next_frame_id_++, in.t_ns, std::move(features), in.depth_m, cam_);
+  out.features_with_depth = static_cast<int>(std::count_if(frame.depth_m.begin(), frame.depth_m.end(),
+                                                           [](float d) { return d > 0; }));
   if (settings_.align_patches) frame.pyramid = std::make_shared<const ImagePyramid>(copy_pyramid(extractor_->pyramid()));
   tracking_->add_motion(in.t_ns, in.imu, in.wheel_ticks);
   std::shared_ptr<KeyFrame> kf = tracking_->track(std::move(frame), mapping_->idle(), mapping_->queue_size());

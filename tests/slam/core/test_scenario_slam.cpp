@@ -158,7 +158,12 @@ TEST(SlamScenario, BaselineModeReportsNoPeMatch) {
     std::vector<std::string> f;
     std::stringstream ss(line);
     for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
-    ASSERT_GE(f.size(), 11u);
+    ASSERT_EQ(f.size(), 24u) << line;
+    // keypoints with depth: at most the keypoints; the depth image's share in [0, 1]
+    EXPECT_LE(std::stoi(f[22]), std::stoi(f[4])) << line;
+    EXPECT_GT(std::stoi(f[22]), 0) << line;
+    EXPECT_GT(std::stod(f[23]), 0.0) << line;
+    EXPECT_LE(std::stod(f[23]), 1.0) << line;
     if (f[3] != "motion") continue;
     ++motion;
     EXPECT_EQ(f[8], f[9]) << line;

@@ -79,6 +79,7 @@ struct FrameResult {
   double orb_ms = 0;                ///< of which ORB extraction
   double mapping_ms = 0;            ///< inline local mapping (synchronous mode)
   int num_features = 0;
+  int features_with_depth = 0;      ///< keypoints whose depth the frame gives
 };
 
 /// What the system holds, by part (docs/slam.md, "Keyframe memory").
