@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <opencv2/core/utility.hpp>
 
@@ -14,6 +15,7 @@ namespace {
 constexpr float kGlintSigmaRad = static_cast<float>(kGlintSigmaDeg * M_PI / 180.0);
 constexpr float kGlintGain = 4.0f;        ///< the lobe saturates within ~1.7 sigma of its centre
 constexpr double kMirrorRayMaxM = 20.0;
+constexpr int kMirrorBlockPx = 4;
 /// A sunlit soil's colour as the mirror shows the ground (linear RGB).
 const Eigen::Vector3f kMirroredGroundRgb(0.36f, 0.30f, 0.23f);
 
@@ -49,6 +51,29 @@ cv::Rect face_rect(const std::vector<Eigen::Vector3d>& corners_c, const geom::Pi
 
 }  // namespace
 
+namespace {
+
+/// fresnel_reflectance(cos, kGlassIndex) at 1025 evenly spaced cosines,
+/// linearly interpolated: the per-pixel paths' Fresnel (within 2e-4).
+struct FresnelTable {
+  std::array<float, 1025> r{};
+  double cos_mirror_wins = 0;  ///< mirror_depth_wins below this cosine
+  FresnelTable();
+  float at(double cos_i) const {
+    const double x = std::clamp(std::abs(cos_i), 0.0, 1.0) * 1024.0;
+    const auto i = std::min<std::size_t>(static_cast<std::size_t>(x), 1023);
+    const float a = static_cast<float>(x - static_cast<double>(i));
+    return (1 - a) * r[i] + a * r[i + 1];
+  }
+};
+
+const FresnelTable& fresnel_table() {
+  static const FresnelTable t;
+  return t;
+}
+
+}  // namespace
+
 double fresnel_reflectance(double cos_i, double index) {
   cos_i = std::clamp(std::abs(cos_i), 0.0, 1.0);
   const double sin_t = std::sqrt(1.0 - cos_i * cos_i) / index;
@@ -59,15 +84,26 @@ double fresnel_reflectance(double cos_i, double index) {
   return 0.5 * (rs * rs + rp * rp);
 }
 
+FresnelTable::FresnelTable() {
+  for (std::size_t i = 0; i < r.size(); ++i) r[i] = static_cast<float>(fresnel_reflectance(static_cast<double>(i) / 1024.0));
+  // The mirror's image wins where R^2 rho_s > rho_c (1 - R)^2, R falling
+  // with the cosine: bisect for the crossing.
+  double lo = 0, hi = 1;
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi), R = fresnel_reflectance(mid);
+    (R * R * kMirroredSurfaceReflectance > kCellNirReflectance * (1 - R) * (1 - R) ? lo : hi) = mid;
+  }
+  cos_mirror_wins = lo;
+}
+
+float fresnel_glass(double cos_i) { return fresnel_table().at(cos_i); }
+
 double glass_pattern_range_m(double cos_i) {
-  const double R = fresnel_reflectance(cos_i);
+  const double R = fresnel_glass(cos_i);
   return kPatternRatedRangeM * std::sqrt(kCellNirReflectance * (1 - R) * (1 - R) / kPatternReferenceReflectance);
 }
 
-bool mirror_depth_wins(double cos_i) {
-  const double R = fresnel_reflectance(cos_i);
-  return R * R * kMirroredSurfaceReflectance > kCellNirReflectance * (1 - R) * (1 - R);
-}
+bool mirror_depth_wins(double cos_i) { return std::abs(cos_i) < fresnel_table().cos_mirror_wins; }
 
 GlassFinder::GlassFinder(const mjModel* m, const std::vector<bool>& specular_arrays) : m_(m) {
   for (int g = 0; g < m->ngeom; ++g) {
@@ -104,6 +140,11 @@ GlassView GlassFinder::find(const mjData* d, const cv::Mat& depth_m, const geom:
     const Eigen::Vector3d n_c = T_c_w.linear() * n_w;
     out.normals_c.push_back(n_c.cast<float>());
     const double tol_base = 0.005;
+    // One mirrored ray per block of kMirrorBlockPx x kMirrorBlockPx pixels
+    // of this face (its first pixel that needs one), shared by the block.
+    const int bw = (rect.width + kMirrorBlockPx - 1) / kMirrorBlockPx;
+    std::vector<float> block_m(static_cast<std::size_t>(bw) * ((rect.height + kMirrorBlockPx - 1) / kMirrorBlockPx),
+                               -1.0f);
     for (int r = rect.y; r < rect.y + rect.height; ++r)
       for (int c = rect.x; c < rect.x + rect.width; ++c) {
         const float z = depth_m.ptr<float>(r)[c];
@@ -115,12 +156,16 @@ GlassView GlassFinder::find(const mjData* d, const cv::Mat& depth_m, const geom:
         out.face.ptr<std::uint16_t>(r)[c] = k;
         const double cos_i = std::abs(n_c.dot(p_c)) / p_c.norm();
         if (!mirror_depth_wins(cos_i)) continue;
-        const Eigen::Vector3d v_w = T_w_c.linear() * p_c.normalized();
-        const Eigen::Vector3d refl = v_w - 2 * v_w.dot(n_w) * n_w;
-        const Eigen::Vector3d from = T_w_c * p_c + 0.01 * refl;
-        int geom = -1;
-        const mjtNum dist = mj_ray(m_, d, from.data(), refl.data(), nullptr, 1, -1, &geom);
-        if (geom >= 0 && dist > 0 && dist < kMirrorRayMaxM) out.mirror_m.ptr<float>(r)[c] = static_cast<float>(dist + 0.01);
+        float& m = block_m[static_cast<std::size_t>(((r - rect.y) / kMirrorBlockPx) * bw + (c - rect.x) / kMirrorBlockPx)];
+        if (m < 0) {
+          const Eigen::Vector3d v_w = T_w_c.linear() * p_c.normalized();
+          const Eigen::Vector3d refl = v_w - 2 * v_w.dot(n_w) * n_w;
+          const Eigen::Vector3d from = T_w_c * p_c + 0.01 * refl;
+          int geom = -1;
+          const mjtNum dist = mj_ray(m_, d, from.data(), refl.data(), nullptr, 1, -1, &geom);
+          m = geom >= 0 && dist > 0 && dist < kMirrorRayMaxM ? static_cast<float>(dist + 0.01) : 0.0f;
+        }
+        out.mirror_m.ptr<float>(r)[c] = m;
       }
   }
   return out;
@@ -139,6 +184,7 @@ void apply_glass(cv::Mat* image, const GlassView& glass, const geom::PinholeIntr
   if (glass.normals_c.empty()) return;
   const bool grey = image->type() == CV_32FC1;
   const Eigen::Vector3f sun_c = to_sun_c.normalized();
+  const float cos_glint_reach = std::cos(6 * kGlintSigmaRad);
   cv::parallel_for_(cv::Range(0, image->rows), [&](const cv::Range& rows) {
     for (int r = rows.start; r < rows.end; ++r) {
       const std::uint16_t* f = glass.face.ptr<std::uint16_t>(r);
@@ -148,11 +194,12 @@ void apply_glass(cv::Mat* image, const GlassView& glass, const geom::PinholeIntr
         const Eigen::Vector3f v = Eigen::Vector3f(static_cast<float>((c - K.cx) / K.fx),
                                                   static_cast<float>((r - K.cy) / K.fy), 1.0f).normalized();
         const float cos_i = std::abs(v.dot(n));
-        const float R = static_cast<float>(fresnel_reflectance(cos_i));
+        const float R = fresnel_glass(cos_i);
         const Eigen::Vector3f refl = v - 2 * v.dot(n) * n;
         Eigen::Vector3f add = 255.0f * R * mirrored_colour(glass.R_w_c * refl);
-        if (sun_up) {
-          const float angle = std::acos(std::clamp(refl.dot(sun_c), -1.0f, 1.0f));
+        const float cos_sun = refl.dot(sun_c);
+        if (sun_up && cos_sun > cos_glint_reach) {  // within 6 sigma of the sun's mirror direction
+          const float angle = std::acos(std::min(cos_sun, 1.0f));
           add += Eigen::Vector3f::Constant(255.0f * kGlintGain * R / 0.04f *
                                            std::exp(-angle * angle / (2 * kGlintSigmaRad * kGlintSigmaRad)));
         }

@@ -56,7 +56,7 @@ float glass_depth(const GlassView& glass, const SunlightFrame* sun, const Eigen:
   const float cos_i = std::abs(dot) / (n.norm() * ray.norm());
   if (z > glass_pattern_range_m(cos_i)) return 0;
   if (!sun) return z;
-  const float R = static_cast<float>(fresnel_reflectance(cos_i));
+  const float R = fresnel_glass(cos_i);
   const Eigen::Vector3f v = ray.normalized(), nf = n.normalized();
   const Eigen::Vector3f refl = v - 2 * v.dot(nf) * nf;
   const float glint_rad = 3 * static_cast<float>(kGlintSigmaDeg * M_PI / 180.0);

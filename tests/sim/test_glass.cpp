@@ -91,7 +91,15 @@ TEST(Glass, FresnelReflectanceOfGlassGrowsTowardsGrazingIncidence) {
     last = R;
   }
   // The cells' pattern comes back to 4 m sqrt(0.08 (1 - R)^2 / 0.5): 1.54 m head on.
-  EXPECT_NEAR(sim::glass_pattern_range_m(1.0), 4.0 * std::sqrt(0.08 * 0.96 * 0.96 / 0.5), 1e-9);
+  EXPECT_NEAR(sim::glass_pattern_range_m(1.0), 4.0 * std::sqrt(0.08 * 0.96 * 0.96 / 0.5), 1e-6);
+  for (double c = 0.0; c <= 1.0; c += 0.0037) {
+    const double R = sim::fresnel_reflectance(c);
+    EXPECT_NEAR(sim::fresnel_glass(c), R, 2e-4) << c;
+    // the mirror's image (R^2 0.3) against the cells' return (0.08 (1 - R)^2)
+    if (std::abs(R * R * 0.3 - 0.08 * (1 - R) * (1 - R)) > 1e-3) {
+      EXPECT_EQ(sim::mirror_depth_wins(c), R * R * 0.3 > 0.08 * (1 - R) * (1 - R)) << c;
+    }
+  }
   EXPECT_FALSE(sim::mirror_depth_wins(1.0));
   EXPECT_TRUE(sim::mirror_depth_wins(std::cos(85 * kDegToRad)));
 }

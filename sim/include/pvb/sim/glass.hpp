@@ -36,6 +36,9 @@ inline constexpr double kGlintSigmaDeg = 1.0;
 /// Fresnel's reflectance of one air-glass surface for unpolarised light
 /// arriving at incidence cosine `cos_i` (the mean of the s and p terms).
 double fresnel_reflectance(double cos_i, double index = kGlassIndex);
+/// fresnel_reflectance for kGlassIndex from a table (within 2e-4): the
+/// per-pixel paths' Fresnel.
+float fresnel_glass(double cos_i);
 
 /// The glass faces one camera sees in one state.
 struct GlassView {
@@ -43,8 +46,9 @@ struct GlassView {
   std::vector<Eigen::Vector3f> normals_c;  ///< unit, camera frame, towards the camera
   /// CV_32FC1: where a Kinect would take the mirror's image for the
   /// surface (mirror_depth_wins), the distance from the glass along the
-  /// mirrored ray to the first surface; 0 elsewhere or where the ray
-  /// meets nothing within 20 m.
+  /// mirrored ray to the first surface (one ray per block of 4 x 4
+  /// pixels of a face); 0 elsewhere or where the ray meets nothing
+  /// within 20 m.
   cv::Mat mirror_m;
   Eigen::Matrix3f R_w_c = Eigen::Matrix3f::Identity();  ///< the camera's orientation
 };
