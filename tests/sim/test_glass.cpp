@@ -2,11 +2,10 @@
 // glass, what the glass adds to colour, and what it does to Kinect depth.
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cmath>
-#include <memory>
 #include <string>
 
+#include "mjcf_scene.hpp"
 #include "pvb/sim/glass.hpp"
 #include "pvb/sim/sensor_model.hpp"
 
@@ -16,10 +15,7 @@ namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
 
-struct Scene {
-  std::unique_ptr<mjModel, void (*)(mjModel*)> m{nullptr, mj_deleteModel};
-  std::unique_ptr<mjData, void (*)(mjData*)> d{nullptr, mj_deleteData};
-};
+using Scene = pvb::test::MjcfScene;
 
 /// A 2 x 1 m panel of array 0 (its material named as the scene builder
 /// names them) lying flat 1 m up, its glass face up, over a ground plane.
@@ -30,18 +26,8 @@ Scene panel_scene() {
     <geom name="glass" type="box" pos="0 0 1" size="1 0.5 0.02" material="a0panel0"/>
     <geom name="other" type="box" pos="0 3 1" size="1 0.5 0.02" material="a1panel0"/>
   </worldbody></mujoco>)";
-  std::array<char, 1000> error{};
-  auto* vfs = new mjVFS;
-  mj_defaultVFS(vfs);
-  mj_makeEmptyFileVFS(vfs, "panel.xml", static_cast<int>(xml.size()));
-  std::copy(xml.begin(), xml.end(), static_cast<char*>(vfs->filedata[0]));
-  Scene s;
-  s.m.reset(mj_loadXML("panel.xml", vfs, error.data(), static_cast<int>(error.size())));
-  mj_deleteVFS(vfs);
-  delete vfs;
-  EXPECT_TRUE(s.m) << error.data();
-  s.d.reset(mj_makeData(s.m.get()));
-  mj_forward(s.m.get(), s.d.get());
+  Scene s = pvb::test::load_mjcf(xml);
+  EXPECT_TRUE(s.m) << s.error;
   return s;
 }
 

@@ -1,40 +1,26 @@
 #include <gtest/gtest.h>
 
-#include <array>
-#include <memory>
 #include <string>
 
+#include "mjcf_scene.hpp"
 #include "pvb/sim/sun_shadow.hpp"
 
 using namespace pvb;
 
 namespace {
 
+using Scene = pvb::test::MjcfScene;
+
 // A ground plane, a 2 x 2 m roof 1 m up and a ball hidden from drawing
 // (group 3), from MuJoCo's own parser.
-struct Scene {
-  std::unique_ptr<mjModel, void (*)(mjModel*)> m{nullptr, mj_deleteModel};
-  std::unique_ptr<mjData, void (*)(mjData*)> d{nullptr, mj_deleteData};
-};
-
 Scene roof_scene() {
   static const std::string xml = R"(<mujoco><worldbody>
     <geom type="plane" size="10 10 1"/>
     <geom type="box" pos="0 0 1" size="1 1 0.02"/>
     <geom type="sphere" pos="4 0 1" size="0.5" group="3"/>
   </worldbody></mujoco>)";
-  std::array<char, 1000> error{};
-  auto* vfs = new mjVFS;
-  mj_defaultVFS(vfs);
-  mj_makeEmptyFileVFS(vfs, "roof.xml", static_cast<int>(xml.size()));
-  std::copy(xml.begin(), xml.end(), static_cast<char*>(vfs->filedata[0]));
-  Scene s;
-  s.m.reset(mj_loadXML("roof.xml", vfs, error.data(), static_cast<int>(error.size())));
-  mj_deleteVFS(vfs);
-  delete vfs;
-  EXPECT_TRUE(s.m) << error.data();
-  s.d.reset(mj_makeData(s.m.get()));
-  mj_forward(s.m.get(), s.d.get());
+  Scene s = pvb::test::load_mjcf(xml);
+  EXPECT_TRUE(s.m) << s.error;
   return s;
 }
 
