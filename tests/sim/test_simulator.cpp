@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 #include <thread>
+#include <algorithm>
 #include <vector>
 
 #include "pvb/common/error.hpp"
@@ -152,6 +153,39 @@ TEST(Simulator, OpticalFramePoseAndDepthAgreeWithTheWallPlane) {
   EXPECT_NEAR(cap.frame.depth_m.at<float>(240, 320), cap.depth_gt_m.at<float>(240, 320),
               0.5 / sensor::kTumDepthFactor + 1e-6);
   EXPECT_NE(cap.frame.depth_m.at<float>(240, 320), 0.0f);
+}
+
+// The d435 model end to end on the default station: two infrared renders,
+// matching, registration; the depth agrees with the rendered truth.
+TEST(Simulator, TheD435ModelsDepthAgreesWithTheTruthOnTheStation) {
+  scenes::Scenario s = scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml");
+  s.camera.model = scenes::CameraModel::kD435;
+  s.camera.width = 640;
+  s.camera.height = 480;
+  s.camera.fx = s.camera.fy = 615.0;
+  sim::Simulator sim(s);
+  sim::RgbdCamera camera(sim, sim::GlBackend::kAuto);
+  for (int i = 0; i < 30; ++i) sim.advance();
+  sim::RenderedFrame rendered = camera.render(sim);
+  ASSERT_TRUE(rendered.stereo.has_value());
+  EXPECT_EQ(rendered.stereo->left.grey.cols, 848);
+  const sim::Capture cap = camera.sensor_model().apply(std::move(rendered));
+  EXPECT_GT(cap.stereo.match_ms, 0.0);
+  int in_range = 0, valid = 0;
+  std::vector<double> rel;
+  for (int r = 0; r < 480; r += 4)
+    for (int c = 0; c < 640; c += 4) {
+      const float zt = cap.depth_gt_m.at<float>(r, c), z = cap.frame.depth_m.at<float>(r, c);
+      if (zt < 0.5f || zt > 4.5f) continue;
+      ++in_range;
+      if (z <= 0) continue;
+      ++valid;
+      rel.push_back(std::abs(z - zt) / zt);
+    }
+  ASSERT_GT(in_range, 5000);
+  EXPECT_GT(static_cast<double>(valid) / in_range, 0.8);
+  std::nth_element(rel.begin(), rel.begin() + static_cast<std::ptrdiff_t>(rel.size() / 2), rel.end());
+  EXPECT_LT(rel[rel.size() / 2], 0.03) << "median relative depth error";
 }
 
 TEST(Simulator, DrivesStraight) {
