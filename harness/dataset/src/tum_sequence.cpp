@@ -86,7 +86,7 @@ std::string orbslam_settings_text(const OrbSlamSettings& s) {
       "Camera.k1: %.6f\nCamera.k2: %.6f\nCamera.p1: %.6f\nCamera.p2: %.6f\nCamera.k3: %.6f\n\n"
       "Camera.width: %d\nCamera.height: %d\n\n"
       "# Camera frames per second\nCamera.fps: %.1f\n\n"
-      "# IR projector baseline times fx (approx.)\nCamera.bf: %.6f\n\n"
+      "# depth baseline (a Kinect's projector to camera, a stereo camera's imagers) times fx\nCamera.bf: %.6f\n\n"
       "# Color order of the images (0: BGR, 1: RGB. It is ignored if images are grayscale)\n"
       "Camera.RGB: %d\n\n"
       "# Close/Far threshold. Baseline times.\nThDepth: %.1f\n\n"
