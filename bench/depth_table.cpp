@@ -117,12 +117,7 @@ int run(const Options& o) {
   if (o.model == "d435") s.camera.model = pvb::scenes::CameraModel::kD435;
   if (o.model == "kinect") s.camera.model = pvb::scenes::CameraModel::kKinect;
   if (!o.sunlight.empty()) s.camera.depth_noise.sunlight.on = o.sunlight == "on";
-  if (s.camera.model == pvb::scenes::CameraModel::kD435 && o.model == "d435") {  // the D435's own colour camera
-    s.camera.width = 640;
-    s.camera.height = 480;
-    s.camera.fx = s.camera.fy = 615.0;
-    s.camera.depth_range_m = {0.2, 6.0};
-  }
+  if (o.model == "d435") s.camera.use_d435_colour_camera();
   pvb::sim::Simulator sim(s);
   pvb::sim::RgbdCamera camera(sim, pvb::sim::parse_gl_backend(o.gl));
   pvb::sim::Renderer ids(sim.model(), camera.backend(), s.camera.width, s.camera.height);

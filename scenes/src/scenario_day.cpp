@@ -167,6 +167,11 @@ double clear_sky_beam_share(double elevation_deg) {
   return elevation_deg > 0 ? detail::beam_share(std::min(elevation_deg, 90.0)) : 0.0;
 }
 
+double beam_relative_to_air_mass_15(double elevation_deg) {
+  constexpr double kAirMass15ElevationDeg = 41.81;
+  return clear_sky_beam_share(elevation_deg) / clear_sky_beam_share(kAirMass15ElevationDeg);
+}
+
 double sky_ambient_for(double elevation_deg) {
   const double sin_el = std::sin(std::clamp(elevation_deg, 0.0, 90.0) * detail::kDeg);
   return std::clamp(0.35 * (0.45 + 0.55 * sin_el / std::sin(45.0 * detail::kDeg)), 0.1, 0.6);

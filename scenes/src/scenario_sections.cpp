@@ -257,12 +257,7 @@ void read_stereo(MapReader& n, ActiveStereo& a) {
 
 void read_camera(MapReader& r, Camera& c) {
   c.model = r.choice<CameraModel>("model", c.model, {{"kinect", CameraModel::kKinect}, {"d435", CameraModel::kD435}});
-  if (c.model == CameraModel::kD435) {  // the D435's colour camera at 640 x 480 and its depth range
-    c.width = 640;
-    c.height = 480;
-    c.fx = c.fy = 615.0;
-    c.depth_range_m = {0.2, 6.0};
-  }
+  if (c.model == CameraModel::kD435) c.use_d435_colour_camera();
   c.width = r.integer("width", c.width, 32, 4096);
   c.height = r.integer("height", c.height, 32, 4096);
   const bool has_fx = r.has("fx");

@@ -101,13 +101,11 @@ float DotPattern::at(float tx, float ty) const {
 }
 
 ActiveStereoModel::ActiveStereoModel(const scenes::Camera& cam, double sun_elevation_deg, std::uint64_t seed)
-    : cam_(cam), seed_(seed), dots_(std::make_shared<DotPattern>(cam.stereo)) {
+    : cam_(cam), seed_(seed), dots_(cam.stereo) {
   const scenes::ActiveStereo& p = cam.stereo;
   K_ir_ = {p.ir_fx, p.ir_fx, p.ir_cx(), p.ir_cy(), p.ir_width, p.ir_height};
   K_colour_ = {cam.fx, cam.fy, cam.cx(), cam.cy(), cam.width, cam.height};
-  constexpr double kAirMass15ElevationDeg = 41.81;  // ASTM G173's sun
-  const double beam = p.band_sun_w_m2 * scenes::clear_sky_beam_share(sun_elevation_deg) /
-                      scenes::clear_sky_beam_share(kAirMass15ElevationDeg);
+  const double beam = p.band_sun_w_m2 * scenes::beam_relative_to_air_mass_15(sun_elevation_deg);
   beam_w_m2_ = static_cast<float>(beam);
   sky_w_m2_ = static_cast<float>(p.sky_share * beam);
   intensity_w_sr_ = static_cast<float>(
@@ -116,7 +114,7 @@ ActiveStereoModel::ActiveStereoModel(const scenes::Camera& cam, double sun_eleva
 
 float ActiveStereoModel::pattern_range_m() const {
   const float shade = std::max(sky_w_m2_, static_cast<float>(cam_.stereo.min_ambient_w_m2));
-  return std::sqrt(intensity_w_sr_ * dots_->peak() / (kPatternFloorShare * shade));
+  return std::sqrt(intensity_w_sr_ * dots_.peak() / (kPatternFloorShare * shade));
 }
 
 cv::Mat ActiveStereoModel::infrared_image(const InfraredView& view, bool right_imager,
@@ -141,7 +139,7 @@ cv::Mat ActiveStereoModel::infrared_image(const InfraredView& view, bool right_i
         if (z[c] <= 0) continue;
         const Eigen::Vector3f ray(xn[static_cast<std::size_t>(c)], yn[static_cast<std::size_t>(r)], 1.0f);
         const Eigen::Vector3f q = z[c] * ray - Eigen::Vector3f(proj_x, 0, 0);  // from the projector
-        const float spot = dots_->at(q.x() / q.z(), q.y() / q.z());
+        const float spot = dots_.at(q.x() / q.z(), q.y() / q.z());
         if (spot <= 0) continue;
         Eigen::Vector3f n;
         float cos_projector = 1, cos_sun = 1;

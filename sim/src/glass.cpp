@@ -41,12 +41,10 @@ cv::Rect face_rect(const std::vector<Eigen::Vector3d>& corners_c, const geom::Pi
     const double u = K.fx * p.x() / p.z() + K.cx, v = K.fy * p.y() / p.z() + K.cy;
     u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
   }
-  const cv::Rect r(static_cast<int>(std::floor(std::max(u0, -1.0))), static_cast<int>(std::floor(std::max(v0, -1.0))),
-                   0, 0);
+  const int x0 = static_cast<int>(std::floor(std::max(u0, -1.0))), y0 = static_cast<int>(std::floor(std::max(v0, -1.0)));
   const int x1 = static_cast<int>(std::ceil(std::min(u1, static_cast<double>(K.width))));
   const int y1 = static_cast<int>(std::ceil(std::min(v1, static_cast<double>(K.height))));
-  return cv::Rect(r.x, r.y, std::max(0, x1 - r.x + 1), std::max(0, y1 - r.y + 1)) &
-         cv::Rect(0, 0, K.width, K.height);
+  return cv::Rect(x0, y0, std::max(0, x1 - x0 + 1), std::max(0, y1 - y0 + 1)) & cv::Rect(0, 0, K.width, K.height);
 }
 
 }  // namespace
@@ -118,7 +116,7 @@ GlassFinder::GlassFinder(const mjModel* m, const std::vector<bool>& specular_arr
 }
 
 GlassView GlassFinder::find(const mjData* d, const cv::Mat& depth_m, const geom::PinholeIntrinsics& K,
-                            const geom::SE3d& T_w_c) const {
+                            const geom::SE3d& T_w_c, bool mirror_rays) const {
   GlassView out;
   out.face = cv::Mat::zeros(depth_m.size(), CV_16UC1);
   out.mirror_m = cv::Mat::zeros(depth_m.size(), CV_32FC1);
@@ -154,8 +152,7 @@ GlassView GlassFinder::find(const mjData* d, const cv::Mat& depth_m, const geom:
         if (std::abs(q.z() - size.z()) > tol_base + 0.002 * z || std::abs(q.x()) > size.x() || std::abs(q.y()) > size.y())
           continue;
         out.face.ptr<std::uint16_t>(r)[c] = k;
-        const double cos_i = std::abs(n_c.dot(p_c)) / p_c.norm();
-        if (!mirror_depth_wins(cos_i)) continue;
+        if (!mirror_rays || !mirror_depth_wins(std::abs(n_c.dot(p_c)) / p_c.norm())) continue;
         float& m = block_m[static_cast<std::size_t>(((r - rect.y) / kMirrorBlockPx) * bw + (c - rect.x) / kMirrorBlockPx)];
         if (m < 0) {
           const Eigen::Vector3d v_w = T_w_c.linear() * p_c.normalized();

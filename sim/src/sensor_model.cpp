@@ -59,8 +59,8 @@ float glass_depth(const GlassView& glass, const SunlightFrame* sun, const Eigen:
   const float R = fresnel_glass(cos_i);
   const Eigen::Vector3f v = ray.normalized(), nf = n.normalized();
   const Eigen::Vector3f refl = v - 2 * v.dot(nf) * nf;
-  const float glint_rad = 3 * static_cast<float>(kGlintSigmaDeg * M_PI / 180.0);
-  if (sun->beam_w_m2 > 0 && refl.dot(sun->to_sun_c) > std::cos(glint_rad)) return 0;  // the sun's glint
+  static const float cos_glint = static_cast<float>(std::cos(3 * kGlintSigmaDeg * M_PI / 180.0));
+  if (sun->beam_w_m2 > 0 && refl.dot(sun->to_sun_c) > cos_glint) return 0;  // within 3 sigma of the sun's glint
   // The mirrored sky over the cells' diffuse share of the pattern.
   const float cells = static_cast<float>(kCellNirReflectance) * (1 - R) * (1 - R);
   return pattern_survives(*sun, n, ray, dot, z, lit, R / cells * sun->sky_w_m2) ? z : 0.0f;
@@ -70,9 +70,7 @@ float glass_depth(const GlassView& glass, const SunlightFrame* sun, const Eigen:
 
 SunlightFrame sunlight_frame(const scenes::Sunlight& params, double sun_elevation_deg,
                              const Eigen::Vector3f& to_sun_c, cv::Mat lit) {
-  constexpr double kAirMass15ElevationDeg = 41.81;  // air mass 1.5, ASTM G173's sun
-  const double beam = params.filter_width_nm * params.sun_w_m2_nm * scenes::clear_sky_beam_share(sun_elevation_deg) /
-                      scenes::clear_sky_beam_share(kAirMass15ElevationDeg);
+  const double beam = params.filter_width_nm * params.sun_w_m2_nm * scenes::beam_relative_to_air_mass_15(sun_elevation_deg);
   SunlightFrame f;
   f.to_sun_c = to_sun_c.normalized();
   f.beam_w_m2 = static_cast<float>(beam);

@@ -219,8 +219,8 @@ RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
   renderer_.set_shadows(sim.scenario().light.shadows);
   std::vector<bool> specular;
   for (const auto& a : sim.scenario().pv_arrays) specular.push_back(a.specular_glass);
-  if (std::find(specular.begin(), specular.end(), true) != specular.end())
-    glass_ = std::make_unique<GlassFinder>(sim.model(), specular);
+  glass_ = std::make_unique<GlassFinder>(sim.model(), specular);
+  if (glass_->empty()) glass_.reset();
   const scenes::Camera& cam = sim.scenario().camera;
   if (cam.model != scenes::CameraModel::kD435) return;
   ir_renderer_ = std::make_unique<Renderer>(sim.model(), renderer_.backend(), cam.stereo.ir_width, cam.stereo.ir_height);
@@ -231,12 +231,11 @@ RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
     throw ConfigError("model", "camera", "the infrared cameras of the d435 model", "none");
 }
 
-StereoRender RgbdCamera::render_infrared(Simulator& sim) {
+StereoRender RgbdCamera::render_infrared(Simulator& sim, const geom::SE3d& T_w_c, const Eigen::Vector3d& to_sun_c) {
   const scenes::Scenario& s = sim.scenario();
   const scenes::ActiveStereo& p = s.camera.stereo;
   StereoRender out;
-  const geom::SE3d T_w_c = sim.T_w_c();
-  out.to_sun_c = (T_w_c.linear().transpose() * sim.to_sun_w()).cast<float>();
+  out.to_sun_c = to_sun_c.cast<float>();
   const float sky = static_cast<float>(sim.assets().max_scene_depth_m);
   std::optional<SunShadowCaster> caster;
   if (s.light.sun_elevation_deg > 0) caster.emplace(sim.model(), sim.data(), sim.to_sun_w());
@@ -251,7 +250,7 @@ StereoRender RgbdCamera::render_infrared(Simulator& sim) {
     const double x_m = -p.colour_offset_m + (k == 0 ? 0.0 : p.baseline_m);  // along the colour camera's x
     const geom::SE3d T_w_ir = T_w_c * geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(x_m, 0, 0));
     if (caster) v.lit = sun_visibility(*caster, v.depth_m, K_ir, T_w_ir, 16, pattern_range_m);
-    if (glass_) v.glass = glass_->find(sim.data(), v.depth_m, K_ir, T_w_ir);
+    if (glass_) v.glass = glass_->find(sim.data(), v.depth_m, K_ir, T_w_ir, false);  // no Kinect depth here
   }
   return out;
 }
@@ -265,26 +264,23 @@ RenderedFrame RgbdCamera::render(Simulator& sim) {
   const float sky = static_cast<float>(sim.assets().max_scene_depth_m);
   out.depth_gt_m.setTo(0.0f, out.depth_gt_m > sky);
   out.sun_px = sim.sun_pixel();
+  const geom::SE3d T_w_c = sim.T_w_c();
+  out.to_sun_c = T_w_c.linear().transpose() * sim.to_sun_w();
   const scenes::Camera& cam = sim.scenario().camera;
-  if (cam.depth_noise.model == scenes::DepthNoiseModel::kKinect && cam.depth_noise.sunlight.on &&
-      sim.scenario().light.sun_elevation_deg > 0) {
-    out.to_sun_c = sim.T_w_c().linear().transpose() * sim.to_sun_w();
+  if (cam.model == scenes::CameraModel::kKinect && cam.depth_noise.model == scenes::DepthNoiseModel::kKinect &&
+      cam.depth_noise.sunlight.on && sim.scenario().light.sun_elevation_deg > 0) {
     const float shade_range_m = sunlight_frame(cam.depth_noise.sunlight, sim.scenario().light.sun_elevation_deg,
                                                out.to_sun_c.cast<float>(), cv::Mat())
                                     .shade_range_m();
     const SunShadowCaster caster(sim.model(), sim.data(), sim.to_sun_w());
-    out.sun_lit = sun_visibility(caster, out.depth_gt_m, sim.intrinsics(), sim.T_w_c(), 16, shade_range_m);
+    out.sun_lit = sun_visibility(caster, out.depth_gt_m, sim.intrinsics(), T_w_c, 16, shade_range_m);
   }
-  out.sun_up = sim.scenario().light.sun_elevation_deg > 0;
-  if (glass_) {
-    out.glass = glass_->find(sim.data(), out.depth_gt_m, sim.intrinsics(), sim.T_w_c());
-    out.to_sun_c = sim.T_w_c().linear().transpose() * sim.to_sun_w();
-  }
-  if (ir_renderer_) out.stereo = render_infrared(sim);
+  if (glass_) out.glass = glass_->find(sim.data(), out.depth_gt_m, sim.intrinsics(), T_w_c, true);
+  if (ir_renderer_) out.stereo = render_infrared(sim, T_w_c, out.to_sun_c);
   out.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   out.index = static_cast<std::uint64_t>(sim.frame_index());
   out.t_ns = sim.t_ns();
-  out.T_w_c = sim.T_w_c();
+  out.T_w_c = T_w_c;
   out.motion = sim.take_motion();
   return out;
 }
@@ -321,7 +317,7 @@ Capture SensorModel::apply(RenderedFrame rendered) const {
                                           rendered.glass ? &*rendered.glass : nullptr);
   }
   if (rendered.glass && !covered)
-    apply_glass(&rendered.rgb, *rendered.glass, K_, rendered.to_sun_c.cast<float>(), rendered.sun_up);
+    apply_glass(&rendered.rgb, *rendered.glass, K_, rendered.to_sun_c.cast<float>(), sun_elevation_deg_ > 0);
   apply_rgb_model(&rendered.rgb, camera_.rgb, covered ? std::nullopt : rendered.sun_px, seed_,
                   rendered.index);
   out.frame.rgb = std::move(rendered.rgb);

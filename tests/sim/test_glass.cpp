@@ -98,7 +98,7 @@ TEST(Glass, TheFinderMarksTheSpecularArraysGlassFaceOnly) {
   const geom::SE3d above = looking_at_panel(40);
   cv::Mat depth, ids;
   cast_depth(s, kK, above, &depth, &ids);
-  const sim::GlassView v = finder.find(s.d.get(), depth, kK, above);
+  const sim::GlassView v = finder.find(s.d.get(), depth, kK, above, true);
   ASSERT_EQ(v.normals_c.size(), 1u) << "one face turned to the camera; array 1 is diffuse";
   int on_glass = 0, agree = 0;
   for (int r = 0; r < kK.height; ++r)
@@ -114,7 +114,7 @@ TEST(Glass, TheFinderMarksTheSpecularArraysGlassFaceOnly) {
   // From below, the camera sees the back: no glass.
   const geom::SE3d below = looking_at_panel(-40);
   cast_depth(s, kK, below, &depth, &ids);
-  EXPECT_EQ(cv::countNonZero(finder.find(s.d.get(), depth, kK, below).face), 0);
+  EXPECT_EQ(cv::countNonZero(finder.find(s.d.get(), depth, kK, below, true).face), 0);
 }
 
 TEST(Glass, ColourMirrorsMoreOfTheSkyTowardsGrazingAndGlintsAtTheSunsMirror) {
@@ -125,7 +125,7 @@ TEST(Glass, ColourMirrorsMoreOfTheSkyTowardsGrazingAndGlintsAtTheSunsMirror) {
     const geom::SE3d T = looking_at_panel(elevation_deg);
     cv::Mat depth, ids;
     cast_depth(s, kK, T, &depth, &ids);
-    const sim::GlassView v = finder.find(s.d.get(), depth, kK, T);
+    const sim::GlassView v = finder.find(s.d.get(), depth, kK, T, true);
     cv::Mat rgb(kK.height, kK.width, CV_8UC3, cv::Scalar(20, 30, 60));
     const Eigen::Vector3f to_sun_c = T.linear().transpose().cast<float>() * to_sun_w.normalized();
     sim::apply_glass(&rgb, v, kK, to_sun_c, sun_up);

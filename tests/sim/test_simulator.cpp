@@ -160,9 +160,7 @@ TEST(Simulator, OpticalFramePoseAndDepthAgreeWithTheWallPlane) {
 TEST(Simulator, TheD435ModelsDepthAgreesWithTheTruthOnTheStation) {
   scenes::Scenario s = scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml");
   s.camera.model = scenes::CameraModel::kD435;
-  s.camera.width = 640;
-  s.camera.height = 480;
-  s.camera.fx = s.camera.fy = 615.0;
+  s.camera.use_d435_colour_camera();
   sim::Simulator sim(s);
   sim::RgbdCamera camera(sim, sim::GlBackend::kAuto);
   for (int i = 0; i < 30; ++i) sim.advance();

@@ -320,12 +320,7 @@ void OfflineSlam::Impl::write_timing_line(const sensor::RgbdFrame& frame, const 
        << "," << r.tracking.align_tried << "," << r.tracking.aligned << "," << format_g(r.tracking.align_ms)
        << "," << r.tracking.kf_tracked_close << "," << r.tracking.kf_untracked_close << ","
        << r.tracking.kf_ref_points << "," << r.tracking.kf_ref_all << "," << r.tracking.kf_ref_shared << ","
-       << r.features_with_depth << ","
-       << format_fixed(frame.depth_m.empty() ? 0.0
-                                             : static_cast<double>(cv::countNonZero(frame.depth_m > 0)) /
-                                                   static_cast<double>(frame.depth_m.total()),
-                       4)
-       << "\n";
+       << r.features_with_depth << "," << format_fixed(r.depth_valid, 4) << "\n";
   timing_.append(line.str());
 }
 

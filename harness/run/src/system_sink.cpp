@@ -88,9 +88,6 @@ void SystemSink::open_outputs() {
 
 slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log) {
   const slam::FrameResult r = system->track(frame);
-  depth_valid = frame.depth_m.empty() ? 0.0
-                                      : static_cast<double>(cv::countNonZero(frame.depth_m > 0)) /
-                                            static_cast<double>(frame.depth_m.total());
   if (!first_t_ns) first_t_ns = frame.t_ns;
   const int index = static_cast<int>(frame.index);
   const double t_s = geom::ns_to_seconds(frame.t_ns);
@@ -150,7 +147,7 @@ void SystemSink::write_lines(const slam::FrameResult& r, int index) {
        << format_g(r.tracking_ms) << "," << format_g(r.orb_ms) << "," << format_g(r.tracking.pe_match_ms)
        << "," << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers
        << "," << (r.tracking.new_keyframe ? 1 : 0) << "," << format_g(r.mapping_ms) << ","
-       << r.features_with_depth << "," << format_fixed(depth_valid, 4) << "\n";
+       << r.features_with_depth << "," << format_fixed(r.depth_valid, 4) << "\n";
   timing.append(line.str());
 }
 

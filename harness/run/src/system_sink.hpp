@@ -28,7 +28,6 @@ struct SystemSink {
   std::unique_ptr<slam::System> system;
   std::string dir;
   OutputFile cam_traj, kf_traj, timing;
-  double depth_valid = 0;  ///< the last frame's share of pixels with depth
   eval::Trajectory est;
   eval::GravityEstimates gravity_estimates;  ///< the core's gravity per frame, once trusted
   eval::Trajectory refined;  ///< filled by finish()

@@ -123,6 +123,8 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
   Frame frame(next_frame_id_++, in.t_ns, std::move(features), in.depth_m, cam_);
   out.features_with_depth = static_cast<int>(std::count_if(frame.depth_m.begin(), frame.depth_m.end(),
                                                            [](float d) { return d > 0; }));
+  if (!in.depth_m.empty())
+    out.depth_valid = static_cast<double>(cv::countNonZero(in.depth_m > 0)) / static_cast<double>(in.depth_m.total());
   if (settings_.align_patches) frame.pyramid = std::make_shared<const ImagePyramid>(copy_pyramid(extractor_->pyramid()));
   tracking_->add_motion(in.t_ns, in.imu, in.wheel_ticks);
   std::shared_ptr<KeyFrame> kf = tracking_->track(std::move(frame), mapping_->idle(), mapping_->queue_size());

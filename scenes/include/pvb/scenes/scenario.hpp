@@ -300,6 +300,14 @@ struct Camera {
   /// The depth sensor's baseline: the Kinect's projector to camera, the
   /// D435's imager to imager.
   double depth_baseline_m() const { return model == CameraModel::kD435 ? stereo.baseline_m : depth_noise.baseline_m; }
+  /// The D435's own colour camera and depth range: 640 x 480 at fx 615,
+  /// [0.2, 6] m (the d435 model's defaults, before the file's keys).
+  void use_d435_colour_camera() {
+    width = 640;
+    height = 480;
+    fx = fy = 615.0;
+    depth_range_m = {0.2, 6.0};
+  }
 };
 
 /// The robot's caster is this far behind the wheels' axle: its wheel base.
@@ -484,6 +492,10 @@ double sun_intensity_for(double elevation_deg);
 /// 0.7^(AM^0.678) (Meinel and Meinel 1976; Kasten and Young's air mass); 0
 /// for a sun at or below the horizon.
 double clear_sky_beam_share(double elevation_deg);
+/// The beam at this elevation relative to the beam of ASTM G173's
+/// reference sun (air mass 1.5, 41.81 degrees up): what multiplies a
+/// spectral irradiance read off G173.
+double beam_relative_to_air_mass_15(double elevation_deg);
 /// The sky's light (light.ambient) likewise: the default 0.35 at 45
 /// degrees, 0.45 + 0.55 sin(elevation) / sin(45) of it; in [0.1, 0.6].
 double sky_ambient_for(double elevation_deg);

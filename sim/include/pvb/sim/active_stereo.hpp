@@ -7,7 +7,6 @@
 // seed, frame index, row), as in the Kinect model.
 #include <Eigen/Core>
 #include <cstdint>
-#include <memory>
 #include <opencv2/core.hpp>
 
 #include "pvb/geometry/pinhole.hpp"
@@ -83,7 +82,7 @@ class ActiveStereoModel {
   geom::PinholeIntrinsics K_ir_, K_colour_;
   float beam_w_m2_ = 0, sky_w_m2_ = 0, intensity_w_sr_ = 0;
   std::uint64_t seed_ = 0;
-  std::shared_ptr<const DotPattern> dots_;
+  DotPattern dots_;
 };
 
 /// Source depth (CV_32FC1, 0 = none) as the destination camera sees it.

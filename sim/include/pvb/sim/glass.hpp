@@ -66,10 +66,11 @@ class GlassFinder {
   bool empty() const { return panels_.empty(); }
   /// The glass in a depth image (CV_32FC1, metres, 0 = none) seen from
   /// T_w_c: pixels whose surface point lies on a glass face (within 5 mm
-  /// plus 0.2 % of the depth), and for mirror_depth_wins pixels the
-  /// mirrored ray cast against the scene.
-  GlassView find(const mjData* d, const cv::Mat& depth_m, const geom::PinholeIntrinsics& K,
-                 const geom::SE3d& T_w_c) const;
+  /// plus 0.2 % of the depth), and with `mirror_rays` (what a Kinect's
+  /// depth needs) for mirror_depth_wins pixels the mirrored ray cast
+  /// against the scene (mirror_m stays 0 without).
+  GlassView find(const mjData* d, const cv::Mat& depth_m, const geom::PinholeIntrinsics& K, const geom::SE3d& T_w_c,
+                 bool mirror_rays) const;
 
  private:
   const mjModel* m_;

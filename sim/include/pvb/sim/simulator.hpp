@@ -132,12 +132,11 @@ struct RenderedFrame {
   cv::Mat depth_gt_m;                 ///< rendered depth, exact, sky = 0
   std::optional<cv::Point2d> sun_px;  ///< the sun's projection (Simulator::sun_pixel)
   /// With the Kinect model's sunlight: 1 where the sun reaches the point a
-  /// pixel sees (sun_visibility), and the sun's direction in the camera.
+  /// pixel sees (sun_visibility).
   cv::Mat sun_lit;
-  Eigen::Vector3d to_sun_c = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d to_sun_c = Eigen::Vector3d::UnitZ();  ///< the sun's direction in the camera
   std::optional<StereoRender> stereo;  ///< the d435 model's infrared views
   std::optional<GlassView> glass;      ///< the colour camera's specular glass
-  bool sun_up = false;                 ///< the sun above the horizon
   std::uint64_t index = 0;            ///< frame index
   std::int64_t t_ns = 0;
   geom::SE3d T_w_c;                   ///< ground-truth camera pose
@@ -182,7 +181,7 @@ class RgbdCamera {
 
  private:
   /// The d435 model's two infrared views of the current state.
-  StereoRender render_infrared(Simulator& sim);
+  StereoRender render_infrared(Simulator& sim, const geom::SE3d& T_w_c, const Eigen::Vector3d& to_sun_c);
   Renderer renderer_;
   SensorModel sensor_;
   std::unique_ptr<Renderer> ir_renderer_;  ///< with camera.model d435

@@ -80,6 +80,7 @@ struct FrameResult {
   double mapping_ms = 0;            ///< inline local mapping (synchronous mode)
   int num_features = 0;
   int features_with_depth = 0;      ///< keypoints whose depth the frame gives
+  double depth_valid = 0;           ///< the depth image's share of pixels with depth
 };
 
 /// What the system holds, by part (docs/slam.md, "Keyframe memory").
