@@ -501,7 +501,9 @@ void read_relief(MapReader& q, Ground& g) {
 void read_ground(MapReader& r, Ground& g) {
   g.type = r.choice<GroundType>("type", g.type, {{"soil", GroundType::kSoil}, {"gravel", GroundType::kGravel}});
   g.size_m = r.vec2("size_m", g.size_m, 5, 2000);
-  g.tiling = r.choice<GroundTiling>("tiling", g.tiling,
+  // A relief takes one repeated image: without a tiling given, that is its default.
+  const GroundTiling fallback = r.has("relief") ? GroundTiling::kRepeat : g.tiling;
+  g.tiling = r.choice<GroundTiling>("tiling", fallback,
                                     {{"repeat", GroundTiling::kRepeat}, {"varied", GroundTiling::kVaried}});
   with_map(r, "relief", [&](MapReader& q) { read_relief(q, g); });
   if (r.has("friction")) g.friction = r.number("friction", 0.0, 0.05, 2);

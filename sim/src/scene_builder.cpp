@@ -269,7 +269,7 @@ struct GroundTile {
 /// station's seed and the cell alone, so the route picks which cells are
 /// drawn, never how one looks.
 std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std::vector<Eigen::Vector2d>& route) {
-  if (s.ground.tiling != scenes::GroundTiling::kVaried) return {};
+  if (s.ground.drawn_tiling() != scenes::GroundTiling::kVaried) return {};
   const double tile = kGroundTileM, half_x = s.ground.size_m.x() / 2, half_y = s.ground.size_m.y() / 2;
   const double reach = kGroundVariedCorridorM + tile / std::sqrt(2.0);
   const auto cells_x = static_cast<long long>(std::floor(s.ground.size_m.x() / tile + 1e-9));
@@ -292,8 +292,8 @@ std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std
   }
   if (cells.size() > static_cast<std::size_t>(kMaxGroundTiles))
     throw ConfigError(s.source_file, "ground.tiling",
-                      "a varied ground of at most " + std::to_string(kMaxGroundTiles) + " tiles of " + f(tile) +
-                          " m along the route (a route of about 140 m)",
+                      "a varied ground (the default) of at most " + std::to_string(kMaxGroundTiles) + " tiles of " +
+                          f(tile) + " m along the route (a route of about 140 m), or tiling: repeat",
                       std::to_string(cells.size()) + " tiles");
   std::vector<GroundTile> tiles;
   for (const auto& [i, j] : cells) {
@@ -666,7 +666,7 @@ void add_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<Groun
     return;
   }
   const std::string size = v3(s.ground.size_m.x() / 2, s.ground.size_m.y() / 2, 1);
-  const bool varied = s.ground.tiling == scenes::GroundTiling::kVaried;
+  const bool varied = s.ground.drawn_tiling() == scenes::GroundTiling::kVaried;
   x.line("<geom name=\"ground\" type=\"plane\" size=\"" + size + "\" material=\"ground\" condim=\"3\" " +
          std::string(varied ? "group=\"3\" " : "") + ground_friction(s.ground) + "/>");
   if (!varied) return;

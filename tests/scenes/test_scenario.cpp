@@ -438,8 +438,10 @@ TEST(Scenario, NestedMistakesNameTheFullKeyAndItsLine) {
   EXPECT_NE(e.find("got unknown key"), std::string::npos) << e;
 }
 
-TEST(Scenario, SunlightOnTheDepthPatternIsOffUnlessAsked) {
-  EXPECT_FALSE(parse_scenario(kMinimal, "min.yaml").camera.depth_noise.sunlight.on);
+TEST(Scenario, SunlightOnTheDepthPatternIsOnUnlessTurnedOff) {
+  EXPECT_TRUE(parse_scenario(kMinimal, "min.yaml").camera.depth_noise.sunlight.on);
+  EXPECT_FALSE(parse_scenario(std::string(kMinimal) + "camera:\n  depth_noise: {sunlight: off}\n", "off.yaml")
+                   .camera.depth_noise.sunlight.on);
   const Scenario s = parse_scenario(std::string(kMinimal) +
                                         "camera:\n  depth_noise: {sunlight: on, sunlight_filter_nm: 20, "
                                         "sunlight_min_contrast: 0.01}\n",

@@ -261,10 +261,13 @@ TEST(ScenarioDays, TrackerRotationFollowsTheSun) {
               a.clearance_m, 1e-12);
 }
 
-// A day keeps its station's ground, varied or repeated, and may not change it.
+// A day keeps its station's ground, varied or repeated, and may not change
+// it.  Varied is the default; a relief keeps the repeated image.
 TEST(ScenarioDays, TheGroundsTilingIsTheStations) {
   EXPECT_EQ(load_scenario(kScenes + "days/loop_varied_part.yaml").ground.tiling, GroundTiling::kVaried);
-  EXPECT_EQ(load_scenario(kScenes + "days/pv_station_1200.yaml").ground.tiling, GroundTiling::kRepeat);
+  EXPECT_EQ(load_scenario(kScenes + "days/pv_station_1200.yaml").ground.tiling, GroundTiling::kVaried);
+  EXPECT_EQ(load_scenario(kScenes + "days/rough_station_dry.yaml").ground.tiling, GroundTiling::kRepeat);
+  EXPECT_EQ(load_scenario(kScenes + "aliasing.yaml").ground.tiling, GroundTiling::kRepeat);
   const Folder f("tiling");
   f.write("station.yaml", kStation);
   const std::string e = f.error_of("day.yaml", "base: station.yaml\nground: {tiling: varied}\n");

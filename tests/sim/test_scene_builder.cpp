@@ -18,6 +18,11 @@ using namespace pvb;
 
 namespace {
 scenes::Scenario station() { return scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml"); }
+/// A shipped file on the repeated soil every station had before varied soil became the default.
+scenes::Scenario on_repeated_soil(scenes::Scenario s) {
+  s.ground.tiling = scenes::GroundTiling::kRepeat;
+  return s;
+}
 }  // namespace
 
 TEST(SceneBuilder, StationCompilesWithTheExpectedContent) {
@@ -182,8 +187,8 @@ std::vector<std::string> lines_of(const std::string& text) {
 // split; the rendered frames follow from these bytes, and were compared
 // with `pvbench record` before and after, docs/scenarios.md).
 TEST(SceneBuilder, ExistingScenesAreTheBytesTheyWere) {
-  EXPECT_EQ(scene_fingerprint(sim::build_scene(scene_file("pv_station.yaml"))), 0xb96d0ddb6b8770c8ULL);
-  EXPECT_EQ(scene_fingerprint(sim::build_scene(scene_file("along_row.yaml"))), 0x9bc4ff330b6ccb88ULL);
+  EXPECT_EQ(scene_fingerprint(sim::build_scene(on_repeated_soil(scene_file("pv_station.yaml")))), 0xb96d0ddb6b8770c8ULL);
+  EXPECT_EQ(scene_fingerprint(sim::build_scene(on_repeated_soil(scene_file("along_row.yaml")))), 0x9bc4ff330b6ccb88ULL);
   // A station seed equal to the seed is the file without one.
   scenes::Scenario s = scene_file("pv_station.yaml");
   const std::uint64_t plain = scene_fingerprint(sim::build_scene(s));
@@ -242,8 +247,8 @@ TEST(SceneBuilder, TwoDaysOfOneStationDifferOnlyInPanelsAndLight) {
 }
 
 TEST(SceneBuilder, AVariedGroundGivesEveryTileAlongTheRouteAnImageOfItsOwn) {
-  scenes::Scenario s = station();
-  s.ground.tiling = scenes::GroundTiling::kVaried;
+  const scenes::Scenario s = station();
+  ASSERT_EQ(s.ground.tiling, scenes::GroundTiling::kVaried);  // the default
   const sim::SceneAssets a = sim::build_scene(s);
   const sim::ModelPtr m = sim::compile_scene(a);
   const int ground = mj_name2id(m.get(), mjOBJ_GEOM, "ground");
@@ -275,7 +280,7 @@ TEST(SceneBuilder, AVariedGroundGivesEveryTileAlongTheRouteAnImageOfItsOwn) {
     })) << p.transpose();
   }
   // The repeated ground has one drawn plane and no tiles.
-  const sim::ModelPtr r = sim::compile_scene(sim::build_scene(station()));
+  const sim::ModelPtr r = sim::compile_scene(sim::build_scene(on_repeated_soil(station())));
   int planes = 0;
   for (int g = 0; g < r->ngeom; ++g) planes += r->geom_type[g] == mjGEOM_PLANE ? 1 : 0;
   EXPECT_EQ(planes, 1);
@@ -378,10 +383,34 @@ TEST(SceneBuilder, EverythingStandsOnTheRelief) {
               relief.height_m(dr->geom_xpos[3 * trunk], dr->geom_xpos[3 * trunk + 1]) - 0.15, 1e-5);
 }
 
+// A route too long for the varied ground's tiles is one error that names
+// the way out; on the repeated soil the same route builds.
+TEST(SceneBuilder, ARouteTooLongForVariedTilesSaysToRepeat) {
+  scenes::Scenario s = scenes::parse_scenario(R"(
+name: long_drive
+seed: 2
+duration_s: 5
+ground: {size_m: [400, 40]}
+route: {waypoints_m: [[-180, 0], [180, 0]], speed_mps: 0.5}
+)",
+                                              "long.yaml");
+  ASSERT_EQ(s.ground.tiling, scenes::GroundTiling::kVaried);
+  try {
+    sim::build_scene(s);
+    ADD_FAILURE() << "a 360 m route built a varied ground";
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("ground.tiling"), std::string::npos) << what;
+    EXPECT_NE(what.find("or tiling: repeat"), std::string::npos) << what;
+  }
+  s.ground.tiling = scenes::GroundTiling::kRepeat;
+  EXPECT_NO_THROW(sim::build_scene(s));
+}
+
 // rough_station is pv_station on a relief: without it, the same scene.
 TEST(SceneBuilder, RoughStationIsPvStationOnARelief) {
   scenes::Scenario rough = rough_scene("rough_station.yaml");
-  const scenes::Scenario flat = station();
+  const scenes::Scenario flat = on_repeated_soil(station());  // the soil a relief takes
   ASSERT_TRUE(rough.ground.relief);
   rough.ground.relief.reset();
   EXPECT_NE(rough.physics.rate_hz, flat.physics.rate_hz);

@@ -53,8 +53,12 @@ struct Relief {
 struct Ground {
   GroundType type = GroundType::kSoil;
   Eigen::Vector2d size_m{60.0, 60.0};  ///< extent along x and y, centred at origin
-  GroundTiling tiling = GroundTiling::kRepeat;
+  /// Varied: every 3 m of soil near the route an image of its own.  A
+  /// relief takes one repeated image (a height field has one texture).
+  GroundTiling tiling = GroundTiling::kVaried;
   std::optional<Relief> relief;  ///< none: the flat plane z = 0
+  /// The tiling the ground is drawn with: repeated under a relief.
+  GroundTiling drawn_tiling() const { return relief ? GroundTiling::kRepeat : tiling; }
   /// Sliding friction of the soil against the tyres (the day's: wet soil
   /// slips).  None: MuJoCo's default combination (the larger of soil 1 and
   /// tyre 1.2).  Given: the ground's friction governs every contact with it.
@@ -213,7 +217,7 @@ struct Route {
 /// `min_contrast` times the ambient near-infrared in the camera's band, the
 /// sun's beam on the surface (where no geom shadows it) plus the sky's.
 struct Sunlight {
-  bool on = false;
+  bool on = true;  ///< off: depth as indoors, whatever the sun
   double projector_power_w = 0.06;         ///< Kinect v1's 830 nm laser at its output (OpenKinect)
   double projector_solid_angle_sr = 0.70;  ///< the pattern's 58 x 45 degree field
   double filter_width_nm = 10.0;           ///< the infrared camera's band-pass (not published)
