@@ -42,7 +42,11 @@ void record_state_change(SlamRun& run, slam::TrackingState prev_state, const sla
   } else if (r.state == slam::TrackingState::kNotInitialized && run.frames == 1) {
     log.line(head + "not initialised: " + reason);
   } else if (r.state == slam::TrackingState::kOk && prev_state == slam::TrackingState::kNotInitialized) {
-    log.line(head + "initialised");
+    log.line(head + (r.tracking.two_view_points > 0
+                         ? "initialised from two views (" + std::to_string(r.tracking.two_view_points) +
+                               " points, scaled by " + std::to_string(r.tracking.two_view_scale_points) +
+                               " measured depths)"
+                         : std::string("initialised")));
   }
 }
 

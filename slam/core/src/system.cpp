@@ -53,6 +53,7 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.reloc_ambiguity_check = settings.loop.ambiguity_check;
   topt.reloc_ambiguity_distance_m = settings.loop.ambiguity_distance_m;
   topt.reloc_lookalikes = settings.reloc_lookalikes;
+  topt.two_view_start = settings.two_view_start;
   topt.new_map_after_lost = settings.new_map_after_lost;
   topt.merge_reloc_every = settings.merge_reloc_every;
   if (settings.vocabulary_path != "none") {
@@ -161,6 +162,7 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
   }
   if (kf) {
     const auto t1 = std::chrono::steady_clock::now();
+    if (auto first = tracking_->take_start_keyframe()) mapping_->insert(first);  // a two-view start's first view
     mapping_->insert(kf);
     out.mapping_ms = ms_since(t1);
   }

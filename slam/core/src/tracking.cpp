@@ -202,9 +202,12 @@ void Tracking::record_relocalisation(const Frame& f) {
 bool Tracking::initialize(Frame& f) {
   int with_depth = 0;
   for (float d : f.depth_m) with_depth += d > 0;
-  if (with_depth <= options_.min_init_points)
-    return fail("initialisation: only " + std::to_string(with_depth) + " keypoints with depth (need more than " +
-                std::to_string(options_.min_init_points) + ")");
+  if (with_depth <= options_.min_init_points) {
+    const std::string why = "initialisation: only " + std::to_string(with_depth) +
+                            " keypoints with depth (need more than " + std::to_string(options_.min_init_points) + ")";
+    return options_.two_view_start ? start_from_two_views(f, why) : fail(why);
+  }
+  start_ref_.reset();
   if (waiting_for_accelerometer(f)) return fail("initialisation: waiting for the accelerometer's first readings");
   f.T_c_w = first_pose();
   f.has_pose = true;
@@ -219,6 +222,65 @@ bool Tracking::initialize(Frame& f) {
   ref_kf_ = kf;
   local_kfs_ = {kf};
   return true;
+}
+
+bool Tracking::start_from_two_views(Frame& f, const std::string& why) {
+  if (waiting_for_accelerometer(f)) return fail(why + "; waiting for the accelerometer's first readings");
+  if (!start_ref_) {
+    start_ref_ = f;
+    start_ref_->T_c_w = first_pose();
+    return fail(why + "; two views: frame " + std::to_string(f.id) + " is the first view");
+  }
+  std::string two_view_why;
+  TwoViewFailure failure = TwoViewFailure::kNotYet;
+  const std::optional<TwoViewStart> s = two_view_start(*start_ref_, f, options_.two_view, &two_view_why, &failure);
+  if (!s) {
+    const std::string text = why + "; two views from frame " + std::to_string(start_ref_->id) + ": " + two_view_why;
+    if (failure == TwoViewFailure::kFewMatches) {  // the view has moved on: a new first view
+      start_ref_ = f;
+      start_ref_->T_c_w = first_pose();
+    }
+    return fail(text);
+  }
+  build_two_view_map(f, *s);
+  start_ref_.reset();
+  return true;
+}
+
+void Tracking::build_two_view_map(Frame& f, const TwoViewStart& s) {
+  Frame& ref = *start_ref_;
+  ref.has_pose = true;
+  f.T_c_w = s.T_cur_ref * ref.T_c_w;
+  f.has_pose = true;
+  const auto kf0 = map_.create_keyframe(ref);
+  if (provisional_ > 0) {  // its own frame until merged: a root like keyframe 0
+    kf0->set_provisional(provisional_);
+    kf0->make_root();
+  }
+  const auto kf1 = map_.create_keyframe(f);
+  kf1->set_provisional(provisional_);
+  // The motion sensors' chain starts at the second keyframe: the first
+  // view's interval was not kept apart.
+  attach_motion(kf1);
+  const geom::SE3d T_w_ref = ref.T_c_w.inverse();
+  for (std::size_t k = 0; k < s.matches.size(); ++k) {
+    const auto [i0, i1] = std::pair(s.matches[k].i1, s.matches[k].i2);
+    auto mp = map_.create_point(T_w_ref * s.p_ref_m[k], kf0);
+    mp->add_observation(kf0, i0);
+    kf0->set_map_point(i0, mp);
+    mp->add_observation(kf1, i1);
+    kf1->set_map_point(i1, mp);
+    mp->compute_distinctive_descriptor();
+    mp->update_normal_and_depth();
+    f.map_points[i1] = mp;
+  }
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (f.depth_m[i] > 0 && !f.map_points[i]) add_point_from_depth(f, kf1, i);
+  stats_.two_view_points = static_cast<int>(s.matches.size());
+  stats_.two_view_scale_points = s.scale_points;
+  start_kf_ = kf0;
+  ref_kf_ = kf1;
+  local_kfs_ = {kf0, kf1};
 }
 
 bool Tracking::fail(const std::string& why) {

@@ -12,6 +12,16 @@
 
 namespace pvb::slam {
 
+/// A start from two views (two_view_start.hpp): what it asks of them.
+struct TwoViewOptions {
+  int min_points = 100;            ///< triangulated points that every check keeps
+  double min_parallax_deg = 1.0;   ///< median angle between a point's two rays
+  int min_scale_points = 5;        ///< of them, measured depths in either view
+  double max_scale_spread = 0.15;  ///< median absolute deviation of the depth ratios, over their median
+  double search_radius_px = 100;   ///< where a first-view keypoint is looked for in the second
+  double max_reprojection_px = 2.0;  ///< in both views, at the keypoint's octave
+};
+
 struct TrackingOptions {
   bool use_pe_match = true;    ///< false: ORB-SLAM2 baseline motion model
   PeMatchParams pe_match = PeMatchParams::for_slam();
@@ -26,6 +36,11 @@ struct TrackingOptions {
   double motion_th = 7.0;      ///< ORB-SLAM2 window for stereo / RGB-D, x scale of the octave
   double motion_ratio = 0.9;   ///< paper sec. 3 step 1
   int min_init_points = 500;   ///< keypoints with depth needed to initialise
+  /// Tracking.twoViewStart: with fewer, start from two views whose points
+  /// are triangulated and scaled by the few measured depths
+  /// (two_view_start.hpp); false: wait for a frame with enough depth.
+  bool two_view_start = true;
+  TwoViewOptions two_view;
   int max_frames = 30;         ///< keyframe spacing limit (= fps)
   int min_frames = 0;
   int kf_min_tracked_close = 200;    ///< KeyFrame.minTrackedClose (ORB-SLAM2: 100)

@@ -122,6 +122,10 @@ struct TrackingStats {
     kLocalMap,       ///< relocalised, then the local map gave too few inliers
   };
   RelocFailure reloc_failure = RelocFailure::kNone;
+  /// A start from two views on this frame (0 otherwise): its points, and
+  /// the measured depths whose median ratio gave its scale.
+  int two_view_points = 0;
+  int two_view_scale_points = 0;
   /// Why the frame was not tracked (empty when it was): each attempted
   /// step's failure, "; "-separated, e.g. "motion model: only 7 map matches
   /// after pose optimisation (need 10); reference keyframe: only 9 matches (need 15)".

@@ -97,6 +97,9 @@ struct Settings {
   /// Tracking.relocLookalikes (ours, optional): best-scoring keyframes a
   /// relocalisation is also checked against (TrackingOptions::reloc_lookalikes).
   int reloc_lookalikes = 10;
+  /// Tracking.twoViewStart (ours, optional): a start from two views when a
+  /// frame has too little depth (TrackingOptions::two_view_start).
+  bool two_view_start = true;
   /// Tracking.newMapAfter (ours, optional): frames lost in a row after
   /// which an extending run begins a provisional map
   /// (TrackingOptions::new_map_after_lost); 0: never.

@@ -18,6 +18,7 @@
 #include "pvb/slam/core/place_recognition.hpp"
 #include "pvb/slam/core/reports.hpp"
 #include "pvb/slam/core/settings.hpp"
+#include "pvb/slam/core/two_view_start.hpp"
 #include "pvb/slam/pematch/pe_match.hpp"
 
 namespace pvb::slam {
@@ -89,9 +90,17 @@ class Tracking {
   /// The merge hypothesis found since the last call, if any
   /// (TrackingOptions::merge_reloc_every).
   std::optional<MergeHint> take_merge_hint() { return std::exchange(merge_hint_, std::nullopt); }
+  /// The first of the two keyframes a two-view start made, once, for local
+  /// mapping to take before the keyframe track() returned (null otherwise).
+  std::shared_ptr<KeyFrame> take_start_keyframe() { return std::exchange(start_kf_, nullptr); }
 
  private:
   bool initialize(Frame& f);
+  /// Without enough depth in one frame: the start from a first view kept
+  /// and f (TwoViewOptions); `why` is the one-frame start's reason.
+  bool start_from_two_views(Frame& f, const std::string& why);
+  /// The two keyframes and the points of a two-view start.
+  void build_two_view_map(Frame& f, const TwoViewStart& s);
   bool track_with_motion_model(Frame& f);
   /// Median translational parallax of the motion-model matches m (last
   /// keypoint with depth) under the predicted motion T_cur_last; +inf with
@@ -202,6 +211,8 @@ class Tracking {
   std::uint32_t provisional_ = 0;  ///< the provisional map the next initialisation begins (0: none)
   int since_merge_probe_ = 0;      ///< frames tracked in a provisional map since the last probe_merge
   std::optional<MergeHint> merge_hint_;
+  std::optional<Frame> start_ref_;      ///< a two-view start's first view, at its levelled pose
+  std::shared_ptr<KeyFrame> start_kf_;  ///< its keyframe, until System takes it
 
   Frame last_;
   bool last_is_keyframe_ = false;
