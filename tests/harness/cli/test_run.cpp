@@ -32,6 +32,16 @@ std::string fresh(const std::string& name) {
 
 bool exists(const std::string& path) { return std::ifstream(path).good(); }
 
+/// Writes the default station to `path` with its line `from` replaced by
+/// `to`; false (nothing written) when the station has no such line.
+bool write_station_with(const std::string& path, const std::string& from, const std::string& to) {
+  std::string text = read_file(kStation);
+  const std::size_t at = text.find(from);
+  if (at == std::string::npos) return false;
+  write_file(path, text.replace(at, from.size(), to));
+  return true;
+}
+
 using pvb::test::data_lines;
 
 YAML::Node metrics(const std::string& dir) { return YAML::Load(read_file(dir + "/metrics.json")); }
@@ -434,11 +444,7 @@ TEST(RunCli, ASecondRunIntoAFolderInUseIsRefused) {
 TEST(RunCli, ARunThatNeverInitialisesFailsAndSavesNoMap) {
   const std::string d = fresh("noinit");
   const std::string scenario = d + "_small.yaml";
-  std::string text = read_file(kStation);
-  const std::string from = "  depth_range_m: [0.5, 4.5]\n", to = "  depth_range_m: [0.5, 0.6]\n";
-  ASSERT_NE(text.find(from), std::string::npos) << from;
-  text.replace(text.find(from), from.size(), to);
-  write_file(scenario, text);
+  ASSERT_TRUE(write_station_with(scenario, "  depth_range_m: [0.5, 4.5]\n", "  depth_range_m: [0.5, 0.6]\n"));
   const std::string map = d + "_map.pvbmap";
   std::remove(map.c_str());
   const test::RunResult r = test::run_pvbench("run --scenario " + scenario + " --out " + d +
@@ -458,11 +464,7 @@ TEST(RunCli, ARunThatNeverInitialisesFailsAndSavesNoMap) {
 TEST(RunCli, AKinectInTheSunStartsFromTwoViews) {
   const std::string d = fresh("sun");
   const std::string scenario = d + "_sun.yaml";
-  std::string text = read_file(kStation);
-  const std::string from = "    sunlight: off\n", to = "    sunlight: on\n";
-  ASSERT_NE(text.find(from), std::string::npos) << from;
-  text.replace(text.find(from), from.size(), to);
-  write_file(scenario, text);
+  ASSERT_TRUE(write_station_with(scenario, "    sunlight: off\n", "    sunlight: on\n"));
   const test::RunResult r =
       test::run_pvbench("run --scenario " + scenario + " --out " + d + " --frames 60 --sync --no-map-eval");
   ASSERT_EQ(r.code, 0) << r.output;
