@@ -236,7 +236,7 @@ LiveOutputs open_live_outputs(const CameraArgs& a, const std::optional<scenes::S
   o.cam_traj = OutputFile(out + "/CameraTrajectory.txt");
   o.cam_traj.append("# timestamp tx ty tz qx qy qz qw (T_w_c)\n");
   if (scenario) {
-    o.gt_sim = std::make_unique<sim::Simulator>(*scenario);
+    o.gt_sim = std::make_unique<sim::Simulator>(*scenario, sim::SceneDetail::kGeometry);  // physics only
     o.gt_file = OutputFile(out + "/groundtruth.txt");
     o.gt_file.append("# timestamp tx ty tz qx qy qz qw (T_w_c, simulator ground truth)\n");
     o.motion = std::make_unique<dataset::MotionFilesWriter>(out, run::robot_calibration_for(*scenario));

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/core/utility.hpp>
@@ -308,28 +309,36 @@ std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std
   return tiles;
 }
 
-/// The textures: the station's, but for the day's dust on the panels.
-void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tiles, SceneAssets* out) {
+/// The textures: the station's, but for the day's dust on the panels.  A
+/// geometry-only scene names the same files, each a 1x1 grey image.
+void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tiles, SceneDetail detail,
+                  SceneAssets* out) {
+  const bool full = detail == SceneDetail::kFull;
+  const std::vector<unsigned char> grey = full ? std::vector<unsigned char>{} : png(cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(128)));
+  const auto add = [&](const std::string& name, const std::function<cv::Mat()>& draw) {
+    out->files.emplace_back("textures/" + name + ".png", full ? png(draw()) : grey);
+  };
   const std::uint64_t station_seed = s.station_seed_or_seed(), day_seed = s.seed;
-  out->files.emplace_back("textures/ground.png", png(make_ground_texture(s.ground.type, station_seed)));
+  add("ground", [&] { return make_ground_texture(s.ground.type, station_seed); });
   // A tile's image depends on its seed alone: drawn and encoded on every core.
-  std::vector<std::vector<unsigned char>> tile_png(tiles.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(tiles.size())), [&](const cv::Range& range) {
-    for (int k = range.start; k < range.end; ++k)
-      tile_png[k] = png(make_ground_texture(s.ground.type, tiles[k].seed), 1);
-  });
+  std::vector<std::vector<unsigned char>> tile_png(tiles.size(), grey);
+  if (full)
+    cv::parallel_for_(cv::Range(0, static_cast<int>(tiles.size())), [&](const cv::Range& range) {
+      for (int k = range.start; k < range.end; ++k)
+        tile_png[k] = png(make_ground_texture(s.ground.type, tiles[k].seed), 1);
+    });
   for (std::size_t k = 0; k < tiles.size(); ++k)
     out->files.emplace_back("textures/groundt" + std::to_string(k) + ".png", std::move(tile_png[k]));
-  out->files.emplace_back("textures/brick.png", png(make_brick_texture(station_seed)));
-  out->files.emplace_back("textures/foliage.png", png(make_foliage_texture(station_seed)));
-  out->files.emplace_back("textures/bark.png", png(make_bark_texture(station_seed)));
+  add("brick", [&] { return make_brick_texture(station_seed); });
+  add("foliage", [&] { return make_foliage_texture(station_seed); });
+  add("bark", [&] { return make_bark_texture(station_seed); });
   for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) {
     for (int k = 0; k < kDirtVariants; ++k) {
       // variant 0 is the cleanest; dirt grows with k up to the array's level
       const double dirt = s.pv_arrays[i].dirt * (0.55 + 0.15 * k);
-      out->files.emplace_back("textures/a" + std::to_string(i) + "panel" + std::to_string(k) + ".png",
-                              png(make_panel_texture(s.pv_arrays[i], dirt, station_seed * 131 + i * 17 + k,
-                                                     day_seed * 131 + i * 17 + k)));
+      add("a" + std::to_string(i) + "panel" + std::to_string(k), [&] {
+        return make_panel_texture(s.pv_arrays[i], dirt, station_seed * 131 + i * 17 + k, day_seed * 131 + i * 17 + k);
+      });
     }
   }
 }
@@ -689,8 +698,9 @@ void add_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<Groun
 
 }  // namespace
 
-SceneAssets build_scene(const scenes::Scenario& s) {
+SceneAssets build_scene(const scenes::Scenario& s, SceneDetail detail) {
   SceneAssets out;
+  out.detail = detail;
   const scenes::Camera& cam = s.camera;
   // Physics step: physics.rate_hz, or the largest step <= 2 ms that divides
   // the frame period, so frame i is rendered at exactly i / fps.
@@ -709,7 +719,7 @@ SceneAssets build_scene(const scenes::Scenario& s) {
     out.route_xy.push_back(p.y());
   }
   const std::vector<GroundTile> tiles = varied_ground_tiles(s, route);
-  add_textures(s, tiles, &out);
+  add_textures(s, tiles, detail, &out);
   const scenes::GroundRelief ground(s);
   if (!ground.flat()) out.files.emplace_back(kReliefFile, hfield_file(ground.grid()));
 

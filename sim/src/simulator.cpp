@@ -31,9 +31,9 @@ int actuator(const mjModel* m, const char* name) {
 
 }  // namespace
 
-Simulator::Simulator(scenes::Scenario scenario) : scenario_(std::move(scenario)) {
+Simulator::Simulator(scenes::Scenario scenario, SceneDetail detail) : scenario_(std::move(scenario)) {
   install_mujoco_handlers();
-  assets_ = build_scene(scenario_);
+  assets_ = build_scene(scenario_, detail);
   model_ = compile_scene(assets_);
   data_.reset(mj_makeData(model_.get()));
   const mjModel* m = model_.get();
@@ -214,8 +214,17 @@ std::optional<cv::Point2d> Simulator::sun_pixel() const {
   return cv::Point2d(K.fx * d.x() / d.z() + K.cx, K.fy * d.y() / d.z() + K.cy);
 }
 
+namespace {
+const Simulator& textured(const Simulator& sim) {
+  if (sim.assets().detail != SceneDetail::kFull)
+    throw Error("a simulator built for its geometry only gives no colour frames (build it with SceneDetail::kFull)");
+  return sim;
+}
+}  // namespace
+
 RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
-    : renderer_(sim.model(), backend, sim.scenario().camera.width, sim.scenario().camera.height), sensor_(sim) {
+    : renderer_(textured(sim).model(), backend, sim.scenario().camera.width, sim.scenario().camera.height),
+      sensor_(sim) {
   renderer_.set_shadows(sim.scenario().light.shadows);
   std::vector<bool> specular;
   for (const auto& a : sim.scenario().pv_arrays) specular.push_back(a.specular_glass);

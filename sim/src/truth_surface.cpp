@@ -134,7 +134,7 @@ void add_frame(Simulator& sim, const cv::Mat& depth_m, const cv::Mat& geom_id, c
 
 std::vector<TruthSample> sample_truth_surface(const scenes::Scenario& scenario, GlBackend backend,
                                               const TruthSurfaceOptions& options) {
-  Simulator sim(scenario);
+  Simulator sim(scenario, SceneDetail::kGeometry);  // depth and geom ids: no texture needed
   Renderer renderer(sim.model(), backend, scenario.camera.width, scenario.camera.height);
   const std::vector<std::optional<SurfaceClass>> classes = geom_classes(sim.model());
   const int n = scenes::frame_count(scenario, options.frames);

@@ -14,6 +14,7 @@
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sensor/depth_encoding.hpp"
 #include "pvb/geometry/time.hpp"
+#include "pvb/sim/renderer.hpp"
 #include "pvb/sim/sim_frame_source.hpp"
 #include "pvb/sim/simulator.hpp"
 
@@ -189,7 +190,7 @@ TEST(Simulator, TheD435ModelsDepthAgreesWithTheTruthOnTheStation) {
 }
 
 TEST(Simulator, DrivesStraight) {
-  sim::Simulator sim(wall_scenario());
+  sim::Simulator sim(wall_scenario(), sim::SceneDetail::kGeometry);
   const sim::Pose2d p0 = sim.base_pose();
   const double w = 4.0;
   sim.set_wheel_override(Eigen::Vector2d(w, w));
@@ -207,7 +208,7 @@ TEST(Simulator, DrivesStraight) {
 }
 
 TEST(Simulator, TurnsAtTheCalibratedRate) {
-  sim::Simulator sim(wall_scenario());
+  sim::Simulator sim(wall_scenario(), sim::SceneDetail::kGeometry);
   const sim::DriveKinematics& k = sim.kinematics();
   // calibration sees the scrub: the effective track is wider than the geometric one
   EXPECT_GT(k.track_m, 0.42);
@@ -226,7 +227,7 @@ TEST(Simulator, RouteFollowerReachesItsWaypoints) {
       "duration_s: 40\nground: {size_m: [30, 30]}\n"
       "route: {waypoints_m: [[0, 0], [4, 0], [5, 2.5], [2, 4], [-1, 2]], speed_mps: 0.5, lookahead_m: 0.6}\n",
       "route_test.yaml");
-  sim::Simulator sim(s);
+  sim::Simulator sim(s, sim::SceneDetail::kGeometry);
   std::vector<double> closest(s.route.waypoints_m.size(), 1e9);
   double worst_cross_track = 0;
   for (int i = 1; i < sim.frame_count() && !sim.follower().finished(); ++i) {
@@ -249,7 +250,7 @@ TEST(Simulator, RouteStartPartWayPutsTheRobotThereAndDrivesOn) {
       "route: {waypoints_m: [[0, 0], [4, 0], [4, 4]], speed_mps: 0.5, lookahead_m: 0.6";
   const scenes::Scenario whole = scenes::parse_scenario(route + "}\n", "whole.yaml");
   const scenes::Scenario later = scenes::parse_scenario(route + ", start_m: 5}\n", "later.yaml");
-  sim::Simulator a(whole), b(later);
+  sim::Simulator a(whole, sim::SceneDetail::kGeometry), b(later, sim::SceneDetail::kGeometry);
   const sim::Pose2d p0 = a.base_pose(), p1 = b.base_pose();
   EXPECT_NEAR(p0.x, 0.0, 0.05);
   EXPECT_NEAR(p0.y, 0.0, 0.05);
@@ -272,7 +273,7 @@ TEST(Simulator, RouteStartPartWayPutsTheRobotThereAndDrivesOn) {
 }
 
 TEST(Simulator, FrameTimesAreExactMultiplesOfThePeriod) {
-  sim::Simulator sim(wall_scenario());
+  sim::Simulator sim(wall_scenario(), sim::SceneDetail::kGeometry);
   for (int i = 0; i < 4; ++i) sim.advance();
   EXPECT_EQ(sim.t_ns(), 133'333'333);  // 4 / 30 s
   EXPECT_NEAR(sim.assets().timestep_s * sim.assets().substeps, 1.0 / 30.0, 1e-15);
@@ -289,11 +290,47 @@ TEST(Simulator, PhysicsIsDeterministic) {
   EXPECT_TRUE(a.T_w_c().matrix() == b.T_w_c().matrix());
 }
 
+// A scene built for its geometry only (no texture drawn) moves as the full
+// scene does, bit for bit, and renders the same depth and geom ids; it
+// gives no colour frames.
+TEST(Simulator, AGeometryOnlySceneMovesAndRendersAsTheFullOne) {
+  const scenes::Scenario s = scenes::parse_scenario(R"(
+name: geometry_test
+seed: 4
+duration_s: 1
+ground: {size_m: [20, 20]}
+pv_arrays: [{origin_m: [2, -1], rows: 1, tables_per_row: 1, panels_per_table: 4}]
+walls: [{start_m: [5, -3], end_m: [5, 3], height_m: 2}]
+vegetation: {shrubs: 4, area_m: [-5, -5, 5, 5]}
+route: {waypoints_m: [[0, 0], [1.5, 0]], speed_mps: 0.5}
+camera: {width: 160, height: 120, fx: 131.25, fy: 131.25, depth_noise: {sunlight: off}}
+)",
+                                                    "geometry_test.yaml");
+  sim::Simulator full(s), geometry(s, sim::SceneDetail::kGeometry);
+  EXPECT_EQ(full.assets().xml, geometry.assets().xml);
+  ASSERT_EQ(full.assets().files.size(), geometry.assets().files.size());
+  for (int i = 1; i < full.frame_count(); ++i) {
+    full.advance();
+    geometry.advance();
+    ASSERT_TRUE(full.T_w_c().matrix() == geometry.T_w_c().matrix()) << "frame " << i;
+  }
+  sim::Renderer a(full.model(), sim::GlBackend::kAuto, 160, 120), b(geometry.model(), sim::GlBackend::kAuto, 160, 120);
+  cv::Mat rgb_a, depth_a, ids_a, rgb_b, depth_b, ids_b;
+  a.render(full.model(), full.data(), full.camera_id(), &rgb_a, &depth_a);
+  a.render_geom_ids(full.model(), full.data(), full.camera_id(), &ids_a);
+  b.render(geometry.model(), geometry.data(), geometry.camera_id(), &rgb_b, &depth_b);
+  b.render_geom_ids(geometry.model(), geometry.data(), geometry.camera_id(), &ids_b);
+  EXPECT_EQ(cv::norm(depth_a, depth_b, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(ids_a, ids_b, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::norm(rgb_a, rgb_b, cv::NORM_INF), 0.0);  // the textures are not there
+  EXPECT_THROW(sim::RgbdCamera(geometry, sim::GlBackend::kAuto), Error);
+}
+
 TEST(Simulator, ShippedScenariosAreDrivenToTheEndOfTheirRoutes) {
   // Physics only: every shipped route is followed closely and finished
   // within the scenario's duration (turns and U-turns included).
   for (const char* name : {"pv_station", "along_row", "lawnmower", "loop", "aliasing", "lawnmower_return"}) {
-    sim::Simulator sim(scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + name + ".yaml"));
+    sim::Simulator sim(scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + name + ".yaml"), sim::SceneDetail::kGeometry);
     double worst = 0;
     int finished_at = -1;
     for (int i = 1; i < sim.frame_count(); ++i) {
@@ -391,7 +428,7 @@ TEST(SimFrameSource, SensorModelOnAnotherThreadGivesTheFramesOfNext) {
 // its exact state of the target frame (pose, velocities, the follower's
 // progress) and drives the route on from there, as it did then.
 TEST(Simulator, KidnapCarriesTheRobotBackToItsEarlierStateAndItDrivesOn) {
-  sim::Simulator sim(kidnap_scenario());
+  sim::Simulator sim(kidnap_scenario(), sim::SceneDetail::kGeometry);
   ASSERT_TRUE(sim.kidnap_frames());
   const scenes::KidnapFrames k = *sim.kidnap_frames();
   ASSERT_EQ(k.target, 15);
@@ -435,7 +472,7 @@ TEST(Simulator, KidnapCarriesTheRobotBackToItsEarlierStateAndItDrivesOn) {
 }
 
 TEST(Simulator, KidnapIsDeterministic) {
-  sim::Simulator a(kidnap_scenario()), b(kidnap_scenario());
+  sim::Simulator a(kidnap_scenario(), sim::SceneDetail::kGeometry), b(kidnap_scenario(), sim::SceneDetail::kGeometry);
   for (int i = 1; i < a.frame_count(); ++i) {
     a.advance();
     b.advance();
@@ -507,7 +544,7 @@ TEST(Simulator, SettlesOnTheReliefAndDrivesRoughStationToItsEnd) {
   for (const char* name : {"pv_station", "rough_station"}) {
     const scenes::Scenario s = scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + name + ".yaml");
     const scenes::GroundRelief relief(s);
-    sim::Simulator sim(s);
+    sim::Simulator sim(s, sim::SceneDetail::kGeometry);
     const int body = mj_name2id(sim.model(), mjOBJ_BODY, sim::kRobotBody);
     const mjtNum* axle = sim.data()->xpos + 3 * body;
     EXPECT_NEAR(axle[2] - relief.height_m(axle[0], axle[1]), s.robot.wheel_radius_m, 0.01) << name << ": settled";
@@ -543,7 +580,7 @@ TEST(Simulator, WetSoilSlipsMoreThanDryUnderFullThrottle) {
     scenes::Scenario s = scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/days/" + day + ".yaml");
     s.robot.max_wheel_accel_radps2.reset();  // full throttle at once
     s.ground.softness = 0;                   // the friction alone
-    sim::Simulator sim(s);
+    sim::Simulator sim(s, sim::SceneDetail::kGeometry);
     const int joint = mj_name2id(sim.model(), mjOBJ_JOINT, sim::kLeftActuator);
     ASSERT_GE(joint, 0);
     const double angle0 = sim.data()->qpos[sim.model()->jnt_qposadr[joint]];

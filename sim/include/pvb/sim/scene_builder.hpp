@@ -11,8 +11,16 @@
 
 namespace pvb::sim {
 
+/// What a scene is built for.  kFull: drawn in colour, every texture
+/// generated.  kGeometry: physics, depth and geom ids only; each texture
+/// is a 1x1 grey image, so the MJCF (every geom, material and name) is
+/// the full scene's, the physics and the rendered depth are the same, and
+/// set-up skips drawing and encoding the images.
+enum class SceneDetail { kFull, kGeometry };
+
 /// A generated scene: scene.xml plus the texture files it names.
 struct SceneAssets {
+  SceneDetail detail = SceneDetail::kFull;
   std::string xml;
   /// Path relative to scene.xml and bytes: the textures' PNGs, and with a
   /// ground relief its height field (kReliefFile).
@@ -48,7 +56,7 @@ inline constexpr double kShadowTexelTargetM = 0.020;
 ShadowMap shadow_map_for(const scenes::Light& light, const std::vector<Eigen::Vector2d>& route_xy_m);
 
 /// Generates the scene.  Deterministic in the scenario (seed included).
-SceneAssets build_scene(const scenes::Scenario& scenario);
+SceneAssets build_scene(const scenes::Scenario& scenario, SceneDetail detail = SceneDetail::kFull);
 
 struct ModelDeleter {
   void operator()(mjModel* m) const { mj_deleteModel(m); }

@@ -25,7 +25,10 @@ class Simulator {
  public:
   /// Generates and compiles the scene, calibrates the drive kinematics and
   /// lets the robot settle on the ground.  Frame 0 is the settled state.
-  explicit Simulator(scenes::Scenario scenario);
+  /// A geometry-only scene (SceneDetail::kGeometry) moves exactly as the
+  /// full one and renders the same depth, but gives no colour frames
+  /// (RgbdCamera refuses it).
+  explicit Simulator(scenes::Scenario scenario, SceneDetail detail = SceneDetail::kFull);
   ~Simulator();
   Simulator(Simulator&&) = delete;
 
