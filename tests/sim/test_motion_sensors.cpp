@@ -72,7 +72,7 @@ struct Strapdown {
 /// initial state; the position and rotation errors at the end.
 std::pair<double, double> imu_integration_error(scenes::Scenario s) {
   perfect_imu(&s);
-  sim::Simulator sim(s);
+  sim::Simulator sim(s, sim::SceneDetail::kGeometry);
   const sim::MotionBatch b = drive(sim, 301);
   EXPECT_GE(b.imu.size(), 2001u);
   EXPECT_EQ(b.imu[0].t_ns, 5'000'000);  // 200 Hz from frame 0
@@ -108,7 +108,7 @@ TEST(MotionSensors, EncodersIntegrateBackToThePathAtLowSpeed) {
   scenes::Scenario s = drive_scenario(0.2, 31);
   s.robot.radius_error = 0;
   s.robot.track_error = 0;
-  sim::Simulator sim(s);
+  sim::Simulator sim(s, sim::SceneDetail::kGeometry);
   const sim::MotionBatch b = drive(sim, 900);
   ASSERT_GE(b.ticks.size(), 1400u);
   EXPECT_EQ(b.ticks[0].t_ns, 20'000'000);  // 50 Hz from frame 0
@@ -183,7 +183,7 @@ Eigen::Vector2d fit_white_and_walk(const std::vector<std::pair<double, double>>&
 const std::vector<sim::ImuTruth>& standstill_truth() {
   static const std::vector<sim::ImuTruth> truth = [] {
     scenes::Scenario s = drive_scenario(0.5, 61);
-    sim::Simulator sim(s);
+    sim::Simulator sim(s, sim::SceneDetail::kGeometry);
     sim.set_wheel_override(Eigen::Vector2d::Zero());
     return drive(sim, 1800).imu_truth;
   }();
@@ -261,7 +261,7 @@ TEST(MotionSensors, TurningShowsTheKinematicTerms) {
   scenes::Scenario s = drive_scenario(0.5, 10);
   perfect_imu(&s);
   s.imu.p_c_i_m = Eigen::Vector3d(0.10, 0.05, -0.08);  // far from the base's axis of turn
-  sim::Simulator sim(s);
+  sim::Simulator sim(s, sim::SceneDetail::kGeometry);
   sim.set_wheel_override(Eigen::Vector2d(3.0, 6.0));  // left slower: a left turn
   const sim::MotionBatch b = drive(sim, 240);
   const Eigen::Vector3d g(0, 0, -9.81);
@@ -297,7 +297,7 @@ TEST(MotionSensors, KidnapShowsInTheImuAndNotInTheWheels) {
   scenes::Scenario s = drive_scenario(0.5, 5);
   s.kidnap = scenes::Kidnap{1.5, 2.0, 0.5};
   perfect_imu(&s);
-  sim::Simulator sim(s);
+  sim::Simulator sim(s, sim::SceneDetail::kGeometry);
   const scenes::KidnapFrames k = *sim.kidnap_frames();
   const sim::MotionBatch b = drive(sim, 150);
   const std::int64_t carry_from = geom::frame_time_ns(0, k.cover_begin, 30), carry_to = geom::frame_time_ns(0, k.teleport, 30);
@@ -340,7 +340,7 @@ TEST(MotionSensors, CoverLeavesTheImuAndTheWheelsAsTheyAre) {
   scenes::Scenario plain = drive_scenario(0.5, 5);
   scenes::Scenario covered = plain;
   covered.cover = scenes::Cover{1.5, 2.0};
-  sim::Simulator a(plain), b(covered);
+  sim::Simulator a(plain, sim::SceneDetail::kGeometry), b(covered, sim::SceneDetail::kGeometry);
   const sim::MotionBatch ra = drive(a, 150), rb = drive(b, 150);
   ASSERT_EQ(ra.imu.size(), rb.imu.size());
   ASSERT_EQ(ra.ticks.size(), rb.ticks.size());
@@ -370,7 +370,7 @@ TEST(MotionSensors, CoverLeavesTheImuAndTheWheelsAsTheyAre) {
 // Two simulators of one scenario give the same readings, bit for bit.
 TEST(MotionSensors, ReadingsAreDeterministic) {
   const scenes::Scenario s = drive_scenario(0.5, 2);
-  sim::Simulator a(s), b(s);
+  sim::Simulator a(s, sim::SceneDetail::kGeometry), b(s, sim::SceneDetail::kGeometry);
   const sim::MotionBatch ra = drive(a, 40), rb = drive(b, 40);
   ASSERT_EQ(ra.imu.size(), rb.imu.size());
   for (std::size_t i = 0; i < ra.imu.size(); ++i) {
@@ -388,7 +388,7 @@ TEST(MotionSensors, MountPosesAgreeWithTheModel) {
   scenes::Scenario s = drive_scenario(0.5, 1);
   s.camera.yaw_deg = 7;
   s.camera.pitch_deg = -20;
-  sim::Simulator sim(s);
+  sim::Simulator sim(s, sim::SceneDetail::kGeometry);
   // the MJCF carries the camera's axes to 7 significant digits
   const geom::SE3d a = sim.T_b_c(), b = scenes::T_base_camera(s);
   EXPECT_LT((a.translation() - b.translation()).norm(), 1e-6);
@@ -408,7 +408,7 @@ struct OdometryOutcome {
 /// description: the odometry's position error at the end, and the slip.
 OdometryOutcome drive_day(const std::string& file) {
   const scenes::Scenario s = scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/" + file);
-  sim::Simulator sim(s);
+  sim::Simulator sim(s, sim::SceneDetail::kGeometry);
   const sim::MotionBatch b = drive(sim, sim.frame_count() - 1);
   sensor::WheelOdometry odo(sim::nominal_description(s));
   OdometryOutcome out;
