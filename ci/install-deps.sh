@@ -4,6 +4,7 @@
 set -euo pipefail
 PKGS=(
   build-essential cmake ninja-build pkg-config ccache git
+  lld   # the linker (about five times faster than GNU ld on the test programs)
   libeigen3-dev libopencv-dev libceres-dev libyaml-cpp-dev libcli11-dev
   libmujoco-dev libqhull-dev
   libegl-dev libegl-mesa0 libgl-dev libgles-dev libosmesa6-dev libgl1-mesa-dri

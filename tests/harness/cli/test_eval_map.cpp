@@ -1,4 +1,4 @@
-// pvbench eval-map end to end: a short pv_station drive recorded, mapped by
+// pvbench eval-map end to end: a short pv_station drive (the shared recording), mapped by
 // pvbench slam and scored against the scene's true surface.  The bounds are
 // sanity bounds (a map put in the wrong frame is metres off, not
 // centimetres); the figures themselves are in docs/map_accuracy.md.
@@ -13,11 +13,13 @@
 #include <fstream>
 #include <regex>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "pvb/common/text.hpp"
 #include "run_pvbench.hpp"
+#include "station_sequence.hpp"
 
 namespace {
 
@@ -71,15 +73,32 @@ void expect_merged_maps_judged(const std::string& dir, const std::string& scenar
   EXPECT_GT(number_after(all, "\"ghosting_between_maps\": "), 0.5) << all;
 }
 
+/// The shared recording of the station cut to its first `frames` frames as
+/// far as eval-map reads it: `dir` gets its meta.json and the ground truth
+/// of those frames.
+void excerpt_of_station(const std::string& dir, std::size_t frames) {
+  const std::string& seq = pvb::test::station_sequence();
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(seq + "/meta.json", dir + "/meta.json");
+  std::istringstream in(pvb::read_file(seq + "/groundtruth.txt"));
+  std::string gt;
+  std::size_t poses = 0;
+  for (std::string line; poses < frames && std::getline(in, line);) {
+    gt += line + "\n";
+    poses += !line.empty() && line[0] != '#';
+  }
+  pvb::write_file(dir + "/groundtruth.txt", gt);
+}
+
 }  // namespace
 
 TEST(EvalMapCli, ScoresAShortPvStationMap) {
   const std::string dir = fresh("pv");
   const std::string scenario = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
-  auto r = pvb::test::run_pvbench("record --scenario " + scenario + " --frames 90 --out " + dir + "/seq");
-  ASSERT_EQ(r.code, 0) << r.output;
-  r = pvb::test::run_pvbench("slam --sequence " + dir + "/seq --settings " + dir + "/seq/camera.yaml --sync --out " +
-                             dir + "/slam");
+  const std::string& seq = pvb::test::station_sequence();
+  excerpt_of_station(dir + "/seq", 90);
+  auto r = pvb::test::run_pvbench("slam --sequence " + seq + " --settings " + seq +
+                                  "/camera.yaml --sync --max-frames 90 --out " + dir + "/slam");
   ASSERT_EQ(r.code, 0) << r.output;
   r = pvb::test::run_pvbench("eval-map --map " + dir + "/slam/PointCloud.ply --scenario " + scenario +
                              " --trajectory " + dir + "/slam/CameraTrajectory.txt --gt " + dir +
@@ -135,8 +154,8 @@ void write_points_ply(const std::string& path, const std::vector<std::array<floa
 TEST(EvalMapCli, BadMapsAndMismatchedInputsAreRefused) {
   const std::string dir = fresh("bad");
   const std::string station = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
-  auto r = pvb::test::run_pvbench("record --scenario " + station + " --frames 30 --out " + dir + "/seq");
-  ASSERT_EQ(r.code, 0) << r.output;
+  excerpt_of_station(dir + "/seq", 30);
+  pvb::test::RunResult r;
   const std::string inputs = " --trajectory " + dir + "/seq/groundtruth.txt --gt " + dir + "/seq/groundtruth.txt";
   const auto eval_map = [&](const std::string& map, const std::string& scenario, const std::string& extra) {
     return pvb::test::run_pvbench("eval-map --map " + map + " --scenario " + scenario + inputs + " " + extra);

@@ -1,4 +1,4 @@
-// pvbench record, end to end: the acceptance run (120 frames of the
+// pvbench record, end to end: the acceptance run (the shared 300 frames of the
 // default station), byte-identical output, depth/pose consistency, errors.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -14,6 +14,7 @@
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "run_pvbench.hpp"
+#include "station_sequence.hpp"
 
 using namespace pvb;
 
@@ -43,16 +44,10 @@ std::vector<std::string> list_files(const std::string& dir) {
   return out;
 }
 
-// The acceptance sequence, recorded once for the tests below.
-const std::string& station_run() {
-  static const std::string dir = [] {
-    const std::string d = fresh("station_a");
-    const Result r = run("record --scenario " + kStation + " --out " + d + " --frames 120 --seed 7");
-    EXPECT_EQ(r.code, 0) << r.output;
-    return d;
-  }();
-  return dir;
-}
+// The acceptance sequence: the default station's shared recording (300
+// frames at seed 7, made once per build; station_sequence.hpp).
+const std::string& station_run() { return pvb::test::station_sequence(); }
+constexpr std::size_t kStationFrames = pvb::test::kStationFrames;
 
 }  // namespace
 
@@ -62,15 +57,15 @@ TEST(RecordCli, WritesAConsistentTumSequence) {
                         "scene.xml", "meta.json", "textures/brick.png"})
     EXPECT_EQ(::access((d + "/" + f).c_str(), R_OK), 0) << f;
   const auto rgb = dataset::read_tum_list(d + "/rgb.txt");
-  ASSERT_EQ(rgb.size(), 120u);
+  ASSERT_EQ(rgb.size(), kStationFrames);
   // exactly 1/30 s apart (TUM text keeps microseconds)
   for (std::size_t i = 0; i < rgb.size(); ++i)
     EXPECT_NEAR(static_cast<double>(rgb[i].first), i * 1e9 / 30.0, 500.0) << i;
   const eval::Trajectory gt_traj = eval::read_tum(d + "/groundtruth.txt");
-  EXPECT_EQ(gt_traj.size(), 120u);
-  // the robot moves: about 0.45 m/s x 4 s
+  ASSERT_EQ(gt_traj.size(), kStationFrames);
+  // the robot moves: about 0.45 m/s x 4 s over the first 120 frames
   const double moved =
-      (gt_traj.poses.back().T_w_c.translation() - gt_traj.poses.front().T_w_c.translation()).norm();
+      (gt_traj.poses[119].T_w_c.translation() - gt_traj.poses.front().T_w_c.translation()).norm();
   EXPECT_GT(moved, 1.0);
   EXPECT_LT(moved, 2.5);
   std::string depth_name = rgb[5].second;
@@ -134,7 +129,8 @@ TEST(RecordCli, RunWritesTheMotionReadingsTheRecordingHolds) {
 TEST(RecordCli, SameScenarioSeedAndBackendGiveIdenticalFiles) {
   const std::string& a = station_run();
   const std::string b = fresh("station_b");
-  const Result r = run("record --scenario " + kStation + " --out " + b + " --frames 120 --seed 7");
+  const Result r = run("record --scenario " + kStation + " --out " + b + " --frames " +
+                       std::to_string(kStationFrames) + " --seed 7");
   ASSERT_EQ(r.code, 0) << r.output;
   const auto files = list_files(a);
   ASSERT_EQ(files, list_files(b));
@@ -314,7 +310,7 @@ TEST(RecordCli, ExistingOutputIsRefusedUnlessOverwriteEmptiesAnEarlierRecording)
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
   EXPECT_NE(r.output.find("pvbench: error: " + full + ": the output folder is not empty"), std::string::npos)
       << r.output;
-  EXPECT_EQ(dataset::read_tum_list(full + "/rgb.txt").size(), 120u);
+  EXPECT_EQ(dataset::read_tum_list(full + "/rgb.txt").size(), kStationFrames);
 
   const std::string d = fresh("overwrite");
   ASSERT_EQ(run("record --scenario " + kStation + " --out " + d + " --frames 6").code, 0);

@@ -15,6 +15,7 @@
 #include "pvb/common/text.hpp"
 #include "cli_output.hpp"
 #include "run_pvbench.hpp"
+#include "station_sequence.hpp"
 
 using namespace pvb;
 
@@ -43,6 +44,16 @@ bool write_station_with(const std::string& path, const std::string& from, const 
 }
 
 using pvb::test::data_lines;
+
+/// The run's ground truth (`frames` poses) is the one `pvbench record`
+/// writes for the station at its seed: the shared recording's first poses.
+void expect_recorded_ground_truth(const std::string& run_dir, std::size_t frames) {
+  const std::vector<std::string> rec_gt = data_lines(test::station_sequence() + "/groundtruth.txt");
+  const std::vector<std::string> run_gt = data_lines(run_dir + "/groundtruth.txt");
+  ASSERT_EQ(run_gt.size(), frames);
+  ASSERT_GE(rec_gt.size(), frames);
+  for (std::size_t i = 0; i < frames; ++i) EXPECT_EQ(rec_gt[i], run_gt[i]) << "frame " << i;
+}
 
 YAML::Node metrics(const std::string& dir) { return YAML::Load(read_file(dir + "/metrics.json")); }
 
@@ -120,13 +131,9 @@ void check_report_files(const std::string& d) {
   const std::string html = read_file(d + "/index.html");
   EXPECT_NE(html.find("trajectory_error.png"), std::string::npos);
   EXPECT_EQ(html.find("<script"), std::string::npos);
-  // The ground truth is the simulator's: the same poses `pvbench record` writes.
-  const std::string rec = fresh("record");
-  ASSERT_EQ(test::run_pvbench("record --scenario " + kStation + " --out " + rec + " --frames 3").code, 0);
-  const std::vector<std::string> rec_gt = data_lines(rec + "/groundtruth.txt");
-  const std::vector<std::string> run_gt = data_lines(d + "/groundtruth.txt");
-  ASSERT_EQ(rec_gt.size(), 3u);
-  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(rec_gt[i], run_gt[i]);
+  // The ground truth is the simulator's: the same poses `pvbench record`
+  // writes (the shared recording of the station at the same seed).
+  expect_recorded_ground_truth(d, 150);
 }
 
 // Sync mode is bit-identical, and a shorter run is a prefix of a longer one
@@ -141,14 +148,15 @@ void check_bit_identical_prefix(const std::string& d) {
 }
 
 // A recording replays what the live run saw: `pvbench slam` on `pvbench
-// record`'s folder gives the live run's trajectory bit for bit (the sensor
-// model emits depth on the PNG grid; settings travel through camera.yaml),
-// with no --seed: PE-match takes the recording's own seed from its meta.json.
+// record`'s folder (the shared recording, its first 40 frames) gives the
+// live run's trajectory bit for bit (the sensor model emits depth on the
+// PNG grid; settings travel through camera.yaml), with no --seed: PE-match
+// takes the recording's own seed from its meta.json.
 void check_replay_of_recording(const std::string& d) {
-  const std::string rec = fresh("replay_rec"), out = fresh("replay_slam");
-  ASSERT_EQ(test::run_pvbench("record --scenario " + kStation + " --out " + rec + " --frames 40").code, 0);
+  const std::string& rec = test::station_sequence();
+  const std::string out = fresh("replay_slam");
   const test::RunResult r = test::run_pvbench("slam --sequence " + rec + " --settings " + rec +
-                                              "/camera.yaml --out " + out + " --sync --no-dense");
+                                              "/camera.yaml --out " + out + " --sync --no-dense --max-frames 40");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("PE-match seed 7 (" + rec + "/meta.json)\n"), std::string::npos) << r.output;
   EXPECT_EQ(test::json_number(read_file(out + "/stats.json"), "seed"), 7.0);
@@ -356,13 +364,7 @@ TEST(RunCli, PipelinedRunProfilesEachThread) {
   EXPECT_GE(p["frame_latency_max"]["total_ms"].as<double>(), p["frame_latency"]["per_frame_ms"].as<double>());
   // Frame 44 is due 44 / 30 s after frame 0: a paced loop cannot be faster.
   EXPECT_GE(m["wall_s"].as<double>(), 44.0 / 30.0);
-  const std::string rec = fresh("record_pipelined");
-  ASSERT_EQ(test::run_pvbench("record --scenario " + kStation + " --out " + rec + " --frames 5").code, 0);
-  const std::vector<std::string> rec_gt = data_lines(rec + "/groundtruth.txt");
-  const std::vector<std::string> run_gt = data_lines(d + "/groundtruth.txt");
-  ASSERT_EQ(run_gt.size(), 45u);
-  ASSERT_EQ(rec_gt.size(), 5u);
-  for (std::size_t i = 0; i < rec_gt.size(); ++i) EXPECT_EQ(rec_gt[i], run_gt[i]);
+  expect_recorded_ground_truth(d, 45);
 }
 
 // Ctrl-C: a child `pvbench run` (pipelined) gets SIGINT once it has

@@ -14,6 +14,7 @@
 #include "cli_output.hpp"
 #include "pvb/common/text.hpp"
 #include "run_pvbench.hpp"
+#include "station_sequence.hpp"
 
 using namespace pvb;
 
@@ -127,14 +128,15 @@ TEST(RunInertialCli, LiveRunsWithAnImuAreBitIdentical) {
   EXPECT_EQ(trajectories[0], trajectories[1]);
 }
 
-// pvbench slam on a recording: the same keys in stats.json, the biases
-// against the recording's imu0/truth.csv.
+// pvbench slam on a recording (the first 120 frames of the shared one):
+// the same keys in stats.json, the biases against the recording's
+// imu0/truth.csv.
 TEST(RunInertialCli, SlamOnARecordingComparesTheBiasesWithItsTruth) {
-  const std::string rec = fresh("rec"), out = fresh("slam");
-  ASSERT_EQ(test::run_pvbench("record --scenario " + kStation + " --out " + rec + " --frames 120").code, 0);
+  const std::string& rec = test::station_sequence();
+  const std::string out = fresh("slam");
   const test::RunResult r =
       test::run_pvbench("slam --sequence " + rec + " --settings " + rec + "/camera.yaml --out " + out +
-                        " --sync --no-dense --sensors camera+imu");
+                        " --sync --no-dense --max-frames 120 --sensors camera+imu");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("inertial state trusted at t = "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("bias error RMS over "), std::string::npos) << r.output;

@@ -22,7 +22,8 @@ TEST(SweepRun, TwoSeedsThenASlurmTaskThenAggregateOnly) {
   const fs::path out = fs::path(::testing::TempDir()) / ("pvb_sweep_run_" + std::to_string(::getpid()));
   fs::remove_all(out);
   const std::string scenario = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
-  const std::string common = " --frames " + std::to_string(kFrames) + " --compare --sync";
+  // Dense maps are written, not scored: what a sweep does with the runs is under test.
+  const std::string common = " --frames " + std::to_string(kFrames) + " --compare --sync --no-map-eval";
 
   const auto r =
       run_pvbench("sweep --scenario " + scenario + " --seeds 1,2 --jobs 2 --out " + out.string() + common);
@@ -85,7 +86,7 @@ TEST(SweepRun, SensorSetupsReachEverySeedsRun) {
   const fs::path out = fs::path(::testing::TempDir()) / ("pvb_sweep_sensors_" + std::to_string(::getpid()));
   fs::remove_all(out);
   const std::string scenario = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
-  const std::string common = " --frames " + std::to_string(kFrames) + " --sync --seeds 1";
+  const std::string common = " --frames " + std::to_string(kFrames) + " --sync --no-map-eval --seeds 1";
 
   const auto pair = run_pvbench("sweep --scenario " + scenario + " --out " + (out / "pair").string() + common +
                                 " --compare-sensors camera,camera+imu");

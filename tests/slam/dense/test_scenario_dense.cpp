@@ -28,6 +28,7 @@
 #include "pvb/common/text.hpp"
 #include "pvb/eval/evaluate.hpp"
 #include "pvb/scenes/scenario.hpp"
+#include "pvb/sim/renderer.hpp"
 #include "pvb/sim/simulator.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/dense/ply.hpp"
@@ -118,29 +119,30 @@ TEST(DenseScenario, CloudLiesOnTheRenderedGeometry) {
   EXPECT_FALSE(live == cloud);
   EXPECT_NE(stats.find("\"pose_updates\": "), std::string::npos) << stats;
 
-  // Reference surface: the same scenario and seed, rendered without the
-  // sensor model at the ground-truth poses.
+  // Reference surface: the same scenario and seed, its exact depth rendered
+  // at the ground-truth poses (the scene's geometry: no texture, no sensor model).
   pvb::scenes::Scenario scenario = pvb::scenes::load_scenario(pvb::test::station_scenario());
   scenario.seed = pvb::test::kStationSeed;
-  pvb::sim::Simulator sim(scenario);
-  pvb::sim::RgbdCamera camera(sim, pvb::sim::GlBackend::kAuto);
+  pvb::sim::Simulator sim(scenario, pvb::sim::SceneDetail::kGeometry);
   const pvb::geom::PinholeIntrinsics K = sim.intrinsics();
+  pvb::sim::Renderer renderer(sim.model(), pvb::sim::GlBackend::kAuto, K.width, K.height);
+  renderer.set_shadows(false);
   constexpr double kThinCell = 0.005;
   Grid surface(0.025);
   std::unordered_set<std::int64_t> taken;
+  cv::Mat depth_gt_m;
   for (int i = 0; i < kFrames; ++i) {
     if (i > 0) sim.advance();
     if (i % kReferenceEvery != 0) continue;
-    const pvb::sim::Capture cap = camera.capture(sim);
+    renderer.render(sim.model(), sim.data(), sim.camera_id(), nullptr, &depth_gt_m);
+    const pvb::geom::SE3d T_w_c = sim.T_w_c();
     // the recording's ground truth is this simulation's
-    ASSERT_LT((cap.T_w_c.translation() - gt.poses[static_cast<std::size_t>(i)].T_w_c.translation()).norm(),
-              1e-6);
-    for (int v = 0; v < cap.depth_gt_m.rows; v += 2)
-      for (int u = 0; u < cap.depth_gt_m.cols; u += 2) {
-        const double z = cap.depth_gt_m.at<float>(v, u);
-        if (!(z > 0)) continue;
-        const Eigen::Vector3d p_w =
-            cap.T_w_c * Eigen::Vector3d((u - K.cx) / K.fx * z, (v - K.cy) / K.fy * z, z);
+    ASSERT_LT((T_w_c.translation() - gt.poses[static_cast<std::size_t>(i)].T_w_c.translation()).norm(), 1e-6);
+    for (int v = 0; v < depth_gt_m.rows; v += 2)
+      for (int u = 0; u < depth_gt_m.cols; u += 2) {
+        const double z = depth_gt_m.at<float>(v, u);
+        if (!(z > 0) || z > sim.assets().max_scene_depth_m) continue;  // the sky lies beyond the scene
+        const Eigen::Vector3d p_w = T_w_c * Eigen::Vector3d((u - K.cx) / K.fx * z, (v - K.cy) / K.fy * z, z);
         const auto c = Grid::index(p_w, kThinCell);
         if (taken.insert(Grid::key(c[0], c[1], c[2])).second) surface.add(p_w);
       }
