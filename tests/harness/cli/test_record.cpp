@@ -44,6 +44,14 @@ std::vector<std::string> list_files(const std::string& dir) {
   return out;
 }
 
+// Lines of a TUM list that are not comments.
+std::size_t data_lines(const std::string& path) {
+  std::ifstream in(path);
+  std::size_t n = 0;
+  for (std::string l; std::getline(in, l);) n += !l.empty() && l[0] != '#';
+  return n;
+}
+
 // The acceptance sequence: the default station's shared recording (300
 // frames at seed 7, made once per build; station_sequence.hpp).
 const std::string& station_run() { return pvb::test::station_sequence(); }
@@ -126,22 +134,38 @@ TEST(RecordCli, RunWritesTheMotionReadingsTheRecordingHolds) {
     EXPECT_TRUE(read_file(rec + "/" + f) == read_file(live + "/" + f)) << f << " differs";
 }
 
+// The same scenario, seed and backend give the same files: a recording of
+// the first 60 frames is the start of the shared 300-frame one, file for
+// file (every image, the scene and the settings the same bytes, every
+// per-frame list and motion file its first lines; meta.json the same but
+// for the frame count and the measured timings; the contact sheet, frames
+// spread over the whole recording, is made of those frames).
 TEST(RecordCli, SameScenarioSeedAndBackendGiveIdenticalFiles) {
   const std::string& a = station_run();
   const std::string b = fresh("station_b");
-  const Result r = run("record --scenario " + kStation + " --out " + b + " --frames " +
-                       std::to_string(kStationFrames) + " --seed 7");
+  constexpr std::size_t kFrames = 60;
+  const Result r =
+      run("record --scenario " + kStation + " --out " + b + " --frames " + std::to_string(kFrames) + " --seed 7");
   ASSERT_EQ(r.code, 0) << r.output;
-  const auto files = list_files(a);
-  ASSERT_EQ(files, list_files(b));
-  for (const auto& f : files) {
-    if (f == "./meta.json") continue;
-    EXPECT_TRUE(read_file(a + "/" + f) == read_file(b + "/" + f)) << f << " differs";
+  const std::vector<std::string> files_a = list_files(a), files_b = list_files(b);
+  std::size_t images = 0;
+  for (const auto& f : files_b) {
+    ASSERT_TRUE(std::binary_search(files_a.begin(), files_a.end(), f)) << f << " is not in the longer recording";
+    images += f.rfind("./rgb/", 0) == 0 || f.rfind("./depth/", 0) == 0;
+    if (f == "./meta.json" || f == "./contact_sheet.png") continue;
+    const std::string fa = read_file(a + "/" + f), fb = read_file(b + "/" + f);
+    EXPECT_FALSE(fb.empty()) << f;
+    EXPECT_TRUE(fa.compare(0, fb.size(), fb) == 0) << f << " is not the start of the longer recording's";
   }
-  // meta.json differs only in its measured timings
-  const std::regex timings("\"timings\": \\{[^}]*\\}");
-  EXPECT_EQ(std::regex_replace(read_file(a + "/meta.json"), timings, ""),
-            std::regex_replace(read_file(b + "/meta.json"), timings, ""));
+  EXPECT_EQ(images, 2 * kFrames);
+  for (const char* list : {"rgb.txt", "depth.txt", "groundtruth.txt", "associations.txt"})
+    EXPECT_EQ(data_lines(b + "/" + list), kFrames) << list;
+  // meta.json differs only in the frame count and its measured timings
+  const auto same_part = [](const std::string& meta) {
+    static const std::regex timings("\"timings\": \\{[^}]*\\}"), frames("\"frames\": [0-9]+");
+    return std::regex_replace(std::regex_replace(meta, timings, ""), frames, "");
+  };
+  EXPECT_EQ(same_part(read_file(a + "/meta.json")), same_part(read_file(b + "/meta.json")));
 }
 
 TEST(RecordCli, BadScenarioGivesOneClearLine) {
@@ -171,14 +195,6 @@ TEST(RecordCli, MissingScenarioFile) {
 }
 
 namespace {
-
-// Lines of a TUM list that are not comments.
-std::size_t data_lines(const std::string& path) {
-  std::ifstream in(path);
-  std::size_t n = 0;
-  for (std::string l; std::getline(in, l);) n += !l.empty() && l[0] != '#';
-  return n;
-}
 
 // Runs `pvbench ARGS` with the working directory `cwd`.
 Result run_in(const std::string& cwd, const std::string& args) {
