@@ -141,6 +141,7 @@ pid_t start_seed(const SweepArgs& a, std::uint64_t seed) {
   fs::create_directories(dir, ec);
   if (ec) throw IoError(dir, "cannot create the seed folder: " + ec.message());
   const std::string log = dir + "/stdout.log";
+  note_output(log);
   const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw IoError(log, std::string("cannot open: ") + std::strerror(errno));
   std::vector<std::string> args = run_args(a, seed);
