@@ -22,6 +22,7 @@
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/run/inertial_eval.hpp"
 #include "pvb/run/map_eval.hpp"
+#include "pvb/run/output_names.hpp"
 #include "pvb/run/place_recognition.hpp"
 #include "pvb/run/sensor_setup.hpp"
 #include "pvb/slam/core/system.hpp"
@@ -110,13 +111,15 @@ void write_tum_file(const std::string& path, const std::vector<geom::StampedPose
 void check_slam_paths(const OfflineSlamOptions& a, const slam::Settings& settings) {
   IoPlan plan;
   if (!a.sequence.empty())
-    plan.inputs("a file of the --sequence folder", dataset::sequence_files(a.sequence));
+    plan.inputs("a file of the --sequence folder", dataset::sequence_files(a.sequence))
+        .input_folder("the --sequence folder", a.sequence);
   plan.input("the --settings file", a.settings).input("the --map file", a.map.load_path);
   if (settings.vocabulary_path != "none")
     plan.input("the vocabulary of the --settings file", settings.vocabulary_path);
-  plan.output_folder("--out", a.out).output_file("--save-map", a.map.save_path);
+  plan.output_folder("--out", a.out, offline_slam_output_names()).output_file("--save-map", a.map.save_path);
   plan.check();
   check_output_folder(a.out, a.overwrite);
+  reserve_output(a.map.save_path, "--save-map");
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include "pvb/geometry/time.hpp"
 #include "pvb/run/blind.hpp"
 #include "pvb/run/motion_truth.hpp"
+#include "pvb/run/output_names.hpp"
 #include "pvb/run/world_json.hpp"
 #include "pvb/scenes/route.hpp"
 #include "pvb/sim/motion_sensors.hpp"
@@ -64,10 +65,11 @@ void check_run_paths(const RunOptions& opt, const scenes::Scenario& scenario) {
   plan.input("the --scenario file", opt.scenario_file)
       .inputs("a base of the --scenario file", scenario.base_files)
       .input("the --map file", opt.map.load_path)
-      .output_folder("--out", opt.out_dir)
+      .output_folder("--out", opt.out_dir, run_output_names())
       .output_file("--save-map", opt.map.save_path);
   plan.check();
   check_output_folder(opt.out_dir, opt.overwrite);
+  reserve_output(opt.map.save_path, "--save-map");
 }
 
 RunReport new_report(const scenes::Scenario& scenario, const RunOptions& opt) {
