@@ -101,6 +101,9 @@ System::~System() { shutdown(); }
 void System::shutdown() {
   if (mapping_) mapping_->stop();
   if (dense_) dense_->stop();
+  // What ended a worker thread reaches the caller here at the latest.
+  if (mapping_) mapping_->rethrow_error();
+  if (dense_) dense_->rethrow_error();
 }
 
 LocalMappingStats System::mapping_stats() const { return mapping_->stats(); }

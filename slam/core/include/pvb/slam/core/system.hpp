@@ -115,7 +115,9 @@ class System {
   MapSettings map_settings() const;
 
   FrameResult track(const sensor::RgbdFrame& frame);
-  /// Lets local and dense mapping finish their queues and stops the workers.
+  /// Lets local and dense mapping finish their queues and stops the workers;
+  /// then rethrows what a worker thread threw, if one did (track() rethrows
+  /// it at the next keyframe handed over).
   void shutdown();
 
   /// Every tracked frame's pose recomputed from its reference keyframe's
