@@ -427,7 +427,7 @@ void OfflineSlam::Impl::evaluate_gravity(const eval::Trajectory& gt, const eval:
   const eval::GravityError g =
       eval::gravity_error(gt, est, down_w, gravity_map_frame(settings_.sensors), tally_.gravity);
   const eval::TiltDrift t =
-      eval::tilt_drift(gt, eval::read_tum(a_.out + "/KeyFrameTrajectory.txt"), alignment);
+      eval::tilt_drift(gt, session_keyframes(eval::read_tum(a_.out + "/KeyFrameTrajectory.txt"), *system_), alignment);
   text(strf("gravity error (map frame: %s): median %.2f deg, p95 %.2f, final %.2f; keyframe pitch error "
             "%+.4f deg/keyframe, roll %+.4f\n",
             g.map_frame.c_str(), g.median_deg, g.p95_deg, g.final_deg, t.pitch_slope_deg_per_kf,

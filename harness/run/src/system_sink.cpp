@@ -244,7 +244,7 @@ void SystemSink::evaluate_gravity(const eval::Trajectory& gt) {
   // The run's ground truth is in the site frame: z up.
   run.gravity = eval::gravity_error(gt, est, geom::Vec3d(0, 0, -1), gravity_map_frame(system->sensors()),
                                    gravity_estimates);
-  run.tilt = eval::tilt_drift(gt, keyframes, run.eval->alignment);
+  run.tilt = eval::tilt_drift(gt, session_keyframes(keyframes, *system), run.eval->alignment);
 }
 
 void SystemSink::evaluate_inertial(const std::vector<BiasTruth>& truth) {
