@@ -183,7 +183,12 @@ std::string seed_summary(const suite::SeedRun& r) {
   };
   std::string s =
       m.status + ", ATE RMSE " + mm(m.ate_rmse_m) + ", " + std::to_string(m.lost_frames) + " lost";
-  if (r.metrics->baseline) s += ", baseline " + mm(r.metrics->baseline->ate_rmse_m);
+  if (const std::optional<suite::RunMetrics>& b = r.metrics->baseline) {
+    // --compare-sensors: the reference run is named by its sensors, as in the aggregate
+    const bool by_sensors = b->sensors != m.sensors;
+    s = (by_sensors ? m.sensors + ": " : std::string()) + s + ", " + (by_sensors ? b->sensors : "baseline") + " " +
+        mm(b->ate_rmse_m);
+  }
   return s;
 }
 

@@ -297,7 +297,7 @@ void evaluate_blind_stretch(const scenes::Scenario& scenario, SystemSinks& sinks
   for (auto& sink : sinks) {
     SlamRun& run = sink->run;
     run.blind = blind_stretch(*cover, scenario.camera.fps, run.per_frame, sink->est, gt, run.eval);
-    log.line(eval::mode_label(run.mode) + ": " + blind_summary(*run.blind));
+    log.line(run.label + ": " + blind_summary(*run.blind));
   }
 }
 
@@ -387,7 +387,7 @@ void log_summary(const RunReport& report, RunLog& log) {
     for (const std::string& line : map_log_lines(*report.primary.map)) log.line(line);
   for (const SlamRun* r : {&report.primary, report.baseline ? &*report.baseline : nullptr}) {
     if (!r || (!r->refined_eval && r->loop_closing_json.empty())) continue;
-    log.line(eval::mode_label(r->mode) + ": refined trajectory ATE rmse " +
+    log.line(r->label + ": refined trajectory ATE rmse " +
              (r->refined_eval ? format_g(r->refined_eval->ate.rmse) : "n/a") + " m, " +
              std::to_string(r->loops_closed) + " loops closed");
   }

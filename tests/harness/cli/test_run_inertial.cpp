@@ -188,4 +188,18 @@ TEST(RunInertialCli, CompareSensorsNamesTheSystemsBySetup) {
   EXPECT_NE(html.find("<h2>Gravity and inertial state</h2>"), std::string::npos);
 }
 
+// Both runs of --compare-sensors share one mode: the log named each by it
+// ("baseline (ORB-SLAM2 motion model): ..." twice with --baseline); each is
+// named by its sensors.
+TEST(RunInertialCli, CompareSensorsNamesEachRunByItsSensorsInTheLog) {
+  const std::string d = fresh("compare_log");
+  const test::RunResult r =
+      test::run_pvbench("run --scenario " + kStation + " --out " + d +
+                        " --sync --frames 15 --no-map-eval --baseline --compare-sensors camera,camera+imu");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("\ncamera+imu: refined trajectory ATE rmse"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\ncamera: refined trajectory ATE rmse"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("motion model): refined trajectory"), std::string::npos) << r.output;
+}
+
 }  // namespace
