@@ -318,7 +318,8 @@ slam::TrackingState track_frame(const sensor::RgbdFrame& frame, const CameraSett
 }
 
 /// Reads and tracks frames until the stream ends, `max_frames` (0: no limit)
-/// or Ctrl-C / SIGTERM, which end a live run cleanly (exit 0).  A stream
+/// or Ctrl-C / SIGTERM / SIGHUP (StopSignals, from before the output folder
+/// is made), which end a live run cleanly (exit 0).  A stream
 /// error ends the loop too and is kept in the counts: what was tracked so far
 /// is still written.
 TrackCounts track_frames(openni::OpenniSource& source, std::size_t max_frames, const CameraSettings& settings,
@@ -328,7 +329,6 @@ TrackCounts track_frames(openni::OpenniSource& source, std::size_t max_frames, c
   TrackCounts counts;
   const auto t0 = Clock::now();
   {
-    const StopSignals stop_signals;
     ProgressBar bar("camera " + source.describe(), total);
     while ((max_frames == 0 || counts.frames < max_frames) && !StopSignals::requested()) {
       std::optional<sensor::RgbdFrame> frame;
@@ -482,6 +482,9 @@ int run_camera(CameraArgs a) {
   slam::System system(settings.slam, options);
   std::optional<run::MapReport> map;  // read (and refused when bad) before the folder is made
   if (!a.map.load_path.empty() || !a.map.save_path.empty()) map = run::start_map(system, a.map);
+  // From here a stop signal (Ctrl-C during the device's set-up too) ends
+  // the run as the end of the stream would: every output written, exit 0.
+  const StopSignals stop_signals;
   prepare_output_folder(a.out, a.overwrite, "camera");
   write_file(a.out + "/camera.yaml", settings.text);
   openni::OpenniSource source(source_options(a, settings.slam, timeout_ms));
