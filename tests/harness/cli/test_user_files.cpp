@@ -8,10 +8,13 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "pvb/common/io_paths.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/run/output_names.hpp"
 #include "run_pvbench.hpp"
 #include "shared_data.hpp"
 
@@ -114,8 +117,17 @@ TEST(UserFiles, OverwriteKeepsAUsersFile) {
   EXPECT_EQ(read_file(d + "/out/notes.txt"), "the user's notes\n");
   EXPECT_TRUE(fs::exists(d + "/out/stats.json")) << "removed before the refusal";
   fs::remove(d + "/out/notes.txt");
-  const test::RunResult again = test::run_pvbench(slam + " --overwrite");
+  const test::RunResult again = test::run_pvbench(slam + " --overwrite --dump-map --dump-matches");
   EXPECT_EQ(again.code, 0) << again.output;
+  // Every file slam wrote is one the IoPlan refuses as --save-map.
+  std::istringstream list(read_file(d + "/out/.pvbench"));
+  int files = 0;
+  for (std::string line; std::getline(list, line);) {
+    if (line.rfind("file ", 0) != 0) continue;
+    ++files;
+    EXPECT_TRUE(is_written_name(line.substr(5), run::offline_slam_output_names())) << line;
+  }
+  EXPECT_GE(files, 6);
 }
 
 // A D435 with a disparity range as wide as its infrared image aborted
