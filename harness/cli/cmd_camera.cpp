@@ -200,7 +200,6 @@ void check_camera_paths(const CameraArgs& a, const std::optional<scenes::Scenari
     std::error_code ec;
     for (const auto& e : std::filesystem::directory_iterator(dump, ec))
       if (e.is_regular_file(ec)) plan.input("a file of the fakenect dump (FAKENECT_PATH)", e.path().string());
-    plan.input_folder("the fakenect dump (FAKENECT_PATH)", dump);
   }
   plan.input("the --map file", a.map.load_path);
   plan.output_folder("--out", a.out, camera_output_names()).output_file("--save-map", a.map.save_path);

@@ -11,8 +11,8 @@
 //    that the command writes into one of its output folders
 //    (`--save-map OUT/stats.json`);
 //  - an output inside a folder the command reads as a recording (a TUM
-//    sequence, a fakenect dump), whatever file it names: a recording is
-//    the user's data and nothing is ever written into it.
+//    sequence), whatever file it names: a recording is the user's data and
+//    nothing is ever written into it.
 // Streams (a character device such as /dev/null, a FIFO) are written
 // through, never replaced, so they are not compared.
 #include <string>
