@@ -70,6 +70,25 @@ void check_file_place(const IoPath& out, const std::vector<IoPath>& folders) {
   }
 }
 
+/// An output in a folder read as a recording: refused, whatever it names.
+void check_not_in_recording(const IoPath& out, bool folder, const std::vector<IoPath>& recordings) {
+  for (const IoPath& in : recordings) {
+    if (!is_inside(out.path, in.path)) continue;
+    const std::string what = folder ? "the " + out.role + " folder lies in " : std::string("lies in ");
+    throw IoError(out.path, what + spelled(in, out.path) +
+                                ", a recording this command reads, and nothing is written into a recording; give " +
+                                out.role + (folder ? " another folder" : " another path"));
+  }
+}
+
+/// `out`'s name in `folder` when it is one of the files the command writes
+/// there (is_written_name), else "".
+std::string written_name(const std::string& out, const std::string& folder, const std::vector<std::string>& written) {
+  if (!is_inside(out, folder)) return {};
+  const std::string rel = canonical_of(out).lexically_relative(canonical_of(folder)).generic_string();
+  return rel != "." && is_written_name(rel, written) ? rel : std::string();
+}
+
 void check_output_folder(const IoPath& out, const std::vector<IoPath>& inputs) {
   struct stat st {};
   if (::stat(out.path.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) return;  // new: holds nothing yet
@@ -97,23 +116,58 @@ IoPlan& IoPlan::output_file(const std::string& role, const std::string& path) {
   return *this;
 }
 
-IoPlan& IoPlan::output_folder(const std::string& role, const std::string& path) {
-  if (!path.empty()) output_folders_.push_back({role, path});
+IoPlan& IoPlan::input_folder(const std::string& role, const std::string& path) {
+  if (!path.empty()) input_folders_.push_back({role, path});
+  return *this;
+}
+
+IoPlan& IoPlan::output_folder(const std::string& role, const std::string& path,
+                              const std::vector<std::string>& written) {
+  if (path.empty()) return *this;
+  output_folders_.push_back({role, path});
+  written_.push_back(written);
   return *this;
 }
 
 void IoPlan::check() const {
-  for (const IoPath& out : output_folders_) check_output_folder(out, inputs_);
+  std::vector<IoPath> read = inputs_;
+  read.insert(read.end(), input_folders_.begin(), input_folders_.end());
+  for (const IoPath& out : output_folders_) {
+    check_not_in_recording(out, true, input_folders_);
+    check_output_folder(out, read);
+  }
   for (std::size_t i = 0; i < output_files_.size(); ++i) {
     const IoPath& out = output_files_[i];
     check_file_place(out, output_folders_);
     check_output_file(out, inputs_);
     if (is_stream(out.path)) continue;
+    check_not_in_recording(out, false, input_folders_);
+    for (std::size_t k = 0; k < output_folders_.size(); ++k)
+      if (const std::string name = written_name(out.path, output_folders_[k].path, written_[k]); !name.empty())
+        throw IoError(out.path, "is " + name + " of the " + output_folders_[k].role +
+                                    " folder, which this command writes; give " + out.role + " another path");
     for (std::size_t j = 0; j < i; ++j)
       if (same_file(out.path, output_files_[j].path))
         throw IoError(out.path, output_files_[j].role + " and " + out.role +
                                     " name the same file; give each output its own path");
   }
+}
+
+bool is_written_name(const std::string& rel, const std::vector<std::string>& written) {
+  for (const std::string& w : written) {
+    if (w.empty()) continue;
+    if (w.back() == '/' && (rel.compare(0, w.size(), w) == 0 || rel + "/" == w)) return true;
+    const std::size_t star = w.find('*');
+    if (star == std::string::npos) {
+      if (rel == w) return true;
+      continue;
+    }
+    const std::string head = w.substr(0, star), tail = w.substr(star + 1);
+    if (rel.find('/') == std::string::npos && rel.size() >= head.size() + tail.size() &&
+        rel.compare(0, head.size(), head) == 0 && rel.compare(rel.size() - tail.size(), tail.size(), tail) == 0)
+      return true;
+  }
+  return false;
 }
 
 bool same_file(const std::string& a, const std::string& b) {

@@ -17,10 +17,12 @@
 #include <vector>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_folder.hpp"
 
 namespace pvb {
 
 OutputFile::OutputFile(const std::string& path) : path_(path) {
+  note_output(path);  // listed in its output folder's marker before it exists
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) throw IoError(path, std::string("cannot open for writing: ") + std::strerror(errno));
 }
@@ -228,6 +230,7 @@ void write_through(const std::string& path, const OutputTarget& target,
 void write_file_via_temp(const std::string& path, const std::function<void(OutputFile&)>& write) {
   const OutputTarget target = resolve_output_target(path);
   if (target.kind == OutputTarget::Kind::kStream) return write_through(path, target, write);
+  note_output(path);  // the name in its folder (a link stays a link), before its temporary file exists
   remove_stale_temporaries(target.path);
   std::string tmp;
   try {

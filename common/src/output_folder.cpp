@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "pvb/common/error.hpp"
+#include "output_manifest.hpp"
 #include "pvb/common/text.hpp"
 
 namespace pvb {
@@ -123,44 +124,47 @@ void check_not_locked(const std::string& dir) {
   ::close(fd);  // closing the only descriptor that holds it releases it
 }
 
-/// The entries to remove for `overwrite` (none for a new or empty folder);
-/// throws for a folder that may not be written.  Nothing is changed.
-std::vector<fs::path> entries_to_replace(const std::string& dir, bool overwrite, bool check_lock) {
+/// What `overwrite` removes (nothing for a new or empty folder); throws
+/// for a folder that may not be written.  Nothing is changed.
+detail::Removal removal_for(const std::string& dir, bool overwrite, bool check_lock) {
   if (dir.empty()) throw IoError("(empty path)", "expected an output folder");
   struct stat st {};
   if (::stat(dir.c_str(), &st) != 0) return {};
   if (!S_ISDIR(st.st_mode)) throw IoError(dir, "is not a folder; expected a new or empty output folder");
   if (check_lock) check_not_locked(dir);
   bool has_marker = false;
-  std::vector<fs::path> entries = entries_of(dir, &has_marker);
-  if (!entries.empty()) {
-    if (!overwrite)
-      throw IoError(dir, "the output folder is not empty (" + listing(entries) +
-                             "); give --overwrite to replace an earlier pvbench output, or another folder");
-    if (!has_marker)
-      throw IoError(dir, "the output folder holds files pvbench did not write (" + listing(entries) +
-                             ", no " + kOutputFolderMarker + " marker); it is not emptied, even with --overwrite");
-  }
-  return entries;
+  const std::vector<fs::path> entries = entries_of(dir, &has_marker);
+  if (entries.empty()) return {};
+  if (!overwrite)
+    throw IoError(dir, "the output folder is not empty (" + listing(entries) +
+                           "); give --overwrite to replace an earlier pvbench output, or another folder");
+  if (!has_marker)
+    throw IoError(dir, "the output folder holds files pvbench did not write (" + listing(entries) + ", no " +
+                           kOutputFolderMarker + " marker); it is not emptied, even with --overwrite");
+  return detail::plan_removal(dir, [](const fs::path& p) { return is_own_stream(p); });
 }
 
 }  // namespace
 
-void check_output_folder(const std::string& dir, bool overwrite) { entries_to_replace(dir, overwrite, true); }
+void check_output_folder(const std::string& dir, bool overwrite) { removal_for(dir, overwrite, true); }
 
 void prepare_output_folder(const std::string& dir, bool overwrite, const std::string& command) {
-  entries_to_replace(dir, overwrite, false);  // refused before anything is created
+  removal_for(dir, overwrite, false);  // refused before anything is created
   create_folder(dir);
   lock_for_process(dir);
   // Under the lock: what is there now (another process may have written
   // into the folder since the first look).
-  const std::vector<fs::path> entries = entries_to_replace(dir, overwrite, false);
-  for (const fs::path& p : entries) {
+  const detail::Removal removal = removal_for(dir, overwrite, false);
+  for (const fs::path& p : removal.files) {
     std::error_code ec;
-    fs::remove_all(p, ec);
+    fs::remove(p, ec);
     if (ec) throw IoError(p.string(), "cannot remove an earlier output: " + ec.message());
   }
-  write_file(dir + "/" + kOutputFolderMarker, "written by pvbench " + command + " " + version() + "\n");
+  for (const fs::path& p : removal.folders) {
+    std::error_code ec;
+    fs::remove(p, ec);  // only when empty: a folder holding a kept stream stays
+  }
+  detail::start_manifest(dir, command);
 }
 
 }  // namespace pvb

@@ -131,7 +131,10 @@ MapReader::MapReader(const YAML::Node& node, const ReadContext& ctx, std::string
   if (!node_.IsMap()) fail(path_.empty() ? "(top level)" : path_, node_, "a mapping of keys");
 }
 
-bool MapReader::has(const std::string& key) const { return node_[key].IsDefined() && !node_[key].IsNull(); }
+bool MapReader::has(const std::string& key) const {
+  asked_.insert(key);
+  return node_[key].IsDefined() && !node_[key].IsNull();
+}
 
 double MapReader::number(const std::string& key, double def, double lo, double hi) {
   const YAML::Node n = take(key);
@@ -212,9 +215,12 @@ void MapReader::finish() const {
   for (const auto& kv : node_) {
     if (!kv.first.IsScalar()) fail(full("?"), kv.first, "a key name", "a list or a map as a key");
     const std::string key = kv.first.Scalar();
-    if (read_.count(key) == 0) {
+    // A null value is the default (absent), also for a key only asked about.
+    if (read_.count(key) == 0 && !(asked_.count(key) && kv.second.IsNull())) {
+      std::set<std::string> all = read_;
+      all.insert(asked_.begin(), asked_.end());
       std::string known;
-      for (const auto& k : read_) known += (known.empty() ? "" : ", ") + k;
+      for (const auto& k : all) known += (known.empty() ? "" : ", ") + k;
       fail(full(key), kv.first, "a known key (" + known + ")", "unknown key");
     }
   }

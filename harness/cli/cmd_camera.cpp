@@ -39,6 +39,7 @@
 #include "pvb/openni/record_target.hpp"
 #include "pvb/openni/sim_uri.hpp"
 #include "pvb/run/motion_truth.hpp"
+#include "pvb/run/output_names.hpp"
 #include "pvb/run/run.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/simulator.hpp"
@@ -68,12 +69,17 @@ struct CameraArgs {
   std::string sensors;  ///< --sensors
 };
 
-/// Files written into --out (a recording must not land on one of them).
-const char* const kOutputs[] = {"camera.yaml", "CameraTrajectory.txt", "KeyFrameTrajectory.txt",
-                                "map.ply",     "stats.json",           "groundtruth.txt",
-                                "imu0",        "accelerometer.txt",    "wheels.csv",
-                                "odom.txt",    "imu.yaml",             "robot.yaml",
-                                "wheels_truth.csv", "robot_truth.yaml"};
+/// Files written into --out (no other output may land on one of them),
+/// with a sim:// source's motion files.
+const std::vector<std::string>& camera_output_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n = {"camera.yaml", "CameraTrajectory.txt", "KeyFrameTrajectory.txt",
+                                  "map.ply",     "stats.json",           "groundtruth.txt"};
+    n.insert(n.end(), run::motion_output_names().begin(), run::motion_output_names().end());
+    return n;
+  }();
+  return names;
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -104,7 +110,10 @@ std::optional<scenes::Scenario> check_inputs(const CameraArgs& a) {
   if (!a.record.empty()) {
     std::vector<openni::RunFile> files = {
         {a.oni, "the --oni recording"}, {a.settings, "the --settings file"}, {scenario_path, "the scenario"}};
-    for (const char* name : kOutputs) files.push_back({a.out + "/" + name, "an output of this run"});
+    for (std::string name : camera_output_names()) {
+      if (name.back() == '/') name.pop_back();  // a folder of outputs
+      files.push_back({a.out + "/" + name, "an output of this run"});
+    }
     openni::check_record_not_on(a.record, files);
     openni::check_new_recording_path(a.record);  // before any device is open
   }
@@ -193,10 +202,11 @@ void check_camera_paths(const CameraArgs& a, const std::optional<scenes::Scenari
       if (e.is_regular_file(ec)) plan.input("a file of the fakenect dump (FAKENECT_PATH)", e.path().string());
   }
   plan.input("the --map file", a.map.load_path);
-  plan.output_folder("--out", a.out).output_file("--save-map", a.map.save_path);
+  plan.output_folder("--out", a.out, camera_output_names()).output_file("--save-map", a.map.save_path);
   plan.output_file("--record", a.record);
   plan.check();
   check_output_folder(a.out, a.overwrite);
+  reserve_output(a.map.save_path, "--save-map");
 }
 
 openni::OpenniOptions source_options(const CameraArgs& a, const slam::Settings& settings, int timeout_ms) {
@@ -307,7 +317,8 @@ slam::TrackingState track_frame(const sensor::RgbdFrame& frame, const CameraSett
 }
 
 /// Reads and tracks frames until the stream ends, `max_frames` (0: no limit)
-/// or Ctrl-C / SIGTERM, which end a live run cleanly (exit 0).  A stream
+/// or Ctrl-C / SIGTERM / SIGHUP (StopSignals, from before the output folder
+/// is made), which end a live run cleanly (exit 0).  A stream
 /// error ends the loop too and is kept in the counts: what was tracked so far
 /// is still written.
 TrackCounts track_frames(openni::OpenniSource& source, std::size_t max_frames, const CameraSettings& settings,
@@ -317,7 +328,6 @@ TrackCounts track_frames(openni::OpenniSource& source, std::size_t max_frames, c
   TrackCounts counts;
   const auto t0 = Clock::now();
   {
-    const StopSignals stop_signals;
     ProgressBar bar("camera " + source.describe(), total);
     while ((max_frames == 0 || counts.frames < max_frames) && !StopSignals::requested()) {
       std::optional<sensor::RgbdFrame> frame;
@@ -471,6 +481,9 @@ int run_camera(CameraArgs a) {
   slam::System system(settings.slam, options);
   std::optional<run::MapReport> map;  // read (and refused when bad) before the folder is made
   if (!a.map.load_path.empty() || !a.map.save_path.empty()) map = run::start_map(system, a.map);
+  // From here a stop signal (Ctrl-C during the device's set-up too) ends
+  // the run as the end of the stream would: every output written, exit 0.
+  const StopSignals stop_signals;
   prepare_output_folder(a.out, a.overwrite, "camera");
   write_file(a.out + "/camera.yaml", settings.text);
   openni::OpenniSource source(source_options(a, settings.slam, timeout_ms));

@@ -59,9 +59,14 @@ class FakenectDump {
         max_m_(s.camera.depth_range_m[1]),
         registration_(sensor::kinect::Calibration{}),
         writer_(dir, registration_.calibration()),
-        R_c_i_(scenes::T_camera_imu(s.imu).linear()) {
+        R_c_i_(scenes::T_camera_imu(s.imu).linear()) {}
+
+  /// A dump holds a Kinect v1's frames: refused, naming the scenario's
+  /// file, before the output folder is made.
+  static void check_camera(const scenes::Scenario& s) {
     if (s.camera.width != sensor::kinect::kWidth || s.camera.height != sensor::kinect::kHeight)
-      throw ConfigError(s.name, "camera.width/height", "640x480 for a fakenect dump (a Kinect v1's frames)",
+      throw ConfigError(s.source_file.empty() ? s.name : s.source_file, "camera.width/height",
+                        "640x480 for a fakenect dump (a Kinect v1's frames)",
                         std::to_string(s.camera.width) + "x" + std::to_string(s.camera.height));
   }
 
@@ -192,6 +197,7 @@ int run_record(const RecordOptions& opt, bool frames_given) {
   IoPlan plan;
   add_scenario_inputs(&plan, "--scenario", scenario);
   plan.output_folder("--out", opt.out).check();
+  if (opt.format == "fakenect") FakenectDump::check_camera(scenario);
   prepare_output_folder(opt.out, opt.overwrite, "record");  // before the work: never into another recording
   const StopSignals stop_signals;  // Ctrl-C during the set-up stops before the first frame
 

@@ -141,6 +141,7 @@ pid_t start_seed(const SweepArgs& a, std::uint64_t seed) {
   fs::create_directories(dir, ec);
   if (ec) throw IoError(dir, "cannot create the seed folder: " + ec.message());
   const std::string log = dir + "/stdout.log";
+  note_output(log);
   const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw IoError(log, std::string("cannot open: ") + std::strerror(errno));
   std::vector<std::string> args = run_args(a, seed);
@@ -182,7 +183,12 @@ std::string seed_summary(const suite::SeedRun& r) {
   };
   std::string s =
       m.status + ", ATE RMSE " + mm(m.ate_rmse_m) + ", " + std::to_string(m.lost_frames) + " lost";
-  if (r.metrics->baseline) s += ", baseline " + mm(r.metrics->baseline->ate_rmse_m);
+  if (const std::optional<suite::RunMetrics>& b = r.metrics->baseline) {
+    // --compare-sensors: the reference run is named by its sensors, as in the aggregate
+    const bool by_sensors = b->sensors != m.sensors;
+    s = (by_sensors ? m.sensors + ": " : std::string()) + s + ", " + (by_sensors ? b->sensors : "baseline") + " " +
+        mm(b->ate_rmse_m);
+  }
   return s;
 }
 

@@ -16,9 +16,12 @@ inline void add_scenario_inputs(IoPlan* plan, const std::string& option, const s
       .inputs("a base of the " + option + " file", s.base_files);
 }
 
-/// The files of a TUM RGB-D folder a reader of it may read.
+/// The files of a TUM RGB-D folder a reader of it may read, and the folder
+/// itself: a recording, which no output may land in.
 inline void add_sequence_inputs(IoPlan* plan, const std::string& option, const std::string& dir) {
-  if (!dir.empty()) plan->inputs("a file of the " + option + " folder", dataset::sequence_files(dir));
+  if (dir.empty()) return;
+  plan->inputs("a file of the " + option + " folder", dataset::sequence_files(dir));
+  plan->input_folder("the " + option + " folder", dir);
 }
 
 /// A campaign file and every session's scenario with its bases.

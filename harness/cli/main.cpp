@@ -6,6 +6,7 @@
 
 #include "command.hpp"
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_folder.hpp"
 #include "pvb/common/text.hpp"
 
 namespace pvb::cli {
@@ -24,6 +25,15 @@ Command add_vocab_command(CLI::App& app);
 Command add_eval_map_command(CLI::App& app);
 Command add_sheet_command(CLI::App& app);
 Command add_campaign_command(CLI::App& app);
+
+/// Prints "pvbench: KIND: WHAT" and marks the output folders this process
+/// began as failed; returns `code`.
+int fail(int code, const char* kind, const std::string& what) {
+  const std::string line = printable(what);
+  std::fprintf(stderr, "pvbench: %s: %s\n", kind, line.c_str());
+  mark_output_folders_failed(line);
+  return code;
+}
 
 // Sub-commands register here (one line each).
 std::vector<Command> add_all_commands(CLI::App& app) {
@@ -64,15 +74,17 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pvbench: error: %s\n", pvb::printable(e.what()).c_str());
     return 1;
   }
+  // Every exception ends here as one line, a library's (OpenCV, Ceres,
+  // yaml-cpp) too, and the output folders begun say the command failed.
   try {
     for (auto& c : cmds)
       if (c.app->parsed()) return c.run();
   } catch (const pvb::Error& e) {
-    std::fprintf(stderr, "pvbench: error: %s\n", pvb::printable(e.what()).c_str());
-    return 1;
+    return pvb::cli::fail(1, "error", e.what());
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "pvbench: internal error: %s\n", pvb::printable(e.what()).c_str());
-    return 2;
+    return pvb::cli::fail(2, "internal error", e.what());
+  } catch (...) {
+    return pvb::cli::fail(2, "internal error", "an exception of unknown type");
   }
   return 0;
 }

@@ -1,7 +1,8 @@
 #pragma once
-// Ctrl-C (SIGINT) and SIGTERM as a request to stop, for `pvbench run`,
-// `slam` and `camera`: the command polls the flag, stops taking frames and
-// still writes everything it has (trajectories, maps, stats, report).
+// Ctrl-C (SIGINT), SIGTERM and SIGHUP (the terminal closed) as a request
+// to stop, for `pvbench record`, `run`, `slam`, `camera` and the others that
+// take frames: the command polls the flag, stops taking frames and still
+// writes everything it has (trajectories, maps, stats, report, meta.json).
 #include <atomic>
 #include <csignal>
 
@@ -17,13 +18,14 @@ class StopSignals {
   StopSignals(const StopSignals&) = delete;
   StopSignals& operator=(const StopSignals&) = delete;
 
-  /// Set by the first SIGINT or SIGTERM (lock-free, so a handler may set it).
+  /// Set by the first SIGINT, SIGTERM or SIGHUP (lock-free, so a handler may set it).
   static std::atomic<bool>& flag();
   static bool requested() { return flag().load(); }
 
  private:
   struct sigaction old_int_ {};
   struct sigaction old_term_ {};
+  struct sigaction old_hup_ {};
 };
 
 }  // namespace pvb::cli

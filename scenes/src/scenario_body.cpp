@@ -152,6 +152,7 @@ void read_imu(MapReader& r, Imu& imu, double physics_hz) {
 void read_body(MapReader& top, Scenario& s) {
   with_map(top, "physics", [&](MapReader& r) {
     const double rate = r.number("rate_hz", 0.0, 100, 10000);
+    if (!r.has("rate_hz")) return;  // absent or null: unset, as without the section
     if (!divides(s.camera.fps, rate))
       r.fail(r.full("rate_hz"), r.child("rate_hz"),
              "a whole multiple of the camera's " + format_exact(s.camera.fps) + " frames/s", format_exact(rate));

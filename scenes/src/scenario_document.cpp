@@ -44,14 +44,20 @@ bool is_day_key(const std::string& full) {
 
 std::string at(const KeyOrigin& o) { return o.line > 0 ? o.file + ":" + std::to_string(o.line) : o.file; }
 
+/// The size limit as errors give it, in bytes too: a file just over it
+/// is never said to be the limit's size.
+std::string scenario_size_limit() {
+  return "a scenario file of at most " + std::to_string(kMaxScenarioBytes / 1024) + " KiB (" +
+         std::to_string(kMaxScenarioBytes) + " bytes)";
+}
+
 YAML::Node parse_yaml(const std::string& text, const std::string& origin) {
   // The parser takes about 100 bytes of memory per byte of text: a file far
   // larger than any scene the renderer draws is refused before it is parsed.
   if (text.size() > kMaxScenarioBytes)
     throw ConfigError(origin, "(file)",
-                      "a scenario file of at most " + std::to_string(kMaxScenarioBytes / 1024) +
-                          " KiB (the largest scene the renderer draws takes far less)",
-                      std::to_string(text.size() / 1024) + " KiB");
+                      scenario_size_limit() + " (the largest scene the renderer draws takes far less)",
+                      std::to_string(text.size()) + " bytes");
   // YAML is text: yaml-cpp reads a raw NUL byte as the start of an escape
   // and names some other character, so a NUL (a binary file, a damaged
   // one) is named here, with its line.
@@ -271,8 +277,7 @@ ScenarioDocument load_document(const std::string& path) {
   require_regular_file(path);
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0 && static_cast<std::size_t>(st.st_size) > kMaxScenarioBytes)
-    throw ConfigError(path, "(file)", "a scenario file of at most " + std::to_string(kMaxScenarioBytes / 1024) + " KiB",
-                      std::to_string(st.st_size / 1024) + " KiB");
+    throw ConfigError(path, "(file)", scenario_size_limit(), std::to_string(st.st_size) + " bytes");
   return parse_document(read_file(path), path);
 }
 

@@ -253,6 +253,15 @@ void read_stereo(MapReader& n, ActiveStereo& a) {
   if (a.block_px % 2 == 0) n.fail(n.full("block_px"), n.node()["block_px"], "an odd number of pixels");
   a.uniqueness_pct = n.integer("uniqueness_pct", a.uniqueness_pct, 0, 100);
   a.ir_noise_sigma = n.number("ir_noise_sigma", a.ir_noise_sigma, 0, 50);
+  // OpenCV's matcher searches that many pixels along each row: a range as
+  // wide as the image makes it throw, or abort the process.
+  if (a.disparities >= a.ir_width) {
+    const std::string key = n.has("disparities") ? "disparities" : "ir_width";
+    n.fail(n.full(key), n.child(key),
+           "a disparity range narrower than the infrared image (disparities below ir_width; OpenCV's matcher "
+           "searches within each row)",
+           "disparities " + std::to_string(a.disparities) + ", ir_width " + std::to_string(a.ir_width));
+  }
 }
 
 void read_camera(MapReader& r, Camera& c) {
@@ -492,9 +501,6 @@ void read_relief(MapReader& q, Ground& g) {
     q.fail(q.full("cell_m"), YAML::Node(),
            "a cell that samples ground.size_m in at most " + std::to_string(kMaxReliefSamples) + " points",
            format_exact(rl.cell_m) + " m (" + std::to_string(n.x()) + " x " + std::to_string(n.y()) + " points)");
-  if (g.tiling == GroundTiling::kVaried)
-    q.fail(q.full("amplitude_cm"), YAML::Node(),
-           "no relief under a varied ground (its tiles are flat planes): ground.tiling repeat", "tiling varied");
   g.relief = rl;
 }
 
@@ -506,6 +512,11 @@ void read_ground(MapReader& r, Ground& g) {
   g.tiling = r.choice<GroundTiling>("tiling", fallback,
                                     {{"repeat", GroundTiling::kRepeat}, {"varied", GroundTiling::kVaried}});
   with_map(r, "relief", [&](MapReader& q) { read_relief(q, g); });
+  // Blamed on the tiling, where it was written (a day file's over its
+  // base's relief): a relief takes one repeated image.
+  if (g.relief && g.tiling == GroundTiling::kVaried)
+    r.fail(r.full("tiling"), r.child("tiling"),
+           "repeat under a relief (ground.relief is given; a varied ground's tiles are flat planes)", "varied");
   if (r.has("friction")) g.friction = r.number("friction", 0.0, 0.05, 2);
   g.softness = r.number("softness", g.softness, 0, 1);
 }

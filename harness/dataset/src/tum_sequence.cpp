@@ -17,6 +17,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/output_file.hpp"
+#include "pvb/common/output_folder.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/image_file.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
@@ -131,6 +132,7 @@ OutputFile open_list(const std::string& path, const std::string& header) {
 /// Writes an image; a failed write (disk full) leaves no partial file.
 void write_image(const std::string& path, const cv::Mat& image) {
   bool ok = false;
+  note_output(path);
   try {
     ok = cv::imwrite(path, image);
   } catch (const cv::Exception& e) {

@@ -10,6 +10,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/io_paths.hpp"
+#include "pvb/common/output_folder.hpp"
 
 namespace pvb::openni {
 
@@ -50,6 +51,7 @@ void check_new_recording_path(const std::string& record_path) {
 
 void create_new_recording_file(const std::string& record_path) {
   check_new_recording_path(record_path);
+  note_output(record_path);  // a recording into an output folder is listed in it
   const int fd = ::open(record_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) {
     const int err = errno;

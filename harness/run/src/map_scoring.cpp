@@ -19,7 +19,7 @@ void write_error_outputs(const SystemSink& sink, const std::string& scenario, co
   p.reserve(map.size());
   e.reserve(map.size());
   for (std::size_t i = 0; i < map.size(); ++i) p.push_back(map[i].p_w), e.push_back(scores[i].error_m);
-  const std::string title = scenario + ", " + eval::mode_label(sink.run.mode) +
+  const std::string title = scenario + ", " + sink.run.label +
                             ": dense map from above, coloured by distance to the true surface";
   d->top_view = "map_error_top.png";
   plot::write_rgb_png(plot::make_map_error_top_view(p, e, title), sink.dir + "/" + d->top_view);
@@ -34,7 +34,7 @@ void score_sink(SystemSink& sink, const std::string& scenario, const eval::Traje
   d.surface_samples = surface.size();
   for (const auto& [name, cloud] : sink.clouds) {
     if (cloud.empty()) {  // nothing to score: never a perfect score
-      log.line(eval::mode_label(sink.run.mode) + ": " + name + " map: not scored, it has no points");
+      log.line(sink.run.label + ": " + name + " map: not scored, it has no points");
       d.note += (d.note.empty() ? "" : "; ") + name + " map not scored: it has no points";
       continue;
     }
@@ -44,7 +44,7 @@ void score_sink(SystemSink& sink, const std::string& scenario, const eval::Traje
     MapResult r{name, eval::evaluate_map(map, surface, {}, &scores), 0.0};
     r.score_s = seconds_since(t0);
     if (name == "corrected") write_error_outputs(sink, scenario, map, scores, &d);
-    log.line(eval::mode_label(sink.run.mode) + ": " + name + " map: accuracy median " +
+    log.line(sink.run.label + ": " + name + " map: accuracy median " +
              format_number("%.1f", 1000 * r.accuracy.all.accuracy.median) + " mm, complete within 5 cm " +
              format_number("%.1f", 100 * r.accuracy.all.completeness_at[2]) + " %, ghosting " +
              format_number("%.2f", 100 * r.accuracy.all.ghosting) + " % (scored in " +

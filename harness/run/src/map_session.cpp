@@ -202,6 +202,17 @@ MapMeta read_map_meta(const std::string& app_json, const std::string& file) {
   return meta;
 }
 
+eval::Trajectory session_keyframes(const eval::Trajectory& written, const slam::System& system) {
+  eval::Trajectory out;
+  out.source = written.source;
+  const std::optional<std::int64_t> first = system.session_first_t_ns();
+  if (!first) return out;
+  const std::int64_t offset = system.session_clock_offset_ns();
+  for (const geom::StampedPose& p : written.poses)
+    if (p.t_ns >= *first + offset) out.poses.push_back({p.t_ns - offset, p.T_w_c});
+  return out;
+}
+
 eval::Trajectory ground_truth_at(const eval::Trajectory& gt, const std::vector<std::int64_t>& t_ns) {
   eval::Trajectory out;
   out.source = gt.source;

@@ -22,6 +22,7 @@
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/run/inertial_eval.hpp"
 #include "pvb/run/map_eval.hpp"
+#include "pvb/run/output_names.hpp"
 #include "pvb/run/place_recognition.hpp"
 #include "pvb/run/sensor_setup.hpp"
 #include "pvb/slam/core/system.hpp"
@@ -110,13 +111,15 @@ void write_tum_file(const std::string& path, const std::vector<geom::StampedPose
 void check_slam_paths(const OfflineSlamOptions& a, const slam::Settings& settings) {
   IoPlan plan;
   if (!a.sequence.empty())
-    plan.inputs("a file of the --sequence folder", dataset::sequence_files(a.sequence));
+    plan.inputs("a file of the --sequence folder", dataset::sequence_files(a.sequence))
+        .input_folder("the --sequence folder", a.sequence);
   plan.input("the --settings file", a.settings).input("the --map file", a.map.load_path);
   if (settings.vocabulary_path != "none")
     plan.input("the vocabulary of the --settings file", settings.vocabulary_path);
-  plan.output_folder("--out", a.out).output_file("--save-map", a.map.save_path);
+  plan.output_folder("--out", a.out, offline_slam_output_names()).output_file("--save-map", a.map.save_path);
   plan.check();
   check_output_folder(a.out, a.overwrite);
+  reserve_output(a.map.save_path, "--save-map");
 }
 
 }  // namespace
@@ -424,7 +427,7 @@ void OfflineSlam::Impl::evaluate_gravity(const eval::Trajectory& gt, const eval:
   const eval::GravityError g =
       eval::gravity_error(gt, est, down_w, gravity_map_frame(settings_.sensors), tally_.gravity);
   const eval::TiltDrift t =
-      eval::tilt_drift(gt, eval::read_tum(a_.out + "/KeyFrameTrajectory.txt"), alignment);
+      eval::tilt_drift(gt, session_keyframes(eval::read_tum(a_.out + "/KeyFrameTrajectory.txt"), *system_), alignment);
   text(strf("gravity error (map frame: %s): median %.2f deg, p95 %.2f, final %.2f; keyframe pitch error "
             "%+.4f deg/keyframe, roll %+.4f\n",
             g.map_frame.c_str(), g.median_deg, g.p95_deg, g.final_deg, t.pitch_slope_deg_per_kf,

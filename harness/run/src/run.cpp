@@ -19,6 +19,7 @@
 #include "pvb/geometry/time.hpp"
 #include "pvb/run/blind.hpp"
 #include "pvb/run/motion_truth.hpp"
+#include "pvb/run/output_names.hpp"
 #include "pvb/run/world_json.hpp"
 #include "pvb/scenes/route.hpp"
 #include "pvb/sim/motion_sensors.hpp"
@@ -64,10 +65,11 @@ void check_run_paths(const RunOptions& opt, const scenes::Scenario& scenario) {
   plan.input("the --scenario file", opt.scenario_file)
       .inputs("a base of the --scenario file", scenario.base_files)
       .input("the --map file", opt.map.load_path)
-      .output_folder("--out", opt.out_dir)
+      .output_folder("--out", opt.out_dir, run_output_names())
       .output_file("--save-map", opt.map.save_path);
   plan.check();
   check_output_folder(opt.out_dir, opt.overwrite);
+  reserve_output(opt.map.save_path, "--save-map");
 }
 
 RunReport new_report(const scenes::Scenario& scenario, const RunOptions& opt) {
@@ -295,7 +297,7 @@ void evaluate_blind_stretch(const scenes::Scenario& scenario, SystemSinks& sinks
   for (auto& sink : sinks) {
     SlamRun& run = sink->run;
     run.blind = blind_stretch(*cover, scenario.camera.fps, run.per_frame, sink->est, gt, run.eval);
-    log.line(eval::mode_label(run.mode) + ": " + blind_summary(*run.blind));
+    log.line(run.label + ": " + blind_summary(*run.blind));
   }
 }
 
@@ -385,7 +387,7 @@ void log_summary(const RunReport& report, RunLog& log) {
     for (const std::string& line : map_log_lines(*report.primary.map)) log.line(line);
   for (const SlamRun* r : {&report.primary, report.baseline ? &*report.baseline : nullptr}) {
     if (!r || (!r->refined_eval && r->loop_closing_json.empty())) continue;
-    log.line(eval::mode_label(r->mode) + ": refined trajectory ATE rmse " +
+    log.line(r->label + ": refined trajectory ATE rmse " +
              (r->refined_eval ? format_g(r->refined_eval->ate.rmse) : "n/a") + " m, " +
              std::to_string(r->loops_closed) + " loops closed");
   }

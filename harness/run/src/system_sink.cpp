@@ -68,6 +68,7 @@ SystemSink::SystemSink(const std::string& mode, const slam::Settings& settings, 
     : map_options(map), dir(out_dir) {
   run.mode = mode;
   run.sensors = slam::to_string(settings.sensors);
+  run.label = eval::mode_label(mode);
   slam::SystemOptions options;
   options.synchronous = sync;
   options.seed = seed;
@@ -244,7 +245,7 @@ void SystemSink::evaluate_gravity(const eval::Trajectory& gt) {
   // The run's ground truth is in the site frame: z up.
   run.gravity = eval::gravity_error(gt, est, geom::Vec3d(0, 0, -1), gravity_map_frame(system->sensors()),
                                    gravity_estimates);
-  run.tilt = eval::tilt_drift(gt, keyframes, run.eval->alignment);
+  run.tilt = eval::tilt_drift(gt, session_keyframes(keyframes, *system), run.eval->alignment);
 }
 
 void SystemSink::evaluate_inertial(const std::vector<BiasTruth>& truth) {
@@ -281,6 +282,10 @@ SystemSinks make_systems(const slam::Settings& settings, const RunOptions& opt, 
     reference_map.save_path.clear();
     sinks.push_back(std::make_unique<SystemSink>(sinks.front()->run.mode, s, opt.sync, seed,
                                                  opt.out_dir + "/baseline", reference_map));
+    for (auto& sink : sinks) {  // both runs have one mode: each is named by its sensors
+      sink->run.label = sink->run.sensors;
+      sink->loss_log = LossLog(sink->run.sensors, sink->prev_state == slam::TrackingState::kLost);
+    }
   }
   return sinks;
 }

@@ -333,6 +333,53 @@ SweepAggregate aggregate(const std::string& scenario, std::vector<SeedRun> runs)
   return a;
 }
 
+namespace {
+
+/// The per-seed table; the reference run's columns by its name (the
+/// baseline, or with --compare-sensors its sensor setup) and the paired
+/// difference's as `difference`.
+std::string per_seed_section(const SweepAggregate& a, const std::string& reference_name,
+                             const std::string& difference) {
+  std::string out =
+      "\n## Per seed\n\n| seed | exit | status | frames | lost | ATE RMSE (mm) | tracking ms | realtime "
+      "factor |";
+  if (a.has_baseline)
+    out += " " + reference_name + " lost | " + reference_name + " ATE RMSE (mm) | " + difference + " (mm) |";
+  out += " note |\n|---|---|---|---|---|---|---|---|";
+  if (a.has_baseline) out += "---|---|---|";
+  out += "---|\n";
+  for (const SeedRun& r : a.runs) {
+    out += "| " + std::to_string(r.seed) + " | " + std::to_string(r.exit_code) + " | ";
+    if (r.metrics) {
+      const RunMetrics& m = r.metrics->primary;
+      out += m.status + " | " + std::to_string(m.frames) + " | " + std::to_string(m.lost_frames) + " | " +
+             opt(m.ate_rmse_m, "%.2f", 1000.0) + " | " + opt(m.tracking_ms_median, "%.2f") + " | " +
+             opt(m.realtime_factor, "%.3f") + " |";
+      if (a.has_baseline) {
+        if (r.metrics->baseline)
+          out += " " + std::to_string(r.metrics->baseline->lost_frames) + " | " +
+                 opt(r.metrics->baseline->ate_rmse_m, "%.2f", 1000.0) + " | " +
+                 opt(paired_ate_difference_m(r), "%.2f", 1000.0) + " |";
+        else
+          out += " | | |";
+      }
+      std::string note;
+      if (!m.loss_events.empty())
+        note = "first loss at frame " + std::to_string(m.loss_events.front().frame) + ": " +
+               m.loss_events.front().reason;
+      for (char& c : note) c = c == '|' ? '/' : c;
+      out += " " + note + " |\n";
+    } else {
+      std::string note = "no metrics: " + r.error;
+      for (char& c : note) c = c == '|' ? '/' : c;
+      out += " | | | | | |" + std::string(a.has_baseline ? " | | |" : "") + " " + note + " |\n";
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string format_markdown(const SweepAggregate& a) {
   int with_metrics = 0;
   for (const SeedRun& r : a.runs) with_metrics += r.metrics ? 1 : 0;
@@ -376,45 +423,12 @@ std::string format_markdown(const SweepAggregate& a) {
              a.paired.reference_label + " ATE RMSE, SD " +
              mm2(a.paired.sd_m) + " mm, standard error " + mm2(a.paired.se_m) +
              " mm; the interval is mean ± t(0.975, n − 1) · SE. Not significantly worse: the upper end is at "
-             "most max(0.5 mm, 10 % of the baseline's mean " +
+             "most max(0.5 mm, 10 % of the " + (by_sensors ? reference_name : std::string("baseline")) +
+             "'s mean " +
              mm2(a.paired.baseline_mean_m) + " mm).\n";
   }
-
-  out +=
-      "\n## Per seed\n\n| seed | exit | status | frames | lost | ATE RMSE (mm) | tracking ms | realtime "
-      "factor |";
-  if (a.has_baseline) out += " baseline lost | baseline ATE RMSE (mm) | PE − baseline (mm) |";
-  out += " note |\n|---|---|---|---|---|---|---|---|";
-  if (a.has_baseline) out += "---|---|---|";
-  out += "---|\n";
-  for (const SeedRun& r : a.runs) {
-    out += "| " + std::to_string(r.seed) + " | " + std::to_string(r.exit_code) + " | ";
-    if (r.metrics) {
-      const RunMetrics& m = r.metrics->primary;
-      out += m.status + " | " + std::to_string(m.frames) + " | " + std::to_string(m.lost_frames) + " | " +
-             opt(m.ate_rmse_m, "%.2f", 1000.0) + " | " + opt(m.tracking_ms_median, "%.2f") + " | " +
-             opt(m.realtime_factor, "%.3f") + " |";
-      if (a.has_baseline) {
-        if (r.metrics->baseline)
-          out += " " + std::to_string(r.metrics->baseline->lost_frames) + " | " +
-                 opt(r.metrics->baseline->ate_rmse_m, "%.2f", 1000.0) + " | " +
-                 opt(paired_ate_difference_m(r), "%.2f", 1000.0) + " |";
-        else
-          out += " | | |";
-      }
-      std::string note;
-      if (!m.loss_events.empty())
-        note = "first loss at frame " + std::to_string(m.loss_events.front().frame) + ": " +
-               m.loss_events.front().reason;
-      for (char& c : note) c = c == '|' ? '/' : c;
-      out += " " + note + " |\n";
-    } else {
-      std::string note = "no metrics: " + r.error;
-      for (char& c : note) c = c == '|' ? '/' : c;
-      out += " | | | | | |" + std::string(a.has_baseline ? " | | |" : "") + " " + note + " |\n";
-    }
-  }
-  return out;
+  if (!by_sensors) return out + per_seed_section(a, "baseline", "PE − baseline");
+  return out + per_seed_section(a, reference_name, primary_name + " − " + reference_name);
 }
 
 std::string format_csv(const SweepAggregate& a) {

@@ -69,7 +69,7 @@ void LocalMapping::start() {
   on_worker_ = true;  // before the thread starts, so it sees the value
   worker_ = std::thread([this] {
     set_thread_name("pvb-mapping");
-    run();
+    if (!worker_error_.run([this] { run(); })) queue_.close();  // later keyframes are refused
   });
 }
 
@@ -80,6 +80,7 @@ void LocalMapping::stop() {
 }
 
 void LocalMapping::insert(std::shared_ptr<KeyFrame> kf) {
+  worker_error_.rethrow();
   ++pending_;
   if (on_worker_) {
     // Push and flag together, as the worker clears the flag and looks at

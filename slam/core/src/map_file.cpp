@@ -41,11 +41,11 @@ void put_pose(ByteWriter& w, const geom::SE3d& T) {
 using SortedIds = std::vector<std::uint64_t>;
 bool has(const SortedIds& ids, std::uint64_t id) { return std::binary_search(ids.begin(), ids.end(), id); }
 
-void put_keyframe(ByteWriter& w, const KeyFrame& kf, const SortedIds& point_ids) {
+void put_keyframe(ByteWriter& w, const KeyFrame& kf, const SortedIds& point_ids, std::int64_t offset_ns) {
   const Frame& f = kf.frame();
   w.u64(kf.id());
   w.u64(f.id);
-  w.i64(f.t_ns);
+  w.i64(f.t_ns + offset_ns);
   w.u32(kf.session());
   put_pose(w, kf.T_c_w());
   w.u32(static_cast<std::uint32_t>(f.size()));
@@ -214,7 +214,7 @@ std::string extrinsic_difference(const char* name, const char* sensor, const geo
 }  // namespace
 
 std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
-                       const std::string& app_json, const BagOf& bag_of) {
+                       const std::string& app_json, const BagOf& bag_of, std::int64_t session_offset_ns) {
   std::vector<std::shared_ptr<KeyFrame>> kfs;
   SortedIds kf_ids;  // the maps iterate in id order
   std::size_t keypoints = 0;
@@ -238,7 +238,8 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   put_settings(head, settings, sessions);
   keyf.reserve(8 + kfs.size() * kKeyframeHeadBytes + keypoints * kKeypointBytes);
   keyf.u64(kfs.size());
-  for (const auto& kf : kfs) put_keyframe(keyf, *kf, point_ids);
+  for (const auto& kf : kfs)
+    put_keyframe(keyf, *kf, point_ids, kf->session() == map.session() ? session_offset_ns : 0);
   poin.u64(point_ids.size());
   for (std::uint64_t id : point_ids) put_point(poin, *map.points().at(id), kf_ids);
   grap.u64(kfs.size());

@@ -81,12 +81,13 @@ class Reader {
   bool flag(const std::string& key, bool required, bool fallback) {
     return integral(key, required, fallback ? 1 : 0, 0, 1, "0 or 1") == 1;
   }
-  /// A string; `fallback` when the key is absent.
-  std::string text(const std::string& key, const std::string& fallback) {
+  /// A string; `fallback` when the key is absent.  `expected` says what
+  /// the key takes, for the error when it is no string.
+  std::string text(const std::string& key, const std::string& fallback, const std::string& expected) {
     seen_.insert(key);
     const cv::FileNode n = fs_[key];
     if (n.empty()) return fallback;
-    if (!n.isString()) throw ConfigError(path_, key, "a string (a file path, or none)");
+    if (!n.isString()) throw ConfigError(path_, key, expected, shown(n));
     return static_cast<std::string>(n);
   }
   /// A 4x4 rigid transform written as an opencv-matrix (ORB-SLAM3's
@@ -147,6 +148,14 @@ class Reader {
     return static_cast<double>(n);
   }
 
+  /// A value that is not what was expected, as an error shows it.
+  static std::string shown(const cv::FileNode& n) {
+    if (n.isInt() || n.isReal()) return number_text(static_cast<double>(n));
+    if (n.isSeq()) return "a list";
+    if (n.isMap()) return "a mapping";
+    return "a value that is no string";
+  }
+
   const cv::FileStorage& fs_;
   std::string path_;
   std::map<std::string, std::string> wide_literals_;
@@ -191,10 +200,10 @@ void read_robot(Reader& r, const cv::FileStorage& fs, RobotSettings* robot) {
 
 /// System.Sensors, checked against the sections the setup needs.
 SensorSetup read_sensors(Reader& r, const Settings& s) {
-  const std::string text = r.text("System.Sensors", "camera");
+  const std::string expected = "camera, camera+imu, camera+imu+wheels or camera+accel";
+  const std::string text = r.text("System.Sensors", "camera", expected);
   const std::optional<SensorSetup> setup = parse_sensor_setup(text);
-  if (!setup)
-    throw ConfigError(r.path(), "System.Sensors", "camera, camera+imu, camera+imu+wheels or camera+accel", text);
+  if (!setup) throw ConfigError(r.path(), "System.Sensors", expected, text);
   check_sensor_setup(s, *setup);
   return *setup;
 }
@@ -389,7 +398,7 @@ Settings settings_from(const cv::FileStorage& fs, const std::string& text, const
   read_imu(r, fs, &s.imu);
   read_robot(r, fs, &s.robot);
   s.sensors = read_sensors(r, s);
-  s.vocabulary_path = vocabulary_path(path, r.text("Vocabulary.path", ""));
+  s.vocabulary_path = vocabulary_path(path, r.text("Vocabulary.path", "", "a string (a file path, or none)"));
   const cv::FileNode root = fs.root();
   for (auto it = root.begin(); it != root.end(); ++it) {
     const std::string key = (*it).name();

@@ -1,5 +1,6 @@
 #include "pvb/slam/core/system.hpp"
 
+#include <algorithm>
 #include <opencv2/imgproc.hpp>
 
 #include <set>
@@ -101,6 +102,9 @@ System::~System() { shutdown(); }
 void System::shutdown() {
   if (mapping_) mapping_->stop();
   if (dense_) dense_->stop();
+  // What ended a worker thread reaches the caller here at the latest.
+  if (mapping_) mapping_->rethrow_error();
+  if (dense_) dense_->rethrow_error();
 }
 
 LocalMappingStats System::mapping_stats() const { return mapping_->stats(); }
@@ -121,6 +125,7 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
   OrbFeatures features = extractor_->extract(grey);
   out.num_features = static_cast<int>(features.keypoints.size());
   out.orb_ms = ms_since(t0);
+  if (!session_first_t_ns_) start_session_clock(in.t_ns);
   Frame frame(next_frame_id_++, in.t_ns, std::move(features), in.depth_m, cam_);
   out.features_with_depth = static_cast<int>(std::count_if(frame.depth_m.begin(), frame.depth_m.end(),
                                                            [](float d) { return d > 0; }));
@@ -216,6 +221,8 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
       place_->add(*kf);
     }
     map_->set_session(head.sessions);
+    for (const auto& [id, kf] : map_->keyframes())
+      loaded_last_t_ns_ = std::max(loaded_last_t_ns_.value_or(kf->t_ns()), kf->t_ns());
     info.keyframes = map_->num_keyframes();
     info.points = map_->num_points();
   }
@@ -254,7 +261,7 @@ MapSaveInfo System::save_map(const std::string& path, const std::string& app_jso
                               " keyframes (each session holds one at least)");
     info.sessions = static_cast<std::uint32_t>(sessions);
     const BagOf bag_of = [this](const KeyFrame& kf) { return place_ ? place_->bag_of(kf) : kf.bow(); };
-    bytes = encode_map(*map_, map_settings(), info.sessions, app_json, bag_of);
+    bytes = encode_map(*map_, map_settings(), info.sessions, app_json, bag_of, session_offset_ns_);
     info.points = map_->num_points();
   }
   write_file(path, bytes);
@@ -266,9 +273,29 @@ MapSaveInfo System::save_map(const std::string& path, const std::string& app_jso
 std::vector<geom::StampedPose> System::keyframe_trajectory() {
   std::lock_guard<std::mutex> lock(map_->mutex());
   std::vector<geom::StampedPose> out;
-  for (const auto& [id, kf] : map_->keyframes())
-    if (!kf->bad() && map_->map_of(*kf) == 0) out.push_back({kf->t_ns(), kf->T_c_w().inverse()});
+  for (const auto& [id, kf] : map_->keyframes()) {
+    if (kf->bad() || map_->map_of(*kf) != 0) continue;
+    const std::int64_t offset = kf->session() == map_->session() ? session_offset_ns_ : 0;
+    out.push_back({kf->t_ns() + offset, kf->T_c_w().inverse()});
+  }
+  std::sort(out.begin(), out.end(),
+            [](const geom::StampedPose& a, const geom::StampedPose& b) { return a.t_ns < b.t_ns; });
   return out;
+}
+
+void System::start_session_clock(std::int64_t t_ns) {
+  session_first_t_ns_ = t_ns;
+  if (!loaded_last_t_ns_ || t_ns > *loaded_last_t_ns_) return;
+  // Whole seconds, so that the stamps keep their digits: the first frame
+  // lands at least a second after the map's last keyframe.
+  constexpr std::int64_t kSecondNs = 1'000'000'000;
+  const long double gap_ns = static_cast<long double>(*loaded_last_t_ns_) - static_cast<long double>(t_ns);
+  if (gap_ns > 1e18L)
+    throw ConfigError("the frames", "time stamps",
+                      "a recording whose clock is within 1e9 s of the saved map's (its stamps are put after the "
+                      "map's)");
+  const std::int64_t gap = *loaded_last_t_ns_ - t_ns;
+  session_offset_ns_ = (gap / kSecondNs + 2) * kSecondNs;
 }
 
 MapSnapshot System::map_snapshot() {

@@ -17,7 +17,7 @@ void DenseMapper::start() {
   if (worker_.joinable() || stopped_) return;
   worker_ = std::thread([this] {
     set_thread_name("pvb-dense");
-    run();
+    if (!worker_error_.run([this] { run(); })) queue_.close();  // later keyframes are refused
   });
 }
 
@@ -29,6 +29,7 @@ void DenseMapper::stop() {
 }
 
 void DenseMapper::insert(DenseKeyFrame kf) {
+  worker_error_.rethrow();
   if (worker_.joinable()) {
     queue_.push(Message(std::move(kf)));
     return;
@@ -37,6 +38,7 @@ void DenseMapper::insert(DenseKeyFrame kf) {
 }
 
 void DenseMapper::update_poses(PoseUpdate update) {
+  worker_error_.rethrow();
   if (worker_.joinable()) {
     queue_.push(Message(std::move(update)));
     return;

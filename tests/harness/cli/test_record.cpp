@@ -372,3 +372,28 @@ TEST(RecordCli, DaysOfAStationAreRecordedWithTheirWorldAndShownSideBySide) {
   EXPECT_NE(r.output.find("--frame: expected a frame below the scenario's 751, got 100000"), std::string::npos)
       << r.output;
 }
+
+// SIGHUP (the terminal closed) stops like Ctrl-C: it used to kill the
+// recording and leave no meta.json.
+TEST(RecordCli, HangUpStopsAtTheNextFrameAndWritesMeta) {
+  const std::string d = fresh("sighup");
+  const std::string log = ::testing::TempDir() + "pvb_rec_sighup_" + std::to_string(::getpid()) + ".txt";
+  const pid_t pid =
+      test::spawn_pvbench({"record", "--scenario", kStation, "--out", d, "--frames", "600"}, log);
+  ASSERT_GE(pid, 0);
+  ASSERT_TRUE(test::wait_until(
+      pid, [&] { return data_lines(d + "/associations.txt") >= 2; }, 300))
+      << "pvbench ended early or wrote nothing: " << read_file(log);
+  ASSERT_EQ(::kill(pid, SIGHUP), 0);
+  int status = 0;
+  for (int i = 0; i < 1200 && ::waitpid(pid, &status, WNOHANG) == 0; ++i) ::usleep(100000);
+  if (::waitpid(pid, nullptr, WNOHANG) == 0) {  // still running after 120 s
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+    FAIL() << "pvbench did not stop within 120 s of SIGHUP";
+  }
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by a signal: " << read_file(log);
+  EXPECT_EQ(WEXITSTATUS(status), 130) << read_file(log);
+  const std::string meta = read_file(d + "/meta.json");
+  EXPECT_NE(meta.find("\"interrupted\": true"), std::string::npos) << meta;
+}

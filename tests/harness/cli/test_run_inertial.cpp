@@ -10,9 +10,13 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <sstream>
+#include <string>
 
 #include "cli_output.hpp"
+#include "pvb/common/io_paths.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/run/output_names.hpp"
 #include "run_pvbench.hpp"
 #include "station_sequence.hpp"
 
@@ -188,6 +192,31 @@ TEST(RunInertialCli, CompareSensorsNamesTheSystemsBySetup) {
   const std::string html = read_file(d + "/index.html");
   EXPECT_NE(html.find("<h2>camera+imu against camera</h2>"), std::string::npos);
   EXPECT_NE(html.find("<h2>Gravity and inertial state</h2>"), std::string::npos);
+}
+
+// Both runs of --compare-sensors share one mode: the log named each by it
+// ("baseline (ORB-SLAM2 motion model): ..." twice with --baseline); each is
+// named by its sensors.
+TEST(RunInertialCli, CompareSensorsNamesEachRunByItsSensorsInTheLog) {
+  const std::string d = fresh("compare_log");
+  const test::RunResult r =
+      test::run_pvbench("run --scenario " + kStation + " --out " + d +
+                        " --sync --frames 15 --no-map-eval --baseline --compare-sensors camera,camera+imu");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("\ncamera+imu: refined trajectory ATE rmse"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\ncamera: refined trajectory ATE rmse"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("motion model): refined trajectory"), std::string::npos) << r.output;
+  // Every file the run wrote (its .pvbench list: the reference run's
+  // folder, the motion files, the figures) is one the IoPlan refuses as
+  // --save-map (pvb/run/output_names.hpp).
+  std::istringstream list(read_file(d + "/.pvbench"));
+  int files = 0;
+  for (std::string line; std::getline(list, line);) {
+    if (line.rfind("file ", 0) != 0) continue;
+    ++files;
+    EXPECT_TRUE(is_written_name(line.substr(5), run::run_output_names())) << line;
+  }
+  EXPECT_GT(files, 30);
 }
 
 }  // namespace

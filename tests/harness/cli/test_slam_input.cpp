@@ -312,3 +312,53 @@ TEST(SlamInput, SeedMustBeAWholeNumberInRange) {
   }
   EXPECT_EQ(slam(seq, fresh("seed_ok"), "--seed 4294967295").code, 0);
 }
+
+// A run that fails after it made its output folder says so in the folder:
+// the list of what it wrote ends with the error.
+TEST(SlamInput, AFailedRunMarksItsOutputFolder) {
+  const std::string seq = make_sequence("failed_mark", 0.0f);
+  const std::string out = fresh("failed_mark_out");
+  const Result r = slam(seq, out);
+  ASSERT_EQ(r.code, 1) << r.output;
+  const std::string list = read_file(out + "/.pvbench");
+  EXPECT_NE(list.find("\nfile CameraTrajectory.txt\n"), std::string::npos) << list;
+  EXPECT_NE(list.find("\nfailed: "), std::string::npos) << list;
+  EXPECT_NE(list.find("tracking never initialised in 20 frames"), std::string::npos) << list;
+}
+
+// Extending a map with another recording of the same place: both clocks
+// start at 0, and the keyframe trajectory of both sessions could hold one
+// stamp twice ("no evaluation: KeyFrameTrajectory.txt:28: duplicate time
+// stamp").  The later session's stamps are put whole seconds past the
+// map's last one, and the evaluation takes this session's keyframes back
+// to its own clock.
+TEST(SlamInput, ExtendingAMapGivesEverySessionItsOwnStamps) {
+  const std::string seq = make_sequence("session_1");
+  const std::string first = fresh("session_1_out"), second = fresh("session_2_out");
+  const std::string map = fresh("session_maps");
+  std::filesystem::create_directories(map);
+  ASSERT_EQ(slam(seq, first, "--save-map " + map + "/one.pvbmap").code, 0);
+  const Result r = slam(seq, second, "--map " + map + "/one.pvbmap --map-mode extend");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.find("no evaluation"), std::string::npos) << r.output;
+  const auto stamps = [](const std::string& path) {
+    std::vector<double> t;
+    std::istringstream in(read_file(path));
+    for (std::string line; std::getline(in, line);)
+      if (!line.empty() && line[0] != '#') t.push_back(std::stod(split_ws(line, " ").at(0)));
+    return t;
+  };
+  const std::vector<double> one = stamps(first + "/KeyFrameTrajectory.txt");
+  const std::vector<double> both = stamps(second + "/KeyFrameTrajectory.txt");
+  ASSERT_FALSE(one.empty());
+  ASSERT_GT(both.size(), one.size()) << "the second session made no keyframe";
+  EXPECT_TRUE(std::is_sorted(both.begin(), both.end()));
+  EXPECT_EQ(std::adjacent_find(both.begin(), both.end()), both.end()) << "a stamp twice";
+  EXPECT_EQ(std::vector<double>(both.begin(), both.begin() + static_cast<long>(one.size())), one);
+  for (std::size_t i = one.size(); i < both.size(); ++i) EXPECT_GE(both[i], one.back() + 1.0) << i;
+  // The tilt is scored on this session's keyframes alone, in its clock.
+  std::smatch m;
+  const std::string stats = read_file(second + "/stats.json");
+  ASSERT_TRUE(std::regex_search(stats, m, std::regex("\"tilt\": \\{\"keyframes\": ([0-9]+)"))) << stats;
+  EXPECT_EQ(std::stoul(m[1]), both.size() - one.size());
+}

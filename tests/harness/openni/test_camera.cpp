@@ -302,3 +302,23 @@ TEST(PVB_CAMERA_SUITE, SettingsErrorsNameTheUsersFile) {
   expect_one_error_line(r, user + ": Camera.fx");
   EXPECT_EQ(r.output.find("out/camera.yaml"), std::string::npos) << r.output;
 }
+
+// Ctrl-C while the device is being set up (the sim:// scene built, the
+// driver loaded) killed the run: exit 130, no message, only camera.yaml
+// written.  A stop signal from the moment the output folder is made ends
+// the run as the end of its stream would: exit 0, every output written.
+TEST(PVB_CAMERA_SUITE, CtrlCDuringSetUpEndsTheRunWithItsOutputs) {
+  const std::string d = fresh("sigint_setup");
+  const std::string out = d + "/out", log = d + "/log.txt";
+  const std::string script =
+      "cd " + std::string(PVB_SOURCE_DIR) + " && (timeout --foreground -s KILL 120 " + kBin +
+      " camera --uri 'sim://scenes/pv_station.yaml?frames=8' --sync --out " + out + " > " + log +
+      " 2>&1 & pid=$!; for i in $(seq 1 2400); do [ -e " + out +
+      "/camera.yaml ] && break; sleep 0.05; done; kill -INT $pid; wait $pid; echo \"exit $?\" >> " + log + ")";
+  std::system(script.c_str());
+  const std::string said = pvb::read_file(log);
+  EXPECT_NE(said.find("exit 0"), std::string::npos) << said;
+  EXPECT_NE(said.find("stopped by a signal"), std::string::npos) << said;
+  for (const char* f : {"stats.json", "CameraTrajectory.txt", "KeyFrameTrajectory.txt", "map.ply"})
+    EXPECT_TRUE(std::ifstream(out + "/" + f).good()) << f << "\n" << said;
+}

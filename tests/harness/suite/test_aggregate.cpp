@@ -380,3 +380,21 @@ TEST(PairedComparison, TwoSensorSetupsAreNamedByTheSetups) {
   EXPECT_NE(suite::format_json(a).find("\"primary\": \"camera+imu+wheels\", \"reference\": \"camera\""),
             std::string::npos);
 }
+
+// The per-seed table named the reference run "baseline" with
+// --compare-sensors too: its columns are named by the setups.
+TEST(SweepAggregate, PerSeedColumnsAreNamedByTheSetupsCompared) {
+  std::vector<suite::SeedRun> runs = {compare_run(1, 9, 6), compare_run(2, 10, 5)};
+  const std::string by_mode = suite::format_markdown(suite::aggregate("s", runs));
+  EXPECT_NE(by_mode.find("| baseline lost | baseline ATE RMSE (mm) | PE − baseline (mm) |"), std::string::npos)
+      << by_mode;
+  for (suite::SeedRun& r : runs) {
+    r.metrics->primary.sensors = "camera+imu";
+    r.metrics->baseline->mode = "pe-slam";
+    r.metrics->baseline->sensors = "camera";
+  }
+  const std::string md = suite::format_markdown(suite::aggregate("s", runs));
+  EXPECT_NE(md.find("| camera lost | camera ATE RMSE (mm) | camera+imu − camera (mm) |"), std::string::npos) << md;
+  EXPECT_EQ(md.find("baseline lost"), std::string::npos) << md;
+  EXPECT_NE(md.find("10 % of the camera's mean"), std::string::npos) << md;
+}

@@ -83,6 +83,8 @@ class MapReader {
   MapReader(const YAML::Node& node, const ReadContext& ctx, std::string path);
   virtual ~MapReader() = default;
 
+  /// True when `key` is given (not null).  The key counts as one this map
+  /// knows, for the list an unknown key's error gives, but not as read.
   bool has(const std::string& key) const;
   /// A finite number in [lo, hi].
   double number(const std::string& key, double def, double lo, double hi);
@@ -127,6 +129,7 @@ class MapReader {
   ReadContext ctx_;
   std::string path_;
   std::set<std::string> read_;
+  mutable std::set<std::string> asked_;  ///< keys has() was asked about: known, maybe not read
 };
 
 /// Runs `fn` on the map under `key` of `parent` if present, then finish().

@@ -110,6 +110,13 @@ MapMeta read_map_meta(const std::string& app_json, const std::string& file);
 /// runs at its own rate (TUM's motion capture); frames without are left out.
 eval::Trajectory ground_truth_at(const eval::Trajectory& gt, const std::vector<std::int64_t>& t_ns);
 
+/// This session's keyframes in its own clock, from a keyframe trajectory as
+/// the tools write it (KeyFrameTrajectory.txt: every session of the map,
+/// this one's stamps plus System::session_clock_offset_ns()): the poses
+/// from the session's first frame on, moved back by the offset.  A map's
+/// earlier sessions have no ground truth in this recording.
+eval::Trajectory session_keyframes(const eval::Trajectory& written, const slam::System& system);
+
 /// The pose of a new map's frame in the world: from the first pose of the
 /// run's trajectory that has ground truth (the map's frame is SLAM's first
 /// camera; in a simulated run that pose is the first one, at identity).

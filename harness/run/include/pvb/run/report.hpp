@@ -133,6 +133,9 @@ std::string dense_map_json(const DenseMapReport& d, const std::string& in);
 struct SlamRun {
   std::string mode;  ///< eval::kPeSlamMode or eval::kBaselineMode ("pe-slam", "baseline")
   std::string sensors = "camera";  ///< slam::to_string(SensorSetup): the sensors the system fused
+  /// Its name in the log: the mode's label, or with --compare-sensors its
+  /// sensors (both runs share the mode there).
+  std::string label;
   std::size_t frames = 0;
   std::size_t lost_frames = 0;  ///< frames in state Lost
   std::size_t not_initialized_frames = 0;

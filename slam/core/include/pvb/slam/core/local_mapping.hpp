@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "pvb/common/closable_queue.hpp"
+#include "pvb/common/worker_error.hpp"
 #include "pvb/slam/core/map.hpp"
 #include "pvb/slam/core/options.hpp"
 #include "pvb/slam/core/reports.hpp"
@@ -61,8 +62,12 @@ class LocalMapping {
 
   /// Starts the worker thread (asynchronous mode).
   void start();
-  /// Processes the keyframes still queued, then joins the worker.
+  /// Processes the keyframes still queued, then joins the worker.  Never
+  /// throws (the destructor calls it): rethrow_error() says how it ended.
   void stop();
+  /// Rethrows what the worker thread threw (an exception of OpenCV, Ceres
+  /// or Eigen), once; insert() does too.
+  void rethrow_error() { worker_error_.rethrow(); }
   bool running() const { return worker_.joinable(); }
 
   /// Hands a keyframe over: processed now (synchronous) or queued.  A
@@ -120,6 +125,7 @@ class LocalMapping {
   std::atomic<bool> stop_ba_{false};      ///< set by insert() in worker mode, cleared before each local BA
   std::atomic<std::int64_t> processed_{0}, ba_runs_{0}, ba_stopped_{0};
   std::function<void(const std::shared_ptr<KeyFrame>&)> after_keyframe_;
+  WorkerError worker_error_;  ///< what ended the worker, for the owner's thread
   std::thread worker_;
 };
 

@@ -76,9 +76,13 @@ using BagOf = std::function<place::BowVector(const KeyFrame&)>;
 /// a frame of its own); bags of words from `bag_of`, or each keyframe's own
 /// when it is empty.  Version 2 with INER when the map's gravity is ready
 /// (within kMinGravityMps2..kMaxGravityMps2) and `settings.sensors` uses
-/// an accelerometer, else version 1.  Call with the map's mutex held.
+/// an accelerometer, else version 1.  The keyframes of the session now
+/// running (map.session()) are saved with `session_offset_ns` added to
+/// their stamps (System::session_clock_offset_ns()).  Call with the map's
+/// mutex held.
 std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
-                       const std::string& app_json, const BagOf& bag_of = nullptr);
+                       const std::string& app_json, const BagOf& bag_of = nullptr,
+                       std::int64_t session_offset_ns = 0);
 
 /// Checks the whole file (magic, version, sections, checksums) and returns
 /// its header.  Throws IoError naming `file` and what is wrong (truncated,

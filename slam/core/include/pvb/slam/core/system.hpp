@@ -115,7 +115,9 @@ class System {
   MapSettings map_settings() const;
 
   FrameResult track(const sensor::RgbdFrame& frame);
-  /// Lets local and dense mapping finish their queues and stops the workers.
+  /// Lets local and dense mapping finish their queues and stops the workers;
+  /// then rethrows what a worker thread threw, if one did (track() rethrows
+  /// it at the next keyframe handed over).
   void shutdown();
 
   /// Every tracked frame's pose recomputed from its reference keyframe's
@@ -123,8 +125,17 @@ class System {
   /// (frames of a provisional map never merged are left out).
   std::vector<geom::StampedPose> refined_trajectory();
   /// Poses of the keyframes still in the map, by id (T_w_c; not those of a
-  /// provisional map never merged).
+  /// provisional map never merged), every session's: this session's
+  /// stamps plus session_clock_offset_ns(), as the saved map has them.
   std::vector<geom::StampedPose> keyframe_trajectory();
+  /// What this session's time stamps gain in the map's clock, so that the
+  /// stamps of a multi-session map are unique: 0, unless the session began
+  /// from a saved map whose last keyframe is not before its first frame;
+  /// then the whole seconds that put that frame at least one second after
+  /// it (docs/map_file.md).  Set by the first frame tracked.
+  std::int64_t session_clock_offset_ns() const { return session_offset_ns_; }
+  /// This session's first frame, in its own clock; nullopt before one.
+  std::optional<std::int64_t> session_first_t_ns() const { return session_first_t_ns_; }
   std::size_t num_keyframes();
   std::size_t num_map_points();
   /// The sparse map with every measurement (map_snapshot.hpp), under the
@@ -194,6 +205,11 @@ class System {
   std::uint64_t vocabulary_fingerprint_ = 0;
   std::optional<MapStart> map_start_;       ///< set when the run started from a saved map
   std::uint32_t loaded_sessions_ = 0;
+  std::optional<std::int64_t> loaded_last_t_ns_;  ///< the loaded map's last keyframe stamp
+  std::optional<std::int64_t> session_first_t_ns_;
+  std::int64_t session_offset_ns_ = 0;  ///< session_clock_offset_ns()
+  /// Sets the session's first frame and its clock's offset (once).
+  void start_session_clock(std::int64_t t_ns);
   std::unique_ptr<Tracking> tracking_;
   std::unique_ptr<LoopClosing> loop_;  ///< null when loop closing is disabled; runs on the mapping thread
   std::unique_ptr<LocalMapping> mapping_;

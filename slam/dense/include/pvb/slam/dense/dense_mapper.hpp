@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "pvb/common/closable_queue.hpp"
+#include "pvb/common/worker_error.hpp"
 #include "pvb/geometry/pinhole.hpp"
 #include "pvb/geometry/se3.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"
@@ -77,8 +78,12 @@ class DenseMapper {
   /// runs already or after stop() (the queue stays closed).
   void start();
   /// Closes the queue, processes the keyframes still in it and joins the
-  /// worker.  Later insert() calls are processed inline.
+  /// worker.  Later insert() calls are processed inline.  Never throws
+  /// (the destructor calls it): rethrow_error() says how it ended.
   void stop();
+  /// Rethrows what the worker thread threw, once; insert() and
+  /// update_poses() do too.
+  void rethrow_error() { worker_error_.rethrow(); }
   bool running() const { return worker_.joinable(); }
 
   /// Hands a keyframe over: queued for the worker, or processed now when no
@@ -129,6 +134,7 @@ class DenseMapper {
   std::optional<LoopSnapshot> first_loop_;
   DenseMapperStats stats_;
   ClosableQueue<Message> queue_;
+  WorkerError worker_error_;  ///< what ended the worker, for the owner's thread
   std::thread worker_;
   bool stopped_ = false;  ///< stop() has closed the queue
 };
