@@ -139,7 +139,8 @@ TEST(RecordCli, RunWritesTheMotionReadingsTheRecordingHolds) {
 // file (every image, the scene and the settings the same bytes, every
 // per-frame list and motion file its first lines; meta.json the same but
 // for the frame count and the measured timings; the contact sheet, frames
-// spread over the whole recording, is made of those frames).
+// spread over the whole recording, is made of those frames; .pvbench lists
+// what was written).
 TEST(RecordCli, SameScenarioSeedAndBackendGiveIdenticalFiles) {
   const std::string& a = station_run();
   const std::string b = fresh("station_b");
@@ -152,7 +153,7 @@ TEST(RecordCli, SameScenarioSeedAndBackendGiveIdenticalFiles) {
   for (const auto& f : files_b) {
     ASSERT_TRUE(std::binary_search(files_a.begin(), files_a.end(), f)) << f << " is not in the longer recording";
     images += f.rfind("./rgb/", 0) == 0 || f.rfind("./depth/", 0) == 0;
-    if (f == "./meta.json" || f == "./contact_sheet.png") continue;
+    if (f == "./meta.json" || f == "./contact_sheet.png" || f == "./.pvbench") continue;
     const std::string fa = read_file(a + "/" + f), fb = read_file(b + "/" + f);
     EXPECT_FALSE(fb.empty()) << f;
     EXPECT_TRUE(fa.compare(0, fb.size(), fb) == 0) << f << " is not the start of the longer recording's";
