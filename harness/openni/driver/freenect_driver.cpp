@@ -373,7 +373,7 @@ OniStatus FreenectDevice::read_accelerometer(void* data, int* size) {
 void FreenectDevice::event_loop() {
   std::int64_t last_accel_us = 0;
   while (!stop_) {
-    timeval timeout{0, kAccelPeriodMs * 1000};
+    timeval timeout{0, has_motor_ ? kAccelPeriodMs * 1000 : 100000};  // no accelerometer: no need to wake
     if (freenect_process_events_timeout(ctx_, &timeout) < 0) {
       finished_ = true;
       driver_.report("freenect device: the Kinect stopped answering (unplugged?)");
