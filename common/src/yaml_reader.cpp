@@ -12,11 +12,9 @@
 namespace pvb::yaml {
 namespace {
 
-/// JSON read by yaml-cpp: yaml-cpp would decode the string "0.003" as a
-/// number; a quoted scalar (tag "!") is a string.
-bool plain_scalar(const YAML::Node& n, const ReadContext& ctx) {
-  return n.IsScalar() && !(ctx.json && n.Tag() == "!");
-}
+/// yaml-cpp would decode the string "0.003" (or '2', "true") as a number
+/// or a flag; a quoted scalar (tag "!") is a string, in JSON and in YAML.
+bool plain_scalar(const YAML::Node& n, const ReadContext& /*ctx*/) { return n.IsScalar() && n.Tag() != "!"; }
 
 int line_of(const YAML::Node& at) {
   const int line = at.Mark().line;
@@ -53,7 +51,7 @@ std::string join(const std::string& path, const std::string& key) {
 }
 
 std::string shown(const YAML::Node& n, const ReadContext& ctx) {
-  if (!ctx.json) return n.IsScalar() ? n.Scalar() : "a non-scalar";
+  if (!ctx.json && !n.IsScalar()) return "a non-scalar";
   if (!n.IsScalar()) return n.IsNull() ? "null" : "a list or an object";
   return n.Tag() == "!" ? "the string \"" + n.Scalar() + "\"" : n.Scalar();
 }

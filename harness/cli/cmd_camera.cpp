@@ -162,6 +162,46 @@ void check_settings_source(const CameraArgs& a, const std::optional<scenes::Scen
                     "have their own)");
 }
 
+bool is_freenect_uri(const CameraArgs& a) { return a.oni.empty() && a.uri.rfind("freenect://", 0) == 0; }
+
+/// What a source gives SLAM beside images, against the sensor setup: a
+/// sim:// device its robot's IMU and encoders (the ground-truth simulator's
+/// readings), a Kinect v1 (freenect://) its accelerometer, an .oni
+/// recording or another OpenNI2 camera nothing.  A setup that needs more is
+/// refused (`file`, `key`: where it was asked for) before any device opens.
+void refuse_unfed_setup(const CameraArgs& a, slam::SensorSetup setup, const std::string& file,
+                        const std::string& key) {
+  if (setup == slam::SensorSetup::kCamera || (a.oni.empty() && openni::is_sim_uri(a.uri))) return;
+  const std::string got = slam::to_string(setup);
+  if (is_freenect_uri(a)) {
+    if (setup == slam::SensorSetup::kCameraAccel) return;
+    throw ConfigError(file, key,
+                      "camera or camera+accel for a Kinect v1 (freenect://): it has an accelerometer, "
+                      "no gyroscope and no wheels",
+                      got);
+  }
+  throw ConfigError(
+      file, key,
+      std::string("camera for ") + (a.oni.empty() ? "this OpenNI2 camera" : "an .oni recording") +
+          ": its streams are depth and colour only (motion readings come from sim:// devices, an "
+          "accelerometer from a Kinect v1 on freenect://)",
+      got);
+}
+
+/// The settings' setup checked against the source; a Kinect's accelerometer
+/// gets its description when the settings have none (docs/sensors.md).
+void check_source_motion(const CameraArgs& a, const std::string& settings_file, slam::Settings* s) {
+  if (a.sensors.empty())
+    refuse_unfed_setup(a, s->sensors, settings_file, "System.Sensors");
+  else
+    refuse_unfed_setup(a, s->sensors, "command line", "--sensors");
+  if (is_freenect_uri(a) && s->sensors == slam::SensorSetup::kCameraAccel &&
+      run::supply_kinect_description(s))
+    std::fprintf(stderr,
+                 "pvbench camera: note: sensors camera+accel: the settings have no IMU.* keys; the "
+                 "Kinect v1 accelerometer's description is used (docs/sensors.md)\n");
+}
+
 /// The settings, read before anything is written (camera.yaml is written
 /// from `text` once the output folder is prepared).
 CameraSettings read_camera_settings(const CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
@@ -184,8 +224,9 @@ CameraSettings read_camera_settings(const CameraArgs& a, const std::optional<sce
   for (const std::string& w : s.slam.warnings)
     std::fprintf(stderr, "pvbench camera: warning: %s\n", w.c_str());
   if (a.no_pe_match) s.slam.pe_match.enabled = false;
-  if (const std::optional<slam::SensorSetup> setup = sensors_from_flag(a.sensors))
-    run::apply_sensor_setup(&s.slam, *setup);
+  if (const std::optional<slam::SensorSetup> setup = sensors_from_flag(a.sensors)) s.slam.sensors = *setup;
+  check_source_motion(a, s.file, &s.slam);
+  run::apply_sensor_setup(&s.slam, s.slam.sensors);
   return s;
 }
 
@@ -234,6 +275,7 @@ struct LiveOutputs {
   OutputFile gt_file;
   std::unique_ptr<dataset::MotionFilesWriter> motion;  ///< a sim:// device's IMU and encoders
   std::unique_ptr<run::MotionTruthWriter> motion_truth;
+  OutputFile accel_txt;  ///< a Kinect's accelerometer (freenect://), as TUM records it
   std::string dump_gt;  ///< a fakenect dump's groundtruth.txt, copied at the end
   bool has_gt() const { return gt_sim || !dump_gt.empty(); }
 };
@@ -245,6 +287,12 @@ LiveOutputs open_live_outputs(const CameraArgs& a, const std::optional<scenes::S
     o.dump_gt = dump + "/groundtruth.txt";
   o.cam_traj = OutputFile(out + "/CameraTrajectory.txt");
   o.cam_traj.append("# timestamp tx ty tz qx qy qz qw (T_w_c)\n");
+  if (is_freenect_uri(a)) {
+    o.accel_txt = OutputFile(out + "/accelerometer.txt");
+    o.accel_txt.append(
+        "# accelerometer data\n# file: 'pvbench camera' (libfreenect's freenect_get_mks_accel, the "
+        "Kinect's axes)\n# timestamp ax ay az\n");
+  }
   if (scenario) {
     o.gt_sim = std::make_unique<sim::Simulator>(*scenario, sim::SceneDetail::kGeometry);  // physics only
     o.gt_file = OutputFile(out + "/groundtruth.txt");
@@ -262,6 +310,7 @@ struct TrackCounts {
   std::size_t not_initialized = 0;
   double elapsed_s = 0;
   std::optional<IoError> stream_error;  ///< unplugged camera or broken file
+  std::string init_failure;             ///< the core's reason the last frame did not initialise
   /// Per frame: its stream time stamp, and the run's clock (s) when the
   /// source handed it over and when its pose was written.
   std::vector<std::int64_t> t_ns;
@@ -301,17 +350,35 @@ slam::TrackingState track_frame(const sensor::RgbdFrame& frame, const CameraSett
     throw ConfigError(settings.file, "Camera.width/height",
                       std::to_string(frame.rgb.cols) + "x" + std::to_string(frame.rgb.rows) + " (the stream)",
                       std::to_string(K.width) + "x" + std::to_string(K.height));
+  sensor::RgbdFrame tracked = frame;  // the images are shared, not copied
   if (live.gt_sim) {
     while (live.gt_sim->frame_index() < static_cast<int>(frame.index)) live.gt_sim->advance();
     live.gt_file.append(geom::format_tum_line({frame.t_ns, live.gt_sim->T_w_c()}) + "\n");
     const sim::MotionBatch b = live.gt_sim->take_motion();  // the readings up to this frame
     live.motion->write(b.imu, b.ticks);
     live.motion_truth->write(b.imu_truth, b.wheel_truth);
+    if (settings.slam.sensors != slam::SensorSetup::kCamera) {  // the device's robot's sensors
+      tracked.imu = b.imu;
+      tracked.wheel_ticks = b.ticks;
+    }
   }
-  const slam::FrameResult r = system.track(frame);
+  if (live.accel_txt.is_open()) {  // the Kinect's readings back in its own axes, TUM's
+    const Eigen::Matrix3d R_k_c = dataset::kinect_accel_to_optical().transpose();
+    std::string lines;
+    for (const sensor::ImuSample& s : frame.imu) {
+      const Eigen::Vector3d k = R_k_c * s.accel_mps2;
+      lines += geom::format_tum_time(s.t_ns) + " " + format_g(k.x(), 9) + " " + format_g(k.y(), 9) + " " +
+               format_g(k.z(), 9) + "\n";
+    }
+    live.accel_txt.append(lines);
+  }
+  const slam::FrameResult r = system.track(tracked);
   ++counts.frames;
   if (r.state == slam::TrackingState::kLost) ++counts.lost;
-  if (r.state == slam::TrackingState::kNotInitialized) ++counts.not_initialized;
+  if (r.state == slam::TrackingState::kNotInitialized) {
+    ++counts.not_initialized;
+    counts.init_failure = r.tracking.failure;
+  }
   if (r.T_w_c) live.cam_traj.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
   return r.state;
 }
@@ -455,8 +522,9 @@ void fail_on_problems(const std::string& source, const TrackCounts& c,
                                  " depth and " + std::to_string(rec->colour_frames) + " colour for " +
                                  std::to_string(c.frames) + " tracked");
   if (never_initialized(c))
-    throw IoError(source, "SLAM never initialised in " + std::to_string(c.frames) +
-                              " frames (too few points with valid depth: is the depth stream all zeros?)");
+    throw IoError(source, "SLAM never initialised in " + std::to_string(c.frames) + " frames (" +
+                              (c.init_failure.empty() ? std::string("no reason given") : c.init_failure) +
+                              ")");
 }
 
 int run_camera(CameraArgs a) {
@@ -467,6 +535,8 @@ int run_camera(CameraArgs a) {
   // pvbench's MuJoCo handlers before the sim:// driver plug-in's own copy,
   // which OpenNI2 unloads at shutdown.
   sim::install_mujoco_handlers();
+  if (const std::optional<slam::SensorSetup> setup = sensors_from_flag(a.sensors))
+    refuse_unfed_setup(a, *setup, "command line", "--sensors");  // before a recording is even scanned
   const std::optional<scenes::Scenario> scenario = check_inputs(a);
   check_settings_source(a, scenario);
   a.map.check();

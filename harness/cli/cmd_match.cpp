@@ -64,7 +64,7 @@ harness::CoarseSet rgbd_coarse_set(const MatchOptions& o, cv::Mat* img1, cv::Mat
   CameraSettings cam;
   std::string d1, d2;
   if (!o.sequence.empty()) {
-    const dataset::TumSequenceReader seq(o.sequence, sensor::kTumDepthFactor, 0.05);
+    const dataset::TumSequenceReader seq(o.sequence, sensor::kTumDepthFactor, 0.05, dataset::MotionNeeds{});
     const auto& frames = seq.entries();
     const std::vector<std::string> ij = split_ws(o.frames, ",");
     int i = -1, j = -1;

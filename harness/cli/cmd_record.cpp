@@ -47,6 +47,22 @@ struct RecordOptions {
   bool overwrite = false;
 };
 
+/// A fakenect dump is a Kinect v1's: its camera, 640 x 480 at 30 Hz, the
+/// one mode the freenect:// device serves and fakenect replays.  Refused
+/// before the output folder is touched.
+void check_fakenect_scenario(const scenes::Scenario& s, const std::string& file) {
+  const std::string why =
+      " for --format fakenect: a dump is a Kinect v1's, and the freenect:// device that plays it serves the "
+      "Kinect's 640x480 depth and colour at 30 Hz only";
+  if (s.camera.model != scenes::CameraModel::kKinect)
+    throw ConfigError(file, "camera.model", "kinect" + why + " (a Kinect measures depth by structured light)",
+                      "d435");
+  if (s.camera.width != sensor::kinect::kWidth || s.camera.height != sensor::kinect::kHeight)
+    throw ConfigError(file, "camera.width/height", "640x480" + why,
+                      std::to_string(s.camera.width) + "x" + std::to_string(s.camera.height));
+  if (s.camera.fps != 30.0) throw ConfigError(file, "camera.fps", "30" + why, format_exact(s.camera.fps));
+}
+
 /// A scenario recorded as a Kinect v1 would have seen it: the rendered
 /// (noise-free) depth, cut to the camera's range, as raw IR-view disparity
 /// (sensor::kinect), the colour as the sensor model made it, and the
@@ -60,15 +76,6 @@ class FakenectDump {
         registration_(sensor::kinect::Calibration{}),
         writer_(dir, registration_.calibration()),
         R_c_i_(scenes::T_camera_imu(s.imu).linear()) {}
-
-  /// A dump holds a Kinect v1's frames: refused, naming the scenario's
-  /// file, before the output folder is made.
-  static void check_camera(const scenes::Scenario& s) {
-    if (s.camera.width != sensor::kinect::kWidth || s.camera.height != sensor::kinect::kHeight)
-      throw ConfigError(s.source_file.empty() ? s.name : s.source_file, "camera.width/height",
-                        "640x480 for a fakenect dump (a Kinect v1's frames)",
-                        std::to_string(s.camera.width) + "x" + std::to_string(s.camera.height));
-  }
 
   void write(const sensor::RgbdFrame& frame, const geom::StampedPose& gt) {
     cv::Mat depth_m = source_.last_depth_gt_m().clone();
@@ -194,10 +201,10 @@ int run_record(const RecordOptions& opt, bool frames_given) {
   const sim::GlBackend backend = sim::parse_gl_backend(opt.gl);
   scenes::Scenario scenario = scenes::load_scenario(opt.scenario);
   if (opt.seed) scenario.seed = *opt.seed;
+  if (opt.format == "fakenect") check_fakenect_scenario(scenario, opt.scenario);
   IoPlan plan;
   add_scenario_inputs(&plan, "--scenario", scenario);
   plan.output_folder("--out", opt.out).check();
-  if (opt.format == "fakenect") FakenectDump::check_camera(scenario);
   prepare_output_folder(opt.out, opt.overwrite, "record");  // before the work: never into another recording
   const StopSignals stop_signals;  // Ctrl-C during the set-up stops before the first frame
 
@@ -216,6 +223,10 @@ int run_record(const RecordOptions& opt, bool frames_given) {
   FrameWriter write;
   if (opt.format == "fakenect") {
     settings.depth_map_factor = 1000.0;  // OpenNI2 serves depth in mm
+    // A Kinect has no gyroscope and no wheels, and its accelerometer is not
+    // the robot's IMU: pvbench camera supplies the Kinect's description.
+    settings.robot.reset();
+    settings.sensors.reset();
     dump = std::make_unique<FakenectDump>(opt.out, scenario, source);
     write = [&dump](const sensor::RgbdFrame& f, const geom::StampedPose& p) { dump->write(f, p); };
   } else {

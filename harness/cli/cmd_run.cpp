@@ -48,6 +48,9 @@ int run_run(RunArgs& a) {
     o.max_frames = static_cast<int>(parse_count("run", "--frames", a.frames, 1, 10'000'000));
   o.seed = a.seed;
   if (!a.map_mode.empty()) o.map.use = run::parse_map_use(a.map_mode, "--map-mode");
+  if (o.map.allow_other_station && o.map.load_path.empty())  // as --map-mode: refused, not ignored
+    throw ConfigError("command line", "--allow-other-station",
+                      "a --map to use (it lets a map of another station be used)");
   o.pace = !a.no_pace;
   o.loop_closing = !a.no_loop_closing;
   o.map_eval = !a.no_map_eval;

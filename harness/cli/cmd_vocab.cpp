@@ -89,7 +89,8 @@ struct VocabGiven {
 };
 
 void add_sequence(const std::string& dir, int every, Collector* c) {
-  dataset::TumSequenceReader reader(dir);
+  dataset::TumSequenceReader reader(dir, sensor::kTumDepthFactor, 0.02,
+                                    dataset::MotionNeeds{});  // images only
   int i = 0;
   while (auto frame = reader.next())
     if (i++ % every == 0) c->add(frame->rgb);  // R,G,B: the grey conversion's channel order barely matters here

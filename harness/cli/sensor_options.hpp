@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "pvb/common/error.hpp"
 #include "pvb/run/sensor_setup.hpp"
 
 namespace pvb::cli {
@@ -14,7 +15,13 @@ namespace pvb::cli {
 inline void add_sensors_option(CLI::App* sub, std::string* text) {
   sub->add_option("--sensors", *text,
                   std::string("sensors the SLAM system fuses: ") + run::kSensorSetupValues +
-                      " (default: the settings' System.Sensors, else camera)");
+                      " (default: the settings' System.Sensors, else camera)")
+      ->check(CLI::Validator(
+          [](std::string& value) {  // an empty value is a mistake, not "the default"
+            if (value.empty()) throw ConfigError("command line", "--sensors", run::kSensorSetupValues, "''");
+            return std::string();
+          },
+          "SETUP"));
 }
 
 /// The setup --sensors names; nullopt when the flag was not given.

@@ -114,13 +114,16 @@ double read_rate(MapReader& r, const std::string& key, double physics_hz, double
 }
 
 void read_inertial(MapReader& r, InertialNoise& n, double max_density, double max_walk, double max_bias,
-                   double max_range) {
+                   double min_range, double max_range) {
   n.noise_density = r.number("noise_density", n.noise_density, 0, max_density);
   n.random_walk = r.number("random_walk", n.random_walk, 0, max_walk);
   n.turn_on_bias = r.number("turn_on_bias", n.turn_on_bias, 0, max_bias);
-  n.range = r.number("range", n.range, 1e-3, max_range);
+  n.range = r.number("range", n.range, min_range, max_range);
   n.bits = r.integer("bits", n.bits, 0, 32);
 }
+
+/// +-2 g, the smallest range MEMS accelerometers offer (BMI088: 3 g at least).
+constexpr double kMinAccelRangeMps2 = 2 * 9.80665;
 
 /// The IMU lies on the robot: within kImuReachM of the camera (its housing
 /// and bracket on the mast).  Checked in the camera's frame, where it is given.
@@ -143,8 +146,10 @@ void read_imu(MapReader& r, Imu& imu, double physics_hz) {
     const std::vector<double> a = r.numbers("rpy_c_i_deg", 3, -180, 180);
     imu.rpy_c_i_deg = Eigen::Vector3d(a[0], a[1], a[2]);
   }
-  with_map(r, "gyro", [&](MapReader& g) { read_inertial(g, imu.gyro, 0.1, 0.01, 0.5, 100); });
-  with_map(r, "accel", [&](MapReader& a) { read_inertial(a, imu.accel, 1.0, 1.0, 5.0, 2000); });
+  with_map(r, "gyro", [&](MapReader& g) { read_inertial(g, imu.gyro, 0.1, 0.01, 0.5, 1e-3, 100); });
+  // An accelerometer's smallest range is +-2 g: below g, gravity alone saturates it.
+  with_map(r, "accel",
+           [&](MapReader& a) { read_inertial(a, imu.accel, 1.0, 1.0, 5.0, kMinAccelRangeMps2, 2000); });
 }
 
 }  // namespace

@@ -280,6 +280,9 @@ void read_camera(MapReader& r, Camera& c) {
   c.pitch_deg = r.number("pitch_deg", c.pitch_deg, -89, 89);
   c.yaw_deg = r.number("yaw_deg", c.yaw_deg, -180, 180);
   c.depth_range_m = r.range("depth_range_m", c.depth_range_m, 0.05, 100);
+  if (c.model == CameraModel::kD435 && r.has("depth_noise"))  // as stereo: under kinect, below
+    r.fail(r.full("depth_noise"), r.node()["depth_noise"],
+           "no depth_noise: section unless model is kinect (a d435's depth comes from its stereo: section)");
   with_map(r, "depth_noise", [&](MapReader& n) {
     DepthNoise& d = c.depth_noise;
     d.model = n.choice<DepthNoiseModel>(
@@ -521,12 +524,31 @@ void read_ground(MapReader& r, Ground& g) {
   g.softness = r.number("softness", g.softness, 0, 1);
 }
 
+/// A height field ends at its edge, and a robot driven past it falls:
+/// every route point must lie kRouteGroundMarginM inside ground.size_m.
+void check_route_on_relief(const Scenario& s, const std::vector<Eigen::Vector2d>& route,
+                           const ReadContext& ctx) {
+  const Eigen::Vector2d half = 0.5 * s.ground.size_m - Eigen::Vector2d::Constant(kRouteGroundMarginM);
+  for (const Eigen::Vector2d& p : route) {
+    if (std::abs(p.x()) <= half.x() && std::abs(p.y()) <= half.y()) continue;
+    throw ConfigError(ctx.origins->where("ground.size_m", ctx.file), "ground.size_m",
+                      "a relief that holds the route with " + format_number("%.1f m", kRouteGroundMarginM) +
+                          " to spare on every side (the robot falls off a height field's edge): at least [" +
+                          format_number("%.1f", 2 * (std::abs(p.x()) + kRouteGroundMarginM)) + ", " +
+                          format_number("%.1f", 2 * (std::abs(p.y()) + kRouteGroundMarginM)) + "]",
+                      "[" + format_exact(s.ground.size_m.x()) + ", " + format_exact(s.ground.size_m.y()) +
+                          "], and the route reaches (x, y) = (" + format_number("%.2f", p.x()) + ", " +
+                          format_number("%.2f", p.y()) + ") m");
+  }
+}
+
 /// A relief the robot cannot drive: the first route point where a grade
 /// exceeds kMaxRouteGrade, named at the key that makes it (the slope when
 /// the plane alone is too steep there, else the roughness).
 void check_ground_relief(const Scenario& s, const ReadContext& ctx) {
   if (!s.ground.relief) return;
   const std::vector<Eigen::Vector2d> route = route_polyline(s);
+  check_route_on_relief(s, route, ctx);
   const GroundRelief ground(s);
   const auto fault = find_route_grade_fault(ground, route, kRobotWheelBaseM, s.robot.track_m);
   if (!fault) return;

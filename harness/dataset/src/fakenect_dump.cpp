@@ -11,6 +11,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/dataset/tum_imu.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 
@@ -74,10 +75,12 @@ void FakenectWriter::write(std::int64_t t_ns, const cv::Mat& rgb, const cv::Mat&
                            const Eigen::Vector3d& gravity_c, const geom::SE3d& T_w_c) {
   CV_Assert(rgb.type() == CV_8UC3 && rgb.cols == kWidth && rgb.rows == kHeight && rgb.isContinuous());
   CV_Assert(raw_ir.type() == CV_16UC1 && raw_ir.cols == kWidth && raw_ir.rows == kHeight && raw_ir.isContinuous());
-  // freenect_raw_tilt_state: int16 x, y, z; int8 tilt angle; pad; int32 status.
+  // freenect_raw_tilt_state: int16 x, y, z; int8 tilt angle; pad; int32 status.  In the
+  // accelerometer's own axes, as a Kinect's, TUM's and libfreenect's.
+  const Eigen::Vector3d k = kinect_accel_to_optical().transpose() * gravity_c;
   unsigned char tilt[kTiltStateBytes] = {};
   for (int i = 0; i < 3; ++i) {
-    const auto counts = static_cast<std::int16_t>(std::lround(gravity_c[i] / 9.80665 * sensor::kinect::kCountsPerG));
+    const auto counts = static_cast<std::int16_t>(std::lround(k[i] / 9.80665 * sensor::kinect::kCountsPerG));
     std::memcpy(tilt + 2 * i, &counts, 2);
   }
   // The accelerometer first: fakenect sleeps before the first entry of a new

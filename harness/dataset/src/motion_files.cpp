@@ -1,13 +1,15 @@
 #include "pvb/dataset/motion_files.hpp"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "pvb/common/error.hpp"
@@ -62,13 +64,15 @@ std::string robot_yaml(const RobotCalibration& c) {
 }
 
 MotionFilesWriter::MotionFilesWriter(const std::string& dir, const RobotCalibration& c)
-    : odometry_(c.drive) {
+    : odometry_(c.drive),
+      R_kinect_i_(kinect_accel_to_optical().transpose() * c.T_b_c.linear().transpose() * c.T_b_i.linear()) {
   make_dirs(dir + "/imu0");
   imu_csv_ = open_with(dir + "/imu0/data.csv",
                        "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
                        "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n");
   accel_txt_ = open_with(dir + "/accelerometer.txt",
-                         "# accelerometer data\n# file: 'pvbench'\n# timestamp ax ay az\n");
+                         "# accelerometer data\n# file: 'pvbench' (the IMU's specific force in the Kinect v1 "
+                         "accelerometer's axes, as TUM's)\n# timestamp ax ay az\n");
   wheels_csv_ = open_with(dir + "/wheels.csv", "#timestamp [ns],left [ticks],right [ticks]\n");
   odom_txt_ = open_with(dir + "/odom.txt", "# wheel odometry of the base in the odometry frame\n"
                                            "# timestamp tx ty tz qx qy qz qw vx vy vz wx wy wz\n");
@@ -84,7 +88,8 @@ void MotionFilesWriter::write(const std::vector<sensor::ImuSample>& imu_samples,
     const Eigen::Vector3d& a = s.accel_mps2;
     imu += std::to_string(s.t_ns) + "," + g(w.x()) + "," + g(w.y()) + "," + g(w.z()) + "," + g(a.x()) + "," +
            g(a.y()) + "," + g(a.z()) + "\n";
-    accel += geom::format_tum_time(s.t_ns) + " " + g(a.x()) + " " + g(a.y()) + " " + g(a.z()) + "\n";
+    const Eigen::Vector3d k = R_kinect_i_ * a;
+    accel += geom::format_tum_time(s.t_ns) + " " + g(k.x()) + " " + g(k.y()) + " " + g(k.z()) + "\n";
   }
   for (const sensor::WheelTicks& t : ticks) {
     wheels += std::to_string(t.t_ns) + "," + std::to_string(t.left) + "," + std::to_string(t.right) + "\n";
@@ -102,51 +107,118 @@ void MotionFilesWriter::write(const std::vector<sensor::ImuSample>& imu_samples,
 
 namespace {
 
-/// The comma-separated numbers of one line, or an IoError naming it.
-std::vector<double> csv_numbers(const std::string& line, std::size_t count, const std::string& file, int n,
-                                const char* expected) {
-  std::vector<double> v;
-  std::stringstream in(line);
-  std::string cell;
-  while (std::getline(in, cell, ',')) {
-    char* end = nullptr;
-    const double x = std::strtod(cell.c_str(), &end);
-    if (end == cell.c_str() || !std::isfinite(x)) throw IoError(file, std::string("expected ") + expected, n);
-    v.push_back(x);
-  }
-  if (v.size() != count) throw IoError(file, std::string("expected ") + expected, n);
-  return v;
+/// A whole number within int64 (no fraction, no exponent), or nullopt.
+std::optional<std::int64_t> whole_count(const std::string& cell) {
+  char* end = nullptr;
+  errno = 0;
+  const long long v = std::strtoll(cell.c_str(), &end, 10);
+  if (end == cell.c_str() || *end != '\0' || errno == ERANGE) return std::nullopt;
+  return static_cast<std::int64_t>(v);
 }
 
-/// Calls f(numbers, line number) for each data line of a CSV file with a '#' header.
-template <typename F>
-void for_each_csv_line(const std::string& file, std::size_t count, const char* expected, F&& f) {
-  std::ifstream in(file);
-  if (!in) throw IoError(file, "cannot open");
-  std::string line;
-  for (int n = 1; std::getline(in, line); ++n) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty() || line[0] == '#') continue;
-    f(csv_numbers(line, count, file, n, expected), n);
+bool path_exists(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+bool path_is_folder(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+/// The IMU's file a run needing `needs` reads in `dir`; IoError when it is
+/// not there or not a file.
+std::string imu_file_for(const std::string& dir, const MotionNeeds& needs) {
+  const std::string imu0 = dir + "/imu0", csv = imu0 + "/data.csv", txt = dir + "/accelerometer.txt";
+  if (path_exists(imu0) && !path_is_folder(imu0))
+    throw IoError(imu0,
+                  "is not a folder; " + needs.who + " reads the IMU from imu0/data.csv (EuRoC's layout)");
+  if (path_exists(csv)) {
+    require_regular_file(csv);
+    return csv;
   }
+  if (needs.gyroscope)
+    throw IoError(csv,
+                  std::string("missing; ") + needs.who + " needs the gyroscope's readings" +
+                      (path_exists(txt) ? " (accelerometer.txt holds an accelerometer's only: use --sensors "
+                                          "camera+accel)"
+                                        : ""));
+  if (!path_exists(txt))
+    throw IoError(dir, "holds no accelerometer readings (neither imu0/data.csv nor accelerometer.txt); " +
+                           needs.who + " needs them");
+  require_regular_file(txt);
+  return txt;
 }
 
 }  // namespace
 
+std::vector<sensor::WheelTicks> read_wheel_ticks(const std::string& path, std::vector<int>* lines) {
+  static const char* kExpected =
+      "expected 't_ns,left,right': three whole numbers (ns, ticks, ticks) within int64";
+  std::vector<sensor::WheelTicks> out;
+  std::istringstream in(read_file(path));
+  std::string line;
+  int prev_line = 0;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::optional<std::int64_t>> v;
+    std::stringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) v.push_back(whole_count(cell));
+    if (v.size() != 3 || !v[0] || !v[1] || !v[2])
+      throw IoError(path, std::string(kExpected) + ", got '" + printable(line) + "'", n);
+    if (!out.empty() && *v[0] <= out.back().t_ns)
+      throw IoError(path,
+                    "time stamp " + std::to_string(*v[0]) + " is not after line " +
+                        std::to_string(prev_line) + "'s: readings must be in time order, each once",
+                    n);
+    out.push_back({*v[0], *v[1], *v[2]});
+    if (lines) lines->push_back(n);
+    prev_line = n;
+  }
+  return out;
+}
+
 MotionReadings read_motion_readings(const std::string& dir) {
   MotionReadings m;
   const std::string wheels_file = dir + "/wheels.csv";
-  m.imu = read_tum_imu(dir);
-  if (::access(wheels_file.c_str(), R_OK) == 0)
-    for_each_csv_line(wheels_file, 3, "t_ns,left,right (3 integers)", [&](const std::vector<double>& v, int n) {
-      sensor::WheelTicks t;
-      t.t_ns = static_cast<std::int64_t>(v[0]);
-      if (!m.ticks.empty() && t.t_ns <= m.ticks.back().t_ns)
-        throw IoError(wheels_file, "expected a time after the line before", n);
-      t.left = static_cast<std::int64_t>(v[1]);
-      t.right = static_cast<std::int64_t>(v[2]);
-      m.ticks.push_back(t);
-    });
+  switch (tum_imu_source(dir)) {
+    case TumImuSource::kEurocImu:
+      m.imu_file = dir + "/imu0/data.csv";
+      m.imu = read_euroc_imu(m.imu_file, &m.imu_line);
+      break;
+    case TumImuSource::kKinectAccelerometer:
+      m.imu_file = dir + "/accelerometer.txt";
+      m.imu = read_tum_accelerometer(m.imu_file, &m.imu_line);
+      break;
+    case TumImuSource::kNone:
+      break;
+  }
+  if (::access(wheels_file.c_str(), R_OK) == 0) {
+    m.ticks_file = wheels_file;
+    m.ticks = read_wheel_ticks(wheels_file, &m.tick_line);
+  }
+  return m;
+}
+
+MotionReadings read_motion_readings(const std::string& dir, const MotionNeeds& needs) {
+  MotionReadings m;
+  if (needs.accelerometer || needs.gyroscope) {
+    m.imu_file = imu_file_for(dir, needs);
+    const bool csv = m.imu_file.size() >= 8 && m.imu_file.compare(m.imu_file.size() - 8, 8, "data.csv") == 0;
+    m.imu = csv ? read_euroc_imu(m.imu_file, &m.imu_line) : read_tum_accelerometer(m.imu_file, &m.imu_line);
+    if (m.imu.empty())
+      throw IoError(m.imu_file, "holds no readings (a header only?); " + needs.who + " needs them");
+  }
+  if (needs.wheels) {
+    m.ticks_file = dir + "/wheels.csv";
+    if (!path_exists(m.ticks_file))
+      throw IoError(m.ticks_file, "missing; " + needs.who + " needs the encoders' readings");
+    require_regular_file(m.ticks_file);
+    m.ticks = read_wheel_ticks(m.ticks_file, &m.tick_line);
+    if (m.ticks.empty())
+      throw IoError(m.ticks_file, "holds no readings (a header only?); " + needs.who + " needs them");
+  }
   return m;
 }
 

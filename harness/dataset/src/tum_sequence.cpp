@@ -308,13 +308,14 @@ std::vector<std::pair<std::int64_t, std::string>> read_tum_list(const std::strin
   return sorted;
 }
 
-TumSequenceReader::TumSequenceReader(const std::string& dir, double depth_factor, double max_diff_s)
+TumSequenceReader::TumSequenceReader(const std::string& dir, double depth_factor, double max_diff_s,
+                                     const std::optional<MotionNeeds>& motion)
     : dir_(dir), depth_factor_(depth_factor) {
   const std::string assoc = dir + "/associations.txt";
   if (::access(assoc.c_str(), R_OK) == 0) entries_ = read_associations(assoc);
   if (entries_.empty()) entries_ = associate_lists(dir, max_diff_s);
   max_skipped_ = std::max<std::size_t>(10, entries_.size() / 10);
-  motion_ = read_motion_readings(dir);
+  motion_ = motion ? read_motion_readings(dir, *motion) : read_motion_readings(dir);
   last_delivered_t_ns_ = std::numeric_limits<std::int64_t>::min();
 }
 

@@ -16,13 +16,20 @@
 // Which one is loaded is told by a symbol only libfreenect exports.
 //
 // Timestamps are the device's (60 MHz, 32 bits), unwrapped, in microseconds.
+// The accelerometer (libfreenect's freenect_get_mks_accel) is served as a
+// device property of our own (kinect_accelerometer.hpp): a dump's 'a'
+// records at their time stamps; a live Kinect's, read through its motor
+// sub-device every kAccelPeriodMs of the event loop, at the device time of
+// the last frame plus the host time since.
 // No Kinect, a busy Kinect and an unplugged one each end with one error line
 // in OpenNI2's extended error (docs/openni.md, "Kinect v1").
 #include <dlfcn.h>
 #include <libfreenect.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdlib>
+#include <deque>
 #include <exception>
 #include <memory>
 #include <mutex>
@@ -33,6 +40,7 @@
 
 #include "plugin.hpp"
 #include "pvb/dataset/fakenect_dump.hpp"
+#include "pvb/openni/kinect_accelerometer.hpp"
 #include "pvb/sensor/kinect_v1.hpp"
 
 namespace {
@@ -43,6 +51,8 @@ namespace kinect = pvb::sensor::kinect;
 
 constexpr const char* kScheme = "freenect://";
 constexpr double kNominalFocalPx = 525.0;  // only for the FOV properties; SLAM takes its own
+constexpr int kAccelPeriodMs = 2;          // a live Kinect's accelerometer: at most 500 readings a second
+constexpr std::size_t kMaxPendingAccel = 20000;  // readings kept unread (40 s at 500 Hz); older ones go
 
 /// True when the loaded libfreenect is fakenect's playback library.
 bool playback_library() {
@@ -74,8 +84,8 @@ class FreenectDriver;
 /// two streams, and the thread or lockstep that feeds them.
 class FreenectDevice : public DeviceBase {
  public:
-  FreenectDevice(FreenectDriver& driver, const OniDeviceInfo& info, freenect_context* ctx, freenect_device* dev,
-                 bool playback);
+  FreenectDevice(FreenectDriver& driver, const OniDeviceInfo& info, freenect_context* ctx,
+                 freenect_device* dev, bool playback, bool has_motor);
   ~FreenectDevice() override;
 
   OniStatus getSensorInfoList(OniSensorInfo** infos, int* count) override {
@@ -88,7 +98,9 @@ class FreenectDevice : public DeviceBase {
   OniBool isImageRegistrationModeSupported(OniImageRegistrationMode mode) override {
     return mode == ONI_IMAGE_REGISTRATION_DEPTH_TO_COLOR;
   }
-  OniBool isPropertySupported(int id) override { return id == ONI_DEVICE_PROPERTY_IMAGE_REGISTRATION; }
+  OniBool isPropertySupported(int id) override {
+    return id == ONI_DEVICE_PROPERTY_IMAGE_REGISTRATION || id == pvb::openni::kAccelerometerProperty;
+  }
   OniStatus getProperty(int id, void* data, int* size) override;
   OniStatus setProperty(int id, const void* data, int size) override;
   OniStatus tryManualTrigger() override;
@@ -100,6 +112,11 @@ class FreenectDevice : public DeviceBase {
   void start_streaming();
   void event_loop();
   void fail(const std::string& message);
+  /// Queues libfreenect's current accelerometer reading, stamped t_us.
+  void take_accelerometer(std::uint64_t t_us);
+  /// Moves the queued readings into `data` (at most *size bytes); *size
+  /// becomes the bytes written.
+  OniStatus read_accelerometer(void* data, int* size);
 
   FreenectDriver& driver_;
   OniDeviceInfo info_;
@@ -113,7 +130,12 @@ class FreenectDevice : public DeviceBase {
   FrameStream colour_{ONI_SENSOR_COLOR, colour_mode_, kNominalFocalPx, kNominalFocalPx, 0};
   std::vector<std::uint16_t> depth_buf_ = std::vector<std::uint16_t>(kinect::kWidth * kinect::kHeight);
   std::vector<std::uint8_t> video_buf_ = std::vector<std::uint8_t>(kinect::kWidth * kinect::kHeight * 3);
-  DeviceClock depth_clock_, video_clock_;
+  DeviceClock depth_clock_, video_clock_, accel_clock_;
+  std::mutex accel_mutex_;
+  std::deque<pvb::openni::AccelerometerReading> accel_;  ///< not read yet
+  bool has_motor_ = false;  ///< a live Kinect whose motor sub-device (the accelerometer) is open
+  std::atomic<std::uint64_t> last_frame_us_{0};      ///< a live Kinect: the last depth frame's device time
+  std::atomic<std::int64_t> last_frame_host_us_{0};  ///< and when it came (steady clock)
   int depth_index_ = 0, video_index_ = 0;
   bool streaming_ = false;
   bool finished_ = false;
@@ -176,7 +198,9 @@ std::optional<std::string> FreenectDriver::open_context() {
     return std::string("no Kinect found: libfreenect cannot open USB (no USB bus, or no permission)");
   }
   freenect_set_log_level(ctx_, FREENECT_LOG_FATAL);
-  freenect_select_subdevices(ctx_, FREENECT_DEVICE_CAMERA);
+  // The motor sub-device holds the accelerometer (deviceOpen falls back to the camera alone).
+  freenect_select_subdevices(ctx_, static_cast<freenect_device_flags>(
+                                       FREENECT_DEVICE_CAMERA | (playback_ ? 0 : FREENECT_DEVICE_MOTOR)));
   return std::nullopt;
 }
 
@@ -212,12 +236,21 @@ DeviceBase* FreenectDriver::deviceOpen(const char* uri, const char* /*mode*/) {
     return nullptr;
   }
   freenect_device* dev = nullptr;
+  bool has_motor = !playback_;
   if (freenect_open_device(ctx_, &dev, *parse_index(uri)) < 0 || !dev) {
+    dev = nullptr;
+    if (has_motor) {  // a Kinect whose motor will not open still has its camera: no accelerometer then
+      has_motor = false;
+      freenect_select_subdevices(ctx_, FREENECT_DEVICE_CAMERA);
+      if (freenect_open_device(ctx_, &dev, *parse_index(uri)) < 0) dev = nullptr;
+    }
+  }
+  if (!dev) {
     report("freenect device: Kinect %s is busy or cannot be opened (does another program hold it?)", uri);
     return nullptr;
   }
   try {
-    return new FreenectDevice(*this, *info, ctx_, dev, playback_);
+    return new FreenectDevice(*this, *info, ctx_, dev, playback_, has_motor);
   } catch (const std::exception& e) {
     freenect_close_device(dev);
     report("freenect device: %s", e.what());
@@ -235,8 +268,8 @@ void video_callback(freenect_device* dev, void* data, std::uint32_t ticks) {
 }
 
 FreenectDevice::FreenectDevice(FreenectDriver& driver, const OniDeviceInfo& info, freenect_context* ctx,
-                               freenect_device* dev, bool playback)
-    : driver_(driver), info_(info), ctx_(ctx), dev_(dev), playback_(playback) {
+                               freenect_device* dev, bool playback, bool has_motor)
+    : driver_(driver), info_(info), ctx_(ctx), dev_(dev), playback_(playback), has_motor_(has_motor) {
   if (playback_) {
     const std::string dump = std::getenv("FAKENECT_PATH");  // checked by the driver's open_context()
     entries_ = pvb::dataset::read_fakenect_index(dump);
@@ -274,6 +307,7 @@ oni::driver::StreamBase* FreenectDevice::createStream(OniSensorType type) {
 void FreenectDevice::destroyStream(oni::driver::StreamBase* stream) { static_cast<FrameStream*>(stream)->stop(); }
 
 OniStatus FreenectDevice::getProperty(int id, void* data, int* size) {
+  if (id == pvb::openni::kAccelerometerProperty) return read_accelerometer(data, size);
   if (id != ONI_DEVICE_PROPERTY_IMAGE_REGISTRATION) return ONI_STATUS_NOT_SUPPORTED;
   if (*size != static_cast<int>(sizeof(OniImageRegistrationMode))) return ONI_STATUS_BAD_PARAMETER;
   const OniImageRegistrationMode mode = ONI_IMAGE_REGISTRATION_DEPTH_TO_COLOR;
@@ -305,16 +339,52 @@ void FreenectDevice::fail(const std::string& message) {
   driver_.state_changed(info_, ONI_DEVICE_STATE_ERROR);
 }
 
+std::int64_t steady_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+void FreenectDevice::take_accelerometer(std::uint64_t t_us) {
+  pvb::openni::AccelerometerReading r;
+  r.t_us = t_us;
+  freenect_get_mks_accel(freenect_get_tilt_state(dev_), &r.x_mps2, &r.y_mps2, &r.z_mps2);
+  std::lock_guard<std::mutex> lock(accel_mutex_);
+  accel_.push_back(r);
+  if (accel_.size() > kMaxPendingAccel) accel_.pop_front();
+}
+
+OniStatus FreenectDevice::read_accelerometer(void* data, int* size) {
+  constexpr int kBytes = static_cast<int>(sizeof(pvb::openni::AccelerometerReading));
+  if (!data || !size || *size < 0) return ONI_STATUS_BAD_PARAMETER;
+  std::lock_guard<std::mutex> lock(accel_mutex_);
+  int n = 0;
+  for (; n < *size / kBytes && !accel_.empty(); ++n) {
+    std::memcpy(static_cast<char*>(data) + static_cast<std::size_t>(n) * kBytes, &accel_.front(), kBytes);
+    accel_.pop_front();
+  }
+  *size = n * kBytes;
+  return ONI_STATUS_OK;
+}
+
 /// Live: libfreenect's events until stopped; an error there is an unplug.
+/// Between them, the accelerometer once a kAccelPeriodMs, once frames come
+/// (its readings are stamped from theirs).
 void FreenectDevice::event_loop() {
+  std::int64_t last_accel_us = 0;
   while (!stop_) {
-    timeval timeout{0, 100000};
+    timeval timeout{0, has_motor_ ? kAccelPeriodMs * 1000 : 100000};  // no accelerometer: no need to wake
     if (freenect_process_events_timeout(ctx_, &timeout) < 0) {
       finished_ = true;
       driver_.report("freenect device: the Kinect stopped answering (unplugged?)");
       driver_.disconnected(info_);
       return;
     }
+    const std::int64_t now_us = steady_us();
+    if (!has_motor_ || last_frame_host_us_ == 0 || now_us - last_accel_us < kAccelPeriodMs * 1000) continue;
+    last_accel_us = now_us;
+    if (freenect_update_tilt_state(dev_) < 0) continue;  // one lost reading, not an unplug
+    take_accelerometer(last_frame_us_ + static_cast<std::uint64_t>(now_us - last_frame_host_us_));
   }
 }
 
@@ -336,17 +406,20 @@ OniStatus FreenectDevice::tryManualTrigger() {
       fail(e.what());
       return ONI_STATUS_ERROR;
     }
-    ++next_entry_;
+    const pvb::dataset::FakenectEntry& entry = entries_[next_entry_++];
     if (freenect_process_events(ctx_) < 0) {
-      fail("fakenect could not play " + entries_[next_entry_ - 1].path);
+      fail("fakenect could not play " + entry.path);
       return ONI_STATUS_ERROR;
     }
+    if (entry.type == 'a') take_accelerometer(accel_clock_.to_us(entry.timestamp));
   }
   return ONI_STATUS_OK;
 }
 
 void FreenectDevice::on_depth(const void* data, std::uint32_t ticks) {
   const std::uint64_t t_us = depth_clock_.to_us(ticks);
+  last_frame_us_ = t_us;
+  last_frame_host_us_ = steady_us();
   cv::Mat depth_mm;
   if (registration_) {
     const cv::Mat raw(kinect::kHeight, kinect::kWidth, CV_16UC1, const_cast<void*>(data));

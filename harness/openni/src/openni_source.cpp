@@ -7,13 +7,16 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <thread>
 #include <vector>
 
 #include "pvb/common/error.hpp"
+#include "pvb/dataset/tum_imu.hpp"
 #include "pvb/openni/frame_pairer.hpp"
+#include "pvb/openni/kinect_accelerometer.hpp"
 #include "pvb/openni/oni_file.hpp"
 #include "pvb/openni/record_target.hpp"
 
@@ -100,6 +103,8 @@ struct OpenniSource::Impl : ::openni::OpenNI::DeviceDisconnectedListener,
   std::atomic<bool> unplugged{false};
   std::atomic<bool> end_of_stream{false};
   std::unique_ptr<FramePairer> pairer;
+  bool has_accelerometer = false;             ///< a Kinect v1 on freenect:// (kinect_accelerometer.hpp)
+  std::deque<sensor::ImuSample> accel_ahead;  ///< readings after the last frame returned
 
   std::mutex reason_mutex;
   std::string device_reason;  ///< what the driver said when it gave up (its thread's extended error)
@@ -126,6 +131,9 @@ struct OpenniSource::Impl : ::openni::OpenNI::DeviceDisconnectedListener,
 
   void open();
   void start_recorder();
+  /// The accelerometer's readings up to and with the frame's time, put into
+  /// the colour camera's optical frame as the TUM reader puts them.
+  void attach_accelerometer(sensor::RgbdFrame* f);
   std::optional<sensor::RgbdFrame> next();
   std::optional<RecordingSummary> stop();
   bool file_done() const { return is_file && depth_read >= depth_total && colour_read >= colour_total; }
@@ -202,6 +210,7 @@ void OpenniSource::Impl::open() {
                                "': cannot turn mirroring off: " + oni_error());
   }
   pairer = std::make_unique<FramePairer>(500'000'000LL / std::max(1, fps));
+  has_accelerometer = !is_file && device.isPropertySupported(kAccelerometerProperty);
 
   // The recorder first: a live camera starts delivering as soon as its
   // streams start, and every frame read must be in the recording.
@@ -248,6 +257,29 @@ void OpenniSource::Impl::start_recorder() {
   }
 }
 
+void OpenniSource::Impl::attach_accelerometer(sensor::RgbdFrame* f) {
+  if (!has_accelerometer) return;
+  const Eigen::Matrix3d R_c_k = dataset::kinect_accel_to_optical();
+  std::vector<AccelerometerReading> buf(kMaxAccelerometerReadings);
+  for (;;) {
+    int size = static_cast<int>(buf.size() * sizeof(AccelerometerReading));
+    if (device.getProperty(kAccelerometerProperty, buf.data(), &size) != ::openni::STATUS_OK) break;
+    const std::size_t n = static_cast<std::size_t>(size) / sizeof(AccelerometerReading);
+    for (std::size_t k = 0; k < n; ++k) {
+      sensor::ImuSample s;
+      s.t_ns = static_cast<std::int64_t>(buf[k].t_us) * 1000;
+      s.gyro_radps = sensor::no_gyro();
+      s.accel_mps2 = R_c_k * Eigen::Vector3d(buf[k].x_mps2, buf[k].y_mps2, buf[k].z_mps2);
+      if (accel_ahead.empty() || s.t_ns > accel_ahead.back().t_ns) accel_ahead.push_back(s);  // in time order
+    }
+    if (n < buf.size()) break;
+  }
+  while (!accel_ahead.empty() && accel_ahead.front().t_ns <= f->t_ns) {
+    f->imu.push_back(accel_ahead.front());
+    accel_ahead.pop_front();
+  }
+}
+
 std::optional<sensor::RgbdFrame> OpenniSource::Impl::next() {
   if (stopped) return std::nullopt;
   constexpr int kSliceMs = 50;
@@ -262,6 +294,7 @@ std::optional<sensor::RgbdFrame> OpenniSource::Impl::next() {
       f.depth_m = std::move(pair->depth.image);
       f.index = next_index++;
       f.rgb_name = "frame " + std::to_string(f.index);
+      attach_accelerometer(&f);
       return f;
     }
     if (file_done() || end_of_stream) return std::nullopt;

@@ -134,6 +134,21 @@ double gravity_tilt_deg(const Eigen::Vector3d& g_w) {
   return std::acos(std::clamp(-g_w.normalized().z(), -1.0, 1.0)) * kInertialDegPerRad;
 }
 
+std::optional<double> gravity_error_at_deg(const eval::Trajectory& gt, const eval::Trajectory& est,
+                                           const geom::Vec3d& down_w, const eval::GravityEstimates& estimates,
+                                           std::int64_t t_ns) {
+  eval::Trajectory one;
+  for (const geom::StampedPose& p : est.poses)
+    if (p.t_ns >= t_ns) {
+      one.poses.push_back(p);
+      break;
+    }
+  if (one.empty() || gt.empty()) return std::nullopt;
+  const eval::GravityError g = eval::gravity_error(gt, one, down_w, "", estimates);
+  if (g.angle_deg.empty()) return std::nullopt;
+  return g.angle_deg.front();
+}
+
 InertialReport inertial_report(const slam::MapGravity& g, std::int64_t t0_ns) {
   InertialReport r;
   r.trusted = g.ready;
@@ -150,7 +165,8 @@ std::string inertial_json(const InertialReport& r) {
   return std::string("{\"trusted\": ") + (r.trusted ? "true" : "false") +
          ", \"trusted_t_s\": " + when(bias_num(r.trusted_t_s)) +
          ", \"trusted_keyframe\": " + when(std::to_string(r.trusted_keyframe)) +
-         ", \"gravity_tilt_deg\": " + when(bias_num(r.gravity_tilt_deg)) +
+         ", \"gravity_tilt_deg\": " + when(bias_num(r.gravity_tilt_deg)) + ", \"gravity_true_deg\": " +
+         (r.gravity_true_deg ? bias_num(*r.gravity_true_deg) : std::string("null")) +
          ", \"init_rms\": " + when(bias_num(r.init_rms)) +
          ", \"biases\": " + (r.biases ? biases_json(*r.biases) : std::string("null")) + "}";
 }

@@ -156,7 +156,10 @@ class OfflineSlam::Impl {
   const slam::Settings& settings() const { return settings_; }
 
  private:
-  slam::Settings read_settings() const;
+  slam::Settings read_settings();
+  /// The motion readings the setup fuses against the frames and the
+  /// settings; a supplied Kinect description takes the readings' rate.
+  void check_motion();
   void open_outputs();
   bool stop_requested() const { return a_.stop && a_.stop->load(); }
   void text(const std::string& s) const {
@@ -186,6 +189,7 @@ class OfflineSlam::Impl {
   /// Scores localisation in a loaded map and saves the final map; appends stats.json's "map".
   void finish_map(std::ostringstream* js);
 
+  bool imu_supplied_ = false;  ///< set by read_settings() (first: initialised before settings_)
   const OfflineSlamOptions a_;
   slam::Settings settings_;
   dataset::TumSequenceReader reader_;
@@ -196,15 +200,19 @@ class OfflineSlam::Impl {
   PlaceRecognition place_;             ///< collected after the run, labelled when there is ground truth
   std::string image_size_error_;       ///< set when the loop stopped on an image of the wrong size
   std::optional<MapReport> map_;       ///< with --map or --save-map
+  std::optional<double>
+      gravity_true_deg_;  ///< the core's gravity at its trusted time against the ground truth
 };
 
-slam::Settings OfflineSlam::Impl::read_settings() const {
+slam::Settings OfflineSlam::Impl::read_settings() {
   slam::Settings settings = slam::read_settings(a_.settings);
   for (const std::string& w : settings.warnings) warn("warning: " + w);
   if (a_.no_pe_match) settings.pe_match.enabled = false;
   if (a_.no_dense) settings.dense.enabled = false;
   if (a_.sensors) settings.sensors = *a_.sensors;
-  if (settings.sensors == slam::SensorSetup::kCameraAccel && supply_kinect_accelerometer(&settings, a_.sequence))
+  imu_supplied_ = settings.sensors == slam::SensorSetup::kCameraAccel &&
+                  supply_kinect_accelerometer(&settings, a_.sequence);
+  if (imu_supplied_)
     warn(std::string("note: sensors ") + slam::to_string(settings.sensors) +
          ": the settings have no IMU.* keys; the Kinect v1 accelerometer's description is used "
          "(docs/sensors.md)");
@@ -213,7 +221,10 @@ slam::Settings OfflineSlam::Impl::read_settings() const {
 }
 
 OfflineSlam::Impl::Impl(const OfflineSlamOptions& a)
-    : a_(a), settings_((check_offline_options(a), read_settings())), reader_(a.sequence, settings_.depth_map_factor) {
+    : a_(a),
+      settings_((check_offline_options(a), read_settings())),
+      reader_(a.sequence, settings_.depth_map_factor, 0.02, motion_needs(settings_.sensors)) {
+  check_motion();
   // One rule for missing frames (docs/slam.md): more than max_missing of
   // the sequence's frames, and more than 5, ends the run.
   reader_.set_max_skipped(std::max<std::size_t>(
@@ -229,6 +240,12 @@ OfflineSlam::Impl::Impl(const OfflineSlamOptions& a)
   if (!a.map.load_path.empty() || !a.map.save_path.empty()) map_ = start_map(*system_, a.map);
   prepare_output_folder(a.out, a.overwrite, "slam");
   open_outputs();
+}
+
+void OfflineSlam::Impl::check_motion() {
+  check_sequence_motion(reader_, static_cast<std::size_t>(a_.max_frames), settings_, a_.settings,
+                        imu_supplied_);
+  if (imu_supplied_) kinect_accelerometer_at(mean_rate_hz(reader_.motion().imu), &settings_.imu);
 }
 
 void OfflineSlam::Impl::open_outputs() {
@@ -428,6 +445,8 @@ void OfflineSlam::Impl::evaluate_gravity(const eval::Trajectory& gt, const eval:
       eval::gravity_error(gt, est, down_w, gravity_map_frame(settings_.sensors), tally_.gravity);
   const eval::TiltDrift t =
       eval::tilt_drift(gt, session_keyframes(eval::read_tum(a_.out + "/KeyFrameTrajectory.txt"), *system_), alignment);
+  const slam::MapGravity core = system_->gravity();
+  if (core.ready) gravity_true_deg_ = gravity_error_at_deg(gt, est, down_w, tally_.gravity, core.ready_t_ns);
   text(strf("gravity error (map frame: %s): median %.2f deg, p95 %.2f, final %.2f; keyframe pitch error "
             "%+.4f deg/keyframe, roll %+.4f\n",
             g.map_frame.c_str(), g.median_deg, g.p95_deg, g.final_deg, t.pitch_slope_deg_per_kf,
@@ -439,6 +458,7 @@ void OfflineSlam::Impl::evaluate_inertial(std::ostringstream* js) {
   if (!slam::uses_accel(settings_.sensors) || tally_.frame_t_ns.empty()) return;
   const std::int64_t t0_ns = tally_.frame_t_ns.front();
   InertialReport r = inertial_report(system_->gravity(), t0_ns);
+  if (r.trusted) r.gravity_true_deg = gravity_true_deg_;
   std::vector<KeyframeBias> kfs;
   for (const slam::System::KeyFrameState& k : system_->keyframe_states())
     kfs.push_back({k.id, k.t_ns, k.bias});
@@ -452,10 +472,15 @@ void OfflineSlam::Impl::evaluate_inertial(std::ostringstream* js) {
       warn(std::string("warning: biases not compared: ") + e.what());
     }
   }
-  text(r.trusted
-           ? strf("inertial state trusted at t = %.2f s (keyframe %llu): gravity %.2f deg off the map's -z\n",
-                  r.trusted_t_s, static_cast<unsigned long long>(r.trusted_keyframe), r.gravity_tilt_deg)
-           : std::string("inertial state not trusted by the end\n"));
+  const std::string truth =
+      r.gravity_true_deg ? strf(", %.2f deg off the true down (ground truth)", *r.gravity_true_deg) : "";
+  text(
+      r.trusted
+          ? strf(
+                "inertial state trusted at t = %.2f s (keyframe %llu): gravity %.2f deg off the map's -z%s\n",
+                r.trusted_t_s, static_cast<unsigned long long>(r.trusted_keyframe), r.gravity_tilt_deg,
+                truth.c_str())
+          : std::string("inertial state not trusted by the end\n"));
   if (r.biases)
     text(strf("bias error RMS over %zu keyframes: gyro %.5f rad/s, accel %.4f m/s^2\n", r.biases->t_s.size(),
               r.biases->gyro_rms_radps, r.biases->accel_rms_mps2));

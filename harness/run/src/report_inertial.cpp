@@ -31,7 +31,10 @@ std::string trusted_text(const InertialReport& in) {
   if (!in.trusted) return "not trusted by the end";
   return "trusted at t = " + fixed_or_dash(in.trusted_t_s, 2) + " s (keyframe " +
          std::to_string(in.trusted_keyframe) + "), gravity " + fixed_or_dash(in.gravity_tilt_deg, 2) +
-         " deg off the map's -z, whitened RMS " + fixed_or_dash(in.init_rms, 2);
+         " deg off the map's -z" +
+         (in.gravity_true_deg ? ", " + fixed_or_dash(*in.gravity_true_deg, 2) + " deg off the true down"
+                              : "") +
+         ", whitened RMS " + fixed_or_dash(in.init_rms, 2);
 }
 
 std::string bias_text(const BiasComparison& b) {

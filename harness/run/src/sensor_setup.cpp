@@ -1,8 +1,11 @@
 #include "pvb/run/sensor_setup.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 
 #include "pvb/common/error.hpp"
+#include "pvb/dataset/motion_checks.hpp"
 #include "pvb/dataset/tum_imu.hpp"
 
 namespace pvb::run {
@@ -35,17 +38,61 @@ const char* gravity_map_frame(slam::SensorSetup setup) {
 }
 
 bool supply_kinect_accelerometer(slam::Settings* settings, const std::string& sequence) {
-  if (settings->imu.present || dataset::tum_imu_source(sequence) != dataset::TumImuSource::kKinectAccelerometer)
+  if (dataset::tum_imu_source(sequence) != dataset::TumImuSource::kKinectAccelerometer) return false;
+  return supply_kinect_description(settings);
+}
+
+bool supply_kinect_description(slam::Settings* settings) {
+  if (settings->imu.present) {
+    settings->imu.T_b_c = geom::SE3d::Identity();  // the Kinect's readings are read into the camera's frame
     return false;
-  using K = dataset::KinectAccelerometer;
+  }
   slam::ImuSettings imu;  // NoiseGyro and GyroWalk keep their defaults: there is no gyroscope
   imu.present = true;
-  imu.noise.accel_noise_density = K::noise_density();
-  imu.noise.accel_random_walk = K::kRandomWalk;
-  imu.rate_hz = K::kRateHz;
+  kinect_accelerometer_at(dataset::KinectAccelerometer::kRateHz, &imu);
+  imu.noise.accel_random_walk = dataset::KinectAccelerometer::kRandomWalk;
   imu.T_b_c = geom::SE3d::Identity();  // the readings are already in the camera's optical frame
   settings->imu = imu;
   return true;
+}
+
+void kinect_accelerometer_at(double rate_hz, slam::ImuSettings* imu) {
+  imu->rate_hz = rate_hz;
+  imu->noise.accel_noise_density = dataset::KinectAccelerometer::kReadingNoiseMps2 / std::sqrt(rate_hz);
+}
+
+dataset::MotionNeeds motion_needs(slam::SensorSetup setup) {
+  dataset::MotionNeeds n;
+  n.accelerometer = slam::uses_accel(setup);
+  n.gyroscope = slam::uses_imu(setup);
+  n.wheels = slam::uses_wheels(setup);
+  n.who = std::string("--sensors ") + slam::to_string(setup);
+  return n;
+}
+
+double mean_rate_hz(const std::vector<sensor::ImuSample>& imu) {
+  if (imu.size() < 2) return 0.0;
+  return static_cast<double>(imu.size() - 1) /
+         (static_cast<double>(imu.back().t_ns - imu.front().t_ns) * 1e-9);
+}
+
+void check_sequence_motion(const dataset::TumSequenceReader& reader, std::size_t max_frames,
+                           const slam::Settings& settings, const std::string& settings_file,
+                           bool rate_from_data) {
+  const auto& entries = reader.entries();
+  if (entries.empty() || reader.motion().empty()) return;
+  const std::size_t n = max_frames > 0 ? std::min(max_frames, entries.size()) : entries.size();
+  dataset::MotionExpectations e;
+  e.first_frame_t_ns = entries.front().t_ns;
+  e.last_frame_t_ns = entries[n - 1].t_ns;
+  e.settings_file = settings_file;
+  if (!rate_from_data) e.imu_rate_hz = settings.imu.rate_hz;
+  if (slam::uses_wheels(settings.sensors)) {
+    e.encoder_rate_hz = settings.robot.encoder_rate_hz;
+    e.ticks_per_rev = settings.robot.drive.ticks_per_rev;
+    e.wheel_radius_m = settings.robot.drive.wheel_radius_m;
+  }
+  dataset::check_motion_readings(reader.motion(), e);
 }
 
 }  // namespace pvb::run

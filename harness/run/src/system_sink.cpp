@@ -246,6 +246,9 @@ void SystemSink::evaluate_gravity(const eval::Trajectory& gt) {
   run.gravity = eval::gravity_error(gt, est, geom::Vec3d(0, 0, -1), gravity_map_frame(system->sensors()),
                                    gravity_estimates);
   run.tilt = eval::tilt_drift(gt, session_keyframes(keyframes, *system), run.eval->alignment);
+  const slam::MapGravity g = system->gravity();
+  if (g.ready)
+    gravity_true_deg = gravity_error_at_deg(gt, est, geom::Vec3d(0, 0, -1), gravity_estimates, g.ready_t_ns);
 }
 
 void SystemSink::evaluate_inertial(const std::vector<BiasTruth>& truth) {
@@ -253,6 +256,7 @@ void SystemSink::evaluate_inertial(const std::vector<BiasTruth>& truth) {
   if (!slam::uses_accel(setup)) return;
   const std::int64_t t0_ns = first_t_ns.value_or(0);
   InertialReport r = inertial_report(system->gravity(), t0_ns);
+  if (r.trusted) r.gravity_true_deg = gravity_true_deg;
   std::vector<KeyframeBias> kfs;
   for (const slam::System::KeyFrameState& k : system->keyframe_states())
     kfs.push_back({k.id, k.t_ns, k.bias});

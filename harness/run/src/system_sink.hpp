@@ -30,6 +30,8 @@ struct SystemSink {
   OutputFile cam_traj, kf_traj, timing;
   eval::Trajectory est;
   eval::GravityEstimates gravity_estimates;  ///< the core's gravity per frame, once trusted
+  std::optional<double>
+      gravity_true_deg;      ///< at the trusted time, against the ground truth (evaluate_gravity)
   eval::Trajectory refined;  ///< filled by finish()
   eval::Trajectory keyframes;  ///< filled by finish(): the keyframes' final poses (KeyFrameTrajectory.txt)
   std::optional<std::int64_t> first_t_ns;  ///< the first frame's time: the inertial report's t = 0

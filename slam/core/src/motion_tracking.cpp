@@ -33,14 +33,23 @@ bool Tracking::inertial_ready() const {
   return motion_ && uses_imu(motion_->setup()) && motion_->has_imu() && map_.gravity().ready && provisional_ == 0;
 }
 
-bool Tracking::waiting_for_accelerometer(const Frame& f) {
-  if (!motion_ || !uses_accel(motion_->setup())) return false;
+std::optional<std::string> Tracking::waiting_for_accelerometer(const Frame& f) {
+  if (!motion_ || !uses_accel(motion_->setup())) return std::nullopt;
   if (!first_frame_t_ns_) first_frame_t_ns_ = f.t_ns;
-  if (f.t_ns - *first_frame_t_ns_ >= kAccelWaitNs) return false;
+  const std::int64_t waited_ns = f.t_ns - *first_frame_t_ns_;
+  if (waited_ns >= kAccelWaitNs) return std::nullopt;
   // Level only on a quiet accelerometer: the robot not jolted (a start
   // rocks it on its caster for a moment).
   const std::optional<Eigen::Vector3d> f_c = motion_->recent_specific_force_c();
-  return !f_c || std::abs(f_c->norm() - 9.81) > kQuietMps2 || motion_->recent_spread_mps2() > kQuietMps2;
+  const std::string so_far = format_number("%.2f s", static_cast<double>(waited_ns) * 1e-9) + " of at most " +
+                             format_number("%.0f s", static_cast<double>(kAccelWaitNs) * 1e-9);
+  if (!f_c) return "waiting for the accelerometer's first readings (" + so_far + ")";
+  const double spread = motion_->recent_spread_mps2();
+  if (std::abs(f_c->norm() - 9.81) <= kQuietMps2 && spread <= kQuietMps2) return std::nullopt;
+  return "waiting for a quiet accelerometer to level the map: mean " + format_number("%.2f", f_c->norm()) +
+         " m/s^2 (g within " + format_number("%.1f", kQuietMps2) + "), spread " +
+         format_number("%.2f", spread) + " m/s^2 (under " + format_number("%.1f", kQuietMps2) +
+         ") over the last " + format_number("%.1f s", MotionIntegrator::kTiltWindowS) + "; " + so_far;
 }
 
 geom::SE3d Tracking::first_pose() const {

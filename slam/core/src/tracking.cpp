@@ -208,7 +208,8 @@ bool Tracking::initialize(Frame& f) {
     return options_.two_view_start ? start_from_two_views(f, why) : fail(why);
   }
   start_ref_.reset();
-  if (waiting_for_accelerometer(f)) return fail("initialisation: waiting for the accelerometer's first readings");
+  if (const std::optional<std::string> wait = waiting_for_accelerometer(f))
+    return fail("initialisation: " + *wait);
   f.T_c_w = first_pose();
   f.has_pose = true;
   auto kf = map_.create_keyframe(f);
@@ -225,7 +226,7 @@ bool Tracking::initialize(Frame& f) {
 }
 
 bool Tracking::start_from_two_views(Frame& f, const std::string& why) {
-  if (waiting_for_accelerometer(f)) return fail(why + "; waiting for the accelerometer's first readings");
+  if (const std::optional<std::string> wait = waiting_for_accelerometer(f)) return fail(why + "; " + *wait);
   if (!start_ref_) {
     start_ref_ = f;
     start_ref_->T_c_w = first_pose();

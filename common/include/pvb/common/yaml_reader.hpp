@@ -41,7 +41,8 @@ struct ReadContext {
   std::string file;                     ///< the file given, as errors name it
   const KeyLocator* locator = nullptr;  ///< where keys were written; null: each node's line
   ErrorKind errors = ErrorKind::kConfig;
-  bool json = false;  ///< JSON read by yaml-cpp: a quoted scalar is text, never a number
+  bool json = false;  ///< JSON read by yaml-cpp (errors say "null", "a list or an object"); in JSON and YAML
+                      ///< a quoted scalar is text, never a number or a flag
 
   /// "FILE:LINE" of `key`: the locator's answer, else the line of `at` in
   /// the file given, else the file alone.
@@ -56,7 +57,7 @@ struct ReadContext {
 
 /// `path.key`, or `key` at the top level.
 std::string join(const std::string& path, const std::string& key);
-/// A value as an error shows it: the scalar's text (JSON: a quoted one as
+/// A value as an error shows it: the scalar's text (a quoted one as
 /// `the string "..."`), else what kind of node it is.
 std::string shown(const YAML::Node& n, const ReadContext& ctx);
 

@@ -316,6 +316,9 @@ struct Camera {
 
 /// The robot's caster is this far behind the wheels' axle: its wheel base.
 inline constexpr double kRobotWheelBaseM = 0.36;
+/// How far inside a relief's edge every route point must lie: the robot's
+/// half length (0.4 m), with room for the path follower to swing wide at a corner.
+inline constexpr double kRouteGroundMarginM = 1.0;
 
 /// The robot as built (the simulated one).  The description a SLAM core or
 /// an odometry gets (robot.yaml) has nominal values that differ from these

@@ -6,7 +6,8 @@
 //   r-<time>-<ts>.ppm   colour: "P6 640 480 255\n" + 640x480 RGB bytes
 //   d-<time>-<ts>.pgm   depth: "P5 640 480 65535\n" + 640x480 raw 11-bit
 //                       disparities, uint16 in the host's (little-endian) order
-//   a-<time>-<ts>.dump  accelerometer: a freenect_raw_tilt_state (12 bytes)
+//   a-<time>-<ts>.dump  accelerometer: a freenect_raw_tilt_state (12 bytes), counts
+//                       (819 a g) in the Kinect accelerometer's axes (tum_imu.hpp)
 //
 // <time> is the recording's wall clock in seconds (fakenect sleeps the
 // differences), <ts> the device's 32-bit timestamp (60 MHz clock).
@@ -37,7 +38,8 @@ class FakenectWriter {
  public:
   FakenectWriter(const std::string& dir, const sensor::kinect::Calibration& cal);
   /// rgb: CV_8UC3 RGB 640x480; raw_ir: CV_16UC1 640x480; gravity_c: the
-  /// accelerometer's reading (specific force, m/s^2) in camera axes.
+  /// accelerometer's reading (specific force, m/s^2) in the colour camera's
+  /// optical axes, written in the Kinect accelerometer's (x and y negated).
   void write(std::int64_t t_ns, const cv::Mat& rgb, const cv::Mat& raw_ir, const Eigen::Vector3d& gravity_c,
              const geom::SE3d& T_w_c);
   int frames_written() const { return frames_; }

@@ -43,14 +43,26 @@ struct KinectAccelerometer {
   static constexpr double kRandomWalk = 4.0e-3;
 };
 
-/// Reads accelerometer.txt.  Samples sorted by time; IoError naming the
-/// file and line for a line that is not "timestamp ax ay az" (a time
-/// stamp in seconds and three finite numbers).
-std::vector<sensor::ImuSample> read_tum_accelerometer(const std::string& path);
+/// Readings no IMU gives, per axis: 200 g (an ADXL375's range) and
+/// 100 rad/s (5700 deg/s, above any MEMS gyroscope's range).  A reading
+/// beyond them is a damaged line, not a measurement.
+inline constexpr double kMaxAccelMps2 = 2000.0;
+inline constexpr double kMaxGyroRadps = 100.0;
+
+/// Reads accelerometer.txt, TUM's "timestamp ax ay az" in the Kinect v1
+/// accelerometer's axes (kinect_accel_to_optical), put into the optical
+/// frame.  IoError naming the file and line for a line that is not that (a
+/// time stamp in seconds and three finite numbers within kMaxAccelMps2), and
+/// for a time stamp not after the line before's (readings are in time
+/// order, each once).  `lines`, when given, gets each reading's line.
+std::vector<sensor::ImuSample> read_tum_accelerometer(const std::string& path,
+                                                      std::vector<int>* lines = nullptr);
 
 /// Reads imu0/data.csv ("t_ns,wx,wy,wz,ax,ay,az"); IoError naming the file
-/// and line for a line that is not that.
-std::vector<sensor::ImuSample> read_euroc_imu(const std::string& path);
+/// and line for a line that is not that (an integer time stamp in ns within
+/// int64 and six finite numbers within the bounds above), and for a time
+/// stamp not after the line before's.
+std::vector<sensor::ImuSample> read_euroc_imu(const std::string& path, std::vector<int>* lines = nullptr);
 
 /// Which motion readings `dir` holds.
 enum class TumImuSource {

@@ -93,8 +93,12 @@ class TumSequenceReader : public sensor::FrameSource {
     std::int64_t depth_t_ns = 0;
     std::string depth;
   };
+  /// `motion`: the motion files a run needs (read_motion_readings: only
+  /// those, each refused when missing or empty); without it, every motion
+  /// file the folder holds.
   explicit TumSequenceReader(const std::string& dir, double depth_factor = sensor::kTumDepthFactor,
-                             double max_diff_s = 0.02);
+                             double max_diff_s = 0.02,
+                             const std::optional<MotionNeeds>& motion = std::nullopt);
   /// The next frame whose images load; a frame whose image is missing or
   /// damaged is skipped with one warning line on stderr.  nullopt at the
   /// end, and once more than max_skipped() frames were skipped

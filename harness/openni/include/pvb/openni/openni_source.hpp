@@ -5,6 +5,9 @@
 // Streams: depth in 1 mm units and RGB888 colour at the requested mode
 // (640x480 at 30 Hz by default), depth registered to colour, mirroring off.
 // Depth and colour are paired by nearest timestamp within half a frame.
+// A Kinect v1 on freenect:// also gives its accelerometer (a device
+// property, kinect_accelerometer.hpp): each frame carries the readings up
+// to its time, in the colour camera's frame (no gyroscope: NaN rates).
 // Intrinsics do not come from here: the driver's field of view is ignored,
 // SLAM takes them from the settings file.
 //

@@ -2,7 +2,8 @@
 // The inertial state a SLAM system reached, against the truth where there
 // is one (docs/evaluation.md, "Inertial state and biases"):
 //  - when the inertial state became trusted (MapGravity::ready), gravity's
-//    tilt from the map's -z and the initialisation's whitened RMS;
+//    tilt from the map's -z, against the true down where there is ground
+//    truth, and the initialisation's whitened RMS;
 //  - per keyframe with an inertial state, its final estimated IMU biases
 //    against the true biases at the keyframe's time (imu0/truth.csv of a
 //    recording or a run's folder, interpolated linearly between readings),
@@ -15,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "pvb/eval/gravity.hpp"
 #include "pvb/slam/core/keyframe_motion.hpp"
 
 namespace pvb::run {
@@ -66,10 +68,23 @@ struct InertialReport {
   double gravity_tilt_deg = 0;           ///< g_w's angle from the map's -z (trusted only)
   double init_rms = 0;                   ///< the initialisation's whitened residual RMS (trusted only)
   std::optional<BiasComparison> biases;  ///< with truth and keyframes with an inertial state
+  /// With ground truth (trusted only): the angle between the core's gravity
+  /// and the true down at the first pose at or after the trusted time, both
+  /// seen from that camera (eval::gravity_error).  Unlike gravity_tilt_deg,
+  /// which measures the map against itself, it sees a map levelled upside
+  /// down: 180 degrees.
+  std::optional<double> gravity_true_deg;
 };
 
 /// The angle, degrees, between g_w and the map's -z.
 double gravity_tilt_deg(const Eigen::Vector3d& g_w);
+
+/// The gravity error (eval::gravity_error, degrees) of the first pose of
+/// `est` at or after t_ns against `gt`, whose world's down is down_w;
+/// nullopt when no such pose associates with the ground truth.
+std::optional<double> gravity_error_at_deg(const eval::Trajectory& gt, const eval::Trajectory& est,
+                                           const geom::Vec3d& down_w, const eval::GravityEstimates& estimates,
+                                           std::int64_t t_ns);
 
 /// What MapGravity says; biases left unset.
 InertialReport inertial_report(const slam::MapGravity& gravity, std::int64_t t0_ns);

@@ -161,8 +161,10 @@ class Tracking {
   bool inertial_ready() const;
   /// A setup with an accelerometer whose readings have not come yet or
   /// are not quiet (for at most kAccelWaitNs after the first frame): the
-  /// map waits for them, to begin level.
-  bool waiting_for_accelerometer(const Frame& f);
+  /// map waits for them, to begin level.  Returns what it waits for ("the
+  /// accelerometer's first readings", or a quiet accelerometer with the
+  /// figures that are not), or nullopt when the map may begin.
+  std::optional<std::string> waiting_for_accelerometer(const Frame& f);
   static constexpr std::int64_t kAccelWaitNs = 1'000'000'000;
   static constexpr double kQuietMps2 = 0.5;  ///< spread and departure from g of a quiet accelerometer
   std::optional<std::int64_t> first_frame_t_ns_;
