@@ -43,3 +43,12 @@ if(PVB_FUZZ)
   # fuzzer's main() themselves (-fsanitize=fuzzer, tests/fuzz).
   add_compile_options(-fsanitize=fuzzer-no-link)
 endif()
+
+# Plug-in modules are linked with --no-undefined (every symbol they need
+# resolved at link time), but for clang's sanitizers: clang puts the
+# sanitizer runtime into the executable only, and a module loaded into an
+# instrumented pvbench finds its __asan_* symbols there.
+set(PVB_MODULE_NO_UNDEFINED -Wl,--no-undefined)
+if(NOT PVB_SANITIZE STREQUAL "" AND CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+  set(PVB_MODULE_NO_UNDEFINED)
+endif()
