@@ -264,6 +264,19 @@ void read_stereo(MapReader& n, ActiveStereo& a) {
   }
 }
 
+/// True when the camera's `section` was written in the file that chose its
+/// model (or no file chose one).  A day file that makes its base's Kinect a
+/// d435, or the other way round, leaves the base's section of the other
+/// model unused; a file that writes both is refused.
+bool written_with_the_model(const MapReader& r, const std::string& section) {
+  if (!r.has("model")) return true;
+  const auto file_of = [&r](const std::string& key) {
+    const std::string where = r.context().where(r.full(key), r.node()[key]);
+    return where.substr(0, where.rfind(':'));
+  };
+  return file_of("model") == file_of(section);
+}
+
 void read_camera(MapReader& r, Camera& c) {
   c.model = r.choice<CameraModel>("model", c.model, {{"kinect", CameraModel::kKinect}, {"d435", CameraModel::kD435}});
   if (c.model == CameraModel::kD435) c.use_d435_colour_camera();
@@ -280,7 +293,7 @@ void read_camera(MapReader& r, Camera& c) {
   c.pitch_deg = r.number("pitch_deg", c.pitch_deg, -89, 89);
   c.yaw_deg = r.number("yaw_deg", c.yaw_deg, -180, 180);
   c.depth_range_m = r.range("depth_range_m", c.depth_range_m, 0.05, 100);
-  if (c.model == CameraModel::kD435 && r.has("depth_noise"))  // as stereo: under kinect, below
+  if (c.model == CameraModel::kD435 && r.has("depth_noise") && written_with_the_model(r, "depth_noise"))
     r.fail(r.full("depth_noise"), r.node()["depth_noise"],
            "no depth_noise: section unless model is kinect (a d435's depth comes from its stereo: section)");
   with_map(r, "depth_noise", [&](MapReader& n) {
@@ -297,7 +310,7 @@ void read_camera(MapReader& r, Camera& c) {
     d.sunlight.min_contrast = n.number("sunlight_min_contrast", d.sunlight.min_contrast, 1e-5, 1);
   });
   with_map(r, "stereo", [&](MapReader& n) { read_stereo(n, c.stereo); });
-  if (c.model != CameraModel::kD435 && r.has("stereo"))
+  if (c.model != CameraModel::kD435 && r.has("stereo") && written_with_the_model(r, "stereo"))
     r.fail(r.full("stereo"), r.node()["stereo"], "no stereo: section unless model is d435");
   with_map(r, "rgb", [&](MapReader& n) {
     RgbNoise& g = c.rgb;

@@ -4,9 +4,11 @@
 // naming the file, the line and the key.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 
 #include "pvb/common/error.hpp"
+#include "pvb/common/text.hpp"
 #include "pvb/scenes/scenario.hpp"
 
 using namespace pvb::scenes;
@@ -42,6 +44,22 @@ TEST(ScenarioStrictKeys, DepthNoiseUnderAD435IsRefusedAsStereoUnderAKinect) {
       strict_error(kRoute + "camera:\n  stereo: {dots: 10}\n").find("camera.stereo: expected no stereo"),
       std::string::npos);
   EXPECT_EQ(strict_error(kRoute + "camera:\n  model: d435\n  stereo: {dots: 10}\n"), "");
+}
+
+// A day file may make its base's Kinect a d435 (or a d435 base a Kinect):
+// the base's section of the other model is then unused, not refused.
+TEST(ScenarioStrictKeys, ADayFileMayChangeTheModelOfItsBasesCamera) {
+  const std::string dir = ::testing::TempDir() + "pvb_strict_keys_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  pvb::write_file(dir + "/kinect.yaml", kRoute + "camera:\n  depth_noise: {sunlight: off}\n");
+  pvb::write_file(dir + "/d435_day.yaml", "base: kinect.yaml\ncamera: {model: d435}\n");
+  EXPECT_EQ(load_scenario(dir + "/d435_day.yaml").camera.model, CameraModel::kD435);
+  pvb::write_file(dir + "/d435.yaml", kRoute + "camera:\n  model: d435\n  stereo: {dots: 10}\n");
+  pvb::write_file(dir + "/kinect_day.yaml", "base: d435.yaml\ncamera: {model: kinect}\n");
+  EXPECT_EQ(load_scenario(dir + "/kinect_day.yaml").camera.model, CameraModel::kKinect);
+  // Written with the model in one file, as above: refused.
+  pvb::write_file(dir + "/both_day.yaml", "base: kinect.yaml\ncamera: {model: d435, depth_noise: {sunlight: on}}\n");
+  EXPECT_THROW(load_scenario(dir + "/both_day.yaml"), pvb::ConfigError);
 }
 
 TEST(ScenarioStrictKeys, AQuotedNumberIsAString) {

@@ -20,7 +20,7 @@
 
 namespace {
 
-constexpr int kFrames = 150;
+constexpr int kFrames = PVB_KINECT_FRAMES;  // the acceptance drive: 60 in the default set, 150 in scenario-full
 
 using Result = pvb::test::RunResult;
 using pvb::test::data_lines;
@@ -69,7 +69,7 @@ std::string break_entry(const std::string& dump, int line, const std::string* co
 
 }  // namespace
 
-TEST(KinectCli, FakenectDumpTracksDeterministicallyAndItsOniReplaysTheSame) {
+TEST(PVB_KINECT_SUITE, FakenectDumpTracksDeterministicallyAndItsOniReplaysTheSame) {
   const std::string dir = fresh("accept");
   const std::string dump = record_dump(dir, kFrames);
   const std::string oni = dir + "/run.oni";
@@ -97,14 +97,14 @@ TEST(KinectCli, FakenectDumpTracksDeterministicallyAndItsOniReplaysTheSame) {
   std::system(("rm -rf " + dir).c_str());  // 230 MB
 }
 
-TEST(KinectCli, RealLibfreenectWithoutAKinectSaysSo) {
+TEST(PVB_KINECT_SUITE, RealLibfreenectWithoutAKinectSaysSo) {
   const std::string dir = fresh("nodevice");
   const Result r = run("FAKENECT_PATH=", "camera --uri freenect://0 --sync --settings " + std::string(PVB_SOURCE_DIR) +
                                              "/configs/kinect/kinect_v1.yaml --out " + dir + "/out");
   expect_one_error_line(r, "no Kinect found");
 }
 
-TEST(KinectCli, BrokenDumpsEndWithOneErrorAndKeepTheTrajectory) {
+TEST(PVB_KINECT_SUITE, BrokenDumpsEndWithOneErrorAndKeepTheTrajectory) {
   const std::string dir = fresh("broken");
   const std::string dump = record_dump(dir, 40);
   const int frame = 20, line_of_depth = 3 * frame + 2;  // a, d, r per frame
@@ -135,7 +135,7 @@ TEST(KinectCli, BrokenDumpsEndWithOneErrorAndKeepTheTrajectory) {
   std::system(("rm -rf " + dir).c_str());
 }
 
-TEST(KinectCli, IndexPastTheDevicesAndBadUrisSaySo) {
+TEST(PVB_KINECT_SUITE, IndexPastTheDevicesAndBadUrisSaySo) {
   const std::string dir = fresh("index");
   const std::string dump = record_dump(dir, 2);
   const std::string settings = " --settings " + std::string(PVB_SOURCE_DIR) + "/configs/kinect/kinect_v1.yaml";
@@ -151,7 +151,7 @@ TEST(KinectCli, IndexPastTheDevicesAndBadUrisSaySo) {
 
 namespace {
 
-TEST(KinectCli, ADumpOfAnotherRunLocalisesInAMapSavedByRun) {
+TEST(PVB_KINECT_SUITE, ADumpOfAnotherRunLocalisesInAMapSavedByRun) {
   // The map from the simulator in memory (pvbench run), the query from a
   // Kinect v1 dump of the same station with other noise and dust: the
   // real-Kinect path must find itself in the map, judged in its frame.
