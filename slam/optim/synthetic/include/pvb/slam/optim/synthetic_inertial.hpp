@@ -110,7 +110,6 @@ struct ImuRig {
   double rate_hz = 200;   ///< reading rate
 
   geom::SE3d T_base_imu() const { return geom::make_se3(R_base_imu, Eigen::Vector3d::Zero()); }
-  geom::SE3d T_w_imu(const BodyMotion& m, double t) const { return m.T_w_base(t) * T_base_imu(); }
 
   /// The exact mean over [t, t + dt] of the angular rate and the specific
   /// force in the IMU frame (3-point Gauss-Legendre of the instantaneous values).
