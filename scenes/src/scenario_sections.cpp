@@ -265,8 +265,8 @@ void read_stereo(MapReader& n, ActiveStereo& a) {
 }
 
 void read_camera(MapReader& r, Camera& c) {
-  c.model = r.choice<CameraModel>("model", c.model, {{"kinect", CameraModel::kKinect}, {"d435", CameraModel::kD435}});
-  if (c.model == CameraModel::kD435) c.use_d435_colour_camera();
+  c.model = r.choice<CameraKind>("model", c.model, {{"kinect", CameraKind::kKinect}, {"d435", CameraKind::kD435}});
+  if (c.model == CameraKind::kD435) c.use_d435_colour_camera();
   c.width = r.integer("width", c.width, 32, 4096);
   c.height = r.integer("height", c.height, 32, 4096);
   const bool has_fx = r.has("fx");
@@ -280,7 +280,7 @@ void read_camera(MapReader& r, Camera& c) {
   c.pitch_deg = r.number("pitch_deg", c.pitch_deg, -89, 89);
   c.yaw_deg = r.number("yaw_deg", c.yaw_deg, -180, 180);
   c.depth_range_m = r.range("depth_range_m", c.depth_range_m, 0.05, 100);
-  if (c.model == CameraModel::kD435 && r.has("depth_noise"))  // as stereo: under kinect, below
+  if (c.model == CameraKind::kD435 && r.has("depth_noise"))  // as stereo: under kinect, below
     r.fail(r.full("depth_noise"), r.node()["depth_noise"],
            "no depth_noise: section unless model is kinect (a d435's depth comes from its stereo: section)");
   with_map(r, "depth_noise", [&](MapReader& n) {
@@ -297,7 +297,7 @@ void read_camera(MapReader& r, Camera& c) {
     d.sunlight.min_contrast = n.number("sunlight_min_contrast", d.sunlight.min_contrast, 1e-5, 1);
   });
   with_map(r, "stereo", [&](MapReader& n) { read_stereo(n, c.stereo); });
-  if (c.model != CameraModel::kD435 && r.has("stereo"))
+  if (c.model != CameraKind::kD435 && r.has("stereo"))
     r.fail(r.full("stereo"), r.node()["stereo"], "no stereo: section unless model is d435");
   with_map(r, "rgb", [&](MapReader& n) {
     RgbNoise& g = c.rgb;

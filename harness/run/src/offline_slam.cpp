@@ -23,7 +23,7 @@
 #include "pvb/run/inertial_eval.hpp"
 #include "pvb/run/map_eval.hpp"
 #include "pvb/run/output_names.hpp"
-#include "pvb/run/place_recognition.hpp"
+#include "pvb/run/place_events.hpp"
 #include "pvb/run/sensor_setup.hpp"
 #include "pvb/slam/core/system.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"

@@ -11,7 +11,7 @@
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
-#include "pvb/run/place_recognition.hpp"
+#include "pvb/run/place_events.hpp"
 #include "pvb/run/sensor_setup.hpp"
 
 namespace pvb::run {

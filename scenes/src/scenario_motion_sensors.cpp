@@ -1,5 +1,5 @@
-// The robot's body sensors: physics rate, IMU and wheel encoders
-// (scenes/SCHEMA.md, docs/sensors.md).
+// The robot's motion sensors as a scenario describes them: physics rate,
+// IMU and wheel encoders (scenes/SCHEMA.md, docs/sensors.md).
 #include <algorithm>
 #include <Eigen/Geometry>
 #include <cmath>
