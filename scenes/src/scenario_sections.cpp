@@ -315,10 +315,9 @@ void read_slam(MapReader& r, SlamTuning& t) {
   if (r.has("keyframe_ref_overlap"))
     t.keyframe_ref_overlap = r.number("keyframe_ref_overlap", 0.0, 0.01, 0.99);
   if (r.has("sensors")) {
-    static const std::vector<std::pair<std::string, std::string>> kSetups = {
-        {"camera", "camera"}, {"camera+imu", "camera+imu"}, {"camera+imu+wheels", "camera+imu+wheels"},
-        {"camera+accel", "camera+accel"}};
-    t.sensors = r.choice<std::string>("sensors", "camera", kSetups);
+    std::vector<std::pair<std::string, sensor::SensorSetup>> setups;
+    for (sensor::SensorSetup s : sensor::kSensorSetups) setups.emplace_back(sensor::to_string(s), s);
+    t.sensors = r.choice("sensors", sensor::SensorSetup::kCamera, setups);
   }
 }
 

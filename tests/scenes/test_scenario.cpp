@@ -219,7 +219,7 @@ TEST(Scenario, SlamSectionIsReadAndOptional) {
   EXPECT_FALSE(none.slam.sensors);
   const Scenario fused = parse_scenario(std::string(kMinimal) + "slam: {sensors: camera+imu+wheels}\n", "f.yaml");
   ASSERT_TRUE(fused.slam.sensors);
-  EXPECT_EQ(*fused.slam.sensors, "camera+imu+wheels");
+  EXPECT_EQ(*fused.slam.sensors, pvb::sensor::SensorSetup::kCameraImuWheels);
   const std::string bad_setup = error_of(base + "  sensors: camera+gps\n");
   EXPECT_NE(bad_setup.find("slam.sensors"), std::string::npos) << bad_setup;
   EXPECT_NE(bad_setup.find("camera+imu+wheels"), std::string::npos) << bad_setup;

@@ -346,9 +346,8 @@ struct SlamTuning {
   /// KeyFrame.refOverlap (pvbench's own key; unset: ORB-SLAM2's 75 % rule)
   std::optional<double> keyframe_ref_overlap;
   /// System.Sensors (pvbench's own key; unset: camera): the sensors the
-  /// SLAM core fuses, "camera", "camera+imu", "camera+imu+wheels" or
-  /// "camera+accel".
-  std::optional<std::string> sensors;
+  /// SLAM core fuses.
+  std::optional<sensor::SensorSetup> sensors;
 };
 
 /// What a seed sweep of this scenario must show (`expect.sweep:`), judged by

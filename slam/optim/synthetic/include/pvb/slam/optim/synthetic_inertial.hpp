@@ -105,7 +105,7 @@ struct ImuRig {
   Eigen::Matrix3d R_base_imu = Eigen::Matrix3d::Identity();
   Eigen::Vector3d g_w = Eigen::Vector3d(0, 0, -9.81);
   ImuBias true_bias;      ///< added to every reading (constant)
-  ImuNoise noise;         ///< the model the preintegration is told
+  sensor::ImuNoise noise; ///< the model the preintegration is told
   bool white_noise = true;///< add discrete white noise of variance density^2 / dt
   double rate_hz = 200;   ///< reading rate
 
@@ -155,7 +155,7 @@ struct ImuRig {
 /// Wheel encoders of a differential drive on the base (no slip): each
 /// wheel's arc is the distance rolled -/+ track/2 times the heading change.
 struct WheelRig {
-  WheelDrive drive;
+  sensor::DriveDescription drive;
   WheelNoise noise;
   double rate_hz = 100;  ///< encoder reading rate
 
