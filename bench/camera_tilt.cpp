@@ -13,7 +13,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
-#include "pvb/eval/plot.hpp"
+#include "pvb/eval/charts.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/plot/png.hpp"
 

@@ -114,8 +114,8 @@ void write_sheet(const std::string& dir, const pvb::sim::RenderedFrame& rendered
 
 int run(const Options& o) {
   pvb::scenes::Scenario s = pvb::scenes::load_scenario(o.scenario);
-  if (o.model == "d435") s.camera.model = pvb::scenes::CameraModel::kD435;
-  if (o.model == "kinect") s.camera.model = pvb::scenes::CameraModel::kKinect;
+  if (o.model == "d435") s.camera.model = pvb::scenes::CameraKind::kD435;
+  if (o.model == "kinect") s.camera.model = pvb::scenes::CameraKind::kKinect;
   if (!o.sunlight.empty()) s.camera.depth_noise.sunlight.on = o.sunlight == "on";
   if (o.model == "d435") s.camera.use_d435_colour_camera();
   pvb::sim::Simulator sim(s);

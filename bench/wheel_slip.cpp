@@ -11,7 +11,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
-#include "pvb/eval/plot.hpp"
+#include "pvb/eval/charts.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/plot/png.hpp"
 #include "pvb/scenes/scenario.hpp"

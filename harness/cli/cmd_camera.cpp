@@ -169,12 +169,12 @@ bool is_freenect_uri(const CameraArgs& a) { return a.oni.empty() && a.uri.rfind(
 /// readings), a Kinect v1 (freenect://) its accelerometer, an .oni
 /// recording or another OpenNI2 camera nothing.  A setup that needs more is
 /// refused (`file`, `key`: where it was asked for) before any device opens.
-void refuse_unfed_setup(const CameraArgs& a, slam::SensorSetup setup, const std::string& file,
+void refuse_unfed_setup(const CameraArgs& a, sensor::SensorSetup setup, const std::string& file,
                         const std::string& key) {
-  if (setup == slam::SensorSetup::kCamera || (a.oni.empty() && openni::is_sim_uri(a.uri))) return;
-  const std::string got = slam::to_string(setup);
+  if (setup == sensor::SensorSetup::kCamera || (a.oni.empty() && openni::is_sim_uri(a.uri))) return;
+  const std::string got = sensor::to_string(setup);
   if (is_freenect_uri(a)) {
-    if (setup == slam::SensorSetup::kCameraAccel) return;
+    if (setup == sensor::SensorSetup::kCameraAccel) return;
     throw ConfigError(file, key,
                       "camera or camera+accel for a Kinect v1 (freenect://): it has an accelerometer, "
                       "no gyroscope and no wheels",
@@ -192,10 +192,10 @@ void refuse_unfed_setup(const CameraArgs& a, slam::SensorSetup setup, const std:
 /// gets its description when the settings have none (docs/sensors.md).
 void check_source_motion(const CameraArgs& a, const std::string& settings_file, slam::Settings* s) {
   if (a.sensors.empty())
-    refuse_unfed_setup(a, s->sensors, settings_file, "System.Sensors");
+    refuse_unfed_setup(a, s->motion.setup, settings_file, "System.Sensors");
   else
-    refuse_unfed_setup(a, s->sensors, "command line", "--sensors");
-  if (is_freenect_uri(a) && s->sensors == slam::SensorSetup::kCameraAccel &&
+    refuse_unfed_setup(a, s->motion.setup, "command line", "--sensors");
+  if (is_freenect_uri(a) && s->motion.setup == sensor::SensorSetup::kCameraAccel &&
       run::supply_kinect_description(s))
     std::fprintf(stderr,
                  "pvbench camera: note: sensors camera+accel: the settings have no IMU.* keys; the "
@@ -224,9 +224,9 @@ CameraSettings read_camera_settings(const CameraArgs& a, const std::optional<sce
   for (const std::string& w : s.slam.warnings)
     std::fprintf(stderr, "pvbench camera: warning: %s\n", w.c_str());
   if (a.no_pe_match) s.slam.pe_match.enabled = false;
-  if (const std::optional<slam::SensorSetup> setup = sensors_from_flag(a.sensors)) s.slam.sensors = *setup;
+  if (const std::optional<sensor::SensorSetup> setup = sensors_from_flag(a.sensors)) s.slam.motion.setup = *setup;
   check_source_motion(a, s.file, &s.slam);
-  run::apply_sensor_setup(&s.slam, s.slam.sensors);
+  run::apply_sensor_setup(&s.slam, s.slam.motion.setup);
   return s;
 }
 
@@ -357,7 +357,7 @@ slam::TrackingState track_frame(const sensor::RgbdFrame& frame, const CameraSett
     const sim::MotionBatch b = live.gt_sim->take_motion();  // the readings up to this frame
     live.motion->write(b.imu, b.ticks);
     live.motion_truth->write(b.imu_truth, b.wheel_truth);
-    if (settings.slam.sensors != slam::SensorSetup::kCamera) {  // the device's robot's sensors
+    if (settings.slam.motion.setup != sensor::SensorSetup::kCamera) {  // the device's robot's sensors
       tracked.imu = b.imu;
       tracked.wheel_ticks = b.ticks;
     }
@@ -476,7 +476,7 @@ void report_run(const CameraArgs& a, const slam::Settings& settings, openni::Ope
   std::ostringstream js;
   js << "{\n  \"source\": \"" << json_escape(source.describe())
      << "\",\n  \"pe_match\": " << (settings.pe_match.enabled ? "true" : "false")
-     << ",\n  \"sensors\": \"" << slam::to_string(settings.sensors) << "\""
+     << ",\n  \"sensors\": \"" << sensor::to_string(settings.motion.setup) << "\""
      << ",\n  \"sync\": " << (a.sync ? "true" : "false") << ",\n  \"seed\": " << a.seed
      << ",\n  \"frames\": " << c.frames << ",\n  \"lost_frames\": " << c.lost
      << ",\n  \"not_initialized_frames\": " << c.not_initialized
@@ -535,7 +535,7 @@ int run_camera(CameraArgs a) {
   // pvbench's MuJoCo handlers before the sim:// driver plug-in's own copy,
   // which OpenNI2 unloads at shutdown.
   sim::install_mujoco_handlers();
-  if (const std::optional<slam::SensorSetup> setup = sensors_from_flag(a.sensors))
+  if (const std::optional<sensor::SensorSetup> setup = sensors_from_flag(a.sensors))
     refuse_unfed_setup(a, *setup, "command line", "--sensors");  // before a recording is even scanned
   const std::optional<scenes::Scenario> scenario = check_inputs(a);
   check_settings_source(a, scenario);

@@ -12,7 +12,7 @@
 #include "pvb/common/output_file.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/eval/evaluate.hpp"
-#include "pvb/eval/plot.hpp"
+#include "pvb/eval/charts.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/plot/png.hpp"
 

@@ -198,8 +198,8 @@ Command add_match_command(CLI::App& app) {
                   "pose T_w_c of img1: \"tx ty tz qx qy qz qw\" or GROUNDTRUTH_FILE@TIMESTAMP");
   sub->add_option("--pose2", opts->pose2, "pose T_w_c of img2 (same forms as --pose1)");
   sub->add_option("--settings", opts->settings,
-                  "ORB-SLAM2 camera yaml (Camera.fx/fy/cx/cy, k1.., DepthMapFactor); with --sequence it "
-                  "overrides DIR/camera.yaml")
+                  "ORB-SLAM2 RGB-D settings, as pvbench slam reads them (its Camera.* and DepthMapFactor are "
+                  "used); with --sequence it overrides DIR/camera.yaml")
       ->check(path_check("match", "--settings"));
   sub->add_option("--sequence", opts->sequence, "TUM-layout folder (rgb.txt, depth.txt, groundtruth.txt)")
       ->check(path_check("match", "--sequence"));

@@ -54,7 +54,7 @@ void check_fakenect_scenario(const scenes::Scenario& s, const std::string& file)
   const std::string why =
       " for --format fakenect: a dump is a Kinect v1's, and the freenect:// device that plays it serves the "
       "Kinect's 640x480 depth and colour at 30 Hz only";
-  if (s.camera.model != scenes::CameraModel::kKinect)
+  if (s.camera.model != scenes::CameraKind::kKinect)
     throw ConfigError(file, "camera.model", "kinect" + why + " (a Kinect measures depth by structured light)",
                       "d435");
   if (s.camera.width != sensor::kinect::kWidth || s.camera.height != sensor::kinect::kHeight)

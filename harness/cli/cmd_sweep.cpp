@@ -32,7 +32,7 @@
 #include "pvb/common/error.hpp"
 #include "pvb/common/output_folder.hpp"
 #include "pvb/common/text.hpp"
-#include "pvb/eval/plot.hpp"
+#include "pvb/eval/charts.hpp"
 #include "pvb/plot/matrix.hpp"
 #include "pvb/plot/png.hpp"
 #include "pvb/run/campaign_run.hpp"

@@ -278,8 +278,8 @@ bool written_with_the_model(const MapReader& r, const std::string& section) {
 }
 
 void read_camera(MapReader& r, Camera& c) {
-  c.model = r.choice<CameraModel>("model", c.model, {{"kinect", CameraModel::kKinect}, {"d435", CameraModel::kD435}});
-  if (c.model == CameraModel::kD435) c.use_d435_colour_camera();
+  c.model = r.choice<CameraKind>("model", c.model, {{"kinect", CameraKind::kKinect}, {"d435", CameraKind::kD435}});
+  if (c.model == CameraKind::kD435) c.use_d435_colour_camera();
   c.width = r.integer("width", c.width, 32, 4096);
   c.height = r.integer("height", c.height, 32, 4096);
   const bool has_fx = r.has("fx");
@@ -293,7 +293,7 @@ void read_camera(MapReader& r, Camera& c) {
   c.pitch_deg = r.number("pitch_deg", c.pitch_deg, -89, 89);
   c.yaw_deg = r.number("yaw_deg", c.yaw_deg, -180, 180);
   c.depth_range_m = r.range("depth_range_m", c.depth_range_m, 0.05, 100);
-  if (c.model == CameraModel::kD435 && r.has("depth_noise") && written_with_the_model(r, "depth_noise"))
+  if (c.model == CameraKind::kD435 && r.has("depth_noise") && written_with_the_model(r, "depth_noise"))
     r.fail(r.full("depth_noise"), r.node()["depth_noise"],
            "no depth_noise: section unless model is kinect (a d435's depth comes from its stereo: section)");
   with_map(r, "depth_noise", [&](MapReader& n) {
@@ -310,7 +310,7 @@ void read_camera(MapReader& r, Camera& c) {
     d.sunlight.min_contrast = n.number("sunlight_min_contrast", d.sunlight.min_contrast, 1e-5, 1);
   });
   with_map(r, "stereo", [&](MapReader& n) { read_stereo(n, c.stereo); });
-  if (c.model != CameraModel::kD435 && r.has("stereo") && written_with_the_model(r, "stereo"))
+  if (c.model != CameraKind::kD435 && r.has("stereo") && written_with_the_model(r, "stereo"))
     r.fail(r.full("stereo"), r.node()["stereo"], "no stereo: section unless model is d435");
   with_map(r, "rgb", [&](MapReader& n) {
     RgbNoise& g = c.rgb;
@@ -328,10 +328,9 @@ void read_slam(MapReader& r, SlamTuning& t) {
   if (r.has("keyframe_ref_overlap"))
     t.keyframe_ref_overlap = r.number("keyframe_ref_overlap", 0.0, 0.01, 0.99);
   if (r.has("sensors")) {
-    static const std::vector<std::pair<std::string, std::string>> kSetups = {
-        {"camera", "camera"}, {"camera+imu", "camera+imu"}, {"camera+imu+wheels", "camera+imu+wheels"},
-        {"camera+accel", "camera+accel"}};
-    t.sensors = r.choice<std::string>("sensors", "camera", kSetups);
+    std::vector<std::pair<std::string, sensor::SensorSetup>> setups;
+    for (sensor::SensorSetup s : sensor::kSensorSetups) setups.emplace_back(sensor::to_string(s), s);
+    t.sensors = r.choice("sensors", sensor::SensorSetup::kCamera, setups);
   }
 }
 

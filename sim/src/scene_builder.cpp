@@ -361,7 +361,7 @@ void write_settings(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& 
   x.line("<option timestep=\"" + std::string(step) + "\" integrator=\"implicit\" cone=\"elliptic\"/>");
   x.line("<statistic extent=\"" + f(extent) + "\" center=\"0 0 0\"/>");
   x.open("<visual>");
-  const bool stereo = s.camera.model == scenes::CameraModel::kD435;  // the infrared views may be larger
+  const bool stereo = s.camera.model == scenes::CameraKind::kD435;  // the infrared views may be larger
   const int off_w = stereo ? std::max(s.camera.width, s.camera.stereo.ir_width) : s.camera.width;
   const int off_h = stereo ? std::max(s.camera.height, s.camera.stereo.ir_height) : s.camera.height;
   x.line("<global offwidth=\"" + std::to_string(off_w) + "\" offheight=\"" + std::to_string(off_h) + "\" fovy=\"" +
@@ -640,7 +640,7 @@ void add_robot_and_sun(XmlWriter& x, const scenes::Scenario& s, const std::vecto
   const Eigen::Vector3d up = right.cross(fwd);
   x.line("<camera name=\"" + std::string(kCameraName) + "\" pos=\"" + v3(cam.mount_forward_m, 0, mast_h) +
          "\" xyaxes=\"" + v3(right) + " " + v3(up) + "\" fovy=\"" + f(cam.fovy_deg()) + "\"/>");
-  if (cam.model == scenes::CameraModel::kD435) {  // the two infrared imagers, beside the colour camera
+  if (cam.model == scenes::CameraKind::kD435) {  // the two infrared imagers, beside the colour camera
     const Eigen::Vector3d left = Eigen::Vector3d(cam.mount_forward_m, 0, mast_h) - cam.stereo.colour_offset_m * right;
     const std::string axes = "\" xyaxes=\"" + v3(right) + " " + v3(up) + "\" fovy=\"" + f(cam.stereo.ir_fovy_deg()) + "\"/>";
     x.line("<camera name=\"" + std::string(kIrLeftCameraName) + "\" pos=\"" + v3(left) + axes);

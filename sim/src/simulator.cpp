@@ -231,7 +231,7 @@ RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
   glass_ = std::make_unique<GlassFinder>(sim.model(), specular);
   if (glass_->empty()) glass_.reset();
   const scenes::Camera& cam = sim.scenario().camera;
-  if (cam.model != scenes::CameraModel::kD435) return;
+  if (cam.model != scenes::CameraKind::kD435) return;
   ir_renderer_ = std::make_unique<Renderer>(sim.model(), renderer_.backend(), cam.stereo.ir_width, cam.stereo.ir_height);
   ir_renderer_->set_shadows(sim.scenario().light.shadows);
   ir_left_id_ = mj_name2id(sim.model(), mjOBJ_CAMERA, kIrLeftCameraName);
@@ -276,7 +276,7 @@ RenderedFrame RgbdCamera::render(Simulator& sim) {
   const geom::SE3d T_w_c = sim.T_w_c();
   out.to_sun_c = T_w_c.linear().transpose() * sim.to_sun_w();
   const scenes::Camera& cam = sim.scenario().camera;
-  if (cam.model == scenes::CameraModel::kKinect && cam.depth_noise.model == scenes::DepthNoiseModel::kKinect &&
+  if (cam.model == scenes::CameraKind::kKinect && cam.depth_noise.model == scenes::DepthNoiseModel::kKinect &&
       cam.depth_noise.sunlight.on && sim.scenario().light.sun_elevation_deg > 0) {
     const float shade_range_m = sunlight_frame(cam.depth_noise.sunlight, sim.scenario().light.sun_elevation_deg,
                                                out.to_sun_c.cast<float>(), cv::Mat())
@@ -302,7 +302,7 @@ SensorModel::SensorModel(const Simulator& sim)
       sun_elevation_deg_(sim.scenario().light.sun_elevation_deg),
       seed_(sim.scenario().seed),
       cover_(scenes::camera_cover_frames(sim.scenario())) {
-  if (camera_.model == scenes::CameraModel::kD435)
+  if (camera_.model == scenes::CameraKind::kD435)
     stereo_ = std::make_shared<ActiveStereoModel>(camera_, sun_elevation_deg_, seed_);
 }
 

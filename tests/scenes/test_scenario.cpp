@@ -219,7 +219,7 @@ TEST(Scenario, SlamSectionIsReadAndOptional) {
   EXPECT_FALSE(none.slam.sensors);
   const Scenario fused = parse_scenario(std::string(kMinimal) + "slam: {sensors: camera+imu+wheels}\n", "f.yaml");
   ASSERT_TRUE(fused.slam.sensors);
-  EXPECT_EQ(*fused.slam.sensors, "camera+imu+wheels");
+  EXPECT_EQ(*fused.slam.sensors, pvb::sensor::SensorSetup::kCameraImuWheels);
   const std::string bad_setup = error_of(base + "  sensors: camera+gps\n");
   EXPECT_NE(bad_setup.find("slam.sensors"), std::string::npos) << bad_setup;
   EXPECT_NE(bad_setup.find("camera+imu+wheels"), std::string::npos) << bad_setup;
@@ -455,13 +455,13 @@ TEST(Scenario, SunlightOnTheDepthPatternIsOnUnlessTurnedOff) {
 
 TEST(Scenario, TheD435ModelBringsItsColourCameraAndStereoKeys) {
   const Scenario kinect = parse_scenario(kMinimal, "min.yaml");
-  EXPECT_EQ(kinect.camera.model, CameraModel::kKinect);
+  EXPECT_EQ(kinect.camera.model, CameraKind::kKinect);
   EXPECT_DOUBLE_EQ(kinect.camera.depth_baseline_m(), 0.075);
   const Scenario d = parse_scenario(std::string(kMinimal) +
                                         "camera:\n  model: d435\n  stereo: {disparities: 96, block_px: 5, "
                                         "projector_power_w: 0}\n",
                                     "d435.yaml");
-  EXPECT_EQ(d.camera.model, CameraModel::kD435);
+  EXPECT_EQ(d.camera.model, CameraKind::kD435);
   EXPECT_DOUBLE_EQ(d.camera.fx, 615.0) << "the D435's colour camera unless given";
   EXPECT_DOUBLE_EQ(d.camera.depth_baseline_m(), 0.050);
   EXPECT_EQ(d.camera.stereo.disparities, 96);

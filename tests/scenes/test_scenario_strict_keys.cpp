@@ -53,10 +53,10 @@ TEST(ScenarioStrictKeys, ADayFileMayChangeTheModelOfItsBasesCamera) {
   std::filesystem::create_directories(dir);
   pvb::write_file(dir + "/kinect.yaml", kRoute + "camera:\n  depth_noise: {sunlight: off}\n");
   pvb::write_file(dir + "/d435_day.yaml", "base: kinect.yaml\ncamera: {model: d435}\n");
-  EXPECT_EQ(load_scenario(dir + "/d435_day.yaml").camera.model, CameraModel::kD435);
+  EXPECT_EQ(load_scenario(dir + "/d435_day.yaml").camera.model, CameraKind::kD435);
   pvb::write_file(dir + "/d435.yaml", kRoute + "camera:\n  model: d435\n  stereo: {dots: 10}\n");
   pvb::write_file(dir + "/kinect_day.yaml", "base: d435.yaml\ncamera: {model: kinect}\n");
-  EXPECT_EQ(load_scenario(dir + "/kinect_day.yaml").camera.model, CameraModel::kKinect);
+  EXPECT_EQ(load_scenario(dir + "/kinect_day.yaml").camera.model, CameraKind::kKinect);
   // Written with the model in one file, as above: refused.
   pvb::write_file(dir + "/both_day.yaml", "base: kinect.yaml\ncamera: {model: d435, depth_noise: {sunlight: on}}\n");
   EXPECT_THROW(load_scenario(dir + "/both_day.yaml"), pvb::ConfigError);

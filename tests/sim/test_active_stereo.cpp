@@ -15,7 +15,7 @@ namespace {
 /// lands where the left image has it.
 scenes::Camera camera_at_left_imager() {
   scenes::Camera cam;
-  cam.model = scenes::CameraModel::kD435;
+  cam.model = scenes::CameraKind::kD435;
   cam.width = cam.stereo.ir_width;
   cam.height = cam.stereo.ir_height;
   cam.fx = cam.fy = cam.stereo.ir_fx;

@@ -36,7 +36,7 @@ struct Fnv {
 
 /// The scenario with every switch at its old bytes.
 scenes::Scenario with_old_switches(scenes::Scenario s) {
-  s.camera.model = scenes::CameraModel::kKinect;
+  s.camera.model = scenes::CameraKind::kKinect;
   s.camera.depth_noise.sunlight.on = false;
   for (auto& a : s.pv_arrays) a.specular_glass = false;
   s.ground.tiling = scenes::GroundTiling::kRepeat;

@@ -77,7 +77,7 @@ TEST(Simulator, OpticalFramePoseAndDepthAgreeWithTheWallPlane) {
 // matching, registration; the depth agrees with the rendered truth.
 TEST(Simulator, TheD435ModelsDepthAgreesWithTheTruthOnTheStation) {
   scenes::Scenario s = scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml");
-  s.camera.model = scenes::CameraModel::kD435;
+  s.camera.model = scenes::CameraKind::kD435;
   s.camera.use_d435_colour_camera();
   sim::Simulator sim(s);
   sim::RgbdCamera camera(sim, sim::GlBackend::kAuto);

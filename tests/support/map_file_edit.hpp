@@ -150,7 +150,7 @@ inline std::string tiny_map(const slam::MapSettings& settings = tiny_settings(),
 /// of the IMU, turned 90 degrees about z, and 0.4 m above the base.
 inline slam::MapSettings tiny_inertial_settings() {
   slam::MapSettings s = tiny_settings();
-  s.sensors = slam::SensorSetup::kCameraImuWheels;
+  s.sensors = sensor::SensorSetup::kCameraImuWheels;
   s.T_b_c = geom::make_se3(Eigen::Matrix3d(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())),
                            Eigen::Vector3d(0.05, 0, 0.01));
   s.T_base_c = geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.1, 0, 0.4));

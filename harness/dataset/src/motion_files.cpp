@@ -40,10 +40,10 @@ OutputFile open_with(const std::string& path, const std::string& header) {
 
 }  // namespace
 
-std::string kalibr_imu_yaml(const ImuCalibration& c) {
+std::string kalibr_imu_yaml(const sensor::ImuNoise& c, double rate_hz) {
   return "# Kalibr IMU noise model (continuous time), written by pvbench\n"
          "rostopic: /imu0\n"
-         "update_rate: " + r(c.rate_hz) + "\n"
+         "update_rate: " + r(rate_hz) + "\n"
          "accelerometer_noise_density: " + r(c.accel_noise_density) + "  # m/s^2/sqrt(Hz)\n"
          "accelerometer_random_walk: " + r(c.accel_random_walk) + "  # m/s^3/sqrt(Hz)\n"
          "gyroscope_noise_density: " + r(c.gyro_noise_density) + "  # rad/s/sqrt(Hz)\n"
@@ -58,7 +58,7 @@ std::string robot_yaml(const RobotCalibration& c) {
          "track_m: " + r(c.drive.track_m) + "\n"
          "ticks_per_rev: " + std::to_string(c.drive.ticks_per_rev) + "\n"
          "encoder_rate_hz: " + r(c.encoder_rate_hz) + "\n"
-         "imu_rate_hz: " + r(c.imu.rate_hz) + "\n"
+         "imu_rate_hz: " + r(c.imu_rate_hz) + "\n"
          "T_b_c: " + matrix_row_major(c.T_b_c) + "\n"
          "T_b_i: " + matrix_row_major(c.T_b_i) + "\n";
 }
@@ -76,7 +76,7 @@ MotionFilesWriter::MotionFilesWriter(const std::string& dir, const RobotCalibrat
   wheels_csv_ = open_with(dir + "/wheels.csv", "#timestamp [ns],left [ticks],right [ticks]\n");
   odom_txt_ = open_with(dir + "/odom.txt", "# wheel odometry of the base in the odometry frame\n"
                                            "# timestamp tx ty tz qx qy qz qw vx vy vz wx wy wz\n");
-  write_file(dir + "/imu.yaml", kalibr_imu_yaml(c.imu));
+  write_file(dir + "/imu.yaml", kalibr_imu_yaml(c.imu, c.imu_rate_hz));
   write_file(dir + "/robot.yaml", robot_yaml(c));
 }
 

@@ -61,7 +61,7 @@ std::string robot_settings_text(const RobotCalibration& c) {
       "# rad/s^2/sqrt(Hz), m/s^3/sqrt(Hz)).  T_b_c1: the camera in the IMU frame (ORB-SLAM3's body).\n"
       "IMU.NoiseGyro: " + format_real(c.imu.gyro_noise_density) + "\nIMU.NoiseAcc: " + format_real(c.imu.accel_noise_density) +
       "\nIMU.GyroWalk: " + format_real(c.imu.gyro_random_walk) + "\nIMU.AccWalk: " + format_real(c.imu.accel_random_walk) +
-      "\nIMU.Frequency: " + format_real(c.imu.rate_hz) + "\n";
+      "\nIMU.Frequency: " + format_real(c.imu_rate_hz) + "\n";
   text += opencv_matrix("IMU.T_b_c1", c.T_b_i.inverse() * c.T_b_c);
   text += "\n# The robot (pvbench's own keys): nominal drive, encoders, the camera in the base frame\n"
           "# (axle centre, x forward, z up) and the IMU in it.\n"
@@ -113,7 +113,8 @@ std::string orbslam_settings_text(const OrbSlamSettings& s) {
     text += std::string("KeyFrame.refOverlap: ") + ov + "\n";
   }
   if (s.sensors)
-    text += "\n# The sensors the SLAM core fuses (pvbench's own key)\nSystem.Sensors: \"" + *s.sensors + "\"\n";
+    text += "\n# The sensors the SLAM core fuses (pvbench's own key)\nSystem.Sensors: \"" +
+            std::string(sensor::to_string(*s.sensors)) + "\"\n";
   if (s.robot) text += robot_settings_text(*s.robot);
   return text;
 }

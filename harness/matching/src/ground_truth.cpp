@@ -16,15 +16,9 @@
 #include "pvb/dataset/image_file.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/geometry/time.hpp"
+#include "pvb/slam/core/settings.hpp"
 
 namespace pvb::harness {
-namespace {
-std::string in_range(double lo, double hi) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, " in [%g, %g]", lo, hi);
-  return buf;
-}
-}  // namespace
 
 Eigen::Matrix3d load_homography(const std::string& path) {
   const std::string text = read_file(path);
@@ -54,48 +48,12 @@ std::vector<MatchLabel> label_by_homography(const std::vector<slam::PointMatch>&
 }
 
 CameraSettings load_camera_settings(const std::string& path) {
-  cv::FileStorage fs;
-  try {
-    fs.open(path, cv::FileStorage::READ);
-  } catch (const cv::Exception& e) {
-    throw IoError(path, std::string("cannot parse settings: ") + e.what());
-  }
-  if (!fs.isOpened()) throw IoError(path, "cannot open camera settings (ORB-SLAM2 yaml)");
-  auto req = [&](const char* key) {
-    const cv::FileNode n = fs[key];
-    if (n.empty() || (!n.isReal() && !n.isInt())) throw ConfigError(path, key, "a number");
-    return static_cast<double>(n);
-  };
-  auto opt = [&](const char* key, double def) {
-    const cv::FileNode n = fs[key];
-    if (n.empty()) return def;
-    if (!n.isReal() && !n.isInt()) throw ConfigError(path, key, "a number");
-    return static_cast<double>(n);
-  };
-  // The ranges of slam::read_settings (slam/core/src/settings.cpp).
-  auto in = [&](const char* key, double v, double lo, double hi, const char* what) {
-    if (!(v >= lo && v <= hi))
-      throw ConfigError(path, key, std::string(what) + in_range(lo, hi), std::to_string(v));
-    return v;
-  };
+  const slam::Settings settings = slam::read_settings(path);
   CameraSettings s;
-  s.K.fx = in("Camera.fx", req("Camera.fx"), 1, 1e6, "a focal length in pixels");
-  s.K.fy = in("Camera.fy", req("Camera.fy"), 1, 1e6, "a focal length in pixels");
-  const double width = in("Camera.width", opt("Camera.width", 640), 16, 16384, "an image width in pixels");
-  const double height =
-      in("Camera.height", opt("Camera.height", 480), 16, 16384, "an image height in pixels");
-  s.K.width = static_cast<int>(width);  // in range: representable
-  s.K.height = static_cast<int>(height);
-  s.K.cx = in("Camera.cx", req("Camera.cx"), 0, width, "a pixel column inside the image (Camera.width)");
-  s.K.cy = in("Camera.cy", req("Camera.cy"), 0, height, "a pixel row inside the image (Camera.height)");
-  const char* keys[5] = {"Camera.k1", "Camera.k2", "Camera.p1", "Camera.p2", "Camera.k3"};
-  double k[5];
-  for (int i = 0; i < 5; ++i) k[i] = in(keys[i], opt(keys[i], 0), -100, 100, "a distortion coefficient");
-  if (std::any_of(k, k + 5, [](double v) { return v != 0.0; })) s.dist_coeffs = cv::Mat(1, 5, CV_64F, (void*)k).clone();
-  s.depth_map_factor = opt("DepthMapFactor", 5000.0);
-  if (!(s.depth_map_factor > 0 && s.depth_map_factor <= 1e6))
-    throw ConfigError(path, "DepthMapFactor", "raw depth units per metre in (0, 1e+06]",
-                      std::to_string(s.depth_map_factor));
+  s.K = settings.K;
+  if (settings.has_distortion())
+    s.dist_coeffs = (cv::Mat_<double>(1, 5) << settings.k1, settings.k2, settings.p1, settings.p2, settings.k3);
+  s.depth_map_factor = settings.depth_map_factor;
   return s;
 }
 

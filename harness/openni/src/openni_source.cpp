@@ -434,7 +434,6 @@ std::string OpenniSource::describe() const {
 
 std::optional<RecordingSummary> OpenniSource::stop() { return impl_->stop(); }
 
-const std::string& OpenniSource::device_uri() const { return impl_->uri; }
 std::size_t OpenniSource::dropped_colour() const {
   return impl_->pairer ? impl_->pairer->dropped_colour() : 0;
 }

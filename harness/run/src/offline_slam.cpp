@@ -23,7 +23,7 @@
 #include "pvb/run/inertial_eval.hpp"
 #include "pvb/run/map_eval.hpp"
 #include "pvb/run/output_names.hpp"
-#include "pvb/run/place_recognition.hpp"
+#include "pvb/run/place_events.hpp"
 #include "pvb/run/sensor_setup.hpp"
 #include "pvb/slam/core/system.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"
@@ -209,21 +209,21 @@ slam::Settings OfflineSlam::Impl::read_settings() {
   for (const std::string& w : settings.warnings) warn("warning: " + w);
   if (a_.no_pe_match) settings.pe_match.enabled = false;
   if (a_.no_dense) settings.dense.enabled = false;
-  if (a_.sensors) settings.sensors = *a_.sensors;
-  imu_supplied_ = settings.sensors == slam::SensorSetup::kCameraAccel &&
+  if (a_.sensors) settings.motion.setup = *a_.sensors;
+  imu_supplied_ = settings.motion.setup == sensor::SensorSetup::kCameraAccel &&
                   supply_kinect_accelerometer(&settings, a_.sequence);
   if (imu_supplied_)
-    warn(std::string("note: sensors ") + slam::to_string(settings.sensors) +
+    warn(std::string("note: sensors ") + sensor::to_string(settings.motion.setup) +
          ": the settings have no IMU.* keys; the Kinect v1 accelerometer's description is used "
          "(docs/sensors.md)");
-  apply_sensor_setup(&settings, settings.sensors);
+  apply_sensor_setup(&settings, settings.motion.setup);
   return settings;
 }
 
 OfflineSlam::Impl::Impl(const OfflineSlamOptions& a)
     : a_(a),
       settings_((check_offline_options(a), read_settings())),
-      reader_(a.sequence, settings_.depth_map_factor, 0.02, motion_needs(settings_.sensors)) {
+      reader_(a.sequence, settings_.depth_map_factor, 0.02, motion_needs(settings_.motion.setup)) {
   check_motion();
   // One rule for missing frames (docs/slam.md): more than max_missing of
   // the sequence's frames, and more than 5, ends the run.
@@ -245,7 +245,7 @@ OfflineSlam::Impl::Impl(const OfflineSlamOptions& a)
 void OfflineSlam::Impl::check_motion() {
   check_sequence_motion(reader_, static_cast<std::size_t>(a_.max_frames), settings_, a_.settings,
                         imu_supplied_);
-  if (imu_supplied_) kinect_accelerometer_at(mean_rate_hz(reader_.motion().imu), &settings_.imu);
+  if (imu_supplied_) kinect_accelerometer_at(mean_rate_hz(reader_.motion().imu), &settings_.motion.imu);
 }
 
 void OfflineSlam::Impl::open_outputs() {
@@ -442,7 +442,7 @@ void OfflineSlam::Impl::evaluate_gravity(const eval::Trajectory& gt, const eval:
   const bool site = std::ifstream(a_.sequence + "/meta.json").good();
   const geom::Vec3d down_w = site ? geom::Vec3d(0, 0, -1) : geom::Vec3d(-dataset::tum_world_up());
   const eval::GravityError g =
-      eval::gravity_error(gt, est, down_w, gravity_map_frame(settings_.sensors), tally_.gravity);
+      eval::gravity_error(gt, est, down_w, gravity_map_frame(settings_.motion.setup), tally_.gravity);
   const eval::TiltDrift t =
       eval::tilt_drift(gt, session_keyframes(eval::read_tum(a_.out + "/KeyFrameTrajectory.txt"), *system_), alignment);
   const slam::MapGravity core = system_->gravity();
@@ -455,7 +455,7 @@ void OfflineSlam::Impl::evaluate_gravity(const eval::Trajectory& gt, const eval:
 }
 
 void OfflineSlam::Impl::evaluate_inertial(std::ostringstream* js) {
-  if (!slam::uses_accel(settings_.sensors) || tally_.frame_t_ns.empty()) return;
+  if (!sensor::uses_accel(settings_.motion.setup) || tally_.frame_t_ns.empty()) return;
   const std::int64_t t0_ns = tally_.frame_t_ns.front();
   InertialReport r = inertial_report(system_->gravity(), t0_ns);
   if (r.trusted) r.gravity_true_deg = gravity_true_deg_;
@@ -467,7 +467,7 @@ void OfflineSlam::Impl::evaluate_inertial(std::ostringstream* js) {
     try {
       const std::vector<BiasTruth> truth = read_bias_truth(truth_path);
       if (!truth.empty())
-        r.biases = compare_biases(std::move(kfs), truth, t0_ns, slam::uses_imu(settings_.sensors));
+        r.biases = compare_biases(std::move(kfs), truth, t0_ns, sensor::uses_imu(settings_.motion.setup));
     } catch (const IoError& e) {
       warn(std::string("warning: biases not compared: ") + e.what());
     }
@@ -516,7 +516,7 @@ std::string OfflineSlam::Impl::stats_json(StopReason stop, const std::string& de
   std::ostringstream js;
   js << "{\n  \"sequence\": \"" << json_escape(a_.sequence)
      << "\",\n  \"pe_match\": " << (settings_.pe_match.enabled ? "true" : "false")
-     << ",\n  \"sensors\": \"" << slam::to_string(settings_.sensors) << "\""
+     << ",\n  \"sensors\": \"" << sensor::to_string(settings_.motion.setup) << "\""
      << ",\n  \"sync\": " << (a_.sync ? "true" : "false") << ",\n  \"seed\": " << a_.seed
      << ",\n  \"seed_source\": \"" << json_escape(a_.seed_source) << "\""
      << ",\n  \"interrupted\": " << (stop == StopReason::kSignal ? "true" : "false") << ",\n  \"stop\": \""

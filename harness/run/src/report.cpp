@@ -7,7 +7,7 @@
 #include <numeric>
 
 #include "pvb/common/text.hpp"
-#include "pvb/eval/plot.hpp"
+#include "pvb/eval/charts.hpp"
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/time.hpp"
 #include "pvb/plot/png.hpp"

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "pvb/common/text.hpp"
-#include "pvb/eval/plot.hpp"
+#include "pvb/eval/charts.hpp"
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/plot/dashes.hpp"
 #include "pvb/plot/png.hpp"

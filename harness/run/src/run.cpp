@@ -88,9 +88,9 @@ RunReport new_report(const scenes::Scenario& scenario, const RunOptions& opt) {
 /// ", sensors S" (--sensors) or ", sensors B against A" (--compare-sensors); "" otherwise.
 std::string sensors_part(const RunOptions& opt) {
   if (opt.compare_sensors)
-    return std::string(", sensors ") + slam::to_string(opt.compare_sensors->second) + " against " +
-           slam::to_string(opt.compare_sensors->first);
-  return opt.sensors ? std::string(", sensors ") + slam::to_string(*opt.sensors) : std::string();
+    return std::string(", sensors ") + sensor::to_string(opt.compare_sensors->second) + " against " +
+           sensor::to_string(opt.compare_sensors->first);
+  return opt.sensors ? std::string(", sensors ") + sensor::to_string(*opt.sensors) : std::string();
 }
 
 std::string start_line(const RunOptions& opt, const scenes::Scenario& scenario, int frames,
@@ -441,11 +441,8 @@ dataset::OrbSlamSettings orbslam_settings_for(const scenes::Scenario& s) {
 
 dataset::RobotCalibration robot_calibration_for(const scenes::Scenario& s) {
   dataset::RobotCalibration c;
-  c.imu.gyro_noise_density = s.imu.gyro.noise_density;
-  c.imu.gyro_random_walk = s.imu.gyro.random_walk;
-  c.imu.accel_noise_density = s.imu.accel.noise_density;
-  c.imu.accel_random_walk = s.imu.accel.random_walk;
-  c.imu.rate_hz = scenes::imu_rate_hz(s);
+  c.imu = scenes::kalibr_noise(s.imu);
+  c.imu_rate_hz = scenes::imu_rate_hz(s);
   c.drive = sim::nominal_description(s);
   c.encoder_rate_hz = scenes::wheel_rate_hz(s);
   c.T_b_c = scenes::T_base_camera(s);

@@ -10,31 +10,31 @@
 
 namespace pvb::run {
 
-slam::SensorSetup parse_sensors_option(const std::string& text, const std::string& option) {
-  const std::optional<slam::SensorSetup> setup = slam::parse_sensor_setup(text);
-  if (!setup) throw ConfigError("command line", option, kSensorSetupValues, text);
+sensor::SensorSetup parse_sensors_option(const std::string& text, const std::string& option) {
+  const std::optional<sensor::SensorSetup> setup = sensor::parse_sensor_setup(text);
+  if (!setup) throw ConfigError("command line", option, sensor::sensor_setup_values(), text);
   return *setup;
 }
 
-std::pair<slam::SensorSetup, slam::SensorSetup> parse_sensor_pair_option(const std::string& text,
+std::pair<sensor::SensorSetup, sensor::SensorSetup> parse_sensor_pair_option(const std::string& text,
                                                                           const std::string& option) {
-  const std::string expected = std::string("two different sensor setups A,B, each ") + kSensorSetupValues;
+  const std::string expected = std::string("two different sensor setups A,B, each ") + sensor::sensor_setup_values();
   const std::size_t comma = text.find(',');
   if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos)
     throw ConfigError("command line", option, expected, text);
-  const std::optional<slam::SensorSetup> a = slam::parse_sensor_setup(text.substr(0, comma));
-  const std::optional<slam::SensorSetup> b = slam::parse_sensor_setup(text.substr(comma + 1));
+  const std::optional<sensor::SensorSetup> a = sensor::parse_sensor_setup(text.substr(0, comma));
+  const std::optional<sensor::SensorSetup> b = sensor::parse_sensor_setup(text.substr(comma + 1));
   if (!a || !b || *a == *b) throw ConfigError("command line", option, expected, text);
   return {*a, *b};
 }
 
-void apply_sensor_setup(slam::Settings* settings, slam::SensorSetup setup) {
-  settings->sensors = setup;
-  slam::check_sensor_setup(*settings, setup);
+void apply_sensor_setup(slam::Settings* settings, sensor::SensorSetup setup) {
+  settings->motion.setup = setup;
+  settings->motion.check(settings->source);
 }
 
-const char* gravity_map_frame(slam::SensorSetup setup) {
-  return slam::uses_accel(setup) ? "gravity_aligned" : "first_camera";
+const char* gravity_map_frame(sensor::SensorSetup setup) {
+  return sensor::uses_accel(setup) ? "gravity_aligned" : "first_camera";
 }
 
 bool supply_kinect_accelerometer(slam::Settings* settings, const std::string& sequence) {
@@ -43,8 +43,8 @@ bool supply_kinect_accelerometer(slam::Settings* settings, const std::string& se
 }
 
 bool supply_kinect_description(slam::Settings* settings) {
-  if (settings->imu.present) {
-    settings->imu.T_b_c = geom::SE3d::Identity();  // the Kinect's readings are read into the camera's frame
+  if (settings->motion.imu.present) {
+    settings->motion.imu.T_b_c = geom::SE3d::Identity();  // the Kinect's readings are read into the camera's frame
     return false;
   }
   slam::ImuSettings imu;  // NoiseGyro and GyroWalk keep their defaults: there is no gyroscope
@@ -52,7 +52,7 @@ bool supply_kinect_description(slam::Settings* settings) {
   kinect_accelerometer_at(dataset::KinectAccelerometer::kRateHz, &imu);
   imu.noise.accel_random_walk = dataset::KinectAccelerometer::kRandomWalk;
   imu.T_b_c = geom::SE3d::Identity();  // the readings are already in the camera's optical frame
-  settings->imu = imu;
+  settings->motion.imu = imu;
   return true;
 }
 
@@ -61,12 +61,12 @@ void kinect_accelerometer_at(double rate_hz, slam::ImuSettings* imu) {
   imu->noise.accel_noise_density = dataset::KinectAccelerometer::kReadingNoiseMps2 / std::sqrt(rate_hz);
 }
 
-dataset::MotionNeeds motion_needs(slam::SensorSetup setup) {
+dataset::MotionNeeds motion_needs(sensor::SensorSetup setup) {
   dataset::MotionNeeds n;
-  n.accelerometer = slam::uses_accel(setup);
-  n.gyroscope = slam::uses_imu(setup);
-  n.wheels = slam::uses_wheels(setup);
-  n.who = std::string("--sensors ") + slam::to_string(setup);
+  n.accelerometer = sensor::uses_accel(setup);
+  n.gyroscope = sensor::uses_imu(setup);
+  n.wheels = sensor::uses_wheels(setup);
+  n.who = std::string("--sensors ") + sensor::to_string(setup);
   return n;
 }
 
@@ -86,11 +86,11 @@ void check_sequence_motion(const dataset::TumSequenceReader& reader, std::size_t
   e.first_frame_t_ns = entries.front().t_ns;
   e.last_frame_t_ns = entries[n - 1].t_ns;
   e.settings_file = settings_file;
-  if (!rate_from_data) e.imu_rate_hz = settings.imu.rate_hz;
-  if (slam::uses_wheels(settings.sensors)) {
-    e.encoder_rate_hz = settings.robot.encoder_rate_hz;
-    e.ticks_per_rev = settings.robot.drive.ticks_per_rev;
-    e.wheel_radius_m = settings.robot.drive.wheel_radius_m;
+  if (!rate_from_data) e.imu_rate_hz = settings.motion.imu.rate_hz;
+  if (sensor::uses_wheels(settings.motion.setup)) {
+    e.encoder_rate_hz = settings.motion.robot.encoder_rate_hz;
+    e.ticks_per_rev = settings.motion.robot.drive.ticks_per_rev;
+    e.wheel_radius_m = settings.motion.robot.drive.wheel_radius_m;
   }
   dataset::check_motion_readings(reader.motion(), e);
 }

@@ -11,7 +11,7 @@
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
-#include "pvb/run/place_recognition.hpp"
+#include "pvb/run/place_events.hpp"
 #include "pvb/run/sensor_setup.hpp"
 
 namespace pvb::run {
@@ -67,7 +67,7 @@ SystemSink::SystemSink(const std::string& mode, const slam::Settings& settings, 
                        const std::string& out_dir, const MapOptions& map)
     : map_options(map), dir(out_dir) {
   run.mode = mode;
-  run.sensors = slam::to_string(settings.sensors);
+  run.sensors = sensor::to_string(settings.motion.setup);
   run.label = eval::mode_label(mode);
   slam::SystemOptions options;
   options.synchronous = sync;
@@ -106,7 +106,7 @@ slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log)
   record_state_change(run, prev_state, r, index, t_s, log);
   if (prev_provisional && r.T_w_c)
     log.line("frame " + std::to_string(index) + ": the provisional map was merged into the loaded map");
-  if (system->sensors() != slam::SensorSetup::kCamera && !inertial_logged) log_inertial_state(index, log);
+  if (system->sensors() != sensor::SensorSetup::kCamera && !inertial_logged) log_inertial_state(index, log);
   prev_state = r.state;
   prev_provisional = r.provisional;
   return r;
@@ -117,7 +117,7 @@ void SystemSink::log_inertial_state(int index, RunLog& log) {
   if (!g.ready) return;
   inertial_logged = true;
   const double tilt_deg = std::acos(std::clamp(-g.g_w.normalized().z(), -1.0, 1.0)) * 180.0 / M_PI;
-  log.line("frame " + std::to_string(index) + ": inertial state trusted (" + slam::to_string(system->sensors()) +
+  log.line("frame " + std::to_string(index) + ": inertial state trusted (" + sensor::to_string(system->sensors()) +
            ", keyframe " + std::to_string(g.ready_keyframe_id) + " at t = " +
            format_fixed(geom::ns_to_seconds(g.ready_t_ns), 3) + " s): gravity " + format_fixed(tilt_deg, 3) +
            " deg off the map's -z, gyro bias " + format_fixed(g.bias.gyro_radps.norm(), 5) + " rad/s, accel bias " +
@@ -252,8 +252,8 @@ void SystemSink::evaluate_gravity(const eval::Trajectory& gt) {
 }
 
 void SystemSink::evaluate_inertial(const std::vector<BiasTruth>& truth) {
-  const slam::SensorSetup setup = system->sensors();
-  if (!slam::uses_accel(setup)) return;
+  const sensor::SensorSetup setup = system->sensors();
+  if (!sensor::uses_accel(setup)) return;
   const std::int64_t t0_ns = first_t_ns.value_or(0);
   InertialReport r = inertial_report(system->gravity(), t0_ns);
   if (r.trusted) r.gravity_true_deg = gravity_true_deg;
@@ -261,7 +261,7 @@ void SystemSink::evaluate_inertial(const std::vector<BiasTruth>& truth) {
   for (const slam::System::KeyFrameState& k : system->keyframe_states())
     kfs.push_back({k.id, k.t_ns, k.bias});
   if (!truth.empty() && !kfs.empty())
-    r.biases = compare_biases(std::move(kfs), truth, t0_ns, slam::uses_imu(setup));
+    r.biases = compare_biases(std::move(kfs), truth, t0_ns, sensor::uses_imu(setup));
   run.inertial = std::move(r);
 }
 

@@ -233,12 +233,6 @@ Observation Frame::observation(std::size_t i) const {
   return o;
 }
 
-int Frame::num_tracked() const {
-  int n = 0;
-  for (const auto& mp : map_points) n += (mp != nullptr);
-  return n;
-}
-
 FrameMemory& FrameMemory::operator+=(const FrameMemory& o) {
   pyramid += o.pyramid;
   keypoints += o.keypoints;

@@ -149,7 +149,7 @@ void LocalMapping::process(const std::shared_ptr<KeyFrame>& kf) {
     std::lock_guard<std::mutex> lock(map_.mutex());
     cull_keyframes(kf);
   }
-  if (options_.sensors != SensorSetup::kCamera) initialize_inertial(kf);
+  if (options_.motion.setup != sensor::SensorSetup::kCamera) initialize_inertial(kf);
   if (options_.align_patches) {
     std::lock_guard<std::mutex> lock(map_.mutex());
     release_pyramids(kf);
@@ -357,7 +357,7 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
         if (it == kf_index.end()) continue;
         problem.edges.push_back({it->second, p, kfs[it->second]->frame().observation(o.idx)});
       }
-    if (options_.sensors != SensorSetup::kCamera) add_motion_terms(&problem, &kfs);
+    if (options_.motion.setup != sensor::SensorSetup::kCamera) add_motion_terms(&problem, &kfs);
   }
   if (problem.edges.empty()) return;
   // Optimise without holding the map: tracking goes on with the old poses.

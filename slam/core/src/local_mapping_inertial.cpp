@@ -53,14 +53,14 @@ void LocalMapping::initialize_inertial(const std::shared_ptr<KeyFrame>& kf) {
   MapGravity& g = map_.gravity();
   if (g.ready || kf->bad() || kf->provisional() != 0) return;
   const auto chain = chain_to(kf);
-  if (options_.sensors == SensorSetup::kCameraAccel) {
+  if (options_.motion.setup == sensor::SensorSetup::kCameraAccel) {
     if (initialize_tilt(chain, options_.init_min_keyframes / 2, &g)) {
       g.ready_keyframe_id = kf->id();
       g.ready_t_ns = kf->t_ns();
     }
     return;
   }
-  if (!uses_imu(options_.sensors)) return;
+  if (!uses_imu(options_.motion.setup)) return;
   // The newest run of keyframes linked by IMU intervals.
   std::size_t first = chain.size() - 1;
   while (first > 0 && chain[first]->motion().from_prev.imu) --first;
@@ -69,7 +69,7 @@ void LocalMapping::initialize_inertial(const std::shared_ptr<KeyFrame>& kf) {
       seconds_between(*run.front(), *run.back()) < options_.init_min_span_s)
     return;
   InertialInitProblem problem;
-  problem.T_b_c = options_.imu.T_b_c;
+  problem.T_b_c = options_.motion.imu.T_b_c;
   problem.g_w_guess = g.g_w;  // its magnitude; the direction comes from the increments
   problem.gyro_bias_prior_radps = options_.init_gyro_bias_sigma_radps;
   problem.accel_bias_prior_mps2 = options_.init_accel_bias_sigma_mps2;
@@ -102,13 +102,13 @@ void LocalMapping::initialize_inertial(const std::shared_ptr<KeyFrame>& kf) {
 
 void LocalMapping::add_motion_terms(BaProblem* problem, std::vector<std::shared_ptr<KeyFrame>>* kfs) {
   const MapGravity& g = map_.gravity();
-  const bool imu = uses_imu(options_.sensors) && g.ready;
-  const bool wheels = uses_wheels(options_.sensors);
-  const bool tilt = options_.sensors == SensorSetup::kCameraAccel && g.ready;
+  const bool imu = uses_imu(options_.motion.setup) && g.ready;
+  const bool wheels = uses_wheels(options_.motion.setup);
+  const bool tilt = options_.motion.setup == sensor::SensorSetup::kCameraAccel && g.ready;
   if (!imu && !wheels && !tilt) return;
   auto in = std::make_shared<BaInertial>();
-  in->T_b_c = options_.imu.T_b_c;
-  in->T_base_c = options_.robot.T_base_c;
+  in->T_b_c = options_.motion.imu.T_b_c;
+  in->T_base_c = options_.motion.robot.T_base_c;
   in->g_w = g.g_w;
   if (imu) in->gravity_sigma_rad = options_.gravity_sigma_rad;
   in->fixed_states_free = true;
@@ -159,7 +159,7 @@ void LocalMapping::write_motion_states(const BaProblem& problem, const std::vect
     if (problem.keyframes[k].fixed || kfs[k]->bad() || !m.has_state) continue;
     m.v_w_mps = problem.inertial->states[k].v_w_mps;
     m.bias = problem.inertial->states[k].bias;
-    if (g.ready && uses_imu(options_.sensors) && kfs[k]->id() >= newest) {
+    if (g.ready && uses_imu(options_.motion.setup) && kfs[k]->id() >= newest) {
       newest = kfs[k]->id();
       g.bias = m.bias;
     }
@@ -167,7 +167,7 @@ void LocalMapping::write_motion_states(const BaProblem& problem, const std::vect
 }
 
 bool LocalMapping::may_cull_in_time(const KeyFrame& kf) const {
-  if (!uses_imu(options_.sensors) && !uses_wheels(options_.sensors)) return true;
+  if (!uses_imu(options_.motion.setup) && !uses_wheels(options_.motion.setup)) return true;
   const auto prev = kf.motion().prev.lock();
   const auto next = kf.motion().next.lock();
   if (!next) return false;  // the chain's end: the next keyframe's interval starts here

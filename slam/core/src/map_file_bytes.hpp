@@ -43,22 +43,21 @@ constexpr std::uint64_t kMaxId = std::uint64_t(1) << 48;
 constexpr std::int32_t kMaxVisible = std::int32_t(1) << 30;
 
 /// A sensor setup's code in INER (fixed, whatever the enum's order).
-inline std::uint32_t sensor_code(SensorSetup s) {
+inline std::uint32_t sensor_code(sensor::SensorSetup s) {
   switch (s) {
-    case SensorSetup::kCamera:
+    case sensor::SensorSetup::kCamera:
       return 0;
-    case SensorSetup::kCameraImu:
+    case sensor::SensorSetup::kCameraImu:
       return 1;
-    case SensorSetup::kCameraImuWheels:
+    case sensor::SensorSetup::kCameraImuWheels:
       return 2;
-    case SensorSetup::kCameraAccel:
+    case sensor::SensorSetup::kCameraAccel:
       return 3;
   }
   return 0;
 }
-inline std::optional<SensorSetup> sensor_of_code(std::uint32_t code) {
-  for (SensorSetup s : {SensorSetup::kCamera, SensorSetup::kCameraImu, SensorSetup::kCameraImuWheels,
-                        SensorSetup::kCameraAccel})
+inline std::optional<sensor::SensorSetup> sensor_of_code(std::uint32_t code) {
+  for (sensor::SensorSetup s : sensor::kSensorSetups)
     if (sensor_code(s) == code) return s;
   return std::nullopt;
 }

@@ -510,7 +510,7 @@ geom::SE3d read_extrinsic(ByteReader& r, const char* name) {
 /// the map's bias, when it became trusted, into *g (ready).
 void read_inertial_head(ByteReader& r, MapSettings* s, MapGravity* g) {
   const std::uint32_t code = r.u32();
-  const std::optional<SensorSetup> setup = sensor_of_code(code);
+  const std::optional<sensor::SensorSetup> setup = sensor_of_code(code);
   if (!setup) r.fail("sensor setup " + std::to_string(code) + " is not known (0 to 3)");
   if (!uses_accel(*setup))
     r.fail(std::string("sensor setup ") + to_string(*setup) + " has no inertial state");

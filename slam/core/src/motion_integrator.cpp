@@ -4,17 +4,17 @@
 
 namespace pvb::slam {
 
-MotionIntegrator::MotionIntegrator(SensorSetup setup, const ImuSettings& imu, const RobotSettings& robot)
-    : setup_(setup),
-      imu_(imu),
-      imu_noise_(imu.fused_noise()),
-      robot_(robot),
-      period_ns_(static_cast<std::int64_t>(std::llround(1e9 / imu.rate_hz))),
-      encoder_period_ns_(static_cast<std::int64_t>(std::llround(1e9 / robot.encoder_rate_hz))),
+MotionIntegrator::MotionIntegrator(const MotionSensorSettings& sensors)
+    : setup_(sensors.setup),
+      imu_(sensors.imu),
+      imu_noise_(sensors.imu.fused_noise()),
+      robot_(sensors.robot),
+      period_ns_(static_cast<std::int64_t>(std::llround(1e9 / sensors.imu.rate_hz))),
+      encoder_period_ns_(static_cast<std::int64_t>(std::llround(1e9 / sensors.robot.encoder_rate_hz))),
       imu_frame_(ImuBias{}, imu_noise_),
       imu_kf_(ImuBias{}, imu_noise_),
-      wheel_frame_(robot.drive, wheel_noise_),
-      wheel_kf_(robot.drive, wheel_noise_) {}
+      wheel_frame_(sensors.robot.drive, wheel_noise_),
+      wheel_kf_(sensors.robot.drive, wheel_noise_) {}
 
 void MotionIntegrator::add_frame(std::int64_t t_ns, const std::vector<sensor::ImuSample>& imu,
                                  const std::vector<sensor::WheelTicks>& ticks) {

@@ -10,12 +10,12 @@
 
 namespace pvb::slam {
 
-void Tracking::use_motion_sensors(SensorSetup setup, const ImuSettings& imu, const RobotSettings& robot) {
-  if (setup == SensorSetup::kCamera) {
+void Tracking::use_motion_sensors(const MotionSensorSettings& sensors) {
+  if (sensors.setup == sensor::SensorSetup::kCamera) {
     motion_.reset();
     return;
   }
-  motion_ = std::make_unique<MotionIntegrator>(setup, imu, robot);
+  motion_ = std::make_unique<MotionIntegrator>(sensors);
 }
 
 void Tracking::add_motion(std::int64_t t_ns, const std::vector<sensor::ImuSample>& imu,

@@ -172,7 +172,7 @@ bool ignored_key(const std::string& key) {
 void read_imu(Reader& r, const cv::FileStorage& fs, ImuSettings* imu) {
   imu->present = !fs["IMU.NoiseGyro"].empty() || !fs["IMU.T_b_c1"].empty();
   const bool req = imu->present;
-  ImuNoise& n = imu->noise;
+  sensor::ImuNoise& n = imu->noise;
   n.gyro_noise_density = r.real("IMU.NoiseGyro", req, n.gyro_noise_density, above(0, 1), "rad/s/sqrt(Hz)");
   n.accel_noise_density = r.real("IMU.NoiseAcc", req, n.accel_noise_density, above(0, 10), "m/s^2/sqrt(Hz)");
   n.gyro_random_walk = r.real("IMU.GyroWalk", req, n.gyro_random_walk, above(0, 1), "rad/s^2/sqrt(Hz)");
@@ -189,7 +189,7 @@ void read_imu(Reader& r, const cv::FileStorage& fs, ImuSettings* imu) {
 void read_robot(Reader& r, const cv::FileStorage& fs, RobotSettings* robot) {
   robot->present = !fs["Robot.WheelRadius"].empty();
   const bool req = robot->present;
-  WheelDrive& d = robot->drive;
+  sensor::DriveDescription& d = robot->drive;
   d.wheel_radius_m = r.real("Robot.WheelRadius", req, d.wheel_radius_m, above(0, 5), "metres");
   d.track_m = r.real("Robot.Track", req, d.track_m, above(0, 10), "metres");
   d.ticks_per_rev = r.integer("Robot.TicksPerRev", req, d.ticks_per_rev, 1, 1 << 24);
@@ -198,13 +198,12 @@ void read_robot(Reader& r, const cv::FileStorage& fs, RobotSettings* robot) {
   robot->T_base_imu = r.pose("Robot.T_base_imu", req, robot->T_base_imu);
 }
 
-/// System.Sensors, checked against the sections the setup needs.
-SensorSetup read_sensors(Reader& r, const Settings& s) {
-  const std::string expected = "camera, camera+imu, camera+imu+wheels or camera+accel";
+/// System.Sensors (checked against the sections it needs by the caller).
+sensor::SensorSetup read_sensors(Reader& r) {
+  const std::string expected = sensor::sensor_setup_values();
   const std::string text = r.text("System.Sensors", "camera", expected);
-  const std::optional<SensorSetup> setup = parse_sensor_setup(text);
+  const std::optional<sensor::SensorSetup> setup = sensor::parse_sensor_setup(text);
   if (!setup) throw ConfigError(r.path(), "System.Sensors", expected, text);
-  check_sensor_setup(s, *setup);
   return *setup;
 }
 
@@ -395,9 +394,10 @@ Settings settings_from(const cv::FileStorage& fs, const std::string& text, const
   read_keyframe(r, &s.keyframe);
   read_point_cloud(r, &s.dense);
   read_loop_closing(r, &s.loop);
-  read_imu(r, fs, &s.imu);
-  read_robot(r, fs, &s.robot);
-  s.sensors = read_sensors(r, s);
+  read_imu(r, fs, &s.motion.imu);
+  read_robot(r, fs, &s.motion.robot);
+  s.motion.setup = read_sensors(r);
+  s.motion.check(path);
   s.vocabulary_path = vocabulary_path(path, r.text("Vocabulary.path", "", "a string (a file path, or none)"));
   const cv::FileNode root = fs.root();
   for (auto it = root.begin(); it != root.end(); ++it) {
@@ -437,33 +437,12 @@ Settings read_settings_text(const std::string& text, const std::string& name) {
   return settings_from(fs, text, name);
 }
 
-const char* to_string(SensorSetup s) {
-  switch (s) {
-    case SensorSetup::kCamera: return "camera";
-    case SensorSetup::kCameraImu: return "camera+imu";
-    case SensorSetup::kCameraImuWheels: return "camera+imu+wheels";
-    case SensorSetup::kCameraAccel: return "camera+accel";
-  }
-  return "?";
-}
-
-std::optional<SensorSetup> parse_sensor_setup(std::string_view text) {
-  for (SensorSetup s : {SensorSetup::kCamera, SensorSetup::kCameraImu, SensorSetup::kCameraImuWheels,
-                        SensorSetup::kCameraAccel})
-    if (text == to_string(s)) return s;
-  return std::nullopt;
-}
-
-bool uses_imu(SensorSetup s) { return s == SensorSetup::kCameraImu || s == SensorSetup::kCameraImuWheels; }
-bool uses_accel(SensorSetup s) { return s != SensorSetup::kCamera; }
-bool uses_wheels(SensorSetup s) { return s == SensorSetup::kCameraImuWheels; }
-
-void check_sensor_setup(const Settings& s, SensorSetup setup) {
-  if (uses_accel(setup) && !s.imu.present)
-    throw ConfigError(s.source, "IMU.NoiseGyro",
+void MotionSensorSettings::check(const std::string& source) const {
+  if (uses_accel(setup) && !imu.present)
+    throw ConfigError(source, "IMU.NoiseGyro",
                       std::string("the IMU.* keys (sensors ") + to_string(setup) + " need them; required key is missing)");
-  if (uses_wheels(setup) && !s.robot.present)
-    throw ConfigError(s.source, "Robot.WheelRadius",
+  if (uses_wheels(setup) && !robot.present)
+    throw ConfigError(source, "Robot.WheelRadius",
                       std::string("the Robot.* keys (sensors ") + to_string(setup) + " need them; required key is missing)");
 }
 

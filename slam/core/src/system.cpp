@@ -63,14 +63,12 @@ System::System(const Settings& settings, const SystemOptions& options)
     place_ = std::make_unique<PlaceRecognizer>(std::move(vocabulary));
   }
   tracking_ = std::make_unique<Tracking>(*map_, cam_, topt, place_.get());
-  check_sensor_setup(settings, settings.sensors);
-  tracking_->use_motion_sensors(settings.sensors, settings.imu, settings.robot);
+  settings.motion.check(settings.source);  // once: tracking and local mapping share them
+  tracking_->use_motion_sensors(settings.motion);
   LocalMappingOptions mopt;
   mopt.align_patches = settings.align_patches;
   mopt.patch_align = topt.patch_align;
-  mopt.sensors = settings.sensors;
-  mopt.imu = settings.imu;
-  mopt.robot = settings.robot;
+  mopt.motion = settings.motion;
   mapping_ = std::make_unique<LocalMapping>(*map_, cam_, mopt);
   if (settings.loop.enabled) loop_ = std::make_unique<LoopClosing>(*map_, settings.loop, place_.get());
   // After local mapping: the keyframe's bag of words, loop detection
@@ -190,9 +188,9 @@ MapSettings System::map_settings() const {
   m.num_levels = static_cast<std::uint32_t>(settings_.orb.num_levels);
   m.num_features = static_cast<std::uint32_t>(settings_.orb.num_features);
   m.vocabulary = vocabulary_fingerprint_;
-  m.sensors = settings_.sensors;  // extrinsics only where the setup uses them (docs/map_file.md)
-  if (uses_accel(m.sensors)) m.T_b_c = settings_.imu.T_b_c;
-  if (uses_wheels(m.sensors)) m.T_base_c = settings_.robot.T_base_c;
+  m.sensors = settings_.motion.setup;  // extrinsics only where the setup uses them (docs/map_file.md)
+  if (uses_accel(m.sensors)) m.T_b_c = settings_.motion.imu.T_b_c;
+  if (uses_wheels(m.sensors)) m.T_base_c = settings_.motion.robot.T_base_c;
   return m;
 }
 
@@ -208,9 +206,9 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
   {
     std::lock_guard<std::mutex> lock(map_->mutex());
     decode_map(bytes, path, head, cam_, map_.get());  // with a version-2 file, gravity ready and the chain
-    if (!uses_accel(settings_.sensors))
+    if (!uses_accel(settings_.motion.setup))
       map_->gravity() = MapGravity{};  // a camera-only run keeps no inertial state
-    else if (start == MapStart::kExtend && uses_imu(settings_.sensors) && !uses_imu(head.settings.sensors))
+    else if (start == MapStart::kExtend && uses_imu(settings_.motion.setup) && !uses_imu(head.settings.sensors))
       map_->gravity().ready = false;  // a tilt alone (camera+accel): the new keyframes initialise the IMU
     std::size_t words = 0;
     for (const auto& [id, kf] : map_->keyframes()) words += kf->bow().size();

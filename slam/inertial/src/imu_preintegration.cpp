@@ -46,7 +46,7 @@ Eigen::Matrix3d so3_right_jacobian_inverse(const Eigen::Vector3d& phi) {
   return Eigen::Matrix3d::Identity() + 0.5 * S + c * S * S;
 }
 
-ImuPreintegration::ImuPreintegration(const ImuBias& bias, const ImuNoise& noise) : bias_(bias), noise_(noise) {}
+ImuPreintegration::ImuPreintegration(const ImuBias& bias, const sensor::ImuNoise& noise) : bias_(bias), noise_(noise) {}
 
 void ImuPreintegration::integrate(const Eigen::Vector3d& gyro_radps, const Eigen::Vector3d& accel_mps2, double dt_s) {
   check_finite_positive(dt_s);

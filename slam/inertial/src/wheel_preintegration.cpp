@@ -32,7 +32,7 @@ Eigen::Vector3d wheel_step(double left_m, double right_m, double track_m) {
   return {ds * std::cos(0.5 * dyaw), ds * std::sin(0.5 * dyaw), dyaw};
 }
 
-WheelPreintegration::WheelPreintegration(const WheelDrive& drive, const WheelNoise& noise)
+WheelPreintegration::WheelPreintegration(const sensor::DriveDescription& drive, const WheelNoise& noise)
     : drive_(drive), noise_(noise) {
   if (!(drive.wheel_radius_m > 0) || !(drive.track_m > 0) || drive.ticks_per_rev <= 0) {
     throw std::invalid_argument("WheelPreintegration: wheel radius, track and ticks per revolution must be positive");

@@ -40,7 +40,12 @@ dataset::RobotCalibration robot() {
   c.T_b_c = geom::make_se3(R_b_c, geom::Vec3d(0.15, 0, 0.8));
   c.T_b_i = c.T_b_c * geom::make_se3(Eigen::Matrix3d(Eigen::AngleAxisd(0.5236, Eigen::Vector3d::UnitY())),
                                      geom::Vec3d(0.01, 0.005, -0.012));
-  c.imu = {2.44e-4, 2e-5, 1.57e-3, 4e-4, 200};  // a BMI088 at 200 Hz
+  // a BMI088 at 200 Hz
+  c.imu.gyro_noise_density = 2.44e-4;
+  c.imu.gyro_random_walk = 2e-5;
+  c.imu.accel_noise_density = 1.57e-3;
+  c.imu.accel_random_walk = 4e-4;
+  c.imu_rate_hz = 200;
   return c;
 }
 

@@ -21,7 +21,11 @@ namespace {
 
 dataset::RobotCalibration calibration() {
   dataset::RobotCalibration c;
-  c.imu = {2.44e-4, 2e-5, 1.57e-3, 4e-4, 200};
+  c.imu.gyro_noise_density = 2.44e-4;
+  c.imu.gyro_random_walk = 2e-5;
+  c.imu.accel_noise_density = 1.57e-3;
+  c.imu.accel_random_walk = 4e-4;
+  c.imu_rate_hz = 200;
   c.drive = {0.1, 0.42, 1024};
   c.encoder_rate_hz = 50;
   c.T_b_c = geom::make_se3(Eigen::Matrix3d(Eigen::AngleAxisd(-1.2, Eigen::Vector3d::UnitX())),

@@ -13,7 +13,7 @@
 #include <limits>
 
 #include "pvb/common/text.hpp"
-#include "pvb/eval/plot.hpp"
+#include "pvb/eval/charts.hpp"
 #include "pvb/run/run.hpp"
 
 namespace pvb::run {

@@ -213,7 +213,7 @@ TEST_F(MapFile, LocaliseStartsLostRelocalisesAndNeverAddsKeyframes) {
 /// The pair's map with inertial state (test::give_tiny_inertial_state), as
 /// a run with an IMU whose camera sits at T_b_c saves it.
 std::string inertial_pair_map(const std::string& bytes, const std::string& file, const geom::SE3d& T_b_c,
-                              SensorSetup setup = SensorSetup::kCameraImu) {
+                              sensor::SensorSetup setup = sensor::SensorSetup::kCameraImu) {
   const MapFileHeader h = read_map_header(bytes, file);
   Map map;
   decode_map(bytes, file, h, camera_for(h.settings), &map);
@@ -227,9 +227,9 @@ std::string inertial_pair_map(const std::string& bytes, const std::string& file,
 
 Settings imu_settings(const geom::SE3d& T_b_c) {
   Settings s = read_settings(kTum3);
-  s.sensors = SensorSetup::kCameraImu;
-  s.imu.present = true;
-  s.imu.T_b_c = T_b_c;
+  s.motion.setup = sensor::SensorSetup::kCameraImu;
+  s.motion.imu.present = true;
+  s.motion.imu.T_b_c = T_b_c;
   return s;
 }
 
@@ -281,7 +281,7 @@ TEST_F(MapFile, ARunWithAnImuHasTheMapsGravityAtOnce) {
 TEST_F(MapFile, AnImuRunExtendingATiltOnlyMapInitialisesItsImu) {
   const geom::SE3d T_b_c = test::tiny_inertial_settings().T_b_c;
   const std::string p = tmp_path("tilt_pair.pvbmap");
-  write_file(p, inertial_pair_map(bytes_, path_, T_b_c, SensorSetup::kCameraAccel));
+  write_file(p, inertial_pair_map(bytes_, path_, T_b_c, sensor::SensorSetup::kCameraAccel));
   System extend(imu_settings(T_b_c), sync_options());
   extend.load_map(p, MapStart::kExtend);
   EXPECT_FALSE(extend.gravity().ready);
@@ -724,7 +724,7 @@ TEST(MapFileInertial, AVersion1FileIsReadAndWrittenAgainByteForByte) {
     const std::string bytes = corpus_file(seed);
     const MapFileHeader h = read_map_header(bytes, seed);
     EXPECT_EQ(h.version, 1u) << seed;
-    EXPECT_EQ(h.settings.sensors, SensorSetup::kCamera) << seed;
+    EXPECT_EQ(h.settings.sensors, sensor::SensorSetup::kCamera) << seed;
     Map map;
     decode_map(bytes, seed, h, camera_for(h.settings), &map);
     std::lock_guard<std::mutex> lock(map.mutex());
@@ -773,7 +773,7 @@ TEST(MapFileInertial, AMapWithInertialStateRoundTripsAsVersion2) {
   const MapFileHeader h = read_map_header(bytes, "tiny_inertial.pvbmap");
   const MapSettings want = test::tiny_inertial_settings();
   EXPECT_EQ(h.version, 2u);
-  EXPECT_EQ(h.settings.sensors, SensorSetup::kCameraImuWheels);
+  EXPECT_EQ(h.settings.sensors, sensor::SensorSetup::kCameraImuWheels);
   EXPECT_TRUE(h.settings.T_b_c.isApprox(want.T_b_c, 0));
   EXPECT_TRUE(h.settings.T_base_c.isApprox(want.T_base_c, 0));
   EXPECT_EQ(h.settings.difference(want), "");
@@ -859,13 +859,13 @@ TEST(MapFileInertial, ExtrinsicsAreComparedWhereMapAndRunBothUseThem) {
   EXPECT_NE(map.difference(run).find("Robot.T_base_c1: the map's and this run's differ by 10.00 mm"),
             std::string::npos)
       << map.difference(run);
-  run.sensors = SensorSetup::kCameraImu;  // the run has no wheels: the base is not compared
+  run.sensors = sensor::SensorSetup::kCameraImu;  // the run has no wheels: the base is not compared
   EXPECT_EQ(map.difference(run), "");
   run.T_b_c = moved(map.T_b_c, 0.05, 5);
-  run.sensors = SensorSetup::kCamera;  // a camera-only run uses the visual map alone
+  run.sensors = sensor::SensorSetup::kCamera;  // a camera-only run uses the visual map alone
   EXPECT_EQ(map.difference(run), "");
   EXPECT_EQ(run.difference(map), "");       // and a camera-only map serves a run with an IMU
-  run.sensors = SensorSetup::kCameraAccel;  // an accelerometer's frame is compared
+  run.sensors = sensor::SensorSetup::kCameraAccel;  // an accelerometer's frame is compared
   EXPECT_NE(map.difference(run).find("IMU.T_b_c1"), std::string::npos);
   run.num_features += 1;  // the visual settings first
   EXPECT_NE(map.difference(run).find("ORBextractor.nFeatures"), std::string::npos);

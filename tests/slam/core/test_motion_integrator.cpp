@@ -14,15 +14,15 @@ constexpr std::int64_t kImuPeriodNs = 5'000'000;  // 200 Hz
 constexpr std::int64_t kFramePeriodNs = 33'333'333;
 
 /// A camera looking along the IMU's x (forward), 10 cm above it.
-Settings robot_settings(SensorSetup setup) {
+Settings robot_settings(sensor::SensorSetup setup) {
   Settings s;
-  s.sensors = setup;
-  s.imu.present = true;
-  s.imu.rate_hz = 200;
-  s.imu.T_b_c = geom::make_se3(geom::R_body_optical(), Eigen::Vector3d(0.05, 0, 0.1));
-  s.robot.present = true;
-  s.robot.T_base_imu = geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 0.3));
-  s.robot.T_base_c = s.robot.T_base_imu * s.imu.T_b_c;
+  s.motion.setup = setup;
+  s.motion.imu.present = true;
+  s.motion.imu.rate_hz = 200;
+  s.motion.imu.T_b_c = geom::make_se3(geom::R_body_optical(), Eigen::Vector3d(0.05, 0, 0.1));
+  s.motion.robot.present = true;
+  s.motion.robot.T_base_imu = geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 0.3));
+  s.motion.robot.T_base_c = s.motion.robot.T_base_imu * s.motion.imu.T_b_c;
   return s;
 }
 
@@ -44,8 +44,8 @@ std::vector<sensor::ImuSample> level_readings(std::int64_t t0_ns, std::int64_t t
 }
 
 TEST(MotionIntegrator, PredictsAStraightDriveAtConstantSpeed) {
-  const Settings s = robot_settings(SensorSetup::kCameraImu);
-  MotionIntegrator m(s.sensors, s.imu, s.robot);
+  const Settings s = robot_settings(sensor::SensorSetup::kCameraImu);
+  MotionIntegrator m(s.motion);
   m.add_frame(0, level_readings(-kFramePeriodNs, 0, 0), {});
   m.add_frame(kFramePeriodNs, level_readings(0, kFramePeriodNs, 0), {});
   // The readings at 5 ... 30 ms, the one at 30 ms held to the frame's time.
@@ -63,12 +63,12 @@ TEST(MotionIntegrator, PredictsAStraightDriveAtConstantSpeed) {
 }
 
 TEST(MotionIntegrator, WheelsCarryTheTranslationAndTheGyroTheTurn) {
-  const Settings s = robot_settings(SensorSetup::kCameraImuWheels);
-  MotionIntegrator m(s.sensors, s.imu, s.robot);
+  const Settings s = robot_settings(sensor::SensorSetup::kCameraImuWheels);
+  MotionIntegrator m(s.motion);
   // An accelerometer bias of 0.5 m/s^2 forward that the IMU alone would
   // integrate; the wheels say 0.2 m/s straight on.
   const Eigen::Vector3d bias_like(0.5, 0, 0);
-  const double metres_per_tick = 2 * M_PI * s.robot.drive.wheel_radius_m / s.robot.drive.ticks_per_rev;
+  const double metres_per_tick = 2 * M_PI * s.motion.robot.drive.wheel_radius_m / s.motion.robot.drive.ticks_per_rev;
   std::vector<sensor::WheelTicks> ticks;
   for (int k = 0; k <= 10; ++k) {
     const auto count = static_cast<std::int64_t>(std::lround(0.2 * 0.1 * k / metres_per_tick));
@@ -79,8 +79,8 @@ TEST(MotionIntegrator, WheelsCarryTheTranslationAndTheGyroTheTurn) {
               std::vector<sensor::WheelTicks>(ticks.begin() + 1, ticks.end()));
   const geom::SE3d T_c_w0 = m.camera_pose(NavState{});
   const geom::SE3d T_c_w1 = m.predict(T_c_w0, Eigen::Vector3d(0.2, 0, 0), Eigen::Vector3d(0, 0, -kG), nullptr);
-  const geom::SE3d T_w_base0 = T_c_w0.inverse() * s.robot.T_base_c.inverse();
-  const geom::SE3d T_w_base1 = T_c_w1.inverse() * s.robot.T_base_c.inverse();
+  const geom::SE3d T_w_base0 = T_c_w0.inverse() * s.motion.robot.T_base_c.inverse();
+  const geom::SE3d T_w_base1 = T_c_w1.inverse() * s.motion.robot.T_base_c.inverse();
   const geom::SE3d T_b0_b1 = T_w_base0.inverse() * T_w_base1;
   // 0.2 m ahead within one count, turned 0.1 rad by the gyro, no height.
   EXPECT_NEAR(T_b0_b1.translation().x(), 0.2, metres_per_tick);
@@ -106,11 +106,11 @@ std::vector<sensor::WheelTicks> straight_ticks(std::int64_t t0_ns, std::int64_t 
 }
 
 TEST(MotionIntegrator, WheelIntervalsEndAtTheFramesBetweenEncoderReadings) {
-  Settings s = robot_settings(SensorSetup::kCameraImuWheels);
-  s.robot.encoder_rate_hz = 50;
-  MotionIntegrator m(s.sensors, s.imu, s.robot);
+  Settings s = robot_settings(sensor::SensorSetup::kCameraImuWheels);
+  s.motion.robot.encoder_rate_hz = 50;
+  MotionIntegrator m(s.motion);
   const double speed = 0.45,
-               metres_per_tick = 2 * M_PI * s.robot.drive.wheel_radius_m / s.robot.drive.ticks_per_rev;
+               metres_per_tick = 2 * M_PI * s.motion.robot.drive.wheel_radius_m / s.motion.robot.drive.ticks_per_rev;
   // Keyframes 1, 2, 3 and 4 frames apart: their ends fall 0, 6.7 and 13.3 ms
   // after the last encoder reading, in turn.
   const int keyframe_at[] = {0, 3, 5, 6, 10, 14, 15, 18};
@@ -132,8 +132,8 @@ TEST(MotionIntegrator, WheelIntervalsEndAtTheFramesBetweenEncoderReadings) {
 }
 
 TEST(MotionIntegrator, KeyframeIntervalsSplitTheReadingsAndGiveTheTilt) {
-  const Settings s = robot_settings(SensorSetup::kCameraImu);
-  MotionIntegrator m(s.sensors, s.imu, s.robot);
+  const Settings s = robot_settings(sensor::SensorSetup::kCameraImu);
+  MotionIntegrator m(s.motion);
   for (int f = 0; f < 10; ++f)
     m.add_frame(f * kFramePeriodNs, level_readings((f - 1) * kFramePeriodNs, f * kFramePeriodNs, 0), {});
   const KeyframeInterval a = m.take_keyframe_interval();
@@ -154,8 +154,8 @@ TEST(MotionIntegrator, KeyframeIntervalsSplitTheReadingsAndGiveTheTilt) {
 }
 
 TEST(MotionIntegrator, AccelerometerOnlyReadingsGiveTiltButNoIntervals) {
-  const Settings s = robot_settings(SensorSetup::kCameraAccel);
-  MotionIntegrator m(s.sensors, s.imu, s.robot);
+  const Settings s = robot_settings(sensor::SensorSetup::kCameraAccel);
+  MotionIntegrator m(s.motion);
   auto readings = level_readings(-kFramePeriodNs, 0, 0);
   for (auto& r : readings) r.gyro_radps = Eigen::Vector3d::Constant(std::nan(""));
   m.add_frame(0, readings, {});
@@ -174,15 +174,15 @@ namespace {
 // A blind stretch feeds each prediction back as the next start: ninety
 // frames with wheels stay a rotation and follow the encoders.
 TEST(MotionIntegrator, ChainedPredictionsStayRigidAndFollowTheWheels) {
-  Settings s = robot_settings(SensorSetup::kCameraImuWheels);
+  Settings s = robot_settings(sensor::SensorSetup::kCameraImuWheels);
   // A mount with a tilt, as a real one (the camera pitched down 15 degrees).
-  s.robot.T_base_c = geom::make_se3(Eigen::Matrix3d(Eigen::AngleAxisd(0.26, Eigen::Vector3d::UnitY())) *
+  s.motion.robot.T_base_c = geom::make_se3(Eigen::Matrix3d(Eigen::AngleAxisd(0.26, Eigen::Vector3d::UnitY())) *
                                         geom::R_body_optical(),
                                     Eigen::Vector3d(0.15, 0, 1.0));
-  s.imu.T_b_c = s.robot.T_base_imu.inverse() * s.robot.T_base_c;
-  MotionIntegrator m(s.sensors, s.imu, s.robot);
-  const double metres_per_tick = 2 * M_PI * s.robot.drive.wheel_radius_m / s.robot.drive.ticks_per_rev;
-  geom::SE3d T_c_w = s.robot.T_base_c.inverse();  // the base at the origin
+  s.motion.imu.T_b_c = s.motion.robot.T_base_imu.inverse() * s.motion.robot.T_base_c;
+  MotionIntegrator m(s.motion);
+  const double metres_per_tick = 2 * M_PI * s.motion.robot.drive.wheel_radius_m / s.motion.robot.drive.ticks_per_rev;
+  geom::SE3d T_c_w = s.motion.robot.T_base_c.inverse();  // the base at the origin
   const Eigen::Vector3d g(0, 0, -kG);
   m.add_frame(0, level_readings(-kFramePeriodNs, 0, 0), {{0, 0, 0}});
   for (int f = 1; f <= 90; ++f) {
@@ -194,7 +194,7 @@ TEST(MotionIntegrator, ChainedPredictionsStayRigidAndFollowTheWheels) {
     ASSERT_NEAR((R * R.transpose() - Eigen::Matrix3d::Identity()).norm(), 0, 1e-12) << "frame " << f;
   }
   // 3 s at 0.5 m/s straight ahead, within a count, the mount's height kept.
-  const geom::SE3d T_w_base = T_c_w.inverse() * s.robot.T_base_c.inverse();
+  const geom::SE3d T_w_base = T_c_w.inverse() * s.motion.robot.T_base_c.inverse();
   EXPECT_NEAR(T_w_base.translation().x(), 1.5, 2 * metres_per_tick);
   EXPECT_NEAR(T_w_base.translation().y(), 0, 1e-9);
   EXPECT_NEAR(T_w_base.translation().z(), 0, 1e-9);

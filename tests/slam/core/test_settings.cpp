@@ -496,38 +496,35 @@ const std::string kRobotKeys =
 
 TEST(Settings, ReadsImuAndRobotKeysAndTheSensorSetup) {
   const Settings plain = read_settings(tum1());
-  EXPECT_EQ(plain.sensors, SensorSetup::kCamera);
-  EXPECT_FALSE(plain.imu.present);
-  EXPECT_FALSE(plain.robot.present);
+  EXPECT_EQ(plain.motion.setup, sensor::SensorSetup::kCamera);
+  EXPECT_FALSE(plain.motion.imu.present);
+  EXPECT_FALSE(plain.motion.robot.present);
   const Settings s = read_settings(
       temp_copy("imu", read_file(tum1()) + kImuKeys + kRobotKeys + "System.Sensors: \"camera+imu+wheels\"\n"));
   EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
-  EXPECT_EQ(s.sensors, SensorSetup::kCameraImuWheels);
-  ASSERT_TRUE(s.imu.present);
-  EXPECT_DOUBLE_EQ(s.imu.noise.gyro_noise_density, 0.00017);
-  EXPECT_DOUBLE_EQ(s.imu.noise.accel_random_walk, 0.0004);
-  EXPECT_DOUBLE_EQ(s.imu.rate_hz, 200.0);
+  EXPECT_EQ(s.motion.setup, sensor::SensorSetup::kCameraImuWheels);
+  ASSERT_TRUE(s.motion.imu.present);
+  EXPECT_DOUBLE_EQ(s.motion.imu.noise.gyro_noise_density, 0.00017);
+  EXPECT_DOUBLE_EQ(s.motion.imu.noise.accel_random_walk, 0.0004);
+  EXPECT_DOUBLE_EQ(s.motion.imu.rate_hz, 200.0);
   // The accelerometer is weighed with its density inflated, 3x unless set.
-  EXPECT_DOUBLE_EQ(s.imu.noise.accel_noise_density, 0.002);
-  EXPECT_DOUBLE_EQ(s.imu.fused_noise().accel_noise_density, 0.006);
-  EXPECT_DOUBLE_EQ(s.imu.fused_noise().gyro_noise_density, 0.00017);
+  EXPECT_DOUBLE_EQ(s.motion.imu.noise.accel_noise_density, 0.002);
+  EXPECT_DOUBLE_EQ(s.motion.imu.fused_noise().accel_noise_density, 0.006);
+  EXPECT_DOUBLE_EQ(s.motion.imu.fused_noise().gyro_noise_density, 0.00017);
   // Its bias walks 100x as fast unless set.
-  EXPECT_DOUBLE_EQ(s.imu.fused_noise().accel_random_walk, 0.04);
-  EXPECT_DOUBLE_EQ(s.imu.fused_noise().gyro_random_walk, s.imu.noise.gyro_random_walk);
+  EXPECT_DOUBLE_EQ(s.motion.imu.fused_noise().accel_random_walk, 0.04);
+  EXPECT_DOUBLE_EQ(s.motion.imu.fused_noise().gyro_random_walk, s.motion.imu.noise.gyro_random_walk);
   const Settings one = read_settings(temp_copy(
       "imu1", read_file(tum1()) + kImuKeys + "IMU.AccNoiseInflation: 1.0\nIMU.AccWalkInflation: 1\n"));
-  EXPECT_DOUBLE_EQ(one.imu.fused_noise().accel_noise_density, 0.002);
-  EXPECT_DOUBLE_EQ(one.imu.fused_noise().accel_random_walk, 0.0004);
+  EXPECT_DOUBLE_EQ(one.motion.imu.fused_noise().accel_noise_density, 0.002);
+  EXPECT_DOUBLE_EQ(one.motion.imu.fused_noise().accel_random_walk, 0.0004);
   // The camera's optical z looks along the IMU's x; its centre 5 cm ahead, 10 cm up.
-  EXPECT_NEAR((s.imu.T_b_c.linear() * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitX()).norm(), 0, 1e-6);
-  EXPECT_NEAR((s.imu.T_b_c.translation() - Eigen::Vector3d(0.05, 0, 0.1)).norm(), 0, 1e-6);
-  ASSERT_TRUE(s.robot.present);
-  EXPECT_EQ(s.robot.drive.ticks_per_rev, 1024);
-  EXPECT_DOUBLE_EQ(s.robot.drive.track_m, 0.42);
-  EXPECT_NEAR(s.robot.T_base_imu.translation().z(), 0.4, 1e-6);
-  for (const char* name : {"camera", "camera+imu", "camera+imu+wheels", "camera+accel"})
-    EXPECT_STREQ(to_string(*parse_sensor_setup(name)), name);
-  EXPECT_FALSE(parse_sensor_setup("imu"));
+  EXPECT_NEAR((s.motion.imu.T_b_c.linear() * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitX()).norm(), 0, 1e-6);
+  EXPECT_NEAR((s.motion.imu.T_b_c.translation() - Eigen::Vector3d(0.05, 0, 0.1)).norm(), 0, 1e-6);
+  ASSERT_TRUE(s.motion.robot.present);
+  EXPECT_EQ(s.motion.robot.drive.ticks_per_rev, 1024);
+  EXPECT_DOUBLE_EQ(s.motion.robot.drive.track_m, 0.42);
+  EXPECT_NEAR(s.motion.robot.T_base_imu.translation().z(), 0.4, 1e-6);
 }
 
 TEST(Settings, SensorSetupWithoutItsKeysOrWithABadExtrinsicIsOneConfigError) {
@@ -555,9 +552,11 @@ TEST(Settings, SensorSetupWithoutItsKeysOrWithABadExtrinsicIsOneConfigError) {
   EXPECT_NE(error_of("s7", base + kImuKeys + "IMU.AccWalkInflation: 2000\n").find("IMU.AccWalkInflation"),
             std::string::npos);
   // With a setup that needs them, a flag's choice is checked the same way.
-  const Settings plain = read_settings(tum1());
-  EXPECT_THROW(check_sensor_setup(plain, SensorSetup::kCameraAccel), ConfigError);
-  EXPECT_NO_THROW(check_sensor_setup(plain, SensorSetup::kCamera));
+  MotionSensorSettings plain = read_settings(tum1()).motion;
+  plain.setup = sensor::SensorSetup::kCameraAccel;
+  EXPECT_THROW(plain.check(tum1()), ConfigError);
+  plain.setup = sensor::SensorSetup::kCamera;
+  EXPECT_NO_THROW(plain.check(tum1()));
 }
 
 }  // namespace

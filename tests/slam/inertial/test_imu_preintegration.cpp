@@ -35,7 +35,7 @@ std::vector<ImuPreintegration::Reading> random_readings(int n, unsigned seed) {
 }
 
 ImuPreintegration integrate_all(const std::vector<ImuPreintegration::Reading>& readings, const ImuBias& b,
-                                const ImuNoise& noise = {}) {
+                                const sensor::ImuNoise& noise = {}) {
   ImuPreintegration pre(b, noise);
   for (const auto& r : readings) pre.integrate(r.gyro_radps, r.accel_mps2, r.dt_s);
   return pre;
@@ -107,7 +107,7 @@ TEST(ImuPreintegration, FirstOrderBiasCorrectionIsSecondOrderAccurate) {
 
 TEST(ImuPreintegration, CovarianceMatchesMonteCarlo) {
   const auto readings = random_readings(60, 3);  // 0.3 s
-  ImuNoise noise;
+  sensor::ImuNoise noise;
   noise.gyro_noise_density = 2e-3;
   noise.accel_noise_density = 2e-2;
   const ImuBias b0;
@@ -232,7 +232,7 @@ TEST(ImuPreintegration, ReintegrateEqualsAFreshIntegration) {
 }
 
 TEST(ImuPreintegration, RejectsNonPositiveDt) {
-  ImuPreintegration pre(ImuBias{}, ImuNoise{});
+  ImuPreintegration pre(ImuBias{}, sensor::ImuNoise{});
   EXPECT_THROW(pre.integrate(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0), std::invalid_argument);
   EXPECT_THROW(pre.integrate(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), -1e-3), std::invalid_argument);
   EXPECT_EQ(pre.size(), 0u);

@@ -111,7 +111,7 @@ TEST(InertialResiduals, WhitenedImuResidualIsChiSquare) {
 }
 
 TEST(InertialResiduals, BiasWalk) {
-  ImuPreintegration pre(ImuBias{}, ImuNoise{});
+  ImuPreintegration pre(ImuBias{}, sensor::ImuNoise{});
   for (int k = 0; k < 100; ++k) pre.integrate(Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 9.81), 0.01);
   const BiasWalkFactor f(pre);
   const std::array<double, 6> bi = {0.001, 0, 0, 0.01, 0, 0}, bj = {0.001, 0, 0, 0.01, 0, 0.004};
@@ -120,8 +120,8 @@ TEST(InertialResiduals, BiasWalk) {
   for (double x : r) EXPECT_EQ(x, 0.0);
   f.residual(bi.data(), bj.data(), r);
   // 0.004 m/s^2 over 1 s at 4e-4 m/s^3/sqrt(Hz): 10 sigma.
-  EXPECT_NEAR(r[5], 0.004 / (ImuNoise{}.accel_random_walk * 1.0), 1e-9);
-  EXPECT_THROW(BiasWalkFactor(ImuPreintegration(ImuBias{}, ImuNoise{})), std::invalid_argument);
+  EXPECT_NEAR(r[5], 0.004 / (sensor::ImuNoise{}.accel_random_walk * 1.0), 1e-9);
+  EXPECT_THROW(BiasWalkFactor(ImuPreintegration(ImuBias{}, sensor::ImuNoise{})), std::invalid_argument);
 }
 
 TEST(InertialResiduals, WheelResidualVanishesOnFlatGround) {

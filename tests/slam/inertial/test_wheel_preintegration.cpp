@@ -12,8 +12,8 @@
 namespace pvb::slam {
 namespace {
 
-WheelDrive drive() {
-  WheelDrive d;
+sensor::DriveDescription drive() {
+  sensor::DriveDescription d;
   d.wheel_radius_m = 0.1;
   d.track_m = 0.4;
   d.ticks_per_rev = 1000;
@@ -114,7 +114,7 @@ TEST(WheelPreintegration, CovarianceMatchesMonteCarlo) {
   // Perturb every interval's increment by noise of the model's variances
   // (isotropic translation sigma_t^2 ds, yaw sigma_m^2 ds + sigma_r^2 |dyaw|)
   // and compose: the spread must match the propagated covariance.
-  const WheelDrive d = drive();
+  const sensor::DriveDescription d = drive();
   const WheelNoise n;
   WheelPreintegration pre(d, n);
   const double mpt = 2 * M_PI * d.wheel_radius_m / d.ticks_per_rev;
@@ -159,7 +159,7 @@ TEST(WheelPreintegration, AppendEqualsAddingEverything) {
 }
 
 TEST(WheelPreintegration, RejectsABadDrive) {
-  WheelDrive d = drive();
+  sensor::DriveDescription d = drive();
   d.track_m = 0;
   EXPECT_THROW(WheelPreintegration(d, WheelNoise{}), std::invalid_argument);
   d = drive();

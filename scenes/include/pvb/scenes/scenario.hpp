@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "pvb/scenes/body.hpp"
+#include "pvb/scenes/motion_sensor_specs.hpp"
 
 namespace pvb::scenes {
 
@@ -22,7 +22,7 @@ enum class RoutePattern { kWaypoints, kAlongRow, kLawnmower, kLoop };
 enum class DepthNoiseModel { kNone, kKinect };
 /// The depth camera: a structured-light Kinect v1 (the depth_noise model)
 /// or an active stereo RealSense D435 (ActiveStereo).
-enum class CameraModel { kKinect, kD435 };
+enum class CameraKind { kKinect, kD435 };
 enum class OnLoss { kWait, kAbort };
 enum class WallFinish { kBrick, kPlaster };
 /// How an array's panels are held: fixed tilted tables, or rows of modules
@@ -291,7 +291,7 @@ struct Camera {
   double pitch_deg = -12.0;  ///< negative looks down
   double yaw_deg = 0.0;      ///< relative to the robot's heading, positive left
   Eigen::Vector2d depth_range_m{0.5, 4.5};
-  CameraModel model = CameraModel::kKinect;
+  CameraKind model = CameraKind::kKinect;
   DepthNoise depth_noise;  ///< the kinect model's depth
   ActiveStereo stereo;     ///< the d435 model's depth
   RgbNoise rgb;
@@ -303,7 +303,7 @@ struct Camera {
   double fovy_deg() const;
   /// The depth sensor's baseline: the Kinect's projector to camera, the
   /// D435's imager to imager.
-  double depth_baseline_m() const { return model == CameraModel::kD435 ? stereo.baseline_m : depth_noise.baseline_m; }
+  double depth_baseline_m() const { return model == CameraKind::kD435 ? stereo.baseline_m : depth_noise.baseline_m; }
   /// The D435's own colour camera and depth range: 640 x 480 at fx 615,
   /// [0.2, 6] m (the d435 model's defaults, before the file's keys).
   void use_d435_colour_camera() {
@@ -346,9 +346,8 @@ struct SlamTuning {
   /// KeyFrame.refOverlap (pvbench's own key; unset: ORB-SLAM2's 75 % rule)
   std::optional<double> keyframe_ref_overlap;
   /// System.Sensors (pvbench's own key; unset: camera): the sensors the
-  /// SLAM core fuses, "camera", "camera+imu", "camera+imu+wheels" or
-  /// "camera+accel".
-  std::optional<std::string> sensors;
+  /// SLAM core fuses.
+  std::optional<sensor::SensorSetup> sensors;
 };
 
 /// What a seed sweep of this scenario must show (`expect.sweep:`), judged by

@@ -8,15 +8,6 @@
 
 namespace pvb::sensor {
 
-/// What odometry needs to know of a differential-drive robot: the nominal
-/// wheel radius, the track (between the wheels' contact points) and the
-/// encoders' counts per wheel revolution.
-struct DriveDescription {
-  double wheel_radius_m = 0.1;
-  double track_m = 0.42;
-  int ticks_per_rev = 1024;
-};
-
 /// The planar pose of the base in the odometry frame (where the first
 /// reading found it: the origin, heading along x) and its body speeds.
 struct OdometryState {

@@ -13,26 +13,18 @@
 
 namespace pvb::dataset {
 
-/// Kalibr's IMU noise parameters (continuous time) and the sample rate.
-struct ImuCalibration {
-  double gyro_noise_density = 0;   ///< rad/s/sqrt(Hz)
-  double gyro_random_walk = 0;     ///< rad/s^2/sqrt(Hz)
-  double accel_noise_density = 0;  ///< m/s^2/sqrt(Hz)
-  double accel_random_walk = 0;    ///< m/s^3/sqrt(Hz)
-  double rate_hz = 200;
-};
-
 /// What a recording says of the robot carrying the camera.
 struct RobotCalibration {
-  ImuCalibration imu;
+  sensor::ImuNoise imu;        ///< Kalibr's noise model of the IMU
+  double imu_rate_hz = 200;
   sensor::DriveDescription drive;        ///< nominal values
   double encoder_rate_hz = 50;
   geom::SE3d T_b_c = geom::SE3d::Identity();  ///< camera optical frame in the base
   geom::SE3d T_b_i = geom::SE3d::Identity();  ///< IMU in the base
 };
 
-/// Kalibr's imu.yaml.
-std::string kalibr_imu_yaml(const ImuCalibration& c);
+/// Kalibr's imu.yaml of an IMU reading at `rate_hz`.
+std::string kalibr_imu_yaml(const sensor::ImuNoise& noise, double rate_hz);
 /// robot.yaml: the nominal drive, the rates and both mounts.
 std::string robot_yaml(const RobotCalibration& c);
 

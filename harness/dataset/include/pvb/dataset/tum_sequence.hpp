@@ -40,7 +40,7 @@ struct OrbSlamSettings {
   /// pvbench's KeyFrame.refOverlap; written only when set.
   std::optional<double> kf_ref_overlap;
   /// pvbench's System.Sensors; written only when set.
-  std::optional<std::string> sensors;
+  std::optional<sensor::SensorSetup> sensors;
   /// The IMU (ORB-SLAM3's IMU.* keys) and the robot (pvbench's Robot.*
   /// keys); written only when set (ORB-SLAM2 ignores both).
   std::optional<RobotCalibration> robot;

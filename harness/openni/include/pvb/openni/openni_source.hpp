@@ -74,8 +74,6 @@ class OpenniSource : public sensor::FrameSource {
   /// when one was made.
   std::optional<RecordingSummary> stop();
 
-  /// Device URI as OpenNI2 reports it.
-  const std::string& device_uri() const;
   /// Images dropped by pairing so far (colour, depth).
   std::size_t dropped_colour() const;
   std::size_t dropped_depth() const;

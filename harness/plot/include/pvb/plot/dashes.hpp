@@ -2,7 +2,7 @@
 // Dashed lines on a chart (pvb::eval::Figure): the line chart draws solid
 // polylines; dash_polylines() breaks those of one colour into dashes, the
 // legend's sample among them.
-#include "pvb/eval/plot.hpp"
+#include "pvb/eval/charts.hpp"
 
 namespace pvb::plot {
 

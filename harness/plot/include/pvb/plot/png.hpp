@@ -4,7 +4,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 
-#include "pvb/eval/plot.hpp"
+#include "pvb/eval/charts.hpp"
 
 namespace pvb::plot {
 

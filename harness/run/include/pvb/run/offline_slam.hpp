@@ -40,7 +40,7 @@ struct OfflineSlamOptions {
   bool dump_map = false;                ///< Map.txt
   MapOptions map;
   /// Overrides the settings' System.Sensors (--sensors); nullopt: keep it.
-  std::optional<slam::SensorSetup> sensors;
+  std::optional<sensor::SensorSetup> sensors;
   /// Set asynchronously (a signal) to stop taking frames; may be null.
   const std::atomic<bool>* stop = nullptr;
 

@@ -49,12 +49,12 @@ struct RunOptions {
   SlamMode mode = SlamMode::kPeSlam;
   /// Overrides the settings' sensor setup (camera.yaml's System.Sensors,
   /// absent: camera) for every system (--sensors).
-  std::optional<slam::SensorSetup> sensors;
+  std::optional<sensor::SensorSetup> sensors;
   /// Two setups on the same rendered frames (--compare-sensors A,B): the
   /// primary run fuses B, the reference run (report.baseline, folder
   /// baseline/) fuses A; both with PE-match unless mode is kBaseline.
   /// Not with kCompare.
-  std::optional<std::pair<slam::SensorSetup, slam::SensorSetup>> compare_sensors;
+  std::optional<std::pair<sensor::SensorSetup, sensor::SensorSetup>> compare_sensors;
   bool closed_loop = false;        ///< steer from the SLAM pose instead of ground truth
   bool loop_closing = true;        ///< false: LoopClosing.enabled = 0 for every system (--no-loop-closing)
   /// Score the dense maps against the scenario's true surface

@@ -1,5 +1,5 @@
 #pragma once
-// The sensor setup of a run (slam::SensorSetup) as the commands take it:
+// The sensor setup of a run (sensor::SensorSetup) as the commands take it:
 // the --sensors and --compare-sensors flags, and the IMU description the
 // harness supplies when a TUM folder's accelerometer has none in the
 // settings (docs/sensors.md, "The Kinect v1's accelerometer").
@@ -12,29 +12,26 @@
 
 namespace pvb::run {
 
-/// The values --sensors accepts, for messages and help.
-inline constexpr const char* kSensorSetupValues = "camera, camera+imu, camera+imu+wheels or camera+accel";
-
 /// `text` as a sensor setup; ConfigError naming `option` and the accepted
-/// values otherwise.
-slam::SensorSetup parse_sensors_option(const std::string& text, const std::string& option);
+/// values (sensor::sensor_setup_values()) otherwise.
+sensor::SensorSetup parse_sensors_option(const std::string& text, const std::string& option);
 
 /// "A,B" of --compare-sensors: two different setups, the reference A first.
-std::pair<slam::SensorSetup, slam::SensorSetup> parse_sensor_pair_option(const std::string& text,
+std::pair<sensor::SensorSetup, sensor::SensorSetup> parse_sensor_pair_option(const std::string& text,
                                                                           const std::string& option);
 
 /// Sets settings->sensors to `setup` and checks that the settings hold the
-/// sections it needs (slam::check_sensor_setup: ConfigError otherwise).
-void apply_sensor_setup(slam::Settings* settings, slam::SensorSetup setup);
+/// sections it needs (slam::MotionSensorSettings::check: ConfigError otherwise).
+void apply_sensor_setup(slam::Settings* settings, sensor::SensorSetup setup);
 
 /// The gravity metric's label of the map frame: "first_camera" for camera
 /// alone, "gravity_aligned" for the setups with an accelerometer.
-const char* gravity_map_frame(slam::SensorSetup setup);
+const char* gravity_map_frame(sensor::SensorSetup setup);
 
 /// The Kinect v1's accelerometer as an IMU.* section: readings already in
 /// the camera's optical frame (IMU.T_b_c1 the identity), noise from its
 /// resolution (dataset/kinect_accelerometer.hpp), 500 Hz.  Sets
-/// settings->imu when the settings have no IMU.* keys and `sequence` holds
+/// settings->motion.imu when the settings have no IMU.* keys and `sequence` holds
 /// a Kinect accelerometer.txt; returns whether it did.  For camera+accel
 /// only (the setups with a gyroscope still need the settings' IMU.*).
 /// Settings with IMU.* keep them, but accelerometer.txt is read into the
@@ -53,7 +50,7 @@ bool supply_kinect_description(slam::Settings* settings);
 void kinect_accelerometer_at(double rate_hz, slam::ImuSettings* imu);
 
 /// What `setup` reads of a folder's motion files (none for camera).
-dataset::MotionNeeds motion_needs(slam::SensorSetup setup);
+dataset::MotionNeeds motion_needs(sensor::SensorSetup setup);
 
 /// Checks the motion readings `reader` holds against the frames a run
 /// tracks (the first `max_frames`, 0: all) and `settings`, read from

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "pvb/eval/plot.hpp"
+#include "pvb/eval/charts.hpp"
 #include "pvb/suite/metrics_file.hpp"
 
 namespace pvb::suite {

@@ -29,17 +29,18 @@ Eigen::Matrix3d load_homography(const std::string& path);
 std::vector<MatchLabel> label_by_homography(const std::vector<slam::PointMatch>& m, const Eigen::Matrix3d& H,
                                             double threshold_px = 3.0);
 
-/// Camera settings read from an ORB-SLAM2 yaml (cv::FileStorage):
-/// Camera.fx/fy/cx/cy (required), Camera.k1/k2/p1/p2/k3 (optional),
-/// Camera.width/height (optional), DepthMapFactor (optional, default 5000).
+/// The camera of an ORB-SLAM2 RGB-D settings file, as the matching
+/// experiment uses it.
 struct CameraSettings {
   geom::PinholeIntrinsics K;
   cv::Mat dist_coeffs;               ///< 1x5 (k1 k2 p1 p2 k3), or empty when zero
   double depth_map_factor = 5000.0;  ///< raw depth units per metre
 };
 
-/// Loads CameraSettings; throws IoError (unreadable) or ConfigError (missing
-/// key, or a value outside the ranges slam::read_settings accepts).
+/// Reads the settings file with slam::read_settings (every key it requires,
+/// the ranges it accepts: IoError or ConfigError otherwise) and keeps its
+/// camera: Camera.fx/fy/cx/cy/width/height, k1, k2, p1, p2, k3 and
+/// DepthMapFactor.
 CameraSettings load_camera_settings(const std::string& path);
 
 /// Loads a 16-bit depth PNG as metres (CV_32F, 0 = invalid).  Throws IoError

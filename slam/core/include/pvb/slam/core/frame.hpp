@@ -138,8 +138,6 @@ class Frame {
   /// the shifts are far smaller than its cells.
   void move_keypoint(std::size_t i, const Eigen::Vector2d& to_px);
   Eigen::Vector3d camera_center_w() const { return T_c_w.inverse().translation(); }
-  /// Number of keypoints with a map point.
-  int num_tracked() const;
   /// What this frame holds, by structure.
   FrameMemory memory() const;
 

@@ -27,7 +27,7 @@ struct MapSettings {
   // The motion sensors: in INER, so only in a map with a trusted inertial
   // state; a map without one reads back as kCamera (its visual map is all
   // it holds).
-  SensorSetup sensors = SensorSetup::kCamera;
+  sensor::SensorSetup sensors = sensor::SensorSetup::kCamera;
   /// IMU.T_b_c1, the camera in the IMU (body) frame; used when
   /// uses_accel(sensors), the identity otherwise.
   geom::SE3d T_b_c = geom::SE3d::Identity();

@@ -24,7 +24,7 @@ class MotionIntegrator {
   /// Seconds of accelerometer readings averaged for a keyframe's tilt.
   static constexpr double kTiltWindowS = 0.2;
 
-  MotionIntegrator(SensorSetup setup, const ImuSettings& imu, const RobotSettings& robot);
+  explicit MotionIntegrator(const MotionSensorSettings& sensors);
 
   /// Adds the readings that came with the frame at t_ns (those since the
   /// previous frame); starts a new since-last-frame interval.
@@ -65,7 +65,7 @@ class MotionIntegrator {
   /// The camera pose of an IMU state.
   geom::SE3d camera_pose(const NavState& s) const;
 
-  SensorSetup setup() const { return setup_; }
+  sensor::SensorSetup setup() const { return setup_; }
   const ImuSettings& imu_settings() const { return imu_; }
   const RobotSettings& robot_settings() const { return robot_; }
   /// Readings have come (a source without them leaves the intervals empty).
@@ -78,9 +78,9 @@ class MotionIntegrator {
   /// Credits the wheels up to the frame at the last interval's rate.
   void wheels_up_to(std::int64_t t_ns);
 
-  SensorSetup setup_;
+  sensor::SensorSetup setup_;
   ImuSettings imu_;
-  ImuNoise imu_noise_;  ///< imu_.fused_noise(): what the preintegrations weigh
+  sensor::ImuNoise imu_noise_;  ///< imu_.fused_noise(): what the preintegrations weigh
   RobotSettings robot_;
   std::int64_t period_ns_;          ///< the IMU's reading period
   std::int64_t encoder_period_ns_;  ///< the encoders' reading period

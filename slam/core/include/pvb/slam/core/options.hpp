@@ -108,9 +108,7 @@ struct LocalMappingOptions {
   BaOptions ba;
   /// The motion sensors fused (inertial initialisation, inertial and wheel
   /// terms in local BA; docs/slam_inertial.md).
-  SensorSetup sensors = SensorSetup::kCamera;
-  ImuSettings imu;
-  RobotSettings robot;
+  MotionSensorSettings motion;
   /// Inertial initialisation: keyframes in the chain and seconds it spans.
   int init_min_keyframes = 10;
   double init_min_span_s = 3.0;

@@ -71,11 +71,6 @@ struct PointCloudMappingSettings {
   bool reassemble = true;
 };
 
-struct Settings;
-/// Throws ConfigError when `s` lacks a section that `setup` needs (an app
-/// calls it after a flag changed Settings::sensors).
-void check_sensor_setup(const Settings& s, SensorSetup setup);
-
 /// The default vocabulary, trained by the build (docs/place_recognition.md).
 inline constexpr const char* kDefaultVocabularyPath = PVB_DEFAULT_VOCABULARY;
 
@@ -118,10 +113,8 @@ struct Settings {
   /// relocalisation against recent keyframes only).  Absent: the default,
   /// kDefaultVocabularyPath.
   std::string vocabulary_path = kDefaultVocabularyPath;
-  /// System.Sensors (ours, optional): the sensors fused; absent: camera.
-  SensorSetup sensors = SensorSetup::kCamera;
-  ImuSettings imu;                  ///< IMU.* (optional section)
-  RobotSettings robot;              ///< Robot.* (optional section)
+  /// System.Sensors, IMU.* and Robot.* (ours and ORB-SLAM3's, optional).
+  MotionSensorSettings motion;
   std::vector<std::string> warnings;  ///< unknown keys and similar, one line each
 
   /// Close/far depth threshold in metres (ORB-SLAM2: bf * ThDepth / fx).

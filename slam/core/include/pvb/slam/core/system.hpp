@@ -166,7 +166,7 @@ class System {
   /// trusted (MapGravity::ready false: not yet, or a camera-only setup).
   MapGravity gravity();
   /// The sensors this system fuses.
-  SensorSetup sensors() const { return settings_.sensors; }
+  sensor::SensorSetup sensors() const { return settings_.motion.setup; }
   /// Each keyframe in the map with an inertial state: its time, velocity
   /// and biases (for reports against the true biases).
   struct KeyFrameState {

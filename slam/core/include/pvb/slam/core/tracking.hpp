@@ -58,8 +58,9 @@ class Tracking {
   Tracking(Map& map, std::shared_ptr<const CameraModel> cam, const TrackingOptions& options,
            const PlaceRecognizer* place = nullptr);
 
-  /// Fuses the motion sensors of `setup` (not kCamera); before the first frame.
-  void use_motion_sensors(SensorSetup setup, const ImuSettings& imu, const RobotSettings& robot);
+  /// Fuses the motion sensors of `sensors` (checked; none for a camera-only
+  /// setup); before the first frame.
+  void use_motion_sensors(const MotionSensorSettings& sensors);
   /// The readings that came with the next frame (before track()).
   void add_motion(std::int64_t t_ns, const std::vector<sensor::ImuSample>& imu,
                   const std::vector<sensor::WheelTicks>& ticks);

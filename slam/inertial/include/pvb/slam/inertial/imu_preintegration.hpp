@@ -13,15 +13,9 @@
 #include <cstddef>
 #include <vector>
 
-namespace pvb::slam {
+#include "pvb/sensor/motion.hpp"
 
-/// Kalibr's continuous-time noise model of an IMU.
-struct ImuNoise {
-  double gyro_noise_density = 1.7e-4;   ///< rad/s/sqrt(Hz)   (IMU.NoiseGyro)
-  double accel_noise_density = 2.0e-3;  ///< m/s^2/sqrt(Hz)   (IMU.NoiseAcc)
-  double gyro_random_walk = 2.0e-5;     ///< rad/s^2/sqrt(Hz) (IMU.GyroWalk)
-  double accel_random_walk = 4.0e-4;    ///< m/s^3/sqrt(Hz)   (IMU.AccWalk)
-};
+namespace pvb::slam {
 
 struct ImuBias {
   Eigen::Vector3d gyro_radps = Eigen::Vector3d::Zero();
@@ -47,7 +41,7 @@ class ImuPreintegration {
 
   ImuPreintegration() = default;
   /// Empty: identity increments at linearisation bias `bias`.
-  ImuPreintegration(const ImuBias& bias, const ImuNoise& noise);
+  ImuPreintegration(const ImuBias& bias, const sensor::ImuNoise& noise);
 
   /// Adds one reading held constant over dt_s (> 0) and propagates the
   /// covariance (discrete noise: density^2 / dt) and the bias Jacobians.
@@ -65,7 +59,7 @@ class ImuPreintegration {
   std::size_t size() const { return readings_.size(); }
   const std::vector<Reading>& readings() const { return readings_; }
   const ImuBias& bias() const { return bias_; }
-  const ImuNoise& noise() const { return noise_; }
+  const sensor::ImuNoise& noise() const { return noise_; }
 
   /// Increments at the linearisation bias.
   const Eigen::Matrix3d& delta_R() const { return dR_; }
@@ -93,7 +87,7 @@ class ImuPreintegration {
 
  private:
   ImuBias bias_;
-  ImuNoise noise_;
+  sensor::ImuNoise noise_;
   std::vector<Reading> readings_;
   double dt_s_ = 0;
   Eigen::Matrix3d dR_ = Eigen::Matrix3d::Identity();

@@ -7,14 +7,9 @@
 #include <Eigen/Core>
 #include <cstdint>
 
-namespace pvb::slam {
+#include "pvb/sensor/motion.hpp"
 
-/// What the increments need to know of the robot.
-struct WheelDrive {
-  double wheel_radius_m = 0.1;
-  double track_m = 0.42;
-  int ticks_per_rev = 1024;
-};
+namespace pvb::slam {
 
 /// Noise of the planar increments, per metre rolled and per radian turned
 /// (variances add: sigma^2 = a^2 d + b^2 |dyaw|), and of the soft planar
@@ -42,7 +37,7 @@ Eigen::Vector3d wheel_step(double left_m, double right_m, double track_m);
 class WheelPreintegration {
  public:
   WheelPreintegration() = default;
-  WheelPreintegration(const WheelDrive& drive, const WheelNoise& noise);
+  WheelPreintegration(const sensor::DriveDescription& drive, const WheelNoise& noise);
 
   /// Adds one encoder interval: the count changes of the left and right
   /// wheel (positive forward), with a fraction where the interval is a
@@ -60,13 +55,13 @@ class WheelPreintegration {
   /// Standard deviations of the soft planar constraint for this increment:
   /// [z (m), roll (rad), pitch (rad)].
   Eigen::Vector3d planar_sigma() const;
-  const WheelDrive& drive() const { return drive_; }
+  const sensor::DriveDescription& drive() const { return drive_; }
   const WheelNoise& noise() const { return noise_; }
   /// Distance a wheel rolls per encoder count, metres.
   double metres_per_tick() const;
 
  private:
-  WheelDrive drive_;
+  sensor::DriveDescription drive_;
   WheelNoise noise_;
   Eigen::Vector3d delta_ = Eigen::Vector3d::Zero();
   Eigen::Matrix3d cov_ = Eigen::Matrix3d::Zero();

@@ -105,12 +105,11 @@ struct ImuRig {
   Eigen::Matrix3d R_base_imu = Eigen::Matrix3d::Identity();
   Eigen::Vector3d g_w = Eigen::Vector3d(0, 0, -9.81);
   ImuBias true_bias;      ///< added to every reading (constant)
-  ImuNoise noise;         ///< the model the preintegration is told
+  sensor::ImuNoise noise; ///< the model the preintegration is told
   bool white_noise = true;///< add discrete white noise of variance density^2 / dt
   double rate_hz = 200;   ///< reading rate
 
   geom::SE3d T_base_imu() const { return geom::make_se3(R_base_imu, Eigen::Vector3d::Zero()); }
-  geom::SE3d T_w_imu(const BodyMotion& m, double t) const { return m.T_w_base(t) * T_base_imu(); }
 
   /// The exact mean over [t, t + dt] of the angular rate and the specific
   /// force in the IMU frame (3-point Gauss-Legendre of the instantaneous values).
@@ -156,7 +155,7 @@ struct ImuRig {
 /// Wheel encoders of a differential drive on the base (no slip): each
 /// wheel's arc is the distance rolled -/+ track/2 times the heading change.
 struct WheelRig {
-  WheelDrive drive;
+  sensor::DriveDescription drive;
   WheelNoise noise;
   double rate_hz = 100;  ///< encoder reading rate
 

@@ -1,5 +1,5 @@
-// The robot's body sensors: physics rate, IMU and wheel encoders
-// (scenes/SCHEMA.md, docs/sensors.md).
+// The robot's motion sensors as a scenario describes them: physics rate,
+// IMU and wheel encoders (scenes/SCHEMA.md, docs/sensors.md).
 #include <algorithm>
 #include <Eigen/Geometry>
 #include <cmath>
@@ -17,6 +17,15 @@ constexpr double kDefaultMaxStepS = 0.002;           // physics step of a file t
 }  // namespace
 
 const char* to_string(ImuPart part) { return part == ImuPart::kBmi055 ? "bmi055" : "bmi088"; }
+
+sensor::ImuNoise kalibr_noise(const Imu& imu) {
+  sensor::ImuNoise n;
+  n.gyro_noise_density = imu.gyro.noise_density;
+  n.gyro_random_walk = imu.gyro.random_walk;
+  n.accel_noise_density = imu.accel.noise_density;
+  n.accel_random_walk = imu.accel.random_walk;
+  return n;
+}
 
 // Datasheet figures (BST-BMI088-DS001, BST-BMI055-DS000): gyroscope rate
 // noise density 0.014 deg/s/sqrt(Hz) and zero-rate offset +-1 deg/s for

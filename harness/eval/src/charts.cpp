@@ -1,4 +1,4 @@
-#include "pvb/eval/plot.hpp"
+#include "pvb/eval/charts.hpp"
 
 #include <algorithm>
 #include <cmath>

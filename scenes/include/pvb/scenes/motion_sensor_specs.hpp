@@ -7,6 +7,7 @@
 #include <string>
 
 #include "pvb/geometry/se3.hpp"
+#include "pvb/sensor/motion.hpp"
 
 namespace pvb::scenes {
 
@@ -40,6 +41,10 @@ struct Imu {
   InertialNoise gyro = part_gyro(ImuPart::kBmi088);
   InertialNoise accel = part_accel(ImuPart::kBmi088);
 };
+
+/// The IMU's noise in Kalibr's model: its gyroscope's and accelerometer's
+/// noise densities and random walks (imu.yaml, the settings' IMU.*).
+sensor::ImuNoise kalibr_noise(const Imu& imu);
 
 /// Incremental encoders on both driven wheels.
 struct Wheels {

@@ -1,7 +1,8 @@
 #pragma once
-// The trajectory error figure (top view + error over time) as a list of
-// drawing primitives in pixel coordinates, and its SVG serialisation.  The
-// PNG renderer lives in pvb::plot (it needs OpenCV; this library does not).
+// Charts as lists of drawing primitives in pixel coordinates: the
+// trajectory error figure (top view + error over time), line charts and
+// histograms, and their SVG serialisation.  The PNG renderer lives in
+// pvb::plot (it needs OpenCV; this library does not).
 #include <string>
 #include <vector>
 

@@ -1,4 +1,4 @@
-#include "pvb/run/place_recognition.hpp"
+#include "pvb/run/place_events.hpp"
 
 namespace pvb::run {
 
