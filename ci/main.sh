@@ -11,7 +11,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash ci/install-deps.sh
-bash ci/build.sh
+# pvbench, its render and camera plug-ins and the ORB vocabulary: the test
+# programs and benchmarks are left to the test command.
+bash ci/build.sh pvbench pvb_vocabulary
 B=./build/bin/pvbench
 OUT="${PVB_OUT:-out}/pv_station"
 rm -rf "$OUT"

@@ -52,16 +52,25 @@ std::string exact(double v) {
   return buf;
 }
 
-/// A PNG file of an RGB image.  zlib's level 6 for the station's few
-/// images (their bytes are pinned, tests/sim/test_old_bytes.cpp); level 1
-/// for a varied ground's many tiles, which encodes 3x faster for 7 % more
-/// bytes (the pixels MuJoCo decodes are the same).
-std::vector<unsigned char> png(const cv::Mat& rgb_img, int zlib_level = 6) {
-  cv::Mat bgr;
-  cv::cvtColor(rgb_img, bgr, cv::COLOR_RGB2BGR);
+constexpr const char* kGroundTilePrefix = "textures/groundt";
+
+/// zlib's level for a texture file as recordings write it: level 6 for the
+/// station's few images (their bytes are pinned, tests/sim/test_old_bytes.cpp);
+/// level 1 for a varied ground's many tiles, which encodes 3x faster for
+/// 7 % more bytes (the pixels MuJoCo decodes are the same).
+int file_zlib_level(const std::string& path) { return path.rfind(kGroundTilePrefix, 0) == 0 ? 1 : 6; }
+
+std::vector<unsigned char> png_of_bgr(const cv::Mat& bgr, int zlib_level) {
   std::vector<unsigned char> out;
   cv::imencode(".png", bgr, out, {cv::IMWRITE_PNG_COMPRESSION, zlib_level});
   return out;
+}
+
+/// The PNG file `path` of an RGB image, compressed as `compression` says.
+std::vector<unsigned char> png(const cv::Mat& rgb_img, const std::string& path, PngCompression compression) {
+  cv::Mat bgr;
+  cv::cvtColor(rgb_img, bgr, cv::COLOR_RGB2BGR);
+  return png_of_bgr(bgr, compression == PngCompression::kStored ? 0 : file_zlib_level(path));
 }
 
 // Deterministic uniform numbers for placement.
@@ -314,9 +323,13 @@ std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std
 void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tiles, SceneDetail detail,
                   SceneAssets* out) {
   const bool full = detail == SceneDetail::kFull;
-  const std::vector<unsigned char> grey = full ? std::vector<unsigned char>{} : png(cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(128)));
+  const PngCompression compression = out->png;
+  const std::vector<unsigned char> grey =
+      full ? std::vector<unsigned char>{}
+           : png(cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(128)), "textures/grey.png", compression);
   const auto add = [&](const std::string& name, const std::function<cv::Mat()>& draw) {
-    out->files.emplace_back("textures/" + name + ".png", full ? png(draw()) : grey);
+    const std::string path = "textures/" + name + ".png";
+    out->files.emplace_back(path, full ? png(draw(), path, compression) : grey);
   };
   const std::uint64_t station_seed = s.station_seed_or_seed(), day_seed = s.seed;
   add("ground", [&] { return make_ground_texture(s.ground.type, station_seed); });
@@ -325,10 +338,10 @@ void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tile
   if (full)
     cv::parallel_for_(cv::Range(0, static_cast<int>(tiles.size())), [&](const cv::Range& range) {
       for (int k = range.start; k < range.end; ++k)
-        tile_png[k] = png(make_ground_texture(s.ground.type, tiles[k].seed), 1);
+        tile_png[k] = png(make_ground_texture(s.ground.type, tiles[k].seed), kGroundTilePrefix, compression);
     });
   for (std::size_t k = 0; k < tiles.size(); ++k)
-    out->files.emplace_back("textures/groundt" + std::to_string(k) + ".png", std::move(tile_png[k]));
+    out->files.emplace_back(kGroundTilePrefix + std::to_string(k) + ".png", std::move(tile_png[k]));
   add("brick", [&] { return make_brick_texture(station_seed); });
   add("foliage", [&] { return make_foliage_texture(station_seed); });
   add("bark", [&] { return make_bark_texture(station_seed); });
@@ -698,9 +711,10 @@ void add_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<Groun
 
 }  // namespace
 
-SceneAssets build_scene(const scenes::Scenario& s, SceneDetail detail) {
+SceneAssets build_scene(const scenes::Scenario& s, SceneDetail detail, PngCompression png) {
   SceneAssets out;
   out.detail = detail;
+  out.png = png;
   const scenes::Camera& cam = s.camera;
   // Physics step: physics.rate_hz, or the largest step <= 2 ms that divides
   // the frame period, so frame i is rendered at exactly i / fps.
@@ -770,8 +784,13 @@ void write_scene(const SceneAssets& assets, const std::string& dir) {
   ::mkdir(dir.c_str(), 0755);
   ::mkdir((dir + "/textures").c_str(), 0755);
   write_file(dir + "/scene.xml", assets.xml);
-  for (const auto& file : assets.files)
-    write_file(dir + "/" + file.first, std::string(file.second.begin(), file.second.end()));
+  for (const auto& [path, bytes] : assets.files) {
+    const bool stored_png =
+        assets.png == PngCompression::kStored && path.size() > 4 && path.compare(path.size() - 4, 4, ".png") == 0;
+    const std::vector<unsigned char> file =
+        stored_png ? png_of_bgr(cv::imdecode(bytes, cv::IMREAD_COLOR), file_zlib_level(path)) : bytes;
+    write_file(dir + "/" + path, std::string(file.begin(), file.end()));
+  }
 }
 
 }  // namespace pvb::sim

@@ -33,7 +33,9 @@ int actuator(const mjModel* m, const char* name) {
 
 Simulator::Simulator(scenes::Scenario scenario, SceneDetail detail) : scenario_(std::move(scenario)) {
   install_mujoco_handlers();
-  assets_ = build_scene(scenario_, detail);
+  // Compiled in memory only: uncompressed PNGs (write_scene() compresses
+  // them as a recording's files are).
+  assets_ = build_scene(scenario_, detail, PngCompression::kStored);
   model_ = compile_scene(assets_);
   data_.reset(mj_makeData(model_.get()));
   const mjModel* m = model_.get();

@@ -8,6 +8,10 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/imgcodecs.hpp>
+#include <unistd.h>
+
+#include "pvb/common/text.hpp"
 #include "pvb/scenes/ground_relief.hpp"
 #include "pvb/scenes/route.hpp"
 #include "pvb/scenes/scenario.hpp"
@@ -52,6 +56,33 @@ TEST(SceneBuilder, SameScenarioGivesTheSameBytes) {
   scenes::Scenario other = station();
   other.seed = 8;
   EXPECT_NE(sim::build_scene(other).files[0].second, a.files[0].second);  // textures follow the seed
+}
+
+// A scene compiled in memory keeps its PNGs uncompressed: the same pixels
+// as the files'; written out, they are the files' bytes.
+TEST(SceneBuilder, StoredTexturesHoldTheFilesPixelsAndAreWrittenAsTheFiles) {
+  const sim::SceneAssets files = sim::build_scene(station());
+  const sim::SceneAssets stored =
+      sim::build_scene(station(), sim::SceneDetail::kFull, sim::PngCompression::kStored);
+  EXPECT_EQ(files.xml, stored.xml);
+  ASSERT_EQ(files.files.size(), stored.files.size());
+  std::size_t file_bytes = 0, stored_bytes = 0;
+  for (std::size_t i = 0; i < files.files.size(); ++i) {
+    const auto& [path, bytes] = files.files[i];
+    ASSERT_EQ(path, stored.files[i].first);
+    file_bytes += bytes.size();
+    stored_bytes += stored.files[i].second.size();
+    const cv::Mat a = cv::imdecode(bytes, cv::IMREAD_UNCHANGED), b = cv::imdecode(stored.files[i].second, cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(a.empty()) << path;
+    ASSERT_EQ(a.size(), b.size()) << path;
+    EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0) << path;
+  }
+  EXPECT_GT(stored_bytes, file_bytes);  // not compressed (noise-like images: about twice the bytes)
+  const std::string dir = ::testing::TempDir() + "pvb_stored_scene_" + std::to_string(::getpid());
+  sim::write_scene(stored, dir);
+  for (const auto& [path, bytes] : files.files)
+    EXPECT_TRUE(read_file(dir + "/" + path) == std::string(bytes.begin(), bytes.end())) << path;
+  EXPECT_EQ(read_file(dir + "/scene.xml"), files.xml);
 }
 
 TEST(SceneBuilder, WallFinishPicksTheMaterial) {

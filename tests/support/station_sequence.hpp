@@ -1,10 +1,10 @@
 #pragma once
-// The default PV station recorded once per build (300 frames, seed 7), read
-// by the tests that need a simulated sequence: CTest makes it first
-// (shared.pv_station_300, tests/CMakeLists.txt), and keeps it while pvbench
-// and the scenario are unchanged.  A test program run by hand without it
-// records it there itself (into a private folder, then renamed into place:
-// a loser of a race keeps the winner's copy, which is byte-identical).
+// The default PV station recorded once per build (300 frames, seed 7), and
+// two runs of it, read by the tests that need them: CTest makes each first
+// (shared.NAME, tests/CMakeLists.txt), and keeps it while pvbench and the
+// scenario are unchanged.  A test program run by hand without one makes it
+// there itself (into a private folder, then renamed into place: a loser of
+// a race keeps the winner's copy, which is byte-identical).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -23,19 +23,62 @@ inline const std::string& station_scenario() {
 constexpr int kStationFrames = 300;
 constexpr int kStationSeed = 7;
 
+/// The shared output `name` (tests/CMakeLists.txt, pvb_add_shared_output):
+/// PVB_TEST_DATA_DIR/name, made with `pvbench ARGS --out ...` first when a
+/// test program run by hand finds it missing.  `key_file` is a file every
+/// finished output holds.
+inline std::string shared_output(const std::string& name, const std::string& args,
+                                 const std::string& key_file) {
+  const std::string final_dir = std::string(PVB_TEST_DATA_DIR) + "/" + name;
+  if (::access((final_dir + "/" + key_file).c_str(), F_OK) == 0) return final_dir;
+  std::system(("mkdir -p " + std::string(PVB_TEST_DATA_DIR)).c_str());
+  const std::string tmp = final_dir + ".tmp" + std::to_string(::getpid());
+  const RunResult r = run_pvbench(args + " --out " + tmp);
+  EXPECT_EQ(r.code, 0) << r.output;
+  if (std::rename(tmp.c_str(), final_dir.c_str()) != 0) std::system(("rm -rf " + tmp).c_str());
+  return final_dir;
+}
+
 inline const std::string& station_sequence() {
-  static const std::string d = [] {
-    const std::string final_dir = std::string(PVB_TEST_DATA_DIR) + "/pv_station_300";
-    if (::access((final_dir + "/groundtruth.txt").c_str(), F_OK) == 0) return final_dir;
-    std::system(("mkdir -p " + std::string(PVB_TEST_DATA_DIR)).c_str());
-    const std::string tmp = final_dir + ".tmp" + std::to_string(::getpid());
-    const RunResult r =
-        run_pvbench("record --scenario " + station_scenario() + " --out " + tmp + " --frames " +
-                    std::to_string(kStationFrames) + " --seed " + std::to_string(kStationSeed));
-    EXPECT_EQ(r.code, 0) << r.output;
-    if (std::rename(tmp.c_str(), final_dir.c_str()) != 0) std::system(("rm -rf " + tmp).c_str());
-    return final_dir;
-  }();
+  static const std::string d =
+      shared_output("pv_station_300",
+                    "record --scenario " + station_scenario() + " --frames " + std::to_string(kStationFrames) +
+                        " --seed " + std::to_string(kStationSeed),
+                    "groundtruth.txt");
+  return d;
+}
+
+/// The fast CI set's run of the default station (shared output
+/// pv_station_ci_run): 150 frames, synchronous, PE-SLAM, map scoring on.
+constexpr int kStationRunFrames = 150;
+inline const std::string& station_ci_run() {
+  static const std::string d = shared_output(
+      "pv_station_ci_run",
+      "run --scenario " + station_scenario() + " --sync --frames " + std::to_string(kStationRunFrames),
+      "metrics.json");
+  return d;
+}
+
+/// pvbench slam on the recording's first 120 frames (shared output
+/// pv_station_slam_120): synchronous, no dense map, Map.txt dumped.
+inline const std::string& station_slam_120() {
+  static const std::string d = shared_output("pv_station_slam_120",
+                                             "slam --sequence " + station_sequence() + " --settings " +
+                                                 station_sequence() +
+                                                 "/camera.yaml --sync --no-dense --dump-map --max-frames 120",
+                                             "stats.json");
+  return d;
+}
+
+/// The station's 200-frame synchronous run with its IMU (shared output
+/// pv_station_imu_200), without map scoring.
+constexpr int kStationImuRunFrames = 200;
+inline const std::string& station_imu_run() {
+  static const std::string d = shared_output("pv_station_imu_200",
+                                             "run --scenario " + station_scenario() + " --sync --frames " +
+                                                 std::to_string(kStationImuRunFrames) +
+                                                 " --no-map-eval --sensors camera+imu",
+                                             "metrics.json");
   return d;
 }
 

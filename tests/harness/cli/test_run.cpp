@@ -166,13 +166,14 @@ void check_replay_of_recording(const std::string& d) {
   for (std::size_t i = 0; i < replay.size(); ++i) EXPECT_EQ(live[i], replay[i]) << "frame " << i;
 }
 
-// One 150-frame synchronous run of the default station (ctest runs every
-// test in its own process, so the checks share this test).
+// One 150-frame synchronous run of the default station, the fast CI set's
+// (the shared output that scenario_ci.pv_station judges by the scenario's
+// bounds; ctest runs every test in its own process, so the checks share
+// this test).
 TEST(RunCli, DefaultStationSync) {
-  const std::string d = fresh("station");
-  const test::RunResult r =
-      test::run_pvbench("run --scenario " + kStation + " --out " + d + " --sync --frames 150");
-  ASSERT_EQ(r.code, 0) << r.output;
+  static_assert(test::kStationRunFrames == 150, "the checks below count 150 frames");
+  const std::string d = test::station_ci_run();
+  ASSERT_TRUE(exists(d + "/metrics.json")) << d;
   {
     SCOPED_TRACE("metrics and accuracy");
     check_metrics_and_accuracy(d);

@@ -89,10 +89,7 @@ TEST(SlamScenario, SyncModeIsBitIdentical) {
 // and re-runs global BA from ground truth; a corrupted file fails on its line.
 TEST(SlamScenario, DumpedMapHoldsEveryKeyframeAndMapCheckReadsIt) {
   const std::string seq = station_sequence();
-  const std::string out = dir("dump_map");
-  const Result r = run("slam --sequence " + seq + " --settings " + seq +
-                       "/camera.yaml --sync --no-dense --dump-map --max-frames 120 --out " + out);
-  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string out = pvb::test::station_slam_120();  // --dump-map, 120 frames
   const std::string stats = pvb::read_file(out + "/stats.json");
   const std::string map = pvb::read_file(out + "/Map.txt");
   int frames = 0, points = 0, measurements = 0;
@@ -112,8 +109,9 @@ TEST(SlamScenario, DumpedMapHoldsEveryKeyframeAndMapCheckReadsIt) {
       << c.output;
   EXPECT_LT(std::stod(m[1]), 20.0) << c.output;  // mm, as the SLAM bound
   EXPECT_NE(c.output.find("reading: "), std::string::npos) << c.output;
-  pvb::write_file(out + "/Bad.txt", map + "O 0 999999 1 2 -1 0\n");
-  const Result bad = run("map-check --map " + out + "/Bad.txt --gt " + seq + "/groundtruth.txt --draws 0");
+  const std::string bad_map = dir("dump_map") + "_Bad.txt";
+  pvb::write_file(bad_map, map + "O 0 999999 1 2 -1 0\n");
+  const Result bad = run("map-check --map " + bad_map + " --gt " + seq + "/groundtruth.txt --draws 0");
   EXPECT_NE(bad.code, 0);
   EXPECT_NE(bad.output.find("Bad.txt:"), std::string::npos) << bad.output;
   EXPECT_NE(bad.output.find("point index 999999 out of range"), std::string::npos) << bad.output;
@@ -220,10 +218,7 @@ int check_keyframe_rule(const std::string& timing_csv,
 // default, the view-overlap rule with KeyFrame.refOverlap.
 TEST(SlamScenario, KeyframeDecisionFollowsItsRule) {
   const std::string seq = station_sequence();
-  const std::string orb = dir("kf_orb");
-  Result r = run("slam --sequence " + seq + " --settings " + seq +
-                 "/camera.yaml --sync --no-dense --max-frames 120 --out " + orb);
-  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string orb = pvb::test::station_slam_120();  // the default rule, 120 frames
   const int orb_weak = check_keyframe_rule(orb + "/timing.csv", [](const auto& row) {
     return std::stoi(row.at("inliers")) < 0.75 * std::stoi(row.at("kf_ref_points"));
   });
@@ -233,8 +228,8 @@ TEST(SlamScenario, KeyframeDecisionFollowsItsRule) {
   const std::string settings = overlap + "_settings.yaml";
   pvb::write_file(settings, pvb::read_file(seq + "/camera.yaml") +
                                 "\nKeyFrame.refOverlap: " + std::to_string(kRefOverlap) + "\n");
-  r = run("slam --sequence " + seq + " --settings " + settings +
-          " --sync --no-dense --max-frames 120 --out " + overlap);
+  const Result r = run("slam --sequence " + seq + " --settings " + settings +
+                       " --sync --no-dense --max-frames 120 --out " + overlap);
   ASSERT_EQ(r.code, 0) << r.output;
   const int overlap_weak = check_keyframe_rule(overlap + "/timing.csv", [](const auto& row) {
     return std::stoi(row.at("kf_ref_shared")) < kRefOverlap * std::stoi(row.at("kf_ref_all"));

@@ -18,9 +18,17 @@ namespace pvb::sim {
 /// set-up skips drawing and encoding the images.
 enum class SceneDetail { kFull, kGeometry };
 
+/// How the textures' PNGs are compressed.  kFiles: as a recording writes
+/// them (zlib level 6, level 1 for a varied ground's tiles; their bytes are
+/// pinned).  kStored: not compressed, for a scene that is only compiled in
+/// memory: the same pixels, encoded and decoded several times faster;
+/// write_scene() writes them as kFiles would.
+enum class PngCompression { kFiles, kStored };
+
 /// A generated scene: scene.xml plus the texture files it names.
 struct SceneAssets {
   SceneDetail detail = SceneDetail::kFull;
+  PngCompression png = PngCompression::kFiles;
   std::string xml;
   /// Path relative to scene.xml and bytes: the textures' PNGs, and with a
   /// ground relief its height field (kReliefFile).
@@ -56,7 +64,8 @@ inline constexpr double kShadowTexelTargetM = 0.020;
 ShadowMap shadow_map_for(const scenes::Light& light, const std::vector<Eigen::Vector2d>& route_xy_m);
 
 /// Generates the scene.  Deterministic in the scenario (seed included).
-SceneAssets build_scene(const scenes::Scenario& scenario, SceneDetail detail = SceneDetail::kFull);
+SceneAssets build_scene(const scenes::Scenario& scenario, SceneDetail detail = SceneDetail::kFull,
+                        PngCompression png = PngCompression::kFiles);
 
 struct ModelDeleter {
   void operator()(mjModel* m) const { mj_deleteModel(m); }
