@@ -150,7 +150,12 @@ def function_name(header):
     """The name before the first top-level parenthesis of a function header."""
     h = " ".join(header.split())
     m = re.search(r"((?:[\w~]+::)*(?:operator\s*[^\s(]+|~?\w+))\s*\($", h[:first_paren(h) + 1])
-    return m.group(1) if m else h[:40]
+    if not m:
+        return h[:40]
+    if m.group(1) in ("TEST", "TEST_F", "TEST_P"):  # GoogleTest: the suite and test names
+        args = re.match(r"\s*\(([^)]*)\)", h[first_paren(h):])
+        return m.group(1) + "(" + (" ".join(args.group(1).split()) if args else "") + ")"
+    return m.group(1)
 
 
 def first_paren(h):
