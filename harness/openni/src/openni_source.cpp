@@ -130,6 +130,13 @@ struct OpenniSource::Impl : ::openni::OpenNI::DeviceDisconnectedListener,
   }
 
   void open();
+  /// A recording: played in lockstep (a frame when asked for one), its
+  /// frame counts and pixel formats checked; returns its colour stream's
+  /// frame rate (0 when it gives none).
+  int start_playback();
+  /// A live camera: the video modes of options, depth registered to colour
+  /// where it can be, mirroring off.
+  void set_up_camera();
   void start_recorder();
   /// The accelerometer's readings up to and with the frame's time, put into
   /// the colour camera's optical frame as the TUM reader puts them.
@@ -170,44 +177,10 @@ void OpenniSource::Impl::open() {
 
   int fps = options.fps;
   if (is_file) {
-    ::openni::PlaybackControl* playback = device.getPlaybackControl();
-    if (!playback) throw IoError(options.oni_path, "OpenNI2 opened it, but not as a recording");
-    // Lockstep: speed -1 makes the player produce a frame only when asked for one.
-    playback->setSpeed(-1.0f);
-    playback->setRepeatEnabled(false);
-    depth_total = playback->getNumberOfFrames(depth);
-    colour_total = playback->getNumberOfFrames(colour);
-    if (depth_total <= 0 || colour_total <= 0)
-      throw IoError(options.oni_path, "the recording reports no frames (depth " +
-                                          std::to_string(depth_total) + ", colour " +
-                                          std::to_string(colour_total) + ")");
-    const ::openni::VideoMode dm = depth.getVideoMode(), cm = colour.getVideoMode();
-    if (dm.getPixelFormat() != ::openni::PIXEL_FORMAT_DEPTH_1_MM &&
-        dm.getPixelFormat() != ::openni::PIXEL_FORMAT_DEPTH_100_UM)
-      throw IoError(options.oni_path, std::string("depth stream is ") +
-                                          pixel_format_name(dm.getPixelFormat()) +
-                                          ", expected depth in 1 mm or 100 um units");
-    if (cm.getPixelFormat() != ::openni::PIXEL_FORMAT_RGB888)
-      throw IoError(options.oni_path, std::string("colour stream is ") +
-                                          pixel_format_name(cm.getPixelFormat()) + ", expected RGB888");
-    if (cm.getFps() > 0) fps = cm.getFps();
+    const int file_fps = start_playback();
+    if (file_fps > 0) fps = file_fps;
   } else {
-    set_video_mode(depth, ::openni::PIXEL_FORMAT_DEPTH_1_MM, options, "depth", source_name);
-    set_video_mode(colour, ::openni::PIXEL_FORMAT_RGB888, options, "colour", source_name);
-    if (device.isImageRegistrationModeSupported(::openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR)) {
-      if (device.setImageRegistrationMode(::openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR) != ::openni::STATUS_OK)
-        throw UnavailableError("OpenNI2 device '" + source_name +
-                               "': cannot register depth to colour: " + oni_error());
-    } else {
-      std::fprintf(
-          stderr,
-          "pvbench: warning: %s cannot register depth to colour; depth and colour pixels will not line up\n",
-          source_name.c_str());
-    }
-    for (::openni::VideoStream* s : {&depth, &colour})
-      if (s->getMirroringEnabled() && s->setMirroringEnabled(false) != ::openni::STATUS_OK)
-        throw UnavailableError("OpenNI2 device '" + source_name +
-                               "': cannot turn mirroring off: " + oni_error());
+    set_up_camera();
   }
   pairer = std::make_unique<FramePairer>(500'000'000LL / std::max(1, fps));
   has_accelerometer = !is_file && device.isPropertySupported(kAccelerometerProperty);
@@ -219,6 +192,49 @@ void OpenniSource::Impl::open() {
     throw UnavailableError("OpenNI2 '" + source_name + "': cannot start the depth stream: " + oni_error());
   if (colour.start() != ::openni::STATUS_OK)
     throw UnavailableError("OpenNI2 '" + source_name + "': cannot start the colour stream: " + oni_error());
+}
+
+int OpenniSource::Impl::start_playback() {
+  ::openni::PlaybackControl* playback = device.getPlaybackControl();
+  if (!playback) throw IoError(options.oni_path, "OpenNI2 opened it, but not as a recording");
+  // Lockstep: speed -1 makes the player produce a frame only when asked for one.
+  playback->setSpeed(-1.0f);
+  playback->setRepeatEnabled(false);
+  depth_total = playback->getNumberOfFrames(depth);
+  colour_total = playback->getNumberOfFrames(colour);
+  if (depth_total <= 0 || colour_total <= 0)
+    throw IoError(options.oni_path, "the recording reports no frames (depth " +
+                                        std::to_string(depth_total) + ", colour " +
+                                        std::to_string(colour_total) + ")");
+  const ::openni::VideoMode dm = depth.getVideoMode(), cm = colour.getVideoMode();
+  if (dm.getPixelFormat() != ::openni::PIXEL_FORMAT_DEPTH_1_MM &&
+      dm.getPixelFormat() != ::openni::PIXEL_FORMAT_DEPTH_100_UM)
+    throw IoError(options.oni_path, std::string("depth stream is ") +
+                                        pixel_format_name(dm.getPixelFormat()) +
+                                        ", expected depth in 1 mm or 100 um units");
+  if (cm.getPixelFormat() != ::openni::PIXEL_FORMAT_RGB888)
+    throw IoError(options.oni_path, std::string("colour stream is ") +
+                                        pixel_format_name(cm.getPixelFormat()) + ", expected RGB888");
+  return cm.getFps();
+}
+
+void OpenniSource::Impl::set_up_camera() {
+  set_video_mode(depth, ::openni::PIXEL_FORMAT_DEPTH_1_MM, options, "depth", source_name);
+  set_video_mode(colour, ::openni::PIXEL_FORMAT_RGB888, options, "colour", source_name);
+  if (device.isImageRegistrationModeSupported(::openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR)) {
+    if (device.setImageRegistrationMode(::openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR) != ::openni::STATUS_OK)
+      throw UnavailableError("OpenNI2 device '" + source_name +
+                             "': cannot register depth to colour: " + oni_error());
+  } else {
+    std::fprintf(
+        stderr,
+        "pvbench: warning: %s cannot register depth to colour; depth and colour pixels will not line up\n",
+        source_name.c_str());
+  }
+  for (::openni::VideoStream* s : {&depth, &colour})
+    if (s->getMirroringEnabled() && s->setMirroringEnabled(false) != ::openni::STATUS_OK)
+      throw UnavailableError("OpenNI2 device '" + source_name +
+                             "': cannot turn mirroring off: " + oni_error());
 }
 
 void OpenniSource::Impl::start_recorder() {

@@ -47,13 +47,10 @@ void split_node(const QuadNode& n, const std::vector<cv::KeyPoint>& kps, std::ve
     if (!ch.keys.empty()) out.push_back(std::move(ch));
 }
 
-/// ORB-SLAM2's DistributeOctTree: splits the detection area in a quadtree
-/// until there are at least `num_wanted` non-empty nodes (or nothing can be
-/// split any more) and keeps the strongest corner of every node.
-std::vector<cv::KeyPoint> distribute_quadtree(const std::vector<cv::KeyPoint>& kps, float min_x,
-                                              float max_x, float min_y, float max_y,
-                                              int num_wanted) {
-  if (kps.empty() || num_wanted <= 0) return {};
+/// The detection area's first nodes: as many side by side as it is wider
+/// than high (at least one), each with its corners; empty ones dropped.
+std::vector<QuadNode> initial_nodes(const std::vector<cv::KeyPoint>& kps, float min_x, float max_x, float min_y,
+                                    float max_y) {
   const float width = max_x - min_x;
   const float height = max_y - min_y;
   const int num_ini = std::max(1, static_cast<int>(std::lround(width / height)));
@@ -70,58 +67,80 @@ std::vector<cv::KeyPoint> distribute_quadtree(const std::vector<cv::KeyPoint>& k
   }
   nodes.erase(std::remove_if(nodes.begin(), nodes.end(), [](const QuadNode& n) { return n.keys.empty(); }),
               nodes.end());
+  return nodes;
+}
 
-  auto splittable = [](const QuadNode& n) {
-    // A node with one corner, or one too small to split further, stays.
-    return n.keys.size() > 1 && (n.br.x - n.ul.x) > 1.0f && (n.br.y - n.ul.y) > 1.0f;
-  };
+/// Whether a node can split: a node with one corner, or one too small to
+/// split further, stays.
+bool splittable(const QuadNode& n) {
+  return n.keys.size() > 1 && (n.br.x - n.ul.x) > 1.0f && (n.br.y - n.ul.y) > 1.0f;
+}
 
-  bool finished = false;
+/// Splits every splittable node once, in order; returns how many of the
+/// new nodes are splittable themselves.
+int split_all(std::vector<QuadNode>& nodes, const std::vector<cv::KeyPoint>& kps) {
   std::vector<QuadNode> next;
-  while (!finished) {
-    const size_t prev_size = nodes.size();
-    next.clear();
-    int to_expand = 0;
-    for (QuadNode& n : nodes) {
-      if (!splittable(n)) {
-        next.push_back(std::move(n));
-        continue;
-      }
-      const size_t before = next.size();
-      split_node(n, kps, next);
-      for (size_t c = before; c < next.size(); ++c)
-        if (splittable(next[c])) ++to_expand;
+  int to_expand = 0;
+  for (QuadNode& n : nodes) {
+    if (!splittable(n)) {
+      next.push_back(std::move(n));
+      continue;
     }
+    const size_t before = next.size();
+    split_node(n, kps, next);
+    for (size_t c = before; c < next.size(); ++c)
+      if (splittable(next[c])) ++to_expand;
+  }
+  nodes.swap(next);
+  return to_expand;
+}
+
+/// Near the target: splits the most populated nodes first, one at a time,
+/// until there are `num_wanted` nodes or nothing splits any more.
+void split_most_populated(std::vector<QuadNode>& nodes, const std::vector<cv::KeyPoint>& kps, int num_wanted) {
+  std::vector<QuadNode> next;
+  bool finished = false;
+  while (!finished) {
+    const size_t size_before = nodes.size();
+    std::vector<size_t> order;
+    for (size_t i = 0; i < nodes.size(); ++i)
+      if (splittable(nodes[i])) order.push_back(i);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return nodes[a].keys.size() > nodes[b].keys.size(); });
+    std::vector<bool> removed(nodes.size(), false);
+    std::vector<QuadNode> added;
+    int count = static_cast<int>(nodes.size());
+    for (size_t i : order) {
+      const size_t before = added.size();
+      split_node(nodes[i], kps, added);
+      removed[i] = true;
+      count += static_cast<int>(added.size() - before) - 1;
+      if (count >= num_wanted) break;
+    }
+    next.clear();
+    for (size_t i = 0; i < nodes.size(); ++i)
+      if (!removed[i]) next.push_back(std::move(nodes[i]));
+    for (auto& a : added) next.push_back(std::move(a));
     nodes.swap(next);
-    if (static_cast<int>(nodes.size()) >= num_wanted || nodes.size() == prev_size) {
-      finished = true;
-    } else if (static_cast<int>(nodes.size()) + 3 * to_expand > num_wanted) {
-      // Near the target: split the most populated nodes first, one at a time.
-      while (!finished) {
-        const size_t size_before = nodes.size();
-        std::vector<size_t> order;
-        for (size_t i = 0; i < nodes.size(); ++i)
-          if (splittable(nodes[i])) order.push_back(i);
-        std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-          return nodes[a].keys.size() > nodes[b].keys.size();
-        });
-        std::vector<bool> removed(nodes.size(), false);
-        std::vector<QuadNode> added;
-        int count = static_cast<int>(nodes.size());
-        for (size_t i : order) {
-          const size_t before = added.size();
-          split_node(nodes[i], kps, added);
-          removed[i] = true;
-          count += static_cast<int>(added.size() - before) - 1;
-          if (count >= num_wanted) break;
-        }
-        next.clear();
-        for (size_t i = 0; i < nodes.size(); ++i)
-          if (!removed[i]) next.push_back(std::move(nodes[i]));
-        for (auto& a : added) next.push_back(std::move(a));
-        nodes.swap(next);
-        if (static_cast<int>(nodes.size()) >= num_wanted || nodes.size() == size_before) finished = true;
-      }
+    if (static_cast<int>(nodes.size()) >= num_wanted || nodes.size() == size_before) finished = true;
+  }
+}
+
+/// ORB-SLAM2's DistributeOctTree: splits the detection area in a quadtree
+/// until there are at least `num_wanted` non-empty nodes (or nothing can be
+/// split any more) and keeps the strongest corner of every node.
+std::vector<cv::KeyPoint> distribute_quadtree(const std::vector<cv::KeyPoint>& kps, float min_x,
+                                              float max_x, float min_y, float max_y,
+                                              int num_wanted) {
+  if (kps.empty() || num_wanted <= 0) return {};
+  std::vector<QuadNode> nodes = initial_nodes(kps, min_x, max_x, min_y, max_y);
+  while (true) {
+    const size_t prev_size = nodes.size();
+    const int to_expand = split_all(nodes, kps);
+    if (static_cast<int>(nodes.size()) >= num_wanted || nodes.size() == prev_size) break;
+    if (static_cast<int>(nodes.size()) + 3 * to_expand > num_wanted) {
+      split_most_populated(nodes, kps, num_wanted);
+      break;
     }
   }
 
@@ -233,6 +252,66 @@ cv::Point2f quadratic_peak_offset(const float s[3][3]) {
   return {static_cast<float>(std::clamp(dx, -0.5, 0.5)),
           static_cast<float>(std::clamp(dy, -0.5, 0.5))};
 }
+
+namespace {
+
+/// The image as 8-bit grey (a view of it when it is grey already).
+/// OpenCV's border copy spins for ever on an empty image (an image file
+/// that did not load), so what cannot be a camera image is an error.
+cv::Mat grey_image(const cv::Mat& image) {
+  if (image.empty() || image.depth() != CV_8U ||
+      (image.channels() != 1 && image.channels() != 3 && image.channels() != 4))
+    throw Error("ORB extraction: expected an 8-bit grey, BGR or BGRA image, got " +
+                (image.empty() ? std::string("an empty one (an image that did not load?)")
+                               : std::to_string(image.cols) + "x" + std::to_string(image.rows) + " with " +
+                                     std::to_string(image.channels()) + " channels of depth " +
+                                     std::to_string(image.depth())));
+  cv::Mat grey;
+  if (image.channels() == 3)
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  else if (image.channels() == 4)
+    cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
+  else
+    grey = image;
+  assert(grey.type() == CV_8UC1);
+  return grey;
+}
+
+/// The sub-pixel offset of corner kp of `level` (level pixels): the peak
+/// of a quadratic through the FAST scores of its 3x3 neighbourhood.
+/// Orientation and descriptor stay at the whole pixel; only the position
+/// moves.  FAST keeps 3 px off its 16 px-inset detection area, so the 3x3
+/// neighbourhood's circles stay inside the level.  The centre's score is
+/// the corner's own FAST response.
+cv::Point2f sub_pixel_offset(const cv::Mat& level, const cv::KeyPoint& kp) {
+  const int x = cvRound(kp.pt.x), y = cvRound(kp.pt.y);
+  float score[3][3];
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      score[dy + 1][dx + 1] = dx == 0 && dy == 0 ? kp.response : static_cast<float>(fast9_score(level, x + dx, y + dy));
+  return quadratic_peak_offset(score);
+}
+
+/// The `num_features` strongest of `all`'s keypoints (the first of equal
+/// responses), with their descriptors, in their order in `all`.
+OrbFeatures strongest(const OrbFeatures& all, int num_features) {
+  const int total = static_cast<int>(all.keypoints.size());
+  std::vector<int> order(total);
+  for (int i = 0; i < total; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return all.keypoints[a].response > all.keypoints[b].response; });
+  order.resize(num_features);
+  std::sort(order.begin(), order.end());
+  OrbFeatures capped;
+  capped.descriptors.create(num_features, 32, CV_8U);
+  for (int i = 0; i < num_features; ++i) {
+    capped.keypoints.push_back(all.keypoints[order[i]]);
+    all.descriptors.row(order[i]).copyTo(capped.descriptors.row(i));
+  }
+  return capped;
+}
+
+}  // namespace
 
 OrbExtractor::OrbExtractor(const OrbParams& params) : params_(params) {
   const int n = params_.num_levels;
@@ -349,24 +428,7 @@ std::vector<cv::KeyPoint> OrbExtractor::detect_level(int level, int num_wanted) 
 }
 
 OrbFeatures OrbExtractor::extract(const cv::Mat& image) {
-  // OpenCV's border copy spins for ever on an empty image (an image file
-  // that did not load), so what cannot be a camera image is an error.
-  if (image.empty() || image.depth() != CV_8U ||
-      (image.channels() != 1 && image.channels() != 3 && image.channels() != 4))
-    throw Error("ORB extraction: expected an 8-bit grey, BGR or BGRA image, got " +
-                (image.empty() ? std::string("an empty one (an image that did not load?)")
-                               : std::to_string(image.cols) + "x" + std::to_string(image.rows) + " with " +
-                                     std::to_string(image.channels()) + " channels of depth " +
-                                     std::to_string(image.depth())));
-  cv::Mat grey;
-  if (image.channels() == 3)
-    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-  else if (image.channels() == 4)
-    cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
-  else
-    grey = image;
-  assert(grey.type() == CV_8UC1);
-  build_pyramid(grey);
+  build_pyramid(grey_image(image));
 
   OrbFeatures out;
   std::vector<std::vector<cv::KeyPoint>> per_level(params_.num_levels);
@@ -396,17 +458,7 @@ OrbFeatures OrbExtractor::extract(const cv::Mat& image) {
     for (cv::KeyPoint kp : per_level[l]) {
       compute_rbrief(view, kp, out.descriptors.ptr<uchar>(row++));
       if (params_.sub_pixel) {
-        // Orientation and descriptor stay at the whole pixel; only the
-        // position moves.  FAST keeps 3 px off its 16 px-inset detection
-        // area, so the 3x3 neighbourhood's circles stay inside the level.
-        // The centre's score is the corner's own FAST response.
-        const int x = cvRound(kp.pt.x), y = cvRound(kp.pt.y);
-        float score[3][3];
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx)
-            score[dy + 1][dx + 1] =
-                dx == 0 && dy == 0 ? kp.response : static_cast<float>(fast9_score(level, x + dx, y + dy));
-        const cv::Point2f off = quadratic_peak_offset(score);
+        const cv::Point2f off = sub_pixel_offset(level, kp);
         kp.pt.x += off.x;
         kp.pt.y += off.y;
       }
@@ -415,21 +467,7 @@ OrbFeatures OrbExtractor::extract(const cv::Mat& image) {
       out.keypoints.push_back(kp);
     }
   }
-  if (total > params_.num_features) {
-    std::vector<int> order(total);
-    for (int i = 0; i < total; ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(),
-                     [&](int a, int b) { return out.keypoints[a].response > out.keypoints[b].response; });
-    order.resize(params_.num_features);
-    std::sort(order.begin(), order.end());
-    OrbFeatures capped;
-    capped.descriptors.create(params_.num_features, 32, CV_8U);
-    for (int i = 0; i < params_.num_features; ++i) {
-      capped.keypoints.push_back(out.keypoints[order[i]]);
-      out.descriptors.row(order[i]).copyTo(capped.descriptors.row(i));
-    }
-    return capped;
-  }
+  if (total > params_.num_features) return strongest(out, params_.num_features);
   return out;
 }
 

@@ -96,6 +96,16 @@ class Tracking {
   std::shared_ptr<KeyFrame> take_start_keyframe() { return std::exchange(start_kf_, nullptr); }
 
  private:
+  /// Not initialised: begins the map at f when it can (the first keyframe
+  /// made, returned; null otherwise).
+  std::shared_ptr<KeyFrame> start_map(Frame& f);
+  /// f's pose by the way the state allows (after a blind stretch; motion
+  /// model, else reference keyframe; relocalisation when lost), before the
+  /// local map; stats_.method says which succeeded.
+  bool track_by_state(Frame& f);
+  /// f tracked: the velocity, its map points cleaned, and the keyframe
+  /// decision; returns the new keyframe (or null).
+  std::shared_ptr<KeyFrame> after_tracked(Frame& f, bool mapping_idle, std::size_t mapping_queue);
   bool initialize(Frame& f);
   /// Without enough depth in one frame: the start from a first view kept
   /// and f (TwoViewOptions); `why` is the one-frame start's reason.
@@ -108,6 +118,8 @@ class Tracking {
   /// fewer than 8 such matches.
   double translation_parallax_px(const std::vector<IndexMatch>& m, const geom::SE3d& T_cur_last) const;
   bool track_reference_keyframe(Frame& f);
+
+  // Relocalisation (relocalisation.cpp) -------------------------------------------
   bool relocalize(Frame& f);
   /// Global relocalisation of f among the keyframes of map `only_map` (of
   /// any map without one), with the ambiguity and look-alike checks:
@@ -142,6 +154,7 @@ class Tracking {
   static constexpr int kLookalikeNeighbours = 5;
   /// Appends the RelocEvent of f, just relocalised and tracked.
   void record_relocalisation(const Frame& f);
+
   bool track_local_map(Frame& f);
   /// Patch alignment of f's map-point matches at its current pose.
   void align_matches(Frame& f);
