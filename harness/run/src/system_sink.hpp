@@ -14,7 +14,7 @@
 #include "pvb/run/inertial_eval.hpp"
 #include "pvb/run/loss_log.hpp"
 #include "pvb/run/report.hpp"
-#include "pvb/run/run.hpp"
+#include "pvb/run/run_options.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
 #include "run_log.hpp"
