@@ -14,7 +14,7 @@
 #include "pvb/plot/matrix.hpp"
 #include "pvb/run/campaign.hpp"
 #include "pvb/run/map_session.hpp"
-#include "pvb/run/report.hpp"
+#include "pvb/report/report.hpp"
 
 namespace pvb::run {
 

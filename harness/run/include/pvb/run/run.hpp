@@ -14,7 +14,7 @@
 
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/se3.hpp"
-#include "pvb/run/report.hpp"
+#include "pvb/report/report.hpp"
 #include "pvb/run/run_options.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/slam/core/settings.hpp"
