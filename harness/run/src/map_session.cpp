@@ -3,7 +3,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +11,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/common/yaml_reader.hpp"
 #include "pvb/slam/core/map_file.hpp"
 
 namespace pvb::run {
@@ -54,6 +54,16 @@ void MapOptions::check() const {
 
 namespace {
 
+/// The common reader's context for a JSON text pvbench wrote and reads
+/// back (a recording's meta.json, a map's META): its mistakes are IoErrors.
+yaml::ReadContext json_context(const std::string& file) {
+  yaml::ReadContext ctx;
+  ctx.file = file;
+  ctx.errors = yaml::ErrorKind::kIo;
+  ctx.json = true;
+  return ctx;
+}
+
 /// The name of a station file: "scenes/pv_station.yaml" -> "pv_station".
 std::string station_name(const std::string& file) { return std::filesystem::path(file).stem().string(); }
 
@@ -67,18 +77,25 @@ MapStation station_of(const scenes::Scenario& s) {
 MapStation recording_station(const std::string& meta_json_path) {
   MapStation st;
   if (!std::ifstream(meta_json_path).good()) return st;
+  const std::string text = read_file(meta_json_path);
+  const yaml::ReadContext ctx = json_context(meta_json_path);
   try {
-    const YAML::Node root = YAML::Load(read_file(meta_json_path));
+    const YAML::Node root = yaml::parse(text, ctx);
     const YAML::Node world = root["world"], scenario = root["scenario"];
-    if (world.IsMap() && world["station_seed"].IsScalar())
-      st.seed = world["station_seed"].as<std::uint64_t>();
+    std::uint64_t seed = 0;
+    if (world.IsMap() && world["station_seed"].IsScalar()) {
+      if (!yaml::decode_seed(world["station_seed"], ctx, &seed)) return MapStation{};
+      st.seed = seed;
+    }
     const YAML::Node bases = world.IsMap() ? world["base_files"] : YAML::Node();
     if (bases.IsSequence() && bases.size() > 0 && bases[bases.size() - 1].IsScalar())
       st.name = station_name(bases[bases.size() - 1].Scalar());
     else if (scenario.IsMap() && scenario["file"].IsScalar())
       st.name = station_name(scenario["file"].Scalar());
-  } catch (const YAML::Exception&) {
+  } catch (const IoError&) {
     return MapStation{};  // informative only: a recording that does not say has no station
+  } catch (const YAML::Exception&) {
+    return MapStation{};
   }
   return st;
 }
@@ -108,7 +125,7 @@ namespace {
 /// T_world_map of META: null, or 12 finite numbers that make a rotation
 /// and a translation within slam::kMaxMapCoordinateM.  `fail` throws.
 template <class Fail>
-std::optional<geom::SE3d> read_T_world_map(const YAML::Node& v, const Fail& fail) {
+std::optional<geom::SE3d> read_T_world_map(const YAML::Node& v, const yaml::ReadContext& ctx, const Fail& fail) {
   if (!v.IsDefined()) fail("no T_world_map (expected 12 numbers, a 3x4 matrix row by row, or null)");
   if (v.IsNull()) return std::nullopt;
   if (!v.IsSequence() || v.size() != 12)
@@ -118,7 +135,7 @@ std::optional<geom::SE3d> read_T_world_map(const YAML::Node& v, const Fail& fail
   Eigen::Matrix<double, 3, 4> m;
   for (int k = 0; k < 12; ++k) {
     double x = 0;
-    if (!v[k].IsScalar() || !YAML::convert<double>::decode(v[k], x) || !std::isfinite(x))
+    if (!yaml::decode_number(v[k], ctx, &x))
       fail("T_world_map number " + std::to_string(k + 1) + " is not a finite number (" +
            printable(v[k].IsScalar() ? v[k].Scalar() : std::string("not a scalar")) + ")");
     m(k / 4, k % 4) = x;
@@ -134,7 +151,7 @@ std::optional<geom::SE3d> read_T_world_map(const YAML::Node& v, const Fail& fail
 /// META's station: "station" a string or null, "station_seed" a whole
 /// number or null (either may be missing: a map made before they were written).
 template <class Fail>
-MapStation read_station(const YAML::Node& root, const Fail& fail) {
+MapStation read_station(const YAML::Node& root, const yaml::ReadContext& ctx, const Fail& fail) {
   MapStation st;
   const YAML::Node name = root["station"], seed = root["station_seed"];
   if (name.IsDefined() && !name.IsNull()) {
@@ -142,15 +159,23 @@ MapStation read_station(const YAML::Node& root, const Fail& fail) {
     st.name = name.Scalar();
   }
   if (seed.IsDefined() && !seed.IsNull()) {
-    const std::string t = seed.IsScalar() ? seed.Scalar() : "";
-    const bool digits =
-        !t.empty() && t.size() <= 20 && t.find_first_not_of("0123456789") == std::string::npos;
-    errno = 0;
-    const unsigned long long v = digits ? std::strtoull(t.c_str(), nullptr, 10) : 0;
-    if (!digits || errno == ERANGE) fail("station_seed is not a whole number from 0 (" + printable(t) + ")");
+    std::uint64_t v = 0;
+    if (!yaml::decode_seed(seed, ctx, &v))
+      fail("station_seed is not a whole number from 0 (" + printable(seed.IsScalar() ? seed.Scalar() : "") + ")");
     st.seed = v;
   }
   return st;
+}
+
+/// The common reader's complaint about META's text as META's errors say
+/// it: "not JSON (what, line N of the section)", or a key given twice.
+std::string meta_problem(const IoError& e) {
+  const std::string syntax = "not valid JSON: ";
+  const std::string& m = e.message();
+  const std::string line = e.line() > 0 ? "line " + std::to_string(e.line()) + " of the section" : "";
+  if (m.compare(0, syntax.size(), syntax) == 0)
+    return "not JSON (" + m.substr(syntax.size()) + (line.empty() ? "" : ", " + line) + ")";
+  return m + (line.empty() ? "" : " (" + line + ")");
 }
 
 }  // namespace
@@ -158,18 +183,18 @@ MapStation read_station(const YAML::Node& root, const Fail& fail) {
 MapMeta read_map_meta(const std::string& app_json, const std::string& file) {
   const auto fail = [&](const std::string& what) -> void { throw IoError(file, "META section: " + what); };
   if (app_json.find_first_not_of(" \t\r\n") == std::string::npos) fail("empty, expected a JSON object");
-  YAML::Node loaded;
+  const yaml::ReadContext ctx = json_context(file);
+  YAML::Node root;
   try {
-    loaded = YAML::Load(app_json);
-  } catch (const YAML::Exception& e) {
-    fail("not JSON (" + e.msg + ")");
+    root = yaml::parse(app_json, ctx);
+  } catch (const IoError& e) {
+    fail(meta_problem(e));
   }
-  const YAML::Node& root = loaded;
   // yaml-cpp reads YAML too: a JSON object is one in braces.
   if (!root.IsMap() || app_json[app_json.find_first_not_of(" \t\r\n")] != '{') fail("not a JSON object");
   MapMeta meta;
-  meta.T_world_map = read_T_world_map(root["T_world_map"], fail);
-  meta.station = read_station(root, fail);
+  meta.T_world_map = read_T_world_map(root["T_world_map"], ctx, fail);
+  meta.station = read_station(root, ctx, fail);
   return meta;
 }
 
