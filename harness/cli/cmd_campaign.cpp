@@ -11,7 +11,7 @@
 #include "count_option.hpp"
 #include "io_plan.hpp"
 #include "pvb/common/error.hpp"
-#include "pvb/run/campaign_run.hpp"
+#include "pvb/campaign/campaign_run.hpp"
 #include "stop_signals.hpp"
 
 namespace pvb::cli {

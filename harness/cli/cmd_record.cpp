@@ -28,7 +28,7 @@
 #include "pvb/plot/contact_sheet.hpp"
 #include "pvb/run/motion_truth.hpp"
 #include "pvb/run/run.hpp"
-#include "pvb/run/world_json.hpp"
+#include "pvb/report/world_json.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sensor/kinect_v1.hpp"
 #include "pvb/sim/sim_frame_source.hpp"

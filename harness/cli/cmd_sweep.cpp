@@ -35,7 +35,7 @@
 #include "pvb/eval/charts.hpp"
 #include "pvb/plot/matrix.hpp"
 #include "pvb/plot/png.hpp"
-#include "pvb/run/campaign_run.hpp"
+#include "pvb/campaign/campaign_run.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/suite/aggregate.hpp"
 #include "pvb/suite/campaign_aggregate.hpp"

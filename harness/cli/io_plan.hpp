@@ -5,7 +5,7 @@
 
 #include "pvb/common/io_paths.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
-#include "pvb/run/campaign.hpp"
+#include "pvb/campaign/campaign.hpp"
 #include "pvb/scenes/scenario.hpp"
 
 namespace pvb::cli {

@@ -1,7 +1,6 @@
 #include "pvb/dataset/fakenect_dump.hpp"
 
 #include <sys/stat.h>
-#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <cstdio>
@@ -11,6 +10,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/common/yaml_reader.hpp"
 #include "pvb/dataset/tum_imu.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
@@ -43,6 +43,12 @@ std::string device_json(const sensor::kinect::Calibration& c) {
                 c.dcmos_emitter_dist_cm, c.dcmos_rcmos_dist_cm, c.reference_distance_cm,
                 c.reference_pixel_size_mm, c.const_shift);
   return buf;
+}
+
+/// A number device.json must give (any finite value; the caller checks its range).
+double required_number(yaml::MapReader& r, const std::string& key) {
+  if (!r.has(key)) r.context().missing(r.full(key), r.node());
+  return r.number(key, 0, -yaml::kInf, yaml::kInf);
 }
 
 }  // namespace
@@ -160,29 +166,24 @@ sensor::kinect::Calibration read_fakenect_calibration(const std::string& dir) {
   sensor::kinect::Calibration c;
   std::ifstream probe(path);
   if (!probe) return c;
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw IoError(path, std::string("not valid JSON: ") + e.what(), e.mark.line + 1);
-  }
-  auto number = [&](const YAML::Node& node, const std::string& key) {
-    const YAML::Node v = node[key];
-    try {
-      if (v) return v.as<double>();
-    } catch (const YAML::Exception&) {
-    }
-    throw ConfigError(path, key, "a number");
-  };
-  const YAML::Node zp = root["zero_plane_info"];
-  if (!zp || !zp.IsMap()) throw ConfigError(path, "zero_plane_info", "an object");
-  c.dcmos_emitter_dist_cm = number(zp, "dcmos_emitter_dist");
-  c.dcmos_rcmos_dist_cm = number(zp, "dcmos_rcmos_dist");
-  c.reference_distance_cm = number(zp, "reference_distance");
-  c.reference_pixel_size_mm = number(zp, "reference_pixel_size");
-  c.const_shift = static_cast<int>(std::lround(number(root, "const_shift")));
+  // The common JSON reader: a damaged file is an IoError naming its line, a
+  // field a ConfigError naming the file, the line and the key.  Only the
+  // fields used are read: libfreenect's file holds more (reg_info, ...).
+  yaml::ReadContext ctx;
+  ctx.file = path;
+  ctx.errors = yaml::ErrorKind::kIo;
+  ctx.json = true;
+  const YAML::Node root = yaml::parse(read_file(path), ctx);
+  ctx.errors = yaml::ErrorKind::kConfig;
+  yaml::MapReader top(root, ctx, "");
+  yaml::MapReader zp(top.child("zero_plane_info"), ctx, "zero_plane_info");
+  c.dcmos_emitter_dist_cm = required_number(zp, "dcmos_emitter_dist");
+  c.dcmos_rcmos_dist_cm = required_number(zp, "dcmos_rcmos_dist");
+  c.reference_distance_cm = required_number(zp, "reference_distance");
+  c.reference_pixel_size_mm = required_number(zp, "reference_pixel_size");
+  c.const_shift = static_cast<int>(std::lround(required_number(top, "const_shift")));
   if (!(c.dcmos_emitter_dist_cm > 0 && c.reference_distance_cm > 0 && c.reference_pixel_size_mm > 0))
-    throw ConfigError(path, "zero_plane_info", "positive distances and pixel size");
+    zp.fail("zero_plane_info", zp.node(), "positive distances and pixel size");
   return c;
 }
 

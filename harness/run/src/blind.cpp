@@ -50,14 +50,6 @@ std::optional<PoseError> aligned_error(int after, double fps, const eval::EvalRe
   return pose_error(eval.T_w_c_gt[i], eval.T_w_c_est[i]);
 }
 
-std::string error_json(const std::optional<PoseError>& e) {
-  if (!e) return "null";
-  return "{\"trans_m\": " + json_number(e->trans_m, 10) + ", \"rot_deg\": " + json_number(e->rot_deg, 10) +
-         "}";
-}
-
-std::string optional_int_json(const std::optional<int>& v) { return v ? std::to_string(*v) : "null"; }
-
 }  // namespace
 
 PoseError pose_error(const geom::SE3d& T_w_c_true, const geom::SE3d& T_w_c_est) {
@@ -92,39 +84,6 @@ BlindStretch blind_stretch(const scenes::CoverFrames& cover, double fps,
   if (b.last_before) b.first_after_error = relative_error(*b.last_before, cover.end, fps, est, gt);
   if (eval) b.first_after_ate = aligned_error(cover.end, fps, *eval);
   return b;
-}
-
-std::string blind_json(const BlindStretch& b) {
-  std::string out = "{\"covered_frames\": [" + std::to_string(b.first_covered) + ", " +
-                    std::to_string(b.last_covered) + "]";
-  out += ", \"covered_frames_processed\": " + std::to_string(b.covered_processed);
-  out += ", \"covered_frames_with_pose\": " + std::to_string(b.covered_with_pose);
-  out += ", \"relocalised_frames\": " + std::to_string(b.relocalised_frames);
-  out += ", \"last_before_frame\": " + optional_int_json(b.last_before);
-  out += ", \"first_after_frame\": " + optional_int_json(b.first_after);
-  out += ", \"first_after_tracked\": " + std::string(b.first_after_tracked ? "true" : "false");
-  out += ", \"first_after_state\": " + (b.first_after ? json_string(b.first_after_state) : "null");
-  out += ", \"first_after_method\": " + (b.first_after ? json_string(b.first_after_method) : "null");
-  out += ", \"first_after_error\": " + error_json(b.first_after_error);
-  out += ", \"first_after_ate\": " + error_json(b.first_after_ate);
-  return out + "}";
-}
-
-std::string blind_summary(const BlindStretch& b) {
-  std::string out = "blind stretch (frames " + std::to_string(b.first_covered) + "-" +
-                    std::to_string(b.last_covered) + "): " + std::to_string(b.covered_with_pose) + " of " +
-                    std::to_string(b.covered_frames()) + " covered frames with a pose";
-  if (!b.first_after) return out + "; the run ended before the camera's return";
-  out += "; frame " + std::to_string(*b.first_after) + " after it ";
-  if (!b.first_after_tracked) return out + "has no pose (state " + b.first_after_state + ")";
-  out += "tracked (" + b.first_after_method + ")";
-  if (b.first_after_method == kRelocalisationMethod) out += " by a global relocalisation";
-  if (b.first_after_error)
-    out += ", " + format_number("%.4f m", b.first_after_error->trans_m) + " / " +
-           format_number("%.3f deg", b.first_after_error->rot_deg) + " off across the stretch";
-  else
-    out += ", no pose before the stretch to measure it from";
-  return out;
 }
 
 }  // namespace pvb::run

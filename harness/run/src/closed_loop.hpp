@@ -8,7 +8,7 @@
 
 #include "frame_producer.hpp"
 #include "pvb/geometry/se3.hpp"
-#include "pvb/run/report.hpp"
+#include "pvb/report/report.hpp"
 #include "pvb/run/run.hpp"
 #include "pvb/slam/core/system.hpp"
 

@@ -14,7 +14,7 @@
 #include <string>
 
 #include "frame_producer.hpp"
-#include "pvb/run/run.hpp"
+#include "pvb/run/run_options.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "run_log.hpp"
 

@@ -3,7 +3,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +11,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/common/yaml_reader.hpp"
 #include "pvb/slam/core/map_file.hpp"
 
 namespace pvb::run {
@@ -33,26 +33,7 @@ std::optional<geom::SE3d> pose_at(const eval::Trajectory& t, std::int64_t t_ns) 
   return geom::make_se3(q0.slerp(s, q1), (1 - s) * a.T_w_c.translation() + s * it->T_w_c.translation());
 }
 
-std::string pose_json(const geom::SE3d& T) {
-  std::string out = "[";
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) out += (r || c ? ", " : "") + json_number(T.matrix()(r, c));
-  return out + "]";
-}
-
 }  // namespace
-
-const char* to_string(MapUse u) {
-  switch (u) {
-    case MapUse::kFresh:
-      return "fresh";
-    case MapUse::kLocalise:
-      return "localise";
-    case MapUse::kExtend:
-      return "extend";
-  }
-  return "?";
-}
 
 MapUse parse_map_use(const std::string& text, const std::string& option) {
   if (text == "localise") return MapUse::kLocalise;
@@ -71,17 +52,17 @@ void MapOptions::check() const {
                       "a map made or extended by the run, not with --map-mode localise");
 }
 
-bool MapStation::differs_from(const MapStation& o) const {
-  return (!name.empty() && !o.name.empty() && name != o.name) || (seed && o.seed && *seed != *o.seed);
-}
-
-std::string MapStation::describe() const {
-  if (!known()) return "an unknown station";
-  const std::string s = seed ? "station seed " + std::to_string(*seed) : "";
-  return name.empty() ? s : s.empty() ? name : name + ", " + s;
-}
-
 namespace {
+
+/// The common reader's context for a JSON text pvbench wrote and reads
+/// back (a recording's meta.json, a map's META): its mistakes are IoErrors.
+yaml::ReadContext json_context(const std::string& file) {
+  yaml::ReadContext ctx;
+  ctx.file = file;
+  ctx.errors = yaml::ErrorKind::kIo;
+  ctx.json = true;
+  return ctx;
+}
 
 /// The name of a station file: "scenes/pv_station.yaml" -> "pv_station".
 std::string station_name(const std::string& file) { return std::filesystem::path(file).stem().string(); }
@@ -96,18 +77,25 @@ MapStation station_of(const scenes::Scenario& s) {
 MapStation recording_station(const std::string& meta_json_path) {
   MapStation st;
   if (!std::ifstream(meta_json_path).good()) return st;
+  const std::string text = read_file(meta_json_path);
+  const yaml::ReadContext ctx = json_context(meta_json_path);
   try {
-    const YAML::Node root = YAML::Load(read_file(meta_json_path));
+    const YAML::Node root = yaml::parse(text, ctx);
     const YAML::Node world = root["world"], scenario = root["scenario"];
-    if (world.IsMap() && world["station_seed"].IsScalar())
-      st.seed = world["station_seed"].as<std::uint64_t>();
+    std::uint64_t seed = 0;
+    if (world.IsMap() && world["station_seed"].IsScalar()) {
+      if (!yaml::decode_seed(world["station_seed"], ctx, &seed)) return MapStation{};
+      st.seed = seed;
+    }
     const YAML::Node bases = world.IsMap() ? world["base_files"] : YAML::Node();
     if (bases.IsSequence() && bases.size() > 0 && bases[bases.size() - 1].IsScalar())
       st.name = station_name(bases[bases.size() - 1].Scalar());
     else if (scenario.IsMap() && scenario["file"].IsScalar())
       st.name = station_name(scenario["file"].Scalar());
-  } catch (const YAML::Exception&) {
+  } catch (const IoError&) {
     return MapStation{};  // informative only: a recording that does not say has no station
+  } catch (const YAML::Exception&) {
+    return MapStation{};
   }
   return st;
 }
@@ -137,7 +125,7 @@ namespace {
 /// T_world_map of META: null, or 12 finite numbers that make a rotation
 /// and a translation within slam::kMaxMapCoordinateM.  `fail` throws.
 template <class Fail>
-std::optional<geom::SE3d> read_T_world_map(const YAML::Node& v, const Fail& fail) {
+std::optional<geom::SE3d> read_T_world_map(const YAML::Node& v, const yaml::ReadContext& ctx, const Fail& fail) {
   if (!v.IsDefined()) fail("no T_world_map (expected 12 numbers, a 3x4 matrix row by row, or null)");
   if (v.IsNull()) return std::nullopt;
   if (!v.IsSequence() || v.size() != 12)
@@ -147,7 +135,7 @@ std::optional<geom::SE3d> read_T_world_map(const YAML::Node& v, const Fail& fail
   Eigen::Matrix<double, 3, 4> m;
   for (int k = 0; k < 12; ++k) {
     double x = 0;
-    if (!v[k].IsScalar() || !YAML::convert<double>::decode(v[k], x) || !std::isfinite(x))
+    if (!yaml::decode_number(v[k], ctx, &x))
       fail("T_world_map number " + std::to_string(k + 1) + " is not a finite number (" +
            printable(v[k].IsScalar() ? v[k].Scalar() : std::string("not a scalar")) + ")");
     m(k / 4, k % 4) = x;
@@ -163,7 +151,7 @@ std::optional<geom::SE3d> read_T_world_map(const YAML::Node& v, const Fail& fail
 /// META's station: "station" a string or null, "station_seed" a whole
 /// number or null (either may be missing: a map made before they were written).
 template <class Fail>
-MapStation read_station(const YAML::Node& root, const Fail& fail) {
+MapStation read_station(const YAML::Node& root, const yaml::ReadContext& ctx, const Fail& fail) {
   MapStation st;
   const YAML::Node name = root["station"], seed = root["station_seed"];
   if (name.IsDefined() && !name.IsNull()) {
@@ -171,15 +159,23 @@ MapStation read_station(const YAML::Node& root, const Fail& fail) {
     st.name = name.Scalar();
   }
   if (seed.IsDefined() && !seed.IsNull()) {
-    const std::string t = seed.IsScalar() ? seed.Scalar() : "";
-    const bool digits =
-        !t.empty() && t.size() <= 20 && t.find_first_not_of("0123456789") == std::string::npos;
-    errno = 0;
-    const unsigned long long v = digits ? std::strtoull(t.c_str(), nullptr, 10) : 0;
-    if (!digits || errno == ERANGE) fail("station_seed is not a whole number from 0 (" + printable(t) + ")");
+    std::uint64_t v = 0;
+    if (!yaml::decode_seed(seed, ctx, &v))
+      fail("station_seed is not a whole number from 0 (" + printable(seed.IsScalar() ? seed.Scalar() : "") + ")");
     st.seed = v;
   }
   return st;
+}
+
+/// The common reader's complaint about META's text as META's errors say
+/// it: "not JSON (what, line N of the section)", or a key given twice.
+std::string meta_problem(const IoError& e) {
+  const std::string syntax = "not valid JSON: ";
+  const std::string& m = e.message();
+  const std::string line = e.line() > 0 ? "line " + std::to_string(e.line()) + " of the section" : "";
+  if (m.compare(0, syntax.size(), syntax) == 0)
+    return "not JSON (" + m.substr(syntax.size()) + (line.empty() ? "" : ", " + line) + ")";
+  return m + (line.empty() ? "" : " (" + line + ")");
 }
 
 }  // namespace
@@ -187,18 +183,18 @@ MapStation read_station(const YAML::Node& root, const Fail& fail) {
 MapMeta read_map_meta(const std::string& app_json, const std::string& file) {
   const auto fail = [&](const std::string& what) -> void { throw IoError(file, "META section: " + what); };
   if (app_json.find_first_not_of(" \t\r\n") == std::string::npos) fail("empty, expected a JSON object");
-  YAML::Node loaded;
+  const yaml::ReadContext ctx = json_context(file);
+  YAML::Node root;
   try {
-    loaded = YAML::Load(app_json);
-  } catch (const YAML::Exception& e) {
-    fail("not JSON (" + e.msg + ")");
+    root = yaml::parse(app_json, ctx);
+  } catch (const IoError& e) {
+    fail(meta_problem(e));
   }
-  const YAML::Node& root = loaded;
   // yaml-cpp reads YAML too: a JSON object is one in braces.
   if (!root.IsMap() || app_json[app_json.find_first_not_of(" \t\r\n")] != '{') fail("not a JSON object");
   MapMeta meta;
-  meta.T_world_map = read_T_world_map(root["T_world_map"], fail);
-  meta.station = read_station(root, fail);
+  meta.T_world_map = read_T_world_map(root["T_world_map"], ctx, fail);
+  meta.station = read_station(root, ctx, fail);
   return meta;
 }
 
@@ -287,77 +283,6 @@ void finish_map(slam::System& system, const MapOptions& options, const eval::Tra
   score_map_localisation(r, gt, est);
   if (!r->load && !gt.empty()) r->T_world_map = T_world_new_map(gt, est);
   save_map(system, options, name, r, scenario_file);
-}
-
-std::vector<std::string> map_log_lines(const MapReport& m) {
-  std::vector<std::string> lines;
-  if (!m.station_warning.empty()) lines.push_back("warning: " + m.station_warning);
-  if (m.load) {
-    std::string line = "map " + m.loaded_from + " (" + to_string(m.use) + ", " + std::to_string(m.load->keyframes) +
-                       " keyframes, loaded in " + format_fixed(m.load->load_ms, 0) + " ms): ";
-    if (m.localisation) {
-      const eval::LocalisationScores& l = *m.localisation;
-      const auto& classes = eval::precision_classes();
-      for (std::size_t k = 0; k < classes.size(); ++k)
-        line += format_fixed(100 * l.share_within[k], 1) + " % within " + format_g(classes[k].max_translation_m) +
-                " m/" + format_g(classes[k].max_rotation_deg) + " deg, ";
-      line += std::to_string(l.wrong_place) + " wrong-place poses, first pose at frame " +
-              (l.first_pose_frame ? std::to_string(*l.first_pose_frame) : std::string("-"));
-      if (m.merges) line += ", " + std::to_string(m.merges) + " provisional map(s) merged";
-    } else {
-      line += "not scored: " + m.localisation_note;
-    }
-    lines.push_back(line);
-  }
-  if (!m.save_note.empty()) lines.push_back("map " + m.saved_to + " " + m.save_note);
-  if (m.save)
-    lines.push_back("map saved to " + m.saved_to + ": " + std::to_string(m.save->sessions) + " sessions, " +
-                    std::to_string(m.save->keyframes) + " keyframes, " + std::to_string(m.save->points) +
-                    " points, " + std::to_string(m.save->bytes) + " bytes in " + format_fixed(m.save->save_ms, 0) +
-                    " ms" +
-                    (m.save->unmerged_keyframes
-                         ? "; " + std::to_string(m.save->unmerged_keyframes) +
-                               " keyframes of a provisional map never merged were left out"
-                         : std::string()));
-  return lines;
-}
-
-std::string map_report_json(const MapReport& r) {
-  std::string out = "{\"use\": \"" + std::string(to_string(r.use)) + "\"";
-  if (r.load) {
-    const slam::MapLoadInfo& l = *r.load;
-    out += ", \"loaded\": {\"file\": \"" + json_escape(r.loaded_from) +
-           "\", \"sessions\": " + std::to_string(l.sessions) +
-           ", \"keyframes\": " + std::to_string(l.keyframes) + ", \"points\": " + std::to_string(l.points) +
-           ", \"bytes\": " + std::to_string(l.bytes) + ", \"load_ms\": " + json_number(l.load_ms) +
-           "}, \"relocalisations\": " + std::to_string(r.relocalisations) +
-           ", \"merges\": " + std::to_string(r.merges);
-  }
-  out += ", \"T_world_map\": " + (r.T_world_map ? pose_json(*r.T_world_map) : std::string("null"));
-  if (r.save) {
-    const slam::MapSaveInfo& s = *r.save;
-    out += ", \"saved\": {\"file\": \"" + json_escape(r.saved_to) +
-           "\", \"sessions\": " + std::to_string(s.sessions) +
-           ", \"keyframes\": " + std::to_string(s.keyframes) + ", \"points\": " + std::to_string(s.points) +
-           ", \"bytes\": " + std::to_string(s.bytes) + ", \"bytes_per_keyframe\": " +
-           json_number(s.keyframes ? double(s.bytes) / double(s.keyframes) : 0.0) +
-           ", \"save_ms\": " + json_number(s.save_ms) +
-           ", \"unmerged_keyframes\": " + std::to_string(s.unmerged_keyframes) + "}";
-  }
-  if (!r.save_note.empty()) out += ", \"save_note\": \"" + json_escape(r.save_note) + "\"";
-  if (!r.matched_landmarks.empty()) {
-    out += ", \"matched_landmarks\": {";
-    for (std::size_t i = 0; i < r.matched_landmarks.size(); ++i)
-      out += (i ? ", \"" : "\"") + r.matched_landmarks[i].first + "\": " + std::to_string(r.matched_landmarks[i].second);
-    out += "}";
-  } else if (!r.matched_landmarks_note.empty()) {
-    out += ", \"matched_landmarks_note\": \"" + json_escape(r.matched_landmarks_note) + "\"";
-  }
-  if (r.load)
-    out += ", \"localisation\": " +
-           (r.localisation ? eval::localisation_json(*r.localisation)
-                           : "null, \"localisation_note\": \"" + json_escape(r.localisation_note) + "\"");
-  return out + "}";
 }
 
 }  // namespace pvb::run

@@ -2,7 +2,7 @@
 // Gathers a run's motion sensor readings and their truth, frame by frame,
 // into the report's MotionSensorsReport.
 #include "frame_producer.hpp"
-#include "pvb/run/report.hpp"
+#include "pvb/report/report.hpp"
 #include "pvb/sensor/wheel_odometry.hpp"
 
 namespace pvb::run {

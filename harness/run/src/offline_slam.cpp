@@ -1,45 +1,12 @@
 #include "pvb/run/offline_slam.hpp"
 
-#include <algorithm>
-#include <cmath>
 #include <cstdarg>
-#include <cstdio>
 #include <ctime>
-#include <fstream>
-#include <sstream>
-#include <vector>
 
-#include "motion_match_scorer.hpp"
-#include "pvb/common/error.hpp"
-#include "pvb/common/io_paths.hpp"
-#include "pvb/common/output_file.hpp"
-#include "pvb/common/output_folder.hpp"
-#include "pvb/common/text.hpp"
-#include "pvb/dataset/tum_sequence.hpp"
-#include "pvb/eval/evaluate.hpp"
-#include "pvb/eval/gravity.hpp"
-#include "pvb/eval/metrics.hpp"
-#include "pvb/geometry/stamped_pose.hpp"
-#include "pvb/run/inertial_eval.hpp"
-#include "pvb/run/map_eval.hpp"
-#include "pvb/run/output_names.hpp"
-#include "pvb/run/place_events.hpp"
-#include "pvb/run/sensor_setup.hpp"
-#include "pvb/slam/core/system.hpp"
-#include "pvb/slam/dense/point_cloud.hpp"
-#include "pvb/suite/metrics_file.hpp"
+#include "offline_slam_impl.hpp"
 
 namespace pvb::run {
-// The run's own types (named: the run's class holds them).
 namespace offline_detail {
-
-/// Why the frame loop ended.
-enum class StopReason {
-  kEnd,             ///< every frame of the sequence (or max_frames of them)
-  kSignal,          ///< a stop request (Ctrl-C or SIGTERM)
-  kTooManyMissing,  ///< more than max_missing of the frames skipped
-  kImageSize,       ///< an image differs from Camera.width x Camera.height
-};
 
 const char* stop_name(StopReason r) {
   switch (r) {
@@ -55,28 +22,6 @@ const char* stop_name(StopReason r) {
   return "?";
 }
 
-/// Counts and per-frame series of one run.
-struct Tally {
-  std::size_t frames = 0, lost = 0, not_init = 0, poses = 0;
-  std::size_t dead_reckoned = 0;  ///< frames carried by the motion sensors (TrackingState::kDeadReckoning)
-  std::vector<double> tracking_ms, pe_ms;
-  std::vector<double> cpu_ms;  ///< caller-thread CPU per frame: tracking, plus inline mapping in sync mode
-  std::string init_failure;    ///< why the last frame failed to initialise
-  std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made
-  std::vector<std::int64_t> frame_t_ns;     ///< every frame tracked
-  eval::GravityEstimates gravity;           ///< the core's gravity per frame, once trusted
-};
-
-}  // namespace offline_detail
-
-namespace {
-
-using offline_detail::StopReason;
-using offline_detail::Tally;
-
-using eval::mean_of;
-using eval::percentile;
-
 /// printf into a string.
 __attribute__((format(printf, 1, 2))) std::string strf(const char* format, ...) {
   va_list args;
@@ -90,6 +35,13 @@ __attribute__((format(printf, 1, 2))) std::string strf(const char* format, ...) 
   va_end(again);
   return out;
 }
+
+}  // namespace offline_detail
+
+namespace {
+
+using eval::mean_of;
+using eval::percentile;
 
 /// CPU time of the calling thread in ms (unlike wall time, not inflated
 /// when other processes share the cores).
@@ -146,63 +98,6 @@ void check_offline_options(const OfflineSlamOptions& a) {
                       format_g(a.max_missing));
 }
 
-/// The run, in stages: inputs and outputs are opened by the constructor,
-/// run() tracks, writes the final outputs and stats.json, and then reports
-/// a run that stopped early or never initialised as an error.
-class OfflineSlam::Impl {
- public:
-  explicit Impl(const OfflineSlamOptions& a);
-  int run();
-  const slam::Settings& settings() const { return settings_; }
-
- private:
-  slam::Settings read_settings();
-  /// The motion readings the setup fuses against the frames and the
-  /// settings; a supplied Kinect description takes the readings' rate.
-  void check_motion();
-  void open_outputs();
-  bool stop_requested() const { return a_.stop && a_.stop->load(); }
-  void text(const std::string& s) const {
-    if (a_.on_text) a_.on_text(s);
-  }
-  void warn(const std::string& line) const {
-    if (a_.on_warning) a_.on_warning(line);
-  }
-  StopReason track_frames();
-  slam::TrackingState track_one(const sensor::RgbdFrame& frame);
-  void write_timing_line(const sensor::RgbdFrame& frame, const slam::FrameResult& r, double cpu_ms);
-  std::string write_final_outputs();
-  std::string dense_json(const NamedClouds& maps);
-  std::string stats_json(StopReason stop, const std::string& dense_json);
-  void print_loop_closing(std::ostringstream* js);
-  void evaluate(std::ostringstream* js);
-  /// Gravity error per frame and the keyframes' pitch and roll error (docs/evaluation.md).
-  void evaluate_gravity(const eval::Trajectory& gt, const eval::Trajectory& est, const eval::Sim3Transform& alignment,
-                        std::ostringstream* js);
-  void evaluate_refined(const eval::Trajectory& gt, const eval::EvalOptions& eo, std::ostringstream* js);
-  /// A setup with an accelerometer: stats.json's "inertial", the keyframes'
-  /// biases against the folder's imu0/truth.csv when it has one.
-  void evaluate_inertial(std::ostringstream* js);
-  /// Labels the loops and relocalisations against `gt` and prints them.
-  void label_places(const eval::Trajectory& gt);
-  void fail_if_incomplete(StopReason stop) const;
-  /// Scores localisation in a loaded map and saves the final map; appends stats.json's "map".
-  void finish_map(std::ostringstream* js);
-
-  bool imu_supplied_ = false;  ///< set by read_settings() (first: initialised before settings_)
-  const OfflineSlamOptions a_;
-  slam::Settings settings_;
-  dataset::TumSequenceReader reader_;
-  std::unique_ptr<slam::System> system_;
-  OutputFile cam_traj_, kf_traj_, timing_;
-  std::unique_ptr<MotionMatchScorer> scorer_;
-  Tally tally_;
-  PlaceRecognition place_;             ///< collected after the run, labelled when there is ground truth
-  std::string image_size_error_;       ///< set when the loop stopped on an image of the wrong size
-  std::optional<MapReport> map_;       ///< with --map or --save-map
-  std::optional<double>
-      gravity_true_deg_;  ///< the core's gravity at its trusted time against the ground truth
-};
 
 slam::Settings OfflineSlam::Impl::read_settings() {
   slam::Settings settings = slam::read_settings(a_.settings);
@@ -385,128 +280,6 @@ std::string OfflineSlam::Impl::dense_json(const NamedClouds& maps) {
     js << (i ? ", " : "") << format_g(dense.loop_update_ms[i]);
   js << "]}";
   return js.str();
-}
-
-/// Evaluates CameraTrajectory.txt (and the refined one) against the
-/// sequence's groundtruth.txt, when there is one; prints the report and
-/// appends its fields to stats.json.  A failed evaluation is a warning.
-void OfflineSlam::Impl::evaluate(std::ostringstream* js) {
-  const std::string gt_path = a_.sequence + "/groundtruth.txt";
-  if (!std::ifstream(gt_path) || tally_.poses == 0) return;
-  try {
-    const eval::Trajectory gt = eval::read_tum(gt_path);
-    const eval::Trajectory est = eval::read_tum(a_.out + "/CameraTrajectory.txt");
-    eval::EvalOptions eo;
-    eval::EvalResult res;
-    try {
-      res = eval::evaluate(gt, est, eo);
-    } catch (const eval::EvalError& e) {
-      // Only a numerically degenerate set lands here (a robot that never
-      // moved, fewer than 3 poses); straight drives align with se3.
-      // The SLAM estimate starts at its first frame, so align that instead.
-      warn(std::string("note: se3 alignment impossible (") + e.what() + "); using origin alignment");
-      eo.alignment = eval::Alignment::kOrigin;
-      res = eval::evaluate(gt, est, eo);
-    }
-    text("\n" + eval::format_report(res));
-    label_places(gt);
-    std::string ev = eval::format_json(res);
-    const std::size_t open = ev.find('{'), close = ev.rfind('}');
-    ev = ev.substr(open + 1, close - open - 1);
-    while (!ev.empty() && (ev.back() == '\n' || ev.back() == ' ')) ev.pop_back();
-    *js << "," << ev;
-    evaluate_refined(gt, eo, js);
-    evaluate_gravity(gt, est, res.alignment, js);
-  } catch (const Error& e) {
-    warn(std::string("warning: no evaluation: ") + e.what());
-  }
-}
-
-void OfflineSlam::Impl::evaluate_refined(const eval::Trajectory& gt, const eval::EvalOptions& eo,
-                                         std::ostringstream* js) {
-  try {
-    const eval::EvalResult ref = eval::evaluate(gt, eval::read_tum(a_.out + "/CameraTrajectoryRefined.txt"), eo);
-    text(strf("refined trajectory (frames re-anchored to bundle-adjusted keyframes): ATE RMSE %.4f m\n",
-              ref.ate.rmse));
-    *js << ",\n  \"refined\": {\"ate_rmse\": " << format_g(ref.ate.rmse)
-        << ", \"rpe_trans_rmse\": " << format_g(ref.rpe_trans_m.rmse) << "}";
-  } catch (const Error& e) {
-    warn(std::string("warning: refined trajectory not evaluated: ") + e.what());
-  }
-}
-
-void OfflineSlam::Impl::evaluate_gravity(const eval::Trajectory& gt, const eval::Trajectory& est,
-                                         const eval::Sim3Transform& alignment, std::ostringstream* js) {
-  // A pvbench recording's world is the site frame (z up); a TUM download's
-  // the mocap world, whose up was measured from the Kinect's accelerometer.
-  const bool site = std::ifstream(a_.sequence + "/meta.json").good();
-  const geom::Vec3d down_w = site ? geom::Vec3d(0, 0, -1) : geom::Vec3d(-dataset::tum_world_up());
-  const eval::GravityError g =
-      eval::gravity_error(gt, est, down_w, gravity_map_frame(settings_.motion.setup), tally_.gravity);
-  const eval::TiltDrift t =
-      eval::tilt_drift(gt, session_keyframes(eval::read_tum(a_.out + "/KeyFrameTrajectory.txt"), *system_), alignment);
-  const slam::MapGravity core = system_->gravity();
-  if (core.ready) gravity_true_deg_ = gravity_error_at_deg(gt, est, down_w, tally_.gravity, core.ready_t_ns);
-  text(strf("gravity error (map frame: %s): median %.2f deg, p95 %.2f, final %.2f; keyframe pitch error "
-            "%+.4f deg/keyframe, roll %+.4f\n",
-            g.map_frame.c_str(), g.median_deg, g.p95_deg, g.final_deg, t.pitch_slope_deg_per_kf,
-            t.roll_slope_deg_per_kf));
-  *js << ",\n  \"gravity\": " << eval::gravity_json(g) << ",\n  \"tilt\": " << eval::tilt_json(t);
-}
-
-void OfflineSlam::Impl::evaluate_inertial(std::ostringstream* js) {
-  if (!sensor::uses_accel(settings_.motion.setup) || tally_.frame_t_ns.empty()) return;
-  const std::int64_t t0_ns = tally_.frame_t_ns.front();
-  InertialReport r = inertial_report(system_->gravity(), t0_ns);
-  if (r.trusted) r.gravity_true_deg = gravity_true_deg_;
-  std::vector<KeyframeBias> kfs;
-  for (const slam::System::KeyFrameState& k : system_->keyframe_states())
-    kfs.push_back({k.id, k.t_ns, k.bias});
-  const std::string truth_path = a_.sequence + "/imu0/truth.csv";
-  if (!kfs.empty() && std::ifstream(truth_path)) {
-    try {
-      const std::vector<BiasTruth> truth = read_bias_truth(truth_path);
-      if (!truth.empty())
-        r.biases = compare_biases(std::move(kfs), truth, t0_ns, sensor::uses_imu(settings_.motion.setup));
-    } catch (const IoError& e) {
-      warn(std::string("warning: biases not compared: ") + e.what());
-    }
-  }
-  const std::string truth =
-      r.gravity_true_deg ? strf(", %.2f deg off the true down (ground truth)", *r.gravity_true_deg) : "";
-  text(
-      r.trusted
-          ? strf(
-                "inertial state trusted at t = %.2f s (keyframe %llu): gravity %.2f deg off the map's -z%s\n",
-                r.trusted_t_s, static_cast<unsigned long long>(r.trusted_keyframe), r.gravity_tilt_deg,
-                truth.c_str())
-          : std::string("inertial state not trusted by the end\n"));
-  if (r.biases)
-    text(strf("bias error RMS over %zu keyframes: gyro %.5f rad/s, accel %.4f m/s^2\n", r.biases->t_s.size(),
-              r.biases->gyro_rms_radps, r.biases->accel_rms_mps2));
-  *js << ",\n  \"inertial\": " << inertial_json(r);
-}
-
-void OfflineSlam::Impl::finish_map(std::ostringstream* js) {
-  if (!map_) return;
-  const std::string gt_path = a_.sequence + "/groundtruth.txt";
-  // The ground truth at the frames' times: every frame counts once.
-  const eval::Trajectory gt =
-      std::ifstream(gt_path) ? ground_truth_at(eval::read_tum(gt_path), tally_.frame_t_ns) : eval::Trajectory{};
-  const eval::Trajectory est =
-      tally_.poses > 0 ? eval::read_tum(a_.out + "/CameraTrajectory.txt") : eval::Trajectory{};
-  run::finish_map(*system_, a_.map, gt, est, a_.sequence, &*map_);
-  for (const std::string& line : map_log_lines(*map_)) text(line + "\n");
-  *js << ",\n  \"map\": " << map_report_json(*map_);
-}
-
-void OfflineSlam::Impl::label_places(const eval::Trajectory& gt) {
-  label_place_recognition(&place_, gt);
-  const eval::PlaceLabels& l = *place_.labels;
-  text(strf("place recognition: loops %d true, %d false, %d missed of %zu true revisits; "
-            "relocalisations %d true, %d false\n",
-            l.loops_true, l.loops_false, l.loops_missed, l.revisits.size(), l.relocalisations_true,
-            l.relocalisations_false));
 }
 
 /// The run's counts, timings and mapping statistics for stats.json (without

@@ -20,7 +20,7 @@
 #include "pvb/run/blind.hpp"
 #include "pvb/run/motion_truth.hpp"
 #include "pvb/run/output_names.hpp"
-#include "pvb/run/world_json.hpp"
+#include "pvb/report/world_json.hpp"
 #include "pvb/scenes/route.hpp"
 #include "pvb/sim/motion_sensors.hpp"
 #include "pvb/slam/core/settings.hpp"

@@ -10,7 +10,7 @@
 
 #include "pvb/geometry/time.hpp"
 #include "pvb/run/blind.hpp"
-#include "pvb/run/report.hpp"
+#include "pvb/report/report.hpp"
 
 namespace pvb::run {
 namespace {

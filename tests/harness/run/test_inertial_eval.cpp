@@ -16,7 +16,7 @@
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/run/inertial_eval.hpp"
-#include "pvb/run/report.hpp"
+#include "pvb/report/report.hpp"
 
 namespace pvb::run {
 namespace {

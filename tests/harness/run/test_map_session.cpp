@@ -76,6 +76,18 @@ TEST(MapSession, ADamagedMetaIsRefusedNamingTheFileMetaAndTheDamage) {
   }
 }
 
+// META is read by the common JSON reader: a key given twice (yaml-cpp would
+// keep both and find the first) is refused, naming it and both lines.
+TEST(MapSession, AMetaKeyGivenTwiceIsRefusedNamingBothLines) {
+  const std::string what = start_error("{\"T_world_map\": null,\n \"T_world_map\": " + std::string(kRotation) + "}");
+  EXPECT_NE(what.find(::testing::TempDir() +
+                      "map_session_meta.pvbmap: META section: T_world_map: expected each key once in its section "
+                      "(first given at line 1), got a second T_world_map (line 2 of the section)"),
+            std::string::npos)
+      << what;
+  EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+}
+
 TEST(MapSession, AMapMadeWithoutGroundTruthIsUsedAndLeftUnscored) {
   const MapReport r = start(meta("null"), {});
   EXPECT_FALSE(r.T_world_map);

@@ -8,7 +8,7 @@
 #include "pvb/eval/evaluate.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/geometry/se3.hpp"
-#include "pvb/run/report.hpp"
+#include "pvb/report/report.hpp"
 #include "pvb/scenes/scenario.hpp"
 
 namespace pvb::run {

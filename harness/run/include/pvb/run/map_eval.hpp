@@ -12,6 +12,7 @@
 #include "pvb/eval/evaluate.hpp"
 #include "pvb/eval/map_accuracy.hpp"
 #include "pvb/eval/trajectory.hpp"
+#include "pvb/report/map_scores.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/gl_context.hpp"
 #include "pvb/sim/truth_surface.hpp"
@@ -56,23 +57,6 @@ std::vector<eval::MapPoint> map_in_world(const slam::dense::PointCloud& cloud, c
 /// The true surface seen along the scenario's route, as evaluation points.
 std::vector<eval::SurfacePoint> true_surface(const scenes::Scenario& scenario, sim::GlBackend backend,
                                              const sim::TruthSurfaceOptions& options);
-
-/// One scored map.
-struct MapResult {
-  std::string name;  ///< corrected, live, before_loop, after_loop
-  eval::MapAccuracy accuracy;
-  double score_s = 0;
-};
-
-/// The result as JSON: {"tau_m", "all", "per_class": {...}, "per_range":
-/// [...]}, each scores object {"map_points", "surface_points",
-/// "accuracy_m": {mean, median, rmse, p95}, "completeness_at",
-/// "precision_at", "fscore_at", "chamfer_m", "ghosting", "ghosting_judged"};
-/// indented by `indent` spaces after each newline.
-std::string map_accuracy_json(const eval::MapAccuracy& r, int indent = 0);
-/// A fixed-width table, one row for the whole map and one per class
-/// (accuracy in mm, completeness in % within each tau, F at 2 cm, ghosting).
-std::string map_accuracy_table(const eval::MapAccuracy& r);
 
 /// The map's points with their class and error as PLY properties
 /// (binary, float x y z, uchar class, float error), for CloudCompare or

@@ -12,30 +12,15 @@
 #include "pvb/eval/localisation.hpp"
 #include "pvb/eval/trajectory.hpp"
 #include "pvb/geometry/se3.hpp"
+#include "pvb/report/map_report.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/slam/core/system.hpp"
 
 namespace pvb::run {
 
-/// How a run uses a saved map.
-enum class MapUse { kFresh, kLocalise, kExtend };
-const char* to_string(MapUse u);
 /// "localise" or "extend"; anything else throws ConfigError naming `option`.
 MapUse parse_map_use(const std::string& text, const std::string& option);
 
-/// The station a map shows or a run is on: the name of its station file
-/// (the file its days derive from, without folder and ".yaml";
-/// "pv_station" for every scenes/days/pv_station_*.yaml) and its station
-/// seed.  Either may be unknown.
-struct MapStation {
-  std::string name;  ///< "" when not known
-  std::optional<std::uint64_t> seed;
-  bool known() const { return !name.empty() || seed.has_value(); }
-  /// True when both name a part (name, seed) and that part differs.
-  bool differs_from(const MapStation& o) const;
-  /// "pv_station, station seed 7" (the parts known).
-  std::string describe() const;
-};
 /// The station of a scenario (its last base file, else its own file).
 MapStation station_of(const scenes::Scenario& s);
 /// The station of a recording by `pvbench record`, from its meta.json
@@ -55,34 +40,6 @@ struct MapOptions {
   /// Checks the combination: a use needs a map and a map a use, and a map
   /// only localised in is not saved again.  Throws ConfigError.
   void check() const;
-};
-
-/// What a run did with maps, for metrics.json and the report.
-struct MapReport {
-  std::string loaded_from;
-  MapUse use = MapUse::kFresh;
-  std::optional<slam::MapLoadInfo> load;
-  MapStation loaded_station;    ///< what the loaded map's META says; an extended map keeps it
-  std::string station_warning;  ///< the loaded map shows another station (allowed)
-  /// The map's frame in the world (its first session's first camera), from
-  /// the loaded map's data or, for a new map, the ground truth.
-  std::optional<geom::SE3d> T_world_map;
-  std::string saved_to;
-  std::optional<slam::MapSaveInfo> save;
-  std::string save_note;  ///< why a map to save was not saved (none: the run made no keyframe)
-  std::size_t relocalisations = 0;                        ///< tracking found again (the first pose included)
-  /// Provisional maps (begun while lost outside the loaded map) merged into it.
-  std::size_t merges = 0;
-  /// Times each loaded landmark had been matched when the map was loaded,
-  /// by id: what this session matched is the difference at its end.
-  std::map<std::uint64_t, int> found_at_load;
-  /// The landmarks this session matched, by the surface they lie on in
-  /// the map's own day (sim::SurfaceClass names, "unlabelled" beyond 5 cm
-  /// of any); empty when not classified.
-  std::vector<std::pair<std::string, int>> matched_landmarks;
-  std::string matched_landmarks_note;  ///< why they were not classified
-  std::optional<eval::LocalisationScores> localisation;  ///< with a loaded map and ground truth
-  std::string localisation_note;                          ///< why there is none
 };
 
 /// The application data of a map file (its META section): the scenario it
@@ -141,11 +98,5 @@ void save_map(slam::System& system, const MapOptions& options, const std::string
 void finish_map(slam::System& system, const MapOptions& options, const eval::Trajectory& gt,
                 const eval::Trajectory& est, const std::string& name, MapReport* report,
                 const std::string& scenario_file = "");
-
-/// What the run did with maps, one line per loaded or saved map.
-std::vector<std::string> map_log_lines(const MapReport& r);
-
-/// The "map" object of metrics.json (one line).
-std::string map_report_json(const MapReport& r);
 
 }  // namespace pvb::run

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "pvb/eval/trajectory.hpp"
-#include "pvb/run/report.hpp"
+#include "pvb/report/report.hpp"
 #include "pvb/slam/core/system.hpp"
 
 namespace pvb::run {

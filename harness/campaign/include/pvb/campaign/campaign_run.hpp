@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "pvb/campaign/campaign.hpp"
 #include "pvb/plot/matrix.hpp"
-#include "pvb/run/campaign.hpp"
-#include "pvb/run/map_session.hpp"
-#include "pvb/run/report.hpp"
+#include "pvb/report/map_report.hpp"
+#include "pvb/report/report.hpp"
 
 namespace pvb::run {
 

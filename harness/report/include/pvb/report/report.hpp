@@ -14,9 +14,9 @@
 #include "pvb/eval/metrics.hpp"
 #include "pvb/eval/place_labels.hpp"
 #include "pvb/plot/contact_sheet.hpp"
-#include "pvb/run/inertial_eval.hpp"
-#include "pvb/run/map_session.hpp"
-#include "pvb/run/map_eval.hpp"
+#include "pvb/report/inertial_report.hpp"
+#include "pvb/report/map_report.hpp"
+#include "pvb/report/map_scores.hpp"
 #include "pvb/slam/core/reports.hpp"
 
 namespace pvb::run {

@@ -1,4 +1,4 @@
-#include "pvb/run/campaign_run.hpp"
+#include "pvb/campaign/campaign_run.hpp"
 
 #include <sys/stat.h>
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "pvb/run/report.hpp"
+#include "pvb/report/report.hpp"
 
 namespace pvb::run {
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "pvb/run/world_json.hpp"
+#include "pvb/report/world_json.hpp"
 
 using namespace pvb;
 

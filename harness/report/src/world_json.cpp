@@ -1,4 +1,4 @@
-#include "pvb/run/world_json.hpp"
+#include "pvb/report/world_json.hpp"
 
 #include "pvb/common/text.hpp"
 

@@ -1,4 +1,4 @@
-#include "pvb/run/campaign.hpp"
+#include "pvb/campaign/campaign.hpp"
 
 #include <sys/stat.h>
 #include <yaml-cpp/yaml.h>

@@ -10,8 +10,8 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
-#include "pvb/run/campaign.hpp"
-#include "pvb/run/campaign_run.hpp"
+#include "pvb/campaign/campaign.hpp"
+#include "pvb/campaign/campaign_run.hpp"
 #include "pvb/suite/campaign_aggregate.hpp"
 
 using namespace pvb;
