@@ -20,6 +20,7 @@
 #include <sstream>
 #include <string>
 
+#include "camera_inputs.hpp"
 #include "command.hpp"
 #include "count_option.hpp"
 #include "io_plan.hpp"
@@ -52,34 +53,6 @@
 namespace pvb::cli {
 namespace {
 
-struct CameraArgs {
-  std::string uri;
-  std::string oni;
-  std::string settings;
-  std::string out;
-  bool overwrite = false;
-  std::string record;
-  std::string frames = "0";  ///< checked by parse_count: 0 = until the stream ends
-  bool sync = false;
-  std::uint32_t seed = 1;
-  bool no_pe_match = false;
-  std::string timeout_ms = "10000";  ///< checked by parse_count
-  run::MapOptions map;
-  std::string map_mode;
-  std::string sensors;  ///< --sensors
-};
-
-/// Files written into --out (no other output may land on one of them),
-/// with a sim:// source's motion files.
-const std::vector<std::string>& camera_output_names() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> n = {"camera.yaml", "CameraTrajectory.txt", "KeyFrameTrajectory.txt",
-                                  "map.ply",     "stats.json",           "groundtruth.txt"};
-    n.insert(n.end(), run::motion_output_names().begin(), run::motion_output_names().end());
-    return n;
-  }();
-  return names;
-}
 
 using Clock = std::chrono::steady_clock;
 
@@ -90,177 +63,6 @@ void write_map_ply(const std::string& path, const std::vector<Eigen::Vector3d>& 
   for (const Eigen::Vector3d& p : points)
     s << format_g(p.x()) << " " << format_g(p.y()) << " " << format_g(p.z()) << "\n";
   write_file(path, s.str());
-}
-
-// ---- inputs and settings ---------------------------------------------------
-
-/// The scenario of a sim:// source (with the URI's seed), else nullopt.  Also
-/// checks an .oni input and where --record may write, before anything is
-/// written: a recording never lands on an input or an output of the run.
-std::optional<scenes::Scenario> check_inputs(const CameraArgs& a) {
-  std::optional<scenes::Scenario> scenario;
-  std::string scenario_path;
-  if (a.oni.empty() && openni::is_sim_uri(a.uri)) {
-    const openni::SimUri uri = openni::parse_sim_uri(a.uri);
-    scenario = scenes::load_scenario(uri.scenario_path);
-    if (uri.seed) scenario->seed = *uri.seed;
-    scenario_path = uri.scenario_path;
-  }
-  if (!a.oni.empty()) openni::check_oni_complete(a.oni, openni::scan_oni_file(a.oni));
-  if (!a.record.empty()) {
-    std::vector<openni::RunFile> files = {
-        {a.oni, "the --oni recording"}, {a.settings, "the --settings file"}, {scenario_path, "the scenario"}};
-    for (std::string name : camera_output_names()) {
-      if (name.back() == '/') name.pop_back();  // a folder of outputs
-      files.push_back({a.out + "/" + name, "an output of this run"});
-    }
-    openni::check_record_not_on(a.record, files);
-    openni::check_new_recording_path(a.record);  // before any device is open
-  }
-  return scenario;
-}
-
-/// The fakenect dump a freenect:// device plays when FAKENECT_PATH names one
-/// (docs/openni.md); empty otherwise.  Its camera.yaml and groundtruth.txt,
-/// written by `pvbench record --format fakenect`, stand in for a sim://
-/// scenario's.
-std::string fakenect_dump_dir(const CameraArgs& a) {
-  const char* dir = std::getenv("FAKENECT_PATH");
-  if (!a.oni.empty() || a.uri.rfind("freenect://", 0) != 0 || !dir || !*dir) return {};
-  return dir;
-}
-
-bool readable(const std::string& path) { return static_cast<bool>(std::ifstream(path)); }
-
-/// The SLAM settings and the file they came from (the one named in errors):
-/// the user's --settings, the scenario's camera for sim:// sources, or a
-/// fakenect dump's camera.yaml.  The
-/// file used is saved as camera.yaml; intrinsics never come from the driver.
-struct CameraSettings {
-  slam::Settings slam;
-  std::string file;
-  std::string text;  ///< saved as camera.yaml once the folder is prepared
-};
-
-/// Where the settings will come from, checked before anything is written:
-/// the user's file, a sim:// scenario, or a fakenect dump's camera.yaml.
-void check_settings_source(const CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
-  if (!a.settings.empty()) {
-    require_regular_file(a.settings);
-    return;
-  }
-  if (scenario) return;
-  if (const std::string dump = fakenect_dump_dir(a); !dump.empty()) {
-    dataset::read_fakenect_index(dump);  // a folder that is no dump says so, not that settings are missing
-    if (readable(dump + "/camera.yaml")) return;
-    throw ConfigError("pvbench camera", "--settings",
-                      "a settings file with the camera's calibrated intrinsics (the fakenect dump " + dump +
-                          " has no camera.yaml of its own)");
-  }
-  throw ConfigError("pvbench camera", "--settings",
-                    "a settings file with the camera's calibrated intrinsics (only sim:// devices and fakenect dumps "
-                    "have their own)");
-}
-
-bool is_freenect_uri(const CameraArgs& a) { return a.oni.empty() && a.uri.rfind("freenect://", 0) == 0; }
-
-/// What a source gives SLAM beside images, against the sensor setup: a
-/// sim:// device its robot's IMU and encoders (the ground-truth simulator's
-/// readings), a Kinect v1 (freenect://) its accelerometer, an .oni
-/// recording or another OpenNI2 camera nothing.  A setup that needs more is
-/// refused (`file`, `key`: where it was asked for) before any device opens.
-void refuse_unfed_setup(const CameraArgs& a, sensor::SensorSetup setup, const std::string& file,
-                        const std::string& key) {
-  if (setup == sensor::SensorSetup::kCamera || (a.oni.empty() && openni::is_sim_uri(a.uri))) return;
-  const std::string got = sensor::to_string(setup);
-  if (is_freenect_uri(a)) {
-    if (setup == sensor::SensorSetup::kCameraAccel) return;
-    throw ConfigError(file, key,
-                      "camera or camera+accel for a Kinect v1 (freenect://): it has an accelerometer, "
-                      "no gyroscope and no wheels",
-                      got);
-  }
-  throw ConfigError(
-      file, key,
-      std::string("camera for ") + (a.oni.empty() ? "this OpenNI2 camera" : "an .oni recording") +
-          ": its streams are depth and colour only (motion readings come from sim:// devices, an "
-          "accelerometer from a Kinect v1 on freenect://)",
-      got);
-}
-
-/// The settings' setup checked against the source; a Kinect's accelerometer
-/// gets its description when the settings have none (docs/sensors.md).
-void check_source_motion(const CameraArgs& a, const std::string& settings_file, slam::Settings* s) {
-  if (a.sensors.empty())
-    refuse_unfed_setup(a, s->motion.setup, settings_file, "System.Sensors");
-  else
-    refuse_unfed_setup(a, s->motion.setup, "command line", "--sensors");
-  if (is_freenect_uri(a) && s->motion.setup == sensor::SensorSetup::kCameraAccel &&
-      run::supply_kinect_description(s))
-    std::fprintf(stderr,
-                 "pvbench camera: note: sensors camera+accel: the settings have no IMU.* keys; the "
-                 "Kinect v1 accelerometer's description is used (docs/sensors.md)\n");
-}
-
-/// The settings, read before anything is written (camera.yaml is written
-/// from `text` once the output folder is prepared).
-CameraSettings read_camera_settings(const CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
-  CameraSettings s;
-  if (!a.settings.empty()) {
-    s.file = a.settings;
-  } else if (scenario) {
-    dataset::OrbSlamSettings o = run::orbslam_settings_for(*scenario);
-    o.depth_map_factor = 1000.0;  // OpenNI2 depth is in millimetres
-    s.text = dataset::orbslam_settings_text(o);
-    s.file = a.out + "/camera.yaml";
-    s.slam = slam::read_settings_text(s.text, s.file);
-  } else {  // a fakenect dump's own (check_settings_source)
-    s.file = fakenect_dump_dir(a) + "/camera.yaml";
-  }
-  if (s.text.empty()) {
-    s.text = read_file(s.file);
-    s.slam = slam::read_settings(s.file);
-  }
-  for (const std::string& w : s.slam.warnings)
-    std::fprintf(stderr, "pvbench camera: warning: %s\n", w.c_str());
-  if (a.no_pe_match) s.slam.pe_match.enabled = false;
-  if (const std::optional<sensor::SensorSetup> setup = sensors_from_flag(a.sensors)) s.slam.motion.setup = *setup;
-  check_source_motion(a, s.file, &s.slam);
-  run::apply_sensor_setup(&s.slam, s.slam.motion.setup);
-  return s;
-}
-
-/// What camera reads and writes, checked before any device opens: no output
-/// lands on the recording played, the settings, the scenario, a fakenect
-/// dump's files or the map, and the recording on none of the outputs.
-void check_camera_paths(const CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
-  IoPlan plan;
-  plan.input("the --oni recording", a.oni).input("the --settings file", a.settings);
-  if (scenario) add_scenario_inputs(&plan, "sim:// scenario", *scenario);
-  if (const std::string dump = fakenect_dump_dir(a); !dump.empty()) {
-    std::error_code ec;
-    for (const auto& e : std::filesystem::directory_iterator(dump, ec))
-      if (e.is_regular_file(ec)) plan.input("a file of the fakenect dump (FAKENECT_PATH)", e.path().string());
-  }
-  plan.input("the --map file", a.map.load_path);
-  plan.output_folder("--out", a.out, camera_output_names()).output_file("--save-map", a.map.save_path);
-  plan.output_file("--record", a.record);
-  plan.check();
-  check_output_folder(a.out, a.overwrite);
-  reserve_output(a.map.save_path, "--save-map");
-}
-
-openni::OpenniOptions source_options(const CameraArgs& a, const slam::Settings& settings, int timeout_ms) {
-  openni::OpenniOptions so;
-  so.uri = a.uri == "any" ? std::string() : a.uri;
-  so.oni_path = a.oni;
-  so.width = settings.K.width;
-  so.height = settings.K.height;
-  so.fps = static_cast<int>(std::lround(settings.fps));
-  so.record_path = a.record;
-  so.timeout_ms = timeout_ms;
-  so.stop_requested = [] { return StopSignals::requested(); };  // Ctrl-C also ends a wait for frames
-  return so;
 }
 
 // ---- tracking --------------------------------------------------------------
@@ -280,14 +82,14 @@ struct LiveOutputs {
   bool has_gt() const { return gt_sim || !dump_gt.empty(); }
 };
 
-LiveOutputs open_live_outputs(const CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
+LiveOutputs open_live_outputs(const camera::CameraArgs& a, const std::optional<scenes::Scenario>& scenario) {
   const std::string& out = a.out;
   LiveOutputs o;
-  if (const std::string dump = fakenect_dump_dir(a); !dump.empty() && readable(dump + "/groundtruth.txt"))
+  if (const std::string dump = camera::fakenect_dump_dir(a); !dump.empty() && camera::readable(dump + "/groundtruth.txt"))
     o.dump_gt = dump + "/groundtruth.txt";
   o.cam_traj = OutputFile(out + "/CameraTrajectory.txt");
   o.cam_traj.append("# timestamp tx ty tz qx qy qz qw (T_w_c)\n");
-  if (is_freenect_uri(a)) {
+  if (camera::is_freenect_uri(a)) {
     o.accel_txt = OutputFile(out + "/accelerometer.txt");
     o.accel_txt.append(
         "# accelerometer data\n# file: 'pvbench camera' (libfreenect's freenect_get_mks_accel, the "
@@ -343,7 +145,7 @@ std::pair<double, double> latency_ms(const TrackCounts& c, bool from_arrival) {
 }
 
 /// Tracks one frame and appends its poses (ground truth first).
-slam::TrackingState track_frame(const sensor::RgbdFrame& frame, const CameraSettings& settings,
+slam::TrackingState track_frame(const sensor::RgbdFrame& frame, const camera::CameraSettings& settings,
                                 slam::System& system, LiveOutputs& live, TrackCounts& counts) {
   const geom::PinholeIntrinsics& K = settings.slam.K;
   if (frame.rgb.cols != K.width || frame.rgb.rows != K.height)
@@ -388,7 +190,7 @@ slam::TrackingState track_frame(const sensor::RgbdFrame& frame, const CameraSett
 /// is made), which end a live run cleanly (exit 0).  A stream
 /// error ends the loop too and is kept in the counts: what was tracked so far
 /// is still written.
-TrackCounts track_frames(openni::OpenniSource& source, std::size_t max_frames, const CameraSettings& settings,
+TrackCounts track_frames(openni::OpenniSource& source, std::size_t max_frames, const camera::CameraSettings& settings,
                          slam::System& system, LiveOutputs& live) {
   const std::size_t hint = source.size_hint();
   const std::size_t total = max_frames ? (hint ? std::min(max_frames, hint) : max_frames) : hint;
@@ -452,7 +254,7 @@ void evaluate_against_ground_truth(const std::string& out, std::ostringstream& j
 
 /// With a map loaded or to save: the localisation scored against the run's
 /// ground truth (when it has one) and the map saved; stats.json's "map".
-void finish_camera_map(const CameraArgs& a, const std::string& source, slam::System& system,
+void finish_camera_map(const camera::CameraArgs& a, const std::string& source, slam::System& system,
                        run::MapReport* map, std::ostringstream& js) {
   const auto read = [](const std::string& path) {
     try {
@@ -461,14 +263,14 @@ void finish_camera_map(const CameraArgs& a, const std::string& source, slam::Sys
       return eval::Trajectory{};  // none, or nothing tracked
     }
   };
-  const eval::Trajectory gt = readable(a.out + "/groundtruth.txt") ? read(a.out + "/groundtruth.txt") : eval::Trajectory{};
+  const eval::Trajectory gt = camera::readable(a.out + "/groundtruth.txt") ? read(a.out + "/groundtruth.txt") : eval::Trajectory{};
   run::finish_map(system, a.map, gt, read(a.out + "/CameraTrajectory.txt"), source, map);
   for (const std::string& line : run::map_log_lines(*map)) std::printf("%s\n", line.c_str());
   js << ",\n  \"map\": " << run::map_report_json(*map);
 }
 
 /// Prints the summary and writes stats.json (and the ATE for sim:// runs).
-void report_run(const CameraArgs& a, const slam::Settings& settings, openni::OpenniSource& source,
+void report_run(const camera::CameraArgs& a, const slam::Settings& settings, openni::OpenniSource& source,
                 slam::System& system, const TrackCounts& c,
                 const std::optional<openni::RecordingSummary>& rec, LiveOutputs& live,
                 std::optional<run::MapReport>& map) {
@@ -527,7 +329,7 @@ void fail_on_problems(const std::string& source, const TrackCounts& c,
                               ")");
 }
 
-int run_camera(CameraArgs a) {
+int run_camera(camera::CameraArgs a) {
   if (!a.map_mode.empty()) a.map.use = run::parse_map_use(a.map_mode, "--map-mode");
   const std::size_t max_frames =
       parse_count("camera", "--frames", a.frames, 0, 1'000'000'000, " (0: until the stream ends)");
@@ -536,15 +338,15 @@ int run_camera(CameraArgs a) {
   // which OpenNI2 unloads at shutdown.
   sim::install_mujoco_handlers();
   if (const std::optional<sensor::SensorSetup> setup = sensors_from_flag(a.sensors))
-    refuse_unfed_setup(a, *setup, "command line", "--sensors");  // before a recording is even scanned
-  const std::optional<scenes::Scenario> scenario = check_inputs(a);
-  check_settings_source(a, scenario);
+    camera::refuse_unfed_setup(a, *setup, "command line", "--sensors");  // before a recording is even scanned
+  const std::optional<scenes::Scenario> scenario = camera::check_inputs(a);
+  camera::check_settings_source(a, scenario);
   a.map.check();
   // A map of another station than a sim:// scenario's is used after a warning.
   if (scenario) a.map.station = run::station_of(*scenario);
   a.map.allow_other_station = true;
-  check_camera_paths(a, scenario);
-  const CameraSettings settings = read_camera_settings(a, scenario);
+  camera::check_camera_paths(a, scenario);
+  const camera::CameraSettings settings = camera::read_camera_settings(a, scenario);
   slam::SystemOptions options;
   options.synchronous = a.sync;
   options.seed = a.seed;
@@ -556,7 +358,7 @@ int run_camera(CameraArgs a) {
   const StopSignals stop_signals;
   prepare_output_folder(a.out, a.overwrite, "camera");
   write_file(a.out + "/camera.yaml", settings.text);
-  openni::OpenniSource source(source_options(a, settings.slam, timeout_ms));
+  openni::OpenniSource source(camera::source_options(a, settings.slam, timeout_ms));
   LiveOutputs live = open_live_outputs(a, scenario);
 
   const TrackCounts counts = track_frames(source, max_frames, settings, system, live);
@@ -573,7 +375,7 @@ int run_camera(CameraArgs a) {
 }  // namespace
 
 Command add_camera_command(CLI::App& app) {
-  auto args = std::make_shared<CameraArgs>();
+  auto args = std::make_shared<camera::CameraArgs>();
   CLI::App* sub =
       app.add_subcommand("camera", "run PE-SLAM live on an OpenNI2 camera, an .oni file or sim://scenario");
   auto* uri =
