@@ -191,16 +191,7 @@ TEST(SuiteCheck, StringsAreNotNumbersAndUnknownVersionsAreRefused) {
 TEST(SuiteCheck, ValuesOutOfRangeAreRefusedNamingFileLineAndKey) {
   const std::string path = ::testing::TempDir() + "pvb_metrics_range_" + std::to_string(::getpid()) + ".json";
   auto message = [&path](const std::string& fixture_name, const std::string& from, const std::string& to) {
-    std::string text = read_file(suite_fixture(fixture_name));
-    const std::size_t at = text.find(from);
-    if (at == std::string::npos) return "(" + from + " not in " + fixture_name + ")";
-    write_file(path, text.replace(at, from.size(), to));
-    try {
-      suite::read_metrics_file(path);
-    } catch (const IoError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(no error)");
+    return test::metrics_error_after_edit(path, fixture_name, from, to);
   };
   const std::string f = path + ":";
   EXPECT_EQ(message("good_compare.json", "\"lost_frames\": 0", "\"lost_frames\": -3"),
@@ -239,16 +230,7 @@ TEST(SuiteCheck, ValuesOutOfRangeAreRefusedNamingFileLineAndKey) {
 TEST(SuiteCheck, DuplicateKeysInMetricsAreRefused) {
   const std::string path = ::testing::TempDir() + "pvb_metrics_dup_" + std::to_string(::getpid()) + ".json";
   auto message = [&path](const std::string& from, const std::string& to) {
-    std::string text = read_file(suite_fixture("good_compare.json"));
-    const std::size_t at = text.find(from);
-    if (at == std::string::npos) return "(" + from + " not in good_compare.json)";
-    write_file(path, text.replace(at, from.size(), to));
-    try {
-      suite::read_metrics_file(path);
-    } catch (const IoError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(no error)");
+    return test::metrics_error_after_edit(path, "good_compare.json", from, to);
   };
   const std::string f = path + ":";
   EXPECT_EQ(message("\"frames\": 300,", "\"frames\": 300,\n  \"frames\": 3,"),

@@ -308,16 +308,7 @@ TEST(SuiteCheckBlind, ACameraOnlyRunViolatesEveryBlindBound) {
 TEST(SuiteCheckBlind, BadBlindObjectsAreRefusedNamingFileLineAndKey) {
   const std::string path = ::testing::TempDir() + "pvb_metrics_blind_" + std::to_string(::getpid()) + ".json";
   auto message = [&path](const std::string& from, const std::string& to) {
-    std::string text = read_file(suite_fixture("blind.json"));
-    const std::size_t at = text.find(from);
-    if (at == std::string::npos) return "(" + from + " not in blind.json)";
-    write_file(path, text.replace(at, from.size(), to));
-    try {
-      suite::read_metrics_file(path);
-    } catch (const IoError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(no error)");
+    return test::metrics_error_after_edit(path, "blind.json", from, to);
   };
   const std::string f = path + ":";
   EXPECT_EQ(
