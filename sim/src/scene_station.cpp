@@ -213,17 +213,18 @@ void add_plant(XmlWriter& x, const std::string& n, bool tree, const Eigen::Vecto
     x.line("<geom name=\"" + n + "_trunk\" class=\"scenery\" type=\"cylinder\" size=\"" +
            v3(0.06 + 0.02 * grown, (trunk_h + into) / 2, 0) + "\" pos=\"" +
            v3(p.x(), p.y(), z0 + (trunk_h - into) / 2) + "\" material=\"bark\"/>");
+    const double yaw_deg = rng.uniform(0, 180), crown_y = crown * rng.uniform(0.8, 1.1);
     x.line("<geom name=\"" + n + "_crown\" class=\"scenery\" type=\"ellipsoid\" size=\"" +
-           v3(crown, crown * rng.uniform(0.8, 1.1), 0.55 * grown * 0.6) + "\" pos=\"" +
-           v3(p.x(), p.y(), z0 + trunk_h + 0.25 * grown) + "\" euler=\"0 0 " + f(rng.uniform(0, 180)) +
-           "\" material=\"foliage\"/>");
+           v3(crown, crown_y, 0.55 * grown * 0.6) + "\" pos=\"" + v3(p.x(), p.y(), z0 + trunk_h + 0.25 * grown) +
+           "\" euler=\"0 0 " + f(yaw_deg) + "\" material=\"foliage\"/>");
     return;
   }
   const double r = grown / 2;
-  x.line("<geom name=\"" + n + "\" class=\"scenery\" type=\"ellipsoid\" size=\"" +
-         v3(r, r * rng.uniform(0.7, 1.0), r * rng.uniform(0.6, 0.9)) + "\" pos=\"" +
-         v3(p.x(), p.y(), z0 + r * 0.55) + "\" euler=\"0 0 " + f(rng.uniform(0, 180)) + "\" material=\"foliage\"/>");
-  const Eigen::Vector2d q = p + Eigen::Vector2d(rng.uniform(-r, r), rng.uniform(-r, r)) * 0.6;
+  const double yaw_deg = rng.uniform(0, 180), r_z = r * rng.uniform(0.6, 0.9), r_y = r * rng.uniform(0.7, 1.0);
+  x.line("<geom name=\"" + n + "\" class=\"scenery\" type=\"ellipsoid\" size=\"" + v3(r, r_y, r_z) + "\" pos=\"" +
+         v3(p.x(), p.y(), z0 + r * 0.55) + "\" euler=\"0 0 " + f(yaw_deg) + "\" material=\"foliage\"/>");
+  const double dy = rng.uniform(-r, r), dx = rng.uniform(-r, r);
+  const Eigen::Vector2d q = p + Eigen::Vector2d(dx, dy) * 0.6;
   x.line("<geom name=\"" + n + "b\" class=\"scenery\" type=\"ellipsoid\" size=\"" + v3(r * 0.7, r * 0.6, r * 0.55) +
          "\" pos=\"" + v3(q.x(), q.y(), ground.height_m(q) + r * 0.5) + "\" material=\"foliage\"/>");
 }
@@ -263,7 +264,8 @@ void add_vegetation(XmlWriter& x, const scenes::Scenario& s, const std::vector<E
     const bool tree = placed >= veg.shrubs;
     const double size = tree ? rng.uniform(veg.tree_height_m.x(), veg.tree_height_m.y())
                              : rng.uniform(veg.shrub_size_m.x(), veg.shrub_size_m.y());
-    const Eigen::Vector2d p(rng.uniform(veg.area_m[0], veg.area_m[2]), rng.uniform(veg.area_m[1], veg.area_m[3]));
+    const double y_m = rng.uniform(veg.area_m[1], veg.area_m[3]), x_m = rng.uniform(veg.area_m[0], veg.area_m[2]);
+    const Eigen::Vector2d p(x_m, y_m);
     const double radius = tree ? 0.3 * size : 0.5 * size;
     if (!clear_of_everything(s, route, p, radius)) continue;
     add_plant(x, (tree ? "tree" : "shrub") + std::to_string(placed), tree, p, size, veg.growth, rng, ground);

@@ -119,12 +119,14 @@ cv::Mat make_panel_texture(const scenes::PvArray& array, double dirt, std::uint6
     }
     const int stains = static_cast<int>(std::round(dirt * 8));
     for (int i = 0; i < stains; ++i) {
-      const cv::Point ctr(rng.integer(frame_px, w - frame_px), rng.integer(frame_px, h - frame_px));
+      const int y = rng.integer(frame_px, h - frame_px), x = rng.integer(frame_px, w - frame_px);
+      const cv::Point ctr(x, y);
       const int rad = rng.integer(2, 6);
       cv::circle(img, ctr, rad, rgb(225, 222, 210), cv::FILLED, cv::LINE_AA);
-      for (int k = 0; k < 4; ++k)
-        cv::circle(img, ctr + cv::Point(rng.integer(-8, 8), rng.integer(-8, 8)), rng.integer(1, 2),
-                   rgb(215, 212, 200), cv::FILLED, cv::LINE_AA);
+      for (int k = 0; k < 4; ++k) {
+        const int r = rng.integer(1, 2), dy = rng.integer(-8, 8), dx = rng.integer(-8, 8);
+        cv::circle(img, ctr + cv::Point(dx, dy), r, rgb(215, 212, 200), cv::FILLED, cv::LINE_AA);
+      }
     }
   }
   // Aluminium frame last, so dirt never covers its silhouette.
@@ -178,17 +180,19 @@ cv::Mat make_ground_texture(scenes::GroundType type, std::uint64_t seed) {
   // Stones and pebbles: what gives the ground texture for tracking.
   const int stones = gravel ? 2600 : 700;
   for (int i = 0; i < stones; ++i) {
-    const cv::Point ctr(rng.integer(0, n - 1), rng.integer(0, n - 1));
-    const cv::Size ax(rng.integer(1, gravel ? 6 : 4), rng.integer(1, gravel ? 5 : 3));
+    const int y = rng.integer(0, n - 1), x = rng.integer(0, n - 1);
+    const int ax_h = rng.integer(1, gravel ? 5 : 3), ax_w = rng.integer(1, gravel ? 6 : 4);
     const double g = gravel ? rng.uniform(90, 200) : rng.uniform(60, 170);
     const cv::Scalar col = gravel ? rgb(g, g * 0.97, g * 0.92) : rgb(g, g * 0.86, g * 0.68);
-    cv::ellipse(img, ctr, ax, rng.uniform(0, 180), 0, 360, col, cv::FILLED, cv::LINE_AA);
+    const double angle_deg = rng.uniform(0, 180);
+    cv::ellipse(img, {x, y}, {ax_w, ax_h}, angle_deg, 0, 360, col, cv::FILLED, cv::LINE_AA);
   }
   if (!gravel) {  // dry grass tufts
     for (int i = 0; i < 250; ++i) {
-      const cv::Point a(rng.integer(0, n - 1), rng.integer(0, n - 1));
-      const cv::Point b = a + cv::Point(rng.integer(-6, 6), rng.integer(-9, -2));
-      cv::line(img, a, b, rgb(rng.uniform(120, 160), rng.uniform(120, 140), 60), 1, cv::LINE_AA);
+      const int ay = rng.integer(0, n - 1), ax = rng.integer(0, n - 1);
+      const int dy = rng.integer(-9, -2), dx = rng.integer(-6, 6);
+      const double green = rng.uniform(120, 140), red = rng.uniform(120, 160);
+      cv::line(img, {ax, ay}, {ax + dx, ay + dy}, rgb(red, green, 60), 1, cv::LINE_AA);
     }
   }
   add_noise(&img, &rng, 5.0);
@@ -200,10 +204,11 @@ cv::Mat make_foliage_texture(std::uint64_t seed) {
   const int n = 256;
   cv::Mat img(n, n, CV_8UC3, rgb(40, 70, 30));
   for (int i = 0; i < 1400; ++i) {
-    const cv::Point ctr(rng.integer(0, n - 1), rng.integer(0, n - 1));
+    const int y = rng.integer(0, n - 1), x = rng.integer(0, n - 1);
     const double g = rng.uniform(60, 140);
-    cv::ellipse(img, ctr, cv::Size(rng.integer(2, 5), rng.integer(1, 3)), rng.uniform(0, 180), 0, 360,
-                rgb(g * 0.55, g, g * 0.35), cv::FILLED, cv::LINE_AA);
+    const double angle_deg = rng.uniform(0, 180);
+    const int ax_h = rng.integer(1, 3), ax_w = rng.integer(2, 5);
+    cv::ellipse(img, {x, y}, {ax_w, ax_h}, angle_deg, 0, 360, rgb(g * 0.55, g, g * 0.35), cv::FILLED, cv::LINE_AA);
   }
   add_noise(&img, &rng, 6.0);
   return img;
@@ -215,7 +220,8 @@ cv::Mat make_bark_texture(std::uint64_t seed) {
   cv::Mat img(n, n, CV_8UC3, rgb(90, 70, 52));
   for (int i = 0; i < 60; ++i) {
     const int x = rng.integer(0, n - 1);
-    cv::line(img, {x, 0}, {x + rng.integer(-4, 4), n - 1}, rgb(60, 46, 34), rng.integer(1, 2), cv::LINE_AA);
+    const int thickness = rng.integer(1, 2), dx = rng.integer(-4, 4);
+    cv::line(img, {x, 0}, {x + dx, n - 1}, rgb(60, 46, 34), thickness, cv::LINE_AA);
   }
   add_noise(&img, &rng, 8.0);
   return img;

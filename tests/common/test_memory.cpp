@@ -7,9 +7,10 @@
 #include <vector>
 
 #include "pvb/common/memory.hpp"
+#include "sanitizers.hpp"
 
 TEST(Memory, HeapBlockBytesIsWhatMallocReserves) {
-#if defined(__SANITIZE_ADDRESS__)
+#if PVB_ADDRESS_SANITIZER
   GTEST_SKIP() << "heap_block_bytes models glibc's malloc; AddressSanitizer's allocator sizes blocks its own way";
 #endif
   // malloc_usable_size is the block less its 8-byte header.

@@ -39,7 +39,8 @@ Synthetic make(double noise_px, double pitch_px_per_kf) {
     MapSnapshot::Measurement m;
     m.keyframe = e.keyframe;
     m.point = e.point;
-    m.uv = e.obs.uv + Eigen::Vector2d(n(rng), n(rng) + pitch_px_per_kf * static_cast<double>(e.keyframe));
+    const double dv = n(rng), du = n(rng);  // drawn v first, as the pinned problems were
+    m.uv = e.obs.uv + Eigen::Vector2d(du, dv + pitch_px_per_kf * static_cast<double>(e.keyframe));
     m.u_right = e.obs.u_right + (m.uv.x() - e.obs.uv.x()) + n(rng) * 0.2;
     m.octave = 0;
     s.map.measurements.push_back(m);

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "pvb/common/memory.hpp"
+#include "sanitizers.hpp"
 
 namespace pvb::slam {
 namespace {
@@ -98,7 +99,11 @@ OrbFeatures random_features(int n, std::uint32_t seed) {
   std::uniform_real_distribution<float> u(0.0f, float(kW - 1)), v(0.0f, float(kH - 1)), angle(0.0f, 360.0f);
   std::uniform_int_distribution<int> octave(0, 7), byte(0, 255);
   OrbFeatures f;
-  for (int i = 0; i < n; ++i) f.keypoints.emplace_back(cv::Point2f(u(rng), v(rng)), 31.0f, angle(rng), 20.0f, octave(rng));
+  for (int i = 0; i < n; ++i) {  // drawn last to first, as the pinned features were
+    const int o = octave(rng);
+    const float a = angle(rng), y = v(rng), x = u(rng);
+    f.keypoints.emplace_back(cv::Point2f(x, y), 31.0f, a, 20.0f, o);
+  }
   f.descriptors.create(n, 32, CV_8U);
   for (int r = 0; r < n; ++r)
     for (int c = 0; c < 32; ++c) f.descriptors.at<uchar>(r, c) = static_cast<uchar>(byte(rng));
@@ -153,8 +158,10 @@ TEST(Frame, AreaSearchFindsWhatAVectorPerCellFinds) {
   for (int n : {1500, 70000}) {
     Frame f(0, 0, random_features(n, 3), depth, cam);
     const VectorPerCellGrid reference(f);
-    for (std::size_t i = 0; i < f.size(); i += 3)
-      f.move_keypoint(i, Eigen::Vector2d(f.keys[i].x + shift(rng), f.keys[i].y + shift(rng)));
+    for (std::size_t i = 0; i < f.size(); i += 3) {
+      const double dy = shift(rng), dx = shift(rng);
+      f.move_keypoint(i, Eigen::Vector2d(f.keys[i].x + dx, f.keys[i].y + dy));
+    }
     std::size_t found = 0;
     for (int q = 0; q < 2000; ++q) {
       const double qu = u(rng), qv = v(rng), r = radius(rng);
@@ -176,7 +183,7 @@ std::size_t heap_in_use() {
 /// malloc's count of the bytes in use follows every block only without its
 /// per-thread cache (which keeps freed blocks counted as in use).
 bool malloc_counts_every_block() {
-#if defined(__SANITIZE_ADDRESS__)
+#if PVB_ADDRESS_SANITIZER
   return false;  // ASan's allocator keeps no such count
 #else
   const char* tunables = std::getenv("GLIBC_TUNABLES");

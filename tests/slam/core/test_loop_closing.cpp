@@ -37,7 +37,8 @@ cv::Mat make_texture(std::uint64_t seed) {
   rng.fill(t, cv::RNG::UNIFORM, 0, 256);
   cv::GaussianBlur(t, t, cv::Size(0, 0), 3.0);
   for (int k = 0; k < 900; ++k) {
-    const cv::Point c(rng.uniform(0, 1600), rng.uniform(0, 1200));
+    const int y = rng.uniform(0, 1200), x = rng.uniform(0, 1600);
+    const cv::Point c(x, y);
     const int r = rng.uniform(4, 30);
     const cv::Scalar grey(rng.uniform(0, 256));
     if (k % 2) cv::circle(t, c, r, grey, cv::FILLED, cv::LINE_AA);

@@ -57,7 +57,8 @@ TEST(FrameGrid, BufferedAreaSearchEqualsTheReturningOne) {
   OrbFeatures feats;
   cv::RNG rng(7);
   for (int i = 0; i < 500; ++i) {
-    cv::KeyPoint k(static_cast<float>(rng.uniform(0.0, 640.0)), static_cast<float>(rng.uniform(0.0, 480.0)), 31.0f);
+    const double y = rng.uniform(0.0, 480.0), x = rng.uniform(0.0, 640.0);
+    cv::KeyPoint k(static_cast<float>(x), static_cast<float>(y), 31.0f);
     k.octave = rng.uniform(0, 8);
     feats.keypoints.push_back(k);
   }

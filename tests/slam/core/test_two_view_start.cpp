@@ -50,7 +50,8 @@ Frame view(const Scene& s, const geom::SE3d& T_c_ref, int with_depth, std::uint6
   cv::Mat desc;
   for (std::size_t i = 0; i < s.p_ref.size(); ++i) {
     const Eigen::Vector3d p = T_c_ref * s.p_ref[i];
-    const Eigen::Vector2d uv = cam->project(p) + Eigen::Vector2d(rng.gaussian(0.3), rng.gaussian(0.3));
+    const double dv = rng.gaussian(0.3), du = rng.gaussian(0.3);
+    const Eigen::Vector2d uv = cam->project(p) + Eigen::Vector2d(du, dv);
     if (!(p.z() > 0) || !cam->in_bounds(uv.x(), uv.y())) continue;
     const cv::Point2f pt(static_cast<float>(uv.x()), static_cast<float>(uv.y()));
     keys.push_back(pt);

@@ -13,9 +13,12 @@ inline cv::Mat random_rectangles(int width, int height, std::uint64_t seed) {
   cv::Mat master(height, width, CV_8U, cv::Scalar(128));
   cv::RNG rng(seed);
   for (int i = 0; i < 2500; ++i) {
-    const cv::Point2f c(rng.uniform(0.f, static_cast<float>(master.cols)),
-                        rng.uniform(0.f, static_cast<float>(master.rows)));
-    const cv::Size2f sz(rng.uniform(12.f, 160.f), rng.uniform(12.f, 160.f));
+    // Each pair drawn second coordinate first: the pinned textures' order.
+    const float y = rng.uniform(0.f, static_cast<float>(master.rows));
+    const float x = rng.uniform(0.f, static_cast<float>(master.cols));
+    const float h = rng.uniform(12.f, 160.f), w = rng.uniform(12.f, 160.f);
+    const cv::Point2f c(x, y);
+    const cv::Size2f sz(w, h);
     cv::Point2f corners[4];
     cv::RotatedRect(c, sz, rng.uniform(0.f, 180.f)).points(corners);
     std::vector<cv::Point> poly;

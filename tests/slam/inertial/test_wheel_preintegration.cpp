@@ -132,7 +132,8 @@ TEST(WheelPreintegration, CovarianceMatchesMonteCarlo) {
       const double ds = std::abs(0.5 * (c.first + c.second) * mpt), dyaw = std::abs(step.z());
       const double st = n.translation_per_sqrt_m * std::sqrt(ds);
       const double sy = std::sqrt(n.yaw_per_sqrt_m * n.yaw_per_sqrt_m * ds + n.yaw_per_sqrt_rad * n.yaw_per_sqrt_rad * dyaw);
-      step += Eigen::Vector3d(st * n01(rng), st * n01(rng), sy * n01(rng));
+      const double n_yaw = n01(rng), n_y = n01(rng), n_x = n01(rng);  // last to first, as pinned
+      step += Eigen::Vector3d(st * n_x, st * n_y, sy * n_yaw);
       delta = planar_compose(delta, step);
     }
     const Eigen::Vector3d e = delta - pre.delta();

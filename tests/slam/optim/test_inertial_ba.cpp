@@ -66,7 +66,7 @@ DriveScene make_drive_scene(int num_keyframes, int num_fixed, int num_points, un
   const double x_end = s.motion.p_w(s.t_s.back()).x();
   std::uniform_real_distribution<double> ux(2.0, x_end + 12.0), uy(-5.0, 5.0), uz(-0.5, 3.0);
   while (static_cast<int>(s.problem.points.size()) < num_points) {
-    const Eigen::Vector3d p_w(ux(rng), uy(rng), uz(rng));
+    const Eigen::Vector3d p_w = testing::draw_zyx(ux, uy, uz, rng);
     std::vector<BaEdge> edges;
     for (int k = 0; k < num_keyframes; ++k) {
       const Eigen::Vector3d p_c = s.T_c_w_true[static_cast<std::size_t>(k)] * p_w;
@@ -129,7 +129,7 @@ void add_pitch_drift(BaProblem* p, int num_fixed, double drift_deg, unsigned see
   }
   std::mt19937 rng(seed);
   std::normal_distribution<double> n01(0.0, 1.0);
-  for (auto& pt : p->points) pt.p_w += 0.02 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng)).normalized();
+  for (auto& pt : p->points) pt.p_w += 0.02 * testing::draw_zyx(n01, rng).normalized();
 }
 
 double max_tilt_error_deg(const DriveScene& s, int num_fixed) {
@@ -390,8 +390,8 @@ double gravity_error_with_noisy_poses(double pose_sigma_m, double pose_sigma_rad
   const int n = 23;  // about 3 s
   for (int k = 0; k < n; ++k) {
     const geom::SE3d T_w_c = (testing::camera_pose(c.motion, T_base_c, t) * T_w0_w.inverse()).inverse();
-    const Eigen::Vector3d dtheta(angle(rng), angle(rng), angle(rng));
-    const Eigen::Vector3d dp(position(rng), position(rng), position(rng));
+    const Eigen::Vector3d dtheta = testing::draw_zyx(angle, rng);
+    const Eigen::Vector3d dp = testing::draw_zyx(position, rng);
     const geom::SE3d noisy = geom::make_se3(Eigen::Quaterniond(T_w_c.linear() * geom::so3_exp(dtheta)),
                                             Eigen::Vector3d(T_w_c.translation() + dp));
     p.T_c_w.push_back(noisy.inverse());

@@ -47,7 +47,9 @@ inline TwoViewData make_two_view(int n, double outlier_ratio, double noise_px, u
       if (p2c.z() > 0 && u2.x() >= 0 && u2.x() < 640 && u2.y() >= 0 && u2.y() < 480) break;
     }
     PointMatch clean{u1, u2};
-    PointMatch m{u1 + Eigen::Vector2d(noise(rng), noise(rng)), u2 + Eigen::Vector2d(noise(rng), noise(rng))};
+    // Each noise drawn v first: the order the pinned matches were made in.
+    const double dv1 = noise(rng), du1 = noise(rng), dv2 = noise(rng), du2 = noise(rng);
+    PointMatch m{u1 + Eigen::Vector2d(du1, dv1), u2 + Eigen::Vector2d(du2, dv2)};
     const bool inl = i >= n_out;
     if (!inl) m.p2 = {ux(rng), uy(rng)};
     d.matches.push_back(m);

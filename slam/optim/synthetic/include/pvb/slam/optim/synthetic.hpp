@@ -17,12 +17,35 @@ constexpr double kPi = 3.14159265358979323846;
 
 inline StereoIntrinsics default_intrinsics() { return StereoIntrinsics{}; }  // fx 525, bf 40
 
+/// (x, y, z) from three draws, z drawn first.  Every problem here draws a
+/// vector's coordinates last to first, so that it is the same whichever
+/// compiler builds it (C++ leaves the order of a constructor's arguments
+/// open; GCC evaluates them last to first, as these problems were made).
+template <class DistX, class DistY, class DistZ, class Rng>
+Eigen::Vector3d draw_zyx(DistX& dx, DistY& dy, DistZ& dz, Rng& rng) {
+  const double z = dz(rng);
+  const double y = dy(rng);
+  const double x = dx(rng);
+  return {x, y, z};
+}
+template <class Dist, class Rng>
+Eigen::Vector3d draw_zyx(Dist& d, Rng& rng) {
+  return draw_zyx(d, d, d, rng);
+}
+/// (x, y) from two draws, y drawn first (see draw_zyx).
+template <class Dist, class Rng>
+Eigen::Vector2d draw_yx(Dist& d, Rng& rng) {
+  const double y = d(rng);
+  const double x = d(rng);
+  return {x, y};
+}
+
 /// Rotates by rot_deg about a random axis and shifts by trans_m in a random
 /// direction, applied in the camera frame: T <- dT * T.
 inline geom::SE3d perturb(const geom::SE3d& T, double trans_m, double rot_deg, std::mt19937& rng) {
   std::normal_distribution<double> n01(0.0, 1.0);
-  const Eigen::Vector3d axis = Eigen::Vector3d(n01(rng), n01(rng), n01(rng)).normalized();
-  const Eigen::Vector3d dir = Eigen::Vector3d(n01(rng), n01(rng), n01(rng)).normalized();
+  const Eigen::Vector3d axis = draw_zyx(n01, rng).normalized();
+  const Eigen::Vector3d dir = draw_zyx(n01, rng).normalized();
   const geom::SE3d dT = geom::make_se3(geom::so3_exp(axis * rot_deg * kPi / 180.0), dir * trans_m);
   return dT * T;
 }
@@ -42,7 +65,7 @@ inline Observation observe(const StereoIntrinsics& K, const Eigen::Vector3d& p_c
   std::normal_distribution<double> noise(0.0, noise_px);
   Observation o;
   const Eigen::Vector2d uv = project(K, p_c);
-  o.uv = uv + Eigen::Vector2d(noise(rng), noise(rng));
+  o.uv = uv + draw_yx(noise, rng);
   o.u_right = stereo ? uv.x() - K.bf / p_c.z() + noise(rng) : -1.0;
   o.inv_sigma2 = 1.0;  // sigma 1 px (ORB-SLAM2 pyramid level 0)
   return o;
@@ -72,7 +95,8 @@ inline PoseScene make_pose_scene(int n, double noise_px, bool stereo, double out
   const geom::SE3d T_w_c = s.T_c_w_gt.inverse();
   for (int i = 0; i < n; ++i) {
     const double z = uz(rng);
-    const Eigen::Vector3d p_c((ux(rng) - K.cx) / K.fx * z, (uy(rng) - K.cy) / K.fy * z, z);
+    const double v = uy(rng), u = ux(rng);
+    const Eigen::Vector3d p_c((u - K.cx) / K.fx * z, (v - K.cy) / K.fy * z, z);
     s.points_w.push_back(T_w_c * p_c);
     Observation o = observe(K, p_c, stereo, noise_px, rng);
     const bool outlier = u01(rng) < outlier_ratio;
@@ -107,7 +131,7 @@ inline BaScene make_ba_scene(int num_keyframes, int num_fixed, int num_points, d
   BaScene s;
   for (int k = 0; k < num_keyframes; ++k) {
     const Eigen::Vector3d c_w(0.25 * k, 0.02 * k, 0.05 * std::sin(k));
-    const Eigen::Matrix3d R_w_c = geom::so3_exp(Eigen::Vector3d(small(rng), small(rng), small(rng)));
+    const Eigen::Matrix3d R_w_c = geom::so3_exp(draw_zyx(small, rng));
     const geom::SE3d T_c_w = geom::make_se3(R_w_c, c_w).inverse();
     s.T_c_w_gt.push_back(T_c_w);
     BaKeyframe kf;
@@ -117,7 +141,7 @@ inline BaScene make_ba_scene(int num_keyframes, int num_fixed, int num_points, d
     s.problem.keyframes.push_back(kf);
   }
   while (static_cast<int>(s.points_gt.size()) < num_points) {
-    const Eigen::Vector3d p_w(ux(rng), uy(rng), uz(rng));
+    const Eigen::Vector3d p_w = draw_zyx(ux, uy, uz, rng);
     std::vector<BaEdge> edges;
     for (int k = 0; k < num_keyframes; ++k) {
       const Eigen::Vector3d p_c = s.T_c_w_gt[static_cast<std::size_t>(k)] * p_w;
@@ -150,7 +174,7 @@ inline void perturb_ba(BaProblem* problem, double trans_m, double rot_deg, doubl
     if (!kf.fixed) kf.T_c_w = perturb(kf.T_c_w, trans_m, rot_deg, rng);
   }
   for (auto& p : problem->points) {
-    p.p_w += point_m * Eigen::Vector3d(n01(rng), n01(rng), n01(rng)).normalized();
+    p.p_w += point_m * draw_zyx(n01, rng).normalized();
   }
 }
 
