@@ -58,11 +58,36 @@ std::vector<unsigned char> png_of_bgr(const cv::Mat& bgr, int zlib_level) {
   return out;
 }
 
-/// The PNG file `path` of an RGB image, compressed as `compression` says.
-std::vector<unsigned char> png(const cv::Mat& rgb_img, const std::string& path, PngCompression compression) {
+/// The PNG file `path` of an RGB image.
+std::vector<unsigned char> png(const cv::Mat& rgb_img, const std::string& path) {
   cv::Mat bgr;
   cv::cvtColor(rgb_img, bgr, cv::COLOR_RGB2BGR);
-  return png_of_bgr(bgr, compression == PngCompression::kStored ? 0 : file_zlib_level(path));
+  return png_of_bgr(bgr, file_zlib_level(path));
+}
+
+/// An RGB image as TextureEncoding::kPixels holds it.
+std::vector<unsigned char> pixels(const cv::Mat& rgb_img) {
+  const std::int32_t size[2] = {rgb_img.cols, rgb_img.rows};
+  std::vector<unsigned char> out(sizeof size + rgb_img.total() * 3);
+  std::memcpy(out.data(), size, sizeof size);
+  for (int r = 0; r < rgb_img.rows; ++r)
+    std::memcpy(out.data() + sizeof size + static_cast<std::size_t>(r) * rgb_img.cols * 3, rgb_img.ptr(r),
+                static_cast<std::size_t>(rgb_img.cols) * 3);
+  return out;
+}
+
+/// The image that pixels() held, as a cv::Mat (RGB) that points into `bytes`.
+cv::Mat pixels_image(const std::vector<unsigned char>& bytes) {
+  std::int32_t size[2] = {0, 0};
+  if (bytes.size() >= sizeof size) std::memcpy(size, bytes.data(), sizeof size);
+  if (size[0] <= 0 || size[1] <= 0 || bytes.size() != sizeof size + std::size_t(size[0]) * size[1] * 3)
+    throw Error("a texture's pixels do not match their size");
+  return cv::Mat(size[1], size[0], CV_8UC3, const_cast<unsigned char*>(bytes.data()) + sizeof size);
+}
+
+/// A texture's bytes as `encoding` holds them.
+std::vector<unsigned char> texture_bytes(const cv::Mat& rgb_img, const std::string& path, TextureEncoding encoding) {
+  return encoding == TextureEncoding::kPixels ? pixels(rgb_img) : png(rgb_img, path);
 }
 
 /// One 3 m tile of a varied ground: its centre and its image's seed.
@@ -116,13 +141,13 @@ std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std
 void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tiles, SceneDetail detail,
                   SceneAssets* out) {
   const bool full = detail == SceneDetail::kFull;
-  const PngCompression compression = out->png;
+  const TextureEncoding encoding = out->textures;
   const std::vector<unsigned char> grey =
       full ? std::vector<unsigned char>{}
-           : png(cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(128)), "textures/grey.png", compression);
+           : texture_bytes(cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(128)), "textures/grey.png", encoding);
   const auto add = [&](const std::string& name, const std::function<cv::Mat()>& draw) {
     const std::string path = "textures/" + name + ".png";
-    out->files.emplace_back(path, full ? png(draw(), path, compression) : grey);
+    out->files.emplace_back(path, full ? texture_bytes(draw(), path, encoding) : grey);
   };
   const std::uint64_t station_seed = s.station_seed_or_seed(), day_seed = s.seed;
   add("ground", [&] { return make_ground_texture(s.ground.type, station_seed); });
@@ -131,7 +156,7 @@ void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tile
   if (full)
     cv::parallel_for_(cv::Range(0, static_cast<int>(tiles.size())), [&](const cv::Range& range) {
       for (int k = range.start; k < range.end; ++k)
-        tile_png[k] = png(make_ground_texture(s.ground.type, tiles[k].seed), kGroundTilePrefix, compression);
+        tile_png[k] = texture_bytes(make_ground_texture(s.ground.type, tiles[k].seed), kGroundTilePrefix, encoding);
     });
   for (std::size_t k = 0; k < tiles.size(); ++k)
     out->files.emplace_back(kGroundTilePrefix + std::to_string(k) + ".png", std::move(tile_png[k]));
@@ -329,11 +354,11 @@ ShadowMap shadow_map_for(const scenes::Light& light, const std::vector<Eigen::Ve
   return m;
 }
 
-SceneAssets build_scene(const scenes::Scenario& s, SceneDetail detail, PngCompression png) {
+SceneAssets build_scene(const scenes::Scenario& s, SceneDetail detail, TextureEncoding textures) {
   using namespace mjcf;
   SceneAssets out;
   out.detail = detail;
-  out.png = png;
+  out.textures = textures;
   const scenes::Camera& cam = s.camera;
   // Physics step: physics.rate_hz, or the largest step <= 2 ms that divides
   // the frame period, so frame i is rendered at exactly i / fps.
@@ -379,8 +404,47 @@ SceneAssets build_scene(const scenes::Scenario& s, SceneDetail detail, PngCompre
   return out;
 }
 
+namespace {
+
+bool is_texture_file(const std::string& path) {
+  return path.rfind("textures/", 0) == 0 && path.size() > 13 && path.compare(path.size() - 4, 4, ".png") == 0;
+}
+
+/// The MJCF that MuJoCo compiles for kPixels textures: each texture a flat
+/// image of its size, whose texels fill_textures() then writes.
+std::string xml_with_flat_textures(const SceneAssets& assets) {
+  std::string xml = assets.xml;
+  for (const auto& [path, bytes] : assets.files) {
+    if (!is_texture_file(path)) continue;
+    const cv::Mat img = mjcf::pixels_image(bytes);
+    const std::string file = "file=\"" + path + "\"";
+    const std::size_t at = xml.find(file);
+    if (at == std::string::npos) throw Error("the generated scene does not name its texture " + path);
+    xml.replace(at, file.size(), "builtin=\"flat\" width=\"" + std::to_string(img.cols) + "\" height=\"" +
+                                     std::to_string(img.rows) + "\" rgb1=\"0 0 0\"");
+  }
+  return xml;
+}
+
+/// Writes each kPixels texture's texels into the compiled model.
+void fill_textures(mjModel* m, const SceneAssets& assets) {
+  for (const auto& [path, bytes] : assets.files) {
+    if (!is_texture_file(path)) continue;
+    const std::string name = path.substr(9, path.size() - 13);  // textures/NAME.png
+    const int id = mj_name2id(m, mjOBJ_TEXTURE, name.c_str());
+    const cv::Mat img = mjcf::pixels_image(bytes);
+    if (id < 0 || m->tex_width[id] != img.cols || m->tex_height[id] != img.rows)
+      throw Error("MuJoCo did not make the texture " + name + " at its size");
+    std::memcpy(m->tex_rgb + m->tex_adr[id], img.data, img.total() * 3);
+  }
+}
+
+}  // namespace
+
 ModelPtr compile_scene(const SceneAssets& assets) {
   install_mujoco_handlers();  // MuJoCo's log goes to stderr, not MUJOCO_LOG.TXT
+  const bool pixels = assets.textures == TextureEncoding::kPixels;
+  const std::string xml = pixels ? xml_with_flat_textures(assets) : assets.xml;
   mjVFS vfs;
   mj_defaultVFS(&vfs);
   auto add = [&](const std::string& name, const void* data, std::size_t size) {
@@ -390,13 +454,16 @@ ModelPtr compile_scene(const SceneAssets& assets) {
     }
     std::memcpy(vfs.filedata[vfs.nfile - 1], data, size);
   };
-  add("scene.xml", assets.xml.data(), assets.xml.size());
-  for (const auto& file : assets.files) add(file.first, file.second.data(), file.second.size());
+  add("scene.xml", xml.data(), xml.size());
+  for (const auto& file : assets.files)
+    if (!pixels || !is_texture_file(file.first)) add(file.first, file.second.data(), file.second.size());
   char err[1024] = {0};
   mjModel* m = mj_loadXML("scene.xml", &vfs, err, sizeof err);
   mj_deleteVFS(&vfs);
   if (m == nullptr) throw Error(std::string("MuJoCo could not compile the generated scene: ") + err);
-  return ModelPtr(m);
+  ModelPtr model(m);
+  if (pixels) fill_textures(m, assets);
+  return model;
 }
 
 void write_scene(const SceneAssets& assets, const std::string& dir) {
@@ -404,10 +471,8 @@ void write_scene(const SceneAssets& assets, const std::string& dir) {
   ::mkdir((dir + "/textures").c_str(), 0755);
   write_file(dir + "/scene.xml", assets.xml);
   for (const auto& [path, bytes] : assets.files) {
-    const bool stored_png =
-        assets.png == PngCompression::kStored && path.size() > 4 && path.compare(path.size() - 4, 4, ".png") == 0;
-    const std::vector<unsigned char> file =
-        stored_png ? mjcf::png_of_bgr(cv::imdecode(bytes, cv::IMREAD_COLOR), mjcf::file_zlib_level(path)) : bytes;
+    const bool pixels = assets.textures == TextureEncoding::kPixels && is_texture_file(path);
+    const std::vector<unsigned char> file = pixels ? mjcf::png(mjcf::pixels_image(bytes), path) : bytes;
     write_file(dir + "/" + path, std::string(file.begin(), file.end()));
   }
 }

@@ -33,9 +33,9 @@ int actuator(const mjModel* m, const char* name) {
 
 Simulator::Simulator(scenes::Scenario scenario, SceneDetail detail) : scenario_(std::move(scenario)) {
   install_mujoco_handlers();
-  // Compiled in memory only: uncompressed PNGs (write_scene() compresses
-  // them as a recording's files are).
-  assets_ = build_scene(scenario_, detail, PngCompression::kStored);
+  // Compiled in memory only: the textures' pixels, no PNG (write_scene()
+  // writes them as a recording's files are).
+  assets_ = build_scene(scenario_, detail, TextureEncoding::kPixels);
   model_ = compile_scene(assets_);
   data_.reset(mj_makeData(model_.get()));
   const mjModel* m = model_.get();

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <algorithm>
 #include <random>
 #include <set>
@@ -9,6 +11,7 @@
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <unistd.h>
 
 #include "pvb/common/text.hpp"
@@ -58,31 +61,50 @@ TEST(SceneBuilder, SameScenarioGivesTheSameBytes) {
   EXPECT_NE(sim::build_scene(other).files[0].second, a.files[0].second);  // textures follow the seed
 }
 
-// A scene compiled in memory keeps its PNGs uncompressed: the same pixels
-// as the files'; written out, they are the files' bytes.
-TEST(SceneBuilder, StoredTexturesHoldTheFilesPixelsAndAreWrittenAsTheFiles) {
+// A scene compiled in memory holds its textures' pixels, no PNG: the same
+// pixels as the files', under the same MJCF; written out, they are the
+// files' bytes.
+TEST(SceneBuilder, PixelTexturesHoldTheFilesPixelsAndAreWrittenAsTheFiles) {
   const sim::SceneAssets files = sim::build_scene(station());
-  const sim::SceneAssets stored =
-      sim::build_scene(station(), sim::SceneDetail::kFull, sim::PngCompression::kStored);
-  EXPECT_EQ(files.xml, stored.xml);
-  ASSERT_EQ(files.files.size(), stored.files.size());
-  std::size_t file_bytes = 0, stored_bytes = 0;
+  const sim::SceneAssets pixels =
+      sim::build_scene(station(), sim::SceneDetail::kFull, sim::TextureEncoding::kPixels);
+  EXPECT_EQ(files.xml, pixels.xml);
+  ASSERT_EQ(files.files.size(), pixels.files.size());
   for (std::size_t i = 0; i < files.files.size(); ++i) {
     const auto& [path, bytes] = files.files[i];
-    ASSERT_EQ(path, stored.files[i].first);
-    file_bytes += bytes.size();
-    stored_bytes += stored.files[i].second.size();
-    const cv::Mat a = cv::imdecode(bytes, cv::IMREAD_UNCHANGED), b = cv::imdecode(stored.files[i].second, cv::IMREAD_UNCHANGED);
-    ASSERT_FALSE(a.empty()) << path;
-    ASSERT_EQ(a.size(), b.size()) << path;
-    EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0) << path;
+    ASSERT_EQ(path, pixels.files[i].first);
+    const cv::Mat bgr = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(bgr.empty()) << path;
+    cv::Mat rgb;
+    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+    const std::vector<unsigned char>& held = pixels.files[i].second;
+    std::int32_t size[2] = {0, 0};
+    ASSERT_EQ(held.size(), sizeof size + rgb.total() * 3) << path;
+    std::memcpy(size, held.data(), sizeof size);
+    EXPECT_EQ(size[0], rgb.cols) << path;
+    EXPECT_EQ(size[1], rgb.rows) << path;
+    EXPECT_EQ(std::memcmp(held.data() + sizeof size, rgb.data, rgb.total() * 3), 0) << path;
   }
-  EXPECT_GT(stored_bytes, file_bytes);  // not compressed (noise-like images: about twice the bytes)
-  const std::string dir = ::testing::TempDir() + "pvb_stored_scene_" + std::to_string(::getpid());
-  sim::write_scene(stored, dir);
+  const std::string dir = ::testing::TempDir() + "pvb_pixel_scene_" + std::to_string(::getpid());
+  sim::write_scene(pixels, dir);
   for (const auto& [path, bytes] : files.files)
     EXPECT_TRUE(read_file(dir + "/" + path) == std::string(bytes.begin(), bytes.end())) << path;
   EXPECT_EQ(read_file(dir + "/scene.xml"), files.xml);
+}
+
+// The model compiled from pixels has the texels MuJoCo decodes from the files.
+TEST(SceneBuilder, PixelTexturesCompileToTheFilesTexels) {
+  const sim::ModelPtr from_files = sim::compile_scene(sim::build_scene(station()));
+  const sim::ModelPtr from_pixels =
+      sim::compile_scene(sim::build_scene(station(), sim::SceneDetail::kFull, sim::TextureEncoding::kPixels));
+  ASSERT_EQ(from_files->ntex, from_pixels->ntex);
+  ASSERT_EQ(from_files->ntexdata, from_pixels->ntexdata);
+  for (int t = 0; t < from_files->ntex; ++t) {
+    EXPECT_EQ(from_files->tex_width[t], from_pixels->tex_width[t]) << t;
+    EXPECT_EQ(from_files->tex_height[t], from_pixels->tex_height[t]) << t;
+    EXPECT_EQ(from_files->tex_adr[t], from_pixels->tex_adr[t]) << t;
+  }
+  EXPECT_EQ(std::memcmp(from_files->tex_rgb, from_pixels->tex_rgb, from_files->ntexdata), 0);
 }
 
 TEST(SceneBuilder, WallFinishPicksTheMaterial) {

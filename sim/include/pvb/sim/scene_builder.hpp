@@ -18,17 +18,19 @@ namespace pvb::sim {
 /// set-up skips drawing and encoding the images.
 enum class SceneDetail { kFull, kGeometry };
 
-/// How the textures' PNGs are compressed.  kFiles: as a recording writes
-/// them (zlib level 6, level 1 for a varied ground's tiles; their bytes are
-/// pinned).  kStored: not compressed, for a scene that is only compiled in
-/// memory: the same pixels, encoded and decoded several times faster;
-/// write_scene() writes them as kFiles would.
-enum class PngCompression { kFiles, kStored };
+/// How the textures are held.  kPng: the PNG files a recording writes
+/// (zlib level 6, level 1 for a varied ground's tiles; their bytes are
+/// pinned).  kPixels: for a scene that is compiled in memory, each
+/// texture's pixels as they are (width and height as two 32-bit integers,
+/// then the RGB rows, top row first), which compile_scene() writes into
+/// the model: the same texels, with no PNG encoded or decoded.  The MJCF
+/// is the same; write_scene() writes the PNG files kPng would hold.
+enum class TextureEncoding { kPng, kPixels };
 
 /// A generated scene: scene.xml plus the texture files it names.
 struct SceneAssets {
   SceneDetail detail = SceneDetail::kFull;
-  PngCompression png = PngCompression::kFiles;
+  TextureEncoding textures = TextureEncoding::kPng;
   std::string xml;
   /// Path relative to scene.xml and bytes: the textures' PNGs, and with a
   /// ground relief its height field (kReliefFile).
@@ -65,7 +67,7 @@ ShadowMap shadow_map_for(const scenes::Light& light, const std::vector<Eigen::Ve
 
 /// Generates the scene.  Deterministic in the scenario (seed included).
 SceneAssets build_scene(const scenes::Scenario& scenario, SceneDetail detail = SceneDetail::kFull,
-                        PngCompression png = PngCompression::kFiles);
+                        TextureEncoding textures = TextureEncoding::kPng);
 
 struct ModelDeleter {
   void operator()(mjModel* m) const { mj_deleteModel(m); }
