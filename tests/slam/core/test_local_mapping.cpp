@@ -11,7 +11,7 @@
 #include "pvb/slam/core/map.hpp"
 
 namespace pvb::slam {
-namespace {
+namespace local_mapping_test {
 
 std::shared_ptr<const CameraModel> camera() {
   static auto cam =
@@ -189,5 +189,5 @@ TEST(LocalMapping, StatsAsJson) {
   EXPECT_EQ(to_json(s), "{\"keyframes\": 12, \"local_ba\": 9, \"local_ba_stopped\": 4, \"busy_ms\": 250.5}");
 }
 
-}  // namespace
+}  // namespace local_mapping_test
 }  // namespace pvb::slam

@@ -6,7 +6,7 @@
 #include "pvb/slam/core/map.hpp"
 
 namespace pvb::slam {
-namespace {
+namespace map_rules_test {
 
 std::shared_ptr<const CameraModel> camera() {
   static auto cam = std::make_shared<const CameraModel>(
@@ -199,5 +199,5 @@ TEST(ProvisionalMap, ARootStaysARootUntilItsMapIsHungUnderAnother) {
   EXPECT_TRUE(map.erase_keyframe(chain[0]));
 }
 
-}  // namespace
+}  // namespace map_rules_test
 }  // namespace pvb::slam

@@ -13,7 +13,7 @@
 #include "pvb/slam/features/orb_extractor.hpp"
 
 namespace pvb::slam {
-namespace {
+namespace patch_refine_test {
 
 constexpr int kW = 640, kH = 480, kM = 4;
 constexpr double kWallM = 2.0, kStepM = 0.12;
@@ -112,5 +112,5 @@ TEST(PatchRefine, MovesObservationsToTheReferencePatch) {
   EXPECT_EQ(moved, 0);
 }
 
-}  // namespace
+}  // namespace patch_refine_test
 }  // namespace pvb::slam

@@ -12,7 +12,7 @@
 #include "pvb/slam/core/two_view_start.hpp"
 
 namespace pvb::slam {
-namespace {
+namespace two_view_start_test {
 
 constexpr int kW = 640, kH = 480;
 
@@ -127,5 +127,5 @@ TEST(TwoViewStart, AnotherViewHasTooFewMatches) {
   EXPECT_NE(why.find("matches (need 100)"), std::string::npos) << why;
 }
 
-}  // namespace
+}  // namespace two_view_start_test
 }  // namespace pvb::slam
