@@ -85,6 +85,12 @@ cv::Mat pixels_image(const std::vector<unsigned char>& bytes) {
   return cv::Mat(size[1], size[0], CV_8UC3, const_cast<unsigned char*>(bytes.data()) + sizeof size);
 }
 
+/// A texture's file, textures/NAME.png, and its NAME.
+bool is_texture_file(const std::string& path) {
+  return path.rfind("textures/", 0) == 0 && path.size() > 13 && path.compare(path.size() - 4, 4, ".png") == 0;
+}
+std::string texture_name(const std::string& path) { return path.substr(9, path.size() - 13); }
+
 /// A texture's bytes as `encoding` holds them.
 std::vector<unsigned char> texture_bytes(const cv::Mat& rgb_img, const std::string& path, TextureEncoding encoding) {
   return encoding == TextureEncoding::kPixels ? pixels(rgb_img) : png(rgb_img, path);
@@ -251,16 +257,15 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
   };
   x.line("<texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"" + rgb(kSkyZenithRgb) + "\" rgb2=\"" +
          rgb(kSkyHorizonRgb) + "\" width=\"512\" height=\"512\"/>");
-  const auto texture = [](const std::string& path) { return path.rfind("textures/", 0) == 0; };
   for (const auto& file : out.files) {
-    if (!texture(file.first)) continue;
-    const std::string name = file.first.substr(9, file.first.size() - 13);  // textures/NAME.png
+    if (!is_texture_file(file.first)) continue;
+    const std::string name = texture_name(file.first);
     x.line("<texture name=\"" + name + "\" type=\"2d\" file=\"" + file.first + "\"/>");
   }
   // The materials after every texture, as a scene without varied ground always had them.
   for (const auto& file : out.files) {
-    if (!texture(file.first)) continue;
-    const std::string name = file.first.substr(9, file.first.size() - 13);  // textures/NAME.png
+    if (!is_texture_file(file.first)) continue;
+    const std::string name = texture_name(file.first);
     if (name.rfind("ground", 0) != 0) continue;  // the ground, and a varied ground's tiles
     x.line("<material name=\"" + name + "\" texture=\"" + name + "\" texuniform=\"true\" texrepeat=\"" +
            f(1.0 / kGroundTileM) + " " + f(1.0 / kGroundTileM) + "\" specular=\"0.02\" shininess=\"0.05\"/>");
@@ -406,9 +411,7 @@ SceneAssets build_scene(const scenes::Scenario& s, SceneDetail detail, TextureEn
 
 namespace {
 
-bool is_texture_file(const std::string& path) {
-  return path.rfind("textures/", 0) == 0 && path.size() > 13 && path.compare(path.size() - 4, 4, ".png") == 0;
-}
+using mjcf::is_texture_file;
 
 /// The MJCF that MuJoCo compiles for kPixels textures: each texture a flat
 /// image of its size, whose texels fill_textures() then writes.
@@ -430,7 +433,7 @@ std::string xml_with_flat_textures(const SceneAssets& assets) {
 void fill_textures(mjModel* m, const SceneAssets& assets) {
   for (const auto& [path, bytes] : assets.files) {
     if (!is_texture_file(path)) continue;
-    const std::string name = path.substr(9, path.size() - 13);  // textures/NAME.png
+    const std::string name = mjcf::texture_name(path);
     const int id = mj_name2id(m, mjOBJ_TEXTURE, name.c_str());
     const cv::Mat img = mjcf::pixels_image(bytes);
     if (id < 0 || m->tex_width[id] != img.cols || m->tex_height[id] != img.rows)
