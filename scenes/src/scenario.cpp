@@ -20,6 +20,7 @@ void read_top(detail::MapReader& top, Scenario& s) {
   detail::with_map(top, "ground", [&](detail::MapReader& r) { detail::read_ground(r, s.ground); });
   detail::read_arrays(top, s.pv_arrays);
   detail::read_walls(top, s.walls);
+  detail::read_plant(top, s);
   detail::with_map(top, "vegetation", [&](detail::MapReader& r) { detail::read_vegetation(r, s.vegetation); });
   detail::with_map(top, "light", [&](detail::MapReader& r) { detail::read_light(r, s.light); });
   detail::read_site(top, s);
@@ -44,6 +45,7 @@ Scenario read_scenario(const detail::ScenarioDocument& doc) {
   detail::refuse_station_keys(doc);  // after the reader named any unknown key as one
   detail::check_scene_size(s, ctx);
   detail::check_route(s, ctx);
+  detail::check_plant_route(s, ctx);
   detail::check_blind_bounds(s, ctx);
   detail::check_ground_relief(s, ctx);
   detail::resolve_day(s, ctx);

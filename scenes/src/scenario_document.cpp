@@ -24,7 +24,7 @@ const std::vector<std::string>& day_keys() {
   static const std::vector<std::string> keys = {
       "base", "name", "description", "seed", "station_seed", "duration_s", "site", "site.*", "light", "light.*",
       "ground", "ground.friction", "ground.softness", "vegetation", "vegetation.growth", "pv_arrays", "pv_arrays[*]", "pv_arrays[*].dirt", "pv_arrays[*].glass", "pv_arrays[*].tracker",
-      "pv_arrays[*].tracker.rotation_deg", "camera", "camera.model", "camera.stereo", "camera.stereo.*", "camera.depth_noise", "camera.depth_noise.*", "camera.rgb",
+      "pv_arrays[*].tracker.rotation_deg", "plant", "plant.dirt", "plant.glass", "plant.tracker", "plant.tracker.rotation_deg", "camera", "camera.model", "camera.stereo", "camera.stereo.*", "camera.depth_noise", "camera.depth_noise.*", "camera.rgb",
       "camera.rgb.*", "route", "route.on_loss", "route.start_m", "kidnap", "kidnap.*", "cover", "cover.*",
       "expect", "expect.*", "slam", "slam.*"};
   return keys;

@@ -11,7 +11,6 @@
 #include "pvb/scenes/route.hpp"
 
 namespace pvb::scenes::detail {
-namespace {
 
 /// The mount: fixed tables at tilt_deg with rails, or a single-axis tracker
 /// whose angle follows the sun (tilt and rails are then not the file's to set).
@@ -43,6 +42,8 @@ void read_mount(MapReader& r, PvArray& a) {
     }
   });
 }
+
+namespace {
 
 PvArray read_array(MapReader& r) {
   PvArray a;
@@ -78,11 +79,11 @@ PvArray read_array(MapReader& r) {
 /// rails and four posts; one per wall; two per shrub or tree.  The ground and
 /// the robot add about ten.
 long long table_geoms(const PvArray& a) {
+  const long long panels = a.panel_slabs ? 1 : static_cast<long long>(a.panels_per_table) * a.panel_lines;
   // A tracker table: its panels, one backsheet, the torque tube and two posts.
-  if (a.mount == Mount::kSingleAxis)
-    return static_cast<long long>(a.panels_per_table) * a.panel_lines + 2 + (a.posts ? 2 : 0);
+  if (a.mount == Mount::kSingleAxis) return panels + 2 + (a.posts ? 2 : 0);
   const long long backsheet = 1, rails = a.rails ? 2 : 0, posts = a.posts ? 4 : 0;
-  return static_cast<long long>(a.panels_per_table) * a.panel_lines + backsheet + rails + posts;
+  return panels + backsheet + rails + posts;
 }
 
 /// MuJoCo's renderer draws at most 4000 geoms a frame (sim/src/renderer.cpp)

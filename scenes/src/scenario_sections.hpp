@@ -18,6 +18,17 @@ inline constexpr long long kMaxSceneGeoms = 3800;
 void read_ground(MapReader& r, Ground& g);
 void read_arrays(MapReader& top, std::vector<PvArray>& out);
 void read_walls(MapReader& top, std::vector<Wall>& out);
+/// A pv array's mount: fixed tables or a single-axis tracker (`mount`,
+/// `tilt_deg`, `rails`, `tracker`).
+void read_mount(MapReader& r, PvArray& a);
+/// The plant: section: its blocks go after the scenario's arrays, its
+/// inverter stations after its walls.  After ground: (the plant must lie
+/// on it), pv_arrays and walls.
+void read_plant(MapReader& top, Scenario& s);
+/// A plant's route keeps this far from every table: the robot's half width.
+inline constexpr double kRouteTableClearanceM = 0.30;
+/// Refuses a plant's route that leaves the plant or runs through a table.
+void check_plant_route(const Scenario& s, const ReadContext& ctx);
 void read_vegetation(MapReader& r, Vegetation& v);
 void read_light(MapReader& r, Light& l);
 void read_route(MapReader& r, Route& rt);

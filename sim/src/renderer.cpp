@@ -1,6 +1,11 @@
 #include "pvb/sim/renderer.hpp"
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "pvb/common/error.hpp"
 #include "pvb/sim/scene_builder.hpp"
@@ -21,7 +26,9 @@ Renderer::Renderer(const mjModel* model, GlBackend backend, int width, int heigh
   mjv_defaultScene(&scene_);
   mjv_defaultOption(&option_);
   mjv_defaultCamera(&camera_);
-  mjv_makeScene(model, &scene_, 4000 + kMaxGroundTiles);  // the scene limit and a varied ground (textures.hpp)
+  // Room for every geom of the model (a plant's thousands; culled to the
+  // view before drawing), a varied ground's tiles (textures.hpp) and decor.
+  mjv_makeScene(model, &scene_, std::max(4000, model->ngeom + 200) + kMaxGroundTiles);
   mjr_makeContext(model, &con_, mjFONTSCALE_100);
   mjr_setBuffer(mjFB_OFFSCREEN, &con_);
   if (con_.currentBuffer != mjFB_OFFSCREEN) {
@@ -93,6 +100,77 @@ void snap_to_shadow_texels(float pos[3], const float dir[3], double texel_m) {
   for (int i = 0; i < 3; ++i) pos[i] = static_cast<float>(pos[i] - da * s[i] - db * u[i]);
 }
 
+namespace {
+
+/// The sphere that holds a primitive geom, its radius; -1 for a geom that is
+/// not culled (a plane, a height field, a mesh, decor).
+double bounding_radius(const mjvGeom& g) {
+  const double a = g.size[0], b = g.size[1], c = g.size[2];
+  switch (g.type) {
+    case mjGEOM_BOX: return std::sqrt(a * a + b * b + c * c);
+    case mjGEOM_SPHERE: return a;
+    case mjGEOM_ELLIPSOID: return std::max({a, b, c});
+    case mjGEOM_CYLINDER: return std::sqrt(a * a + b * b);
+    case mjGEOM_CAPSULE: return a + b;
+    default: return -1;
+  }
+}
+
+/// The beam of the first shadow-casting directional light (unit, pointing
+/// down from the light), or none.
+std::optional<Eigen::Vector3d> shadow_beam(const mjvScene& scn) {
+  if (!scn.flags[mjRND_SHADOW]) return std::nullopt;
+  for (int i = 0; i < scn.nlight; ++i) {
+    const mjvLight& l = scn.lights[i];
+    if (l.directional && l.castshadow) return Eigen::Vector3d(l.dir[0], l.dir[1], l.dir[2]).normalized();
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+int cull_to_view(mjvScene* scn, double aspect) {
+  const mjvGLCamera& cam = scn->camera[0];
+  const Eigen::Vector3d pos(cam.pos[0], cam.pos[1], cam.pos[2]), fwd(cam.forward[0], cam.forward[1], cam.forward[2]);
+  const Eigen::Vector3d up(cam.up[0], cam.up[1], cam.up[2]);
+  const Eigen::Vector3d right = fwd.cross(up);
+  const double tan_top = cam.frustum_top / cam.frustum_near, tan_bottom = -cam.frustum_bottom / cam.frustum_near;
+  const double tan_side = 0.5 * (cam.frustum_top - cam.frustum_bottom) * aspect / cam.frustum_near;
+  // Outward normals of the four side planes through the eye, in (right, up, forward).
+  const Eigen::Vector3d planes[4] = {Eigen::Vector3d(1, 0, -tan_side).normalized(),
+                                     Eigen::Vector3d(-1, 0, -tan_side).normalized(),
+                                     Eigen::Vector3d(0, 1, -tan_top).normalized(),
+                                     Eigen::Vector3d(0, -1, -tan_bottom).normalized()};
+  const std::optional<Eigen::Vector3d> beam = shadow_beam(*scn);
+  int kept = 0;
+  for (int i = 0; i < scn->ngeom; ++i) {
+    const mjvGeom g = scn->geoms[i];
+    double r = g.category == mjCAT_STATIC && g.objtype == mjOBJ_GEOM ? bounding_radius(g) : -1;
+    Eigen::Vector3d c(g.pos[0], g.pos[1], g.pos[2]);
+    if (r >= 0 && beam && beam->z() < -1e-3) {
+      // Its shadow: swept along the beam down to 2 m below its foot.
+      const double len = std::min((c.z() + r + 2.0) / -beam->z(), 500.0);
+      c += 0.5 * len * *beam;
+      r += 0.5 * len;
+    }
+    bool visible = r < 0;
+    if (!visible) {
+      const Eigen::Vector3d d = c - pos;
+      const Eigen::Vector3d q(d.dot(right), d.dot(up), d.dot(fwd));
+      visible = q.z() > cam.frustum_near - r && q.z() < cam.frustum_far + r;
+      for (const Eigen::Vector3d& n : planes) visible = visible && q.dot(n) <= r;
+    }
+    if (!visible) continue;
+    scn->geoms[kept] = g;
+    // Segmentation paints a geom by its segid, mjv_updateScene's index of it.
+    if (scn->geoms[kept].segid >= 0) scn->geoms[kept].segid = kept;
+    ++kept;
+  }
+  const int culled = scn->ngeom - kept;
+  scn->ngeom = kept;
+  return culled;
+}
+
 void Renderer::set_shadows(bool on) { scene_.flags[mjRND_SHADOW] = on ? 1 : 0; }
 
 void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat* rgb, cv::Mat* depth_m) {
@@ -102,6 +180,7 @@ void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat
   camera_.type = mjCAMERA_FIXED;
   camera_.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
+  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_) : 0;
   if (stable_shadows_) {
     const double texel_m = shadow_texel_m(con_.shadowClip, con_.shadowSize);
     for (int i = 0; i < scene_.nlight; ++i) {
@@ -138,6 +217,7 @@ void Renderer::render_geom_ids(const mjModel* model, mjData* data, int camera_id
   camera_.type = mjCAMERA_FIXED;
   camera_.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
+  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_) : 0;
   const unsigned char shadow = scene_.flags[mjRND_SHADOW];
   scene_.flags[mjRND_SEGMENT] = 1;
   scene_.flags[mjRND_IDCOLOR] = 1;

@@ -281,6 +281,10 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
       // cells only; the sensor model mirrors the sky and the sun (glass.hpp).
       const double specular = s.pv_arrays[i].specular_glass ? 0.0 : 0.9 - 0.4 * s.pv_arrays[i].dirt;
       x.line("<material name=\"" + n + "\" texture=\"" + n + "\" specular=\"" + f(specular) + "\" shininess=\"0.85\"/>");
+      if (s.pv_arrays[i].panel_slabs)  // a table's slab: the module texture once per module
+        x.line("<material name=\"a" + std::to_string(i) + "slab" + std::to_string(k) + "\" texture=\"" + n +
+               "\" texrepeat=\"" + std::to_string(s.pv_arrays[i].panels_per_table) + " " +
+               std::to_string(s.pv_arrays[i].panel_lines) + "\" specular=\"" + f(specular) + "\" shininess=\"0.85\"/>");
     }
   // Plaster: one flat colour, matte (walls with finish: plaster).
   x.line("<material name=\"plaster\" rgba=\"0.78 0.76 0.72 1\" specular=\"0.02\" shininess=\"0.05\"/>");

@@ -40,6 +40,15 @@ std::string panel_geom(const std::string& name, double pw, double ph, const Eige
          "\" pos=\"" + v3(pos) + "\" xyaxes=\"" + axes + "\" material=\"" + material + "\"/>";
 }
 
+/// A table's panels as one slab: its material repeats the module texture
+/// once per module (`PREslabK`, scene_builder.cpp); one dust variant a table.
+std::string table_slab_geom(const std::string& table, const scenes::PvArray& a, const Eigen::Vector3d& centre,
+                            const std::string& axes, const std::string& pre, Placer& rng) {
+  const int variant = static_cast<int>(rng.uniform(0, kDirtVariants)) % kDirtVariants;
+  return panel_geom(table + "slab", a.table_length_m(), a.table_depth_m(), centre, axes,
+                    pre + "slab" + std::to_string(variant));
+}
+
 /// Where a post under `top` starts: on flat ground at z = 0, on a relief
 /// kIntoReliefM into the ground.
 double post_foot_m(const scenes::GroundRelief& ground, const Eigen::Vector3d& top) {
@@ -72,13 +81,17 @@ void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uin
         return Eigen::Vector3d(g.x(), g.y(), a.clearance_m + s * std::sin(tilt) + dz);
       };
       const std::string tname = pre + "r" + std::to_string(row) + "t" + std::to_string(t);
-      for (int line = 0; line < a.panel_lines; ++line) {
-        for (int c = 0; c < a.panels_per_table; ++c) {
-          const double u = u_start + c * (pw + gap) + pw / 2;
-          const double s = line * (ph + gap) + ph / 2;
-          const int variant = static_cast<int>(rng.uniform(0, kDirtVariants)) % kDirtVariants;
-          x.line(panel_geom(tname + "p" + std::to_string(line) + "_" + std::to_string(c), pw, ph, slope_point(u, s), axes,
-                            pre + "panel" + std::to_string(variant)));
+      if (a.panel_slabs) {
+        x.line(table_slab_geom(tname, a, slope_point(u_start + tl / 2, td / 2), axes, pre, rng));
+      } else {
+        for (int line = 0; line < a.panel_lines; ++line) {
+          for (int c = 0; c < a.panels_per_table; ++c) {
+            const double u = u_start + c * (pw + gap) + pw / 2;
+            const double s = line * (ph + gap) + ph / 2;
+            const int variant = static_cast<int>(rng.uniform(0, kDirtVariants)) % kDirtVariants;
+            x.line(panel_geom(tname + "p" + std::to_string(line) + "_" + std::to_string(c), pw, ph, slope_point(u, s),
+                              axes, pre + "panel" + std::to_string(variant)));
+          }
         }
       }
       // backsheet and frame structure under the panels, one box per table
@@ -140,13 +153,17 @@ void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::u
         return axis_point(u) + (s - td / 2) * across + scenes::kTrackerPanelAboveAxisM * normal;
       };
       const std::string tname = pre + "r" + std::to_string(row) + "t" + std::to_string(t);
-      for (int line = 0; line < a.panel_lines; ++line)
-        for (int c = 0; c < a.panels_per_table; ++c) {
-          const int variant = static_cast<int>(rng.uniform(0, kDirtVariants)) % kDirtVariants;
-          x.line(panel_geom(tname + "p" + std::to_string(line) + "_" + std::to_string(c), pw, ph,
-                            plane_point(u_start + c * (pw + gap) + pw / 2, line * (ph + gap) + ph / 2), axes,
-                            pre + "panel" + std::to_string(variant)));
-        }
+      if (a.panel_slabs) {
+        x.line(table_slab_geom(tname, a, plane_point(u_start + tl / 2, td / 2), axes, pre, rng));
+      } else {
+        for (int line = 0; line < a.panel_lines; ++line)
+          for (int c = 0; c < a.panels_per_table; ++c) {
+            const int variant = static_cast<int>(rng.uniform(0, kDirtVariants)) % kDirtVariants;
+            x.line(panel_geom(tname + "p" + std::to_string(line) + "_" + std::to_string(c), pw, ph,
+                              plane_point(u_start + c * (pw + gap) + pw / 2, line * (ph + gap) + ph / 2), axes,
+                              pre + "panel" + std::to_string(variant)));
+          }
+      }
       const Eigen::Vector3d mid = axis_point(u_start + tl / 2);
       x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2, td / 2, 0.015) + "\" pos=\"" +
              v3(plane_point(u_start + tl / 2, td / 2) - normal * (kPanelHalfThicknessM + 0.016)) + "\" xyaxes=\"" +

@@ -242,16 +242,31 @@ RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
     throw ConfigError("model", "camera", "the infrared cameras of the d435 model", "none");
 }
 
+namespace {
+
+/// The ball that holds every point of an image of width x height pixels up
+/// to max_depth_m along the optical axis, seen from T_w_c (its corner rays
+/// are the longest), with a centimetre to spare.
+ShadeRegion shade_region(const geom::SE3d& T_w_c, const geom::PinholeIntrinsics& K, int width, int height,
+                         double max_depth_m) {
+  const double x = std::max(K.cx, width - 1 - K.cx) / K.fx, y = std::max(K.cy, height - 1 - K.cy) / K.fy;
+  return {T_w_c.translation(), max_depth_m * std::sqrt(1 + x * x + y * y) + 0.01};
+}
+
+}  // namespace
+
 StereoRender RgbdCamera::render_infrared(Simulator& sim, const geom::SE3d& T_w_c, const Eigen::Vector3d& to_sun_c) {
   const scenes::Scenario& s = sim.scenario();
   const scenes::ActiveStereo& p = s.camera.stereo;
   StereoRender out;
   out.to_sun_c = to_sun_c.cast<float>();
   const float sky = static_cast<float>(sim.assets().max_scene_depth_m);
-  std::optional<SunShadowCaster> caster;
-  if (s.light.sun_elevation_deg > 0) caster.emplace(sim.model(), sim.data(), sim.to_sun_w());
   const geom::PinholeIntrinsics K_ir = sensor_.stereo_model()->ir_intrinsics();
   const float pattern_range_m = sensor_.stereo_model()->pattern_range_m();
+  std::optional<SunShadowCaster> caster;
+  if (s.light.sun_elevation_deg > 0)
+    caster.emplace(sim.model(), sim.data(), sim.to_sun_w(),
+                   shade_region(T_w_c, K_ir, p.ir_width, p.ir_height, pattern_range_m + p.baseline_m + p.colour_offset_m));
   for (int k = 0; k < 2; ++k) {
     InfraredView& v = k == 0 ? out.left : out.right;
     cv::Mat rgb;
@@ -283,7 +298,8 @@ RenderedFrame RgbdCamera::render(Simulator& sim) {
     const float shade_range_m = sunlight_frame(cam.depth_noise.sunlight, sim.scenario().light.sun_elevation_deg,
                                                out.to_sun_c.cast<float>(), cv::Mat())
                                     .shade_range_m();
-    const SunShadowCaster caster(sim.model(), sim.data(), sim.to_sun_w());
+    const SunShadowCaster caster(sim.model(), sim.data(), sim.to_sun_w(),
+                                 shade_region(T_w_c, sim.intrinsics(), cam.width, cam.height, shade_range_m));
     out.sun_lit = sun_visibility(caster, out.depth_gt_m, sim.intrinsics(), T_w_c, 16, shade_range_m);
   }
   if (glass_) out.glass = glass_->find(sim.data(), out.depth_gt_m, sim.intrinsics(), T_w_c, true);

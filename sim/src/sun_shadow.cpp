@@ -5,7 +5,8 @@
 
 namespace pvb::sim {
 
-SunShadowCaster::SunShadowCaster(const mjModel* m, const mjData* d, const Eigen::Vector3d& to_sun_w)
+SunShadowCaster::SunShadowCaster(const mjModel* m, const mjData* d, const Eigen::Vector3d& to_sun_w,
+                                 const std::optional<ShadeRegion>& region)
     : m_(m), d_(d), s_(to_sun_w.normalized()) {
   // Two axes across the sun's direction.
   const Eigen::Vector3d other = std::abs(s_.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
@@ -17,6 +18,14 @@ SunShadowCaster::SunShadowCaster(const mjModel* m, const mjData* d, const Eigen:
       continue;
     const Eigen::Map<const Eigen::Vector3d> c(d->geom_xpos + 3 * g);
     const double a = e1_.dot(c), b = e2_.dot(c), r = m->geom_rbound[g];
+    if (region) {
+      // Every ray starts within the region's ball and runs along s_: the
+      // geom's sphere behind the ball, or wider of the ball's axis than
+      // both radii, is met by none.
+      const Eigen::Vector3d to_c = c - region->centre_w;
+      const double along = to_c.dot(s_), reach = region->radius_m + r;
+      if (along < -reach || (to_c - along * s_).squaredNorm() > reach * reach) continue;
+    }
     const long a0 = std::lround(std::floor((a - r) / cell_m_)),
                a1 = std::lround(std::floor((a + r) / cell_m_));
     const long b0 = std::lround(std::floor((b - r) / cell_m_)),

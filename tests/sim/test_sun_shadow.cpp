@@ -60,3 +60,29 @@ TEST(SunShadow, VisibilityOnBlocksEqualsEveryPixelTested) {
   // Points deeper than asked for are not lit.
   EXPECT_EQ(cv::countNonZero(sim::sun_visibility(caster, depth, K, T_w_c, 16, 2.5f)), 0);
 }
+
+TEST(SunShadow, ARegionLeavesOutOnlyGeomsThatCannotShadeItsPoints) {
+  // A row of roofs 1 m up, 3 m apart; a sun 45 degrees up in +x.
+  std::string xml = "<mujoco><worldbody><geom type=\"plane\" size=\"50 50 1\"/>";
+  for (int k = -10; k <= 10; ++k)
+    xml += "<geom type=\"box\" pos=\"" + std::to_string(3 * k) + " 0 1\" size=\"0.5 0.5 0.02\"/>";
+  xml += "</worldbody></mujoco>";
+  const Scene s = pvb::test::load_mjcf(xml);
+  ASSERT_TRUE(s.m) << s.error;
+  const Eigen::Vector3d sun(1, 0, 1);
+  const sim::SunShadowCaster all(s.m.get(), s.d.get(), sun);
+  const sim::ShadeRegion region{Eigen::Vector3d(0.5, 0, 0.5), 2.0};
+  const sim::SunShadowCaster near(s.m.get(), s.d.get(), sun, region);
+  int shaded = 0;
+  for (double x = -1.5; x <= 2.5; x += 0.05)
+    for (double y = -1.5; y <= 1.5; y += 0.25) {
+      const Eigen::Vector3d p(x, y, 0);
+      if ((p - region.centre_w).norm() > region.radius_m) continue;
+      EXPECT_EQ(near.shadowed(p), all.shadowed(p)) << p.transpose();
+      shaded += all.shadowed(p) ? 1 : 0;
+    }
+  EXPECT_GT(shaded, 10);  // the roofs at 0 and 3 m shade the region
+  // Far outside the region the roof that shades a point was left out.
+  EXPECT_TRUE(all.shadowed({-25, 0, 0}));
+  EXPECT_FALSE(near.shadowed({-25, 0, 0}));
+}

@@ -105,6 +105,10 @@ struct PvArray {
   /// in the same places), so its tables and rows look alike.  False: each
   /// panel's variant is drawn on its own.
   bool identical_tables = false;
+  /// Each table's panels drawn as one slab, its module texture repeated
+  /// once per module (a plant's arrays: a few geoms a table, not one a
+  /// module).  False: one geom per module, 2 cm apart.
+  bool panel_slabs = false;
   Mount mount = Mount::kFixed;
   TrackerMount tracker;  ///< mount single_axis only
   /// The tracker's rotation on the day (degrees; 0 for a fixed mount),
@@ -454,6 +458,20 @@ struct KidnapFrames {
   bool covered(std::int64_t frame) const { return frame >= cover_begin && frame < cover_end; }
 };
 
+/// What a `plant:` section made (pvb/scenes/plant.hpp): its blocks are the
+/// scenario's last `pv_arrays`, its inverter stations its last `walls`.
+struct PlantSummary {
+  int first_array = 0;  ///< the index of the first block in pv_arrays
+  int blocks = 0;
+  int rows_per_block = 0;
+  long long modules = 0;
+  double dc_mw = 0.0;
+  double ground_coverage_ratio = 0.0;
+  double row_pitch_m = 0.0;
+  int inverter_stations = 0;
+  std::vector<Eigen::Vector2d> corners_m;  ///< the plant's extent, headlands included
+};
+
 struct Scenario {
   std::string source_file;  ///< where it was loaded from ("" if built in code)
   /// The files it derives from (base:), nearest first; empty for a file
@@ -472,6 +490,7 @@ struct Scenario {
   Ground ground;
   std::vector<PvArray> pv_arrays;
   std::vector<Wall> walls;
+  std::optional<PlantSummary> plant;  ///< none unless the file has a plant: section
   Vegetation vegetation;
   Light light;
   std::optional<Site> site;  ///< none unless the file has a site: section

@@ -44,6 +44,12 @@ class Renderer {
   /// light fixed in the world (on by default; see snap_to_shadow_texels).
   /// Off is MuJoCo's own behaviour, kept for tests that show the difference.
   void set_stable_shadows(bool on) { stable_shadows_ = on; }
+  /// Whether geoms that neither lie in the camera's view nor shadow it are
+  /// left out before drawing (cull_to_view; on by default).
+  void set_culling(bool on) { cull_ = on; }
+  /// Geoms the last render left out of the scene, and those it drew.
+  int culled_geoms() const { return culled_; }
+  int drawn_geoms() const { return scene_.ngeom; }
   const std::string& description() const { return gl_->description(); }
   GlBackend backend() const { return gl_->backend(); }
   int width() const { return width_; }
@@ -58,6 +64,8 @@ class Renderer {
   int width_;
   int height_;
   bool stable_shadows_ = true;
+  bool cull_ = true;
+  int culled_ = 0;
   std::vector<unsigned char> rgb_buf_;
   std::vector<float> depth_buf_;
 };
@@ -72,6 +80,13 @@ class Renderer {
 /// the same wherever the light is, up to which part of the world the map
 /// covers.
 void snap_to_shadow_texels(float pos[3], const float dir[3], double texel_m);
+
+/// Leaves out of `scn` (after mjv_updateScene) every static primitive geom
+/// whose bounding sphere lies outside the view frustum of its first
+/// camera, the sphere swept first along the beam of the shadow-casting sun
+/// (when shadows are on) so that a geom whose shadow falls in view stays.
+/// `aspect` is the image's width over its height.  Returns the geoms left out.
+int cull_to_view(mjvScene* scn, double aspect);
 
 /// Converts one standard-Z-buffer value to metric depth (0 for d >= 1).
 inline float depth_from_buffer(float d, double znear_m, double zfar_m) {

@@ -6,6 +6,7 @@
 #include <mujoco/mujoco.h>
 
 #include <Eigen/Core>
+#include <optional>
 #include <cstdint>
 #include <limits>
 #include <opencv2/core.hpp>
@@ -22,9 +23,21 @@ namespace pvb::sim {
 /// whose bounding spheres it may meet.  Geoms of the groups MuJoCo draws by
 /// default (0-2) cast shadows; planes and height fields do not (the ground
 /// does not shade itself here).  shadowed() is const and thread-safe.
+/// Where the points that shadowed() will be asked about lie: within
+/// radius_m of centre_w.
+struct ShadeRegion {
+  Eigen::Vector3d centre_w = Eigen::Vector3d::Zero();
+  double radius_m = 0.0;
+};
+
 class SunShadowCaster {
  public:
-  SunShadowCaster(const mjModel* m, const mjData* d, const Eigen::Vector3d& to_sun_w);
+  /// With a region, geoms that no ray from a point in it towards the sun
+  /// can meet are left out (a plant's thousands, of which a camera's few
+  /// metres of depth see a handful): shadowed() then answers as without
+  /// the region for every point in it, and for no point outside it.
+  SunShadowCaster(const mjModel* m, const mjData* d, const Eigen::Vector3d& to_sun_w,
+                  const std::optional<ShadeRegion>& region = std::nullopt);
   /// True when the ray from p_w towards the sun meets a geom farther than
   /// `start_m` along it (past the surface the point lies on).
   bool shadowed(const Eigen::Vector3d& p_w, double start_m = 0.02) const;
