@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 #include <functional>
 #include <memory>
@@ -41,6 +42,7 @@ struct RecordOptions {
   std::string scenario;
   std::string out;
   std::string frames;  ///< empty: the scenario's duration; else checked by parse_count
+  std::string every = "1";  ///< record every Nth simulated frame
   std::optional<std::uint64_t> seed;
   std::string gl = "auto";
   std::string format = "tum";
@@ -123,7 +125,7 @@ struct RecordLoop {
 using FrameWriter = std::function<void(const sensor::RgbdFrame&, const geom::StampedPose&)>;
 
 RecordLoop record_frames(sim::SimFrameSource& source, const geom::StampedPose& gt, const FrameWriter& write,
-                         const std::string& name, int n) {
+                         const std::string& name, int n, int every) {
   RecordLoop loop;
   const std::vector<int> sheet_frames = plot::spread_indices(n, 12);
   const auto t_loop = Clock::now();
@@ -134,7 +136,11 @@ RecordLoop record_frames(sim::SimFrameSource& source, const geom::StampedPose& g
       break;
     }
     auto t0 = Clock::now();
-    const std::optional<sensor::RgbdFrame> frame = source.next();
+    // The frames between two recorded ones are simulated, not drawn: the
+    // next frame's motion readings span them.
+    bool more = true;
+    for (int k = 1; k < every && i > 0 && more; ++k) more = source.skip();
+    const std::optional<sensor::RgbdFrame> frame = more ? source.next() : std::nullopt;
     loop.capture_ms += ms_since(t0);
     if (!frame) break;
     const sim::SimFrameSource::StageTimes& st = source.last_stage_times();
@@ -159,7 +165,7 @@ RecordLoop record_frames(sim::SimFrameSource& source, const geom::StampedPose& g
 }
 
 void write_meta(const std::string& path, const RecordOptions& opt, const scenes::Scenario& scenario,
-                sim::SimFrameSource& source, const RecordLoop& loop, double total_s, double setup_ms) {
+                sim::SimFrameSource& source, const RecordLoop& loop, double total_s, double setup_ms, int every) {
   const sim::Simulator& sim = source.simulator();
   const double per_frame = loop.frames > 0 ? 1.0 / loop.frames : 0.0;
   // The world first, whatever its size; the rest fits a line each.
@@ -171,6 +177,7 @@ void write_meta(const std::string& path, const RecordOptions& opt, const scenes:
                 "  \"frames\": %d,\n"
                 "  \"interrupted\": %s,\n"
                 "  \"fps\": %.6g,\n"
+                "  \"every\": %d,\n"
                 "  \"versions\": {\"pvbench\": \"%s\", \"mujoco\": \"%s\"},\n"
                 "  \"renderer\": {\"backend\": \"%s\", \"description\": \"%s\"},\n"
                 "  \"physics\": {\"timestep_s\": %.9g, \"substeps_per_frame\": %d},\n"
@@ -181,7 +188,7 @@ void write_meta(const std::string& path, const RecordOptions& opt, const scenes:
                 "\"write_ms_per_frame\": %.3f, \"frames_per_s\": %.2f, \"physics_ms_per_frame\": %.3f, "
                 "\"render_ms_per_frame\": %.3f, \"sensor_ms_per_frame\": %.3f, \"stereo_match_ms_per_frame\": %.3f}\n"
                 "}\n",
-                loop.frames, loop.interrupted ? "true" : "false", scenario.camera.fps, pvb::version(),
+                loop.frames, loop.interrupted ? "true" : "false", scenario.camera.fps / every, every, pvb::version(),
                 mj_versionString(), sim::to_string(source.camera().backend()),
                 json_escape(source.camera().description()).c_str(), sim.assets().timestep_s, sim.assets().substeps,
                 sim.kinematics().wheel_radius_m, sim.kinematics().track_m, scenes::to_string(scenario.imu.part),
@@ -195,13 +202,44 @@ void write_meta(const std::string& path, const RecordOptions& opt, const scenes:
   write_file(path, meta);
 }
 
+/// What a recording of n frames of the scenario's camera will take on the
+/// disk, estimated before it starts: the default station's frames, noisy
+/// colour PNG 1.45 bytes a pixel and 16-bit depth PNG 0.5, measured on
+/// `pv_station` (150 frames: 433 and 140 KB a frame at 640 x 480), plus
+/// 1 KB a frame of lists and motion readings and 16 MB of scene and textures.
+double recording_bytes(const scenes::Scenario& s, int n) {
+  const double pixels = static_cast<double>(s.camera.width) * s.camera.height;
+  return n * (pixels * (1.45 + 0.5) + 1024.0) + 16e6;
+}
+
+/// Refuses, with one line, a recording the disk under `out` cannot hold;
+/// else says what it will take when that is a gigabyte or more.
+void check_disk(const std::string& out, const scenes::Scenario& s, int n) {
+  std::error_code ec;
+  const std::filesystem::space_info space = std::filesystem::space(out, ec);
+  const double need = recording_bytes(s, n);
+  const auto gb = [](double b) { return format_number("%.2f GB", b / 1e9); };
+  if (ec) return;  // no figure to judge by: the writes say so if the disk fills
+  if (static_cast<double>(space.available) < need)
+    throw IoError(out, "expected a disk with about " + gb(need) + " free for " + std::to_string(n) +
+                           " frames (fewer with --frames or --every), got " +
+                           gb(static_cast<double>(space.available)) + " free");
+  if (need >= 1e9)
+    std::printf("record: %d frames, about %s on the disk (%s free)\n", n, gb(need).c_str(),
+                gb(static_cast<double>(space.available)).c_str());
+}
+
 int run_record(const RecordOptions& opt, bool frames_given) {
   const int max_frames =
       frames_given ? static_cast<int>(parse_count("record", "--frames", opt.frames, 1, 1'000'000'000)) : 0;
+  const int every = static_cast<int>(parse_count("record", "--every", opt.every, 1, 1'000'000));
   const sim::GlBackend backend = sim::parse_gl_backend(opt.gl);
   scenes::Scenario scenario = scenes::load_scenario(opt.scenario);
   if (opt.seed) scenario.seed = *opt.seed;
   if (opt.format == "fakenect") check_fakenect_scenario(scenario, opt.scenario);
+  if (opt.format == "fakenect" && every > 1)
+    throw ConfigError("pvbench record", "--every", "1 with --format fakenect (a Kinect v1 dump is 30 Hz)",
+                      std::to_string(every));
   IoPlan plan;
   add_scenario_inputs(&plan, "--scenario", scenario);
   plan.output_folder("--out", opt.out).check();
@@ -209,13 +247,18 @@ int run_record(const RecordOptions& opt, bool frames_given) {
   const StopSignals stop_signals;  // Ctrl-C during the set-up stops before the first frame
 
   const auto t_start = Clock::now();
-  const int n = scenes::frame_count(scenario, max_frames);
+  // n recorded frames, every `every`th of the scenario's.
+  const int simulated = scenes::frame_count(scenario);
+  const int n = std::min((simulated - 1) / every + 1, max_frames > 0 ? max_frames : simulated);
+  check_disk(opt.out, scenario, n);
   geom::StampedPose gt;  // ground truth arrives through its own sink
-  sim::SimFrameSource source(scenario, backend, n, [&gt](const geom::StampedPose& p) { gt = p; });
+  sim::SimFrameSource source(scenario, backend, (n - 1) * every + 1,
+                             [&gt](const geom::StampedPose& p) { gt = p; });
   const double setup_ms = ms_since(t_start);
 
   sim::write_scene(source.simulator().assets(), opt.out);
   dataset::OrbSlamSettings settings = run::orbslam_settings_for(scenario);
+  settings.fps = scenario.camera.fps / every;
   std::unique_ptr<dataset::TumSequenceWriter> tum;
   std::unique_ptr<FakenectDump> dump;
   std::unique_ptr<dataset::MotionFilesWriter> motion;
@@ -242,12 +285,12 @@ int run_record(const RecordOptions& opt, bool frames_given) {
     };
   }
   dataset::write_orbslam_settings(opt.out + "/camera.yaml", settings);
-  const RecordLoop loop = record_frames(source, gt, write, scenario.name, n);
+  const RecordLoop loop = record_frames(source, gt, write, scenario.name, n, every);
   if (loop.interrupted)
     std::printf("record: stopped by a signal after %d of %d frames; writing meta.json for them\n",
                 loop.frames, n);
 
-  write_meta(opt.out + "/meta.json", opt, scenario, source, loop, ms_since(t_start) / 1000.0, setup_ms);
+  write_meta(opt.out + "/meta.json", opt, scenario, source, loop, ms_since(t_start) / 1000.0, setup_ms, every);
   plot::write_rgb_png(plot::make_contact_sheet(loop.thumbs, 4, 320), opt.out + "/contact_sheet.png");
   std::printf("recorded %d frames of %s to %s (%s; %.1f frames/s, capture %.1f ms/frame)\n", loop.frames,
               scenario.name.c_str(), opt.out.c_str(), source.camera().description().c_str(),
@@ -270,6 +313,10 @@ Command add_record_command(CLI::App& app) {
   sub->add_flag("--overwrite", opt->overwrite, "empty an earlier pvbench output in --out first");
   CLI::Option* frames =
       sub->add_option("--frames", opt->frames, "record at most N frames (default: the scenario's duration)");
+  sub->add_option("--every", opt->every,
+                  "record every Nth frame of the scenario's camera (a long drive at a lower rate; the "
+                  "frames between are simulated, not drawn, and their motion readings kept)")
+      ->capture_default_str();
   sub->add_option("--seed", opt->seed, "override the scenario's seed")
       ->check(seed_check("record", "--seed", std::numeric_limits<std::uint64_t>::max()));
   sub->add_option("--gl", opt->gl, "rendering backend")->check(CLI::IsMember({"auto", "egl", "osmesa"}));

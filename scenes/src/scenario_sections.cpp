@@ -109,6 +109,16 @@ void check_scene_size(const Scenario& s, const ReadContext& ctx) {
   }
   if (total <= kMaxSceneGeoms) return;
   std::string got = std::to_string(total);
+  if (s.plant) {
+    const PvArray& b = s.pv_arrays[static_cast<std::size_t>(s.plant->first_array)];
+    throw ConfigError(ctx.origins->where("plant", ctx.file), "plant",
+                      "at most " + std::to_string(kMaxSceneGeoms) +
+                          " geoms in the scene (a plant's table is its slab and up to 7 parts; a wall 1, a shrub "
+                          "or tree 2): fewer blocks or rows",
+                      got + " (" + std::to_string(s.plant->blocks) + " blocks x " + std::to_string(b.rows) +
+                          " rows x " + std::to_string(b.tables_per_row) + " tables x " +
+                          std::to_string(table_geoms(b)) + " geoms)");
+  }
   if (largest >= 0) {
     const PvArray& a = s.pv_arrays[largest_index];
     got += " (pv_arrays[" + std::to_string(largest_index) + "]: " + std::to_string(a.rows) + " rows x " +

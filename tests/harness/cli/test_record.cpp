@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <regex>
@@ -397,4 +398,51 @@ TEST(RecordCli, HangUpStopsAtTheNextFrameAndWritesMeta) {
   EXPECT_EQ(WEXITSTATUS(status), 130) << read_file(log);
   const std::string meta = read_file(d + "/meta.json");
   EXPECT_NE(meta.find("\"interrupted\": true"), std::string::npos) << meta;
+}
+
+// Every Nth frame: the frames a full recording has at those times, byte for
+// byte (the noise is seeded per frame), at the lower rate, with the motion
+// readings of the frames between.
+TEST(RecordCli, EveryNthFrameIsTheFullRecordingsFrameWithTheMotionBetween) {
+  const std::string d = fresh("every");
+  const Result r = run("record --scenario " + kStation + " --out " + d + " --frames 4 --every 6 --seed " +
+                       std::to_string(pvb::test::kStationSeed));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(data_lines(d + "/rgb.txt"), 4);
+  for (const char* t : {"0.000000", "0.200000", "0.400000", "0.600000"})
+    EXPECT_TRUE(read_file(d + "/rgb/" + t + ".png") == read_file(station_run() + "/rgb/" + t + ".png")) << t;
+  EXPECT_NE(read_file(d + "/camera.yaml").find("Camera.fps: 5.0"), std::string::npos);
+  EXPECT_NE(read_file(d + "/meta.json").find("\"every\": 6"), std::string::npos);
+  // The IMU's readings run on through the frames that were not drawn.
+  const std::vector<std::string> imu = [&] {
+    std::ifstream in(d + "/imu0/data.csv");
+    std::vector<std::string> lines;
+    for (std::string l; std::getline(in, l);)
+      if (!l.empty() && l[0] != '#') lines.push_back(l);
+    return lines;
+  }();
+  ASSERT_GT(imu.size(), 50u);
+  EXPECT_GT(std::stoll(imu.back().substr(0, imu.back().find(','))), 550'000'000LL);
+  const Result fake = run("record --scenario " + kStation + " --out " + fresh("every_fake") +
+                          " --frames 4 --every 2 --format fakenect");
+  EXPECT_EQ(fake.code, 1);
+  EXPECT_NE(fake.output.find("--every: expected 1 with --format fakenect"), std::string::npos) << fake.output;
+}
+
+// A recording larger than the disk's free space is refused with one line
+// before a frame is drawn: an hour at 240 frames/s is 864 001 frames, about
+// a terabyte.
+TEST(RecordCli, ARecordingTheDiskCannotHoldIsRefusedBeforeItStarts) {
+  const std::string yaml = ::testing::TempDir() + "pvb_rec_disk_" + std::to_string(::getpid()) + ".yaml";
+  write_file(yaml, "duration_s: 3600\nroute: {waypoints_m: [[0, 0], [5, 0]]}\ncamera: {fps: 240}\n");
+  const std::string d = fresh("disk");
+  std::filesystem::create_directories(d);
+  if (std::filesystem::space(d).available > 1.5e12) GTEST_SKIP() << "this disk holds a terabyte";
+  const Result r = run("record --scenario " + yaml + " --out " + d);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  EXPECT_NE(r.output.find("pvbench: error: " + d + ": expected a disk with about "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" free for 864001 frames (fewer with --frames or --every), got "), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(d + "/rgb.txt"));
 }
