@@ -145,8 +145,9 @@ TEST(Plant, ShippedPlantsAreTenMegawattBlocksWithAKilometreRoute) {
     EXPECT_GE(row_length_m(block), 100.0) << name;
     const double route_m = polyline_length(route_polyline(s));
     EXPECT_GE(route_m, 1000.0) << name;
-    // The robot drives it within the scenario's time.
-    EXPECT_GE(s.duration_s * s.route.speed_mps, route_m) << name;
+    // The robot drives it within the scenario's time: its U-turns and starts
+    // are slower than the route's speed (the slow PlantRoutes test drives it).
+    EXPECT_GE(s.duration_s * s.route.speed_mps, 1.04 * route_m) << name;
   }
 }
 
