@@ -537,6 +537,9 @@ void read_ground(MapReader& r, Ground& g) {
   const GroundTiling fallback = r.has("relief") ? GroundTiling::kRepeat : g.tiling;
   g.tiling = r.choice<GroundTiling>("tiling", fallback,
                                     {{"repeat", GroundTiling::kRepeat}, {"varied", GroundTiling::kVaried}});
+  g.soil_images = r.integer("soil_images", g.soil_images, 1, 1000);
+  if (g.soil_images > 0 && g.tiling != GroundTiling::kVaried)
+    r.fail(r.full("soil_images"), r.child("soil_images"), "soil_images with tiling: varied only");
   with_map(r, "relief", [&](MapReader& q) { read_relief(q, g); });
   // Blamed on the tiling, where it was written (a day file's over its
   // base's relief): a relief takes one repeated image.

@@ -112,6 +112,8 @@ double bounding_radius(const mjvGeom& g) {
     case mjGEOM_ELLIPSOID: return std::max({a, b, c});
     case mjGEOM_CYLINDER: return std::sqrt(a * a + b * b);
     case mjGEOM_CAPSULE: return a + b;
+    case mjGEOM_PLANE:  // a ground tile (the ground plane's is far larger); an infinite plane stays
+      return a > 0 && b > 0 ? std::sqrt(a * a + b * b) : -1;
     default: return -1;
   }
 }
@@ -129,7 +131,7 @@ std::optional<Eigen::Vector3d> shadow_beam(const mjvScene& scn) {
 
 }  // namespace
 
-int cull_to_view(mjvScene* scn, double aspect) {
+int cull_to_view(mjvScene* scn, double aspect, double far_tile_m) {
   const mjvGLCamera& cam = scn->camera[0];
   const Eigen::Vector3d pos(cam.pos[0], cam.pos[1], cam.pos[2]), fwd(cam.forward[0], cam.forward[1], cam.forward[2]);
   const Eigen::Vector3d up(cam.up[0], cam.up[1], cam.up[2]);
@@ -154,6 +156,7 @@ int cull_to_view(mjvScene* scn, double aspect) {
       r += 0.5 * len;
     }
     bool visible = r < 0;
+    if (!visible && far_tile_m > 0 && g.type == mjGEOM_PLANE && (c - pos).norm() > far_tile_m + r) continue;
     if (!visible) {
       const Eigen::Vector3d d = c - pos;
       const Eigen::Vector3d q(d.dot(right), d.dot(up), d.dot(fwd));
@@ -180,7 +183,7 @@ void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat
   camera_.type = mjCAMERA_FIXED;
   camera_.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
-  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_) : 0;
+  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_) : 0;
   if (stable_shadows_) {
     const double texel_m = shadow_texel_m(con_.shadowClip, con_.shadowSize);
     for (int i = 0; i < scene_.nlight; ++i) {
@@ -217,7 +220,7 @@ void Renderer::render_geom_ids(const mjModel* model, mjData* data, int camera_id
   camera_.type = mjCAMERA_FIXED;
   camera_.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
-  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_) : 0;
+  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_) : 0;
   const unsigned char shadow = scene_.flags[mjRND_SHADOW];
   scene_.flags[mjRND_SEGMENT] = 1;
   scene_.flags[mjRND_IDCOLOR] = 1;

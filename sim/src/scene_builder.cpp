@@ -28,6 +28,7 @@
 #include "pvb/scenes/route.hpp"
 #include "pvb/sim/simulator.hpp"
 #include "pvb/sim/textures.hpp"
+#include "splitmix.hpp"
 #include "scene_mjcf.hpp"
 
 namespace pvb::sim {
@@ -96,12 +97,6 @@ std::vector<unsigned char> texture_bytes(const cv::Mat& rgb_img, const std::stri
   return encoding == TextureEncoding::kPixels ? pixels(rgb_img) : png(rgb_img, path);
 }
 
-/// One 3 m tile of a varied ground: its centre and its image's seed.
-struct GroundTile {
-  Eigen::Vector2d centre_m;
-  std::uint64_t seed = 0;
-};
-
 /// The tiles of a varied ground (none for a repeated one): every 3 m cell
 /// of the ground whose centre lies within kGroundVariedCorridorM (and half
 /// a tile's diagonal) of the route.  A cell's image seed comes from the
@@ -129,15 +124,28 @@ std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std
       for (long long j = j0; j <= j1; ++j)
         if ((p - centre(i, j)).norm() <= reach) cells.insert({i, j});
   }
-  if (cells.size() > static_cast<std::size_t>(kMaxGroundTiles))
+  const int images = s.ground.soil_images;
+  if (images == 0 && cells.size() > static_cast<std::size_t>(kMaxGroundTiles))
     throw ConfigError(s.source_file, "ground.tiling",
                       "a varied ground (the default) of at most " + std::to_string(kMaxGroundTiles) + " tiles of " +
-                          f(tile) + " m along the route (a route of about 140 m), or tiling: repeat",
+                          f(tile) + " m along the route (a route of about 140 m), ground.soil_images for a longer "
+                          "one, or tiling: repeat",
+                      std::to_string(cells.size()) + " tiles");
+  if (cells.size() > static_cast<std::size_t>(kMaxSharedImageTiles))
+    throw ConfigError(s.source_file, "ground.soil_images",
+                      "a route whose varied ground takes at most " + std::to_string(kMaxSharedImageTiles) + " tiles",
                       std::to_string(cells.size()) + " tiles");
   std::vector<GroundTile> tiles;
   for (const auto& [i, j] : cells) {
     const auto cell = static_cast<std::uint64_t>(i * cells_y + j);
-    tiles.push_back({centre(i, j), s.station_seed_or_seed() * 2654435761ULL + 1000003ULL * (cell + 1)});
+    GroundTile t{centre(i, j), s.station_seed_or_seed() * 2654435761ULL + 1000003ULL * (cell + 1)};
+    if (images > 0) {  // a shared image and a quarter turn, from the station and the cell alone
+      SplitMix pick(s.station_seed_or_seed(), 0x711E0000ULL + cell);
+      t.image = static_cast<int>(pick.next() % static_cast<std::uint64_t>(images));
+      t.quarter_turns = static_cast<int>(pick.next() % 4);
+      t.seed = shared_soil_image_seed(s.station_seed_or_seed(), t.image);
+    }
+    tiles.push_back(t);
   }
   return tiles;
 }
@@ -158,13 +166,19 @@ void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tile
   const std::uint64_t station_seed = s.station_seed_or_seed(), day_seed = s.seed;
   add("ground", [&] { return make_ground_texture(s.ground.type, station_seed); });
   // A tile's image depends on its seed alone: drawn and encoded on every core.
-  std::vector<std::vector<unsigned char>> tile_png(tiles.size(), grey);
+  // Shared images: image k is groundtK; else tile k's own image is.
+  std::vector<std::uint64_t> seeds;
+  for (int k = 0; k < s.ground.soil_images && !tiles.empty(); ++k)
+    seeds.push_back(shared_soil_image_seed(station_seed, k));
+  if (s.ground.soil_images == 0)
+    for (const GroundTile& t : tiles) seeds.push_back(t.seed);
+  std::vector<std::vector<unsigned char>> tile_png(seeds.size(), grey);
   if (full)
-    cv::parallel_for_(cv::Range(0, static_cast<int>(tiles.size())), [&](const cv::Range& range) {
+    cv::parallel_for_(cv::Range(0, static_cast<int>(seeds.size())), [&](const cv::Range& range) {
       for (int k = range.start; k < range.end; ++k)
-        tile_png[k] = texture_bytes(make_ground_texture(s.ground.type, tiles[k].seed), kGroundTilePrefix, encoding);
+        tile_png[k] = texture_bytes(make_ground_texture(s.ground.type, seeds[k]), kGroundTilePrefix, encoding);
     });
-  for (std::size_t k = 0; k < tiles.size(); ++k)
+  for (std::size_t k = 0; k < seeds.size(); ++k)
     out->files.emplace_back(kGroundTilePrefix + std::to_string(k) + ".png", std::move(tile_png[k]));
   add("brick", [&] { return make_brick_texture(station_seed); });
   add("foliage", [&] { return make_foliage_texture(station_seed); });
@@ -331,14 +345,25 @@ void add_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<Groun
          std::string(varied ? "group=\"3\" " : "") + ground_friction(s.ground) + "/>");
   if (!varied) return;
   x.line("<geom class=\"scenery\" type=\"plane\" size=\"" + size + "\" pos=\"0 0 -0.005\" material=\"ground\"/>");
-  for (std::size_t k = 0; k < tiles.size(); ++k)
+  for (std::size_t k = 0; k < tiles.size(); ++k) {
+    const GroundTile& t = tiles[k];
+    const std::string turn = t.quarter_turns > 0 ? "\" euler=\"0 0 " + std::to_string(90 * t.quarter_turns) : "";
     x.line("<geom class=\"scenery\" type=\"plane\" size=\"" + v3(kGroundTileM / 2, kGroundTileM / 2, 1) +
-           "\" pos=\"" + v3(tiles[k].centre_m.x(), tiles[k].centre_m.y(), 0) + "\" material=\"groundt" +
-           std::to_string(k) + "\"/>");
+           "\" pos=\"" + v3(t.centre_m.x(), t.centre_m.y(), 0) + turn + "\" material=\"groundt" +
+           std::to_string(t.image >= 0 ? static_cast<std::size_t>(t.image) : k) + "\"/>");
+  }
 }
 
 }  // namespace
 }  // namespace mjcf
+
+std::vector<GroundTile> ground_tiles(const scenes::Scenario& s) {
+  return mjcf::varied_ground_tiles(s, scenes::route_polyline(s));
+}
+
+std::uint64_t shared_soil_image_seed(std::uint64_t station_seed, int k) {
+  return SplitMix(station_seed, 0x5011000ULL + static_cast<std::uint64_t>(k)).next();
+}
 
 ShadowMap shadow_map_for(const scenes::Light& light, const std::vector<Eigen::Vector2d>& route_xy_m) {
   ShadowMap m;

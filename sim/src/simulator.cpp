@@ -12,6 +12,7 @@
 #include "pvb/scenes/route.hpp"
 #include "pvb/sim/sensor_model.hpp"
 #include "pvb/sim/sun_shadow.hpp"
+#include "pvb/sim/textures.hpp"
 #include "carry_path.hpp"
 
 namespace pvb::sim {
@@ -217,6 +218,13 @@ std::optional<cv::Point2d> Simulator::sun_pixel() const {
 }
 
 namespace {
+/// A ground of shared soil images lays a tile every 3 m along the route:
+/// those beyond where the soil's stones shrink below half a pixel are left
+/// out (textures.hpp).  Other grounds keep every tile, and their bytes.
+double far_tile_cull_m(const scenes::Scenario& s) {
+  return s.ground.soil_images > 0 ? s.camera.fx * kSoilFeatureM / 0.5 : 0.0;
+}
+
 const Simulator& textured(const Simulator& sim) {
   if (sim.assets().detail != SceneDetail::kFull)
     throw Error("a simulator built for its geometry only gives no colour frames (build it with SceneDetail::kFull)");
@@ -228,6 +236,7 @@ RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
     : renderer_(textured(sim).model(), backend, sim.scenario().camera.width, sim.scenario().camera.height),
       sensor_(sim) {
   renderer_.set_shadows(sim.scenario().light.shadows);
+  renderer_.set_far_tile_cull_m(far_tile_cull_m(sim.scenario()));
   std::vector<bool> specular;
   for (const auto& a : sim.scenario().pv_arrays) specular.push_back(a.specular_glass);
   glass_ = std::make_unique<GlassFinder>(sim.model(), specular);
@@ -236,6 +245,7 @@ RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
   if (cam.model != scenes::CameraKind::kD435) return;
   ir_renderer_ = std::make_unique<Renderer>(sim.model(), renderer_.backend(), cam.stereo.ir_width, cam.stereo.ir_height);
   ir_renderer_->set_shadows(sim.scenario().light.shadows);
+  ir_renderer_->set_far_tile_cull_m(far_tile_cull_m(sim.scenario()));
   ir_left_id_ = mj_name2id(sim.model(), mjOBJ_CAMERA, kIrLeftCameraName);
   ir_right_id_ = mj_name2id(sim.model(), mjOBJ_CAMERA, kIrRightCameraName);
   if (ir_left_id_ < 0 || ir_right_id_ < 0)

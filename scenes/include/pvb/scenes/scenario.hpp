@@ -56,6 +56,11 @@ struct Ground {
   /// Varied: every 3 m of soil near the route an image of its own.  A
   /// relief takes one repeated image (a height field has one texture).
   GroundTiling tiling = GroundTiling::kVaried;
+  /// Varied tiling: 0 gives every tile an image of its own (at most 200
+  /// tiles); N > 0 draws N images, and each tile takes one of them with a
+  /// quarter turn, both from the station's seed and the tile's place
+  /// (memory bounded by N, not by the route).
+  int soil_images = 0;
   std::optional<Relief> relief;  ///< none: the flat plane z = 0
   /// The tiling the ground is drawn with: repeated under a relief.
   GroundTiling drawn_tiling() const { return relief ? GroundTiling::kRepeat : tiling; }

@@ -47,6 +47,10 @@ class Renderer {
   /// Whether geoms that neither lie in the camera's view nor shadow it are
   /// left out before drawing (cull_to_view; on by default).
   void set_culling(bool on) { cull_ = on; }
+  /// Ground tiles (finite planes) farther than this from the camera are
+  /// left out too, where the base plane's repeated soil shows instead
+  /// (0: none; cull_to_view).
+  void set_far_tile_cull_m(double m) { far_tile_m_ = m; }
   /// Geoms the last render left out of the scene, and those it drew.
   int culled_geoms() const { return culled_; }
   int drawn_geoms() const { return scene_.ngeom; }
@@ -65,6 +69,7 @@ class Renderer {
   int height_;
   bool stable_shadows_ = true;
   bool cull_ = true;
+  double far_tile_m_ = 0;
   int culled_ = 0;
   std::vector<unsigned char> rgb_buf_;
   std::vector<float> depth_buf_;
@@ -85,8 +90,11 @@ void snap_to_shadow_texels(float pos[3], const float dir[3], double texel_m);
 /// whose bounding sphere lies outside the view frustum of its first
 /// camera, the sphere swept first along the beam of the shadow-casting sun
 /// (when shadows are on) so that a geom whose shadow falls in view stays.
-/// `aspect` is the image's width over its height.  Returns the geoms left out.
-int cull_to_view(mjvScene* scn, double aspect);
+/// `aspect` is the image's width over its height.  With far_tile_m > 0, a
+/// finite plane (a ground tile) farther than that is left out as well: the
+/// one cull that changes pixels (colour only, beyond the depth range).
+/// Returns the geoms left out.
+int cull_to_view(mjvScene* scn, double aspect, double far_tile_m = 0);
 
 /// Converts one standard-Z-buffer value to metric depth (0 for d >= 1).
 inline float depth_from_buffer(float d, double znear_m, double zfar_m) {

@@ -63,6 +63,21 @@ struct ShadowMap {
 };
 inline constexpr double kShadowMarginM = 9.0;
 inline constexpr double kShadowTexelTargetM = 0.020;
+/// One 3 m tile of a varied ground: its centre, the seed of its image, and
+/// on a ground of shared images (`ground.soil_images`) which image it takes
+/// and how many quarter turns (counter-clockwise) it lies at.
+struct GroundTile {
+  Eigen::Vector2d centre_m;
+  std::uint64_t seed = 0;
+  int image = -1;  ///< -1: an image of its own
+  int quarter_turns = 0;
+};
+/// The tiles of a varied ground along the scenario's route (none for a
+/// repeated one), as the scene lays them.
+std::vector<GroundTile> ground_tiles(const scenes::Scenario& s);
+/// The seed of shared soil image `k` of a station.
+std::uint64_t shared_soil_image_seed(std::uint64_t station_seed, int k);
+
 ShadowMap shadow_map_for(const scenes::Light& light, const std::vector<Eigen::Vector2d>& route_xy_m);
 
 /// Generates the scene.  Deterministic in the scenario (seed included).

@@ -26,8 +26,16 @@ constexpr double kGroundTileM = 3.0;
 /// this distance of the route an image of its own (the camera resolves the
 /// soil's stones closer than that); the repeated image lies beyond.
 constexpr double kGroundVariedCorridorM = 4.0;
-/// At most this many varied tiles (a route of about 140 m): 512 x 512 RGB each.
+/// At most this many varied tiles with an image each (a route of about
+/// 140 m): 512 x 512 RGB each.
 constexpr int kMaxGroundTiles = 200;
+/// At most this many tiles on a ground of `soil_images` shared images (a
+/// route of several kilometres): a plane geom each, culled to the view.
+constexpr int kMaxSharedImageTiles = 20000;
+/// The soil's stones, about 4 cm: a ground tile farther than where they
+/// shrink below half a pixel shows nothing the repeated soil under it does
+/// not (fx x 0.04 / 0.5: 42 m at fx 525).
+constexpr double kSoilFeatureM = 0.04;
 /// Leaves for shrubs and tree crowns.
 cv::Mat make_foliage_texture(std::uint64_t seed);
 /// Tree bark.
