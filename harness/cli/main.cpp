@@ -24,6 +24,7 @@ Command add_map_check_command(CLI::App& app);
 Command add_vocab_command(CLI::App& app);
 Command add_eval_map_command(CLI::App& app);
 Command add_sheet_command(CLI::App& app);
+Command add_plan_command(CLI::App& app);
 Command add_campaign_command(CLI::App& app);
 
 /// Prints "pvbench: KIND: WHAT" and marks the output folders this process
@@ -53,6 +54,7 @@ std::vector<Command> add_all_commands(CLI::App& app) {
   cmds.push_back(add_vocab_command(app));
   cmds.push_back(add_eval_map_command(app));
   cmds.push_back(add_sheet_command(app));
+  cmds.push_back(add_plan_command(app));
   return cmds;
 }
 }  // namespace pvb::cli

@@ -100,6 +100,7 @@ const std::vector<Command>& commands() {
       {"match --sequence {seq} --frames 0,1 --settings {settings} --runs 1", {"seq", "settings"}, {"--json", "--draw"}},
       {"vocab --scenario {scenario} --sequence {seq} --images {images}", {"scenario", "seq", "images"}, {"--out"}},
       {"sheet --scenario {scenario}", {"scenario"}, {"--out"}},
+      {"plan --scenario {scenario}", {"scenario"}, {"--out"}},
       {"campaign --campaign {campaign}", {"campaign", "day", "scenario"}, {"--out/"}},
       {"sweep --scenario {day} --seeds 1", {"day", "scenario"}, {"--out/"}},
       {"sweep --campaign {campaign} --seeds 1", {"campaign", "day"}, {"--out/"}},
