@@ -82,6 +82,12 @@ Eigen::Vector2d array_to_world(const PvArray& a, double u, double v) {
   return a.origin_m + u * eu + v * ev;
 }
 
+Eigen::Vector2d world_to_array(const PvArray& a, const Eigen::Vector2d& p_m) {
+  const double az = a.azimuth_deg * kDegToRad;
+  const Eigen::Vector2d q = p_m - a.origin_m;
+  return {q.x() * std::cos(az) + q.y() * std::sin(az), -q.x() * std::sin(az) + q.y() * std::cos(az)};
+}
+
 double row_length_m(const PvArray& a) {
   return a.tables_per_row * a.table_length_m() + (a.tables_per_row - 1) * a.table_gap_m;
 }

@@ -141,9 +141,8 @@ namespace {
 
 /// A route point `clear_m` or less from a table's footprint in `block`.
 bool in_a_table(const PvArray& block, const Eigen::Vector2d& p, double clear_m) {
-  const double az = block.azimuth_deg * M_PI / 180.0;
-  const Eigen::Vector2d q = p - block.origin_m;
-  const double u = q.x() * std::cos(az) + q.y() * std::sin(az), v = -q.x() * std::sin(az) + q.y() * std::cos(az);
+  const Eigen::Vector2d uv = world_to_array(block, p);
+  const double u = uv.x(), v = uv.y();
   const double footprint = row_footprint_m(block), tl = block.table_length_m();
   const int row = static_cast<int>(std::floor((v + clear_m) / block.row_pitch_m));
   if (row < 0 || row >= block.rows || v - row * block.row_pitch_m > footprint + clear_m) return false;

@@ -138,12 +138,14 @@ std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std
   std::vector<GroundTile> tiles;
   for (const auto& [i, j] : cells) {
     const auto cell = static_cast<std::uint64_t>(i * cells_y + j);
-    GroundTile t{centre(i, j), s.station_seed_or_seed() * 2654435761ULL + 1000003ULL * (cell + 1)};
+    GroundTile t{centre(i, j)};
     if (images > 0) {  // a shared image and a quarter turn, from the station and the cell alone
       SplitMix pick(s.station_seed_or_seed(), 0x711E0000ULL + cell);
       t.image = static_cast<int>(pick.next() % static_cast<std::uint64_t>(images));
       t.quarter_turns = static_cast<int>(pick.next() % 4);
       t.seed = shared_soil_image_seed(s.station_seed_or_seed(), t.image);
+    } else {
+      t.seed = s.station_seed_or_seed() * 2654435761ULL + 1000003ULL * (cell + 1);
     }
     tiles.push_back(t);
   }

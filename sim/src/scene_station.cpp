@@ -207,11 +207,8 @@ bool clear_of_everything(const scenes::Scenario& s, const std::vector<Eigen::Vec
   for (const auto& w : s.walls)
     if (dist_to_segment(p, w.start_m, w.end_m) < keep + w.thickness_m / 2) return false;
   for (const auto& a : s.pv_arrays) {
-    // inverse of array_to_world
-    const double az = a.azimuth_deg * kDeg;
-    const Eigen::Vector2d q = p - a.origin_m;
-    const double u = q.x() * std::cos(az) + q.y() * std::sin(az);
-    const double v = -q.x() * std::sin(az) + q.y() * std::cos(az);
+    const Eigen::Vector2d uv = scenes::world_to_array(a, p);
+    const double u = uv.x(), v = uv.y();
     const double len = scenes::row_length_m(a);
     const double depth = (a.rows - 1) * a.row_pitch_m + scenes::row_footprint_m(a);
     if (u > -keep && u < len + keep && v > -keep && v < depth + keep) return false;

@@ -19,13 +19,6 @@ Scenario plant_scenario(const std::string& plant, const std::string& route = "{p
                         "plant.yaml");
 }
 
-/// World point to the array frame of `a` (u along its rows, v across).
-Eigen::Vector2d to_uv(const PvArray& a, const Eigen::Vector2d& p) {
-  const double az = a.azimuth_deg * M_PI / 180.0;
-  const Eigen::Vector2d q = p - a.origin_m;
-  return {q.x() * std::cos(az) + q.y() * std::sin(az), -q.x() * std::sin(az) + q.y() * std::cos(az)};
-}
-
 TEST(Plant, ModulesPowerAndCoverageFollowTheLayout) {
   const Scenario s = plant_scenario("{rows: 10, module_power_w: 580, ground_coverage_ratio: 0.4}");
   ASSERT_TRUE(s.plant.has_value());
@@ -69,17 +62,17 @@ TEST(Plant, BlocksStandApartWithHeadlandsAndRoadsBetween) {
   const PvArray& b0 = s.pv_arrays[0];
   const double len = row_length_m(b0), depth = 5 * b0.row_pitch_m + row_footprint_m(b0);
   // Along the rows: a headland, the road, a headland.
-  const Eigen::Vector2d b1 = to_uv(b0, s.pv_arrays[1].origin_m);
+  const Eigen::Vector2d b1 = world_to_array(b0, s.pv_arrays[1].origin_m);
   EXPECT_NEAR(b1.x(), len + 2 * 8 + 4, 1e-9);
   EXPECT_NEAR(b1.y(), 0, 1e-9);
   // Across them: the next line of blocks beyond the aisle, the road, the skids and an aisle.
-  const Eigen::Vector2d b2 = to_uv(b0, s.pv_arrays[2].origin_m);
+  const Eigen::Vector2d b2 = world_to_array(b0, s.pv_arrays[2].origin_m);
   EXPECT_NEAR(b2.x(), 0, 1e-9);
   EXPECT_GT(b2.y(), depth + 4 + kInverterSkidWidthM);
   // Every skid lies clear of every block's rows and headlands.
   for (const Wall& w : s.walls)
     for (const PvArray& b : s.pv_arrays) {
-      const Eigen::Vector2d mid = to_uv(b, 0.5 * (w.start_m + w.end_m));
+      const Eigen::Vector2d mid = world_to_array(b, 0.5 * (w.start_m + w.end_m));
       const bool in_block = mid.x() > -8 - kInverterSkidLengthM / 2 && mid.x() < len + 8 + kInverterSkidLengthM / 2 &&
                             mid.y() > -kInverterSkidWidthM && mid.y() < depth + kInverterSkidWidthM;
       EXPECT_FALSE(in_block) << "a skid at (" << mid.transpose() << ") in a block's frame";

@@ -52,9 +52,9 @@ TEST(PlanView, APlantsTablesCoverTheirShareOfTheRowsAndTheRouteIsDrawn) {
   EXPECT_GT(route, 500);
   // Table pixels over the block's area in pixels: the footprint over the pitch.
   const double block_m2 = pvb::scenes::row_length_m(a) * a.rows * a.row_pitch_m;
-  const double px_per_m = img.cols > 0 ? 3000.0 / std::max(s.plant->corners_m[1].x() - s.plant->corners_m[0].x() + 20,
-                                                             s.plant->corners_m[3].y() - s.plant->corners_m[0].y() + 20)
-                                        : 0;
+  // The plan spans the plant's extent and 10 m around it (azimuth 0: u is x, v is y).
+  const double px_per_m = 3000.0 / std::max(s.plant->corners_m[1].x() - s.plant->corners_m[0].x() + 20,
+                                            s.plant->corners_m[3].y() - s.plant->corners_m[0].y() + 20);
   const double table_m2 = tables / (px_per_m * px_per_m);
   const double tables_over_length = static_cast<double>(a.tables_per_row) * a.table_length_m() /
                                     pvb::scenes::row_length_m(a);

@@ -10,6 +10,8 @@ namespace pvb::scenes {
 
 /// Maps array-frame (u along rows, v across rows) to world x, y.
 Eigen::Vector2d array_to_world(const PvArray& a, double u, double v);
+/// The inverse: world x, y to the array frame (u, v).
+Eigen::Vector2d world_to_array(const PvArray& a, const Eigen::Vector2d& p_m);
 /// Length of one row along u: tables and the gaps between them.
 double row_length_m(const PvArray& a);
 /// Ground footprint depth of one row along v (the tilted table's projection;
