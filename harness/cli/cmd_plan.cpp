@@ -6,11 +6,13 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "command.hpp"
 #include "io_plan.hpp"
 #include "pvb/plot/contact_sheet.hpp"
 #include "pvb/report/plan_view.hpp"
+#include "pvb/scenes/route.hpp"
 #include "pvb/scenes/scenario.hpp"
 
 namespace pvb::cli {
@@ -28,7 +30,9 @@ int run_plan(const PlanArgs& a) {
   add_scenario_inputs(&plan, "--scenario", s);
   plan.output_file("--out", a.out).check();
   plot::write_rgb_png(run::make_plan_view(s, a.max_side_px), a.out);
-  std::printf("wrote %s\n", a.out.c_str());
+  const std::vector<Eigen::Vector2d> route = scenes::route_polyline(s, 0.25);
+  std::printf("wrote %s (route %.1f m: %.0f s at %.2f m/s)\n", a.out.c_str(), scenes::polyline_length(route),
+              scenes::polyline_length(route) / s.route.speed_mps, s.route.speed_mps);
   return 0;
 }
 

@@ -28,7 +28,111 @@ void add_skids(const Plant& p, const PvArray& block, double block_dc_mw, PlantLa
   }
 }
 
+/// The centre of aisle k of a block (0: in front of the first row, rows:
+/// behind the last), across the rows.
+Fixture box(const PvArray& frame, double u, double v, const Eigen::Vector3d& size_m, double base_m,
+            FixtureFinish finish) {
+  Fixture f;
+  f.centre_m = array_to_world(frame, u, v);
+  f.yaw_deg = frame.azimuth_deg;
+  f.size_m = size_m;
+  f.base_m = base_m;
+  f.finish = finish;
+  return f;
+}
+
+/// A combiner box on its post past the east end of every combiner_rows-th
+/// row of each block, its door to the headland.
+void add_combiner_boxes(const Plant& p, PlantLayout* out) {
+  if (p.combiner_rows <= 0) return;
+  for (const PvArray& block : out->blocks) {
+    const double u_post = row_length_m(block) + 0.35 + kCombinerPostM / 2;
+    const double u_box = u_post + kCombinerPostM / 2 + kCombinerBoxAlongM / 2;
+    for (int row = p.combiner_rows - 1; row < block.rows; row += p.combiner_rows) {
+      const double v = row * block.row_pitch_m + row_footprint_m(block) / 2;
+      out->fixtures.push_back(box(block, u_post, v, {kCombinerPostM, kCombinerPostM, kCombinerBoxBaseM + kCombinerBoxHighM},
+                                  0.0, FixtureFinish::kSteel));
+      out->fixtures.push_back(box(block, u_box, v, {kCombinerBoxAlongM, kCombinerBoxAcrossM, kCombinerBoxHighM},
+                                  kCombinerBoxBaseM, FixtureFinish::kEnclosure));
+    }
+  }
+}
+
+/// The dock in the first block's west headland, on its aisle's centre line:
+/// a cabinet half a metre from the headland's outer edge, a canopy over it
+/// on a post behind it.
+void add_dock(const Plant& p, const PvArray& base, double aisle_m, PlantLayout* out) {
+  if (!p.dock_aisle) return;
+  const double v = *p.dock_aisle * base.row_pitch_m - aisle_m / 2;
+  const double u_back = -p.headland_m + 0.5, u_cab = u_back + kDockCabinetAlongM / 2;
+  out->fixtures.push_back(box(base, u_cab, v, {kDockCabinetAlongM, kDockCabinetAcrossM, kDockCabinetHighM}, 0.0,
+                              FixtureFinish::kEnclosure));
+  out->fixtures.push_back(box(base, u_back - kCombinerPostM / 2, v, {kCombinerPostM, kCombinerPostM, kDockCanopyBaseM},
+                              0.0, FixtureFinish::kSteel));
+  out->fixtures.push_back(box(base, u_back + kDockCanopyAlongM / 2 - kCombinerPostM, v,
+                              {kDockCanopyAlongM, kDockCanopyAcrossM, 0.06}, kDockCanopyBaseM, FixtureFinish::kSteel));
+  out->dock_front_u_m = u_back + kDockCabinetAlongM + kDockStandoffM;
+  out->dock_v_m = v;
+}
+
+/// The service roads: between blocks along the rows, behind each line of
+/// blocks, and (with a fence) around the plant, 1 m inside the fence.
+void add_roads(const Plant& p, double stride_u, double stride_v, double rows_depth_m, int columns, int lines,
+               PlantLayout* out) {
+  const Eigen::Vector4d e = out->extent_uv;
+  const double w = p.road_width_m;
+  for (int c = 1; c < columns; ++c)
+    out->roads_uv.emplace_back(c * stride_u - p.headland_m - w, e[1], c * stride_u - p.headland_m, e[3]);
+  for (int l = 0; l < lines; ++l) out->roads_uv.emplace_back(e[0], l * stride_v + rows_depth_m, e[2], l * stride_v + rows_depth_m + w);
+  if (!out->fence) return;
+  const double a = 1.0, b = 1.0 + w;
+  out->roads_uv.emplace_back(e[0] - b, e[1] - b, e[2] + b, e[1] - a);  // south
+  out->roads_uv.emplace_back(e[0] - b, e[3] + a, e[2] + b, e[3] + b);  // north
+  out->roads_uv.emplace_back(e[0] - b, e[1] - a, e[0] - a, e[3] + a);  // west
+  out->roads_uv.emplace_back(e[2] + a, e[1] - a, e[2] + b, e[3] + a);  // east
+  out->perimeter_road_m = 1.0 + w / 2;
+}
+
+/// The fence around the extent at its setback, counter-clockwise, with a
+/// gate wherever a road meets it and on the dock's aisle at both ends.
+void add_fence(const Plant& p, const PvArray& base, double aisle_m, double stride_u, double stride_v, int columns,
+               int lines, double rows_depth_m, PlantLayout* out) {
+  if (!p.fence.on) return;
+  const double sb = fence_setback_m(p);
+  const Eigen::Vector4d e = out->extent_uv;
+  const double u0 = e[0] - sb, v0 = e[1] - sb, u1 = e[2] + sb, v1 = e[3] + sb;
+  Fence f;
+  f.height_m = p.fence.height_m;
+  f.post_spacing_m = p.fence.post_spacing_m;
+  f.gate_width_m = p.fence.gate_width_m;
+  for (const auto& [u, v] : {std::pair{u0, v0}, {u1, v0}, {u1, v1}, {u0, v1}})
+    f.corners_m.push_back(array_to_world(base, u, v));
+  const double v_main = p.dock_aisle.value_or(0) * base.row_pitch_m - aisle_m / 2;
+  for (const double u : {u0, u1}) f.gates_m.push_back(array_to_world(base, u, v_main));
+  for (int c = 1; c < columns; ++c)
+    for (const double v : {v0, v1})
+      f.gates_m.push_back(array_to_world(base, c * stride_u - p.headland_m - p.road_width_m / 2, v));
+  for (int l = 0; l < lines; ++l)
+    for (const double u : {u0, u1})
+      f.gates_m.push_back(array_to_world(base, u, l * stride_v + rows_depth_m + p.road_width_m / 2));
+  out->fence = f;
+}
+
 }  // namespace
+
+double fence_setback_m(const Plant& p) {
+  return p.fence.setback_m > 0 ? p.fence.setback_m : p.road_width_m + 2.0;
+}
+
+std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> fence_sections(const Fence& f) {
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> out;
+  for (std::size_t i = 0; i < f.corners_m.size(); ++i) {
+    const Eigen::Vector2d a = f.corners_m[i], b = f.corners_m[(i + 1) % f.corners_m.size()];
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / kFenceSectionM - 1e-9)));
+    for (int k = 0; k < n; ++k) out.emplace_back(a + (b - a) * (double(k) / n), a + (b - a) * (double(k + 1) / n));
+  }
+  return out;
+}
 
 PvArray plant_block_array(const Plant& p) {
   PvArray a;
@@ -90,6 +194,11 @@ PlantLayout lay_out_plant(const Plant& p) {
   const Eigen::Vector4d& e = out.extent_uv;
   for (const auto& [u, v] : {std::pair{e[0], e[1]}, {e[2], e[1]}, {e[2], e[3]}, {e[0], e[3]}})
     out.corners_m.push_back(array_to_world(base, u, v));
+  const double rows_depth_m = base.rows * base.row_pitch_m;
+  add_fence(p, base, aisle_m, stride_u, stride_v, columns, lines, rows_depth_m, &out);
+  add_roads(p, stride_u, stride_v, rows_depth_m, columns, lines, &out);
+  add_dock(p, base, aisle_m, &out);
+  add_combiner_boxes(p, &out);
   return out;
 }
 

@@ -1,6 +1,8 @@
 #include "pvb/scenes/route.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "pvb/geometry/angles.hpp"
 
@@ -70,7 +72,61 @@ void append_return(std::vector<Eigen::Vector2d>* uv, double u0, double u1, doubl
     append_segment(uv, {u1, v0 - 2 * r}, {u0, v0 - 2 * r}, spacing);
     append_arc(uv, {u0, v0 - r}, r, -M_PI / 2, -1.5 * M_PI, spacing);
   }
-  append_segment(uv, {u0, v0}, {u0 + overlap_m, v0}, spacing);
+  append_segment_if_long(uv, {u0, v0}, {u0 + overlap_m, v0}, spacing);
+}
+
+/// Radius of the corners of a loop along a plant's perimeter road.
+constexpr double kRoadCornerRadiusM = 3.0;
+
+/// Around a plant along its perimeter road, `laps` times, counter-clockwise
+/// from the west side level with the dock (or the west side's middle),
+/// heading south; in the first block's frame.
+void append_road_loop(std::vector<Eigen::Vector2d>* uv, const PlantSummary& plant, int laps, double spacing) {
+  const Eigen::Vector4d& e = plant.extent_uv;
+  const double d = plant.perimeter_road_m, r = kRoadCornerRadiusM;
+  const double u0 = e[0] - d, v0 = e[1] - d, u1 = e[2] + d, v1 = e[3] + d;
+  const double vs = plant.dock_aisle ? std::clamp(plant.dock_v_m, v0 + r, v1 - r) : 0.5 * (v0 + v1);
+  for (int lap = 0; lap < laps; ++lap) {
+    append_segment(uv, {u0, vs}, {u0, v0 + r}, spacing);
+    append_arc(uv, {u0 + r, v0 + r}, r, M_PI, 1.5 * M_PI, spacing);
+    append_segment(uv, {u0 + r, v0}, {u1 - r, v0}, spacing);
+    append_arc(uv, {u1 - r, v0 + r}, r, -M_PI / 2, 0, spacing);
+    append_segment(uv, {u1, v0 + r}, {u1, v1 - r}, spacing);
+    append_arc(uv, {u1 - r, v1 - r}, r, 0, M_PI / 2, spacing);
+    append_segment(uv, {u1 - r, v1}, {u0 + r, v1}, spacing);
+    append_arc(uv, {u0 + r, v1 - r}, r, M_PI / 2, M_PI, spacing);
+    append_segment(uv, {u0, v1 - r}, {u0, vs}, spacing);
+  }
+}
+
+/// A lawnmower through `aisles` aisles from `first`, U-turns beyond the row
+/// ends; from a plant's dock and back to it when `dock_u` is set.
+void append_lawnmower(std::vector<Eigen::Vector2d>* uv, const PvArray& a, const Route& rt, double u0, double u1,
+                      std::optional<double> dock_u, double spacing) {
+  const int first = rt.first_aisle, last = rt.first_aisle + rt.aisles - 1;
+  if (dock_u) append_segment(uv, {*dock_u, aisle_v(a, first, rt.offset_m)}, {u0, aisle_v(a, first, rt.offset_m)}, spacing);
+  for (int k = first; k <= last; ++k) {
+    const double v = aisle_v(a, k, rt.offset_m);
+    const bool forward = (k - first) % 2 == 0;
+    const Eigen::Vector2d start(forward ? u0 : u1, v), end(forward ? u1 : u0, v);
+    append_segment(uv, start, end, spacing);
+    if (k < last) {
+      const double v_next = aisle_v(a, k + 1, rt.offset_m);
+      const double radius = 0.5 * (v_next - v);
+      const Eigen::Vector2d centre(end.x(), v + radius);
+      // forward pass ends at u1 and turns through +u; backward through -u
+      if (forward)
+        append_arc(uv, centre, radius, -M_PI / 2, M_PI / 2, spacing);
+      else
+        append_arc(uv, centre, radius, -M_PI / 2, -3 * M_PI / 2, spacing);
+    }
+  }
+  const bool odd = rt.aisles % 2 == 1;
+  if (dock_u)
+    append_return(uv, *dock_u, u1, aisle_v(a, first, rt.offset_m), aisle_v(a, last, rt.offset_m), odd, 0.0, spacing);
+  else if (rt.return_to_start)
+    append_return(uv, u0, u1, aisle_v(a, first, rt.offset_m), aisle_v(a, last, rt.offset_m), odd,
+                  rt.return_overlap_m, spacing);
 }
 
 }  // namespace
@@ -128,7 +184,9 @@ std::vector<Eigen::Vector2d> route_polyline(const Scenario& s, double spacing_m)
       append_segment(&out, rt.waypoints_m[i - 1], rt.waypoints_m[i], spacing_m);
     return out;
   }
-  const PvArray& a = s.pv_arrays.at(static_cast<std::size_t>(rt.array));
+  const std::size_t frame = rt.pattern == RoutePattern::kRoads && s.plant ? static_cast<std::size_t>(s.plant->first_array)
+                                                                          : static_cast<std::size_t>(rt.array);
+  const PvArray& a = s.pv_arrays.at(frame);
   const double u0 = -rt.margin_m;
   const double u1 = row_length_m(a) + rt.margin_m;
   switch (rt.pattern) {
@@ -138,27 +196,14 @@ std::vector<Eigen::Vector2d> route_polyline(const Scenario& s, double spacing_m)
       break;
     }
     case RoutePattern::kLawnmower: {
-      for (int k = 0; k < rt.aisles; ++k) {
-        const double v = aisle_v(a, k, rt.offset_m);
-        const bool forward = k % 2 == 0;
-        const Eigen::Vector2d start(forward ? u0 : u1, v), end(forward ? u1 : u0, v);
-        append_segment(&uv, start, end, spacing_m);
-        if (k + 1 < rt.aisles) {
-          const double v_next = aisle_v(a, k + 1, rt.offset_m);
-          const double radius = 0.5 * (v_next - v);
-          const Eigen::Vector2d centre(end.x(), v + radius);
-          // forward pass ends at u1 and turns through +u; backward through -u
-          if (forward)
-            append_arc(&uv, centre, radius, -M_PI / 2, M_PI / 2, spacing_m);
-          else
-            append_arc(&uv, centre, radius, -M_PI / 2, -3 * M_PI / 2, spacing_m);
-        }
-      }
-      if (rt.return_to_start)
-        append_return(&uv, u0, u1, aisle_v(a, 0, rt.offset_m), aisle_v(a, rt.aisles - 1, rt.offset_m),
-                      rt.aisles % 2 == 1, rt.return_overlap_m, spacing_m);
+      std::optional<double> dock_u;
+      if (rt.from_dock && s.plant) dock_u = s.plant->dock_front_u_m;
+      append_lawnmower(&uv, a, rt, u0, u1, dock_u, spacing_m);
       break;
     }
+    case RoutePattern::kRoads:
+      if (s.plant) append_road_loop(&uv, *s.plant, rt.laps, spacing_m);
+      break;
     case RoutePattern::kLoop: {
       const double v0 = -rt.offset_m;
       const double v1 = (a.rows - 1) * a.row_pitch_m + row_footprint_m(a) + rt.offset_m;

@@ -127,6 +127,8 @@ const char* to_string(RoutePattern p) {
       return "lawnmower";
     case RoutePattern::kLoop:
       return "loop";
+    case RoutePattern::kRoads:
+      return "roads";
   }
   return "?";
 }

@@ -1,7 +1,9 @@
 // The plant: section (scenes/SCHEMA.md, "plant"): read, checked, laid out
 // into blocks (the scenario's last arrays) and inverter stations (its last
 // walls); and the checks of a plant's route.
+#include <array>
 #include <cmath>
+#include <functional>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
@@ -83,6 +85,37 @@ void read_blocks(MapReader& r, Plant& p) {
   p.headland_m = r.number("headland_m", p.headland_m, 2, 100);
 }
 
+/// A switch that is either `false` (off) or a map of its settings
+/// (`fn` reads it; `{}` or `true` keep the defaults).  Returns whether it is on.
+bool read_switch(MapReader& r, const std::string& key, const std::function<void(MapReader&)>& fn) {
+  if (!r.has(key)) return true;
+  const YAML::Node n = r.node()[key];
+  if (n.IsScalar()) return r.boolean(key, true);
+  if (!n.IsMap()) r.fail(r.full(key), n, "false, true or a map of its settings");
+  with_map(r, key, fn);
+  return true;
+}
+
+/// The fence, the dock and the combiner boxes.
+void read_fixtures(MapReader& r, Plant& p) {
+  p.fence.on = read_switch(r, "fence", [&](MapReader& q) {
+    p.fence.setback_m = q.number("setback_m", p.road_width_m + 2.0, p.road_width_m + 1.0, 100);
+    p.fence.height_m = q.number("height_m", p.fence.height_m, 0.5, 5);
+    p.fence.post_spacing_m = q.number("post_spacing_m", p.fence.post_spacing_m, 1, 10);
+    p.fence.gate_width_m = q.number("gate_width_m", p.fence.gate_width_m, 1, 20);
+  });
+  int aisle = 0;
+  const bool dock = read_switch(r, "dock", [&](MapReader& q) { aisle = q.integer("aisle", 0, 0, p.rows_per_block); });
+  p.dock_aisle = dock ? std::optional<int>(aisle) : std::nullopt;
+  const double dock_needs_m = 0.5 + kDockCabinetAlongM + kDockStandoffM + 0.5;
+  if (dock && p.headland_m < dock_needs_m)
+    r.fail(r.full("dock"), r.node()["dock"],
+           "a headland_m of at least " + format_number("%.1f m", dock_needs_m) +
+               " to hold the dock and the robot in front of it (or dock: false)",
+           "a headland of " + format_exact(p.headland_m) + " m");
+  p.combiner_rows = r.integer("combiner_rows", p.combiner_rows, 0, 400);
+}
+
 Plant read_plant_section(MapReader& r) {
   Plant p;
   p.origin_m = r.vec2("origin_m", p.origin_m, -1e4, 1e4);
@@ -90,6 +123,7 @@ Plant read_plant_section(MapReader& r) {
   read_module_and_mount(r, p);
   read_pitch(r, p);
   read_blocks(r, p);
+  read_fixtures(r, p);
   p.dirt = r.number("dirt", p.dirt, 0, 1);
   p.specular_glass = r.choice<bool>("glass", p.specular_glass, {{"diffuse", false}, {"specular", true}});
   p.identical_tables = r.boolean("identical_tables", p.identical_tables);
@@ -100,17 +134,66 @@ Plant read_plant_section(MapReader& r) {
 /// naming its farthest corner and the ground that would hold it.
 void check_on_ground(const Scenario& s, const PlantLayout& layout, const MapReader& top) {
   Eigen::Vector2d need = Eigen::Vector2d::Zero(), far = Eigen::Vector2d::Zero();
-  for (const Eigen::Vector2d& c : layout.corners_m) {
+  for (const Eigen::Vector2d& c : layout.fence ? layout.fence->corners_m : layout.corners_m) {
     need = need.cwiseMax(2 * c.cwiseAbs());
     if (c.cwiseAbs().maxCoeff() > far.cwiseAbs().maxCoeff()) far = c;
   }
   if (need.x() <= s.ground.size_m.x() && need.y() <= s.ground.size_m.y()) return;
   top.fail("plant", top.node()["plant"],
            "a plant inside ground.size_m [" + format_exact(s.ground.size_m.x()) + ", " +
-               format_exact(s.ground.size_m.y()) + "] (centred on the origin, headlands included)",
+               format_exact(s.ground.size_m.y()) + "] (centred on the origin, headlands and fence included)",
            "a plant reaching (x, y) = (" + format_number("%.1f", far.x()) + ", " + format_number("%.1f", far.y()) +
                ") m: a ground of at least [" + format_number("%.0f", std::ceil(need.x())) + ", " +
                format_number("%.0f", std::ceil(need.y())) + "]");
+}
+
+/// Whether a quadrilateral (convex, in order) overlaps an axis-aligned
+/// rectangle [u0, v0, u1, v1]: separating axes of both.
+bool overlaps(const std::array<Eigen::Vector2d, 4>& quad, const Eigen::Vector4d& rect) {
+  const std::array<Eigen::Vector2d, 4> box = {Eigen::Vector2d(rect[0], rect[1]), Eigen::Vector2d(rect[2], rect[1]),
+                                              Eigen::Vector2d(rect[2], rect[3]), Eigen::Vector2d(rect[0], rect[3])};
+  const Eigen::Vector2d axes[4] = {Eigen::Vector2d::UnitX(), Eigen::Vector2d::UnitY(),
+                                   (quad[1] - quad[0]).normalized(), (quad[3] - quad[0]).normalized()};
+  for (const Eigen::Vector2d& ax : axes) {
+    double a0 = kInf, a1 = -kInf, b0 = kInf, b1 = -kInf;
+    for (const Eigen::Vector2d& p : quad) a0 = std::min(a0, p.dot(ax)), a1 = std::max(a1, p.dot(ax));
+    for (const Eigen::Vector2d& p : box) b0 = std::min(b0, p.dot(ax)), b1 = std::max(b1, p.dot(ax));
+    if (a1 <= b0 || b1 <= a0) return false;
+  }
+  return true;
+}
+
+/// Refuses a row of a hand-written array that crosses one of the plant's
+/// roads or its fence, naming the array, the row and what it crosses.
+void check_rows_clear(const Scenario& s, const PlantLayout& layout, const PvArray& base, MapReader& top) {
+  std::vector<std::pair<Eigen::Vector4d, std::string>> keep_out;
+  if (layout.fence) {  // the fence as four strips 10 cm wide
+    const Eigen::Vector2d a = world_to_array(base, layout.fence->corners_m[0]);
+    const Eigen::Vector2d b = world_to_array(base, layout.fence->corners_m[2]);
+    const double w = 0.05;
+    for (const Eigen::Vector4d& r : {Eigen::Vector4d(a.x(), a.y() - w, b.x(), a.y() + w),
+                                     Eigen::Vector4d(a.x(), b.y() - w, b.x(), b.y() + w),
+                                     Eigen::Vector4d(a.x() - w, a.y(), a.x() + w, b.y()),
+                                     Eigen::Vector4d(b.x() - w, a.y(), b.x() + w, b.y())})
+      keep_out.emplace_back(r, "the fence");
+  }
+  for (const Eigen::Vector4d& r : layout.roads_uv) keep_out.emplace_back(r, "a service road");
+  for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) {
+    const PvArray& a = s.pv_arrays[i];
+    const double len = row_length_m(a), depth = row_footprint_m(a);
+    for (int row = 0; row < a.rows; ++row) {
+      const double v = row * a.row_pitch_m;
+      std::array<Eigen::Vector2d, 4> quad;
+      int k = 0;
+      for (const auto& [du, dv] : {std::pair{0.0, 0.0}, {len, 0.0}, {len, depth}, {0.0, depth}})
+        quad[static_cast<std::size_t>(k++)] = world_to_array(base, array_to_world(a, du, v + dv));
+      for (const auto& [rect, what] : keep_out)
+        if (overlaps(quad, rect))
+          top.fail("pv_arrays[" + std::to_string(i) + "]", top.node()["pv_arrays"][i],
+                   "rows clear of the plant's service roads and its fence",
+                   "row " + std::to_string(row) + " crossing " + what);
+    }
+  }
 }
 
 }  // namespace
@@ -122,6 +205,7 @@ void read_plant(MapReader& top, Scenario& s) {
   const Plant& p = *plant;
   const PlantLayout layout = lay_out_plant(p);
   check_on_ground(s, layout, top);
+  check_rows_clear(s, layout, plant_block_array(p), top);
   PlantSummary sum;
   sum.first_array = static_cast<int>(s.pv_arrays.size());
   sum.blocks = p.blocks;
@@ -132,6 +216,15 @@ void read_plant(MapReader& top, Scenario& s) {
   sum.row_pitch_m = p.row_pitch_m;
   sum.inverter_stations = static_cast<int>(layout.inverter_stations.size());
   sum.corners_m = layout.corners_m;
+  sum.extent_uv = layout.extent_uv;
+  sum.road_width_m = p.road_width_m;
+  sum.perimeter_road_m = layout.perimeter_road_m;
+  sum.fence = layout.fence;
+  sum.fixtures = layout.fixtures;
+  sum.dock_aisle = p.dock_aisle;
+  sum.dock_front_u_m = layout.dock_front_u_m;
+  sum.dock_v_m = layout.dock_v_m;
+  sum.roads_uv = layout.roads_uv;
   s.pv_arrays.insert(s.pv_arrays.end(), layout.blocks.begin(), layout.blocks.end());
   s.walls.insert(s.walls.end(), layout.inverter_stations.begin(), layout.inverter_stations.end());
   s.plant = sum;
@@ -151,9 +244,59 @@ bool in_a_table(const PvArray& block, const Eigen::Vector2d& p, double clear_m) 
   return table >= 0 && table < block.tables_per_row && u - table * stride <= tl + clear_m;
 }
 
+/// A fixture this high above the ground (the dock's canopy) is above the robot.
+constexpr double kOverheadM = 1.5;
+
+/// A route point within `clear_m` of a fixture's or an inverter station's footprint.
+bool in_a_fixture(const Scenario& s, const PlantSummary& plant, const Eigen::Vector2d& p, double clear_m) {
+  const auto in_box = [&](const Eigen::Vector2d& c, double yaw_deg, double along, double across) {
+    const double a = yaw_deg * M_PI / 180.0;
+    const Eigen::Vector2d q = p - c;
+    const double u = q.x() * std::cos(a) + q.y() * std::sin(a), v = -q.x() * std::sin(a) + q.y() * std::cos(a);
+    return std::abs(u) <= along / 2 + clear_m && std::abs(v) <= across / 2 + clear_m;
+  };
+  for (const Fixture& f : plant.fixtures)  // the dock's canopy stands over the robot
+    if (f.base_m < kOverheadM && in_box(f.centre_m, f.yaw_deg, f.size_m.x(), f.size_m.y())) return true;
+  for (std::size_t i = s.walls.size() - static_cast<std::size_t>(plant.inverter_stations); i < s.walls.size(); ++i) {
+    const Wall& w = s.walls[i];
+    const Eigen::Vector2d d = w.end_m - w.start_m;
+    if (in_box(0.5 * (w.start_m + w.end_m), std::atan2(d.y(), d.x()) * 180.0 / M_PI, d.norm(), w.thickness_m))
+      return true;
+  }
+  return false;
+}
+
+/// The checks of a route that needs a plant: a loop along its roads, a
+/// route from its dock.
+void check_plant_pattern(const Scenario& s, const ReadContext& ctx) {
+  const Route& rt = s.route;
+  const auto at = [&](const char* key) { return ctx.origins->where(std::string("route.") + key, ctx.file); };
+  if (rt.pattern == RoutePattern::kRoads && (!s.plant || !s.plant->fence))
+    throw ConfigError(at("pattern"), "route.pattern",
+                      "roads only in a plant with a fence (the loop follows the perimeter road inside it)", "roads");
+  if (!rt.from_dock) return;
+  if (!s.plant || !s.plant->dock_aisle)
+    throw ConfigError(at("from_dock"), "route.from_dock", "false unless the plant has a dock (plant.dock)", "true");
+  const PlantSummary& plant = *s.plant;
+  if (rt.array != plant.first_array)
+    throw ConfigError(at("array"), "route.array",
+                      "the plant's first block, " + std::to_string(plant.first_array) + ", which holds the dock",
+                      std::to_string(rt.array));
+  if (rt.first_aisle != *plant.dock_aisle)
+    throw ConfigError(at("first_aisle"), "route.first_aisle",
+                      "the dock's aisle, " + std::to_string(*plant.dock_aisle) + " (plant.dock.aisle)",
+                      std::to_string(rt.first_aisle));
+  if (!(plant.dock_front_u_m < -rt.margin_m))
+    throw ConfigError(at("margin_m"), "route.margin_m",
+                      "a run-out that starts past the dock: below " +
+                          format_number("%.2f m", -plant.dock_front_u_m) + " (a wider plant.headland_m makes room)",
+                      format_exact(rt.margin_m));
+}
+
 }  // namespace
 
 void check_plant_route(const Scenario& s, const ReadContext& ctx) {
+  check_plant_pattern(s, ctx);
   if (!s.plant) return;
   const PlantSummary& plant = *s.plant;
   const std::string key = s.route.pattern == RoutePattern::kWaypoints ? "route.waypoints_m" : "route.pattern";
@@ -162,20 +305,28 @@ void check_plant_route(const Scenario& s, const ReadContext& ctx) {
                       "a route through (x, y) = (" + format_number("%.2f", p.x()) + ", " +
                           format_number("%.2f", p.y()) + ") m, " + format_number("%.1f m", along_m) + " along it");
   };
-  const Eigen::Vector2d c0 = plant.corners_m[0];
-  const Eigen::Vector2d eu = plant.corners_m[1] - c0, ev = plant.corners_m[3] - c0;
+  // Inside the fence by the robot's half width, or without one inside the extent.
+  const std::vector<Eigen::Vector2d>& bound = plant.fence ? plant.fence->corners_m : plant.corners_m;
+  const double inset_m = plant.fence ? kRouteTableClearanceM : 0.0;
+  const Eigen::Vector2d c0 = bound[0];
+  const Eigen::Vector2d eu = bound[1] - c0, ev = bound[3] - c0;
   const std::vector<Eigen::Vector2d> route = route_polyline(s);
   double along_m = 0;
   for (std::size_t i = 0; i < route.size(); ++i) {
     const Eigen::Vector2d& p = route[i];
     if (i > 0) along_m += (p - route[i - 1]).norm();
-    const double u = (p - c0).dot(eu) / eu.squaredNorm(), v = (p - c0).dot(ev) / ev.squaredNorm();
-    if (u < 0 || u > 1 || v < 0 || v > 1)
-      refuse("a route inside the plant (its blocks, their headlands and the aisles beside them)", p, along_m);
+    const double u = (p - c0).dot(eu) / eu.norm(), v = (p - c0).dot(ev) / ev.norm();
+    if (u < inset_m || u > eu.norm() - inset_m || v < inset_m || v > ev.norm() - inset_m)
+      refuse(plant.fence ? "a route inside the plant's fence, the robot's half width from it"
+                         : "a route inside the plant (its blocks, their headlands and the aisles beside them)",
+             p, along_m);
     for (int b = plant.first_array; b < plant.first_array + plant.blocks; ++b)
       if (in_a_table(s.pv_arrays[static_cast<std::size_t>(b)], p, kRouteTableClearanceM))
         refuse("a route that keeps " + format_number("%.2f m", kRouteTableClearanceM) +
                    " from every table (the robot's half width)", p, along_m);
+    if (in_a_fixture(s, plant, p, kRouteTableClearanceM))
+      refuse("a route that keeps " + format_number("%.2f m", kRouteTableClearanceM) +
+                 " from the dock, the combiner boxes and the inverter stations", p, along_m);
   }
 }
 

@@ -8,6 +8,7 @@
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/scenes/ground_relief.hpp"
+#include "pvb/scenes/plant.hpp"
 #include "pvb/scenes/route.hpp"
 
 namespace pvb::scenes::detail {
@@ -96,6 +97,10 @@ long long table_geoms(const PvArray& a) {
 /// the limit, the total and the largest array.
 void check_scene_size(const Scenario& s, const ReadContext& ctx) {
   long long total = 2LL * (s.vegetation.shrubs + s.vegetation.trees) + static_cast<long long>(s.walls.size());
+  if (s.plant) {  // a fixture is one geom, a fence section one
+    total += static_cast<long long>(s.plant->fixtures.size());
+    if (s.plant->fence) total += static_cast<long long>(fence_sections(*s.plant->fence).size());
+  }
   long long largest = -1;
   std::size_t largest_index = 0;
   for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) {
@@ -113,8 +118,8 @@ void check_scene_size(const Scenario& s, const ReadContext& ctx) {
     const PvArray& b = s.pv_arrays[static_cast<std::size_t>(s.plant->first_array)];
     throw ConfigError(ctx.origins->where("plant", ctx.file), "plant",
                       "at most " + std::to_string(kMaxSceneGeoms) +
-                          " geoms in the scene (a plant's table is its slab and up to 7 parts; a wall 1, a shrub "
-                          "or tree 2): fewer blocks or rows",
+                          " geoms in the scene (a plant's table is its slab and up to 7 parts; a wall, a fixture or "
+                          "40 m of fence 1, a shrub or tree 2): fewer blocks or rows",
                       got + " (" + std::to_string(s.plant->blocks) + " blocks x " + std::to_string(b.rows) +
                           " rows x " + std::to_string(b.tables_per_row) + " tables x " +
                           std::to_string(table_geoms(b)) + " geoms)");
@@ -200,7 +205,8 @@ void read_route(MapReader& r, Route& rt) {
                                       {{"waypoints", RoutePattern::kWaypoints},
                                        {"along_row", RoutePattern::kAlongRow},
                                        {"lawnmower", RoutePattern::kLawnmower},
-                                       {"loop", RoutePattern::kLoop}});
+                                       {"loop", RoutePattern::kLoop},
+                                       {"roads", RoutePattern::kRoads}});
   if (const YAML::Node wps = r.child("waypoints_m")) {
     if (!wps.IsSequence() || wps.size() < 2)
       r.fail(r.full("waypoints_m"), wps, "a list of at least 2 [x, y] points");
@@ -215,11 +221,20 @@ void read_route(MapReader& r, Route& rt) {
   rt.array = r.integer("array", rt.array, 0, 1000);
   rt.aisle = r.integer("aisle", rt.aisle, 0, 1000);
   rt.aisles = r.integer("aisles", rt.aisles, 1, 100);
-  if (r.has("laps") && rt.pattern != RoutePattern::kLoop)
-    r.fail(r.full("laps"), r.child("laps"), "no laps unless route.pattern is loop (it would be ignored)",
+  if (r.has("laps") && rt.pattern != RoutePattern::kLoop && rt.pattern != RoutePattern::kRoads)
+    r.fail(r.full("laps"), r.child("laps"), "no laps unless route.pattern is loop or roads (it would be ignored)",
            r.child("laps").Scalar());
   rt.laps = r.integer("laps", rt.laps, 1, 100);
+  for (const char* key : {"first_aisle", "from_dock"})
+    if (r.has(key) && rt.pattern != RoutePattern::kLawnmower)
+      r.fail(r.full(key), r.child(key), "no " + std::string(key) + " unless route.pattern is lawnmower (it would be ignored)",
+             r.child(key).Scalar());
+  rt.first_aisle = r.integer("first_aisle", rt.first_aisle, 0, 1000);
+  rt.from_dock = r.boolean("from_dock", rt.from_dock);
   rt.return_to_start = r.boolean("return_to_start", rt.return_to_start);
+  if (rt.from_dock && rt.return_to_start)
+    r.fail(r.full("return_to_start"), r.child("return_to_start"),
+           "false with route.from_dock (a route from the dock comes back to it)", "true");
   if (rt.return_to_start && rt.pattern != RoutePattern::kLawnmower)
     r.fail(r.full("return_to_start"), r.child("return_to_start"), "false unless route.pattern is lawnmower",
            "true");
@@ -489,8 +504,9 @@ void check_route(const Scenario& s, const ReadContext& ctx) {
     if (rt.pattern == RoutePattern::kAlongRow && rt.aisle > a.rows)
       throw ConfigError(at("aisle"), "route.aisle", "an aisle in [0, " + std::to_string(a.rows) + "]",
                         std::to_string(rt.aisle));
-    if (rt.pattern == RoutePattern::kLawnmower && rt.aisles > a.rows + 1)
-      throw ConfigError(at("aisles"), "route.aisles", "at most rows + 1 = " + std::to_string(a.rows + 1),
+    if (rt.pattern == RoutePattern::kLawnmower && rt.first_aisle + rt.aisles > a.rows + 1)
+      throw ConfigError(at("aisles"), "route.aisles",
+                        "at most rows + 1 - first_aisle = " + std::to_string(a.rows + 1 - rt.first_aisle),
                         std::to_string(rt.aisles));
     const double first_aisle_m = row_length_m(a) + 2 * rt.margin_m;
     if (rt.pattern == RoutePattern::kLawnmower && rt.return_to_start && rt.return_overlap_m > first_aisle_m)

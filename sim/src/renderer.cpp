@@ -131,7 +131,7 @@ std::optional<Eigen::Vector3d> shadow_beam(const mjvScene& scn) {
 
 }  // namespace
 
-int cull_to_view(mjvScene* scn, double aspect, double far_tile_m) {
+int cull_to_view(mjvScene* scn, double aspect, double far_tile_m, const double* geom_rbound) {
   const mjvGLCamera& cam = scn->camera[0];
   const Eigen::Vector3d pos(cam.pos[0], cam.pos[1], cam.pos[2]), fwd(cam.forward[0], cam.forward[1], cam.forward[2]);
   const Eigen::Vector3d up(cam.up[0], cam.up[1], cam.up[2]);
@@ -148,6 +148,8 @@ int cull_to_view(mjvScene* scn, double aspect, double far_tile_m) {
   for (int i = 0; i < scn->ngeom; ++i) {
     const mjvGeom g = scn->geoms[i];
     double r = g.category == mjCAT_STATIC && g.objtype == mjOBJ_GEOM ? bounding_radius(g) : -1;
+    if (g.type == mjGEOM_MESH && geom_rbound && g.category == mjCAT_STATIC && g.objtype == mjOBJ_GEOM)
+      r = geom_rbound[g.objid];
     Eigen::Vector3d c(g.pos[0], g.pos[1], g.pos[2]);
     if (r >= 0 && beam && beam->z() < -1e-3) {
       // Its shadow: swept along the beam down to 2 m below its foot.
@@ -183,7 +185,7 @@ void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat
   camera_.type = mjCAMERA_FIXED;
   camera_.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
-  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_) : 0;
+  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_, model->geom_rbound) : 0;
   if (stable_shadows_) {
     const double texel_m = shadow_texel_m(con_.shadowClip, con_.shadowSize);
     for (int i = 0; i < scene_.nlight; ++i) {
@@ -220,7 +222,7 @@ void Renderer::render_geom_ids(const mjModel* model, mjData* data, int camera_id
   camera_.type = mjCAMERA_FIXED;
   camera_.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
-  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_) : 0;
+  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_, model->geom_rbound) : 0;
   const unsigned char shadow = scene_.flags[mjRND_SHADOW];
   scene_.flags[mjRND_SEGMENT] = 1;
   scene_.flags[mjRND_IDCOLOR] = 1;

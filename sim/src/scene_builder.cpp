@@ -308,6 +308,7 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
   x.line("<material name=\"steel\" rgba=\"0.58 0.60 0.62 1\" specular=\"0.4\" shininess=\"0.4\"/>");
   x.line("<material name=\"robot\" rgba=\"0.95 0.55 0.10 1\" specular=\"0.3\"/>");
   x.line("<material name=\"tyre\" rgba=\"0.08 0.08 0.08 1\"/>");
+  add_plant_assets(x, s, ground);
   x.close("</asset>");
 }
 
@@ -426,6 +427,7 @@ SceneAssets build_scene(const scenes::Scenario& s, SceneDetail detail, TextureEn
   for (std::size_t i = 0; i < s.pv_arrays.size(); ++i)
     add_array(x, s.pv_arrays[i], static_cast<int>(i), s.seed, ground);
   add_walls(x, s, ground);
+  add_plant_fixtures(x, s, ground);
   add_vegetation(x, s, route, ground);
   add_robot_and_sun(x, s, driven, shadow, ground);
   x.close("</worldbody>");

@@ -64,6 +64,12 @@ void add_walls(XmlWriter& x, const scenes::Scenario& s, const scenes::GroundReli
 void add_vegetation(XmlWriter& x, const scenes::Scenario& s, const std::vector<Eigen::Vector2d>& route,
                     const scenes::GroundRelief& ground);
 
+// scene_plant.cpp
+/// A plant's materials and its fence's meshes (nothing without a plant).
+void add_plant_assets(XmlWriter& x, const scenes::Scenario& s, const scenes::GroundRelief& ground);
+/// A plant's fence sections, dock and combiner boxes.
+void add_plant_fixtures(XmlWriter& x, const scenes::Scenario& s, const scenes::GroundRelief& ground);
+
 // scene_robot.cpp
 /// The robot (differential drive, two driven wheels and a caster) at the
 /// start of the driven route, its camera, and the sun.

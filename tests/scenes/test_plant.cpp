@@ -108,9 +108,15 @@ TEST(PlantErrors, ARouteThroughATableIsRefused) {
 }
 
 TEST(PlantErrors, ARouteThatLeavesThePlantIsRefused) {
+  // Through the fence, or without one beyond the headlands.
   const std::string e = error_of(
-      "ground: {size_m: [400, 400]}\nplant: {rows: 4}\nroute:\n  waypoints_m: [[-2, -3], [-30, -3]]\n");
-  EXPECT_NE(e.find("route.waypoints_m: expected a route inside the plant"), std::string::npos) << e;
+      "ground: {size_m: [400, 400]}\nplant: {rows: 4}\nroute:\n  waypoints_m: [[-2, -1.5], [-30, -1.5]]\n");
+  EXPECT_NE(e.find("bad.yaml:4: route.waypoints_m: expected a route inside the plant's fence"), std::string::npos) << e;
+  EXPECT_NE(e.find("got a route through (x, y) = (-13.7"), std::string::npos) << e;
+  const std::string open = error_of(
+      "ground: {size_m: [400, 400]}\nplant: {rows: 4, fence: false}\nroute:\n  waypoints_m: [[-2, -1.5], [-30, -1.5]]\n");
+  EXPECT_NE(open.find("route.waypoints_m: expected a route inside the plant (its blocks"), std::string::npos) << open;
+  EXPECT_NE(open.find("(x, y) = (-8.05, -1.50) m"), std::string::npos) << open;
 }
 
 TEST(PlantErrors, RowsAndATargetPowerTogetherAreRefused) {

@@ -291,7 +291,7 @@ TEST(Scenario, LoopLapsAreReadAndRefusedOnOtherPatterns) {
   EXPECT_EQ(parse_scenario(arrays + "route: {pattern: loop, laps: 5}\n", "l.yaml").route.laps, 5);
   std::string e = error_of(arrays + "route:\n  pattern: lawnmower\n  laps: 2\n");
   EXPECT_NE(e.find("bad.yaml:5"), std::string::npos) << e;
-  EXPECT_NE(e.find("route.laps: expected no laps unless route.pattern is loop (it would be ignored), got 2"),
+  EXPECT_NE(e.find("route.laps: expected no laps unless route.pattern is loop or roads (it would be ignored), got 2"),
             std::string::npos)
       << e;
   e = error_of(arrays + "route: {pattern: loop, laps: 0}\n");

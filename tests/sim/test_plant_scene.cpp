@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/renderer.hpp"
@@ -11,8 +12,8 @@
 namespace pvb::test {
 namespace plant_scene_test {
 
-/// Two blocks of trackers, in the sun, with shadows; the route turns in
-/// the headland from the first aisle into the second.
+/// Two blocks of trackers, in the sun, with shadows, fenced; the route
+/// turns in the headland from the first aisle into the second.
 scenes::Scenario small_plant() {
   return scenes::parse_scenario(R"(
 name: small_plant
@@ -43,7 +44,14 @@ TEST(PlantScene, CulledFramesMatchFramesDrawnWhole) {
   sim::Simulator sim(small_plant());
   sim::Renderer culled(sim.model(), sim::GlBackend::kAuto, 320, 240), whole(sim.model(), sim::GlBackend::kAuto, 320, 240);
   whole.set_culling(false);
-  int most_culled = 0;
+  // The fence's sections are meshes, culled by their bounding spheres.
+  std::vector<int> fence;
+  for (int g = 0; g < sim.model()->ngeom; ++g) {
+    const char* name = mj_id2name(sim.model(), mjOBJ_GEOM, g);
+    if (name && std::string(name).rfind("fence", 0) == 0) fence.push_back(g);
+  }
+  ASSERT_FALSE(fence.empty());
+  int most_culled = 0, fence_pixels = 0;
   for (int i = 0; i < 240; ++i) {
     if (i % 12 == 0) {
       cv::Mat rgb_c, depth_c, ids_c, rgb_w, depth_w, ids_w;
@@ -57,10 +65,12 @@ TEST(PlantScene, CulledFramesMatchFramesDrawnWhole) {
       EXPECT_EQ(cv::norm(depth_c, depth_w, cv::NORM_INF), 0.0) << "frame " << i;
       EXPECT_EQ(cv::norm(ids_c, ids_w, cv::NORM_INF), 0.0) << "frame " << i;
       EXPECT_EQ(whole.culled_geoms(), 0);
+      for (const int g : fence) fence_pixels += cv::countNonZero(ids_c == g);
     }
     sim.advance();
   }
   EXPECT_GT(most_culled, sim.model()->ngeom / 2);
+  EXPECT_GT(fence_pixels, 100);  // the fence was in view, and matched
 }
 
 }  // namespace plant_scene_test

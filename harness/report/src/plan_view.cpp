@@ -31,8 +31,9 @@ PlanFrame frame_for(const scenes::Scenario& s, int max_side_px) {
   f.min_m = -0.5 * s.ground.size_m;
   f.max_m = 0.5 * s.ground.size_m;
   if (s.plant) {
-    Eigen::Vector2d lo = s.plant->corners_m[0], hi = lo;
-    for (const Eigen::Vector2d& c : s.plant->corners_m) {
+    const std::vector<Eigen::Vector2d>& corners = s.plant->fence ? s.plant->fence->corners_m : s.plant->corners_m;
+    Eigen::Vector2d lo = corners[0], hi = lo;
+    for (const Eigen::Vector2d& c : corners) {
       lo = lo.cwiseMin(c);
       hi = hi.cwiseMax(c);
     }
@@ -72,6 +73,41 @@ void draw_walls(cv::Mat& img, const PlanFrame& f, const scenes::Scenario& s) {
     const Eigen::Vector2d side = Eigen::Vector2d(-along.y(), along.x()) * std::max(w.thickness_m / 2, 0.5 / f.px_per_m);
     const cv::Vec3b rgb = w.finish == scenes::WallFinish::kPlaster ? cv::Vec3b(200, 195, 185) : cv::Vec3b(150, 70, 50);
     fill_quad(img, f, {w.start_m - side, w.end_m - side, w.end_m + side, w.start_m + side}, rgb);
+  }
+}
+
+/// The plant's roads (gravel), fence (a line, gates left open), dock and combiner boxes.
+void draw_plant(cv::Mat& img, const PlanFrame& f, const scenes::Scenario& s) {
+  if (!s.plant) return;
+  const scenes::PlantSummary& plant = *s.plant;
+  const scenes::PvArray& base = s.pv_arrays[static_cast<std::size_t>(plant.first_array)];
+  for (const Eigen::Vector4d& r : plant.roads_uv)
+    fill_quad(img, f,
+              {scenes::array_to_world(base, r[0], r[1]), scenes::array_to_world(base, r[2], r[1]),
+               scenes::array_to_world(base, r[2], r[3]), scenes::array_to_world(base, r[0], r[3])},
+              cv::Vec3b(225, 215, 195));
+  if (plant.fence) {
+    const scenes::Fence& fence = *plant.fence;
+    const cv::Scalar grey(90, 90, 90), soil(205, 180, 140);
+    for (std::size_t i = 0; i < fence.corners_m.size(); ++i)
+      cv::line(img, f.px(fence.corners_m[i]), f.px(fence.corners_m[(i + 1) % fence.corners_m.size()]), grey, 2);
+    for (std::size_t i = 0; i < fence.corners_m.size(); ++i) {
+      const Eigen::Vector2d a = fence.corners_m[i], b = fence.corners_m[(i + 1) % fence.corners_m.size()];
+      const Eigen::Vector2d d = (b - a).normalized();
+      for (const Eigen::Vector2d& g : fence.gates_m)
+        if (std::abs((g - a).x() * d.y() - (g - a).y() * d.x()) < 0.01)
+          cv::line(img, f.px(g - d * fence.gate_width_m / 2), f.px(g + d * fence.gate_width_m / 2), soil, 3);
+    }
+  }
+  for (const scenes::Fixture& fx : plant.fixtures) {
+    const double a = fx.yaw_deg * M_PI / 180.0;
+    const Eigen::Vector2d eu(std::cos(a), std::sin(a)), ev(-std::sin(a), std::cos(a));
+    const double hu = std::max(fx.size_m.x() / 2, 0.75 / f.px_per_m), hv = std::max(fx.size_m.y() / 2, 0.75 / f.px_per_m);
+    const cv::Vec3b rgb = fx.base_m >= 1.5 ? cv::Vec3b(120, 120, 130) : cv::Vec3b(40, 90, 200);
+    fill_quad(img, f,
+              {fx.centre_m - hu * eu - hv * ev, fx.centre_m + hu * eu - hv * ev, fx.centre_m + hu * eu + hv * ev,
+               fx.centre_m - hu * eu + hv * ev},
+              rgb);
   }
 }
 
@@ -121,6 +157,7 @@ cv::Mat make_plan_view(const scenes::Scenario& s, int max_side_px) {
   cv::Mat img(f.height + kFooterPx, std::max(f.width, text_width_px(title_of(s)) + 20), CV_8UC3,
               cv::Scalar::all(255));
   img(cv::Rect(0, 0, f.width, f.height)).setTo(cv::Scalar(205, 180, 140));  // soil
+  draw_plant(img, f, s);
   draw_arrays(img, f, s);
   draw_walls(img, f, s);
   draw_route(img, f, s);

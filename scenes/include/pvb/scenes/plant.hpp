@@ -7,6 +7,7 @@
 // default is a published figure; scenes/SCHEMA.md names its source.
 #include <Eigen/Core>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "pvb/scenes/scenario.hpp"
@@ -18,6 +19,27 @@ namespace pvb::scenes {
 inline constexpr double kInverterSkidLengthM = 6.06;
 inline constexpr double kInverterSkidWidthM = 2.44;
 inline constexpr double kInverterSkidHeightM = 2.90;
+
+/// A chain-link fence's figures, and gates (a gate is an opening, closed
+/// by a gate of tubes).
+struct PlantFence {
+  bool on = true;
+  /// From the plant's extent to the fence; the perimeter road (road_width_m)
+  /// runs in between, 1 m from each.  0: road_width_m + 2.
+  double setback_m = 0.0;
+  double height_m = 2.0;        ///< 2 m chain link (utility plants: 1.8-2.4 m)
+  double post_spacing_m = 3.0;  ///< line posts every 3 m (10 ft)
+  double gate_width_m = 6.0;    ///< a double gate a truck passes
+};
+
+/// A string combiner box on its own post, past a row's east end.
+inline constexpr double kCombinerBoxAlongM = 0.25, kCombinerBoxAcrossM = 0.60, kCombinerBoxHighM = 0.50;
+inline constexpr double kCombinerBoxBaseM = 0.70, kCombinerPostM = 0.08;
+/// The dock: a charging cabinet (along the rows x across x high) under a
+/// canopy; the robot stands kDockStandoffM in front of the cabinet.
+inline constexpr double kDockCabinetAlongM = 0.8, kDockCabinetAcrossM = 1.2, kDockCabinetHighM = 1.1;
+inline constexpr double kDockCanopyAlongM = 1.6, kDockCanopyAcrossM = 2.0, kDockCanopyBaseM = 2.1;
+inline constexpr double kDockStandoffM = 2.0;
 
 struct Plant {
   /// Front-left corner of the first block's first row, and the rows'
@@ -49,6 +71,12 @@ struct Plant {
   /// An inverter station (a skid) per this much DC power of a block; 0: none.
   double inverter_mwdc = 2.0;
 
+  PlantFence fence;
+  /// The aisle (of the first block) at whose west end the dock stands; none: no dock.
+  std::optional<int> dock_aisle = 0;
+  /// A combiner box past the east end of every this many rows; 0: none.
+  int combiner_rows = 6;
+
   double dirt = 0.2;
   bool specular_glass = false;
   bool identical_tables = false;
@@ -68,6 +96,17 @@ struct PlantLayout {
   Eigen::Vector4d extent_uv{0, 0, 0, 0};
   /// The same extent's corners in the world.
   std::vector<Eigen::Vector2d> corners_m;
+  /// The perimeter road's centre line beyond the extent, and the fence (none
+  /// when the plant has no fence).
+  double perimeter_road_m = 0.0;
+  std::optional<Fence> fence;
+  std::vector<Fixture> fixtures;  ///< the dock and the combiner boxes
+  double dock_front_u_m = 0.0;    ///< where the robot stands at the dock (u, first block's frame)
+  double dock_v_m = 0.0;          ///< the dock's centre across the rows
+  /// Where a service road runs (rectangles [u0, v0, u1, v1] in the first
+  /// block's frame): between blocks, behind each line of blocks, around the
+  /// plant inside the fence.
+  std::vector<Eigen::Vector4d> roads_uv;
 };
 
 /// The array a plant's blocks share (rows, origin and azimuth aside).
@@ -76,7 +115,15 @@ PvArray plant_block_array(const Plant& p);
 double plant_collector_width_m(const Plant& p);
 /// Rows of one block that hold at least `mwdc` of DC power.
 int rows_for_block_mwdc(const Plant& p, double mwdc);
-/// The blocks, the skids and the plant's figures.
+/// The fence's setback from the extent (its default resolved).
+double fence_setback_m(const Plant& p);
+/// A fence is drawn in straight sections of at most this length (one geom
+/// each, so that the view cull can leave out the ones not in view).
+inline constexpr double kFenceSectionM = 40.0;
+/// The fence's sections, [start, end] in the world.
+std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> fence_sections(const Fence& f);
+/// The blocks, the skids, the fence, the dock, the combiner boxes and the
+/// plant's figures.
 PlantLayout lay_out_plant(const Plant& p);
 
 }  // namespace pvb::scenes

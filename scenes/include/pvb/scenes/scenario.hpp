@@ -18,7 +18,7 @@ enum class GroundType { kSoil, kGravel };
 /// near the route every 3 m tile an image of its own.
 enum class GroundTiling { kRepeat, kVaried };
 enum class PanelOrientation { kPortrait, kLandscape };
-enum class RoutePattern { kWaypoints, kAlongRow, kLawnmower, kLoop };
+enum class RoutePattern { kWaypoints, kAlongRow, kLawnmower, kLoop, kRoads };
 enum class DepthNoiseModel { kNone, kKinect };
 /// The depth camera: a structured-light Kinect v1 (the depth_noise model)
 /// or an active stereo RealSense D435 (ActiveStereo).
@@ -210,6 +210,10 @@ struct Route {
   /// the direction of the start.
   bool return_to_start = false;
   double return_overlap_m = 4.0;             ///< lawnmower with return_to_start
+  int first_aisle = 0;                       ///< lawnmower: the first aisle driven
+  /// lawnmower in a plant: start at the plant's dock (its aisle must be the
+  /// first driven), drive the aisles, and come back to the same place.
+  bool from_dock = false;
   double offset_m = 1.5;                     ///< distance from the table edges
   double margin_m = 2.0;                     ///< run-out beyond the row ends
   double speed_mps = 0.5;
@@ -463,6 +467,29 @@ struct KidnapFrames {
   bool covered(std::int64_t frame) const { return frame >= cover_begin && frame < cover_end; }
 };
 
+/// What a plant's fixtures are made of (a material of the scene each).
+enum class FixtureFinish { kSteel, kEnclosure, kPlaster };
+
+/// A box standing on the ground: the robot's dock, a combiner box and its
+/// post.  Sizes are full sizes: along (the yaw's direction), across, high.
+struct Fixture {
+  Eigen::Vector2d centre_m{0.0, 0.0};
+  double yaw_deg = 0.0;
+  Eigen::Vector3d size_m{0.1, 0.1, 1.0};
+  double base_m = 0.0;  ///< its bottom above the ground
+  FixtureFinish finish = FixtureFinish::kSteel;
+};
+
+/// A chain-link perimeter fence: posts and three wires along a closed
+/// polygon, with gates (closed, a frame of tubes between heavier posts).
+struct Fence {
+  std::vector<Eigen::Vector2d> corners_m;  ///< the closed polygon, counter-clockwise
+  double height_m = 2.0;
+  double post_spacing_m = 3.0;
+  double gate_width_m = 6.0;
+  std::vector<Eigen::Vector2d> gates_m;  ///< each gate's centre, on the polygon
+};
+
 /// What a `plant:` section made (pvb/scenes/plant.hpp): its blocks are the
 /// scenario's last `pv_arrays`, its inverter stations its last `walls`.
 struct PlantSummary {
@@ -475,6 +502,20 @@ struct PlantSummary {
   double row_pitch_m = 0.0;
   int inverter_stations = 0;
   std::vector<Eigen::Vector2d> corners_m;  ///< the plant's extent, headlands included
+  /// The same extent in the first block's array frame, [u0, v0, u1, v1].
+  Eigen::Vector4d extent_uv{0, 0, 0, 0};
+  double road_width_m = 4.0;
+  /// Where the perimeter road's centre line runs, beyond the extent (0: no
+  /// fence, no perimeter road).
+  double perimeter_road_m = 0.0;
+  std::optional<Fence> fence;
+  std::vector<Fixture> fixtures;  ///< the dock and the combiner boxes
+  /// The aisle of the first block whose west end holds the dock, and where
+  /// the robot stands in front of it (u in the first block's frame).
+  std::optional<int> dock_aisle;
+  double dock_front_u_m = 0.0;
+  double dock_v_m = 0.0;  ///< the dock's centre across the rows (first block's frame)
+  std::vector<Eigen::Vector4d> roads_uv;  ///< the service roads, [u0, v0, u1, v1] in the first block's frame
 };
 
 struct Scenario {

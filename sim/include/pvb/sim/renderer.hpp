@@ -86,15 +86,16 @@ class Renderer {
 /// covers.
 void snap_to_shadow_texels(float pos[3], const float dir[3], double texel_m);
 
-/// Leaves out of `scn` (after mjv_updateScene) every static primitive geom
+/// Leaves out of `scn` (after mjv_updateScene) every static geom
 /// whose bounding sphere lies outside the view frustum of its first
 /// camera, the sphere swept first along the beam of the shadow-casting sun
 /// (when shadows are on) so that a geom whose shadow falls in view stays.
 /// `aspect` is the image's width over its height.  With far_tile_m > 0, a
 /// finite plane (a ground tile) farther than that is left out as well: the
 /// one cull that changes pixels (colour only, beyond the depth range).
-/// Returns the geoms left out.
-int cull_to_view(mjvScene* scn, double aspect, double far_tile_m = 0);
+/// A mesh (a plant's fence section) is culled by its model's bounding
+/// sphere (`geom_rbound`, when given).  Returns the geoms left out.
+int cull_to_view(mjvScene* scn, double aspect, double far_tile_m = 0, const double* geom_rbound = nullptr);
 
 /// Converts one standard-Z-buffer value to metric depth (0 for d >= 1).
 inline float depth_from_buffer(float d, double znear_m, double zfar_m) {

@@ -1,0 +1,191 @@
+// A plant's fixtures in the scene: the perimeter fence (posts, wires and
+// gates as one mesh a section), the dock and the combiner boxes.
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "pvb/scenes/plant.hpp"
+#include "scene_mjcf.hpp"
+
+namespace pvb::sim::mjcf {
+namespace {
+
+/// Line posts, the top rail and the two line wires, the gates' posts and tubes.
+constexpr double kLinePostM = 0.06, kGatePostM = 0.12, kTopRailM = 0.04, kWireM = 0.02, kGateTubeM = 0.04;
+
+/// One section's triangles, vertices relative to the section's start.
+struct FenceMesh {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::array<int, 3>> faces;
+
+  /// A box around the segment p0 -> p1 with half extents e1 and e2 across it.
+  void bar(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& e1, const Eigen::Vector3d& e2) {
+    const Eigen::Vector3d c = 0.5 * (p0 + p1), h = 0.5 * (p1 - p0);
+    const Eigen::Vector3d axes[3] = {h, e1, e2};
+    for (int axis = 0; axis < 3; ++axis)
+      for (const double side : {-1.0, 1.0}) {
+        const Eigen::Vector3d n = side * axes[axis], a = axes[(axis + 1) % 3], b = axes[(axis + 2) % 3];
+        std::array<Eigen::Vector3d, 4> q = {c + n - a - b, c + n + a - b, c + n + a + b, c + n - a + b};
+        if ((q[1] - q[0]).cross(q[2] - q[0]).dot(n) < 0) std::swap(q[1], q[3]);  // counter-clockwise from outside
+        const int base = static_cast<int>(vertices.size());
+        vertices.insert(vertices.end(), q.begin(), q.end());
+        faces.push_back({base, base + 1, base + 2});
+        faces.push_back({base, base + 2, base + 3});
+      }
+  }
+};
+
+/// Builds one side of the fence (corner a to corner b) into the meshes of
+/// its sections: posts, and rails between them, except across a gate,
+/// which gets heavier posts and a frame of tubes.
+struct FenceSide {
+  const scenes::Fence& fence;
+  const scenes::GroundRelief& ground;
+  Eigen::Vector2d a, b;
+  std::vector<FenceMesh>* sections;  ///< this side's, equal lengths from a
+  std::vector<Eigen::Vector2d> starts;
+
+  double length() const { return (b - a).norm(); }
+  Eigen::Vector2d at(double t) const { return a + (b - a) * (t / length()); }
+  Eigen::Vector3d point(double t, double above_m) const {
+    const Eigen::Vector2d p = at(t);
+    return {p.x(), p.y(), ground.height_m(p) + above_m};
+  }
+  FenceMesh& section(double t) {
+    const int n = static_cast<int>(sections->size());
+    return (*sections)[static_cast<std::size_t>(std::clamp(static_cast<int>(t / length() * n), 0, n - 1))];
+  }
+  Eigen::Vector3d local(double t, const Eigen::Vector3d& p) {
+    const int n = static_cast<int>(sections->size());
+    const Eigen::Vector2d s0 = starts[static_cast<std::size_t>(std::clamp(static_cast<int>(t / length() * n), 0, n - 1))];
+    return p - Eigen::Vector3d(s0.x(), s0.y(), 0);
+  }
+  void post(double t, double width_m) {
+    const Eigen::Vector2d d = (b - a).normalized(), nrm(-d.y(), d.x());
+    const double into = ground.flat() ? 0.0 : kIntoReliefM;
+    section(t).bar(local(t, point(t, -into)), local(t, point(t, fence.height_m)),
+                   Eigen::Vector3d(d.x(), d.y(), 0) * width_m / 2, Eigen::Vector3d(nrm.x(), nrm.y(), 0) * width_m / 2);
+  }
+  void rail(double t0, double t1, double above_m, double thick_m) {
+    const Eigen::Vector2d d = (b - a).normalized(), nrm(-d.y(), d.x());
+    const double tm = 0.5 * (t0 + t1);
+    section(tm).bar(local(tm, point(t0, above_m)), local(tm, point(t1, above_m)), Eigen::Vector3d(0, 0, thick_m / 2),
+                    Eigen::Vector3d(nrm.x(), nrm.y(), 0) * thick_m / 2);
+  }
+  void gate(double t0, double t1) {
+    post(t0, kGatePostM);
+    post(t1, kGatePostM);
+    const double g0 = t0 + kGatePostM, g1 = t1 - kGatePostM, h = fence.height_m;
+    for (const double z : {0.15, 0.5 * h, h - 0.05}) rail(g0, g1, z, kGateTubeM);
+    const Eigen::Vector2d d = (b - a).normalized(), nrm(-d.y(), d.x());
+    for (const double t : {g0, 0.5 * (t0 + t1), g1})
+      section(t).bar(local(t, point(t, 0.15)), local(t, point(t, h - 0.05)),
+                     Eigen::Vector3d(d.x(), d.y(), 0) * kGateTubeM / 2, Eigen::Vector3d(nrm.x(), nrm.y(), 0) * kGateTubeM / 2);
+  }
+
+  /// Posts at an even spacing of at most post_spacing_m, three rails
+  /// between each pair, gates where the fence has them on this side.
+  void build() {
+    const double len = length(), half_gate = fence.gate_width_m / 2;
+    std::vector<std::pair<double, double>> gates;
+    const Eigen::Vector2d d = (b - a) / len;
+    for (const Eigen::Vector2d& g : fence.gates_m) {
+      const double t = (g - a).dot(d), off = std::abs((g - a).x() * d.y() - (g - a).y() * d.x());
+      if (off < 0.01 && t > half_gate && t < len - half_gate) gates.emplace_back(t - half_gate, t + half_gate);
+    }
+    const auto in_gate = [&](double t) {
+      return std::any_of(gates.begin(), gates.end(), [&](const auto& g) { return t > g.first - 0.3 && t < g.second + 0.3; });
+    };
+    const int n = std::max(1, static_cast<int>(std::ceil(len / fence.post_spacing_m - 1e-9)));
+    std::vector<double> posts;
+    for (int k = 0; k <= n; ++k)
+      if (!in_gate(len * k / n)) posts.push_back(len * k / n);
+    for (const auto& g : gates) posts.insert(std::upper_bound(posts.begin(), posts.end(), g.first), {g.first, g.second});
+    for (std::size_t i = 0; i < posts.size(); ++i) {
+      const bool gate_post = std::any_of(gates.begin(), gates.end(),
+                                         [&](const auto& g) { return posts[i] == g.first || posts[i] == g.second; });
+      if (!gate_post) post(posts[i], kLinePostM);
+      if (i + 1 == posts.size()) continue;
+      const bool across_gate = std::any_of(gates.begin(), gates.end(),
+                                           [&](const auto& g) { return posts[i] == g.first && posts[i + 1] == g.second; });
+      if (across_gate) continue;
+      rail(posts[i], posts[i + 1], fence.height_m - kTopRailM / 2, kTopRailM);
+      for (const double z : {0.6 * fence.height_m, 0.15}) rail(posts[i], posts[i + 1], z, kWireM);
+    }
+    for (const auto& g : gates) gate(g.first, g.second);
+  }
+};
+
+/// The fence's sections, in the order of scenes::fence_sections.
+std::vector<std::pair<Eigen::Vector2d, FenceMesh>> fence_meshes(const scenes::Fence& fence,
+                                                                 const scenes::GroundRelief& ground) {
+  std::vector<std::pair<Eigen::Vector2d, FenceMesh>> out;
+  for (std::size_t i = 0; i < fence.corners_m.size(); ++i) {
+    const Eigen::Vector2d a = fence.corners_m[i], b = fence.corners_m[(i + 1) % fence.corners_m.size()];
+    // The sections of scenes::fence_sections: equal parts of the side.
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / scenes::kFenceSectionM - 1e-9)));
+    std::vector<FenceMesh> meshes(static_cast<std::size_t>(n));
+    std::vector<Eigen::Vector2d> starts;
+    for (int k = 0; k < n; ++k) starts.push_back(a + (b - a) * (static_cast<double>(k) / n));
+    FenceSide side{fence, ground, a, b, &meshes, starts};
+    side.build();
+    for (int k = 0; k < n; ++k) out.emplace_back(starts[static_cast<std::size_t>(k)], std::move(meshes[static_cast<std::size_t>(k)]));
+  }
+  return out;
+}
+
+const char* finish_material(scenes::FixtureFinish f) {
+  switch (f) {
+    case scenes::FixtureFinish::kSteel: return "steel";
+    case scenes::FixtureFinish::kEnclosure: return "enclosure";
+    case scenes::FixtureFinish::kPlaster: return "plaster";
+  }
+  return "steel";
+}
+
+std::string mesh_line(const std::string& name, const FenceMesh& m) {
+  std::string v, fc;
+  v.reserve(m.vertices.size() * 24);
+  for (const Eigen::Vector3d& p : m.vertices) v += (v.empty() ? "" : "  ") + v3(p);
+  for (const auto& t : m.faces)
+    fc += (fc.empty() ? "" : "  ") + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]);
+  return "<mesh name=\"" + name + "\" vertex=\"" + v + "\" face=\"" + fc + "\"/>";
+}
+
+}  // namespace
+
+void add_plant_assets(XmlWriter& x, const scenes::Scenario& s, const scenes::GroundRelief& ground) {
+  if (!s.plant) return;
+  // A combiner box's or the dock's light grey polyester; galvanised chain link.
+  x.line("<material name=\"enclosure\" rgba=\"0.86 0.86 0.84 1\" specular=\"0.15\" shininess=\"0.2\"/>");
+  x.line("<material name=\"fence\" rgba=\"0.66 0.68 0.70 1\" specular=\"0.3\" shininess=\"0.3\"/>");
+  if (!s.plant->fence) return;
+  const auto meshes = fence_meshes(*s.plant->fence, ground);
+  for (std::size_t k = 0; k < meshes.size(); ++k)
+    if (!meshes[k].second.faces.empty()) x.line(mesh_line("fence" + std::to_string(k), meshes[k].second));
+}
+
+void add_plant_fixtures(XmlWriter& x, const scenes::Scenario& s, const scenes::GroundRelief& ground) {
+  if (!s.plant) return;
+  const scenes::PlantSummary& plant = *s.plant;
+  if (plant.fence) {
+    const auto meshes = fence_meshes(*plant.fence, ground);
+    for (std::size_t k = 0; k < meshes.size(); ++k) {
+      if (meshes[k].second.faces.empty()) continue;
+      const Eigen::Vector2d& p = meshes[k].first;
+      x.line("<geom name=\"fence" + std::to_string(k) + "\" class=\"scenery\" type=\"mesh\" mesh=\"fence" +
+             std::to_string(k) + "\" pos=\"" + v3(p.x(), p.y(), 0) + "\" material=\"fence\"/>");
+    }
+  }
+  for (std::size_t i = 0; i < plant.fixtures.size(); ++i) {
+    const scenes::Fixture& fx = plant.fixtures[i];
+    const double z0 = ground.height_m(fx.centre_m) + fx.base_m;
+    const double foot = fx.base_m == 0 && !ground.flat() ? kIntoReliefM : 0.0;
+    x.line("<geom name=\"fixture" + std::to_string(i) + "\" class=\"scenery\" type=\"box\" size=\"" +
+           v3(fx.size_m.x() / 2, fx.size_m.y() / 2, (fx.size_m.z() + foot) / 2) + "\" pos=\"" +
+           v3(fx.centre_m.x(), fx.centre_m.y(), z0 + (fx.size_m.z() - foot) / 2) + "\" euler=\"0 0 " + f(fx.yaw_deg) +
+           "\" material=\"" + finish_material(fx.finish) + "\"/>");
+  }
+}
+
+}  // namespace pvb::sim::mjcf
