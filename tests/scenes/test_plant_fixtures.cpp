@@ -79,7 +79,7 @@ TEST(PlantFixtures, ACombinerBoxEveryNRowsAndTheDockInTheHeadlandOfItsAisle) {
   EXPECT_TRUE(bare.plant->fixtures.empty());
 }
 
-TEST(PlantRoutes, ADayFromTheDockComesBackToWhereItStarted) {
+TEST(PlantRouteShapes, ADayFromTheDockComesBackToWhereItStarted) {
   for (const int aisles : {3, 4}) {  // the way back differs after an odd and an even number of aisles
     const Scenario s = plant_scenario("{rows: 8}", "{pattern: lawnmower, aisles: " + std::to_string(aisles) +
                                                        ", from_dock: true}");
@@ -96,7 +96,7 @@ TEST(PlantRoutes, ADayFromTheDockComesBackToWhereItStarted) {
   }
 }
 
-TEST(PlantRoutes, ALoopAlongThePerimeterRoadStaysOnTheRoad) {
+TEST(PlantRouteShapes, ALoopAlongThePerimeterRoadStaysOnTheRoad) {
   const Scenario s = plant_scenario("{rows: 8}", "{pattern: roads, laps: 2}");
   const std::vector<Eigen::Vector2d> route = route_polyline(s, 0.25);
   const Eigen::Vector4d e = s.plant->extent_uv;

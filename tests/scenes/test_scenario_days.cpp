@@ -314,3 +314,26 @@ TEST(ScenarioDays, ShippedDaysKeepTheirStation) {
     EXPECT_NE(d.seed, station.seed) << entry.path();
   }
 }
+
+// A plant's days: the same plant (blocks, fence, dock, boxes) under the
+// day's sun and dust.
+TEST(PlantDays, KeepThePlantAndChangeTheDay) {
+  for (const char* plant : {"plant_10mw_fixed", "plant_10mw_tracker"}) {
+    const Scenario base = load_scenario(kScenes + "plants/" + plant + ".yaml");
+    for (const char* day : {"_0800", "_1200", "_1600", "_dusty"}) {
+      const Scenario s = load_scenario(kScenes + "days/" + plant + day + ".yaml");
+      EXPECT_EQ(s.station_seed_or_seed(), base.station_seed_or_seed()) << plant << day;
+      EXPECT_NE(s.seed, base.seed) << plant << day;
+      ASSERT_EQ(s.pv_arrays.size(), base.pv_arrays.size());
+      EXPECT_EQ(s.pv_arrays[0].origin_m, base.pv_arrays[0].origin_m);
+      ASSERT_TRUE(s.plant && s.plant->fence);
+      EXPECT_EQ(s.plant->fence->corners_m, base.plant->fence->corners_m);
+      EXPECT_EQ(s.plant->fixtures.size(), base.plant->fixtures.size());
+      EXPECT_EQ(s.route.from_dock, true);
+      EXPECT_NE(s.light.sun_azimuth_deg, base.light.sun_azimuth_deg) << plant << day;
+    }
+    const Scenario dusty = load_scenario(kScenes + "days/" + plant + "_dusty.yaml");
+    EXPECT_DOUBLE_EQ(dusty.pv_arrays[0].dirt, 0.8);
+    EXPECT_LT(base.pv_arrays[0].dirt, 0.5);
+  }
+}

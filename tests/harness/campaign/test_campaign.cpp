@@ -38,7 +38,7 @@ std::string error_of(const std::string& text) {
 }  // namespace
 
 TEST(Campaign, ShippedCampaignsLoad) {
-  for (const char* name : {"daily", "trackers", "same_day"}) {
+  for (const char* name : {"daily", "trackers", "same_day", "plant_10mw_fixed_daily", "plant_10mw_tracker_daily"}) {
     const run::Campaign c = run::load_campaign(kCampaigns + name + ".yaml");
     EXPECT_EQ(c.name, name);
     ASSERT_GE(c.sessions.size(), 3u) << name;
@@ -47,6 +47,17 @@ TEST(Campaign, ShippedCampaignsLoad) {
       EXPECT_EQ(c.sessions[i].mode, run::SessionMode::kLocalise) << name;
       EXPECT_EQ(c.sessions[i].map, c.sessions[0].name) << name;
       EXPECT_TRUE(std::filesystem::exists(c.sessions[i].scenario_file)) << c.sessions[i].scenario_file;
+    }
+  }
+  // A growing map: each day extends the map of the day before.
+  for (const char* name : {"growing", "plant_10mw_fixed_growing", "plant_10mw_tracker_growing"}) {
+    const run::Campaign c = run::load_campaign(kCampaigns + name + ".yaml");
+    ASSERT_GE(c.sessions.size(), 5u) << name;
+    EXPECT_EQ(c.sessions[0].mode, run::SessionMode::kMap) << name;
+    for (std::size_t i = 1; i < c.sessions.size(); ++i) {
+      EXPECT_EQ(c.sessions[i].mode, run::SessionMode::kExtend) << name;
+      EXPECT_EQ(c.sessions[i].map, c.sessions[i - 1].name) << name;
+      EXPECT_TRUE(c.sessions[i].start_m.has_value()) << name;
     }
   }
   const run::Campaign same = run::load_campaign(kCampaigns + "same_day.yaml");
