@@ -57,7 +57,10 @@ void append_segment_if_long(std::vector<Eigen::Vector2d>* out, const Eigen::Vect
 void append_return(std::vector<Eigen::Vector2d>* uv, double u0, double u1, double v0, double v_last,
                    bool ends_at_u1, double overlap_m, double spacing) {
   if (!ends_at_u1) {
-    // heading -u at (u0, v_last): left turn down the run-out, left turn into the first aisle
+    // heading -u at (u0, v_last), after the run-out to there when u0 lies
+    // beyond the last aisle's end (a dock): left turn down the run-out, left
+    // turn into the first aisle
+    if (!uv->empty()) append_segment_if_long(uv, uv->back(), {u0, v_last}, spacing);
     const double r = std::min(kReturnTurnRadiusM, 0.5 * (v_last - v0));
     append_arc(uv, {u0, v_last - r}, r, M_PI / 2, M_PI, spacing);
     append_segment_if_long(uv, {u0 - r, v_last - r}, {u0 - r, v0 + r}, spacing);

@@ -19,6 +19,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -476,6 +477,40 @@ void fill_textures(mjModel* m, const SceneAssets& assets) {
 }
 
 }  // namespace
+
+SceneAssets physics_assets(const SceneAssets& scene) {
+  SceneAssets out = scene;
+  out.textures = TextureEncoding::kPng;
+  out.files.clear();
+  for (const auto& file : scene.files)
+    if (!is_texture_file(file.first)) out.files.push_back(file);
+  // Every line is one element (XmlWriter).  The scenery's geoms go, the
+  // meshes only they use, every texture and the materials' references to them.
+  std::istringstream in(scene.xml);
+  std::ostringstream xml;
+  std::set<std::string> scenery_meshes;
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) {
+    if (line.find("class=\"scenery\"") != std::string::npos && line.find("<geom ") != std::string::npos) {
+      const std::size_t at = line.find(" mesh=\"");
+      if (at != std::string::npos) scenery_meshes.insert(line.substr(at + 7, line.find('"', at + 7) - at - 7));
+      continue;
+    }
+    lines.push_back(line);
+  }
+  const std::regex texture_ref(" texture=\"[^\"]*\"");
+  for (const std::string& line : lines) {
+    const std::size_t open = line.find_first_not_of(' ');
+    if (line.compare(open, 9, "<texture ") == 0) continue;
+    if (line.compare(open, 6, "<mesh ") == 0) {
+      const std::size_t at = line.find(" name=\"") + 7;
+      if (scenery_meshes.count(line.substr(at, line.find('"', at) - at))) continue;
+    }
+    xml << (line.compare(open, 10, "<material ") == 0 ? std::regex_replace(line, texture_ref, "") : line) << "\n";
+  }
+  out.xml = xml.str();
+  return out;
+}
 
 ModelPtr compile_scene(const SceneAssets& assets) {
   install_mujoco_handlers();  // MuJoCo's log goes to stderr, not MUJOCO_LOG.TXT

@@ -39,7 +39,12 @@ Simulator::Simulator(scenes::Scenario scenario, SceneDetail detail) : scenario_(
   assets_ = build_scene(scenario_, detail, TextureEncoding::kPixels);
   model_ = compile_scene(assets_);
   data_.reset(mj_makeData(model_.get()));
-  const mjModel* m = model_.get();
+  phys_model_ = compile_scene(physics_assets(assets_));
+  phys_data_.reset(mj_makeData(phys_model_.get()));
+  const mjModel* m = phys_model_.get();
+  if (m->nq != model_->nq || m->nv != model_->nv || m->nu != model_->nu || m->nbody != model_->nbody ||
+      m->ncam != model_->ncam)
+    throw Error("the physics model lost part of the robot");
   camera_id_ = mj_name2id(m, mjOBJ_CAMERA, kCameraName);
   const int body = mj_name2id(m, mjOBJ_BODY, kRobotBody);
   if (camera_id_ < 0 || body < 0) throw Error("generated model lacks the robot or its camera");
@@ -87,10 +92,25 @@ Simulator::Simulator(scenes::Scenario scenario, SceneDetail detail) : scenario_(
 
   // Settle: the robot starts 2 mm above the ground.
   step_physics(static_cast<int>(kSettleS / m->opt.timestep));
-  mj_forward(m, data_.get());
+  mj_forward(m, phys_data_.get());
   if (scenario_.kidnap) kidnap_ = scenes::kidnap_frames(*scenario_.kidnap, scenario_.camera.fps);
   motion_ = std::make_unique<MotionSensors>(m, scenario_, body, T_b_c());
   kidnap_step();
+  sync_scene();
+}
+
+void Simulator::sync_scene() {
+  const mjModel* m = model_.get();
+  mjData* d = data_.get();
+  const mjData* p = phys_data_.get();
+  std::copy(p->qpos, p->qpos + m->nq, d->qpos);
+  std::copy(p->qvel, p->qvel + m->nv, d->qvel);
+  std::copy(p->act, p->act + m->na, d->act);
+  std::copy(p->ctrl, p->ctrl + m->nu, d->ctrl);
+  std::copy(p->mocap_pos, p->mocap_pos + 3 * m->nmocap, d->mocap_pos);
+  std::copy(p->mocap_quat, p->mocap_quat + 4 * m->nmocap, d->mocap_quat);
+  d->time = p->time;
+  mj_forward(m, d);
 }
 
 Simulator::~Simulator() = default;
@@ -113,9 +133,9 @@ std::int64_t Simulator::t_ns() const { return geom::frame_time_ns(0, frame_, sce
 
 void Simulator::step_physics(int steps) {
   for (int i = 0; i < steps; ++i) {
-    if (motion_) motion_->before_step(data_.get());
-    mj_step(model_.get(), data_.get());
-    if (motion_) motion_->after_step(model_.get(), data_.get(), false);
+    if (motion_) motion_->before_step(phys_data_.get());
+    mj_step(phys_model_.get(), phys_data_.get());
+    if (motion_) motion_->after_step(phys_model_.get(), phys_data_.get(), false);
   }
 }
 
@@ -124,8 +144,8 @@ bool Simulator::carrying() const {
 }
 
 void Simulator::carry_steps(int steps) {
-  const mjModel* m = model_.get();
-  mjData* d = data_.get();
+  const mjModel* m = phys_model_.get();
+  mjData* d = phys_data_.get();
   if (!carry_) {
     const double duration_s = (kidnap_->teleport - kidnap_->cover_begin) / scenario_.camera.fps;
     carry_ = std::make_unique<CarryPath>(free_state(d, free_qpos_, free_dof_),
@@ -153,34 +173,35 @@ void Simulator::advance() {
   }
   if (scenario_.robot.max_wheel_accel_radps2) {  // ramp towards the command
     const double step = *scenario_.robot.max_wheel_accel_radps2 / scenario_.camera.fps;
-    const Eigen::Vector2d last(data_->ctrl[act_left_], data_->ctrl[act_right_]);
+    const Eigen::Vector2d last(phys_data_->ctrl[act_left_], phys_data_->ctrl[act_right_]);
     lr = last + (lr - last).cwiseMax(-step).cwiseMin(step);
   }
-  data_->ctrl[act_left_] = lr.x();
-  data_->ctrl[act_right_] = lr.y();
+  phys_data_->ctrl[act_left_] = lr.x();
+  phys_data_->ctrl[act_right_] = lr.y();
   if (carrying())
     carry_steps(assets_.substeps);
   else
     step_physics(assets_.substeps);
-  mj_forward(model_.get(), data_.get());  // camera poses for the new state
+  mj_forward(phys_model_.get(), phys_data_.get());  // the state a frame ends with (the next step starts from it)
   ++frame_;
   kidnap_step();
+  sync_scene();  // camera poses for the new state
 }
 
 void Simulator::kidnap_step() {
   if (!kidnap_) return;
   if (frame_ == kidnap_->target) {
-    kidnap_data_.reset(mj_makeData(model_.get()));
-    mj_copyData(kidnap_data_.get(), model_.get(), data_.get());
+    kidnap_data_.reset(mj_makeData(phys_model_.get()));
+    mj_copyData(kidnap_data_.get(), phys_model_.get(), phys_data_.get());
     kidnap_follower_ = *follower_;
   } else if (frame_ == kidnap_->teleport && kidnap_data_) {
     // The whole physical state (positions, velocities, contacts, the
     // solver's warm start) and the follower as they were; only time goes on.
-    const mjtNum time_s = data_->time;
-    if (motion_) motion_->rebase_wheels(data_.get(), kidnap_data_.get());
+    const mjtNum time_s = phys_data_->time;
+    if (motion_) motion_->rebase_wheels(phys_data_.get(), kidnap_data_.get());
     carry_.reset();
-    mj_copyData(data_.get(), model_.get(), kidnap_data_.get());
-    data_->time = time_s;
+    mj_copyData(phys_data_.get(), phys_model_.get(), kidnap_data_.get());
+    phys_data_->time = time_s;
     *follower_ = *kidnap_follower_;
   }
 }

@@ -91,6 +91,9 @@ TEST(PlantRouteShapes, ADayFromTheDockComesBackToWhereItStarted) {
     const Eigen::Vector2d first = uv(s, route[1]) - start, last = end - uv(s, route[route.size() - 2]);
     EXPECT_GT(first.normalized().x(), 0.99);
     EXPECT_GT(last.normalized().x(), 0.99) << aisles;
+    // No gap between points longer than their spacing: a follower moves on along it.
+    for (std::size_t i = 1; i < route.size(); ++i)
+      ASSERT_LE((route[i] - route[i - 1]).norm(), 0.05 + 1e-9) << aisles << " aisles, point " << i;
     // Longer than its aisles: it drives to them and back.
     EXPECT_GT(polyline_length(route), aisles * row_length_m(s.pv_arrays[0]));
   }

@@ -97,6 +97,13 @@ using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 /// carrying MuJoCo's message on failure.
 ModelPtr compile_scene(const SceneAssets& assets);
 
+/// The scene for physics alone: without the scenery (geoms that never
+/// collide: the arrays, walls, fence, plants, ground tiles), its meshes and
+/// every texture.  The robot, the ground it drives on and every body,
+/// joint, actuator and camera keep their ids; the robot moves exactly as
+/// in the whole scene, while a step no longer visits thousands of geoms.
+SceneAssets physics_assets(const SceneAssets& scene);
+
 /// Writes scene.xml and the files it names under `dir` (created if needed).
 void write_scene(const SceneAssets& assets, const std::string& dir);
 

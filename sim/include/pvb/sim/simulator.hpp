@@ -87,6 +87,9 @@ class Simulator {
 
  private:
   void step_physics(int steps);
+  /// Brings the whole scene's data to the physics' state (positions,
+  /// velocities, controls, time) and its kinematics up to date.
+  void sync_scene();
   /// One camera period of the kidnap's carry (frames cover_begin..teleport).
   void carry_steps(int steps);
   bool carrying() const;
@@ -94,8 +97,12 @@ class Simulator {
   void kidnap_step();
   scenes::Scenario scenario_;
   SceneAssets assets_;
-  ModelPtr model_;
+  ModelPtr model_;  ///< the whole scene: what is drawn, ray-cast and read
   DataPtr data_;
+  /// The robot's physics: the scene without its scenery (physics_assets),
+  /// stepped; data_ follows it once a frame.
+  ModelPtr phys_model_;
+  DataPtr phys_data_;
   DriveKinematics kinematics_;
   std::unique_ptr<RouteFollower> follower_;
   std::optional<Pose2d> steering_pose_;
@@ -107,7 +114,7 @@ class Simulator {
   int free_dof_ = 0;
   int act_left_ = -1, act_right_ = -1;
   std::optional<scenes::KidnapFrames> kidnap_;
-  DataPtr kidnap_data_;                           ///< the state at kidnap_->target
+  DataPtr kidnap_data_;                           ///< the physics' state at kidnap_->target
   std::optional<RouteFollower> kidnap_follower_;  ///< the follower at kidnap_->target
   std::unique_ptr<MotionSensors> motion_;         ///< from frame 0 on
   std::unique_ptr<CarryPath> carry_;        ///< while the kidnap carries the robot
