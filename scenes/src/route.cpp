@@ -82,15 +82,16 @@ void append_return(std::vector<Eigen::Vector2d>* uv, double u0, double u1, doubl
 constexpr double kRoadCornerRadiusM = 3.0;
 
 /// Around a plant along its perimeter road, `laps` times, counter-clockwise
-/// from the west side level with the dock (or the west side's middle),
-/// heading south; in the first block's frame.
+/// seen from above, from the side before the rows' start (-u) level with
+/// the dock (or that side's middle), heading -v; in the first block's frame.
 void append_road_loop(std::vector<Eigen::Vector2d>* uv, const PlantSummary& plant, int laps, double spacing) {
   const Eigen::Vector4d& e = plant.extent_uv;
   const double d = plant.perimeter_road_m, r = kRoadCornerRadiusM;
   const double u0 = e[0] - d, v0 = e[1] - d, u1 = e[2] + d, v1 = e[3] + d;
   const double vs = plant.dock_aisle ? std::clamp(plant.dock_v_m, v0 + r, v1 - r) : 0.5 * (v0 + v1);
   for (int lap = 0; lap < laps; ++lap) {
-    append_segment(uv, {u0, vs}, {u0, v0 + r}, spacing);
+    if (uv->empty()) uv->push_back({u0, vs});
+    append_segment_if_long(uv, {u0, vs}, {u0, v0 + r}, spacing);
     append_arc(uv, {u0 + r, v0 + r}, r, M_PI, 1.5 * M_PI, spacing);
     append_segment(uv, {u0 + r, v0}, {u1 - r, v0}, spacing);
     append_arc(uv, {u1 - r, v0 + r}, r, -M_PI / 2, 0, spacing);
@@ -98,7 +99,7 @@ void append_road_loop(std::vector<Eigen::Vector2d>* uv, const PlantSummary& plan
     append_arc(uv, {u1 - r, v1 - r}, r, 0, M_PI / 2, spacing);
     append_segment(uv, {u1 - r, v1}, {u0 + r, v1}, spacing);
     append_arc(uv, {u0 + r, v1 - r}, r, M_PI / 2, M_PI, spacing);
-    append_segment(uv, {u0, v1 - r}, {u0, vs}, spacing);
+    append_segment_if_long(uv, {u0, v1 - r}, {u0, vs}, spacing);
   }
 }
 
