@@ -103,6 +103,16 @@ std::vector<unsigned char> texture_bytes(const cv::Mat& rgb_img, const std::stri
 /// a tile's diagonal) of the route.  A cell's image seed comes from the
 /// station's seed and the cell alone, so the route picks which cells are
 /// drawn, never how one looks.
+/// Whether a point lies on one of a plant's service roads.
+bool on_plant_road(const scenes::Scenario& s, const Eigen::Vector2d& p_m) {
+  if (!s.plant) return false;
+  const Eigen::Vector2d uv =
+      scenes::world_to_array(s.pv_arrays[static_cast<std::size_t>(s.plant->first_array)], p_m);
+  for (const Eigen::Vector4d& r : s.plant->roads_uv)
+    if (uv.x() >= r[0] && uv.x() <= r[2] && uv.y() >= r[1] && uv.y() <= r[3]) return true;
+  return false;
+}
+
 std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std::vector<Eigen::Vector2d>& route) {
   if (s.ground.drawn_tiling() != scenes::GroundTiling::kVaried) return {};
   const double tile = kGroundTileM, half_x = s.ground.size_m.x() / 2, half_y = s.ground.size_m.y() / 2;
@@ -145,6 +155,12 @@ std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std
       t.image = static_cast<int>(pick.next() % static_cast<std::uint64_t>(images));
       t.quarter_turns = static_cast<int>(pick.next() % 4);
       t.seed = shared_soil_image_seed(s.station_seed_or_seed(), t.image);
+      if (on_plant_road(s, t.centre_m)) {  // gravel: one of the road's images
+        SplitMix road(s.station_seed_or_seed(), 0x6A4E1000ULL + cell);
+        t.image = images + static_cast<int>(road.next() % kRoadGravelImages);
+        t.quarter_turns = static_cast<int>(road.next() % 4);
+        t.seed = shared_soil_image_seed(s.station_seed_or_seed(), t.image);
+      }
     } else {
       t.seed = s.station_seed_or_seed() * 2654435761ULL + 1000003ULL * (cell + 1);
     }
@@ -170,16 +186,23 @@ void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tile
   add("ground", [&] { return make_ground_texture(s.ground.type, station_seed); });
   // A tile's image depends on its seed alone: drawn and encoded on every core.
   // Shared images: image k is groundtK; else tile k's own image is.
+  // A plant's roads add their gravel images after the soil's.
   std::vector<std::uint64_t> seeds;
-  for (int k = 0; k < s.ground.soil_images && !tiles.empty(); ++k)
-    seeds.push_back(shared_soil_image_seed(station_seed, k));
+  const bool gravel = std::any_of(tiles.begin(), tiles.end(),
+                                  [&](const GroundTile& t) { return t.image >= s.ground.soil_images; }) &&
+                      s.ground.soil_images > 0;
+  const int shared = s.ground.soil_images + (gravel ? kRoadGravelImages : 0);
+  for (int k = 0; k < shared && !tiles.empty(); ++k) seeds.push_back(shared_soil_image_seed(station_seed, k));
   if (s.ground.soil_images == 0)
     for (const GroundTile& t : tiles) seeds.push_back(t.seed);
   std::vector<std::vector<unsigned char>> tile_png(seeds.size(), grey);
   if (full)
     cv::parallel_for_(cv::Range(0, static_cast<int>(seeds.size())), [&](const cv::Range& range) {
-      for (int k = range.start; k < range.end; ++k)
-        tile_png[k] = texture_bytes(make_ground_texture(s.ground.type, seeds[k]), kGroundTilePrefix, encoding);
+      for (int k = range.start; k < range.end; ++k) {
+        const bool road = s.ground.soil_images > 0 && k >= s.ground.soil_images;
+        const scenes::GroundType type = road ? scenes::GroundType::kGravel : s.ground.type;
+        tile_png[k] = texture_bytes(make_ground_texture(type, seeds[k]), kGroundTilePrefix, encoding);
+      }
     });
   for (std::size_t k = 0; k < seeds.size(); ++k)
     out->files.emplace_back(kGroundTilePrefix + std::to_string(k) + ".png", std::move(tile_png[k]));

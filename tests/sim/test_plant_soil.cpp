@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "pvb/scenes/route.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/scene_builder.hpp"
 #include "pvb/sim/textures.hpp"
@@ -32,7 +33,8 @@ class Patches {
   cv::Mat patch(std::size_t k) {
     const sim::GroundTile& t = tiles_[k];
     auto it = images_.find(t.seed);
-    if (it == images_.end()) it = images_.emplace(t.seed, sim::make_ground_texture(s_.ground.type, t.seed)).first;
+    const scenes::GroundType type = t.image >= s_.ground.soil_images ? scenes::GroundType::kGravel : s_.ground.type;
+    if (it == images_.end()) it = images_.emplace(t.seed, sim::make_ground_texture(type, t.seed)).first;
     cv::Mat img = it->second;
     for (int q = 0; q < t.quarter_turns; ++q) cv::rotate(img.clone(), img, cv::ROTATE_90_COUNTERCLOCKWISE);
     const int side = static_cast<int>(img.cols / sim::kGroundTileM);  // 1 m
@@ -110,6 +112,39 @@ TEST(PlantSoil, FarPatchesMatchOnlyWhereTheyTookTheSameImage) {
   // ...and one far pair in soil_images takes the same image (at most three
   // times that: a binomial count of about 5 in 330 pairs stays below it).
   EXPECT_LE(static_cast<double>(far_same.size()) / far, 3.0 / s.ground.soil_images);
+}
+
+// A plant's service roads are gravel: a tile whose centre lies on a road
+// takes one of the road's images, every other tile a soil image.
+TEST(PlantSoil, TilesOnTheRoadsTakeGravelImages) {
+  const scenes::Scenario s = scenes::parse_scenario(
+      "ground: {size_m: [200, 160], tiling: varied, soil_images: 8}\n"
+      "plant: {origin_m: [-40, -20], rows: 6, tables_per_row: 2, modules_per_table: 20}\n"
+      "route: {pattern: roads}\n",
+      "roads.yaml");
+  const scenes::PvArray& frame = s.pv_arrays[static_cast<std::size_t>(s.plant->first_array)];
+  int gravel = 0, soil = 0;
+  for (const sim::GroundTile& t : sim::ground_tiles(s)) {
+    const Eigen::Vector2d uv = scenes::world_to_array(frame, t.centre_m);
+    bool on_road = false;
+    for (const Eigen::Vector4d& r : s.plant->roads_uv)
+      on_road = on_road || (uv.x() >= r[0] && uv.x() <= r[2] && uv.y() >= r[1] && uv.y() <= r[3]);
+    if (on_road) {
+      ++gravel;
+      EXPECT_GE(t.image, 8);
+      EXPECT_LT(t.image, 8 + sim::kRoadGravelImages);
+    } else {
+      ++soil;
+      EXPECT_LT(t.image, 8);
+    }
+  }
+  EXPECT_GT(gravel, 100);  // the loop drives the road all the way round
+  EXPECT_GT(soil, 10);     // the ground beside it
+  // The scene draws the road's images as gravel.
+  const sim::SceneAssets a = sim::build_scene(s, sim::SceneDetail::kFull, sim::TextureEncoding::kPixels);
+  const auto n = std::count_if(a.files.begin(), a.files.end(),
+                               [](const auto& f) { return f.first.rfind("textures/groundt", 0) == 0; });
+  EXPECT_EQ(n, 8 + sim::kRoadGravelImages);
 }
 
 }  // namespace plant_soil_test

@@ -32,6 +32,10 @@ constexpr int kMaxGroundTiles = 200;
 /// At most this many tiles on a ground of `soil_images` shared images (a
 /// route of several kilometres): a plane geom each, culled to the view.
 constexpr int kMaxSharedImageTiles = 20000;
+/// A plant's service roads, on a ground of shared soil images: every tile
+/// whose centre lies on a road takes one of this many gravel images instead
+/// (after the soil images: groundt{soil_images + k}).
+constexpr int kRoadGravelImages = 8;
 /// The soil's stones, about 4 cm: a ground tile farther than where they
 /// shrink below half a pixel shows nothing the repeated soil under it does
 /// not (fx x 0.04 / 0.5: 42 m at fx 525).
