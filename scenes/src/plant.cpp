@@ -152,6 +152,7 @@ PvArray plant_block_array(const Plant& p) {
   a.table_gap_m = p.table_gap_m;
   a.clearance_m = p.clearance_m;
   a.dirt = p.dirt;
+  a.row_soiling = p.row_soiling;
   a.specular_glass = p.specular_glass;
   a.identical_tables = p.identical_tables;
   a.panel_slabs = true;

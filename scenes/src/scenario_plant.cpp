@@ -125,6 +125,7 @@ Plant read_plant_section(MapReader& r) {
   read_blocks(r, p);
   read_fixtures(r, p);
   p.dirt = r.number("dirt", p.dirt, 0, 1);
+  p.row_soiling = r.number("row_soiling", p.row_soiling, 0, 1);
   p.specular_glass = r.choice<bool>("glass", p.specular_glass, {{"diffuse", false}, {"specular", true}});
   p.identical_tables = r.boolean("identical_tables", p.identical_tables);
   return p;

@@ -212,7 +212,10 @@ void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tile
   for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) {
     for (int k = 0; k < kDirtVariants; ++k) {
       // variant 0 is the cleanest; dirt grows with k up to the array's level
-      const double dirt = s.pv_arrays[i].dirt * (0.55 + 0.15 * k);
+      const scenes::PvArray& a = s.pv_arrays[i];
+      const double spread = a.row_soiling;
+      const double dirt = spread > 0 ? std::clamp(a.dirt * (1 - spread + 2 * spread * k / (kDirtVariants - 1)), 0.0, 1.0)
+                                     : a.dirt * (0.55 + 0.15 * k);
       add("a" + std::to_string(i) + "panel" + std::to_string(k), [&] {
         return make_panel_texture(s.pv_arrays[i], dirt, station_seed * 131 + i * 17 + k, day_seed * 131 + i * 17 + k);
       });
@@ -449,7 +452,7 @@ SceneAssets build_scene(const scenes::Scenario& s, SceneDetail detail, TextureEn
   x.open("<worldbody>");
   add_ground(x, s, tiles, ground);
   for (std::size_t i = 0; i < s.pv_arrays.size(); ++i)
-    add_array(x, s.pv_arrays[i], static_cast<int>(i), s.seed, ground);
+    add_array(x, s.pv_arrays[i], static_cast<int>(i), s.seed, s.station_seed_or_seed(), ground);
   add_walls(x, s, ground);
   add_plant_fixtures(x, s, ground);
   add_vegetation(x, s, route, ground);

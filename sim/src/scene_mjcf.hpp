@@ -52,7 +52,7 @@ class XmlWriter {
 // scene_station.cpp
 /// The PV array `a` (fixed tables or single-axis trackers), the
 /// `index`-th, its dust drawn from `day_seed`.
-void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed,
+void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed, std::uint64_t station_seed,
                const scenes::GroundRelief& ground);
 /// The walls: boxes with local x along the wall and local y up, so that
 /// the brick texture maps onto the face.  On a relief a wall's top is

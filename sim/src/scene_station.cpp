@@ -10,6 +10,7 @@
 
 #include "pvb/scenes/route.hpp"
 #include "scene_mjcf.hpp"
+#include "splitmix.hpp"
 
 namespace pvb::sim::mjcf {
 namespace {
@@ -40,11 +41,21 @@ std::string panel_geom(const std::string& name, double pw, double ph, const Eige
          "\" pos=\"" + v3(pos) + "\" xyaxes=\"" + axes + "\" material=\"" + material + "\"/>";
 }
 
+/// The dust variant of every table of `row` with row_soiling: from the
+/// station's seed, so the same rows are the dirtier ones every day.
+int row_dust_variant(std::uint64_t station_seed, int index, int row) {
+  SplitMix pick(station_seed, 0x50170000ULL + 100000ULL * static_cast<std::uint64_t>(index) +
+                                  static_cast<std::uint64_t>(row));
+  return static_cast<int>(pick.next() % kDirtVariants);
+}
+
 /// A table's panels as one slab: its material repeats the module texture
-/// once per module (`PREslabK`, scene_builder.cpp); one dust variant a table.
+/// once per module (`PREslabK`, scene_builder.cpp); one dust variant a
+/// table, the row's with row_soiling (`row_variant` >= 0).
 std::string table_slab_geom(const std::string& table, const scenes::PvArray& a, const Eigen::Vector3d& centre,
-                            const std::string& axes, const std::string& pre, Placer& rng) {
-  const int variant = static_cast<int>(rng.uniform(0, kDirtVariants)) % kDirtVariants;
+                            const std::string& axes, const std::string& pre, Placer& rng, int row_variant) {
+  const int variant =
+      row_variant >= 0 ? row_variant : static_cast<int>(rng.uniform(0, kDirtVariants)) % kDirtVariants;
   return panel_geom(table + "slab", a.table_length_m(), a.table_depth_m(), centre, axes,
                     pre + "slab" + std::to_string(variant));
 }
@@ -56,7 +67,7 @@ double post_foot_m(const scenes::GroundRelief& ground, const Eigen::Vector3d& to
 }
 
 /// Fixed tables: each tilted by tilt_deg, facing -v, on rails and four posts.
-void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed,
+void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed, std::uint64_t station_seed,
                      const scenes::GroundRelief& ground) {
   const double az = a.azimuth_deg * kDeg, tilt = a.tilt_deg * kDeg;
   const Eigen::Vector3d eu(std::cos(az), std::sin(az), 0), ev(-std::sin(az), std::cos(az), 0);
@@ -82,7 +93,8 @@ void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uin
       };
       const std::string tname = pre + "r" + std::to_string(row) + "t" + std::to_string(t);
       if (a.panel_slabs) {
-        x.line(table_slab_geom(tname, a, slope_point(u_start + tl / 2, td / 2), axes, pre, rng));
+        x.line(table_slab_geom(tname, a, slope_point(u_start + tl / 2, td / 2), axes, pre, rng,
+                               a.row_soiling > 0 ? row_dust_variant(station_seed, index, row) : -1));
       } else {
         for (int line = 0; line < a.panel_lines; ++line) {
           for (int c = 0; c < a.panels_per_table; ++c) {
@@ -125,7 +137,7 @@ void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uin
 /// row's middle, turned by rotation_deg (right-handed about +u, 0 flat), on
 /// two posts per table.  The panels sit kTrackerPanelAboveAxisM above the
 /// tube's axis along their normal.
-void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed,
+void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed, std::uint64_t station_seed,
                        const scenes::GroundRelief& ground) {
   const double az = a.azimuth_deg * kDeg, rot = a.rotation_deg * kDeg;
   const Eigen::Vector3d eu(std::cos(az), std::sin(az), 0), ev(-std::sin(az), std::cos(az), 0);
@@ -154,7 +166,8 @@ void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::u
       };
       const std::string tname = pre + "r" + std::to_string(row) + "t" + std::to_string(t);
       if (a.panel_slabs) {
-        x.line(table_slab_geom(tname, a, plane_point(u_start + tl / 2, td / 2), axes, pre, rng));
+        x.line(table_slab_geom(tname, a, plane_point(u_start + tl / 2, td / 2), axes, pre, rng,
+                               a.row_soiling > 0 ? row_dust_variant(station_seed, index, row) : -1));
       } else {
         for (int line = 0; line < a.panel_lines; ++line)
           for (int c = 0; c < a.panels_per_table; ++c) {
@@ -245,12 +258,12 @@ void add_plant(XmlWriter& x, const std::string& n, bool tree, const Eigen::Vecto
 
 }  // namespace
 
-void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed,
+void add_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uint64_t day_seed, std::uint64_t station_seed,
                const scenes::GroundRelief& ground) {
   if (a.mount == scenes::Mount::kSingleAxis)
-    add_tracker_array(x, a, index, day_seed, ground);
+    add_tracker_array(x, a, index, day_seed, station_seed, ground);
   else
-    add_fixed_array(x, a, index, day_seed, ground);
+    add_fixed_array(x, a, index, day_seed, station_seed, ground);
 }
 
 void add_walls(XmlWriter& x, const scenes::Scenario& s, const scenes::GroundRelief& ground) {

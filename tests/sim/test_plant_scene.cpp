@@ -2,11 +2,16 @@
 // camera's view that match frames drawn whole.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <map>
+#include <regex>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/renderer.hpp"
+#include "pvb/sim/scene_builder.hpp"
 #include "pvb/sim/simulator.hpp"
 
 namespace pvb::test {
@@ -71,6 +76,38 @@ TEST(PlantScene, CulledFramesMatchFramesDrawnWhole) {
   }
   EXPECT_GT(most_culled, sim.model()->ngeom / 2);
   EXPECT_GT(fence_pixels, 100);  // the fence was in view, and matched
+}
+
+/// The dust variant of each slab of array 0, by row, from the scene's MJCF.
+std::map<int, std::set<int>> slab_variants_by_row(const std::string& yaml) {
+  const scenes::Scenario s = scenes::parse_scenario(yaml, "rows.yaml");
+  const sim::SceneAssets a = sim::build_scene(s, sim::SceneDetail::kGeometry);
+  const std::regex slab("name=\"a0r([0-9]+)t[0-9]+slab\"[^>]*material=\"a0slab([0-9])\"");
+  std::map<int, std::set<int>> out;
+  for (std::sregex_iterator it(a.xml.begin(), a.xml.end(), slab), end; it != end; ++it)
+    out[std::stoi((*it)[1])].insert(std::stoi((*it)[2]));
+  return out;
+}
+
+// Soiling that varies from row to row: every table of a row has the row's
+// dust, the rows differ, and the same rows are the dirty ones every day.
+TEST(PlantScene, RowSoilingGivesEveryTableOfARowTheRowsDust) {
+  const std::string plant = "ground: {size_m: [300, 300], tiling: repeat}\nstation_seed: 9\n"
+                            "plant: {origin_m: [-60, -60], rows: 16, row_soiling: 0.6}\n"
+                            "route: {pattern: along_row, aisle: 1}\n";
+  const auto day1 = slab_variants_by_row("seed: 1\n" + plant), day2 = slab_variants_by_row("seed: 2\n" + plant);
+  ASSERT_EQ(day1.size(), 16u);
+  std::set<int> rows_dust;
+  for (const auto& [row, variants] : day1) {
+    EXPECT_EQ(variants.size(), 1u) << "row " << row;
+    rows_dust.insert(*variants.begin());
+  }
+  EXPECT_GE(rows_dust.size(), 3u);
+  EXPECT_EQ(day1, day2);
+  // Without it each table draws its own: some row mixes variants.
+  const auto mixed = slab_variants_by_row("seed: 1\n" + std::string("ground: {size_m: [300, 300], tiling: repeat}\n"
+                                          "plant: {origin_m: [-60, -60], rows: 16}\nroute: {pattern: along_row, aisle: 1}\n"));
+  EXPECT_TRUE(std::any_of(mixed.begin(), mixed.end(), [](const auto& r) { return r.second.size() > 1; }));
 }
 
 }  // namespace plant_scene_test

@@ -78,6 +78,7 @@ struct Plant {
   int combiner_rows = 6;
 
   double dirt = 0.2;
+  double row_soiling = 0.0;  ///< the spread of the rows' dust (PvArray::row_soiling); 0: rows alike
   bool specular_glass = false;
   bool identical_tables = false;
 };

@@ -114,6 +114,11 @@ struct PvArray {
   /// once per module (a plant's arrays: a few geoms a table, not one a
   /// module).  False: one geom per module, 2 cm apart.
   bool panel_slabs = false;
+  /// Soiling that varies from row to row (slabs only): every table of a row
+  /// takes the row's dust variant, drawn from the station's seed, and the
+  /// variants spread over dirt x [1 - s, 1 + s].  0: each table draws its
+  /// own variant from the day's seed, over dirt x [0.55, 1].
+  double row_soiling = 0.0;
   Mount mount = Mount::kFixed;
   TrackerMount tracker;  ///< mount single_axis only
   /// The tracker's rotation on the day (degrees; 0 for a fixed mount),
