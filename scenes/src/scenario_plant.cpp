@@ -126,6 +126,9 @@ Plant read_plant_section(MapReader& r) {
   read_fixtures(r, p);
   p.dirt = r.number("dirt", p.dirt, 0, 1);
   p.row_soiling = r.number("row_soiling", p.row_soiling, 0, 1);
+  const long long block_modules =
+      static_cast<long long>(p.rows_per_block) * p.tables_per_row * p.modules_per_table * p.modules_high;
+  p.broken_modules = r.integer("broken_modules", 0, 0, static_cast<int>(std::min<long long>(block_modules, 1000)));
   p.specular_glass = r.choice<bool>("glass", p.specular_glass, {{"diffuse", false}, {"specular", true}});
   p.identical_tables = r.boolean("identical_tables", p.identical_tables);
   return p;

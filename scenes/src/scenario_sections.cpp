@@ -105,7 +105,7 @@ void check_scene_size(const Scenario& s, const ReadContext& ctx) {
   std::size_t largest_index = 0;
   for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) {
     const PvArray& a = s.pv_arrays[i];
-    const long long n = static_cast<long long>(a.rows) * a.tables_per_row * table_geoms(a);
+    const long long n = static_cast<long long>(a.rows) * a.tables_per_row * table_geoms(a) + a.broken_modules;
     total += n;
     if (n > largest) {
       largest = n;

@@ -336,6 +336,8 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
   x.line("<material name=\"robot\" rgba=\"0.95 0.55 0.10 1\" specular=\"0.3\"/>");
   x.line("<material name=\"tyre\" rgba=\"0.08 0.08 0.08 1\"/>");
   add_plant_assets(x, s, ground);
+  if (std::any_of(s.pv_arrays.begin(), s.pv_arrays.end(), [](const scenes::PvArray& a) { return a.broken_modules > 0; }))
+    x.line("<material name=\"broken\" rgba=\"0.62 0.66 0.70 1\" specular=\"0.5\" shininess=\"0.3\"/>");  // shattered glass
   x.close("</asset>");
 }
 

@@ -4,9 +4,12 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <random>
+#include <set>
 
 #include "pvb/scenes/route.hpp"
 #include "scene_mjcf.hpp"
@@ -60,6 +63,33 @@ std::string table_slab_geom(const std::string& table, const scenes::PvArray& a, 
                     pre + "slab" + std::to_string(variant));
 }
 
+/// The modules of a slab array shown broken: a.broken_modules distinct
+/// (row, table, line, column), drawn from the station's seed.
+std::set<std::array<int, 4>> broken_modules(const scenes::PvArray& a, std::uint64_t station_seed, int index) {
+  std::set<std::array<int, 4>> out;
+  SplitMix pick(station_seed, 0xB40C0000ULL + static_cast<std::uint64_t>(index));
+  const auto draw = [&](int n) { return static_cast<int>(pick.next() % static_cast<std::uint64_t>(n)); };
+  while (static_cast<int>(out.size()) < a.broken_modules)
+    out.insert({draw(a.rows), draw(a.tables_per_row), draw(a.panel_lines), draw(a.panels_per_table)});
+  return out;
+}
+
+/// The broken modules of one table of a slab array: a pane of shattered
+/// glass just over each, `point(u, s)` the slab's surface, `normal` its face.
+void add_broken_modules(XmlWriter& x, const scenes::PvArray& a, const std::set<std::array<int, 4>>& broken, int row,
+                        int table, double u_start, const std::function<Eigen::Vector3d(double, double)>& point,
+                        const Eigen::Vector3d& normal, const std::string& axes, const std::string& tname) {
+  const double mw = a.table_length_m() / a.panels_per_table, mh = a.table_depth_m() / a.panel_lines;
+  for (auto it = broken.lower_bound({row, table, 0, 0}); it != broken.end() && (*it)[0] == row && (*it)[1] == table;
+       ++it) {
+    const Eigen::Vector3d c = point(u_start + ((*it)[3] + 0.5) * mw, ((*it)[2] + 0.5) * mh) +
+                              normal * (kPanelHalfThicknessM + 0.002);
+    x.line("<geom name=\"" + tname + "broken" + std::to_string((*it)[2]) + "_" + std::to_string((*it)[3]) +
+           "\" class=\"scenery\" type=\"box\" size=\"" + v3(0.49 * mw, 0.49 * mh, 0.001) + "\" pos=\"" + v3(c) +
+           "\" xyaxes=\"" + axes + "\" material=\"broken\"/>");
+  }
+}
+
 /// Where a post under `top` starts: on flat ground at z = 0, on a relief
 /// kIntoReliefM into the ground.
 double post_foot_m(const scenes::GroundRelief& ground, const Eigen::Vector3d& top) {
@@ -79,6 +109,7 @@ void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uin
   Placer rng = dust_placer(day_seed, index);
   const std::string pre = "a" + std::to_string(index);
   const Placer first_table_rng = rng;  // identical_tables: every table draws the first one's variants
+  const std::set<std::array<int, 4>> broken = broken_modules(a, station_seed, index);
   for (int row = 0; row < a.rows; ++row) {
     for (int t = 0; t < a.tables_per_row; ++t) {
       if (a.identical_tables) rng = first_table_rng;
@@ -95,6 +126,7 @@ void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uin
       if (a.panel_slabs) {
         x.line(table_slab_geom(tname, a, slope_point(u_start + tl / 2, td / 2), axes, pre, rng,
                                a.row_soiling > 0 ? row_dust_variant(station_seed, index, row) : -1));
+        add_broken_modules(x, a, broken, row, t, u_start, slope_point, normal, axes, tname);
       } else {
         for (int line = 0; line < a.panel_lines; ++line) {
           for (int c = 0; c < a.panels_per_table; ++c) {
@@ -149,6 +181,7 @@ void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::u
   Placer rng = dust_placer(day_seed, index);
   const Placer first_table_rng = rng;
   const std::string pre = "a" + std::to_string(index);
+  const std::set<std::array<int, 4>> broken = broken_modules(a, station_seed, index);
   for (int row = 0; row < a.rows; ++row) {
     for (int t = 0; t < a.tables_per_row; ++t) {
       if (a.identical_tables) rng = first_table_rng;
@@ -168,6 +201,7 @@ void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::u
       if (a.panel_slabs) {
         x.line(table_slab_geom(tname, a, plane_point(u_start + tl / 2, td / 2), axes, pre, rng,
                                a.row_soiling > 0 ? row_dust_variant(station_seed, index, row) : -1));
+        add_broken_modules(x, a, broken, row, t, u_start, plane_point, normal, axes, tname);
       } else {
         for (int line = 0; line < a.panel_lines; ++line)
           for (int c = 0; c < a.panels_per_table; ++c) {

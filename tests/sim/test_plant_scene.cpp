@@ -110,5 +110,25 @@ TEST(PlantScene, RowSoilingGivesEveryTableOfARowTheRowsDust) {
   EXPECT_TRUE(std::any_of(mixed.begin(), mixed.end(), [](const auto& r) { return r.second.size() > 1; }));
 }
 
+// Broken modules: the number asked for, each over one module of a table,
+// in the same places every day.
+TEST(PlantScene, BrokenModulesAreShatteredPanesWhereTheStationPutsThem) {
+  const auto panes = [](int seed) {
+    const scenes::Scenario s = scenes::parse_scenario(
+        "seed: " + std::to_string(seed) + "\nstation_seed: 4\nground: {size_m: [400, 300], tiling: repeat}\n"
+        "plant: {origin_m: [-60, -60], rows: 10, blocks: 2, blocks_along: 2, broken_modules: 7}\n"
+        "route: {pattern: along_row, aisle: 1}\n", "broken.yaml");
+    const sim::SceneAssets a = sim::build_scene(s, sim::SceneDetail::kGeometry);
+    const std::regex pane("<geom name=\"(a[0-9]+r[0-9]+t[0-9]+)broken[0-9]+_[0-9]+\"[^>]*material=\"broken\"");
+    std::multiset<std::string> tables;
+    for (std::sregex_iterator it(a.xml.begin(), a.xml.end(), pane), end; it != end; ++it) tables.insert((*it)[1]);
+    return std::make_pair(tables, a.xml.find("<geom name=\"a0r") != std::string::npos);
+  };
+  const auto [day1, drawn] = panes(1);
+  ASSERT_TRUE(drawn);
+  EXPECT_EQ(day1.size(), 2u * 7u);  // two blocks of 7
+  EXPECT_EQ(day1, panes(2).first);
+}
+
 }  // namespace plant_scene_test
 }  // namespace pvb::test

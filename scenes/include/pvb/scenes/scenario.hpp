@@ -119,6 +119,9 @@ struct PvArray {
   /// variants spread over dirt x [1 - s, 1 + s].  0: each table draws its
   /// own variant from the day's seed, over dirt x [0.55, 1].
   double row_soiling = 0.0;
+  /// Modules shown broken (slabs only): shattered glass over this many
+  /// modules of the array, where the station's seed puts them.
+  int broken_modules = 0;
   Mount mount = Mount::kFixed;
   TrackerMount tracker;  ///< mount single_axis only
   /// The tracker's rotation on the day (degrees; 0 for a fixed mount),
