@@ -75,67 +75,6 @@ PvArray read_array(MapReader& r) {
 
 }  // namespace
 
-/// Geoms the scene builder makes for what the scenario asks for (keep in step
-/// with sim/src/scene_builder.cpp): per table its panels, one backsheet, two
-/// rails and four posts; one per wall; two per shrub or tree.  The ground and
-/// the robot add about ten.
-long long table_geoms(const PvArray& a) {
-  const long long panels = a.panel_slabs ? 1 : static_cast<long long>(a.panels_per_table) * a.panel_lines;
-  // A tracker table: its panels, one backsheet, the torque tube and two posts.
-  if (a.mount == Mount::kSingleAxis) return panels + 2 + (a.posts ? 2 : 0);
-  const long long backsheet = 1, rails = a.rails ? 2 : 0, posts = a.posts ? 4 : 0;
-  return panels + backsheet + rails + posts;
-}
-
-/// MuJoCo's renderer draws at most 4000 geoms a frame (sim/src/renderer.cpp)
-/// and leaves the rest out of the image, with one warning.  Far larger scenes
-/// also take minutes in MuJoCo's compiler: 50 x 50 tables of 240 panels
-/// (617 500 geoms) were not compiled after 5 minutes.
-
-
-/// Refuses a scenario whose scene would not fit the renderer: one line naming
-/// the limit, the total and the largest array.
-void check_scene_size(const Scenario& s, const ReadContext& ctx) {
-  long long total = 2LL * (s.vegetation.shrubs + s.vegetation.trees) + static_cast<long long>(s.walls.size());
-  if (s.plant) {  // a fixture is one geom, a fence section one
-    total += static_cast<long long>(s.plant->fixtures.size());
-    if (s.plant->fence) total += static_cast<long long>(fence_sections(*s.plant->fence).size());
-  }
-  long long largest = -1;
-  std::size_t largest_index = 0;
-  for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) {
-    const PvArray& a = s.pv_arrays[i];
-    const long long n = static_cast<long long>(a.rows) * a.tables_per_row * table_geoms(a) + a.broken_modules;
-    total += n;
-    if (n > largest) {
-      largest = n;
-      largest_index = i;
-    }
-  }
-  if (total <= kMaxSceneGeoms) return;
-  std::string got = std::to_string(total);
-  if (s.plant) {
-    const PvArray& b = s.pv_arrays[static_cast<std::size_t>(s.plant->first_array)];
-    throw ConfigError(ctx.origins->where("plant", ctx.file), "plant",
-                      "at most " + std::to_string(kMaxSceneGeoms) +
-                          " geoms in the scene (a plant's table is its slab and up to 7 parts; a wall, a fixture or "
-                          "40 m of fence 1, a shrub or tree 2): fewer blocks or rows",
-                      got + " (" + std::to_string(s.plant->blocks) + " blocks x " + std::to_string(b.rows) +
-                          " rows x " + std::to_string(b.tables_per_row) + " tables x " +
-                          std::to_string(table_geoms(b)) + " geoms)");
-  }
-  if (largest >= 0) {
-    const PvArray& a = s.pv_arrays[largest_index];
-    got += " (pv_arrays[" + std::to_string(largest_index) + "]: " + std::to_string(a.rows) + " rows x " +
-           std::to_string(a.tables_per_row) + " tables x " + std::to_string(table_geoms(a)) + " geoms)";
-  }
-  throw ConfigError(ctx.origins->where("pv_arrays", ctx.file), "pv_arrays",
-                    "at most " + std::to_string(kMaxSceneGeoms) +
-                        " geoms in the scene (MuJoCo's renderer draws 4000; a table is panels_per_table x "
-                        "panel_lines panels + up to 7 parts, a wall 1, a shrub or tree 2)",
-                    got);
-}
-
 /// The sections of a scenario file, one reader each.
 void read_arrays(MapReader& top, std::vector<PvArray>& out) {
   if (const YAML::Node arrays = top.child("pv_arrays")) {
