@@ -495,6 +495,10 @@ void read_ground(MapReader& r, Ground& g) {
   g.soil_images = r.integer("soil_images", g.soil_images, 1, 1000);
   if (g.soil_images > 0 && g.tiling != GroundTiling::kVaried)
     r.fail(r.full("soil_images"), r.child("soil_images"), "soil_images with tiling: varied only");
+  g.unique_within_m = r.number("unique_within_m", g.unique_within_m, 0, 20);
+  if (r.has("unique_within_m") && g.soil_images == 0)
+    r.fail(r.full("unique_within_m"), r.child("unique_within_m"), "unique_within_m with soil_images only",
+           format_exact(g.unique_within_m));
   with_map(r, "relief", [&](MapReader& q) { read_relief(q, g); });
   // Blamed on the tiling, where it was written (a day file's over its
   // base's relief): a relief takes one repeated image.

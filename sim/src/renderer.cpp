@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "pvb/common/error.hpp"
+#include "pvb/sim/ground_stream.hpp"
 #include "pvb/sim/scene_builder.hpp"
 #include "pvb/sim/simulator.hpp"
 #include "pvb/sim/textures.hpp"
@@ -176,6 +177,23 @@ int cull_to_view(mjvScene* scn, double aspect, double far_tile_m, const double* 
   return culled;
 }
 
+void Renderer::apply_ground_stream() {
+  if (stream_ == nullptr) return;
+  const std::vector<std::uint64_t>& versions = stream_->slot_versions();
+  uploaded_.resize(versions.size(), 0);  // version 0: as mjr_makeContext uploaded the slot
+  for (std::size_t i = 0; i < versions.size(); ++i)
+    if (uploaded_[i] != versions[i]) {
+      mjr_uploadTexture(stream_->model(), &con_, stream_->slot_textures()[i]);
+      uploaded_[i] = versions[i];
+    }
+  for (int i = 0; i < scene_.ngeom; ++i) {
+    mjvGeom& g = scene_.geoms[i];
+    if (g.objtype != mjOBJ_GEOM || g.category != mjCAT_STATIC) continue;
+    const int tex = stream_->texture_of_geom(g.objid);
+    if (tex >= 0) g.texid = tex;
+  }
+}
+
 void Renderer::set_shadows(bool on) { scene_.flags[mjRND_SHADOW] = on ? 1 : 0; }
 
 void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat* rgb, cv::Mat* depth_m) {
@@ -186,6 +204,7 @@ void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat
   camera_.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
   culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_, model->geom_rbound) : 0;
+  apply_ground_stream();
   if (stable_shadows_) {
     const double texel_m = shadow_texel_m(con_.shadowClip, con_.shadowSize);
     for (int i = 0; i < scene_.nlight; ++i) {

@@ -155,7 +155,9 @@ std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std
       t.image = static_cast<int>(pick.next() % static_cast<std::uint64_t>(images));
       t.quarter_turns = static_cast<int>(pick.next() % 4);
       t.seed = shared_soil_image_seed(s.station_seed_or_seed(), t.image);
-      if (on_plant_road(s, t.centre_m)) {  // gravel: one of the road's images
+      t.own_seed = SplitMix(s.station_seed_or_seed(), 0x0A1E0000ULL + cell).next();
+      if (on_plant_road(s, t.centre_m)) {
+        t.gravel = true;  // gravel: one of the road's images
         SplitMix road(s.station_seed_or_seed(), 0x6A4E1000ULL + cell);
         t.image = images + static_cast<int>(road.next() % kRoadGravelImages);
         t.quarter_turns = static_cast<int>(road.next() % 4);
@@ -305,6 +307,17 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
     const std::string name = texture_name(file.first);
     x.line("<texture name=\"" + name + "\" type=\"2d\" file=\"" + file.first + "\"/>");
   }
+  // A ground of shared soil images: the slots of the images that tiles near
+  // the camera show instead (GroundStream fills them).
+  const int slots = s.ground.soil_images > 0 && out.detail == SceneDetail::kFull &&
+                                std::any_of(out.files.begin(), out.files.end(),
+                                            [](const auto& f) { return f.first.rfind(kGroundTilePrefix, 0) == 0; })
+                        ? unique_ground_slots(s.ground.unique_within_m)
+                        : 0;
+  for (int k = 0; k < slots; ++k)
+    x.line("<texture name=\"" + std::string(kGroundSlotPrefix) + std::to_string(k) +
+           "\" type=\"2d\" builtin=\"flat\" width=\"" + std::to_string(kGroundTexturePx) + "\" height=\"" +
+           std::to_string(kGroundTexturePx) + "\" rgb1=\"0.44 0.35 0.24\"/>");
   // The materials after every texture, as a scene without varied ground always had them.
   for (const auto& file : out.files) {
     if (!is_texture_file(file.first)) continue;

@@ -39,6 +39,7 @@ Simulator::Simulator(scenes::Scenario scenario, SceneDetail detail) : scenario_(
   assets_ = build_scene(scenario_, detail, TextureEncoding::kPixels);
   model_ = compile_scene(assets_);
   data_.reset(mj_makeData(model_.get()));
+  if (GroundStream::wanted(scenario_, detail)) ground_stream_ = std::make_unique<GroundStream>(model_.get(), scenario_);
   phys_model_ = compile_scene(physics_assets(assets_));
   phys_data_.reset(mj_makeData(phys_model_.get()));
   const mjModel* m = phys_model_.get();
@@ -111,6 +112,8 @@ void Simulator::sync_scene() {
   std::copy(p->mocap_quat, p->mocap_quat + 4 * m->nmocap, d->mocap_quat);
   d->time = p->time;
   mj_forward(m, d);
+  if (ground_stream_) ground_stream_->update(Eigen::Vector3d(d->cam_xpos[3 * camera_id_], d->cam_xpos[3 * camera_id_ + 1],
+                                                           d->cam_xpos[3 * camera_id_ + 2]));
 }
 
 Simulator::~Simulator() = default;
@@ -258,6 +261,7 @@ RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
       sensor_(sim) {
   renderer_.set_shadows(sim.scenario().light.shadows);
   renderer_.set_far_tile_cull_m(far_tile_cull_m(sim.scenario()));
+  renderer_.set_ground_stream(sim.ground_stream());
   std::vector<bool> specular;
   for (const auto& a : sim.scenario().pv_arrays) specular.push_back(a.specular_glass);
   glass_ = std::make_unique<GlassFinder>(sim.model(), specular);
@@ -267,6 +271,7 @@ RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
   ir_renderer_ = std::make_unique<Renderer>(sim.model(), renderer_.backend(), cam.stereo.ir_width, cam.stereo.ir_height);
   ir_renderer_->set_shadows(sim.scenario().light.shadows);
   ir_renderer_->set_far_tile_cull_m(far_tile_cull_m(sim.scenario()));
+  ir_renderer_->set_ground_stream(sim.ground_stream());
   ir_left_id_ = mj_name2id(sim.model(), mjOBJ_CAMERA, kIrLeftCameraName);
   ir_right_id_ = mj_name2id(sim.model(), mjOBJ_CAMERA, kIrRightCameraName);
   if (ir_left_id_ < 0 || ir_right_id_ < 0)

@@ -163,9 +163,17 @@ cv::Mat make_brick_texture(std::uint64_t seed) {
   return img;
 }
 
+int unique_ground_slots(double within_m) {
+  if (within_m <= 0) return 0;
+  // A tile is near when its centre lies within r = within_m + h (h: half the
+  // diagonal); the 3 m cells of those centres lie in the disc of r + h.
+  const double h = kGroundTileM / std::sqrt(2.0), r = within_m + 2 * h;
+  return static_cast<int>(std::ceil(M_PI * r * r / (kGroundTileM * kGroundTileM)));
+}
+
 cv::Mat make_ground_texture(scenes::GroundType type, std::uint64_t seed) {
   Rng rng(seed ^ 0x50C1);
-  const int n = 512;
+  const int n = kGroundTexturePx;
   cv::Mat low = value_noise(n, 6, &rng), mid = value_noise(n, 24, &rng);
   const bool gravel = type == scenes::GroundType::kGravel;
   const cv::Vec3d base = gravel ? cv::Vec3d(128, 124, 118) : cv::Vec3d(112, 88, 62);

@@ -65,6 +65,8 @@ TEST(PlantRoutes, CulledFramesMatchFramesDrawnWholeAlongTheKilometre) {
       sim::Renderer whole(sim.model(), sim::GlBackend::kAuto, 640, 480);
       culled.set_far_tile_cull_m(s.ground.soil_images > 0 ? s.camera.fx * sim::kSoilFeatureM / 0.5 : 0.0);
       whole.set_culling(false);
+      culled.set_ground_stream(sim.ground_stream());  // the near tiles' own images, in both
+      whole.set_ground_stream(sim.ground_stream());
       for (int frame = 0; frame < 10; ++frame) {
         cv::Mat rgb_c, depth_c, rgb_w, depth_w;
         culled.render(sim.model(), sim.data(), sim.camera_id(), &rgb_c, &depth_c);

@@ -1,6 +1,7 @@
 // A plant's ground of shared soil images: ORB descriptors of 1 m² soil
 // patches match only where two tiles took the same image (ORB does not see
-// a quarter turn), and that happens to about one far pair in N images.
+// a quarter turn), and that happens to about one far pair in N images;
+// near the camera, where every tile shows its own image, no far pair does.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,15 +27,17 @@ constexpr double kDifferentMax = 0.10;
 
 class Patches {
  public:
-  explicit Patches(const scenes::Scenario& s) : s_(s), tiles_(sim::ground_tiles(s)) {}
+  /// own: each tile's own image, as it shows near the camera (GroundStream).
+  explicit Patches(const scenes::Scenario& s, bool own = false) : s_(s), tiles_(sim::ground_tiles(s)), own_(own) {}
   const std::vector<sim::GroundTile>& tiles() const { return tiles_; }
 
   /// The 1 m² in the middle of tile k as the scene lays it (its image at its quarter turns), 2 px a texel.
   cv::Mat patch(std::size_t k) {
     const sim::GroundTile& t = tiles_[k];
-    auto it = images_.find(t.seed);
-    const scenes::GroundType type = t.image >= s_.ground.soil_images ? scenes::GroundType::kGravel : s_.ground.type;
-    if (it == images_.end()) it = images_.emplace(t.seed, sim::make_ground_texture(type, t.seed)).first;
+    const std::uint64_t seed = own_ ? t.own_seed : t.seed;
+    auto it = images_.find(seed);
+    const scenes::GroundType type = t.gravel ? scenes::GroundType::kGravel : s_.ground.type;
+    if (it == images_.end()) it = images_.emplace(seed, sim::make_ground_texture(type, seed)).first;
     cv::Mat img = it->second;
     for (int q = 0; q < t.quarter_turns; ++q) cv::rotate(img.clone(), img, cv::ROTATE_90_COUNTERCLOCKWISE);
     const int side = static_cast<int>(img.cols / sim::kGroundTileM);  // 1 m
@@ -72,6 +75,7 @@ class Patches {
   }
   scenes::Scenario s_;
   std::vector<sim::GroundTile> tiles_;
+  bool own_ = false;
   std::map<std::uint64_t, cv::Mat> images_;
   std::map<std::size_t, Features> features_;
 };
@@ -112,6 +116,26 @@ TEST(PlantSoil, FarPatchesMatchOnlyWhereTheyTookTheSameImage) {
   // ...and one far pair in soil_images takes the same image (at most three
   // times that: a binomial count of about 5 in 330 pairs stays below it).
   EXPECT_LE(static_cast<double>(far_same.size()) / far, 3.0 / s.ground.soil_images);
+}
+
+// Near the camera every tile shows an image of its own
+// (ground.unique_within_m): there no two patches 50 m or more apart match,
+// any more than patches of different images do.
+TEST(PlantSoil, NearTheCameraNoFarPatchesMatch) {
+  const scenes::Scenario s =
+      scenes::load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/plants/plant_10mw_tracker.yaml");
+  ASSERT_GT(s.ground.unique_within_m, 0.0);
+  Patches p(s, true);
+  const std::vector<sim::GroundTile>& t = p.tiles();
+  std::vector<double> far;
+  const std::size_t step = t.size() / 40;
+  for (std::size_t a = 0; a < t.size(); a += step)
+    for (std::size_t b = a + step / 2; b < t.size(); b += step)
+      if ((t[a].centre_m - t[b].centre_m).norm() >= 50.0) far.push_back(p.match_share(a, b));
+  ASSERT_GE(far.size(), 300u);
+  std::printf("own images: far pairs matched share mean %.4f max %.4f (%zu pairs)\n", mean(far),
+              *std::max_element(far.begin(), far.end()), far.size());
+  for (double share : far) EXPECT_LT(share, kDifferentMax);
 }
 
 // A plant's service roads are gravel: a tile whose centre lies on a road

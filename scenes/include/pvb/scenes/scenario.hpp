@@ -62,6 +62,10 @@ struct Ground {
   /// quarter turn, both from the station's seed and the tile's place
   /// (memory bounded by N, not by the route).
   int soil_images = 0;
+  /// With soil_images: within this distance of the camera every tile shows
+  /// an image of its own instead, drawn as the camera nears it, so no two
+  /// places of the route look alike up close (0: the shared images only).
+  double unique_within_m = 12.0;
   std::optional<Relief> relief;  ///< none: the flat plane z = 0
   /// The tiling the ground is drawn with: repeated under a relief.
   GroundTiling drawn_tiling() const { return relief ? GroundTiling::kRepeat : tiling; }

@@ -5,10 +5,14 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
+#include <cstdint>
 
 #include "pvb/sim/gl_context.hpp"
 
 namespace pvb::sim {
+
+class GroundStream;
 
 /// Renders one fixed camera of a model into RGB and metric depth.
 ///
@@ -51,6 +55,10 @@ class Renderer {
   /// left out too, where the base plane's repeated soil shows instead
   /// (0: none; cull_to_view).
   void set_far_tile_cull_m(double m) { far_tile_m_ = m; }
+  /// Draws the ground's tiles near the camera with their own images, as
+  /// `stream` holds them at each render (null: every tile its material's).
+  /// The stream must outlive the renderer or be unset first.
+  void set_ground_stream(const GroundStream* stream) { stream_ = stream; }
   /// Geoms the last render left out of the scene, and those it drew.
   int culled_geoms() const { return culled_; }
   int drawn_geoms() const { return scene_.ngeom; }
@@ -60,6 +68,9 @@ class Renderer {
   int height() const { return height_; }
 
  private:
+  /// Uploads the stream's redrawn slots and points its near tiles at them.
+  void apply_ground_stream();
+
   std::unique_ptr<GlContext> gl_;
   mjrContext con_;
   mjvScene scene_;
@@ -70,6 +81,8 @@ class Renderer {
   bool stable_shadows_ = true;
   bool cull_ = true;
   double far_tile_m_ = 0;
+  const GroundStream* stream_ = nullptr;
+  std::vector<std::uint64_t> uploaded_;  ///< the stream's slot versions this context holds
   int culled_ = 0;
   std::vector<unsigned char> rgb_buf_;
   std::vector<float> depth_buf_;

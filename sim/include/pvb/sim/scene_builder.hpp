@@ -71,6 +71,11 @@ struct GroundTile {
   std::uint64_t seed = 0;
   int image = -1;  ///< -1: an image of its own
   int quarter_turns = 0;
+  /// On a ground of shared soil images: the seed of the image the tile
+  /// shows near the camera (ground.unique_within_m; GroundStream), drawn
+  /// from the station's seed and the tile's place.
+  std::uint64_t own_seed = 0;
+  bool gravel = false;  ///< on a plant's service road: its images are gravel
 };
 /// The tiles of a varied ground along the scenario's route (none for a
 /// repeated one), as the scene lays them.

@@ -12,6 +12,7 @@
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sensor/rgbd_frame.hpp"
 #include "pvb/sim/active_stereo.hpp"
+#include "pvb/sim/ground_stream.hpp"
 #include "pvb/sim/motion_sensors.hpp"
 #include "pvb/sim/renderer.hpp"
 #include "pvb/sim/robot.hpp"
@@ -84,6 +85,9 @@ class Simulator {
   mjData* data() { return data_.get(); }
   const mjData* data() const { return data_.get(); }
   int camera_id() const { return camera_id_; }
+  /// The images of the ground's tiles near the camera, kept up to date with
+  /// every frame (GroundStream), or null where the ground has none.
+  const GroundStream* ground_stream() const { return ground_stream_.get(); }
 
  private:
   void step_physics(int steps);
@@ -117,6 +121,7 @@ class Simulator {
   DataPtr kidnap_data_;                           ///< the physics' state at kidnap_->target
   std::optional<RouteFollower> kidnap_follower_;  ///< the follower at kidnap_->target
   std::unique_ptr<MotionSensors> motion_;         ///< from frame 0 on
+  std::unique_ptr<GroundStream> ground_stream_;  ///< follows camera_id_ in sync_scene
   std::unique_ptr<CarryPath> carry_;        ///< while the kidnap carries the robot
   int carry_step_ = 0;
 };

@@ -22,6 +22,15 @@ constexpr double kBrickTileHeightM = 0.75;  // 10 courses of 0.065 m + 10 mm joi
 /// Soil or gravel; the image covers kGroundTileM x kGroundTileM.
 cv::Mat make_ground_texture(scenes::GroundType type, std::uint64_t seed);
 constexpr double kGroundTileM = 3.0;
+/// The side of a ground image, pixels (512: a texel of 6 mm).
+constexpr int kGroundTexturePx = 512;
+/// The textures that hold the images of a ground's tiles near the camera
+/// (GroundStream): grounds0, grounds1, ...
+constexpr const char* kGroundSlotPrefix = "grounds";
+/// How many tile images a ground keeps near the camera: every tile with a
+/// point within `within_m` of the camera (a centre within within_m plus
+/// half a tile's diagonal) fits, wherever the camera stands.
+int unique_ground_slots(double within_m);
 /// A varied ground (ground.tiling: varied) gives every 3 m tile within
 /// this distance of the route an image of its own (the camera resolves the
 /// soil's stones closer than that); the repeated image lies beyond.
