@@ -4,7 +4,8 @@
 //   bench_render --gl=egl      (or --gl=osmesa, --gl=auto; default auto)
 //   bench_render --scenario=scenes/rough_station.yaml   (default: the station)
 // Benchmarks: render+readback with and without shadows, the full capture
-// (render, sky mask, Kinect depth model, RGB noise) and one physics frame.
+// (render, sky mask, Kinect depth model, RGB noise), one physics frame and
+// one soil image.
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 
@@ -14,6 +15,7 @@
 
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/simulator.hpp"
+#include "pvb/sim/textures.hpp"
 
 namespace {
 
@@ -95,6 +97,14 @@ void BM_PhysicsFrame(benchmark::State& state) {
   for (auto _ : state) w.sim->advance();
 }
 BENCHMARK(BM_PhysicsFrame)->Unit(benchmark::kMillisecond);
+
+// One soil image drawn from its seed: what a ground tile near the camera
+// costs when the camera comes near it (GroundStream).
+void BM_GroundTexture(benchmark::State& state) {
+  std::uint64_t seed = 1;
+  for (auto _ : state) benchmark::DoNotOptimize(pvb::sim::make_ground_texture(pvb::scenes::GroundType::kSoil, ++seed));
+}
+BENCHMARK(BM_GroundTexture)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
