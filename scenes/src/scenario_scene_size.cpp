@@ -18,13 +18,11 @@ long long table_geoms(const PvArray& a) {
   return panels + backsheet + rails + posts;
 }
 
-/// MuJoCo's renderer draws at most 4000 geoms a frame (sim/src/renderer.cpp)
-/// and leaves the rest out of the image, with one warning.  Far larger scenes
-/// also take minutes in MuJoCo's compiler: 50 x 50 tables of 240 panels
-/// (617 500 geoms) were not compiled after 5 minutes.
+/// At most kMaxSceneGeoms geoms: what MuJoCo's compiler builds in seconds
+/// (scenario_sections.hpp); the renderer draws the ones in view.
 ///
-/// Refuses a scenario whose scene would not fit the renderer: one line naming
-/// the limit, the total and the largest array.
+/// Refuses a scenario whose scene would be larger: one line naming the
+/// limit, the total and the largest array.
 void check_scene_size(const Scenario& s, const ReadContext& ctx) {
   long long total = 2LL * (s.vegetation.shrubs + s.vegetation.trees) + static_cast<long long>(s.walls.size());
   if (s.plant) {  // a fixture is one geom, a fence section one
@@ -61,7 +59,7 @@ void check_scene_size(const Scenario& s, const ReadContext& ctx) {
   }
   throw ConfigError(ctx.origins->where("pv_arrays", ctx.file), "pv_arrays",
                     "at most " + std::to_string(kMaxSceneGeoms) +
-                        " geoms in the scene (MuJoCo's renderer draws 4000; a table is panels_per_table x "
+                        " geoms in the scene (what MuJoCo compiles in seconds; a table is panels_per_table x "
                         "panel_lines panels + up to 7 parts, a wall 1, a shrub or tree 2)",
                     got);
 }

@@ -158,10 +158,10 @@ namespace plant_test {
 
 TEST(PlantErrors, APlantLargerThanTheSceneLimitIsRefusedAtItsKey) {
   const std::string e = error_of(
-      "ground: {size_m: [2000, 2000]}\nplant:\n  rows: 100\n  tables_per_row: 10\n  origin_m: [-200, -600]\n"
+      "ground: {size_m: [2000, 2000]}\nplant:\n  rows: 100\n  tables_per_row: 30\n  origin_m: [-700, -600]\n"
       "route: {pattern: along_row}\n");
-  EXPECT_NE(e.find("bad.yaml:2: plant: expected at most 3800 geoms in the scene"), std::string::npos) << e;
-  EXPECT_NE(e.find("(1 blocks x 100 rows x 10 tables x 8 geoms)"), std::string::npos) << e;
+  EXPECT_NE(e.find("bad.yaml:2: plant: expected at most 20000 geoms in the scene"), std::string::npos) << e;
+  EXPECT_NE(e.find("(1 blocks x 100 rows x 30 tables x 8 geoms)"), std::string::npos) << e;
 }
 
 }  // namespace plant_test

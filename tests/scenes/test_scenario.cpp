@@ -246,14 +246,14 @@ TEST(Scenario, EveryShippedScenarioHasBoundsAndTheCiSubsetIsSmall) {
   EXPECT_LE(in_ci, 3);
 }
 
-// A scene larger than MuJoCo's renderer draws (4000 geoms) is refused with
-// one line naming the key, the limit and the largest array, even when every
-// key is within its own range: 50 x 50 tables of 240 panels did not compile
-// in 5 minutes, and 50 x 50 tables of 16 panels lose geoms in the image.
+// A scene larger than MuJoCo compiles in seconds (20 000 geoms) is refused
+// with one line naming the key, the limit and the largest array, even when
+// every key is within its own range: 50 x 50 tables of 240 panels did not
+// compile in 5 minutes.
 TEST(Scenario, SceneLargerThanTheRendererDrawsIsRefused) {
   const std::string big = std::string(kMinimal) + "pv_arrays:\n  - {rows: 50, tables_per_row: 50}\n";
   const std::string e = error_of(big);
-  EXPECT_EQ(e.rfind("bad.yaml:2: pv_arrays: expected at most 3800 geoms in the scene", 0), 0u) << e;
+  EXPECT_EQ(e.rfind("bad.yaml:2: pv_arrays: expected at most 20000 geoms in the scene", 0), 0u) << e;
   // 2500 tables x (16 panels + backsheet + 2 rails + 4 posts)
   EXPECT_NE(e.find("got 57500 (pv_arrays[0]: 50 rows x 50 tables x 23 geoms)"), std::string::npos) << e;
   EXPECT_EQ(e.find('\n'), std::string::npos) << e;
@@ -268,21 +268,21 @@ TEST(Scenario, SceneLargerThanTheRendererDrawsIsRefused) {
 }
 
 // The limit counts every array, wall, shrub and tree: a scene of exactly
-// 3800 geoms loads, one more shrub (two geoms) does not.
+// 20 000 geoms loads, one more shrub (two geoms) does not.
 TEST(Scenario, SceneSizeLimitCountsEveryPart) {
   const std::string arrays =
       "pv_arrays:\n"
-      "  - {rows: 5, tables_per_row: 10, panels_per_table: 30, panel_lines: 1}\n"  // 50 x 37 = 1850
-      "  - {origin_m: [0, 100], rows: 5, tables_per_row: 10, panels_per_table: 30, panel_lines: 1,"
-      " posts: false, rails: false}\n";  // 50 x 31 = 1550
+      "  - {rows: 50, tables_per_row: 10, panels_per_table: 30, panel_lines: 1}\n"  // 500 x 37 = 18500
+      "  - {origin_m: [0, 400], rows: 2, tables_per_row: 10, panels_per_table: 30, panel_lines: 1,"
+      " posts: false, rails: false}\n";  // 20 x 31 = 620
   const std::string walls =
       "walls:\n  - {start_m: [0, -5], end_m: [5, -5]}\n  - {start_m: [0, -8], end_m: [5, -8]}\n";
   const auto with_shrubs = [&](int n) {
     return std::string(kMinimal) + arrays + walls + "vegetation: {shrubs: " + std::to_string(n) + "}\n";
   };
-  EXPECT_EQ(error_of(with_shrubs(199)), "");  // 1850 + 1550 + 2 + 398 = 3800
-  const std::string e = error_of(with_shrubs(200));
-  EXPECT_NE(e.find("got 3802 (pv_arrays[0]: 5 rows x 10 tables x 37 geoms)"), std::string::npos) << e;
+  EXPECT_EQ(error_of(with_shrubs(439)), "");  // 18500 + 620 + 2 + 878 = 20000
+  const std::string e = error_of(with_shrubs(440));
+  EXPECT_NE(e.find("got 20002 (pv_arrays[0]: 50 rows x 10 tables x 37 geoms)"), std::string::npos) << e;
 }
 
 TEST(Scenario, LoopLapsAreReadAndRefusedOnOtherPatterns) {
@@ -426,9 +426,9 @@ TEST(Scenario, TooDeepNestingSaysSo) {
 // walls took 20 s and 1.1 GB before its geom count was checked).
 TEST(Scenario, HugeFilesAndWallListsAreRefusedBeforeTheyAreBuilt) {
   std::string walls = "walls:\n";
-  for (int i = 0; i < 4000; ++i) walls += "  - {start_m: [0, " + std::to_string(i) + "], end_m: [1, " + std::to_string(i) + "]}\n";
+  for (int i = 0; i < 20001; ++i) walls += "  - {start_m: [0, 0], end_m: [1, 0]}\n";
   std::string e = error_of(std::string(kMinimal) + walls);
-  EXPECT_NE(e.find("bad.yaml:2: walls: expected at most 3800 walls (the renderer's geom limit), got 4000"),
+  EXPECT_NE(e.find("bad.yaml:2: walls: expected at most 20000 walls (the scene's geom limit), got 20001"),
             std::string::npos)
       << e;
   std::string huge = std::string(kMinimal) + "description: \"" + std::string(2 * 1024 * 1024, 'x') + "\"\n";

@@ -35,7 +35,7 @@ std::string in_fresh_folder(const std::string& name, Fn fn) {
 
 // compile_scene is the first MuJoCo call of every command: after it, a
 // MuJoCo warning (here the real one of a visual scene too small for the
-// model, as with a scene of more than 4000 geoms) is one stderr line.
+// model, as with a scene larger than its room for geoms) is one stderr line.
 TEST(MujocoLog, WarningAfterCompileIsOneStderrLineAndNoLogFile) {
   std::string err;
   const std::string dir = in_fresh_folder("compile", [&] {
