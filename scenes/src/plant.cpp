@@ -1,6 +1,7 @@
 #include "pvb/scenes/plant.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "pvb/scenes/route.hpp"
 
@@ -54,6 +55,25 @@ void add_combiner_boxes(const Plant& p, PlantLayout* out) {
                                   0.0, FixtureFinish::kSteel));
       out->fixtures.push_back(box(block, u_box, v, {kCombinerBoxAlongM, kCombinerBoxAcrossM, kCombinerBoxHighM},
                                   kCombinerBoxBaseM, FixtureFinish::kEnclosure));
+    }
+  }
+}
+
+/// A sign with the row's number past both ends of every row of every
+/// block: "B<block> R<row>", counted from 1 in the order the blocks are laid.
+void add_row_signs(const Plant& p, PlantLayout* out) {
+  if (!p.row_signs) return;
+  for (std::size_t b = 0; b < out->blocks.size(); ++b) {
+    const PvArray& block = out->blocks[b];
+    const double u_west = -kRowSignEndM - kRowSignPostM / 2, u_east = row_length_m(block) - u_west;
+    for (int row = 0; row < block.rows; ++row) {
+      const double v = row * block.row_pitch_m + row_footprint_m(block) / 2 - kRowSignAsideM;
+      const int label = static_cast<int>(out->sign_labels.size());
+      char text[32];
+      std::snprintf(text, sizeof text, "B%zu R%03d", b + 1, row + 1);
+      out->sign_labels.emplace_back(text);
+      out->row_signs.push_back({array_to_world(block, u_west, v), block.azimuth_deg + 180.0, label});
+      out->row_signs.push_back({array_to_world(block, u_east, v), block.azimuth_deg, label});
     }
   }
 }
@@ -201,6 +221,7 @@ PlantLayout lay_out_plant(const Plant& p) {
   add_roads(p, stride_u, stride_v, rows_depth_m, columns, lines, &out);
   add_dock(p, base, aisle_m, &out);
   add_combiner_boxes(p, &out);
+  add_row_signs(p, &out);
   return out;
 }
 

@@ -114,6 +114,7 @@ void read_fixtures(MapReader& r, Plant& p) {
                " to hold the dock and the robot in front of it (or dock: false)",
            "a headland of " + format_exact(p.headland_m) + " m");
   p.combiner_rows = r.integer("combiner_rows", p.combiner_rows, 0, 400);
+  p.row_signs = r.boolean("row_signs", p.row_signs);
 }
 
 Plant read_plant_section(MapReader& r) {
@@ -225,6 +226,8 @@ void read_plant(MapReader& top, Scenario& s) {
   sum.perimeter_road_m = layout.perimeter_road_m;
   sum.fence = layout.fence;
   sum.fixtures = layout.fixtures;
+  sum.row_signs = layout.row_signs;
+  sum.sign_labels = layout.sign_labels;
   sum.dock_aisle = p.dock_aisle;
   sum.dock_front_u_m = layout.dock_front_u_m;
   sum.dock_v_m = layout.dock_v_m;
@@ -261,6 +264,8 @@ bool in_a_fixture(const Scenario& s, const PlantSummary& plant, const Eigen::Vec
   };
   for (const Fixture& f : plant.fixtures)  // the dock's canopy stands over the robot
     if (f.base_m < kOverheadM && in_box(f.centre_m, f.yaw_deg, f.size_m.x(), f.size_m.y())) return true;
+  for (const RowSign& r : plant.row_signs)  // the post, the plate across it
+    if (in_box(r.centre_m, r.yaw_deg, kRowSignPostM, kRowSignPlateWideM)) return true;
   for (std::size_t i = s.walls.size() - static_cast<std::size_t>(plant.inverter_stations); i < s.walls.size(); ++i) {
     const Wall& w = s.walls[i];
     const Eigen::Vector2d d = w.end_m - w.start_m;
@@ -330,7 +335,7 @@ void check_plant_route(const Scenario& s, const ReadContext& ctx) {
                    " from every table (the robot's half width)", p, along_m);
     if (in_a_fixture(s, plant, p, kRouteTableClearanceM))
       refuse("a route that keeps " + format_number("%.2f m", kRouteTableClearanceM) +
-                 " from the dock, the combiner boxes and the inverter stations", p, along_m);
+                 " from the dock, the combiner boxes, the row signs and the inverter stations", p, along_m);
   }
 }
 

@@ -26,7 +26,7 @@ long long table_geoms(const PvArray& a) {
 void check_scene_size(const Scenario& s, const ReadContext& ctx) {
   long long total = 2LL * (s.vegetation.shrubs + s.vegetation.trees) + static_cast<long long>(s.walls.size());
   if (s.plant) {  // a fixture is one geom, a fence section one
-    total += static_cast<long long>(s.plant->fixtures.size());
+    total += static_cast<long long>(s.plant->fixtures.size() + 2 * s.plant->row_signs.size());
     if (s.plant->fence) total += static_cast<long long>(fence_sections(*s.plant->fence).size());
   }
   long long largest = -1;
@@ -47,7 +47,7 @@ void check_scene_size(const Scenario& s, const ReadContext& ctx) {
     throw ConfigError(ctx.origins->where("plant", ctx.file), "plant",
                       "at most " + std::to_string(kMaxSceneGeoms) +
                           " geoms in the scene (a plant's table is its slab and up to 7 parts; a wall, a fixture or "
-                          "40 m of fence 1, a shrub or tree 2): fewer blocks or rows",
+                          "40 m of fence 1, a shrub, a tree or a row sign 2): fewer blocks or rows",
                       got + " (" + std::to_string(s.plant->blocks) + " blocks x " + std::to_string(b.rows) +
                           " rows x " + std::to_string(b.tables_per_row) + " tables x " +
                           std::to_string(table_geoms(b)) + " geoms)");

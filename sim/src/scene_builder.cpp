@@ -208,6 +208,8 @@ void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tile
     });
   for (std::size_t k = 0; k < seeds.size(); ++k)
     out->files.emplace_back(kGroundTilePrefix + std::to_string(k) + ".png", std::move(tile_png[k]));
+  if (s.plant && !s.plant->row_signs.empty())
+    add("rowsigns", [&] { return make_sign_atlas(s.plant->sign_labels); });
   add("brick", [&] { return make_brick_texture(station_seed); });
   add("foliage", [&] { return make_foliage_texture(station_seed); });
   add("bark", [&] { return make_bark_texture(station_seed); });

@@ -1,10 +1,12 @@
 // A plant's fixtures in the scene: the perimeter fence (posts, wires and
-// gates as one mesh a section), the dock and the combiner boxes.
+// gates as one mesh a section), the dock, the combiner boxes and the row
+// signs (a post and a plate with the row's number).
 #include <algorithm>
 #include <array>
 #include <cmath>
 
 #include "pvb/scenes/plant.hpp"
+#include "pvb/sim/textures.hpp"
 #include "scene_mjcf.hpp"
 
 namespace pvb::sim::mjcf {
@@ -143,6 +145,33 @@ const char* finish_material(scenes::FixtureFinish f) {
   return "steel";
 }
 
+/// A row sign's plate as a mesh: the plate's centre at the origin, its
+/// front facing +x, its width along y, the label's cell of the atlas on the
+/// front and on the back, each read the right way round from its side.
+std::string sign_plate_mesh_line(const std::string& name, int label, int labels) {
+  const int lines = std::max(1, (labels + kSignAtlasColumns - 1) / kSignAtlasColumns);
+  const double u0 = static_cast<double>(label % kSignAtlasColumns) / kSignAtlasColumns,
+               u1 = u0 + 1.0 / kSignAtlasColumns;
+  // MuJoCo's texture coordinate v runs from the image's first row down.
+  const double v_top = static_cast<double>(label / kSignAtlasColumns) / lines, v_bottom = v_top + 1.0 / lines;
+  const double t = scenes::kRowSignPlateThickM / 2, w = scenes::kRowSignPlateWideM / 2,
+               h = scenes::kRowSignPlateHighM / 2;
+  // Front (x = +t; the viewer's right is +y), then back (x = -t; right is -y):
+  // bottom left, bottom right, top right, top left as each viewer sees them.
+  const std::array<Eigen::Vector3d, 8> vertices = {
+      Eigen::Vector3d(t, -w, -h), Eigen::Vector3d(t, w, -h),   Eigen::Vector3d(t, w, h),   Eigen::Vector3d(t, -w, h),
+      Eigen::Vector3d(-t, w, -h), Eigen::Vector3d(-t, -w, -h), Eigen::Vector3d(-t, -w, h), Eigen::Vector3d(-t, w, h)};
+  const std::array<std::array<double, 2>, 4> corners = {{{u0, v_bottom}, {u1, v_bottom}, {u1, v_top}, {u0, v_top}}};
+  std::string v, tc;
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    v += (i ? "  " : "") + v3(vertices[i]);
+    tc += (i ? "  " : "") + f(corners[i % 4][0]) + " " + f(corners[i % 4][1]);
+  }
+  // Both faces, then the edges: bottom, right of the front, top, left of the front.
+  const char* faces = "0 1 2  0 2 3  4 5 6  4 6 7  0 5 4  0 4 1  1 4 7  1 7 2  2 7 6  2 6 3  3 6 5  3 5 0";
+  return "<mesh name=\"" + name + "\" vertex=\"" + v + "\" texcoord=\"" + tc + "\" face=\"" + faces + "\"/>";
+}
+
 std::string mesh_line(const std::string& name, const FenceMesh& m) {
   std::string v, fc;
   v.reserve(m.vertices.size() * 24);
@@ -159,6 +188,12 @@ void add_plant_assets(XmlWriter& x, const scenes::Scenario& s, const scenes::Gro
   // A combiner box's or the dock's light grey polyester; galvanised chain link.
   x.line("<material name=\"enclosure\" rgba=\"0.86 0.86 0.84 1\" specular=\"0.15\" shininess=\"0.2\"/>");
   x.line("<material name=\"fence\" rgba=\"0.66 0.68 0.70 1\" specular=\"0.3\" shininess=\"0.3\"/>");
+  if (!s.plant->row_signs.empty()) {
+    x.line("<material name=\"rowsign\" texture=\"rowsigns\" specular=\"0.2\" shininess=\"0.3\"/>");
+    const int labels = static_cast<int>(s.plant->sign_labels.size());
+    for (std::size_t k = 0; k < s.plant->row_signs.size(); ++k)
+      x.line(sign_plate_mesh_line("sign" + std::to_string(k), s.plant->row_signs[k].label, labels));
+  }
   if (!s.plant->fence) return;
   const auto meshes = fence_meshes(*s.plant->fence, ground);
   for (std::size_t k = 0; k < meshes.size(); ++k)
@@ -176,6 +211,21 @@ void add_plant_fixtures(XmlWriter& x, const scenes::Scenario& s, const scenes::G
       x.line("<geom name=\"fence" + std::to_string(k) + "\" class=\"scenery\" type=\"mesh\" mesh=\"fence" +
              std::to_string(k) + "\" pos=\"" + v3(p.x(), p.y(), 0) + "\" material=\"fence\"/>");
     }
+  }
+  for (std::size_t k = 0; k < plant.row_signs.size(); ++k) {
+    const scenes::RowSign& r = plant.row_signs[k];
+    const double yaw = r.yaw_deg * M_PI / 180.0, z0 = ground.height_m(r.centre_m);
+    const double foot = ground.flat() ? 0.0 : kIntoReliefM;
+    x.line("<geom name=\"signpost" + std::to_string(k) + "\" class=\"scenery\" type=\"box\" size=\"" +
+           v3(scenes::kRowSignPostM / 2, scenes::kRowSignPostM / 2, (scenes::kRowSignPostHighM + foot) / 2) +
+           "\" pos=\"" + v3(r.centre_m.x(), r.centre_m.y(), z0 + (scenes::kRowSignPostHighM - foot) / 2) +
+           "\" euler=\"0 0 " + f(r.yaw_deg) + "\" material=\"steel\"/>");
+    // The plate on the post's front face.
+    const double out_m = scenes::kRowSignPostM / 2 + scenes::kRowSignPlateThickM / 2;
+    const Eigen::Vector3d c(r.centre_m.x() + out_m * std::cos(yaw), r.centre_m.y() + out_m * std::sin(yaw),
+                            z0 + scenes::kRowSignPlateBaseM + scenes::kRowSignPlateHighM / 2);
+    x.line("<geom name=\"sign" + std::to_string(k) + "\" class=\"scenery\" type=\"mesh\" mesh=\"sign" +
+           std::to_string(k) + "\" pos=\"" + v3(c) + "\" euler=\"0 0 " + f(r.yaw_deg) + "\" material=\"rowsign\"/>");
   }
   for (std::size_t i = 0; i < plant.fixtures.size(); ++i) {
     const scenes::Fixture& fx = plant.fixtures[i];

@@ -207,6 +207,29 @@ cv::Mat make_ground_texture(scenes::GroundType type, std::uint64_t seed) {
   return img;
 }
 
+cv::Mat make_sign_atlas(const std::vector<std::string>& labels) {
+  const int lines = std::max(1, (static_cast<int>(labels.size()) + kSignAtlasColumns - 1) / kSignAtlasColumns);
+  cv::Mat img(lines * kSignCellHeightPx, kSignAtlasColumns * kSignCellWidthPx, CV_8UC3, rgb(236, 236, 230));
+  const cv::Scalar ink = rgb(20, 22, 26);
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    const cv::Point corner(static_cast<int>(i % kSignAtlasColumns) * kSignCellWidthPx,
+                           static_cast<int>(i / kSignAtlasColumns) * kSignCellHeightPx);
+    cv::rectangle(img, cv::Rect(corner, cv::Size(kSignCellWidthPx, kSignCellHeightPx)), ink, 4);
+    const std::size_t space = labels[i].find(' ');
+    const std::string words[2] = {space == std::string::npos ? "" : labels[i].substr(0, space),
+                                  space == std::string::npos ? labels[i] : labels[i].substr(space + 1)};
+    const double scale[2] = {0.8, 1.25};
+    const int thick[2] = {2, 3}, baseline[2] = {32, 80};
+    for (int w = 0; w < 2; ++w) {
+      int base = 0;
+      const cv::Size size = cv::getTextSize(words[w], cv::FONT_HERSHEY_SIMPLEX, scale[w], thick[w], &base);
+      cv::putText(img, words[w], corner + cv::Point((kSignCellWidthPx - size.width) / 2, baseline[w]),
+                  cv::FONT_HERSHEY_SIMPLEX, scale[w], ink, thick[w], cv::LINE_AA);
+    }
+  }
+  return img;
+}
+
 cv::Mat make_foliage_texture(std::uint64_t seed) {
   Rng rng(seed ^ 0xF011);
   const int n = 256;

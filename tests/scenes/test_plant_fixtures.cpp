@@ -161,8 +161,8 @@ TEST(PlantErrors, ARouteThroughTheDockIsRefused) {
   // Along the dock's aisle from beyond the headland's edge: through the cabinet.
   const std::string e = error_of(
       "ground: {size_m: [400, 400]}\nplant: {rows: 4}\nroute:\n  waypoints_m: [[-12, -3], [-2, -3]]\n");
-  EXPECT_NE(e.find("route.waypoints_m: expected a route that keeps 0.30 m from the dock, the combiner boxes and the "
-                   "inverter stations"),
+  EXPECT_NE(e.find("route.waypoints_m: expected a route that keeps 0.30 m from the dock, the combiner boxes, the row "
+                   "signs and the inverter stations"),
             std::string::npos)
       << e;
 }

@@ -9,10 +9,13 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/renderer.hpp"
 #include "pvb/sim/scene_builder.hpp"
 #include "pvb/sim/simulator.hpp"
+#include "pvb/sim/textures.hpp"
 
 namespace pvb::test {
 namespace plant_scene_test {
@@ -128,6 +131,91 @@ TEST(PlantScene, BrokenModulesAreShatteredPanesWhereTheStationPutsThem) {
   ASSERT_TRUE(drawn);
   EXPECT_EQ(day1.size(), 2u * 7u);  // two blocks of 7
   EXPECT_EQ(day1, panes(2).first);
+}
+
+/// How well two grey images of one size agree: their normalised correlation.
+double agreement(const cv::Mat& a, const cv::Mat& b) {
+  cv::Mat r;
+  cv::matchTemplate(a, b, r, cv::TM_CCOEFF_NORMED);
+  return r.at<float>(0, 0);
+}
+
+// Every row has its number on a sign at both ends: a plate seen from in
+// front (the headland) shows its row's label the right way round, at the
+// west end and at the east; its back shows the label mirrored in the
+// plate's frame, so that it reads the right way round from behind too.
+TEST(PlantScene, RowSignsShowTheirRowsNumberTheRightWayRound) {
+  const std::string plant = "ground: {size_m: [120, 120], tiling: repeat}\nseed: 4\nduration_s: 2\n"
+                            "plant: {origin_m: [-20, -10], rows: 4, tables_per_row: 1, modules_per_table: 12, "
+                            "dock: false, combiner_rows: 0}\n";
+  const scenes::Scenario bare = scenes::parse_scenario(plant + "route: {pattern: along_row, aisle: 1}\n", "s.yaml");
+  ASSERT_EQ(bare.plant->row_signs.size(), 8u);  // two a row
+  ASSERT_EQ(bare.plant->sign_labels.size(), 4u);
+  EXPECT_EQ(bare.plant->sign_labels[2], "B1 R003");
+  const cv::Mat atlas = sim::make_sign_atlas(bare.plant->sign_labels);
+  for (const int k : {4, 5}) {  // row 3's west sign and its east sign
+    const scenes::RowSign& sign = bare.plant->row_signs[static_cast<std::size_t>(k)];
+    EXPECT_EQ(sign.label, 2);
+    const double yaw = sign.yaw_deg * M_PI / 180.0;
+    const Eigen::Vector2d out(std::cos(yaw), std::sin(yaw));
+    const Eigen::Vector2d a = sign.centre_m + 2.2 * out, b = sign.centre_m + 1.0 * out;
+    char route[160];
+    std::snprintf(route, sizeof route, "route: {waypoints_m: [[%.3f, %.3f], [%.3f, %.3f]]}\n", a.x(), a.y(), b.x(),
+                  b.y());
+    sim::Simulator sim(scenes::parse_scenario(plant + route, "s.yaml"));
+    sim::Renderer r(sim.model(), sim::GlBackend::kAuto, sim.scenario().camera.width, sim.scenario().camera.height);
+    cv::Mat rgb, depth, ids;
+    r.render(sim.model(), sim.data(), sim.camera_id(), &rgb, &depth);
+    r.render_geom_ids(sim.model(), sim.data(), sim.camera_id(), &ids);
+    const int plate = mj_name2id(sim.model(), mjOBJ_GEOM, ("sign" + std::to_string(k)).c_str());
+    ASSERT_GE(plate, 0);
+    const cv::Rect box = cv::boundingRect(ids == plate);
+    ASSERT_GT(box.width, 60) << "sign " << k;
+    // The plate as seen, against the label's cell of the atlas.
+    cv::Mat grey, seen, want, mirrored, upside_down;
+    cv::cvtColor(rgb(box), grey, cv::COLOR_RGB2GRAY);
+    cv::cvtColor(atlas(cv::Rect((sign.label % sim::kSignAtlasColumns) * sim::kSignCellWidthPx,
+                                (sign.label / sim::kSignAtlasColumns) * sim::kSignCellHeightPx,
+                                sim::kSignCellWidthPx, sim::kSignCellHeightPx)),
+                 want, cv::COLOR_RGB2GRAY);
+    cv::resize(grey, seen, want.size(), 0, 0, cv::INTER_AREA);
+    cv::flip(want, mirrored, 1);
+    cv::flip(want, upside_down, 0);
+    const double right = agreement(seen, want);
+    std::printf("sign %d: agreement %.3f, mirrored %.3f, upside down %.3f\n", k, right, agreement(seen, mirrored),
+                agreement(seen, upside_down));
+    // The frame and the centred words agree with their mirror image about
+    // 0.75; the label read the right way round agrees above 0.9.
+    EXPECT_GT(right, 0.85) << "sign " << k;
+    EXPECT_GT(right, agreement(seen, mirrored) + 0.1) << "sign " << k;
+    EXPECT_GT(right, agreement(seen, upside_down) + 0.3) << "sign " << k;
+    // The back: the same cell, its texture coordinate u running the other
+    // way along the plate's width than on the front.  (MuJoCo turns a mesh
+    // to its principal axes: the thinnest is the plate's normal, the widest
+    // its width.)
+    const mjModel* m = sim.model();
+    const int mesh = m->geom_dataid[plate], n = m->mesh_vertnum[mesh];
+    const float* vert = m->mesh_vert + 3 * m->mesh_vertadr[mesh];
+    ASSERT_GE(m->mesh_texcoordadr[mesh], 0);
+    const float* tex = m->mesh_texcoord + 2 * m->mesh_texcoordadr[mesh];
+    Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e9f), hi = -lo;
+    for (int i = 0; i < n; ++i) {
+      lo = lo.cwiseMin(Eigen::Vector3f(vert[3 * i], vert[3 * i + 1], vert[3 * i + 2]));
+      hi = hi.cwiseMax(Eigen::Vector3f(vert[3 * i], vert[3 * i + 1], vert[3 * i + 2]));
+    }
+    int thin = 0, wide = 0;
+    (hi - lo).minCoeff(&thin);
+    (hi - lo).maxCoeff(&wide);
+    int runs[2] = {0, 0};  // per face: +1 where u grows with the width axis, -1 where it falls
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const int face = vert[3 * i + thin] > 0 ? 1 : 0;
+        const float dw = vert[3 * j + wide] - vert[3 * i + wide], du = tex[2 * j] - tex[2 * i];
+        if ((vert[3 * j + thin] > 0 ? 1 : 0) != face || std::abs(dw) < 1e-4f) continue;
+        runs[face] = (du > 0) == (dw > 0) ? 1 : -1;
+      }
+    EXPECT_EQ(runs[0] * runs[1], -1) << "sign " << k;
+  }
 }
 
 }  // namespace plant_scene_test

@@ -35,6 +35,12 @@ struct PlantFence {
 /// A string combiner box on its own post, past a row's east end.
 inline constexpr double kCombinerBoxAlongM = 0.25, kCombinerBoxAcrossM = 0.60, kCombinerBoxHighM = 0.50;
 inline constexpr double kCombinerBoxBaseM = 0.70, kCombinerPostM = 0.08;
+/// A row sign: a post kRowSignEndM past each end of a row, kRowSignAsideM
+/// from the row's centre line towards its front (clear of a combiner box),
+/// and a plate across the row on it, its foot kRowSignPlateBaseM up.
+inline constexpr double kRowSignEndM = 0.35, kRowSignAsideM = 0.6, kRowSignPostM = 0.05, kRowSignPostHighM = 1.1;
+inline constexpr double kRowSignPlateWideM = 0.30, kRowSignPlateHighM = 0.20, kRowSignPlateThickM = 0.012;
+inline constexpr double kRowSignPlateBaseM = 0.85;
 /// The dock: a charging cabinet (along the rows x across x high) under a
 /// canopy; the robot stands kDockStandoffM in front of the cabinet.
 inline constexpr double kDockCabinetAlongM = 0.8, kDockCabinetAcrossM = 1.2, kDockCabinetHighM = 1.1;
@@ -76,6 +82,8 @@ struct Plant {
   std::optional<int> dock_aisle = 0;
   /// A combiner box past the east end of every this many rows; 0: none.
   int combiner_rows = 6;
+  /// A sign with the row's number at both ends of every row.
+  bool row_signs = true;
 
   double dirt = 0.2;
   double row_soiling = 0.0;  ///< the spread of the rows' dust (PvArray::row_soiling); 0: rows alike
@@ -103,6 +111,8 @@ struct PlantLayout {
   double perimeter_road_m = 0.0;
   std::optional<Fence> fence;
   std::vector<Fixture> fixtures;  ///< the dock and the combiner boxes
+  std::vector<RowSign> row_signs;        ///< two a row (Plant::row_signs)
+  std::vector<std::string> sign_labels;  ///< their texts, a row's each
   double dock_front_u_m = 0.0;    ///< where the robot stands at the dock (u, first block's frame)
   double dock_v_m = 0.0;          ///< the dock's centre across the rows
   /// Where a service road runs (rectangles [u0, v0, u1, v1] in the first

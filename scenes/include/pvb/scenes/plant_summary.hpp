@@ -4,6 +4,7 @@
 // dock and the combiner boxes.  pvb/scenes/plant.hpp lays a plant out.
 #include <Eigen/Core>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace pvb::scenes {
@@ -19,6 +20,14 @@ struct Fixture {
   Eigen::Vector3d size_m{0.1, 0.1, 1.0};
   double base_m = 0.0;  ///< its bottom above the ground
   FixtureFinish finish = FixtureFinish::kSteel;
+};
+
+/// A row's number on a post at one of its ends: a plate facing out of the
+/// row into the headland, the number on both faces (plant.hpp's kRowSign*).
+struct RowSign {
+  Eigen::Vector2d centre_m{0.0, 0.0};  ///< the post's foot
+  double yaw_deg = 0.0;                ///< the direction the plate's front faces
+  int label = 0;                       ///< its text in PlantSummary::sign_labels
 };
 
 /// A chain-link perimeter fence: posts and three wires along a closed
@@ -51,6 +60,8 @@ struct PlantSummary {
   double perimeter_road_m = 0.0;
   std::optional<Fence> fence;
   std::vector<Fixture> fixtures;  ///< the dock and the combiner boxes
+  std::vector<RowSign> row_signs;        ///< two a row, one at each end (plant.row_signs)
+  std::vector<std::string> sign_labels;  ///< a row's "B<block> R<row>", from 1, block by block
   /// The aisle of the first block whose west end holds the dock, and where
   /// the robot stands in front of it (u in the first block's frame).
   std::optional<int> dock_aisle;

@@ -3,6 +3,8 @@
 // All images are CV_8UC3 in R, G, B order.
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <vector>
+#include <string>
 
 #include "pvb/scenes/scenario.hpp"
 
@@ -49,6 +51,11 @@ constexpr int kRoadGravelImages = 8;
 /// shrink below half a pixel shows nothing the repeated soil under it does
 /// not (fx x 0.04 / 0.5: 42 m at fx 525).
 constexpr double kSoilFeatureM = 0.04;
+/// The plates of a plant's row signs: each label (two words, "B1 R017")
+/// black on white in its own cell of kSignCellPx, kSignAtlasColumns cells
+/// a line, first word small above the second.
+cv::Mat make_sign_atlas(const std::vector<std::string>& labels);
+inline constexpr int kSignCellWidthPx = 144, kSignCellHeightPx = 96, kSignAtlasColumns = 16;
 /// Leaves for shrubs and tree crowns.
 cv::Mat make_foliage_texture(std::uint64_t seed);
 /// Tree bark.
