@@ -127,6 +127,8 @@ Plant read_plant_section(MapReader& r) {
   read_fixtures(r, p);
   p.dirt = r.number("dirt", p.dirt, 0, 1);
   p.row_soiling = r.number("row_soiling", p.row_soiling, 0, 1);
+  p.tyre_tracks = r.number("tyre_tracks", p.tyre_tracks, 0, 1);
+  p.vegetation_strips = r.number("vegetation_strips", p.vegetation_strips, 0, 1);
   const long long block_modules =
       static_cast<long long>(p.rows_per_block) * p.tables_per_row * p.modules_per_table * p.modules_high;
   p.broken_modules = r.integer("broken_modules", 0, 0, static_cast<int>(std::min<long long>(block_modules, 1000)));
@@ -232,6 +234,11 @@ void read_plant(MapReader& top, Scenario& s) {
   sum.dock_front_u_m = layout.dock_front_u_m;
   sum.dock_v_m = layout.dock_v_m;
   sum.roads_uv = layout.roads_uv;
+  sum.tracked_aisles = static_cast<int>(std::lround(p.tyre_tracks * (p.rows_per_block + 1)));
+  sum.grass_rows = static_cast<int>(std::lround(p.vegetation_strips * p.rows_per_block));
+  if ((sum.tracked_aisles > 0 || sum.grass_rows > 0) && s.ground.relief)
+    top.fail("plant", top.child("plant"), "tyre_tracks and vegetation_strips on a flat ground (no ground.relief)",
+             "a relief");
   s.pv_arrays.insert(s.pv_arrays.end(), layout.blocks.begin(), layout.blocks.end());
   s.walls.insert(s.walls.end(), layout.inverter_stations.begin(), layout.inverter_stations.end());
   s.plant = sum;

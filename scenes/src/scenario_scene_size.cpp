@@ -27,6 +27,7 @@ void check_scene_size(const Scenario& s, const ReadContext& ctx) {
   long long total = 2LL * (s.vegetation.shrubs + s.vegetation.trees) + static_cast<long long>(s.walls.size());
   if (s.plant) {  // a fixture is one geom, a fence section one
     total += static_cast<long long>(s.plant->fixtures.size() + 2 * s.plant->row_signs.size());
+    total += static_cast<long long>(s.plant->blocks) * (2 * s.plant->tracked_aisles + s.plant->grass_rows);
     if (s.plant->fence) total += static_cast<long long>(fence_sections(*s.plant->fence).size());
   }
   long long largest = -1;

@@ -33,13 +33,17 @@ GroundStream::GroundStream(mjModel* model, const scenes::Scenario& s)
                       std::abs(model->geom_pos[3 * g + 1] - tiles_[k].centre_m.y()) < 1e-6;
     if (!tile) throw Error("the scene's ground tiles are not where its tile list puts tile " + std::to_string(k));
   }
+  // The slots the scene has room for (build_scene): at most one for each
+  // tile that can be near.
   for (int k = 0; k < unique_ground_slots(s.ground.unique_within_m); ++k) {
     const std::string name = kGroundSlotPrefix + std::to_string(k);
     const int id = mj_name2id(model, mjOBJ_TEXTURE, name.c_str());
-    if (id < 0 || model->tex_width[id] != kGroundTexturePx || model->tex_height[id] != kGroundTexturePx)
-      throw Error("the scene has no ground slot texture " + name + " of " + std::to_string(kGroundTexturePx) + " px");
+    if (id < 0) break;
+    if (model->tex_width[id] != kGroundTexturePx || model->tex_height[id] != kGroundTexturePx)
+      throw Error("the scene's ground slot texture " + name + " is not " + std::to_string(kGroundTexturePx) + " px");
     slot_tex_.push_back(id);
   }
+  if (slot_tex_.empty()) throw Error("the scene has no ground slot textures");
   slot_version_.assign(slot_tex_.size(), 0);
   slot_tile_.assign(slot_tex_.size(), -1);
   slot_used_.assign(slot_tex_.size(), 0);

@@ -139,7 +139,7 @@ std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std
   if (images == 0 && cells.size() > static_cast<std::size_t>(kMaxGroundTiles))
     throw ConfigError(s.source_file, "ground.tiling",
                       "a varied ground (the default) of at most " + std::to_string(kMaxGroundTiles) + " tiles of " +
-                          f(tile) + " m along the route (a route of about 140 m), ground.soil_images for a longer "
+                          f(tile) + " m along the route (a route of about 55 m), ground.soil_images for a longer "
                           "one, or tiling: repeat",
                       std::to_string(cells.size()) + " tiles");
   if (cells.size() > static_cast<std::size_t>(kMaxSharedImageTiles))
@@ -210,6 +210,8 @@ void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tile
     out->files.emplace_back(kGroundTilePrefix + std::to_string(k) + ".png", std::move(tile_png[k]));
   if (s.plant && !s.plant->row_signs.empty())
     add("rowsigns", [&] { return make_sign_atlas(s.plant->sign_labels); });
+  if (s.plant && s.plant->tracked_aisles > 0) add("track", [&] { return make_track_texture(station_seed); });
+  if (s.plant && s.plant->grass_rows > 0) add("grass", [&] { return make_grass_texture(station_seed); });
   add("brick", [&] { return make_brick_texture(station_seed); });
   add("foliage", [&] { return make_foliage_texture(station_seed); });
   add("bark", [&] { return make_bark_texture(station_seed); });
@@ -310,11 +312,20 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
     x.line("<texture name=\"" + name + "\" type=\"2d\" file=\"" + file.first + "\"/>");
   }
   // A ground of shared soil images: the slots of the images that tiles near
-  // the camera show instead (GroundStream fills them).
+  // the camera show instead (GroundStream fills them), as many as fit the
+  // render context's textures after the scene's own and the sky.
+  const int textures = 1 + static_cast<int>(std::count_if(out.files.begin(), out.files.end(),
+                                                          [](const auto& f) { return is_texture_file(f.first); }));
+  if (textures > kMaxSceneTextures)
+    throw ConfigError(s.source_file, s.ground.soil_images > 0 ? "ground.soil_images" : "ground.tiling",
+                      "a scene of at most " + std::to_string(kMaxSceneTextures) +
+                          " textures (MuJoCo's renderer holds no more): fewer soil images, a shorter route on a "
+                          "varied ground, fewer arrays, or tiling: repeat",
+                      std::to_string(textures) + " textures");
   const int slots = s.ground.soil_images > 0 && out.detail == SceneDetail::kFull &&
-                                std::any_of(out.files.begin(), out.files.end(),
-                                            [](const auto& f) { return f.first.rfind(kGroundTilePrefix, 0) == 0; })
-                        ? unique_ground_slots(s.ground.unique_within_m)
+                            std::any_of(out.files.begin(), out.files.end(),
+                                        [](const auto& f) { return f.first.rfind(kGroundTilePrefix, 0) == 0; })
+                        ? std::min(unique_ground_slots(s.ground.unique_within_m), kMaxSceneTextures - textures)
                         : 0;
   for (int k = 0; k < slots; ++k)
     x.line("<texture name=\"" + std::string(kGroundSlotPrefix) + std::to_string(k) +

@@ -4,10 +4,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "pvb/scenes/plant.hpp"
 #include "pvb/sim/textures.hpp"
 #include "scene_mjcf.hpp"
+#include "splitmix.hpp"
 
 namespace pvb::sim::mjcf {
 namespace {
@@ -136,6 +139,45 @@ std::vector<std::pair<Eigen::Vector2d, FenceMesh>> fence_meshes(const scenes::Fe
   return out;
 }
 
+/// `count` of `n` indices, which from the seed: a partial shuffle.
+std::vector<int> seeded_pick(int n, int count, std::uint64_t seed, std::uint64_t stream) {
+  std::vector<int> all(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) all[static_cast<std::size_t>(i)] = i;
+  SplitMix rng(seed, stream);
+  for (int i = 0; i < count && i < n; ++i)
+    std::swap(all[static_cast<std::size_t>(i)], all[static_cast<std::size_t>(i + static_cast<int>(rng.next() % static_cast<std::uint64_t>(n - i)))]);
+  all.resize(static_cast<std::size_t>(std::min(count, n)));
+  std::sort(all.begin(), all.end());
+  return all;
+}
+
+/// A band of ground cover along the rows of `block`: v its centre line
+/// across them, `width_m` wide, the rows' length long.
+void add_cover_band(XmlWriter& x, const scenes::PvArray& block, double v, double width_m, const std::string& material) {
+  const double length_m = scenes::row_length_m(block);
+  const Eigen::Vector2d c = scenes::array_to_world(block, length_m / 2, v);
+  x.line("<geom class=\"scenery\" type=\"plane\" size=\"" + v3(length_m / 2, width_m / 2, 1) + "\" pos=\"" +
+         v3(c.x(), c.y(), scenes::kGroundCoverM) + "\" euler=\"0 0 " + f(block.azimuth_deg) + "\" material=\"" +
+         material + "\"/>");
+}
+
+/// Tyre tracks in a share of each block's aisles, grass under a share of
+/// its rows, which ones from the station's seed.
+void add_ground_cover(XmlWriter& x, const scenes::Scenario& s) {
+  const scenes::PlantSummary& plant = *s.plant;
+  for (int b = 0; b < plant.blocks; ++b) {
+    const scenes::PvArray& block = s.pv_arrays[static_cast<std::size_t>(plant.first_array + b)];
+    const double pitch = block.row_pitch_m, footprint = scenes::row_footprint_m(block);
+    const auto seed = s.station_seed_or_seed();
+    for (const int k : seeded_pick(block.rows + 1, plant.tracked_aisles, seed, 0x7AC40000ULL + static_cast<std::uint64_t>(b)))
+      for (const double side : {-1.0, 1.0})
+        add_cover_band(x, block, k * pitch - (pitch - footprint) / 2 + side * scenes::kTrackGaugeM / 2,
+                       scenes::kTrackWidthM, "groundtrack");
+    for (const int row : seeded_pick(block.rows, plant.grass_rows, seed, 0x6A550000ULL + static_cast<std::uint64_t>(b)))
+      add_cover_band(x, block, row * pitch + footprint / 2, scenes::kGrassStripShare * footprint, "groundgrass");
+  }
+}
+
 const char* finish_material(scenes::FixtureFinish f) {
   switch (f) {
     case scenes::FixtureFinish::kSteel: return "steel";
@@ -188,6 +230,11 @@ void add_plant_assets(XmlWriter& x, const scenes::Scenario& s, const scenes::Gro
   // A combiner box's or the dock's light grey polyester; galvanised chain link.
   x.line("<material name=\"enclosure\" rgba=\"0.86 0.86 0.84 1\" specular=\"0.15\" shininess=\"0.2\"/>");
   x.line("<material name=\"fence\" rgba=\"0.66 0.68 0.70 1\" specular=\"0.3\" shininess=\"0.3\"/>");
+  // Ground cover: named "ground..." so that it is the ground's surface.
+  for (const auto& [count, name] : {std::pair{s.plant->tracked_aisles, "track"}, {s.plant->grass_rows, "grass"}})
+    if (count > 0)
+      x.line(std::string("<material name=\"ground") + name + "\" texture=\"" + name + "\" texuniform=\"true\" texrepeat=\"" +
+             f(1.0 / kCoverTileM) + " " + f(1.0 / kCoverTileM) + "\" specular=\"0.02\" shininess=\"0.05\"/>");
   if (!s.plant->row_signs.empty()) {
     x.line("<material name=\"rowsign\" texture=\"rowsigns\" specular=\"0.2\" shininess=\"0.3\"/>");
     const int labels = static_cast<int>(s.plant->sign_labels.size());
@@ -212,6 +259,7 @@ void add_plant_fixtures(XmlWriter& x, const scenes::Scenario& s, const scenes::G
              std::to_string(k) + "\" pos=\"" + v3(p.x(), p.y(), 0) + "\" material=\"fence\"/>");
     }
   }
+  add_ground_cover(x, s);
   for (std::size_t k = 0; k < plant.row_signs.size(); ++k) {
     const scenes::RowSign& r = plant.row_signs[k];
     const double yaw = r.yaw_deg * M_PI / 180.0, z0 = ground.height_m(r.centre_m);

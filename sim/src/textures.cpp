@@ -230,6 +230,49 @@ cv::Mat make_sign_atlas(const std::vector<std::string>& labels) {
   return img;
 }
 
+cv::Mat make_track_texture(std::uint64_t seed) {
+  Rng rng(seed ^ 0x7AC4);
+  const int n = 256;
+  cv::Mat img(n, n, CV_8UC3);
+  const cv::Mat low = value_noise(n, 4, &rng);
+  for (int r = 0; r < n; ++r) {
+    auto* p = img.ptr<cv::Vec3b>(r);
+    for (int c = 0; c < n; ++c) {
+      const double s = 0.52 + 0.16 * low.at<float>(r, c);
+      p[c] = cv::Vec3b(cv::saturate_cast<uchar>(112 * s), cv::saturate_cast<uchar>(88 * s), cv::saturate_cast<uchar>(62 * s));
+    }
+  }
+  // The tread: a bar across the track every 8 cm (41 px), each a little
+  // skewed and broken where the soil did not take it.
+  for (int x = 0; x < n; x += 41) {
+    const int skew = rng.integer(-6, 6), width = rng.integer(8, 12);
+    for (int y = 0; y < n; y += 16)
+      if (rng.uniform(0, 1) > 0.15)
+        cv::line(img, {x + skew * y / n, y}, {x + skew * (y + 16) / n, y + 16}, rgb(52, 40, 30), width, cv::LINE_AA);
+  }
+  for (int i = 0; i < 120; ++i) {  // crushed stones
+    const int y = rng.integer(0, n - 1), x = rng.integer(0, n - 1);
+    const double g = rng.uniform(70, 150);
+    cv::circle(img, {x, y}, rng.integer(1, 2), rgb(g, g * 0.86, g * 0.7), cv::FILLED, cv::LINE_AA);
+  }
+  add_noise(&img, &rng, 5.0);
+  return img;
+}
+
+cv::Mat make_grass_texture(std::uint64_t seed) {
+  Rng rng(seed ^ 0x6A55);
+  const int n = 256;
+  cv::Mat img(n, n, CV_8UC3, rgb(96, 78, 54));
+  for (int i = 0; i < 1800; ++i) {  // blades: short strokes, green to straw
+    const int y = rng.integer(0, n - 1), x = rng.integer(0, n - 1);
+    const int dx = rng.integer(-5, 5), dy = rng.integer(-12, -3);
+    const double dry = rng.uniform(0, 1), g = rng.uniform(90, 160);
+    cv::line(img, {x, y}, {x + dx, y + dy}, rgb(g * (0.55 + 0.5 * dry), g, g * (0.3 + 0.2 * dry)), 1, cv::LINE_AA);
+  }
+  add_noise(&img, &rng, 6.0);
+  return img;
+}
+
 cv::Mat make_foliage_texture(std::uint64_t seed) {
   Rng rng(seed ^ 0xF011);
   const int n = 256;

@@ -42,14 +42,14 @@ std::vector<unsigned char> texels(const mjModel* m, int tex) {
 Eigen::Vector3d eye(const Eigen::Vector2d& p) { return {p.x(), p.y(), 0.6}; }
 
 TEST(GroundStream, NearTilesShowImagesOfTheirOwnWhateverTheDriveBefore) {
-  const scenes::Scenario s = streamed();
+  const scenes::Scenario s = streamed(", unique_within_m: 9");
   const sim::SceneAssets a = sim::build_scene(s, sim::SceneDetail::kFull, sim::TextureEncoding::kPixels);
   sim::ModelPtr driven = sim::compile_scene(a), fresh = sim::compile_scene(a);
   sim::GroundStream along(driven.get(), s), here(fresh.get(), s);
   const std::vector<Eigen::Vector2d> route = scenes::route_polyline(s);
   ASSERT_GT(route.size(), 100u);
   const int slots = static_cast<int>(along.slot_textures().size());
-  EXPECT_EQ(slots, sim::unique_ground_slots(s.ground.unique_within_m));
+  EXPECT_EQ(slots, sim::unique_ground_slots(s.ground.unique_within_m));  // 62: the scene has room for them
   // Drive the route: the slots hold every near tile wherever the camera is.
   std::size_t most_near = 0;
   for (std::size_t i = 0; i < route.size(); i += 20) {
@@ -92,7 +92,7 @@ TEST(GroundStream, NearTilesShowImagesOfTheirOwnWhateverTheDriveBefore) {
 }
 
 TEST(GroundStream, RendersTheSameFrameAfterAnyDriveAndOnlyWithItsSlots) {
-  const scenes::Scenario s = streamed();
+  const scenes::Scenario s = streamed(", unique_within_m: 9");
   sim::Simulator sim(s);
   ASSERT_NE(sim.ground_stream(), nullptr);
   sim::Renderer early(sim.model(), sim::GlBackend::kAuto, 160, 120);
@@ -119,6 +119,26 @@ TEST(GroundStream, RendersTheSameFrameAfterAnyDriveAndOnlyWithItsSlots) {
 
 TEST(GroundStream, OffWhereTheGroundHasNoSharedImagesOrTheUserTurnsItOff) {
   EXPECT_FALSE(sim::GroundStream::wanted(streamed(", unique_within_m: 0"), sim::SceneDetail::kFull));
+  // The slots take what the renderer's 100 textures leave: with 12 m (93
+  // wanted) the scene has room for fewer, and the stream takes those.
+  const sim::SceneAssets wide = sim::build_scene(streamed(", unique_within_m: 12"), sim::SceneDetail::kFull,
+                                                 sim::TextureEncoding::kPixels);
+  int textures = 0;
+  for (std::size_t at = wide.xml.find("<texture "); at != std::string::npos; at = wide.xml.find("<texture ", at + 1))
+    ++textures;
+  EXPECT_EQ(textures, sim::kMaxSceneTextures);
+  EXPECT_LT(textures, 30 + sim::unique_ground_slots(12));
+  // A scene that would need more textures than the renderer holds is refused.
+  try {
+    sim::build_scene(scenes::parse_scenario("ground: {size_m: [160, 120], tiling: varied, soil_images: 97}\n"
+                                            "route: {waypoints_m: [[0, 0], [30, 0]]}\n",
+                                            "many.yaml"));
+    FAIL() << "a scene of more than 100 textures";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("ground.soil_images: expected a scene of at most 100 textures"),
+              std::string::npos)
+        << e.what();
+  }
   EXPECT_FALSE(sim::GroundStream::wanted(streamed(), sim::SceneDetail::kGeometry));
   EXPECT_TRUE(sim::GroundStream::wanted(streamed(), sim::SceneDetail::kFull));
   const sim::SceneAssets off = sim::build_scene(streamed(", unique_within_m: 0"), sim::SceneDetail::kFull,

@@ -218,5 +218,57 @@ TEST(PlantScene, RowSignsShowTheirRowsNumberTheRightWayRound) {
   }
 }
 
+// Tyre tracks in a share of the aisles and grass under a share of the rows,
+// which ones from the station's seed: the same every day, others for
+// another station; and a robot in a tracked aisle sees the tracks.
+TEST(PlantScene, TyreTracksAndGrassStripsLieWhereTheStationPutsThem) {
+  const auto plant = [](int station_seed, int day_seed, const std::string& cover) {
+    return scenes::parse_scenario("ground: {size_m: [200, 200], tiling: repeat}\nseed: " + std::to_string(day_seed) +
+                                      "\nstation_seed: " + std::to_string(station_seed) +
+                                      "\nduration_s: 2\nplant: {origin_m: [-30, -20], rows: 8, tables_per_row: 2, "
+                                      "modules_per_table: 12, " + cover + "}\nroute: {pattern: along_row, aisle: 3}\n",
+                                  "cover.yaml");
+  };
+  // Each band's centre, by material.
+  const auto bands = [](const scenes::Scenario& s) {
+    const sim::ModelPtr m = sim::compile_scene(sim::build_scene(s, sim::SceneDetail::kGeometry));
+    std::map<std::string, std::set<std::pair<long, long>>> out;
+    for (int g = 0; g < m->ngeom; ++g) {
+      const char* mat = m->geom_matid[g] >= 0 ? mj_id2name(m.get(), mjOBJ_MATERIAL, m->geom_matid[g]) : nullptr;
+      if (mat && (std::string(mat) == "groundtrack" || std::string(mat) == "groundgrass"))
+        out[mat].insert({std::lround(m->geom_pos[3 * g] * 100), std::lround(m->geom_pos[3 * g + 1] * 100)});
+    }
+    return out;
+  };
+  const std::string half = "tyre_tracks: 0.5, vegetation_strips: 0.5";
+  const auto a = bands(plant(7, 1, half));
+  EXPECT_EQ(a.at("groundtrack").size(), 2u * 5u);  // two bands in each of round(0.5 x 9) aisles
+  EXPECT_EQ(a.at("groundgrass").size(), 4u);       // half the 8 rows
+  EXPECT_EQ(bands(plant(7, 2, half)), a);          // another day: the same
+  EXPECT_NE(bands(plant(8, 1, half)), a);          // another station: others
+  EXPECT_TRUE(bands(plant(7, 1, "tyre_tracks: 0")).empty());
+  // From the aisle, every aisle tracked: the tracks in view.
+  sim::Simulator sim(plant(7, 1, "tyre_tracks: 1"));
+  sim::Renderer r(sim.model(), sim::GlBackend::kAuto, 320, 240);
+  cv::Mat ids;
+  r.render_geom_ids(sim.model(), sim.data(), sim.camera_id(), &ids);
+  int track_px = 0;
+  for (auto it = ids.begin<int>(); it != ids.end<int>(); ++it)
+    if (*it >= 0 && sim.model()->geom_matid[*it] == mj_name2id(sim.model(), mjOBJ_MATERIAL, "groundtrack")) ++track_px;
+  EXPECT_GT(track_px, 320 * 240 / 50);
+  // They are flat bands on flat ground.
+  try {
+    scenes::parse_scenario("ground: {size_m: [200, 200], relief: {amplitude_cm: 3}}\n"
+                           "plant: {origin_m: [-30, -20], rows: 8, tyre_tracks: 0.5}\n",
+                           "cover.yaml");
+    FAIL() << "tracks on a relief";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("cover.yaml:2: plant: expected tyre_tracks and vegetation_strips on a flat "
+                                         "ground"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace plant_scene_test
 }  // namespace pvb::test

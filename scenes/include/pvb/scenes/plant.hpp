@@ -41,6 +41,12 @@ inline constexpr double kCombinerBoxBaseM = 0.70, kCombinerPostM = 0.08;
 inline constexpr double kRowSignEndM = 0.35, kRowSignAsideM = 0.6, kRowSignPostM = 0.05, kRowSignPostHighM = 1.1;
 inline constexpr double kRowSignPlateWideM = 0.30, kRowSignPlateHighM = 0.20, kRowSignPlateThickM = 0.012;
 inline constexpr double kRowSignPlateBaseM = 0.85;
+/// Tyre tracks in an aisle: two bands of compacted soil kTrackWidthM wide,
+/// kTrackGaugeM apart (a service vehicle's), on the aisle's centre line
+/// along the rows.  A strip of grass under a row: kGrassStripShare of the
+/// row's footprint wide, on its centre line.  Both lie kGroundCoverM above
+/// the soil, along the rows' length.
+inline constexpr double kTrackWidthM = 0.35, kTrackGaugeM = 1.6, kGrassStripShare = 0.6, kGroundCoverM = 0.004;
 /// The dock: a charging cabinet (along the rows x across x high) under a
 /// canopy; the robot stands kDockStandoffM in front of the cabinet.
 inline constexpr double kDockCabinetAlongM = 0.8, kDockCabinetAcrossM = 1.2, kDockCabinetHighM = 1.1;
@@ -84,6 +90,10 @@ struct Plant {
   int combiner_rows = 6;
   /// A sign with the row's number at both ends of every row.
   bool row_signs = true;
+  /// The share of each block's aisles with tyre tracks, and of its rows
+  /// with a strip of grass under them, which ones from the station's seed.
+  double tyre_tracks = 0.0;
+  double vegetation_strips = 0.0;
 
   double dirt = 0.2;
   double row_soiling = 0.0;  ///< the spread of the rows' dust (PvArray::row_soiling); 0: rows alike

@@ -67,6 +67,10 @@ struct PlantSummary {
   std::optional<int> dock_aisle;
   double dock_front_u_m = 0.0;
   double dock_v_m = 0.0;  ///< the dock's centre across the rows (first block's frame)
+  /// In each block: how many aisles have tyre tracks, how many rows a
+  /// strip of grass (plant.tyre_tracks, plant.vegetation_strips).
+  int tracked_aisles = 0;
+  int grass_rows = 0;
   std::vector<Eigen::Vector4d> roads_uv;  ///< the service roads, [u0, v0, u1, v1] in the first block's frame
 };
 

@@ -30,7 +30,8 @@ class GroundStream {
 
   /// Gives every tile near `eye_w` (its centre within unique_within_m plus
   /// half a tile's diagonal, across the ground) its own image, drawing the
-  /// images it lacks.  A slot whose tile is no longer near keeps its image
+  /// images it lacks; the nearest ones where the scene had room for fewer
+  /// slots than tiles can be near (kMaxSceneTextures).  A slot whose tile is no longer near keeps its image
   /// until a near tile needs the slot.  Which tiles show their own image
   /// depends on the eye alone, never on the eyes before it.  Returns how
   /// many images it drew.

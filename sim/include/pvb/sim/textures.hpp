@@ -29,6 +29,10 @@ constexpr int kGroundTexturePx = 512;
 /// The textures that hold the images of a ground's tiles near the camera
 /// (GroundStream): grounds0, grounds1, ...
 constexpr const char* kGroundSlotPrefix = "grounds";
+/// MuJoCo 2.2.2's render context holds the names of at most 100 textures
+/// (mjrContext::texture[100], although mjMAXTEXTURE says 1000): a model
+/// with more corrupts the context.  Every scene stays within it.
+constexpr int kMaxSceneTextures = 100;
 /// How many tile images a ground keeps near the camera: every tile with a
 /// point within `within_m` of the camera (a centre within within_m plus
 /// half a tile's diagonal) fits, wherever the camera stands.
@@ -38,8 +42,8 @@ int unique_ground_slots(double within_m);
 /// soil's stones closer than that); the repeated image lies beyond.
 constexpr double kGroundVariedCorridorM = 4.0;
 /// At most this many varied tiles with an image each (a route of about
-/// 140 m): 512 x 512 RGB each.
-constexpr int kMaxGroundTiles = 200;
+/// 55 m): 512 x 512 RGB each, and a texture each within kMaxSceneTextures.
+constexpr int kMaxGroundTiles = 80;
 /// At most this many tiles on a ground of `soil_images` shared images (a
 /// route of several kilometres): a plane geom each, culled to the view.
 constexpr int kMaxSharedImageTiles = 20000;
@@ -56,6 +60,12 @@ constexpr double kSoilFeatureM = 0.04;
 /// a line, first word small above the second.
 cv::Mat make_sign_atlas(const std::vector<std::string>& labels);
 inline constexpr int kSignCellWidthPx = 144, kSignCellHeightPx = 96, kSignAtlasColumns = 16;
+/// Tyre tracks: compacted, darker soil with the tread's bars across the
+/// track; the image covers kCoverTileM x kCoverTileM, its x along the track.
+cv::Mat make_track_texture(std::uint64_t seed);
+/// Grass and weeds on soil, the same size.
+cv::Mat make_grass_texture(std::uint64_t seed);
+inline constexpr double kCoverTileM = 0.5;
 /// Leaves for shrubs and tree crowns.
 cv::Mat make_foliage_texture(std::uint64_t seed);
 /// Tree bark.
