@@ -79,8 +79,8 @@ PvArray read_array(MapReader& r) {
 void read_arrays(MapReader& top, std::vector<PvArray>& out) {
   if (const YAML::Node arrays = top.child("pv_arrays")) {
     if (!arrays.IsSequence()) top.fail("pv_arrays", arrays, "a list of arrays");
-    if (arrays.size() > static_cast<std::size_t>(kMaxSceneGeoms))
-      top.fail("pv_arrays", arrays, "at most " + std::to_string(kMaxSceneGeoms) + " arrays (the scene's geom limit)",
+    if (arrays.size() > static_cast<std::size_t>(kMaxListEntries))
+      top.fail("pv_arrays", arrays, "at most " + std::to_string(kMaxListEntries) + " arrays in a file",
                std::to_string(arrays.size()));
     for (std::size_t i = 0; i < arrays.size(); ++i) {
       MapReader r(arrays[i], top.context(), "pv_arrays[" + std::to_string(i) + "]");
@@ -93,8 +93,8 @@ void read_arrays(MapReader& top, std::vector<PvArray>& out) {
 void read_walls(MapReader& top, std::vector<Wall>& out) {
   if (const YAML::Node walls = top.child("walls")) {
     if (!walls.IsSequence()) top.fail("walls", walls, "a list of walls");
-    if (walls.size() > static_cast<std::size_t>(kMaxSceneGeoms))  // one geom each: refused before reading them
-      top.fail("walls", walls, "at most " + std::to_string(kMaxSceneGeoms) + " walls (the scene's geom limit)",
+    if (walls.size() > static_cast<std::size_t>(kMaxListEntries))  // refused before reading them
+      top.fail("walls", walls, "at most " + std::to_string(kMaxListEntries) + " walls in a file",
                std::to_string(walls.size()));
     for (std::size_t i = 0; i < walls.size(); ++i) {
       MapReader r(walls[i], top.context(), "walls[" + std::to_string(i) + "]");

@@ -14,6 +14,11 @@ namespace pvb::scenes::detail {
 /// set up in 4.2 s, while 50 x 50 tables of 240 panels (617 500 geoms)
 /// were not compiled after 5 minutes.
 inline constexpr long long kMaxSceneGeoms = 20000;
+/// A file's list of arrays or walls longer than this is refused before its
+/// entries are read: a hand-written station has far fewer, and reading a
+/// file of 200 000 walls took 20 s and 1.1 GB (a plant's inverter stations
+/// are walls it makes, not a list).
+inline constexpr long long kMaxListEntries = 3800;
 
 /// The ground: section (type, size, tiling, relief, the soil's friction).
 void read_ground(MapReader& r, Ground& g);
