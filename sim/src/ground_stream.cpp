@@ -51,7 +51,8 @@ GroundStream::GroundStream(mjModel* model, const scenes::Scenario& s)
 
 int GroundStream::update(const Eigen::Vector3d& eye_w) {
   ++updates_;
-  // The near tiles, nearest first (the slots hold every one: unique_ground_slots).
+  // The near tiles, nearest first; as many as there are slots (every one
+  // where the scene had room for unique_ground_slots).
   std::vector<std::pair<double, int>> near;
   for (std::size_t k = 0; k < tiles_.size(); ++k) {
     const double d = (tiles_[k].centre_m - eye_w.head<2>()).norm();

@@ -64,6 +64,14 @@ void add_walls(XmlWriter& x, const scenes::Scenario& s, const scenes::GroundReli
 void add_vegetation(XmlWriter& x, const scenes::Scenario& s, const std::vector<Eigen::Vector2d>& route,
                     const scenes::GroundRelief& ground);
 
+// scene_ground_tiles.cpp
+/// The tiles of a varied ground (none for a repeated one): every 3 m cell
+/// of the ground whose centre lies within kGroundVariedCorridorM (and half
+/// a tile's diagonal) of the route.  A cell's image seed comes from the
+/// station's seed and the cell alone, so the route picks which cells are
+/// drawn, never how one looks.
+std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std::vector<Eigen::Vector2d>& route);
+
 // scene_plant.cpp
 /// A plant's materials and its fence's meshes (nothing without a plant).
 void add_plant_assets(XmlWriter& x, const scenes::Scenario& s, const scenes::GroundRelief& ground);

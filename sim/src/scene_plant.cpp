@@ -144,8 +144,10 @@ std::vector<int> seeded_pick(int n, int count, std::uint64_t seed, std::uint64_t
   std::vector<int> all(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) all[static_cast<std::size_t>(i)] = i;
   SplitMix rng(seed, stream);
-  for (int i = 0; i < count && i < n; ++i)
-    std::swap(all[static_cast<std::size_t>(i)], all[static_cast<std::size_t>(i + static_cast<int>(rng.next() % static_cast<std::uint64_t>(n - i)))]);
+  for (int i = 0; i < count && i < n; ++i) {
+    const auto j = static_cast<std::size_t>(i) + rng.next() % static_cast<std::uint64_t>(n - i);
+    std::swap(all[static_cast<std::size_t>(i)], all[j]);
+  }
   all.resize(static_cast<std::size_t>(std::min(count, n)));
   std::sort(all.begin(), all.end());
   return all;
