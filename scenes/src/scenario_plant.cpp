@@ -1,6 +1,7 @@
 // The plant: section (scenes/SCHEMA.md, "plant"): read, checked, laid out
 // into blocks (the scenario's last arrays) and inverter stations (its last
 // walls); and the checks of a plant's route.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
@@ -261,25 +262,37 @@ bool in_a_table(const PvArray& block, const Eigen::Vector2d& p, double clear_m) 
 /// A fixture this high above the ground (the dock's canopy) is above the robot.
 constexpr double kOverheadM = 1.5;
 
-/// A route point within `clear_m` of a fixture's or an inverter station's footprint.
-bool in_a_fixture(const Scenario& s, const PlantSummary& plant, const Eigen::Vector2d& p, double clear_m) {
-  const auto in_box = [&](const Eigen::Vector2d& c, double yaw_deg, double along, double across) {
-    const double a = yaw_deg * M_PI / 180.0;
-    const Eigen::Vector2d q = p - c;
-    const double u = q.x() * std::cos(a) + q.y() * std::sin(a), v = -q.x() * std::sin(a) + q.y() * std::cos(a);
-    return std::abs(u) <= along / 2 + clear_m && std::abs(v) <= across / 2 + clear_m;
+/// A footprint a route keeps clear of: a box turned by its yaw, grown by the
+/// clearance, with the radius of the circle around it.
+struct KeepOutBox {
+  Eigen::Vector2d centre_m;
+  double cos_yaw, sin_yaw, half_u_m, half_v_m, radius2_m2;
+  bool holds(const Eigen::Vector2d& p) const {
+    const Eigen::Vector2d q = p - centre_m;
+    if (q.squaredNorm() > radius2_m2) return false;
+    const double u = q.x() * cos_yaw + q.y() * sin_yaw, v = -q.x() * sin_yaw + q.y() * cos_yaw;
+    return std::abs(u) <= half_u_m && std::abs(v) <= half_v_m;
+  }
+};
+
+/// The footprints of the fixtures and the inverter stations, each grown by `clear_m`.
+std::vector<KeepOutBox> fixture_boxes(const Scenario& s, const PlantSummary& plant, double clear_m) {
+  std::vector<KeepOutBox> boxes;
+  const auto add = [&](const Eigen::Vector2d& c, double yaw_deg, double along, double across) {
+    const double a = yaw_deg * M_PI / 180.0, hu = along / 2 + clear_m, hv = across / 2 + clear_m;
+    // The circle is a hair wider than the box's corners, so rounding never rejects a point inside.
+    boxes.push_back({c, std::cos(a), std::sin(a), hu, hv, (hu * hu + hv * hv) * (1 + 1e-9) + 1e-12});
   };
   for (const Fixture& f : plant.fixtures)  // the dock's canopy stands over the robot
-    if (f.base_m < kOverheadM && in_box(f.centre_m, f.yaw_deg, f.size_m.x(), f.size_m.y())) return true;
+    if (f.base_m < kOverheadM) add(f.centre_m, f.yaw_deg, f.size_m.x(), f.size_m.y());
   for (const RowSign& r : plant.row_signs)  // the post, the plate across it
-    if (in_box(r.centre_m, r.yaw_deg, kRowSignPostM, kRowSignPlateWideM)) return true;
+    add(r.centre_m, r.yaw_deg, kRowSignPostM, kRowSignPlateWideM);
   for (std::size_t i = s.walls.size() - static_cast<std::size_t>(plant.inverter_stations); i < s.walls.size(); ++i) {
     const Wall& w = s.walls[i];
     const Eigen::Vector2d d = w.end_m - w.start_m;
-    if (in_box(0.5 * (w.start_m + w.end_m), std::atan2(d.y(), d.x()) * 180.0 / M_PI, d.norm(), w.thickness_m))
-      return true;
+    add(0.5 * (w.start_m + w.end_m), std::atan2(d.y(), d.x()) * 180.0 / M_PI, d.norm(), w.thickness_m);
   }
-  return false;
+  return boxes;
 }
 
 /// The checks of a route that needs a plant: a loop along its roads, a
@@ -327,6 +340,7 @@ void check_plant_route(const Scenario& s, const ReadContext& ctx) {
   const Eigen::Vector2d c0 = bound[0];
   const Eigen::Vector2d eu = bound[1] - c0, ev = bound[3] - c0;
   const std::vector<Eigen::Vector2d> route = route_polyline(s);
+  const std::vector<KeepOutBox> fixtures = fixture_boxes(s, plant, kRouteTableClearanceM);
   double along_m = 0;
   for (std::size_t i = 0; i < route.size(); ++i) {
     const Eigen::Vector2d& p = route[i];
@@ -340,7 +354,7 @@ void check_plant_route(const Scenario& s, const ReadContext& ctx) {
       if (in_a_table(s.pv_arrays[static_cast<std::size_t>(b)], p, kRouteTableClearanceM))
         refuse("a route that keeps " + format_number("%.2f m", kRouteTableClearanceM) +
                    " from every table (the robot's half width)", p, along_m);
-    if (in_a_fixture(s, plant, p, kRouteTableClearanceM))
+    if (std::any_of(fixtures.begin(), fixtures.end(), [&](const KeepOutBox& b) { return b.holds(p); }))
       refuse("a route that keeps " + format_number("%.2f m", kRouteTableClearanceM) +
                  " from the dock, the combiner boxes, the row signs and the inverter stations", p, along_m);
   }
