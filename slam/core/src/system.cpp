@@ -58,7 +58,7 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.new_map_after_lost = settings.new_map_after_lost;
   topt.merge_reloc_every = settings.merge_reloc_every;
   if (settings.vocabulary_path != "none") {
-    auto vocabulary = std::make_shared<const place::Vocabulary>(place::Vocabulary::load(settings.vocabulary_path));
+    auto vocabulary = place::Vocabulary::load_shared(settings.vocabulary_path);
     vocabulary_fingerprint_ = vocabulary->fingerprint();
     place_ = std::make_unique<PlaceRecognizer>(std::move(vocabulary));
   }

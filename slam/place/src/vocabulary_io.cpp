@@ -20,7 +20,9 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <string_view>
+#include <tuple>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/fnv.hpp"
@@ -372,6 +374,25 @@ Vocabulary Vocabulary::load(const std::string& path) {
   const std::size_t n = std::min<std::size_t>(bytes.size(), 6);
   if (n > 0 && std::memcmp(bytes.data(), kMagic, n) == 0) return VocabularyFiles::load_binary(path, bytes);
   return VocabularyFiles::load_text(path, bytes);
+}
+
+std::shared_ptr<const Vocabulary> Vocabulary::load_shared(const std::string& path) {
+  // The file as it is now: a save goes through a new file (another inode),
+  // and a rewrite in place changes the size or the modification time.
+  using Key = std::tuple<std::string, dev_t, ino_t, off_t, std::int64_t>;
+  static std::mutex mutex;
+  static Key cached_key;
+  static std::shared_ptr<const Vocabulary> cached;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return std::make_shared<const Vocabulary>(load(path));  // load() says why
+  const Key key{path, st.st_dev, st.st_ino, st.st_size,
+                static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec};
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (!cached || cached_key != key) {
+    cached = std::make_shared<const Vocabulary>(load(path));
+    cached_key = key;
+  }
+  return cached;
 }
 
 void Vocabulary::save_binary(const std::string& path) const {

@@ -122,6 +122,28 @@ TEST(VocabularyFiles, TrainedVocabularyRoundTripsThroughBothFormats) {
   EXPECT_EQ(read_bytes(bin.path).size(), 24 + 45 * (t.voc.node_count() - 1) + 8);
 }
 
+// The systems of one process share a vocabulary file's tree until the file
+// is saved again.
+TEST(VocabularyFiles, ASharedLoadIsReadOnceUntilTheFileChanges) {
+  const Trained t = trained();
+  TempFile bin("shared.bin");
+  t.voc.save_binary(bin.path);
+  const std::shared_ptr<const Vocabulary> first = Vocabulary::load_shared(bin.path);
+  expect_same_tree(t.voc, *first);
+  EXPECT_EQ(Vocabulary::load_shared(bin.path), first);
+  TrainParams p;
+  p.k = 3;
+  p.levels = 2;
+  const Vocabulary other = Vocabulary::train(t.images, p);
+  other.save_binary(bin.path);
+  const std::shared_ptr<const Vocabulary> again = Vocabulary::load_shared(bin.path);
+  EXPECT_NE(again, first);
+  expect_same_tree(other, *again);
+  expect_same_tree(t.voc, *first);  // the first holders keep theirs
+  std::remove(bin.path.c_str());
+  EXPECT_THROW(Vocabulary::load_shared(bin.path), pvb::IoError);
+}
+
 TEST(VocabularyFiles, EmptyVocabularyIsNotSaved) {
   TempFile f("empty_save.bin");
   EXPECT_THROW(Vocabulary().save_binary(f.path), pvb::IoError);

@@ -19,6 +19,7 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <utility>
@@ -75,6 +76,10 @@ class Vocabulary {
   /// truncated file throws pvb::IoError naming the file and the line (text)
   /// or byte offset (binary).
   static Vocabulary load(const std::string& path);
+  /// load(), once per process for as long as the file keeps its size and
+  /// modification time: the systems of one process (a comparison, the
+  /// sessions of a campaign) share the last vocabulary read.  Thread-safe.
+  static std::shared_ptr<const Vocabulary> load_shared(const std::string& path);
   /// Our binary format (docs/place_recognition.md).  Written through a
   /// temporary file: a failed write keeps the old file.
   void save_binary(const std::string& path) const;
