@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "inertial_cost_functions.hpp"
 #include "inertial_costs.hpp"
 #include "pvb/slam/optim/inertial_ba.hpp"
 #include "residuals.hpp"
@@ -372,16 +373,16 @@ class LocalBa {
     if (free_gravity_) gravity_prior_ = std::make_unique<optim_detail::GravityPriorCost>(in.g_w, in.gravity_sigma_rad);
     for (const BaImuEdge& e : in.imu_edges) {
       has_imu_state_[e.i] = has_imu_state_[e.j] = 1;
-      if (free_gravity_) imu_costs_.emplace_back(new optim_detail::ImuCostFreeGravity(*e.pre, in.T_b_c));
-      else imu_costs_.emplace_back(new optim_detail::ImuCost(*e.pre, in.T_b_c, in.g_w));
-      walk_costs_.emplace_back(new optim_detail::BiasWalkCost(*e.pre));
+      if (free_gravity_) imu_costs_.push_back(optim_detail::make_imu_cost_free_gravity(*e.pre, in.T_b_c));
+      else imu_costs_.push_back(optim_detail::make_imu_cost(*e.pre, in.T_b_c, in.g_w));
+      walk_costs_.push_back(optim_detail::make_bias_walk_cost(*e.pre));
     }
     for (const BaWheelEdge& e : in.wheel_edges) {
-      wheel_costs_.emplace_back(new optim_detail::WheelPlanarCost(*e.pre, in.T_base_c));
-      wheel_costs_.emplace_back(new optim_detail::WheelTiltCost(*e.pre, in.T_base_c));
+      wheel_costs_.push_back(optim_detail::make_wheel_planar_cost(*e.pre, in.T_base_c));
+      wheel_costs_.push_back(optim_detail::make_wheel_tilt_cost(*e.pre, in.T_base_c));
     }
     for (const BaGravityEdge& e : in.gravity_edges)
-      gravity_costs_.emplace_back(new optim_detail::GravityCost(e.f_c, in.g_w, e.sigma_rad));
+      gravity_costs_.push_back(optim_detail::make_gravity_cost(e.f_c, in.g_w, e.sigma_rad));
     if (in.wheel_huber > 0) wheel_loss_ = std::make_unique<ceres::HuberLoss>(in.wheel_huber);
   }
 
