@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
@@ -121,7 +122,7 @@ TEST(InertialEval, KeyframeBiasErrorsOfKnownSize) {
   EXPECT_NEAR(compare_biases(exact, truth, t0_ns, true).gyro_rms_radps, 0.0, 1e-15);
   EXPECT_NEAR(compare_biases(exact, truth, t0_ns, true).accel_rms_mps2, 0.0, 1e-15);
 
-  const YAML::Node j = YAML::Load(inertial_json({true, 0.5, 12, 1.0, 0.8, c}))["biases"];
+  const YAML::Node j = YAML::Load(inertial_json({true, 0.5, 12, 1.0, 0.8, c, std::nullopt}))["biases"];
   EXPECT_EQ(j["keyframes"].as<int>(), 4);
   EXPECT_NEAR(j["gyro_rms_radps"].as<double>(), 2.5e-3, 1e-9);
   EXPECT_NEAR(j["accel_rms_mps2"].as<double>(), std::sqrt(0.025), 1e-9);
@@ -131,7 +132,7 @@ TEST(InertialEval, KeyframeBiasErrorsOfKnownSize) {
   EXPECT_NEAR(j["accel_true_mps2"][0][1].as<double>(), 0.1, 1e-12);  // [keyframe][axis]
   // An accelerometer alone: no gyro bias to compare.
   const YAML::Node a =
-      YAML::Load(inertial_json({true, 0.5, 12, 1.0, 0.8, compare_biases(kfs, truth, t0_ns, false)}));
+      YAML::Load(inertial_json({true, 0.5, 12, 1.0, 0.8, compare_biases(kfs, truth, t0_ns, false), std::nullopt}));
   EXPECT_TRUE(a["biases"]["gyro_rms_radps"].IsNull());
   EXPECT_TRUE(a["biases"]["gyro_est_radps"].IsNull());
   EXPECT_NEAR(a["biases"]["accel_rms_mps2"].as<double>(), std::sqrt(0.025), 1e-9);
@@ -174,7 +175,7 @@ SlamRun inertial_run(const std::string& sensors, std::size_t dead_reckoned) {
   r.sensors = sensors;
   r.frames = 40;
   r.dead_reckoned_frames = dead_reckoned;
-  for (int i = 0; i < 40; ++i) r.per_frame.push_back({i, i / 30.0, true, 10.0 + i % 3, 200, 190});
+  for (int i = 0; i < 40; ++i) r.per_frame.push_back({i, i / 30.0, true, 10.0 + i % 3, 200, 190, {}, {}});
   eval::GravityError g;
   g.map_frame = sensors == "camera" ? "first_camera" : "gravity_aligned";
   g.t_s = {0.0, 0.5, 1.0};
@@ -193,7 +194,7 @@ SlamRun inertial_run(const std::string& sensors, std::size_t dead_reckoned) {
     const std::vector<BiasTruth> truth = ramp_truth(0, 21, 100'000'000);
     std::vector<KeyframeBias> kfs;
     for (int i = 0; i < 5; ++i) kfs.push_back({static_cast<std::uint64_t>(i), i * 300'000'000LL, {}});
-    r.inertial = InertialReport{true, 0.9, 3, 0.4, 1.1, compare_biases(kfs, truth, 0, true)};
+    r.inertial = InertialReport{true, 0.9, 3, 0.4, 1.1, compare_biases(kfs, truth, 0, true), std::nullopt};
   }
   return r;
 }
