@@ -3,6 +3,7 @@
 // its own process, so each process loads one backend only.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <opencv2/imgproc.hpp>
 #include <vector>
@@ -307,6 +308,15 @@ TEST(GlContext, OneProcessNeverLoadsBothBackends) {
   }
   // auto resolves to what is loaded, never to the other one
   EXPECT_EQ(sim::resolve_gl_backend(sim::GlBackend::kAuto), first->backend());
+}
+
+// Without MUJOCO_GL, auto probes for a backend that renders (EGL first, in
+// a child process) and the context it names is made.
+TEST(GlContext, AutoWithoutMujocoGlProbesForABackendThatRenders) {
+  unsetenv("MUJOCO_GL");
+  const sim::GlBackend b = sim::resolve_gl_backend(sim::GlBackend::kAuto);
+  ASSERT_TRUE(b == sim::GlBackend::kEgl || b == sim::GlBackend::kOsmesa);
+  EXPECT_EQ(sim::GlContext::create(sim::GlBackend::kAuto, 64, 64)->backend(), b);
 }
 
 TEST(GlContext, ParseBackendNames) {
