@@ -136,15 +136,49 @@ void check_report_files(const std::string& d) {
   expect_recorded_ground_truth(d, 150);
 }
 
+// Both systems on the same frames (--compare): the baseline named for what
+// it is and never running PE-match, one ground truth for both.
+void check_comparison(const std::string& d, const std::string& output) {
+  EXPECT_NE(output.find("PE-SLAM"), std::string::npos) << output;
+  // The baseline is named for what it is, never as the ORB-SLAM2 program.
+  EXPECT_NE(output.find("PE-SLAM against the baseline (ORB-SLAM2 motion model) on the same frames:"),
+            std::string::npos)
+      << output;
+  EXPECT_EQ(output.find("ORB-SLAM2 baseline"), std::string::npos) << output;
+  const YAML::Node m = metrics(d);
+  EXPECT_EQ(m["metrics_version"].as<int>(), 2);
+  EXPECT_EQ(m["mode"].as<std::string>(), "pe-slam");
+  ASSERT_TRUE(m["baseline"]);
+  EXPECT_EQ(m["baseline"]["mode"].as<std::string>(), "baseline");
+  EXPECT_TRUE(m["comparison"]["tracking_ms_median"]["baseline"].IsScalar());
+  EXPECT_EQ(m["baseline"]["frames"].as<int>(), 40);
+  EXPECT_LT(m["baseline"]["ate"]["rmse"].as<double>(), 0.02);
+  EXPECT_TRUE(m["comparison"]["ate_rmse_reduction_pct"].IsScalar());
+  EXPECT_EQ(data_lines(d + "/baseline/CameraTrajectory.txt").size(), 40u);
+  // Both saw the same frames: one ground truth for both.
+  EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 40u);
+  // The baseline never runs PE-match.
+  for (const std::string& line : data_lines(d + "/baseline/timing.csv")) {
+    const std::vector<std::string> f = split_ws(line, ",");
+    if (f[0] == "frame") continue;
+    EXPECT_EQ(f[8], f[9]) << line;  // coarse == kept
+  }
+}
+
 // Sync mode is bit-identical, and a shorter run is a prefix of a longer one
-// (nothing depends on frames not yet seen).
+// (nothing depends on frames not yet seen); running the baseline beside it
+// (--compare, which renders once for both) changes nothing of PE-SLAM's.
 void check_bit_identical_prefix(const std::string& d) {
   const std::string s = fresh("short");
-  ASSERT_EQ(test::run_pvbench("run --scenario " + kStation + " --out " + s + " --sync --frames 40").code, 0);
+  const test::RunResult r =
+      test::run_pvbench("run --scenario " + kStation + " --out " + s + " --sync --frames 40 --compare");
+  ASSERT_EQ(r.code, 0) << r.output;
   const std::vector<std::string> a = data_lines(d + "/CameraTrajectory.txt"),
                                  b = data_lines(s + "/CameraTrajectory.txt");
   ASSERT_EQ(b.size(), 40u);
   for (std::size_t i = 0; i < b.size(); ++i) EXPECT_EQ(a[i], b[i]) << "frame " << i;
+  SCOPED_TRACE("the comparison beside it");
+  check_comparison(s, r.output);
 }
 
 // A recording replays what the live run saw: `pvbench slam` on `pvbench
@@ -187,43 +221,12 @@ TEST(RunCli, DefaultStationSync) {
     check_dense_map(d);
   }
   {
-    SCOPED_TRACE("bit-identical prefix");
+    SCOPED_TRACE("bit-identical prefix, beside the baseline");
     check_bit_identical_prefix(d);
   }
   {
     SCOPED_TRACE("replay of the recording");
     check_replay_of_recording(d);
-  }
-}
-
-TEST(RunCli, CompareRendersOnceForBothSystems) {
-  const std::string d = fresh("compare");
-  const test::RunResult r =
-      test::run_pvbench("run --scenario " + kStation + " --out " + d + " --sync --frames 40 --compare");
-  ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("PE-SLAM"), std::string::npos) << r.output;
-  // The baseline is named for what it is, never as the ORB-SLAM2 program.
-  EXPECT_NE(r.output.find("PE-SLAM against the baseline (ORB-SLAM2 motion model) on the same frames:"),
-            std::string::npos)
-      << r.output;
-  EXPECT_EQ(r.output.find("ORB-SLAM2 baseline"), std::string::npos) << r.output;
-  const YAML::Node m = metrics(d);
-  EXPECT_EQ(m["metrics_version"].as<int>(), 2);
-  EXPECT_EQ(m["mode"].as<std::string>(), "pe-slam");
-  ASSERT_TRUE(m["baseline"]);
-  EXPECT_EQ(m["baseline"]["mode"].as<std::string>(), "baseline");
-  EXPECT_TRUE(m["comparison"]["tracking_ms_median"]["baseline"].IsScalar());
-  EXPECT_EQ(m["baseline"]["frames"].as<int>(), 40);
-  EXPECT_LT(m["baseline"]["ate"]["rmse"].as<double>(), 0.02);
-  EXPECT_TRUE(m["comparison"]["ate_rmse_reduction_pct"].IsScalar());
-  EXPECT_EQ(data_lines(d + "/baseline/CameraTrajectory.txt").size(), 40u);
-  // Both saw the same frames: one ground truth for both.
-  EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 40u);
-  // The baseline never runs PE-match.
-  for (const std::string& line : data_lines(d + "/baseline/timing.csv")) {
-    const std::vector<std::string> f = split_ws(line, ",");
-    if (f[0] == "frame") continue;
-    EXPECT_EQ(f[8], f[9]) << line;  // coarse == kept
   }
 }
 
