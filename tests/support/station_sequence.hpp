@@ -60,12 +60,12 @@ inline const std::string& station_ci_run() {
 }
 
 /// pvbench slam on the recording's first 120 frames (shared output
-/// pv_station_slam_120): synchronous, no dense map, Map.txt dumped.
+/// pv_station_slam_120): synchronous, with its dense map, Map.txt dumped.
 inline const std::string& station_slam_120() {
   static const std::string d = shared_output("pv_station_slam_120",
                                              "slam --sequence " + station_sequence() + " --settings " +
                                                  station_sequence() +
-                                                 "/camera.yaml --sync --no-dense --dump-map --max-frames 120",
+                                                 "/camera.yaml --sync --dump-map --max-frames 120",
                                              "stats.json");
   return d;
 }

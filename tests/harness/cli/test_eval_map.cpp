@@ -1,5 +1,5 @@
 // pvbench eval-map end to end: a short pv_station drive (the shared recording), mapped by
-// pvbench slam and scored against the scene's true surface.  The bounds are
+// pvbench slam (the shared run of its first 120 frames) and scored against the scene's true surface.  The bounds are
 // sanity bounds (a map put in the wrong frame is metres off, not
 // centimetres); the figures themselves are in docs/map_accuracy.md.
 #include <gtest/gtest.h>
@@ -52,10 +52,10 @@ void write_moved_map(const std::string& from, const std::string& to, float dy_m)
 
 /// Two sessions' maps in one frame: the same map twice is one surface;
 /// the map and a copy 8 cm above it are the surface drawn twice, apart.
-void expect_merged_maps_judged(const std::string& dir, const std::string& scenario) {
-  const std::string map = dir + "/slam/PointCloud.ply", inputs = " --scenario " + scenario + " --trajectory " + dir +
-                                                                 "/slam/CameraTrajectory.txt --gt " + dir +
-                                                                 "/seq/groundtruth.txt";
+void expect_merged_maps_judged(const std::string& dir, const std::string& slam, const std::string& scenario) {
+  const std::string map = slam + "/PointCloud.ply", inputs = " --scenario " + scenario + " --trajectory " + slam +
+                                                              "/CameraTrajectory.txt --gt " + dir +
+                                                              "/seq/groundtruth.txt";
   write_moved_map(map, dir + "/moved/PointCloud.ply", -0.08f);
   auto r = pvb::test::run_pvbench("eval-map --map " + map + " --map " + map + inputs + " --out " + dir + "/same");
   ASSERT_EQ(r.code, 0) << r.output;
@@ -95,14 +95,11 @@ void excerpt_of_station(const std::string& dir, std::size_t frames) {
 TEST(EvalMapCli, ScoresAShortPvStationMap) {
   const std::string dir = fresh("pv");
   const std::string scenario = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
-  const std::string& seq = pvb::test::station_sequence();
-  excerpt_of_station(dir + "/seq", 90);
-  auto r = pvb::test::run_pvbench("slam --sequence " + seq + " --settings " + seq +
-                                  "/camera.yaml --sync --max-frames 90 --out " + dir + "/slam");
-  ASSERT_EQ(r.code, 0) << r.output;
-  r = pvb::test::run_pvbench("eval-map --map " + dir + "/slam/PointCloud.ply --scenario " + scenario +
-                             " --trajectory " + dir + "/slam/CameraTrajectory.txt --gt " + dir +
-                             "/seq/groundtruth.txt --out " + dir + "/eval");
+  const std::string& slam = pvb::test::station_slam_120();  // slam --sync, its dense map
+  excerpt_of_station(dir + "/seq", 120);
+  const auto r = pvb::test::run_pvbench("eval-map --map " + slam + "/PointCloud.ply --scenario " + scenario +
+                                        " --trajectory " + slam + "/CameraTrajectory.txt --gt " + dir +
+                                        "/seq/groundtruth.txt --out " + dir + "/eval");
   ASSERT_EQ(r.code, 0) << r.output;
   const std::string js = pvb::read_file(dir + "/eval/map_accuracy.json");
   EXPECT_NE(js.find("\"panel\""), std::string::npos) << js;
@@ -118,7 +115,7 @@ TEST(EvalMapCli, ScoresAShortPvStationMap) {
   const std::string ply = pvb::read_file(dir + "/eval/map_errors.ply");
   EXPECT_NE(ply.find("property uchar class"), std::string::npos);
   EXPECT_NE(ply.find("property float error"), std::string::npos);
-  expect_merged_maps_judged(dir, scenario);
+  expect_merged_maps_judged(dir, slam, scenario);
   std::filesystem::remove_all(dir);
 }
 

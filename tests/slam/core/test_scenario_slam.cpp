@@ -72,12 +72,12 @@ TEST(SlamScenario, PvStationSyncAccurateAndNeverLost) {
 
 TEST(SlamScenario, SyncModeIsBitIdentical) {
   const std::string seq = station_sequence();
-  const std::string a = dir("det_a"), b = dir("det_b");
-  const std::string common = "slam --sequence " + seq + " --settings " + seq + "/camera.yaml --sync --max-frames 120 --out ";
-  const auto first = run(common + a);
-  ASSERT_EQ(first.code, 0);
-  EXPECT_NE(first.output.find("dense map: "), std::string::npos) << first.output;
-  ASSERT_EQ(run(common + b).code, 0);
+  // The shared run (made in another process, with --dump-map) and this one.
+  const std::string a = pvb::test::station_slam_120(), b = dir("det_b");
+  const auto r =
+      run("slam --sequence " + seq + " --settings " + seq + "/camera.yaml --sync --max-frames 120 --out " + b);
+  ASSERT_EQ(r.code, 0);
+  EXPECT_NE(r.output.find("dense map: "), std::string::npos) << r.output;
   const std::string ta = pvb::read_file(a + "/CameraTrajectory.txt");
   EXPECT_GT(ta.size(), 1000u);
   EXPECT_EQ(ta, pvb::read_file(b + "/CameraTrajectory.txt"));
