@@ -82,4 +82,17 @@ inline const std::string& station_imu_run() {
   return d;
 }
 
+/// A Kinect v1 dump of the station's first 60 frames (shared output
+/// pv_station_fakenect_60, `record --format fakenect`).  Tests copy it
+/// before they break it.
+constexpr int kStationFakenectFrames = 60;
+inline const std::string& station_fakenect_dump() {
+  static const std::string d = shared_output("pv_station_fakenect_60",
+                                             "record --scenario " + station_scenario() +
+                                                 " --format fakenect --frames " +
+                                                 std::to_string(kStationFakenectFrames),
+                                             "INDEX.txt");
+  return d;
+}
+
 }  // namespace pvb::test

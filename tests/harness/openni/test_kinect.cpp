@@ -17,6 +17,7 @@
 
 #include "cli_output.hpp"
 #include "pvb/common/text.hpp"
+#include "station_sequence.hpp"
 
 namespace {
 
@@ -41,7 +42,10 @@ std::string fresh(const std::string& name) {
   return d;
 }
 
-std::string record_dump(const std::string& dir, int frames) {
+/// The station's first `frames` frames as a fakenect dump: the shared one
+/// when it has them, else one recorded into `dir`.
+std::string station_dump(const std::string& dir, int frames) {
+  if (frames == pvb::test::kStationFakenectFrames) return pvb::test::station_fakenect_dump();
   const std::string dump = dir + "/dump";
   const Result rec = run("", "record --scenario scenes/pv_station.yaml --format fakenect --frames " +
                                  std::to_string(frames) + " --out " + dump);
@@ -71,7 +75,7 @@ std::string break_entry(const std::string& dump, int line, const std::string* co
 
 TEST(PVB_KINECT_SUITE, FakenectDumpTracksDeterministicallyAndItsOniReplaysTheSame) {
   const std::string dir = fresh("accept");
-  const std::string dump = record_dump(dir, kFrames);
+  const std::string dump = station_dump(dir, kFrames);
   const std::string oni = dir + "/run.oni";
   const Result first =
       run(fakenect_env(dump), "camera --uri freenect://0 --sync --record " + oni + " --out " + dir + "/a");
@@ -94,7 +98,7 @@ TEST(PVB_KINECT_SUITE, FakenectDumpTracksDeterministicallyAndItsOniReplaysTheSam
       run("", "camera --oni " + oni + " --settings " + dir + "/a/camera.yaml --sync --out " + dir + "/c");
   ASSERT_EQ(replay.code, 0) << replay.output;
   EXPECT_EQ(data_lines(dir + "/c/CameraTrajectory.txt"), a);
-  std::system(("rm -rf " + dir).c_str());  // 230 MB
+  std::system(("rm -rf " + dir).c_str());  // the .oni, and on the longer drive its own dump
 }
 
 TEST(PVB_KINECT_SUITE, RealLibfreenectWithoutAKinectSaysSo) {
@@ -106,7 +110,7 @@ TEST(PVB_KINECT_SUITE, RealLibfreenectWithoutAKinectSaysSo) {
 
 TEST(PVB_KINECT_SUITE, BrokenDumpsEndWithOneErrorAndKeepTheTrajectory) {
   const std::string dir = fresh("broken");
-  const std::string dump = record_dump(dir, 40);
+  const std::string& dump = pvb::test::station_fakenect_dump();
   const int frame = 20, line_of_depth = 3 * frame + 2;  // a, d, r per frame
   struct Case {
     const char* what;
@@ -124,7 +128,7 @@ TEST(PVB_KINECT_SUITE, BrokenDumpsEndWithOneErrorAndKeepTheTrajectory) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.what);
     const std::string copy = dir + "/" + c.what;
-    std::system(("cp -r " + dump + " " + copy).c_str());
+    std::system(("cp -rs " + dump + " " + copy).c_str());  // links: break_entry replaces a link, not its file
     const std::string name = break_entry(copy, c.line, c.remove ? nullptr : &c.content);
     const Result r = run(fakenect_env(copy), "camera --uri freenect://0 --sync --out " + copy + "/out");
     expect_one_error_line(r, c.expect);
@@ -137,7 +141,7 @@ TEST(PVB_KINECT_SUITE, BrokenDumpsEndWithOneErrorAndKeepTheTrajectory) {
 
 TEST(PVB_KINECT_SUITE, IndexPastTheDevicesAndBadUrisSaySo) {
   const std::string dir = fresh("index");
-  const std::string dump = record_dump(dir, 2);
+  const std::string& dump = pvb::test::station_fakenect_dump();
   const std::string settings = " --settings " + std::string(PVB_SOURCE_DIR) + "/configs/kinect/kinect_v1.yaml";
   expect_one_error_line(run(fakenect_env(dump), "camera --uri freenect://1" + settings + " --out " + dir + "/a"),
                         "no Kinect 1 (libfreenect sees 1)");
