@@ -4,7 +4,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <functional>
+#include <unordered_map>
+#include <utility>
+#include <vector>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
@@ -295,6 +299,43 @@ std::vector<KeepOutBox> fixture_boxes(const Scenario& s, const PlantSummary& pla
   return boxes;
 }
 
+/// The keep-out boxes in a grid of cells as wide as the widest box's circle:
+/// a point can lie in a box only if the box's centre is in the point's cell
+/// or one of the eight around it, so a point is tested against a few boxes,
+/// not a plant's hundreds of row signs.
+class KeepOutGrid {
+ public:
+  explicit KeepOutGrid(std::vector<KeepOutBox> boxes) : boxes_(std::move(boxes)) {
+    for (const KeepOutBox& b : boxes_) cell_m_ = std::max(cell_m_, std::sqrt(b.radius2_m2));
+    for (std::size_t i = 0; i < boxes_.size(); ++i) {
+      const auto [cx, cy] = cell_of(boxes_[i].centre_m);
+      cells_[key(cx, cy)].push_back(i);
+    }
+  }
+  bool holds(const Eigen::Vector2d& p) const {
+    const auto [cx, cy] = cell_of(p);
+    for (std::int64_t dx = -1; dx <= 1; ++dx)
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        const auto it = cells_.find(key(cx + dx, cy + dy));
+        if (it == cells_.end()) continue;
+        for (const std::size_t i : it->second)
+          if (boxes_[i].holds(p)) return true;
+      }
+    return false;
+  }
+
+ private:
+  std::pair<std::int64_t, std::int64_t> cell_of(const Eigen::Vector2d& p) const {
+    return {static_cast<std::int64_t>(std::floor(p.x() / cell_m_)),
+            static_cast<std::int64_t>(std::floor(p.y() / cell_m_))};
+  }
+  static std::int64_t key(std::int64_t cx, std::int64_t cy) { return cx * 1000003 + cy; }
+
+  std::vector<KeepOutBox> boxes_;
+  double cell_m_ = 1.0;
+  std::unordered_map<std::int64_t, std::vector<std::size_t>> cells_;
+};
+
 /// The checks of a route that needs a plant: a loop along its roads, a
 /// route from its dock.
 void check_plant_pattern(const Scenario& s, const ReadContext& ctx) {
@@ -340,7 +381,7 @@ void check_plant_route(const Scenario& s, const ReadContext& ctx) {
   const Eigen::Vector2d c0 = bound[0];
   const Eigen::Vector2d eu = bound[1] - c0, ev = bound[3] - c0;
   const std::vector<Eigen::Vector2d> route = route_polyline(s);
-  const std::vector<KeepOutBox> fixtures = fixture_boxes(s, plant, kRouteTableClearanceM);
+  const KeepOutGrid fixtures(fixture_boxes(s, plant, kRouteTableClearanceM));
   double along_m = 0;
   for (std::size_t i = 0; i < route.size(); ++i) {
     const Eigen::Vector2d& p = route[i];
@@ -354,7 +395,7 @@ void check_plant_route(const Scenario& s, const ReadContext& ctx) {
       if (in_a_table(s.pv_arrays[static_cast<std::size_t>(b)], p, kRouteTableClearanceM))
         refuse("a route that keeps " + format_number("%.2f m", kRouteTableClearanceM) +
                    " from every table (the robot's half width)", p, along_m);
-    if (std::any_of(fixtures.begin(), fixtures.end(), [&](const KeepOutBox& b) { return b.holds(p); }))
+    if (fixtures.holds(p))
       refuse("a route that keeps " + format_number("%.2f m", kRouteTableClearanceM) +
                  " from the dock, the combiner boxes, the row signs and the inverter stations", p, along_m);
   }
