@@ -414,12 +414,14 @@ TEST(RunCli, SigintWhileTheMapIsSavedEndsInterruptedWithAWholeMap) {
   ASSERT_TRUE(ended.has_value() && WIFEXITED(*ended)) << read_file(log);
   EXPECT_EQ(WEXITSTATUS(*ended), 130) << read_file(log);
   EXPECT_EQ(metrics(d)["status"].as<std::string>(), "interrupted");
-  // The map is whole: a localise run loads it.
-  const test::RunResult again = test::run_pvbench("run --scenario " + kStation + " --out " + d +
-                                                  "_again --frames 2 "
-                                                  "--sync --no-map-eval --map " +
-                                                  map + " --map-mode localise");
+  // The map is whole: pvbench slam loads it to localise in (on the shared
+  // recording of the same station: no scene to build for two frames).
+  const std::string& rec = test::station_sequence();
+  const test::RunResult again =
+      test::run_pvbench("slam --sequence " + rec + " --settings " + rec + "/camera.yaml --out " + d +
+                        "_again --max-frames 2 --sync --no-dense --map " + map + " --map-mode localise");
   EXPECT_EQ(again.code, 0) << again.output;
+  EXPECT_NE(again.output.find(map), std::string::npos) << again.output;
 }
 
 // Two runs into one folder at once: the second is refused while the first
