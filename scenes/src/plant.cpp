@@ -69,7 +69,7 @@ void add_row_signs(const Plant& p, PlantLayout* out) {
     for (int row = 0; row < block.rows; ++row) {
       const double v = row * block.row_pitch_m + row_footprint_m(block) / 2 - kRowSignAsideM;
       const int label = static_cast<int>(out->sign_labels.size());
-      char text[32];
+      char text[48];  // "B" and 20 digits, " R" and 11: never cut
       std::snprintf(text, sizeof text, "B%zu R%03d", b + 1, row + 1);
       out->sign_labels.emplace_back(text);
       out->row_signs.push_back({array_to_world(block, u_west, v), block.azimuth_deg + 180.0, label});
