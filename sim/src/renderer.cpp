@@ -223,20 +223,23 @@ void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat
       std::copy(src, src + static_cast<std::size_t>(width_) * 3, rgb->ptr<unsigned char>(r));
     }
   }
-  if (depth_m != nullptr) {
-    const double extent = model->stat.extent;
-    const double n = model->vis.map.znear * extent;
-    const double f = model->vis.map.zfar * extent;
-    depth_m->create(height_, width_, CV_32FC1);
-    for (int r = 0; r < height_; ++r) {
-      const float* src = depth_buf_.data() + static_cast<std::size_t>(height_ - 1 - r) * width_;
-      float* dst = depth_m->ptr<float>(r);
-      for (int c = 0; c < width_; ++c) dst[c] = depth_from_buffer(src[c], n, f);
-    }
+  if (depth_m != nullptr) copy_depth(model, depth_m);
+}
+
+void Renderer::copy_depth(const mjModel* model, cv::Mat* depth_m) const {
+  const double extent = model->stat.extent;
+  const double n = model->vis.map.znear * extent;
+  const double f = model->vis.map.zfar * extent;
+  depth_m->create(height_, width_, CV_32FC1);
+  for (int r = 0; r < height_; ++r) {
+    const float* src = depth_buf_.data() + static_cast<std::size_t>(height_ - 1 - r) * width_;
+    float* dst = depth_m->ptr<float>(r);
+    for (int c = 0; c < width_; ++c) dst[c] = depth_from_buffer(src[c], n, f);
   }
 }
 
-void Renderer::render_geom_ids(const mjModel* model, mjData* data, int camera_id, cv::Mat* geom_id) {
+void Renderer::render_geom_ids(const mjModel* model, mjData* data, int camera_id, cv::Mat* geom_id,
+                               cv::Mat* depth_m) {
   gl_->make_current();
   camera_.type = mjCAMERA_FIXED;
   camera_.fixedcamid = camera_id;
@@ -248,7 +251,7 @@ void Renderer::render_geom_ids(const mjModel* model, mjData* data, int camera_id
   scene_.flags[mjRND_SHADOW] = 0;
   const mjrRect viewport{0, 0, width_, height_};
   mjr_render(viewport, &scene_, &con_);
-  mjr_readPixels(rgb_buf_.data(), nullptr, viewport, &con_);
+  mjr_readPixels(rgb_buf_.data(), depth_m ? depth_buf_.data() : nullptr, viewport, &con_);
   scene_.flags[mjRND_SEGMENT] = 0;
   scene_.flags[mjRND_IDCOLOR] = 0;
   scene_.flags[mjRND_SHADOW] = shadow;
@@ -263,6 +266,7 @@ void Renderer::render_geom_ids(const mjModel* model, mjData* data, int camera_id
       dst[c] = is_geom ? scene_.geoms[seg].objid : -1;
     }
   }
+  if (depth_m != nullptr) copy_depth(model, depth_m);
 }
 
 }  // namespace pvb::sim

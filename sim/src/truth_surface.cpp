@@ -7,7 +7,9 @@
 #include <cstring>
 #include <optional>
 #include <string>
-#include <unordered_map>
+#include <cstdint>
+#include <utility>
+#include <vector>
 
 #include "pvb/scenes/ground_relief.hpp"
 #include "pvb/sim/renderer.hpp"
@@ -78,17 +80,60 @@ Eigen::Vector3d geom_normal(const mjModel* m, const mjData* d, int g, const Eige
 
 namespace {
 
-struct VoxelKey {
-  std::int64_t k;
-  bool operator==(const VoxelKey& o) const { return k == o.k; }
-};
-struct VoxelHash {
-  std::size_t operator()(const VoxelKey& v) const { return std::hash<std::int64_t>()(v.k); }
+/// The samples, one per voxel, in the order their voxels were first seen,
+/// found by voxel key through an open-addressed table (linear probing): the
+/// pixels of a route look a voxel up tens of millions of times.
+class VoxelSamples {
+ public:
+  VoxelSamples() { rehash(1u << 16); }
+  /// The index of voxel `key`'s sample; `*added` when it is new (then default).
+  std::size_t find_or_add(std::int64_t key, bool* added) {
+    if (2 * (samples_.size() + 1) > slots_.size()) rehash(2 * slots_.size());
+    std::size_t i = slot_of(key);
+    for (; slots_[i].index != kEmpty; i = (i + 1) & mask_)
+      if (slots_[i].key == key) {
+        *added = false;
+        return slots_[i].index;
+      }
+    slots_[i] = {key, static_cast<std::uint32_t>(samples_.size())};
+    samples_.emplace_back(key, TruthSample{});
+    *added = true;
+    return slots_[i].index;
+  }
+  TruthSample& operator[](std::size_t i) { return samples_[i].second; }
+  /// (voxel key, sample) pairs.
+  std::vector<std::pair<std::int64_t, TruthSample>>& samples() { return samples_; }
+
+ private:
+  static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
+  struct Slot {  // the key too, so that a probe reads one cache line
+    std::int64_t key;
+    std::uint32_t index;
+  };
+  std::size_t slot_of(std::int64_t key) const {
+    return static_cast<std::size_t>((static_cast<std::uint64_t>(key) * 0x9E3779B97F4A7C15ull) >> shift_);
+  }
+  void rehash(std::size_t slots) {
+    slots_.assign(slots, Slot{0, kEmpty});
+    mask_ = slots - 1;
+    shift_ = 64;
+    for (std::size_t n = slots; n > 1; n >>= 1) --shift_;
+    for (std::uint32_t j = 0; j < samples_.size(); ++j) {
+      std::size_t i = slot_of(samples_[j].first);
+      while (slots_[i].index != kEmpty) i = (i + 1) & mask_;
+      slots_[i] = {samples_[j].first, j};
+    }
+  }
+  std::vector<std::pair<std::int64_t, TruthSample>> samples_;
+  std::vector<Slot> slots_;
+  std::size_t mask_ = 0;
+  int shift_ = 64;
 };
 
-VoxelKey voxel_of(const Eigen::Vector3d& p, double size) {
+/// The key of the voxel holding p: 21 bits an axis.
+std::int64_t voxel_of(const Eigen::Vector3d& p, double size) {
   const auto q = [size](double v) { return static_cast<std::int64_t>(std::floor(v / size)) & 0x1FFFFF; };
-  return {(q(p.x()) << 42) | (q(p.y()) << 21) | q(p.z())};
+  return (q(p.x()) << 42) | (q(p.y()) << 21) | q(p.z());
 }
 
 /// The class of every geom of the model, nullopt for the robot's own.
@@ -104,10 +149,14 @@ std::vector<std::optional<SurfaceClass>> geom_classes(const mjModel* m) {
 /// Adds the pixels of one rendered frame to the voxel map.
 void add_frame(Simulator& sim, const cv::Mat& depth_m, const cv::Mat& geom_id, const scenes::Camera& cam,
                const std::vector<std::optional<SurfaceClass>>& classes, double voxel_m,
-               std::unordered_map<VoxelKey, TruthSample, VoxelHash>* voxels) {
+               VoxelSamples* voxels) {
   const geom::PinholeIntrinsics K = sim.intrinsics();
   const geom::SE3d T_w_c = sim.T_w_c();
   const Eigen::Vector3d eye = T_w_c.translation();
+  // Neighbouring pixels mostly fall in one voxel: the last one is kept at
+  // hand.
+  std::int64_t last_key = -1;
+  std::size_t last = 0;
   for (int v = 0; v < depth_m.rows; ++v)
     for (int u = 0; u < depth_m.cols; ++u) {
       const double z = depth_m.at<float>(v, u);
@@ -117,8 +166,16 @@ void add_frame(Simulator& sim, const cv::Mat& depth_m, const cv::Mat& geom_id, c
       const Eigen::Vector3d p_c((u - K.cx) / K.fx * z, (v - K.cy) / K.fy * z, z);
       const Eigen::Vector3d p_w = T_w_c * p_c;
       const double range = p_c.norm();
-      auto [it, added] = voxels->try_emplace(voxel_of(p_w, voxel_m));
-      TruthSample& s = it->second;
+      const std::int64_t key = voxel_of(p_w, voxel_m);
+      if (key == last_key) {
+        TruthSample& s = (*voxels)[last];
+        s.range_m = std::min(s.range_m, range);
+        continue;
+      }
+      bool added = false;
+      last = voxels->find_or_add(key, &added);
+      last_key = key;
+      TruthSample& s = (*voxels)[last];
       if (added) {
         s.p_w = p_w;
         s.cls = *classes[static_cast<std::size_t>(g)];
@@ -138,19 +195,16 @@ std::vector<TruthSample> sample_truth_surface(const scenes::Scenario& scenario, 
   Renderer renderer(sim.model(), backend, scenario.camera.width, scenario.camera.height);
   const std::vector<std::optional<SurfaceClass>> classes = geom_classes(sim.model());
   const int n = scenes::frame_count(scenario, options.frames);
-  std::unordered_map<VoxelKey, TruthSample, VoxelHash> voxels;
+  VoxelSamples voxels;
   cv::Mat depth, ids;
   for (int i = 0; i < n; ++i) {
     if (i > 0) sim.advance();
     if (i % std::max(1, options.every) != 0) continue;
-    renderer.render(sim.model(), sim.data(), sim.camera_id(), nullptr, &depth);
-    renderer.render_geom_ids(sim.model(), sim.data(), sim.camera_id(), &ids);
+    renderer.render_geom_ids(sim.model(), sim.data(), sim.camera_id(), &ids, &depth);
     add_frame(sim, depth, ids, scenario.camera, classes, options.voxel_m, &voxels);
   }
-  // Sort by voxel key: the output does not depend on hash-table order.
-  std::vector<std::pair<std::int64_t, TruthSample>> sorted;
-  sorted.reserve(voxels.size());
-  for (const auto& [k, s] : voxels) sorted.emplace_back(k.k, s);
+  // In voxel-key order, as the samples have always been listed.
+  std::vector<std::pair<std::int64_t, TruthSample>>& sorted = voxels.samples();
   std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<TruthSample> out;
   out.reserve(sorted.size());

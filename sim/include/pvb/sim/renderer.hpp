@@ -39,8 +39,11 @@ class Renderer {
   void render(const mjModel* model, mjData* data, int camera_id, cv::Mat* rgb, cv::Mat* depth_m);
 
   /// Renders which model geom each pixel shows (CV_32SC1, -1 = none), with
-  /// MuJoCo's segmentation mode (mjRND_SEGMENT + mjRND_IDCOLOR).
-  void render_geom_ids(const mjModel* model, mjData* data, int camera_id, cv::Mat* geom_id);
+  /// MuJoCo's segmentation mode (mjRND_SEGMENT + mjRND_IDCOLOR).  depth_m,
+  /// when given, is read from the same pass: the depth render() gives for
+  /// the same state, in one draw instead of two.
+  void render_geom_ids(const mjModel* model, mjData* data, int camera_id, cv::Mat* geom_id,
+                       cv::Mat* depth_m = nullptr);
 
   /// Turns shadows on or off for the following renders.
   void set_shadows(bool on);
@@ -70,6 +73,8 @@ class Renderer {
  private:
   /// Uploads the stream's redrawn slots and points its near tiles at them.
   void apply_ground_stream();
+  /// The depth buffer read last, flipped to image rows, in metres.
+  void copy_depth(const mjModel* model, cv::Mat* depth_m) const;
 
   std::unique_ptr<GlContext> gl_;
   mjrContext con_;
