@@ -75,25 +75,48 @@ struct GhostFlags {
 };
 
 /// Two layers: a gap wider than 2 tau in the sorted offsets with k points on each side.
-int two_layers(std::vector<double> offsets, const MapAccuracyOptions& o) {
+int two_layers(std::vector<double>* offsets, const MapAccuracyOptions& o) {
   const auto k = static_cast<std::size_t>(o.ghost_min_points);
-  if (offsets.size() < k) return -1;
-  std::sort(offsets.begin(), offsets.end());
-  for (std::size_t i = k; i + k <= offsets.size(); ++i)
-    if (offsets[i] - offsets[i - 1] > 2.0 * o.ghost_tau_m) return 1;
+  if (offsets->size() < k) return -1;
+  std::sort(offsets->begin(), offsets->end());
+  for (std::size_t i = k; i + k <= offsets->size(); ++i)
+    if ((*offsets)[i] - (*offsets)[i - 1] > 2.0 * o.ghost_tau_m) return 1;
   return 0;
 }
 
+/// The median of sorted values.
+double sorted_median(const double* d, std::size_t n) { return n % 2 ? d[n / 2] : 0.5 * (d[n / 2 - 1] + d[n / 2]); }
+
 /// Two source maps apart: the median offsets of the sources with k points
-/// span more than 2 tau.
-int maps_apart(const std::map<int, std::vector<double>>& by_source, const MapAccuracyOptions& o) {
-  std::vector<double> medians;
-  for (const auto& [source, offsets] : by_source)
-    if (offsets.size() >= static_cast<std::size_t>(o.ghost_min_points)) medians.push_back(summarise(offsets).median);
-  if (medians.size() < 2) return -1;
-  const auto [lo, hi] = std::minmax_element(medians.begin(), medians.end());
-  return *hi - *lo > 2.0 * o.ghost_tau_m ? 1 : 0;
+/// span more than 2 tau.  `by_source` holds (source, offset) pairs.
+int maps_apart(std::vector<std::pair<int, double>>* by_source, const MapAccuracyOptions& o) {
+  std::sort(by_source->begin(), by_source->end());
+  std::vector<double> offsets;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  int judged = 0;
+  for (std::size_t i = 0; i < by_source->size();) {
+    std::size_t j = i;
+    offsets.clear();
+    for (; j < by_source->size() && (*by_source)[j].first == (*by_source)[i].first; ++j)
+      offsets.push_back((*by_source)[j].second);
+    if (offsets.size() >= static_cast<std::size_t>(o.ghost_min_points)) {
+      const double median = sorted_median(offsets.data(), offsets.size());
+      lo = std::min(lo, median);
+      hi = std::max(hi, median);
+      ++judged;
+    }
+    i = j;
+  }
+  if (judged < 2) return -1;
+  return hi - lo > 2.0 * o.ghost_tau_m ? 1 : 0;
 }
+
+/// What ghosted() fills for each surface point, kept between points.
+struct GhostScratch {
+  std::vector<std::pair<std::size_t, double>> near;
+  std::vector<double> offsets;
+  std::vector<std::pair<int, double>> by_source;
+};
 
 /// Ghosting of one surface point from the map points whose nearest surface
 /// point lies within the lateral radius: their offsets along this point's
@@ -101,20 +124,19 @@ int maps_apart(const std::map<int, std::vector<double>>& by_source, const MapAcc
 /// and, for merged maps, split by source.
 GhostFlags ghosted(std::size_t at, const std::vector<SurfacePoint>& surface, const Tree& surface_tree,
                    const std::vector<std::vector<std::size_t>>& map_by_surface, const std::vector<MapPoint>& map,
-                   const MapAccuracyOptions& o, bool merged) {
+                   const MapAccuracyOptions& o, bool merged, GhostScratch* scratch) {
   const SurfacePoint& s = surface[at];
-  std::vector<std::pair<std::size_t, double>> near;
   nanoflann::SearchParams unsorted;  // the offsets are sorted below, whatever order they come in
   unsorted.sorted = false;
-  surface_tree.radiusSearch(s.p_w.data(), o.ghost_radius_m * o.ghost_radius_m, near, unsorted);
-  std::vector<double> offsets;
-  std::map<int, std::vector<double>> by_source;
-  for (const auto& [j, d2] : near)
+  surface_tree.radiusSearch(s.p_w.data(), o.ghost_radius_m * o.ghost_radius_m, scratch->near, unsorted);
+  scratch->offsets.clear();
+  scratch->by_source.clear();
+  for (const auto& [j, d2] : scratch->near)
     for (std::size_t m : map_by_surface[j]) {
-      offsets.push_back((map[m].p_w - s.p_w).dot(s.n_w));
-      if (merged) by_source[map[m].source].push_back(offsets.back());
+      scratch->offsets.push_back((map[m].p_w - s.p_w).dot(s.n_w));
+      if (merged) scratch->by_source.emplace_back(map[m].source, scratch->offsets.back());
     }
-  return {two_layers(std::move(offsets), o), merged ? maps_apart(by_source, o) : -1};
+  return {two_layers(&scratch->offsets, o), merged ? maps_apart(&scratch->by_source, o) : -1};
 }
 
 /// The share of judged flags that are set, and how many were judged.
@@ -186,8 +208,9 @@ MapAccuracy evaluate_map(const std::vector<MapPoint>& map, const std::vector<Sur
   std::set<int> sources;
   for (const MapPoint& m : map) sources.insert(m.source);
   std::vector<int> ghosts(surface.size(), -1), between(surface.size(), -1);
+  GhostScratch scratch;
   for (std::size_t i = 0; i < surface.size(); ++i) {
-    const GhostFlags g = ghosted(i, surface, surf_tree, map_by_surface, map, options, sources.size() > 1);
+    const GhostFlags g = ghosted(i, surface, surf_tree, map_by_surface, map, options, sources.size() > 1, &scratch);
     ghosts[i] = g.within;
     between[i] = g.between;
   }
