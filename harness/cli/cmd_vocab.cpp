@@ -17,6 +17,7 @@
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/scenes/scenario.hpp"
+#include "pvb/sensor/image_codec.hpp"
 #include "pvb/sim/sim_frame_source.hpp"
 #include "pvb/slam/features/orb_extractor.hpp"
 #include "pvb/slam/place/vocabulary.hpp"
@@ -73,7 +74,7 @@ void add_image_folder(const std::string& dir, Collector* c) {
   std::sort(files.begin(), files.end());
   if (files.empty()) throw IoError(dir, "--images: no .png, .jpg, .ppm or .pgm file in the folder");
   for (const auto& f : files) {
-    const cv::Mat img = cv::imread(f.string(), cv::IMREAD_GRAYSCALE);
+    const cv::Mat img = sensor::imread(f.string(), cv::IMREAD_GRAYSCALE);
     if (img.empty()) throw IoError(f.string(), "cannot read the image");
     c->add(img);
   }

@@ -16,7 +16,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // the flags
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -28,6 +28,7 @@
 #include "pvb/common/text.hpp"
 #include "pvb/scenes/ground_relief.hpp"
 #include "pvb/scenes/route.hpp"
+#include "pvb/sensor/image_codec.hpp"
 #include "pvb/sim/ground_stream.hpp"
 #include "pvb/sim/simulator.hpp"
 #include "pvb/sim/textures.hpp"
@@ -57,7 +58,7 @@ int file_zlib_level(const std::string& path) { return path.rfind(kGroundTilePref
 
 std::vector<unsigned char> png_of_bgr(const cv::Mat& bgr, int zlib_level) {
   std::vector<unsigned char> out;
-  cv::imencode(".png", bgr, out, {cv::IMWRITE_PNG_COMPRESSION, zlib_level});
+  sensor::imencode(".png", bgr, &out, {cv::IMWRITE_PNG_COMPRESSION, zlib_level});
   return out;
 }
 

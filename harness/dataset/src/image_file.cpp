@@ -8,6 +8,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
+#include "pvb/sensor/image_codec.hpp"
 
 namespace pvb::dataset {
 namespace {
@@ -160,7 +161,7 @@ cv::Mat read_image(const std::string& path, int imread_flags, const std::string&
   cv::Mat image;
   try {
     const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8U, bytes.data());
-    image = cv::imdecode(buffer, imread_flags);
+    image = sensor::imdecode(buffer, imread_flags);
   } catch (const cv::Exception& e) {
     throw IoError(path, "unreadable " + what + ": " + e.err);
   }

@@ -22,6 +22,7 @@
 #include "pvb/dataset/image_file.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/geometry/time.hpp"
+#include "pvb/sensor/image_codec.hpp"
 
 namespace pvb::dataset {
 
@@ -135,7 +136,7 @@ void write_image(const std::string& path, const cv::Mat& image) {
   bool ok = false;
   note_output(path);
   try {
-    ok = cv::imwrite(path, image);
+    ok = sensor::imwrite(path, image);
   } catch (const cv::Exception& e) {
     std::remove(path.c_str());
     throw IoError(path, "cannot write image: " + e.msg);

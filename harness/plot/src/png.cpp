@@ -7,6 +7,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/output_file.hpp"
+#include "pvb/sensor/image_codec.hpp"
 
 namespace pvb::plot {
 namespace {
@@ -76,7 +77,7 @@ void write_image(const cv::Mat& image, const std::string& path) {
   std::vector<unsigned char> bytes;
   bool ok = false;
   try {
-    ok = cv::imencode(ext, image, bytes);
+    ok = sensor::imencode(ext, image, &bytes);
   } catch (const cv::Exception& e) {
     throw IoError(path, std::string("cannot encode the image: ") + e.what());
   }

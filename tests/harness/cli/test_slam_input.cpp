@@ -98,6 +98,21 @@ TEST(SlamInput, CleanSequenceTracksEveryFrame) {
   EXPECT_EQ(stat(out, "not_initialized_frames"), 0);
 }
 
+// Without the image codecs module (moved away, or PVB_MODULE_DIR naming a
+// folder without it) the first image read is one error line naming the
+// module, and nothing is tracked.
+TEST(SlamInput, AMissingImageCodecsModuleIsOneErrorLine) {
+  const std::string seq = make_sequence("no_codecs"), out = fresh("no_codecs_out");
+  const std::string empty = fresh("no_codecs_modules");
+  std::filesystem::create_directories(empty);
+  const Result r = test::run_pvbench_from_source("PVB_MODULE_DIR=" + empty, "slam --sequence " + seq + " --settings " +
+                                                 seq + "/camera.yaml --out " + out + " --sync --no-dense");
+  EXPECT_NE(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("cannot load the image codecs module " + empty + "/libpvb_imgcodecs.so"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(count(r.output, "\n"), 1u) << r.output;
+}
+
 // A NaN or huge time stamp in associations.txt (or rgb.txt) is an error
 // naming the file and line, before anything is written.
 TEST(SlamInput, NanOrHugeTimeStampIsAnErrorNamingFileAndLine) {
