@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <array>
-#include <atomic>
 #include <cstdlib>
 #include <mutex>
 #include <optional>
@@ -22,8 +21,6 @@ struct Codecs {
   void (*read)(const std::string*, int, cv::Mat*) = nullptr;
   bool (*write)(const std::string*, const cv::Mat*, const std::vector<int>*) = nullptr;
 };
-
-std::atomic<bool> g_loaded{false};
 
 /// PVB_MODULE_DIR when set; else the running program's ../lib when the
 /// module is there (an installed tree, or a build's bin/); else where the
@@ -61,7 +58,6 @@ Codecs load() {
   find(dl, "pvb_imdecode", &c.decode, path);
   find(dl, "pvb_imread", &c.read, path);
   find(dl, "pvb_imwrite", &c.write, path);
-  g_loaded = true;
   return c;
 }
 
@@ -96,7 +92,5 @@ cv::Mat imread(const std::string& path, int flags) {
 bool imwrite(const std::string& path, const cv::Mat& image, const std::vector<int>& params) {
   return codecs().write(&path, &image, &params);
 }
-
-bool image_codecs_loaded() { return g_loaded; }
 
 }  // namespace pvb::sensor

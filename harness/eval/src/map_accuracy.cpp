@@ -44,6 +44,12 @@ Nearest nearest(const std::vector<Eigen::Vector3d>& from, const Tree* to) {
   return n;
 }
 
+/// The median of n sorted values, value k being at(k).
+template <typename At>
+double sorted_median(std::size_t n, At at) {
+  return n % 2 ? at(n / 2) : 0.5 * (at(n / 2 - 1) + at(n / 2));
+}
+
 DistanceSummary summarise(std::vector<double> d) {
   DistanceSummary s;
   s.count = d.size();
@@ -57,7 +63,7 @@ DistanceSummary summarise(std::vector<double> d) {
   s.rmse = std::sqrt(sum2 / static_cast<double>(d.size()));
   std::sort(d.begin(), d.end());
   const std::size_t n = d.size();
-  s.median = n % 2 ? d[n / 2] : 0.5 * (d[n / 2 - 1] + d[n / 2]);
+  s.median = sorted_median(n, [&](std::size_t k) { return d[k]; });
   s.p95 = d[static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(n))) - 1];
   return s;
 }
@@ -84,23 +90,19 @@ int two_layers(std::vector<double>* offsets, const MapAccuracyOptions& o) {
   return 0;
 }
 
-/// The median of sorted values.
-double sorted_median(const double* d, std::size_t n) { return n % 2 ? d[n / 2] : 0.5 * (d[n / 2 - 1] + d[n / 2]); }
-
 /// Two source maps apart: the median offsets of the sources with k points
 /// span more than 2 tau.  `by_source` holds (source, offset) pairs.
 int maps_apart(std::vector<std::pair<int, double>>* by_source, const MapAccuracyOptions& o) {
+  // Sorted by source, then offset: each source's offsets lie in a sorted run.
+  const std::vector<std::pair<int, double>>& v = *by_source;
   std::sort(by_source->begin(), by_source->end());
-  std::vector<double> offsets;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   int judged = 0;
-  for (std::size_t i = 0; i < by_source->size();) {
+  for (std::size_t i = 0; i < v.size();) {
     std::size_t j = i;
-    offsets.clear();
-    for (; j < by_source->size() && (*by_source)[j].first == (*by_source)[i].first; ++j)
-      offsets.push_back((*by_source)[j].second);
-    if (offsets.size() >= static_cast<std::size_t>(o.ghost_min_points)) {
-      const double median = sorted_median(offsets.data(), offsets.size());
+    while (j < v.size() && v[j].first == v[i].first) ++j;
+    if (j - i >= static_cast<std::size_t>(o.ghost_min_points)) {
+      const double median = sorted_median(j - i, [&](std::size_t k) { return v[i + k].second; });
       lo = std::min(lo, median);
       hi = std::max(hi, median);
       ++judged;

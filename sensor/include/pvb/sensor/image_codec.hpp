@@ -21,7 +21,4 @@ cv::Mat imdecode(const cv::Mat& buffer, int flags);
 cv::Mat imread(const std::string& path, int flags);
 bool imwrite(const std::string& path, const cv::Mat& image, const std::vector<int>& params = {});
 
-/// Whether this process has loaded the codecs module.
-bool image_codecs_loaded();
-
 }  // namespace pvb::sensor
