@@ -146,8 +146,10 @@ bool Tracking::dead_reckon(Frame& f) {
                 format_fixed(options_.blind_max_m, 2) + " m)");
   if (rise_m > options_.kidnap_lift_m)
     return fail("kidnap: the IMU rose " + format_fixed(rise_m, 2) + " m while vision was lost");
-  if (uses_wheels(motion_->setup()) && motion_->has_wheels() && apart_m > options_.kidnap_disagree_m)
-    return fail("kidnap: the IMU and the wheels part by " + format_fixed(apart_m, 2) + " m while vision was lost");
+  const double apart_max_m = options_.kidnap_disagree_m + 0.5 * options_.kidnap_disagree_accel_mps2 * blind_s * blind_s;
+  if (uses_wheels(motion_->setup()) && motion_->has_wheels() && apart_m > apart_max_m)
+    return fail("kidnap: the IMU and the wheels part by " + format_fixed(apart_m, 2) + " m while vision was lost (" +
+                format_fixed(apart_max_m, 2) + " m allowed after " + format_fixed(blind_s, 2) + " s)");
   f.T_c_w = T_c_w;
   f.has_pose = true;
   std::fill(f.map_points.begin(), f.map_points.end(), nullptr);

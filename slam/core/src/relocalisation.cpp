@@ -21,6 +21,7 @@ const char* to_string(TrackingStats::RelocFailure f) {
     case F::kFewInliers: return "too few pose inliers";
     case F::kAmbiguous: return "ambiguous";
     case F::kLookalike: return "look-alike place";
+    case F::kOdometry: return "outside the wheels' bound";
     case F::kLocalMap: return "local map after relocalisation";
   }
   return "?";
@@ -150,6 +151,10 @@ std::string Tracking::relocalise_in(Frame& f, std::optional<std::uint32_t> only_
   int best_matches = 0, with_matches = 0, best_pnp = 0, with_pnp = 0, best_inliers = 0;
   std::vector<std::pair<Frame, std::shared_ptr<KeyFrame>>> found;
   std::vector<int> found_inliers;
+  // In this map's frame while lost in it, the wheels bound where f can be:
+  // a match beyond is no candidate (nor a rival for the ambiguity check).
+  const bool odometry_bound = !only_map.has_value();
+  std::string refused;
   for (const auto& kf : cands) {
     if (kf->bad()) continue;
     Frame trial = f;
@@ -161,11 +166,19 @@ std::string Tracking::relocalise_in(Frame& f, std::optional<std::uint32_t> only_
     with_pnp += pnp >= 10;
     best_inliers = std::max(best_inliers, good);
     if (good < kRelocMinInliers) continue;
+    if (std::string why = odometry_bound ? odometry_refuses(f, trial) : std::string(); !why.empty()) {
+      if (refused.empty()) refused = why + " (keyframe " + std::to_string(kf->id()) + ")";
+      continue;
+    }
     found.emplace_back(std::move(trial), kf);
     found_inliers.push_back(good);
     if (!options_.reloc_ambiguity_check) break;
   }
   std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
+  if (found.empty() && !refused.empty()) {
+    *kind = F::kOdometry;
+    return refused;
+  }
   if (found.empty())
     return no_match_reason(cands.size(), place_ != nullptr, best_matches, with_matches, best_pnp, with_pnp,
                            best_inliers, kRelocMinInliers, kind);
@@ -223,6 +236,7 @@ std::string Tracking::lookalike(const Frame& f, const Frame& found, const place:
     if (relocalize_against(trial, kf, &f_features, &matches) < kRelocMinInliers) return {};
     const double apart_m = (trial.camera_center_w() - found.camera_center_w()).norm();
     if (apart_m <= far_m) return {};
+    if (!only_map && !odometry_refuses(f, trial).empty()) return {};  // where the wheels say f cannot be
     return "relocalisation: ambiguous (look-alike keyframe " + std::to_string(kf.id()) + " matched at a place " +
            format_fixed(apart_m, 2) + " m from the candidates')";
   };

@@ -390,6 +390,10 @@ Settings settings_from(const cv::FileStorage& fs, const std::string& text, const
   s.two_view_start = r.flag("Tracking.twoViewStart", false, s.two_view_start);  // ours, optional
   s.new_map_after_lost = r.integer("Tracking.newMapAfter", false, s.new_map_after_lost, 0, 100000);  // ours, optional
   s.merge_reloc_every = r.integer("Tracking.mergeRelocEvery", false, s.merge_reloc_every, 0, 100000);  // ours, optional
+  s.reloc_odometry_floor_m =
+      r.real("Tracking.relocOdometryFloor", false, s.reloc_odometry_floor_m, above(0, 1000), "metres");  // ours
+  s.reloc_odometry_rate =
+      r.real("Tracking.relocOdometryRate", false, s.reloc_odometry_rate, closed(0, 10), "metres per metre");  // ours
   read_pe_match(r, &s.pe_match);
   read_keyframe(r, &s.keyframe);
   read_point_cloud(r, &s.dense);

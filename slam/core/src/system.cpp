@@ -57,6 +57,8 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.two_view_start = settings.two_view_start;
   topt.new_map_after_lost = settings.new_map_after_lost;
   topt.merge_reloc_every = settings.merge_reloc_every;
+  topt.reloc_odometry_floor_m = settings.reloc_odometry_floor_m;
+  topt.reloc_odometry_rate = settings.reloc_odometry_rate;
   if (settings.vocabulary_path != "none") {
     auto vocabulary = place::Vocabulary::load_shared(settings.vocabulary_path);
     vocabulary_fingerprint_ = vocabulary->fingerprint();

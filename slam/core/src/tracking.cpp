@@ -57,8 +57,10 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
     state_ = TrackingState::kNotInitialized;
     provisional_ = map_.begin_provisional();
     lost_in_row_ = 0;
+    lost_odom_.reset();
   }
   if (state_ == TrackingState::kNotInitialized) return start_map(f);
+  if (state_ == TrackingState::kLost) carry_lost_odometry(f);
 
   const bool was_tracking = state_ == TrackingState::kOk || state_ == TrackingState::kDeadReckoning;
   bool ok = track_by_state(f);
@@ -71,6 +73,8 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
   if (ok && stats_.method == TrackingMethod::kRelocalization) record_relocalisation(f);
   const bool dead = !ok && was_tracking && motion_ && dead_reckon(f);
   if (dead) stats_.method = TrackingMethod::kDeadReckoning;
+  if (ok || dead) lost_odom_.reset();
+  else if (was_tracking) begin_lost_odometry();
   if (!dead) blind_.reset();
   state_ = ok ? TrackingState::kOk : dead ? TrackingState::kDeadReckoning : TrackingState::kLost;
   lost_in_row_ = ok || dead ? 0 : lost_in_row_ + 1;

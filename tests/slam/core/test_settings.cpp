@@ -435,6 +435,27 @@ TEST(Settings, ReadsMapReuseTrackingKeys) {
   }
 }
 
+TEST(Settings, ReadsTheWheelsBoundOnRelocalisation) {
+  const Settings d = read_settings(tum1());
+  EXPECT_DOUBLE_EQ(d.reloc_odometry_floor_m, 0.5);
+  EXPECT_DOUBLE_EQ(d.reloc_odometry_rate, 0.1);
+  const Settings s = read_settings(temp_copy(
+      "odometry_bound", read_file(tum1()) + "\nTracking.relocOdometryFloor: 1.5\nTracking.relocOdometryRate: 0\n"));
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_DOUBLE_EQ(s.reloc_odometry_floor_m, 1.5);
+  EXPECT_DOUBLE_EQ(s.reloc_odometry_rate, 0.0);
+  for (const char* bad : {"Tracking.relocOdometryFloor: 0", "Tracking.relocOdometryRate: -0.1",
+                          "Tracking.relocOdometryRate: 11"}) {
+    const std::string key = std::string(bad).substr(0, std::string(bad).find(':'));
+    try {
+      read_settings(temp_copy("bad_odometry_bound", read_file(tum1()) + "\n" + bad + "\n"));
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), key) << e.what();
+    }
+  }
+}
+
 // OpenCV's parser reads the first of two equal keys and ignores the second:
 // a key given twice is an error naming both lines.
 TEST(Settings, DuplicateKeyNamesBothLines) {

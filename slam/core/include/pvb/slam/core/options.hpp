@@ -82,6 +82,21 @@ struct TrackingOptions {
   /// the IMU's and the wheels' positions part by more than kidnap_disagree_m.
   double kidnap_lift_m = 0.15;
   double kidnap_disagree_m = 0.25;
+  /// The parting allowed grows by 0.5 a t^2 over t seconds blind: the
+  /// IMU's double integration drifts with the residual accelerometer bias
+  /// a (m/s^2), most in a turn.
+  double kidnap_disagree_accel_mps2 = 0.05;
+  /// With the wheels and a trusted IMU, while lost: the motion sensors
+  /// carry a pose on from the last one, and a relocalisation farther from
+  /// it than reloc_odometry_floor_m + reloc_odometry_rate x the distance
+  /// carried is refused (the wheels say the robot cannot be there).  The
+  /// bound is lifted when the IMU shows the robot lifted (a carry) within
+  /// reloc_odometry_lift_window_s of the loss, and after
+  /// reloc_odometry_max_s lost.  reloc_odometry_rate 0: off.
+  double reloc_odometry_floor_m = 0.5;
+  double reloc_odometry_rate = 0.1;
+  double reloc_odometry_lift_window_s = 6.0;
+  double reloc_odometry_max_s = 120.0;
   /// Search radius (px at level 0) for the local map's points in the
   /// first frame after a blind stretch, around the dead-reckoned pose.
   double after_blind_radius_px = 12.0;

@@ -119,6 +119,7 @@ struct TrackingStats {
     kFewInliers,     ///< no candidate reached 50 pose inliers
     kAmbiguous,      ///< two candidates matched at places apart
     kLookalike,      ///< a look-alike keyframe matched at another place
+    kOdometry,       ///< every match lay where the wheels say the robot cannot be
     kLocalMap,       ///< relocalised, then the local map gave too few inliers
   };
   RelocFailure reloc_failure = RelocFailure::kNone;

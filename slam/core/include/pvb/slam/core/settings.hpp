@@ -103,6 +103,12 @@ struct Settings {
   /// map, frames between tries to relocalise in the loaded map
   /// (TrackingOptions::merge_reloc_every); 0: never.
   int merge_reloc_every = 5;
+  /// Tracking.relocOdometryFloor and Tracking.relocOdometryRate (ours,
+  /// optional): while lost with the wheels, a relocalisation farther from
+  /// the pose they carried than floor + rate x the distance is refused
+  /// (TrackingOptions::reloc_odometry_*); rate 0: off.
+  double reloc_odometry_floor_m = 0.5;
+  double reloc_odometry_rate = 0.1;
   PeMatchSettings pe_match;         ///< PEMatch.* (optional section)
   KeyFrameSettings keyframe;        ///< KeyFrame.* (optional section)
   PointCloudMappingSettings dense;  ///< PointCloudMapping.* (optional section)

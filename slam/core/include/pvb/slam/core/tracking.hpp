@@ -213,6 +213,28 @@ class Tracking {
     Eigen::Vector3d p_imu_w = Eigen::Vector3d::Zero(), v_imu_w = Eigen::Vector3d::Zero();
   };
   std::optional<Blind> blind_;
+  /// While lost (lost_odometry.cpp): the pose the wheels and the gyro carry
+  /// on from the last one, and what bounds a relocalisation by it.
+  struct LostOdometry {
+    std::int64_t start_t_ns = 0;
+    geom::SE3d T_c_w;                                   ///< the carried camera pose
+    Eigen::Vector3d v_w = Eigen::Vector3d::Zero();      ///< the IMU's velocity (wheels)
+    double distance_m = 0;                              ///< carried so far
+    Eigen::Vector3d p_start_w = Eigen::Vector3d::Zero();  ///< the IMU's position where vision was lost
+    Eigen::Vector3d p_imu_w = Eigen::Vector3d::Zero(), v_imu_w = Eigen::Vector3d::Zero();  ///< IMU alone
+    bool lifted = false;  ///< the IMU rose kidnap_lift_m: carried, no bound
+  };
+  std::optional<LostOdometry> lost_odom_;
+  /// The frame being tracked is lost after a tracked or dead-reckoned one
+  /// (last_): the carried pose begins at last_'s and takes this frame's
+  /// readings (with the wheels and a trusted IMU; none otherwise).
+  void begin_lost_odometry();
+  /// The next lost frame's readings, before it is relocalised.
+  void carry_lost_odometry(const Frame& f);
+  /// How far from the carried pose a relocalisation may be (+inf: no bound).
+  double lost_odometry_bound_m(const Frame& f) const;
+  /// Why the motion sensors refuse the relocalised pose of f, or empty.
+  std::string odometry_refuses(const Frame& f, const Frame& found) const;
 
   Map& map_;
   std::shared_ptr<const CameraModel> cam_;
