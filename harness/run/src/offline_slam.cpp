@@ -224,11 +224,9 @@ slam::TrackingState OfflineSlam::Impl::track_one(const sensor::RgbdFrame& frame)
 
 void OfflineSlam::Impl::write_timing_line(const sensor::RgbdFrame& frame, const slam::FrameResult& r,
                                           double cpu_ms) {
-  static const char* kMethods[] = {"none",  "init",           "motion",     "refkf",
-                                   "reloc", "dead_reckoning", "after_blind"};
   std::ostringstream line;
   line << frame.index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
-       << kMethods[static_cast<int>(r.tracking.method)] << "," << r.num_features << ","
+       << slam::to_string(r.tracking.method) << "," << r.num_features << ","
        << format_g(r.tracking_ms) << "," << format_g(r.orb_ms) << "," << format_g(r.tracking.pe_match_ms)
        << "," << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers
        << "," << (r.tracking.new_keyframe ? 1 : 0) << "," << format_g(r.mapping_ms) << "," << format_g(cpu_ms)

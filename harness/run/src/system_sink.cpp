@@ -36,9 +36,11 @@ void record_state_change(SlamRun& run, slam::TrackingState prev_state, const sla
     log.line(head + std::string("lost tracking: ") + reason);
   } else if (r.state == slam::TrackingState::kOk && prev_state == slam::TrackingState::kLost) {
     if (!run.loss_events.empty()) run.loss_events.back().recovered_frame = index;
+    const bool carried = r.tracking.method == slam::TrackingMethod::kCarriedRestart;
     log.line(head + std::string(r.tracking.method == slam::TrackingMethod::kInitialization
                                     ? "began a provisional map (lost in the loaded map for too long)"
-                                    : "relocalised"));
+                                : carried ? "tracking begun again at the pose the wheels carried (new points)"
+                                          : "relocalised"));
   } else if (r.state == slam::TrackingState::kNotInitialized && run.frames == 1) {
     log.line(head + "not initialised: " + reason);
   } else if (r.state == slam::TrackingState::kOk && prev_state == slam::TrackingState::kNotInitialized) {
@@ -48,12 +50,6 @@ void record_state_change(SlamRun& run, slam::TrackingState prev_state, const sla
                                " measured depths)"
                          : std::string("initialised")));
   }
-}
-
-/// The tracking method as timing.csv writes it.
-const char* method_name(slam::TrackingMethod m) {
-  static const char* kMethods[] = {"none", "init", "motion", "refkf", "reloc", "dead_reckoning", "after_blind"};
-  return kMethods[static_cast<int>(m)];
 }
 
 void write_tum(const std::string& path, const std::string& header,
@@ -137,7 +133,7 @@ void SystemSink::count(const slam::FrameResult& r, int index, double t_s) {
   inline_mapping_ms += r.mapping_ms;
   run.per_frame.push_back({index, t_s, r.T_w_c.has_value(), r.tracking_ms, r.tracking.coarse_matches,
                            r.tracking.matches_kept, slam::to_string(r.state),
-                           method_name(r.tracking.method)});
+                           slam::to_string(r.tracking.method)});
 }
 
 void SystemSink::write_lines(const slam::FrameResult& r, int index) {
@@ -148,7 +144,7 @@ void SystemSink::write_lines(const slam::FrameResult& r, int index) {
   }
   std::ostringstream line;
   line << index << "," << geom::format_tum_time(r.t_ns) << "," << slam::to_string(r.state) << ","
-       << method_name(r.tracking.method) << "," << r.num_features << ","
+       << slam::to_string(r.tracking.method) << "," << r.num_features << ","
        << format_g(r.tracking_ms) << "," << format_g(r.orb_ms) << "," << format_g(r.tracking.pe_match_ms)
        << "," << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers
        << "," << (r.tracking.new_keyframe ? 1 : 0) << "," << format_g(r.mapping_ms) << ","

@@ -5,6 +5,7 @@
 // error grows with the distance driven, so the bound does too.  A carry
 // (the IMU rises) or a long loss lifts the bound: the wheels no longer
 // know where the robot is.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -91,6 +92,40 @@ std::string Tracking::odometry_refuses(const Frame& f, const Frame& found) const
   return "relocalisation: the match puts the camera " + format_fixed(off_m, 2) +
          " m from where the wheels carried it (within " + format_fixed(bound_m, 2) + " m after " +
          format_fixed(lost_odom_->distance_m, 2) + " m)";
+}
+
+std::shared_ptr<KeyFrame> Tracking::restart_at_carried_pose(Frame& f) {
+  if (options_.carried_restart_after <= 0 || localise_only_ || lost_in_row_ < options_.carried_restart_after ||
+      !std::isfinite(lost_odometry_bound_m(f)))
+    return nullptr;
+  int with_depth = 0;
+  for (float d : f.depth_m) with_depth += d > 0;
+  if (with_depth <= options_.min_init_points) return nullptr;
+  f.T_c_w = lost_odom_->T_c_w;
+  f.has_pose = true;
+  std::fill(f.map_points.begin(), f.map_points.end(), nullptr);
+  std::fill(f.outlier.begin(), f.outlier.end(), 0);
+  v_last_ = lost_odom_->v_w;
+  v_last_known_ = true;
+  auto kf = map_.create_keyframe(f);
+  attach_motion(kf);  // chained to the last keyframe by the readings since: the wheels hold it to the map
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (f.depth_m[i] > 0) add_point_from_depth(f, kf, i);
+  ref_kf_ = kf;
+  local_kfs_ = {kf};
+  last_kf_frame_id_ = f.id;
+  stats_.method = TrackingMethod::kCarriedRestart;
+  stats_.new_keyframe = true;
+  stats_.reloc_failure = TrackingStats::RelocFailure::kNone;
+  state_ = TrackingState::kOk;
+  lost_in_row_ = 0;
+  lost_odom_.reset();
+  velocity_.reset();
+  update_motion_state(f, false);
+  last_is_keyframe_ = true;
+  T_last_ref_ = geom::SE3d::Identity();
+  last_ = std::move(f);
+  return kf;
 }
 
 }  // namespace pvb::slam

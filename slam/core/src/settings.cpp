@@ -394,6 +394,8 @@ Settings settings_from(const cv::FileStorage& fs, const std::string& text, const
       r.real("Tracking.relocOdometryFloor", false, s.reloc_odometry_floor_m, above(0, 1000), "metres");  // ours
   s.reloc_odometry_rate =
       r.real("Tracking.relocOdometryRate", false, s.reloc_odometry_rate, closed(0, 10), "metres per metre");  // ours
+  s.carried_restart_after =
+      r.integer("Tracking.carriedRestartAfter", false, s.carried_restart_after, 0, 100000);  // ours, optional
   read_pe_match(r, &s.pe_match);
   read_keyframe(r, &s.keyframe);
   read_point_cloud(r, &s.dense);

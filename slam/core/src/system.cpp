@@ -59,6 +59,7 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.merge_reloc_every = settings.merge_reloc_every;
   topt.reloc_odometry_floor_m = settings.reloc_odometry_floor_m;
   topt.reloc_odometry_rate = settings.reloc_odometry_rate;
+  topt.carried_restart_after = settings.carried_restart_after;
   if (settings.vocabulary_path != "none") {
     auto vocabulary = place::Vocabulary::load_shared(settings.vocabulary_path);
     vocabulary_fingerprint_ = vocabulary->fingerprint();

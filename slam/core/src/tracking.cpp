@@ -22,6 +22,20 @@ const char* to_string(TrackingState s) {
   return "?";
 }
 
+const char* to_string(TrackingMethod m) {
+  switch (m) {
+    case TrackingMethod::kNone: return "none";
+    case TrackingMethod::kInitialization: return "init";
+    case TrackingMethod::kMotionModel: return "motion";
+    case TrackingMethod::kReferenceKeyFrame: return "refkf";
+    case TrackingMethod::kRelocalization: return "reloc";
+    case TrackingMethod::kDeadReckoning: return "dead_reckoning";
+    case TrackingMethod::kAfterBlind: return "after_blind";
+    case TrackingMethod::kCarriedRestart: return "carried_restart";
+  }
+  return "?";
+}
+
 void IdMarks::new_pass() {
   ++pass_;
   if (pass_ == 0) {  // wrapped: clear the stamps once every 2^32 passes
@@ -78,6 +92,8 @@ std::shared_ptr<KeyFrame> Tracking::track(Frame f, bool mapping_idle, std::size_
   if (!dead) blind_.reset();
   state_ = ok ? TrackingState::kOk : dead ? TrackingState::kDeadReckoning : TrackingState::kLost;
   lost_in_row_ = ok || dead ? 0 : lost_in_row_ + 1;
+  if (!ok && !dead && !was_tracking)
+    if (std::shared_ptr<KeyFrame> kf = restart_at_carried_pose(f)) return kf;
   update_motion_state(f, ok);
 
   std::shared_ptr<KeyFrame> new_kf;

@@ -439,13 +439,16 @@ TEST(Settings, ReadsTheWheelsBoundOnRelocalisation) {
   const Settings d = read_settings(tum1());
   EXPECT_DOUBLE_EQ(d.reloc_odometry_floor_m, 0.5);
   EXPECT_DOUBLE_EQ(d.reloc_odometry_rate, 0.1);
-  const Settings s = read_settings(temp_copy(
-      "odometry_bound", read_file(tum1()) + "\nTracking.relocOdometryFloor: 1.5\nTracking.relocOdometryRate: 0\n"));
+  EXPECT_EQ(d.carried_restart_after, 15);
+  const Settings s = read_settings(
+      temp_copy("odometry_bound", read_file(tum1()) + "\nTracking.relocOdometryFloor: 1.5\nTracking.relocOdometryRate: 0\n"
+                                                      "Tracking.carriedRestartAfter: 0\n"));
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_DOUBLE_EQ(s.reloc_odometry_floor_m, 1.5);
   EXPECT_DOUBLE_EQ(s.reloc_odometry_rate, 0.0);
+  EXPECT_EQ(s.carried_restart_after, 0);
   for (const char* bad : {"Tracking.relocOdometryFloor: 0", "Tracking.relocOdometryRate: -0.1",
-                          "Tracking.relocOdometryRate: 11"}) {
+                          "Tracking.relocOdometryRate: 11", "Tracking.carriedRestartAfter: -1"}) {
     const std::string key = std::string(bad).substr(0, std::string(bad).find(':'));
     try {
       read_settings(temp_copy("bad_odometry_bound", read_file(tum1()) + "\n" + bad + "\n"));

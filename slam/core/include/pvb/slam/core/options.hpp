@@ -97,6 +97,14 @@ struct TrackingOptions {
   double reloc_odometry_rate = 0.1;
   double reloc_odometry_lift_window_s = 6.0;
   double reloc_odometry_max_s = 120.0;
+  /// Under that bound, after this many frames lost in a row without a
+  /// relocalisation, tracking begins again at the carried pose: a new
+  /// keyframe with points from the frame's depth, chained in time to the
+  /// last one (Tracking.carriedRestartAfter; 0: never).  A lost robot
+  /// among look-alike rows keeps a pose whose error is the wheels'
+  /// instead of waiting for a place it may never see again; loop closing
+  /// joins the new points to the old when the robot comes back.
+  int carried_restart_after = 15;
   /// Search radius (px at level 0) for the local map's points in the
   /// first frame after a blind stretch, around the dead-reckoned pose.
   double after_blind_radius_px = 12.0;

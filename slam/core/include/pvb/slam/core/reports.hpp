@@ -66,7 +66,11 @@ enum class TrackingMethod {
   kRelocalization,
   kDeadReckoning,  ///< the pose predicted by the motion sensors alone
   kAfterBlind,     ///< the local map found again from the dead-reckoned pose
+  kCarriedRestart, ///< lost: a new keyframe at the pose the wheels carried
 };
+/// The method as timing.csv writes it: "none", "init", "motion", "refkf",
+/// "reloc", "dead_reckoning", "after_blind", "carried_restart".
+const char* to_string(TrackingMethod m);
 
 /// Per-frame figures for timing.csv and the tests.
 struct TrackingStats {

@@ -109,6 +109,10 @@ struct Settings {
   /// (TrackingOptions::reloc_odometry_*); rate 0: off.
   double reloc_odometry_floor_m = 0.5;
   double reloc_odometry_rate = 0.1;
+  /// Tracking.carriedRestartAfter (ours, optional): lost frames under that
+  /// bound after which tracking begins again at the carried pose
+  /// (TrackingOptions::carried_restart_after); 0: never.
+  int carried_restart_after = 15;
   PeMatchSettings pe_match;         ///< PEMatch.* (optional section)
   KeyFrameSettings keyframe;        ///< KeyFrame.* (optional section)
   PointCloudMappingSettings dense;  ///< PointCloudMapping.* (optional section)

@@ -235,6 +235,10 @@ class Tracking {
   double lost_odometry_bound_m(const Frame& f) const;
   /// Why the motion sensors refuse the relocalised pose of f, or empty.
   std::string odometry_refuses(const Frame& f, const Frame& found) const;
+  /// Lost for carried_restart_after frames under the wheels' bound, with
+  /// enough depth: f becomes a keyframe at the carried pose (returned;
+  /// null when not due).
+  std::shared_ptr<KeyFrame> restart_at_carried_pose(Frame& f);
 
   Map& map_;
   std::shared_ptr<const CameraModel> cam_;
