@@ -14,23 +14,17 @@
 
 namespace pvb::slam {
 
-namespace {
-
-/// The IMU's position and velocity carried by one frame's readings alone
-/// (without the wheels: the kidnap check's lift).
-void carry_imu_only(const MotionIntegrator& motion, const Eigen::Vector3d& g_w, const Eigen::Matrix3d& R_w_b,
-                    Eigen::Vector3d* p_w, Eigen::Vector3d* v_w) {
+void Tracking::ImuAlone::carry(const MotionIntegrator& motion, const Eigen::Vector3d& g_w,
+                               const Eigen::Matrix3d& R_w_b) {
   if (motion.imu_since_frame().size() == 0) return;
   NavState s;
   s.R_w_b = R_w_b;
-  s.p_w_m = *p_w;
-  s.v_w_mps = *v_w;
+  s.p_w_m = p_w;
+  s.v_w_mps = v_w;
   s = motion.imu_since_frame().predict(s, g_w, motion.bias());
-  *p_w = s.p_w_m;
-  *v_w = s.v_w_mps;
+  p_w = s.p_w_m;
+  v_w = s.v_w_mps;
 }
-
-}  // namespace
 
 void Tracking::begin_lost_odometry() {
   lost_odom_.reset();
@@ -41,21 +35,15 @@ void Tracking::begin_lost_odometry() {
   const NavState last_state = motion_->nav_state(last_.T_c_w, v_last_);
   LostOdometry o;
   o.T_c_w = motion_->predict(last_.T_c_w, v_last_, g_w, &o.v_w);
-  const double step_m = (motion_->nav_state(o.T_c_w, o.v_w).p_w_m - last_state.p_w_m).norm();
   if (blind_) {  // dead_reckon() has already carried the IMU alone through f
-    o.start_t_ns = blind_->start_t_ns;
     o.distance_m = blind_->distance_m;
-    o.p_start_w = blind_->p_start_w;
-    o.p_imu_w = blind_->p_imu_w;
-    o.v_imu_w = blind_->v_imu_w;
+    o.imu = blind_->imu;
   } else {
-    o.start_t_ns = last_.t_ns;
-    o.distance_m = step_m;
-    o.p_start_w = o.p_imu_w = last_state.p_w_m;
-    o.v_imu_w = v_last_;
-    carry_imu_only(*motion_, g_w, last_state.R_w_b, &o.p_imu_w, &o.v_imu_w);
+    o.distance_m = (motion_->nav_state(o.T_c_w, o.v_w).p_w_m - last_state.p_w_m).norm();
+    o.imu = ImuAlone{last_.t_ns, last_state.p_w_m, last_state.p_w_m, v_last_};
+    o.imu.carry(*motion_, g_w, last_state.R_w_b);
   }
-  o.lifted = (o.p_imu_w - o.p_start_w).dot(-g_w.normalized()) > options_.kidnap_lift_m;
+  o.lifted = o.imu.rise_m(g_w) > options_.kidnap_lift_m;
   lost_odom_ = o;
 }
 
@@ -68,17 +56,17 @@ void Tracking::carry_lost_odometry(const Frame& f) {
   o.T_c_w = motion_->predict(o.T_c_w, o.v_w, g_w, &v_w);
   o.v_w = v_w;
   o.distance_m += (motion_->nav_state(o.T_c_w, o.v_w).p_w_m - before.p_w_m).norm();
-  const double lost_s = static_cast<double>(f.t_ns - o.start_t_ns) * 1e-9;
+  const double lost_s = static_cast<double>(f.t_ns - o.imu.start_t_ns) * 1e-9;
   if (o.lifted || lost_s > options_.reloc_odometry_lift_window_s) return;
   // The IMU alone, for a lift, only near the loss: its double integration
   // drifts by metres within a minute.
-  carry_imu_only(*motion_, g_w, before.R_w_b, &o.p_imu_w, &o.v_imu_w);
-  o.lifted = (o.p_imu_w - o.p_start_w).dot(-g_w.normalized()) > options_.kidnap_lift_m;
+  o.imu.carry(*motion_, g_w, before.R_w_b);
+  o.lifted = o.imu.rise_m(g_w) > options_.kidnap_lift_m;
 }
 
 double Tracking::lost_odometry_bound_m(const Frame& f) const {
   if (!lost_odom_ || lost_odom_->lifted) return std::numeric_limits<double>::infinity();
-  const double lost_s = static_cast<double>(f.t_ns - lost_odom_->start_t_ns) * 1e-9;
+  const double lost_s = static_cast<double>(f.t_ns - lost_odom_->imu.start_t_ns) * 1e-9;
   if (lost_s > options_.reloc_odometry_max_s) return std::numeric_limits<double>::infinity();
   return options_.reloc_odometry_floor_m + options_.reloc_odometry_rate * lost_odom_->distance_m;
 }

@@ -125,19 +125,13 @@ bool Tracking::dead_reckon(Frame& f) {
   const geom::SE3d T_c_w = predicted_pose(&v_w);
   const Eigen::Vector3d g_w = map_.gravity().g_w;
   const NavState last_state = motion_->nav_state(last_.T_c_w, v_last_);
-  if (!blind_) blind_ = Blind{last_.t_ns, 0.0, last_state.p_w_m, last_state.p_w_m, v_last_};
-  // IMU alone, for the kidnap check (the prediction may follow the wheels).
-  NavState imu_only = last_state;
-  imu_only.p_w_m = blind_->p_imu_w;
-  imu_only.v_w_mps = blind_->v_imu_w;
-  if (motion_->imu_since_frame().size() > 0) imu_only = motion_->imu_since_frame().predict(imu_only, g_w, motion_->bias());
-  blind_->p_imu_w = imu_only.p_w_m;
-  blind_->v_imu_w = imu_only.v_w_mps;
+  if (!blind_) blind_ = Blind{0.0, ImuAlone{last_.t_ns, last_state.p_w_m, last_state.p_w_m, v_last_}};
+  blind_->imu.carry(*motion_, g_w, last_state.R_w_b);
   const NavState predicted = motion_->nav_state(T_c_w, v_w);
   blind_->distance_m += (predicted.p_w_m - last_state.p_w_m).norm();
-  const double blind_s = static_cast<double>(f.t_ns - blind_->start_t_ns) * 1e-9;
-  const double rise_m = (blind_->p_imu_w - blind_->p_start_w).dot(-g_w.normalized());
-  const double apart_m = (blind_->p_imu_w - predicted.p_w_m).norm();
+  const double blind_s = static_cast<double>(f.t_ns - blind_->imu.start_t_ns) * 1e-9;
+  const double rise_m = blind_->imu.rise_m(g_w);
+  const double apart_m = (blind_->imu.p_w - predicted.p_w_m).norm();
   if (blind_s > options_.blind_max_s)
     return fail("dead reckoning: blind for " + format_fixed(blind_s, 2) + " s (limit " +
                 format_fixed(options_.blind_max_s, 2) + " s)");

@@ -204,24 +204,30 @@ class Tracking {
   Eigen::Vector3d v_last_ = Eigen::Vector3d::Zero();  ///< the IMU's velocity at the last frame
   bool v_last_known_ = false;
   std::shared_ptr<KeyFrame> last_kf_;         ///< the newest keyframe in time (the chain's end)
-  /// The blind stretch so far: its start, the distance carried, and
-  /// the IMU-only and wheel-only positions of the base (kidnap check).
-  struct Blind {
+  /// The IMU's position integrated alone from where vision was lost (the
+  /// prediction may follow the wheels): it rises when the robot is carried.
+  struct ImuAlone {
     std::int64_t start_t_ns = 0;
-    double distance_m = 0;
     Eigen::Vector3d p_start_w = Eigen::Vector3d::Zero();
-    Eigen::Vector3d p_imu_w = Eigen::Vector3d::Zero(), v_imu_w = Eigen::Vector3d::Zero();
+    Eigen::Vector3d p_w = Eigen::Vector3d::Zero(), v_w = Eigen::Vector3d::Zero();
+    /// One frame's readings, the base turned by R_w_b (lost_odometry.cpp).
+    void carry(const MotionIntegrator& motion, const Eigen::Vector3d& g_w, const Eigen::Matrix3d& R_w_b);
+    double rise_m(const Eigen::Vector3d& g_w) const { return (p_w - p_start_w).dot(-g_w.normalized()); }
+  };
+  /// The blind stretch so far: the distance carried and the IMU alone
+  /// (kidnap check).
+  struct Blind {
+    double distance_m = 0;
+    ImuAlone imu;
   };
   std::optional<Blind> blind_;
   /// While lost (lost_odometry.cpp): the pose the wheels and the gyro carry
   /// on from the last one, and what bounds a relocalisation by it.
   struct LostOdometry {
-    std::int64_t start_t_ns = 0;
     geom::SE3d T_c_w;                                   ///< the carried camera pose
     Eigen::Vector3d v_w = Eigen::Vector3d::Zero();      ///< the IMU's velocity (wheels)
     double distance_m = 0;                              ///< carried so far
-    Eigen::Vector3d p_start_w = Eigen::Vector3d::Zero();  ///< the IMU's position where vision was lost
-    Eigen::Vector3d p_imu_w = Eigen::Vector3d::Zero(), v_imu_w = Eigen::Vector3d::Zero();  ///< IMU alone
+    ImuAlone imu;                                       ///< from where vision was lost
     bool lifted = false;  ///< the IMU rose kidnap_lift_m: carried, no bound
   };
   std::optional<LostOdometry> lost_odom_;
