@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
@@ -24,6 +25,9 @@ using geom::kRadToDeg;
 /// Best-scoring keyframes of the map, one by one, that a merge is also
 /// verified against (as a relocalisation is, Tracking.relocLookalikes).
 constexpr std::size_t kMergeLookalikes = 10;
+/// A keyframe confirms a held-back merge when it verifies this close to the
+/// pose the transform predicts (or within maxCorrection, if smaller).
+constexpr double kMergeConfirmTolerance_m = 0.5;
 
 /// Nearest-rank quantile q of the values (0 for none).
 double quantile(std::vector<double> v, double q) {
@@ -148,17 +152,32 @@ namespace {
 
 /// The grouped candidates of a merge can all lie at one of two look-alike
 /// places (a ground texture repeating along the route), and no later check
-/// tells them apart: the map's best-scoring keyframes one by one are
-/// verified too, and the camera centre of each that verifies is added to
-/// `centres_w` for the ambiguity check.
+/// tells them apart; a loop that corrects the keyframe by metres may have
+/// found the next row instead of its own.  The map's best-scoring keyframes
+/// one by one (those of map `map_id` that `skip` leaves) are verified too,
+/// and the camera centre of each that verifies is added to `centres_w` for
+/// the ambiguity check.
 void add_lookalikes(const PlaceRecognizer& place, const Map& map, const LoopClosingOptions& options,
                     const KeyFrame& kf, const std::vector<std::shared_ptr<KeyFrame>>& tried,
+                    std::uint32_t map_id, const std::function<bool(std::uint64_t)>& skip,
                     std::vector<Eigen::Vector3d>* centres_w) {
-  for (const auto& c : place.lookalike_candidates(map, place.bag_of(kf), kMergeLookalikes)) {
-    if (map.map_of(*c) != 0 || std::find(tried.begin(), tried.end(), c) != tried.end()) continue;
+  for (const auto& c : place.lookalike_candidates(map, place.bag_of(kf), kMergeLookalikes, skip)) {
+    if (map.map_of(*c) != map_id || std::find(tried.begin(), tried.end(), c) != tried.end()) continue;
     const LoopMatch m = verify_loop(kf, c, options);
     if (m.accepted) centres_w->push_back(m.T_c_w.inverse().translation());
   }
+}
+
+/// For a loop's look-alikes: the keyframe's own neighbourhood (its
+/// covisibles and the last `min_keyframe_gap` ids) shows the same place at
+/// the drifted pose, and is no rival.
+std::function<bool(std::uint64_t)> own_neighbourhood(const KeyFrame& kf, int min_keyframe_gap) {
+  auto connected = std::make_shared<std::set<std::uint64_t>>();
+  connected->insert(kf.id());
+  for (const auto& n : kf.best_covisibles(-1)) connected->insert(n->id());
+  const std::uint64_t newest = kf.id();
+  const auto gap = static_cast<std::uint64_t>(min_keyframe_gap);
+  return [connected, newest, gap](std::uint64_t id) { return connected->count(id) > 0 || id + gap > newest; };
 }
 
 }  // namespace
@@ -178,7 +197,8 @@ LoopMatch verify_at(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, c
   out.points = probe.map_points;
   double dist_m = 0, angle_deg = 0;
   pose_difference(probe.T_c_w, T_c_w, &dist_m, &angle_deg);
-  out.accepted = out.inliers >= options.min_inliers && dist_m <= options.max_correction_m &&
+  out.accepted = out.inliers >= options.min_inliers &&
+                 dist_m <= std::min(options.max_correction_m, kMergeConfirmTolerance_m) &&
                  angle_deg <= options.max_correction_deg;
   if (out.accepted) out.stage = LoopMatch::Stage::kAccepted;
   return out;
@@ -205,6 +225,7 @@ std::string to_json(const LoopClosingStats& stats) {
          ", \"rejected\": " + std::to_string(stats.rejected) +
          ", \"refused_drift\": " + std::to_string(stats.refused_drift) +
          ", \"refused_ambiguous\": " + std::to_string(stats.refused_ambiguous) +
+         ", \"lookalike_checked\": " + std::to_string(stats.lookalike_checked) +
          ", \"merge_confirmed\": " + std::to_string(stats.merge_confirmed) +
          ", \"merge_unconfirmed\": " + std::to_string(stats.merge_unconfirmed) +
          ", \"merge_suggested\": " + std::to_string(stats.merge_suggested) +
@@ -315,6 +336,7 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
   const auto t0 = std::chrono::steady_clock::now();
   std::array<int, 3> refused_at{};  // by LoopMatch::Stage: matches, RANSAC, inliers
   int verified = 0, refused_correction = 0;
+  double best_dist_m = 0;
   for (const auto& cand : consistent) {
     ++verified;
     LoopMatch m = verify_loop(*kf, cand, options_);
@@ -337,11 +359,15 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
     if (!loop_kf || m.inliers > best->inliers) {
       *best = std::move(m);
       loop_kf = cand;
+      best_dist_m = dist_m;
     }
     if (!options_.ambiguity_check) break;  // ORB-SLAM2: the first verified candidate
   }
-  if (merge && loop_kf && options_.ambiguity_check && place_)
-    add_lookalikes(*place_, map_, options_, *kf, consistent, &verified_centres_w);
+  const bool large = !merge && loop_kf && best_dist_m > options_.lookalike_check_above_m;
+  if (loop_kf && (merge || large) && options_.ambiguity_check && place_)
+    add_lookalikes(*place_, map_, options_, *kf, consistent, merge ? 0 : map_.map_of(*kf),
+                   merge ? std::function<bool(std::uint64_t)>{} : own_neighbourhood(*kf, options_.min_keyframe_gap),
+                   &verified_centres_w);
   bool ambiguous = false;
   for (std::size_t i = 0; i < verified_centres_w.size() && options_.ambiguity_check; ++i)
     for (std::size_t j = i + 1; j < verified_centres_w.size(); ++j)
@@ -352,6 +378,7 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
   stats_.refused_ransac += refused_at[1];
   stats_.refused_inliers += refused_at[2];
   stats_.refused_correction += refused_correction;
+  stats_.lookalike_checked += large ? 1 : 0;
   stats_.verify_ms_total += ms_since(t0);
   if (ambiguous) {
     ++stats_.refused_ambiguous;

@@ -100,9 +100,11 @@ std::vector<KeyFramePtr> PlaceRecognizer::relocalisation_candidates(const Map& m
   return accumulate_groups(map, database_.query(bow, 0.0, 0.8, skip));
 }
 
-std::vector<KeyFramePtr> PlaceRecognizer::lookalike_candidates(const Map& map, const place::BowVector& bow,
-                                                               std::size_t n) const {
+std::vector<KeyFramePtr> PlaceRecognizer::lookalike_candidates(
+    const Map& map, const place::BowVector& bow, std::size_t n,
+    const std::function<bool(std::uint64_t)>& also_skip) const {
   const auto skip = [&](std::uint64_t id) {
+    if (also_skip && also_skip(id)) return true;
     auto it = map.keyframes().find(id);
     return it == map.keyframes().end() || it->second->bad();
   };

@@ -299,6 +299,8 @@ void read_loop_closing(Reader& r, LoopClosingOptions* lc) {
       r.real("LoopClosing.maxCorrection", false, lc->max_correction_m, above(0, 1e4), "metres");
   lc->max_correction_deg =
       r.real("LoopClosing.maxCorrectionAngle", false, lc->max_correction_deg, above(0, 180), "degrees");
+  lc->lookalike_check_above_m = r.real("LoopClosing.lookalikeCheckAbove", false, lc->lookalike_check_above_m,
+                                       above(0, 1e4), "metres");
   lc->essential_weight = r.integer("LoopClosing.essentialWeight", false, lc->essential_weight, 1, 1000000);
   lc->global_ba = r.flag("LoopClosing.globalBA", false, lc->global_ba);
   lc->rotation_weight = r.real("LoopClosing.rotationWeight", false, lc->rotation_weight, above(0, 1e6));

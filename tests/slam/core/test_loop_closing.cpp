@@ -1,14 +1,17 @@
 // Loop closing on a synthetic textured wall: pose-proximity candidates,
 // geometric verification of a true revisit and of a wrong place (a wall
 // with another texture at the same estimated pose), and the correction of
-// a drifted keyframe once the detection has been consistent.
+// a drifted keyframe once the detection has been consistent, and the
+// look-alike check of a large correction on a wall that repeats every 2 m.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
 #include "pvb/slam/core/loop_closing.hpp"
+#include "pvb/slam/core/place_recognition.hpp"
 #include "pvb/slam/core/settings.hpp"
+#include "pvb/slam/place/vocabulary.hpp"
 
 namespace pvb::slam {
 namespace {
@@ -331,6 +334,74 @@ TEST(LoopClosing, DriftBoundRefusesTheSameCentreMoveWithoutATurn) {
   EXPECT_EQ(s.verified, 1);
   EXPECT_EQ(s.refused_drift, 1);
   EXPECT_TRUE(s.loops.empty());
+}
+
+/// A wall whose texture repeats every 2 m along x: the views from x and
+/// x + 2 m are the same but for the texture's ends.
+cv::Mat make_repeating_texture(std::uint64_t seed) {
+  cv::Mat t = make_texture(seed);
+  t(cv::Rect(0, 0, 800, 1200)).copyTo(t(cv::Rect(800, 0, 800, 1200)));
+  return t;
+}
+
+/// Loop closing with the bag of words (the default vocabulary) over a map
+/// whose keyframes are all in the database; `kf` is detected twice.
+LoopClosingStats close_with_words(Map& map, const std::shared_ptr<KeyFrame>& kf, LoopClosingOptions o) {
+  static const auto vocabulary = place::Vocabulary::load_shared(kDefaultVocabularyPath);
+  PlaceRecognizer place(vocabulary);
+  for (const auto& [id, k] : map.keyframes()) {
+    place.compute_bow(*k);
+    if (k != kf) place.add(*k);
+  }
+  o.consistency = 1;
+  o.max_drift_rate = 0;  // no path in this map: the drift bound is not judged here
+  LoopClosing lc(map, o, &place);
+  lc.process(kf);
+  lc.process(kf);
+  return lc.stats();
+}
+
+TEST(LoopClosing, ALargeCorrectionWithoutALookalikeCloses) {
+  // 0.8 m of drift since the first keyframe, the place seen nowhere else.
+  Map map;
+  const cv::Mat tex = make_repeating_texture(3);
+  const geom::SE3d A = pose(0, -0.9, 0);
+  add_keyframe(map, tex, A, A);
+  const geom::SE3d drift = geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.8, 0, 0));
+  auto kf1 = add_keyframe(map, tex, A, drift * A);
+  const LoopClosingStats s = close_with_words(map, kf1, test_options());
+  EXPECT_EQ(s.lookalike_checked, 1);
+  EXPECT_EQ(s.refused_ambiguous, 0);
+  ASSERT_EQ(s.loops.size(), 1u);
+  EXPECT_NEAR(s.loops[0].correction_m, 0.8, 0.02);
+  EXPECT_LT(centre_error_m(kf1->T_c_w(), A), 0.01);
+}
+
+TEST(LoopClosing, ALargeCorrectionIsRefusedWhenTheViewVerifiesAtALookalike) {
+  // The same drift, and the same view 2 m further along the wall in the
+  // map: only one candidate is verified as a loop (maxCandidates 1), and
+  // the look-alike check finds the other.  Without the check the loop
+  // closes on one of the two.
+  const auto run = [](double lookalike_check_above_m) {
+    Map map;
+    const cv::Mat tex = make_repeating_texture(3);
+    const geom::SE3d A = pose(0, -0.9, 0), B = pose(0, 1.1, 0);
+    add_keyframe(map, tex, A, A);
+    add_keyframe(map, tex, B, B);
+    const geom::SE3d drift = geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.8, 0, 0));
+    auto kf = add_keyframe(map, tex, A, drift * A);
+    LoopClosingOptions o = test_options();
+    o.max_candidates = 1;
+    o.lookalike_check_above_m = lookalike_check_above_m;
+    return close_with_words(map, kf, o);
+  };
+  const LoopClosingStats checked = run(0.5);
+  EXPECT_EQ(checked.lookalike_checked, 1);
+  EXPECT_EQ(checked.refused_ambiguous, 1);
+  EXPECT_TRUE(checked.loops.empty());
+  const LoopClosingStats unchecked = run(10000);
+  EXPECT_EQ(unchecked.lookalike_checked, 0);
+  EXPECT_EQ(unchecked.loops.size(), 1u);
 }
 
 TEST(LoopClosing, ClosesOnlyAfterConsistentDetectionsAndRemovesTheDrift) {

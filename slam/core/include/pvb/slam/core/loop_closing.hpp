@@ -16,7 +16,10 @@
 //   3. geometric verification: EPnP RANSAC on the brute-force matches, pose
 //      optimisation, guided search by projection of the candidate's
 //      neighbourhood, pose optimisation again; >= `min_inliers` inliers and
-//      a correction within `max_correction_m` / `max_correction_deg`;
+//      a correction within `max_correction_m` / `max_correction_deg`; a
+//      correction over `lookalike_check_above_m` also verifies the keyframe
+//      against the map's best-scoring keyframes one by one, and any that
+//      verifies at another place makes it ambiguous;
 //   4. correction: the new keyframe's covisibility neighbourhood is moved
 //      with it, duplicated points fused (the loop side replaces the current
 //      side), loop edges added, the essential graph (spanning tree, loop
@@ -90,7 +93,8 @@ LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand,
 /// Verification of `kf` at a predicted pose `T_c_w` in `cand`'s map (a
 /// held-back merge): the points of `cand`, its covisibles and theirs,
 /// projected and matched, then a pose optimisation; accepted with
-/// min_inliers inliers within max_correction of the prediction.
+/// min_inliers inliers within 0.5 m (or max_correction_m, if smaller) of
+/// the prediction.
 LoopMatch verify_at(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, const geom::SE3d& T_c_w,
                     const LoopClosingOptions& options);
 

@@ -162,7 +162,12 @@ struct LoopClosingOptions {
   int min_matches = 20;            ///< LoopClosing.minMatches: appearance check, descriptor matches
   int consistency = 2;             ///< LoopClosing.consistency: consecutive consistent detections needed
   int min_inliers = 40;            ///< LoopClosing.minInliers: after the guided search
-  double max_correction_m = 0.5;   ///< LoopClosing.maxCorrection: larger corrections are refused, metres
+  double max_correction_m = 20;    ///< LoopClosing.maxCorrection: larger corrections are refused, metres
+  /// LoopClosing.lookalikeCheckAbove: a loop correcting the keyframe by more
+  /// than this (metres) is closed only if the keyframe, verified against the
+  /// map's best-scoring keyframes one by one, verifies at no other place
+  /// (the ambiguity check); 10000 turns the look-alike check off.
+  double lookalike_check_above_m = 0.5;
   double max_correction_deg = 10;  ///< LoopClosing.maxCorrectionAngle, degrees
   int essential_weight = 100;      ///< LoopClosing.essentialWeight: covisibility edges in the essential graph
   int keyframes_between_loops = 10;  ///< no detection for this many keyframes after a loop (ORB-SLAM2: 10)

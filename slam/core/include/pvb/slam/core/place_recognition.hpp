@@ -7,6 +7,8 @@
 // accumulated over each candidate's 10 best covisibles that are candidates
 // too; the best keyframe of every group whose accumulated score exceeds
 // 75 % of the best group's.  docs/place_recognition.md.
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -50,9 +52,11 @@ class PlaceRecognizer {
                                                                    const place::BowVector& bow) const;
   /// The `n` best-scoring keyframes for `bow` one by one, without grouping
   /// and keeping those sharing at least half of the most shared words: the
-  /// look-alike places a relocalisation is checked against.
-  std::vector<std::shared_ptr<KeyFrame>> lookalike_candidates(const Map& map, const place::BowVector& bow,
-                                                              std::size_t n) const;
+  /// look-alike places a relocalisation is checked against.  `skip`, when
+  /// given, leaves out keyframes by id before they take one of the `n` places.
+  std::vector<std::shared_ptr<KeyFrame>> lookalike_candidates(
+      const Map& map, const place::BowVector& bow, std::size_t n,
+      const std::function<bool(std::uint64_t)>& skip = {}) const;
 
  private:
   std::shared_ptr<const place::Vocabulary> vocabulary_;

@@ -195,6 +195,7 @@ struct LoopClosingStats {
   int rejected = 0;               ///< consistent detections refused by geometry or the correction bound
   int refused_drift = 0;          ///< of those, verified but implausible against the drift bound
   int refused_ambiguous = 0;      ///< of those, verified at two places apart
+  int lookalike_checked = 0;      ///< loops over lookalikeCheckAbove sent to the look-alike check
   int merge_confirmed = 0;        ///< keyframes that confirmed a held-back merge transform
   int merge_unconfirmed = 0;      ///< held-back merge transforms the next keyframe did not confirm (dropped)
   int merge_suggested = 0;        ///< merge transforms held back from a relocalisation (suggest_merge)
@@ -203,7 +204,7 @@ struct LoopClosingStats {
   int refused_matches = 0;        ///< fewer than min_matches descriptor matches
   int refused_ransac = 0;         ///< too few EPnP RANSAC / pose-optimisation inliers
   int refused_inliers = 0;        ///< fewer than min_inliers after the guided search
-  int refused_correction = 0;     ///< a correction over max_correction_m / max_correction_deg
+  int refused_correction = 0;     ///< a correction over max_correction_m / max_correction_deg (hard caps)
   double verify_ms_total = 0;     ///< the part of detect_ms_total spent in step 3
   double detect_ms_total = 0;     ///< all detection work
   std::vector<double> detect_ms;  ///< detection and verification per keyframe examined
