@@ -198,6 +198,10 @@ void Frame::features_in_area(double u, double v, double r, int min_level, int ma
   std::sort(out.begin(), out.end());
 }
 
+int Frame::num_with_depth() const {
+  return static_cast<int>(std::count_if(depth_m.begin(), depth_m.end(), [](float d) { return d > 0; }));
+}
+
 std::vector<std::pair<float, std::size_t>> Frame::keypoints_by_depth() const {
   std::vector<std::pair<float, std::size_t>> by_depth;
   for (std::size_t i = 0; i < size(); ++i)

@@ -22,9 +22,10 @@ namespace pvb::slam {
 namespace {
 
 using geom::kRadToDeg;
-/// Best-scoring keyframes of the map, one by one, that a merge is also
-/// verified against (as a relocalisation is, Tracking.relocLookalikes).
-constexpr std::size_t kMergeLookalikes = 10;
+/// Best-scoring keyframes of the map, one by one, that a merge or a large
+/// loop correction is also verified against (as a relocalisation is,
+/// Tracking.relocLookalikes).
+constexpr std::size_t kLookalikes = 10;
 /// A keyframe confirms a held-back merge when it verifies this close to the
 /// pose the transform predicts (or within maxCorrection, if smaller).
 constexpr double kMergeConfirmTolerance_m = 0.5;
@@ -161,23 +162,11 @@ void add_lookalikes(const PlaceRecognizer& place, const Map& map, const LoopClos
                     const KeyFrame& kf, const std::vector<std::shared_ptr<KeyFrame>>& tried,
                     std::uint32_t map_id, const std::function<bool(std::uint64_t)>& skip,
                     std::vector<Eigen::Vector3d>* centres_w) {
-  for (const auto& c : place.lookalike_candidates(map, place.bag_of(kf), kMergeLookalikes, skip)) {
+  for (const auto& c : place.lookalike_candidates(map, place.bag_of(kf), kLookalikes, skip)) {
     if (map.map_of(*c) != map_id || std::find(tried.begin(), tried.end(), c) != tried.end()) continue;
     const LoopMatch m = verify_loop(kf, c, options);
     if (m.accepted) centres_w->push_back(m.T_c_w.inverse().translation());
   }
-}
-
-/// For a loop's look-alikes: the keyframe's own neighbourhood (its
-/// covisibles and the last `min_keyframe_gap` ids) shows the same place at
-/// the drifted pose, and is no rival.
-std::function<bool(std::uint64_t)> own_neighbourhood(const KeyFrame& kf, int min_keyframe_gap) {
-  auto connected = std::make_shared<std::set<std::uint64_t>>();
-  connected->insert(kf.id());
-  for (const auto& n : kf.best_covisibles(-1)) connected->insert(n->id());
-  const std::uint64_t newest = kf.id();
-  const auto gap = static_cast<std::uint64_t>(min_keyframe_gap);
-  return [connected, newest, gap](std::uint64_t id) { return connected->count(id) > 0 || id + gap > newest; };
 }
 
 }  // namespace
@@ -366,7 +355,7 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
   const bool large = !merge && loop_kf && best_dist_m > options_.lookalike_check_above_m;
   if (loop_kf && (merge || large) && options_.ambiguity_check && place_)
     add_lookalikes(*place_, map_, options_, *kf, consistent, merge ? 0 : map_.map_of(*kf),
-                   merge ? std::function<bool(std::uint64_t)>{} : own_neighbourhood(*kf, options_.min_keyframe_gap),
+                   merge ? std::function<bool(std::uint64_t)>{} : own_neighbourhood(*kf, kf->best_covisibles(-1), options_.min_keyframe_gap),
                    &verified_centres_w);
   bool ambiguous = false;
   for (std::size_t i = 0; i < verified_centres_w.size() && options_.ambiguity_check; ++i)

@@ -86,9 +86,7 @@ std::shared_ptr<KeyFrame> Tracking::restart_at_carried_pose(Frame& f) {
   if (options_.carried_restart_after <= 0 || localise_only_ || lost_in_row_ < options_.carried_restart_after ||
       !std::isfinite(lost_odometry_bound_m(f)))
     return nullptr;
-  int with_depth = 0;
-  for (float d : f.depth_m) with_depth += d > 0;
-  if (with_depth <= options_.min_init_points) return nullptr;
+  if (f.num_with_depth() <= options_.min_init_points) return nullptr;
   f.T_c_w = lost_odom_->T_c_w;
   f.has_pose = true;
   std::fill(f.map_points.begin(), f.map_points.end(), nullptr);

@@ -72,22 +72,31 @@ place::BowVector PlaceRecognizer::bag_of(const KeyFrame& kf) const {
   return kf.bow().empty() ? database_.bag(kf.id()) : kf.bow();
 }
 
+std::function<bool(std::uint64_t)> own_neighbourhood(const KeyFrame& kf, const std::vector<KeyFramePtr>& covisibles,
+                                                     int min_keyframe_gap) {
+  auto connected = std::make_shared<std::set<std::uint64_t>>();
+  connected->insert(kf.id());
+  for (const auto& n : covisibles) connected->insert(n->id());
+  const std::uint64_t newest = kf.id();
+  const auto gap = static_cast<std::uint64_t>(min_keyframe_gap);
+  return [connected, newest, gap](std::uint64_t id) { return connected->count(id) > 0 || id + gap > newest; };
+}
+
 std::vector<KeyFramePtr> PlaceRecognizer::loop_candidates(const Map& map, const KeyFrame& kf,
                                                           int min_keyframe_gap) const {
   // ORB-SLAM2: the least score of the covisibles is the threshold (0 for a
   // keyframe without any); the database computes it in the same walk.
-  std::set<std::uint64_t> connected = {kf.id()};
+  const std::vector<KeyFramePtr> covisibles = kf.best_covisibles(-1);
   std::vector<std::uint64_t> reference;
-  for (const auto& n : kf.best_covisibles(-1)) {
-    connected.insert(n->id());
+  for (const auto& n : covisibles)
     if (!n->bad()) reference.push_back(n->id());
-  }
+  const auto own = own_neighbourhood(kf, covisibles, min_keyframe_gap);
   const auto skip = [&](std::uint64_t id) {
-    if (connected.count(id) || id + static_cast<std::uint64_t>(min_keyframe_gap) > kf.id()) return true;
+    if (own(id)) return true;
     auto it = map.keyframes().find(id);
     return it == map.keyframes().end() || it->second->bad();
   };
-  if (connected.size() == 1) return accumulate_groups(map, database_.query(kf.bow(), 0.0, 0.8, skip));
+  if (covisibles.empty()) return accumulate_groups(map, database_.query(kf.bow(), 0.0, 0.8, skip));
   return accumulate_groups(map, database_.query_above(kf.bow(), reference, 0.8, skip));
 }
 

@@ -128,8 +128,7 @@ FrameResult System::track(const sensor::RgbdFrame& in) {
   out.orb_ms = ms_since(t0);
   if (!session_first_t_ns_) start_session_clock(in.t_ns);
   Frame frame(next_frame_id_++, in.t_ns, std::move(features), in.depth_m, cam_);
-  out.features_with_depth = static_cast<int>(std::count_if(frame.depth_m.begin(), frame.depth_m.end(),
-                                                           [](float d) { return d > 0; }));
+  out.features_with_depth = frame.num_with_depth();
   if (!in.depth_m.empty())
     out.depth_valid = static_cast<double>(cv::countNonZero(in.depth_m > 0)) / static_cast<double>(in.depth_m.total());
   if (settings_.align_patches) frame.pyramid = std::make_shared<const ImagePyramid>(copy_pyramid(extractor_->pyramid()));

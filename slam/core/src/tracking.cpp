@@ -170,8 +170,7 @@ void Tracking::start_in_map(bool localise_only) {
 }
 
 bool Tracking::initialize(Frame& f) {
-  int with_depth = 0;
-  for (float d : f.depth_m) with_depth += d > 0;
+  const int with_depth = f.num_with_depth();
   if (with_depth <= options_.min_init_points) {
     const std::string why = "initialisation: only " + std::to_string(with_depth) +
                             " keypoints with depth (need more than " + std::to_string(options_.min_init_points) + ")";

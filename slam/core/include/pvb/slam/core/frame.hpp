@@ -128,6 +128,8 @@ class Frame {
                         std::vector<std::size_t>* out) const;
   /// World point of keypoint i from its depth; precondition depth_m[i] > 0.
   Eigen::Vector3d unproject_world(std::size_t i) const;
+  /// Keypoints with a depth.
+  int num_with_depth() const;
   /// (depth, keypoint index) of the keypoints with depth, nearest first.
   std::vector<std::pair<float, std::size_t>> keypoints_by_depth() const;
   /// Observation of keypoint i for the optimiser.

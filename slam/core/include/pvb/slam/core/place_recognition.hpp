@@ -18,6 +18,14 @@
 
 namespace pvb::slam {
 
+/// A keyframe's own neighbourhood: itself, its `covisibles` and the
+/// keyframes fewer than `min_keyframe_gap` ids older.  They show its place
+/// at its own (drifted) pose, so they are neither loop candidates nor
+/// look-alike rivals of a loop.
+std::function<bool(std::uint64_t)> own_neighbourhood(const KeyFrame& kf,
+                                                     const std::vector<std::shared_ptr<KeyFrame>>& covisibles,
+                                                     int min_keyframe_gap);
+
 class PlaceRecognizer {
  public:
   /// Groups features by the node this many levels above the words (ORB-SLAM2: 4).
