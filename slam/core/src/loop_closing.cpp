@@ -205,7 +205,8 @@ std::string to_json(const LoopClosingStats& stats) {
            ", \"fused_points\": " + std::to_string(e.fused_points) +
            ", \"graph_keyframes\": " + std::to_string(e.graph_keyframes) +
            ", \"graph_edges\": " + std::to_string(e.graph_edges) + ", \"detect_ms\": " + num(e.detect_ms) +
-           ", \"correct_ms\": " + num(e.correct_ms) + ", \"global_ba_ms\": " + num(e.global_ba_ms) +
+           ", \"correct_ms\": " + num(e.correct_ms) + ", \"correct_locked_ms\": " + num(e.correct_locked_ms) +
+           ", \"global_ba_ms\": " + num(e.global_ba_ms) +
            ", \"global_ba_outliers\": " + std::to_string(e.global_ba_outliers) +
            ", \"merge\": " + (e.merge ? "true" : "false") + "}";
   }
@@ -446,7 +447,7 @@ void LoopClosing::suggest_merge(std::uint32_t from, const geom::SE3d& T_into_fro
 bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
   if (!options_.enabled) return false;
   const auto t0 = std::chrono::steady_clock::now();
-  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::unique_lock<std::mutex> lock(map_.mutex());
   {
     std::lock_guard<std::mutex> s(stats_mutex_);
     ++stats_.keyframes;
@@ -471,12 +472,12 @@ bool LoopClosing::process(const std::shared_ptr<KeyFrame>& kf) {
       return false;
     }
   }
-  close(kf, loop_kf, best, merge, ms_since(t0));
+  close(kf, loop_kf, best, merge, ms_since(t0), lock);
   return true;
 }
 
 void LoopClosing::close(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf,
-                        const LoopMatch& best, bool merge, double detect_ms) {
+                        const LoopMatch& best, bool merge, double detect_ms, std::unique_lock<std::mutex>& lock) {
   LoopEvent event;
   event.keyframe_id = kf->id();
   event.frame_id = kf->frame_id();
@@ -491,7 +492,7 @@ void LoopClosing::close(const std::shared_ptr<KeyFrame>& kf, const std::shared_p
   event.merge = merge;
   const auto t1 = std::chrono::steady_clock::now();
   if (merge) detail::merge_into(map_, kf, loop_kf, best.T_c_w);
-  correct(kf, loop_kf, best, &event);
+  correct(kf, loop_kf, best, &event, lock);
   event.correct_ms = ms_since(t1);
   if (options_.global_ba) {
     const auto t2 = std::chrono::steady_clock::now();

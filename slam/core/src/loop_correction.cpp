@@ -4,12 +4,14 @@
 #include "pvb/slam/core/loop_closing.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <map>
 #include <memory>
 #include <set>
 #include <vector>
 
 #include "loop_correction.hpp"
+#include "pvb/common/clock.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/matcher.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
@@ -205,22 +207,14 @@ class EssentialGraph {
   std::set<std::pair<std::size_t, std::size_t>> inserted_;
 };
 
-/// Step 4.5: writes the optimised poses back; every point moves with its
-/// reference keyframe (or the keyframe that corrected it in step 4.1).
-/// Keyframes not in the graph (queued for local mapping) move as the new
-/// keyframe did.
-void write_back(Map& map, const EssentialGraph& g, const KeyFramePtr& kf, const MovedGroup& moved) {
-  std::map<std::uint64_t, geom::SE3d> final_pose;
-  for (std::size_t i = 0; i < g.node_kf.size(); ++i)
-    final_pose[g.node_kf[i]->id()] = g.problem.nodes[i].T_c_w;
-  const geom::SE3d kf_move =
-      final_pose.count(kf->id())
-          ? geom::SE3d(final_pose.at(kf->id()).inverse() * moved.uncorrected.at(kf->id()))
-          : geom::SE3d::Identity();
-  for (const auto& [id, k] : map.keyframes()) {
-    if (k->bad() || final_pose.count(id) || !g.initial.count(id)) continue;
-    final_pose[id] = (kf_move * g.initial.at(id).inverse()).inverse();  // T_c_w' = T_c_w * kf_move^-1
-  }
+/// Poses T_c_w of keyframes before and after a move, by id.
+struct PoseMoves {
+  std::map<std::uint64_t, geom::SE3d> before, after;
+};
+
+/// Every point of the map moves with its reference keyframe (or the
+/// keyframe that corrected it in step 4.1), when that keyframe moved.
+void move_points(Map& map, const PoseMoves& moves, const MovedGroup& moved) {
   for (const auto& [id, mp] : map.points()) {
     if (mp->bad()) continue;
     std::uint64_t ref_id;
@@ -232,13 +226,56 @@ void write_back(Map& map, const EssentialGraph& g, const KeyFramePtr& kf, const 
       if (!ref) continue;
       ref_id = ref->id();
     }
-    auto it0 = g.initial.find(ref_id);
-    auto it1 = final_pose.find(ref_id);
-    if (it0 == g.initial.end() || it1 == final_pose.end()) continue;
+    auto it0 = moves.before.find(ref_id);
+    auto it1 = moves.after.find(ref_id);
+    if (it0 == moves.before.end() || it1 == moves.after.end()) continue;
     mp->set_p_w(it1->second.inverse() * (it0->second * mp->p_w()));
   }
-  for (const auto& [id, k] : map.keyframes())
-    if (!k->bad() && final_pose.count(id)) k->correct_T_c_w(final_pose.at(id));
+}
+
+/// The moves of the good keyframes of `map_id` that are not in the graph
+/// (queued for local mapping, or made by tracking since) nor in `skip`:
+/// each as the new keyframe moved, T_c_w' = T_c_w * kf_move^-1 with
+/// kf_move = T_kf_w'^-1 * T_kf_w.
+PoseMoves move_off_graph(const Map& map, const EssentialGraph& g, std::uint32_t map_id, const geom::SE3d& kf_move,
+                         const std::map<std::uint64_t, geom::SE3d>& skip = {}) {
+  PoseMoves moves;
+  for (const auto& [id, k] : map.keyframes()) {
+    if (k->bad() || g.node.count(id) || skip.count(id) || map.map_of(*k) != map_id) continue;
+    moves.before[id] = k->T_c_w();
+    moves.after[id] = k->T_c_w() * kf_move.inverse();
+  }
+  return moves;
+}
+
+/// Before the graph is optimised with the map unlocked: the keyframes
+/// local mapping has not processed yet follow the new keyframe's move in
+/// step 4.1, so that tracking, which goes on meanwhile, finds the recent
+/// map in one frame.  (The neighbourhood moved in step 4.1 already.)
+void move_queued(Map& map, const EssentialGraph& g, const KeyFramePtr& kf, const MovedGroup& moved) {
+  const geom::SE3d kf_move = kf->T_c_w().inverse() * moved.uncorrected.at(kf->id());
+  const PoseMoves moves = move_off_graph(map, g, map.map_of(*kf), kf_move, moved.uncorrected);
+  move_points(map, moves, moved);
+  for (const auto& [id, T_c_w] : moves.after) map.keyframes().at(id)->correct_T_c_w(T_c_w);
+}
+
+/// Step 4.5: writes the optimised poses back; every point moves with its
+/// reference keyframe (or the keyframe that corrected it in step 4.1).
+/// Keyframes not in the graph (queued, or made by tracking while the graph
+/// was optimised) move as the new keyframe did in the optimisation.
+void write_back(Map& map, const EssentialGraph& g, const KeyFramePtr& kf, const MovedGroup& moved) {
+  geom::SE3d kf_move = geom::SE3d::Identity();
+  if (auto it = g.node.find(kf->id()); it != g.node.end())
+    kf_move = g.problem.nodes[it->second].T_c_w.inverse() * g.initial.at(kf->id());
+  PoseMoves moves = move_off_graph(map, g, map.map_of(*kf), kf_move);
+  for (std::size_t i = 0; i < g.node_kf.size(); ++i) {
+    if (g.node_kf[i]->bad()) continue;
+    const std::uint64_t id = g.node_kf[i]->id();
+    moves.before[id] = g.initial.at(id);
+    moves.after[id] = g.problem.nodes[i].T_c_w;
+  }
+  move_points(map, moves, moved);
+  for (const auto& [id, T_c_w] : moves.after) map.keyframes().at(id)->correct_T_c_w(T_c_w);
   for (const auto& [id, mp] : map.points())
     if (!mp->bad()) mp->update_normal_and_depth();
 }
@@ -265,7 +302,8 @@ void detail::merge_into(Map& map, const std::shared_ptr<KeyFrame>& kf, const std
 }
 
 void LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf,
-                          const LoopMatch& m, LoopEvent* event) {
+                          const LoopMatch& m, LoopEvent* event, std::unique_lock<std::mutex>& lock) {
+  const auto t0 = std::chrono::steady_clock::now();
   kf->update_connections();
   const MovedGroup moved = move_neighbourhood(kf, m.T_c_w);
   auto neighbours_before = neighbour_ids(moved.keyframes);
@@ -276,10 +314,19 @@ void LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared
   graph.add_odometry_edges(moved.uncorrected, options_.essential_weight);
   event->graph_keyframes = static_cast<int>(graph.problem.nodes.size());
   event->graph_edges = static_cast<int>(graph.problem.edges.size());
-  optimize_pose_graph(&graph.problem);
-  write_back(map_, graph, kf, moved);
+  move_queued(map_, graph, kf, moved);
   kf->add_loop_edge(loop_kf);
   loop_kf->add_loop_edge(kf);
+  // The graph is a copy of the poses: tracking goes on while it is
+  // optimised (local mapping, on this thread, waits).
+  const double locked_before_ms = ms_since(t0);
+  lock.unlock();
+  if (while_optimising_) while_optimising_();
+  optimize_pose_graph(&graph.problem);
+  lock.lock();
+  const auto t1 = std::chrono::steady_clock::now();
+  write_back(map_, graph, kf, moved);
+  event->correct_locked_ms = locked_before_ms + ms_since(t1);
 }
 
 void LoopClosing::global_bundle_adjustment(LoopEvent* event, std::uint32_t map_id) {

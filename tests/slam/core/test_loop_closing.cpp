@@ -445,6 +445,69 @@ TEST(LoopClosing, ClosesOnlyAfterConsistentDetectionsAndRemovesTheDrift) {
   EXPECT_FALSE(kfs[2]->set_bad());  // a keyframe with a loop edge is kept
 }
 
+/// Makes `parent` the keyframe's parent in the spanning tree, as local
+/// mapping's first connections do: one point of `kf` is taken to be one of
+/// the parent's.
+void hang_under(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& parent) {
+  std::shared_ptr<MapPoint> own, shared;
+  for (const auto& mp : kf->map_points())
+    if (mp && !mp->bad()) own = mp;
+  for (const auto& mp : parent->map_points())
+    if (mp && !mp->bad() && !shared) shared = mp;  // its first point, the last may be another's
+  own->replace(shared, own);
+  kf->update_connections();
+  ASSERT_EQ(kf->parent(), parent);
+}
+
+TEST(LoopClosing, TrackingGoesOnWhileTheGraphIsOptimised) {
+  // Keyframes in a chain (each the parent of the next, as local mapping
+  // makes them), the last one drifted back onto the first keyframe's view.
+  Map map;
+  const cv::Mat tex = make_texture(1);
+  auto kf0 = add_keyframe(map, tex, pose(0, 0, 0), pose(0, 0, 0));
+  std::vector<std::shared_ptr<KeyFrame>> chain = {kf0};
+  for (const double x : {0.4, 0.8}) {
+    const geom::SE3d T = pose(-10, x, 0);
+    chain.push_back(add_keyframe(map, tex, T, T));
+    hang_under(chain.back(), chain[chain.size() - 2]);
+  }
+  const geom::SE3d T_loop = pose(2, 0.06, 0.02);
+  auto kf = add_keyframe(map, tex, T_loop, drifted(T_loop));
+  hang_under(kf, chain.back());
+  LoopClosingOptions o = test_options();
+  o.consistency = 1;
+  LoopClosing lc(map, o);
+  // Meanwhile tracking takes the map and makes a keyframe 5 cm ahead of
+  // the corrected one, with a point 2 m in front of it.
+  bool map_was_free = false;
+  std::shared_ptr<KeyFrame> made;
+  std::shared_ptr<MapPoint> made_point;
+  geom::SE3d T_kf_w_then;
+  const geom::SE3d T_made_kf = geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, -0.05));
+  const Eigen::Vector3d p_made_m(0.1, -0.2, 2.0);
+  lc.set_while_optimising([&] {
+    std::unique_lock<std::mutex> lock(map.mutex(), std::try_to_lock);
+    map_was_free = lock.owns_lock();
+    if (!map_was_free) return;
+    T_kf_w_then = kf->T_c_w();
+    made = add_keyframe(map, tex, T_made_kf * T_loop, T_made_kf * T_kf_w_then);
+    made_point = map.create_point(made->T_c_w().inverse() * p_made_m, made);
+  });
+  lc.process(kf);
+  ASSERT_TRUE(lc.process(kf));
+  ASSERT_TRUE(map_was_free);
+  ASSERT_TRUE(made);
+  // The optimisation moved the new keyframe on (else this proves nothing),
+  // and tracking's keyframe and point went with it.
+  EXPECT_GT(centre_error_m(kf->T_c_w(), T_kf_w_then), 1e-3);
+  const geom::SE3d rel = made->T_c_w() * kf->T_c_w().inverse();
+  EXPECT_LT((rel.matrix() - T_made_kf.matrix()).norm(), 1e-9);
+  EXPECT_LT((made->T_c_w() * made_point->p_w() - p_made_m).norm(), 1e-9);
+  const LoopClosingStats s = lc.stats();
+  ASSERT_EQ(s.loops.size(), 1u);
+  EXPECT_LE(s.loops[0].correct_locked_ms, s.loops[0].correct_ms);
+}
+
 TEST(LoopClosing, CorrectionIsBitIdenticalRunToRun) {
   const auto run_once = [] {
     Map map;

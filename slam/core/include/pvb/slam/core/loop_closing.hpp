@@ -25,7 +25,10 @@
 //      side), loop edges added, the essential graph (spanning tree, loop
 //      edges, covisibility edges of weight >= `essential_weight`) optimised
 //      as an SE(3) pose graph, and every map point moved with its reference
-//      keyframe;
+//      keyframe.  The graph is optimised on a copy of the poses with the
+//      map mutex free, so tracking goes on meanwhile; keyframes not yet in
+//      the graph (queued, or made by tracking in the meantime) move with
+//      the new keyframe, before and after;
 //   5. optionally (`global_ba`, off by default) a bundle adjustment of the
 //      whole map, inline, with the map locked (tracking waits).
 //
@@ -53,6 +56,7 @@
 // only works while the drift is small compared with the search radius.
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -118,6 +122,11 @@ class LoopClosing {
   LoopClosingStats stats() const;
   const LoopClosingOptions& options() const { return options_; }
 
+  /// Called on the loop-closing thread while a correction's essential
+  /// graph is optimised, with the map mutex free (what tracking does
+  /// meanwhile, for tests).
+  void set_while_optimising(std::function<void()> f) { while_optimising_ = std::move(f); }
+
  private:
   /// A merge transform held back until confirmed (merge_confirmations).
   struct PendingMerge {
@@ -158,11 +167,12 @@ class LoopClosing {
   std::shared_ptr<KeyFrame> find(const std::shared_ptr<KeyFrame>& kf, LoopMatch* best, bool* merge,
                                  std::chrono::steady_clock::time_point t0);
   /// Steps 4-6 (a merge first moves the provisional map) and the event.
+  /// `lock` holds the map mutex; the correction lets go of it for a while.
   void close(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf, const LoopMatch& best,
-             bool merge, double detect_ms);
-  /// Step 4.
+             bool merge, double detect_ms, std::unique_lock<std::mutex>& lock);
+  /// Step 4, with `lock` let go while the essential graph is optimised.
   void correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf, const LoopMatch& m,
-               LoopEvent* event);
+               LoopEvent* event, std::unique_lock<std::mutex>& lock);
 
   Map& map_;
   LoopClosingOptions options_;
@@ -171,6 +181,7 @@ class LoopClosing {
   std::optional<PendingMerge> pending_merge_;
   std::uint64_t last_loop_kf_id_ = 0;
   bool any_loop_ = false;
+  std::function<void()> while_optimising_;
   mutable std::mutex stats_mutex_;
   LoopClosingStats stats_;
 };

@@ -181,6 +181,9 @@ struct LoopEvent {
   int graph_edges = 0;
   double detect_ms = 0;       ///< detection and verification for this keyframe
   double correct_ms = 0;      ///< correction (fusion, pose graph, points)
+  /// Of correct_ms, the time with the map locked (tracking waits): all of
+  /// it but the essential graph's optimisation.
+  double correct_locked_ms = 0;
   double global_ba_ms = 0;    ///< global bundle adjustment afterwards (0 when off)
   int global_ba_outliers = 0; ///< observations it removed
   bool merge = false;         ///< a provisional map merged into the map (correction_m: how far it moved)
@@ -213,7 +216,7 @@ struct LoopClosingStats {
 /// The stats as one JSON object for stats.json / metrics.json:
 /// {"loops": n, "events": [{keyframe, frame, loop_keyframe, loop_frame,
 /// inliers, correction_m, correction_deg, fused_points, graph_keyframes,
-/// graph_edges, detect_ms, correct_ms}], "keyframes", "candidates",
+/// graph_edges, detect_ms, correct_ms, correct_locked_ms}], "keyframes", "candidates",
 /// "consistent", "rejected", "detect_ms_total"}.
 std::string to_json(const LoopClosingStats& stats);
 
