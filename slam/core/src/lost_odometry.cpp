@@ -93,8 +93,7 @@ std::shared_ptr<KeyFrame> Tracking::restart_at_carried_pose(Frame& f) {
   std::fill(f.outlier.begin(), f.outlier.end(), 0);
   v_last_ = lost_odom_->v_w;
   v_last_known_ = true;
-  auto kf = map_.create_keyframe(f);
-  attach_motion(kf);  // chained to the last keyframe by the readings since: the wheels hold it to the map
+  auto kf = add_keyframe_in_own_map(f);  // the wheels' readings since hold it to the last keyframe
   for (std::size_t i = 0; i < f.size(); ++i)
     if (f.depth_m[i] > 0) add_point_from_depth(f, kf, i);
   ref_kf_ = kf;

@@ -562,10 +562,15 @@ void Tracking::add_point_from_depth(Frame& f, const std::shared_ptr<KeyFrame>& k
   f.map_points[i] = mp;
 }
 
-std::shared_ptr<KeyFrame> Tracking::create_keyframe(Frame& f) {
+std::shared_ptr<KeyFrame> Tracking::add_keyframe_in_own_map(const Frame& f) {
   auto kf = map_.create_keyframe(f);
   if (ref_kf_) kf->set_provisional(ref_kf_->provisional());
   attach_motion(kf);
+  return kf;
+}
+
+std::shared_ptr<KeyFrame> Tracking::create_keyframe(Frame& f) {
+  auto kf = add_keyframe_in_own_map(f);
   ref_kf_ = kf;
   // New points from depth: the closest keypoints first, all nearer than the
   // close/far threshold and at least 100 (ORB-SLAM2 CreateNewKeyFrame).

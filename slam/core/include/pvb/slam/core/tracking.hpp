@@ -163,6 +163,10 @@ class Tracking {
   /// ORB-SLAM2's keyframe decision; also fills stats_.kf_* with its inputs.
   bool need_new_keyframe(const Frame& f, bool mapping_idle, std::size_t mapping_queue);
   std::shared_ptr<KeyFrame> create_keyframe(Frame& f);
+  /// A keyframe of `f` in the map the reference keyframe belongs to (a
+  /// provisional one, or the map's own), chained to the last keyframe by
+  /// the motion readings since.
+  std::shared_ptr<KeyFrame> add_keyframe_in_own_map(const Frame& f);
   /// A new map point at keypoint i of f, from its depth, observed by kf (made from f).
   void add_point_from_depth(Frame& f, const std::shared_ptr<KeyFrame>& kf, std::size_t i);
   void discard_outliers(Frame& f, int* map_matches);
