@@ -102,6 +102,11 @@ std::uint64_t saved_observer(const MapPoint& mp, const SortedIds& kf_ids, std::u
   return kNone;
 }
 
+/// Finite and within kMaxMapCoordinateM of the origin on each axis, as the reader asks.
+bool within_map_bounds(const Eigen::Vector3d& p_w) {
+  return p_w.allFinite() && p_w.cwiseAbs().maxCoeff() <= kMaxMapCoordinateM;
+}
+
 void put_point(ByteWriter& w, const MapPoint& mp, const SortedIds& kf_ids) {
   w.u64(mp.id());
   for (int r = 0; r < 3; ++r) w.f64(mp.p_w()(r));
@@ -229,10 +234,13 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
     throw std::logic_error("encode_map: " + std::to_string(sessions) + " sessions for " +
                            std::to_string(kfs.size()) + " keyframes");
   // A point no keyframe of the file names (seen only by keyframes left out)
-  // is left out too: the reader links points from the keyframes' side.
+  // is left out too: the reader links points from the keyframes' side.  So
+  // is a point beyond kMaxMapCoordinateM (triangulated from nearly parallel
+  // rays), which the reader would refuse.
   SortedIds point_ids;
   for (const auto& [id, mp] : map.points())
-    if (!mp->bad() && saved_observer(*mp, kf_ids, kNone) != kNone) point_ids.push_back(id);
+    if (!mp->bad() && within_map_bounds(mp->p_w()) && saved_observer(*mp, kf_ids, kNone) != kNone)
+      point_ids.push_back(id);
 
   ByteWriter head, keyf, poin, grap, bowv, iner;
   put_settings(head, settings, sessions);

@@ -137,6 +137,22 @@ TEST_F(MapFile, AProvisionalMapNeverMergedIsLeftOutOfTheFile) {
   EXPECT_GT(encode_map(map, h.settings, h.sessions, h.app_json).size(), bytes_.size());
 }
 
+TEST_F(MapFile, APointBeyondTheReadersBoundIsLeftOutSoTheFileLoads) {
+  // Nearly parallel rays can triangulate a point a thousand kilometres
+  // off; a file holding it would be refused by its own reader.
+  const MapFileHeader h = read_map_header(bytes_, path_);
+  Map map;
+  decode_map(bytes_, path_, h, camera_for(h.settings), &map);
+  std::lock_guard<std::mutex> lock(map.mutex());
+  const std::size_t points = map.num_points();
+  map.points().begin()->second->set_p_w(Eigen::Vector3d(5.4e5, 5.4e5, -2.1e6));
+  const std::string bytes = encode_map(map, h.settings, h.sessions, h.app_json);
+  const MapFileHeader h2 = read_map_header(bytes, path_);
+  Map loaded;
+  EXPECT_NO_THROW(decode_map(bytes, path_, h2, camera_for(h2.settings), &loaded));
+  EXPECT_EQ(loaded.num_points(), points - 1);
+}
+
 TEST_F(MapFile, EveryTruncationIsOneErrorNamingTheFile) {
   for (std::size_t n : {std::size_t(0), std::size_t(5), std::size_t(8), std::size_t(12), std::size_t(20),
                         bytes_.size() / 3, bytes_.size() / 2, bytes_.size() - 9, bytes_.size() - 1}) {
