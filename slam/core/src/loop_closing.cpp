@@ -356,7 +356,8 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
   const bool large = !merge && loop_kf && best_dist_m > options_.lookalike_check_above_m;
   if (loop_kf && (merge || large) && options_.ambiguity_check && place_)
     add_lookalikes(*place_, map_, options_, *kf, consistent, merge ? 0 : map_.map_of(*kf),
-                   merge ? std::function<bool(std::uint64_t)>{} : own_neighbourhood(*kf, kf->best_covisibles(-1), options_.min_keyframe_gap),
+                   merge ? std::function<bool(std::uint64_t)>{}
+                         : own_neighbourhood(*kf, kf->best_covisibles(-1), options_.min_keyframe_gap),
                    &verified_centres_w);
   bool ambiguous = false;
   for (std::size_t i = 0; i < verified_centres_w.size() && options_.ambiguity_check; ++i)
@@ -492,8 +493,9 @@ void LoopClosing::close(const std::shared_ptr<KeyFrame>& kf, const std::shared_p
   event.merge = merge;
   const auto t1 = std::chrono::steady_clock::now();
   if (merge) detail::merge_into(map_, kf, loop_kf, best.T_c_w);
-  correct(kf, loop_kf, best, &event, lock);
+  const double unlocked_ms = correct(kf, loop_kf, best, &event, lock);
   event.correct_ms = ms_since(t1);
+  event.correct_locked_ms = event.correct_ms - unlocked_ms;
   if (options_.global_ba) {
     const auto t2 = std::chrono::steady_clock::now();
     global_bundle_adjustment(&event, map_.map_of(*loop_kf));

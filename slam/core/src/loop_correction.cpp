@@ -301,9 +301,8 @@ void detail::merge_into(Map& map, const std::shared_ptr<KeyFrame>& kf, const std
   for (const auto& mp : moved) mp->update_normal_and_depth();
 }
 
-void LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf,
-                          const LoopMatch& m, LoopEvent* event, std::unique_lock<std::mutex>& lock) {
-  const auto t0 = std::chrono::steady_clock::now();
+double LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf,
+                            const LoopMatch& m, LoopEvent* event, std::unique_lock<std::mutex>& lock) {
   kf->update_connections();
   const MovedGroup moved = move_neighbourhood(kf, m.T_c_w);
   auto neighbours_before = neighbour_ids(moved.keyframes);
@@ -319,14 +318,14 @@ void LoopClosing::correct(const std::shared_ptr<KeyFrame>& kf, const std::shared
   loop_kf->add_loop_edge(kf);
   // The graph is a copy of the poses: tracking goes on while it is
   // optimised (local mapping, on this thread, waits).
-  const double locked_before_ms = ms_since(t0);
+  const auto t0 = std::chrono::steady_clock::now();
   lock.unlock();
   if (while_optimising_) while_optimising_();
   optimize_pose_graph(&graph.problem);
   lock.lock();
-  const auto t1 = std::chrono::steady_clock::now();
+  const double unlocked_ms = ms_since(t0);
   write_back(map_, graph, kf, moved);
-  event->correct_locked_ms = locked_before_ms + ms_since(t1);
+  return unlocked_ms;
 }
 
 void LoopClosing::global_bundle_adjustment(LoopEvent* event, std::uint32_t map_id) {

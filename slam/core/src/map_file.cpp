@@ -102,11 +102,6 @@ std::uint64_t saved_observer(const MapPoint& mp, const SortedIds& kf_ids, std::u
   return kNone;
 }
 
-/// Finite and within kMaxMapCoordinateM of the origin on each axis, as the reader asks.
-bool within_map_bounds(const Eigen::Vector3d& p_w) {
-  return p_w.allFinite() && p_w.cwiseAbs().maxCoeff() <= kMaxMapCoordinateM;
-}
-
 void put_point(ByteWriter& w, const MapPoint& mp, const SortedIds& kf_ids) {
   w.u64(mp.id());
   for (int r = 0; r < 3; ++r) w.f64(mp.p_w()(r));

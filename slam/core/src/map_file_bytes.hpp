@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "pvb/common/error.hpp"
 #include "pvb/slam/core/map_file.hpp"
 
@@ -20,6 +22,12 @@ constexpr std::array<const char*, 6> kSectionsV1 = {"HEAD", "KEYF", "POIN", "GRA
 /// The sections of a version-2 file: INER (the inertial state) before META.
 constexpr std::array<const char*, 7> kSectionsV2 = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "INER", "META"};
 constexpr std::size_t kInerSection = 5;  ///< INER's place in a version-2 file
+/// A position the file may hold: within kMaxMapCoordinateM of the origin on
+/// every axis (and so finite).  The writer leaves out a point outside it;
+/// the reader refuses one.
+inline bool within_map_bounds(const Eigen::Vector3d& p) {
+  return p.allFinite() && p.cwiseAbs().maxCoeff() <= kMaxMapCoordinateM;
+}
 /// The sections of a file of `version` (1 or 2), in order.
 inline std::vector<const char*> section_tags(std::uint32_t version) {
   if (version == 1) return {kSectionsV1.begin(), kSectionsV1.end()};

@@ -166,7 +166,7 @@ geom::SE3d read_pose(ByteReader& r) {
   if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 || R.determinant() < 0)
     r.fail("a pose's rotation is not a rotation");
   const Eigen::Vector3d centre = -R.transpose() * t;
-  if (centre.cwiseAbs().maxCoeff() > kMaxMapCoordinateM)
+  if (!within_map_bounds(centre))
     r.fail("a camera centre at (" + format_g(centre.x()) + ", " + format_g(centre.y()) + ", " +
            format_g(centre.z()) + ") m lies beyond " + format_g(kMaxMapCoordinateM) +
            " m of the map's origin");
@@ -264,7 +264,7 @@ void check_point(ByteReader& r, std::uint64_t id, const SavedPoint& p, const Map
   const auto fail = [&](const std::string& why) { r.fail("point " + std::to_string(id) + why); };
   if (id >= kMaxId) fail(": its id is not below 2^48");
   if (!p.p_w.allFinite()) fail(" has a position that is not finite");
-  if (p.p_w.cwiseAbs().maxCoeff() > kMaxMapCoordinateM)
+  if (!within_map_bounds(p.p_w))
     fail(" at (" + format_g(p.p_w.x()) + ", " + format_g(p.p_w.y()) + ", " + format_g(p.p_w.z()) +
          ") m lies beyond " + format_g(kMaxMapCoordinateM) + " m of the map's origin");
   if (p.ref != kNone && !map.keyframes().count(p.ref))

@@ -5,8 +5,10 @@
 // look-alike check of a large correction on a wall that repeats every 2 m.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <thread>
 
 #include "pvb/slam/core/loop_closing.hpp"
 #include "pvb/slam/core/place_recognition.hpp"
@@ -492,6 +494,7 @@ TEST(LoopClosing, TrackingGoesOnWhileTheGraphIsOptimised) {
     T_kf_w_then = kf->T_c_w();
     made = add_keyframe(map, tex, T_made_kf * T_loop, T_made_kf * T_kf_w_then);
     made_point = map.create_point(made->T_c_w().inverse() * p_made_m, made);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));  // counts as time with the map free
   });
   lc.process(kf);
   ASSERT_TRUE(lc.process(kf));
@@ -505,7 +508,7 @@ TEST(LoopClosing, TrackingGoesOnWhileTheGraphIsOptimised) {
   EXPECT_LT((made->T_c_w() * made_point->p_w() - p_made_m).norm(), 1e-9);
   const LoopClosingStats s = lc.stats();
   ASSERT_EQ(s.loops.size(), 1u);
-  EXPECT_LE(s.loops[0].correct_locked_ms, s.loops[0].correct_ms);
+  EXPECT_GE(s.loops[0].correct_ms - s.loops[0].correct_locked_ms, 50.0);
 }
 
 TEST(LoopClosing, CorrectionIsBitIdenticalRunToRun) {

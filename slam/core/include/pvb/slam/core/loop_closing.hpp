@@ -170,9 +170,10 @@ class LoopClosing {
   /// `lock` holds the map mutex; the correction lets go of it for a while.
   void close(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf, const LoopMatch& best,
              bool merge, double detect_ms, std::unique_lock<std::mutex>& lock);
-  /// Step 4, with `lock` let go while the essential graph is optimised.
-  void correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf, const LoopMatch& m,
-               LoopEvent* event, std::unique_lock<std::mutex>& lock);
+  /// Step 4, with `lock` let go while the essential graph is optimised;
+  /// returns how long it was let go (ms).
+  double correct(const std::shared_ptr<KeyFrame>& kf, const std::shared_ptr<KeyFrame>& loop_kf, const LoopMatch& m,
+                 LoopEvent* event, std::unique_lock<std::mutex>& lock);
 
   Map& map_;
   LoopClosingOptions options_;
