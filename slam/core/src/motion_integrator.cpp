@@ -11,6 +11,7 @@ MotionIntegrator::MotionIntegrator(const MotionSensorSettings& sensors)
       robot_(sensors.robot),
       period_ns_(static_cast<std::int64_t>(std::llround(1e9 / sensors.imu.rate_hz))),
       encoder_period_ns_(static_cast<std::int64_t>(std::llround(1e9 / sensors.robot.encoder_rate_hz))),
+      wheel_noise_(sensors.robot.wheel_noise),
       imu_frame_(ImuBias{}, imu_noise_),
       imu_kf_(ImuBias{}, imu_noise_),
       wheel_frame_(sensors.robot.drive, wheel_noise_),

@@ -196,6 +196,11 @@ void read_robot(Reader& r, const cv::FileStorage& fs, RobotSettings* robot) {
   robot->encoder_rate_hz = r.real("Robot.EncoderFrequency", req, robot->encoder_rate_hz, closed(1, 10000), "readings per second");
   robot->T_base_c = r.pose("Robot.T_base_c1", req, robot->T_base_c);
   robot->T_base_imu = r.pose("Robot.T_base_imu", req, robot->T_base_imu);
+  WheelNoise& n = robot->wheel_noise;
+  n.translation_per_sqrt_m =
+      r.real("Robot.WheelNoiseTranslation", false, n.translation_per_sqrt_m, above(0, 1), "m/sqrt(m)");
+  n.yaw_per_sqrt_m = r.real("Robot.WheelNoiseYaw", false, n.yaw_per_sqrt_m, above(0, 1), "rad/sqrt(m)");
+  n.yaw_per_sqrt_rad = r.real("Robot.WheelNoiseYawTurn", false, n.yaw_per_sqrt_rad, above(0, 1), "rad/sqrt(rad)");
 }
 
 /// System.Sensors (checked against the sections it needs by the caller).

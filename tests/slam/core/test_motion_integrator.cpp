@@ -131,6 +131,28 @@ TEST(MotionIntegrator, WheelIntervalsEndAtTheFramesBetweenEncoderReadings) {
   }
 }
 
+TEST(MotionIntegrator, WheelIntervalsAreWeighedWithTheSettingsWheelNoise) {
+  const auto yaw_sigma_after_a_metre = [](double yaw_per_sqrt_m) {
+    Settings s = robot_settings(sensor::SensorSetup::kCameraImuWheels);
+    s.motion.robot.encoder_rate_hz = 30;
+    s.motion.robot.wheel_noise.yaw_per_sqrt_m = yaw_per_sqrt_m;
+    MotionIntegrator m(s.motion);
+    const double metres_per_tick = 2 * M_PI * s.motion.robot.drive.wheel_radius_m / s.motion.robot.drive.ticks_per_rev;
+    for (int f = 0; f <= 60; ++f) {  // 2 s at 0.5 m/s, straight
+      const std::int64_t t0 = (f - 1) * kFramePeriodNs, t1 = f * kFramePeriodNs;
+      m.add_frame(t1, level_readings(t0, t1, 0),
+                  f == 0 ? std::vector<sensor::WheelTicks>{{0, 0, 0}} : straight_ticks(t0, t1, 0.5, metres_per_tick));
+      if (f == 0) m.take_keyframe_interval();
+    }
+    const KeyframeInterval in = m.take_keyframe_interval();
+    EXPECT_TRUE(in.wheels);
+    return in.wheels ? std::sqrt(in.wheels->covariance()(2, 2) / in.wheels->distance_m()) : 0.0;
+  };
+  // Straight, the yaw variance is the per-metre term alone.
+  EXPECT_NEAR(yaw_sigma_after_a_metre(0.01), 0.01, 1e-6);
+  EXPECT_NEAR(yaw_sigma_after_a_metre(0.001), 0.001, 1e-7);
+}
+
 TEST(MotionIntegrator, KeyframeIntervalsSplitTheReadingsAndGiveTheTilt) {
   const Settings s = robot_settings(sensor::SensorSetup::kCameraImu);
   MotionIntegrator m(s.motion);

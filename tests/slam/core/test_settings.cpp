@@ -553,6 +553,14 @@ TEST(Settings, ReadsImuAndRobotKeysAndTheSensorSetup) {
   EXPECT_EQ(s.motion.robot.drive.ticks_per_rev, 1024);
   EXPECT_DOUBLE_EQ(s.motion.robot.drive.track_m, 0.42);
   EXPECT_NEAR(s.motion.robot.T_base_imu.translation().z(), 0.4, 1e-6);
+  // The wheels' noise keeps its defaults unless set.
+  EXPECT_DOUBLE_EQ(s.motion.robot.wheel_noise.yaw_per_sqrt_m, WheelNoise{}.yaw_per_sqrt_m);
+  const Settings tight = read_settings(temp_copy(
+      "wheels", read_file(tum1()) + kImuKeys + kRobotKeys +
+                    "Robot.WheelNoiseTranslation: 0.01\nRobot.WheelNoiseYaw: 0.001\nRobot.WheelNoiseYawTurn: 0.02\n"));
+  EXPECT_DOUBLE_EQ(tight.motion.robot.wheel_noise.translation_per_sqrt_m, 0.01);
+  EXPECT_DOUBLE_EQ(tight.motion.robot.wheel_noise.yaw_per_sqrt_m, 0.001);
+  EXPECT_DOUBLE_EQ(tight.motion.robot.wheel_noise.yaw_per_sqrt_rad, 0.02);
 }
 
 TEST(Settings, SensorSetupWithoutItsKeysOrWithABadExtrinsicIsOneConfigError) {
@@ -578,6 +586,11 @@ TEST(Settings, SensorSetupWithoutItsKeysOrWithABadExtrinsicIsOneConfigError) {
   EXPECT_NE(error_of("s6", base + kImuKeys + "IMU.AccNoiseInflation: 0.5\n").find("IMU.AccNoiseInflation"),
             std::string::npos);
   EXPECT_NE(error_of("s7", base + kImuKeys + "IMU.AccWalkInflation: 2000\n").find("IMU.AccWalkInflation"),
+            std::string::npos);
+  EXPECT_NE(error_of("s8", base + kImuKeys + kRobotKeys + "Robot.WheelNoiseYaw: 0\n").find("Robot.WheelNoiseYaw"),
+            std::string::npos);
+  EXPECT_NE(error_of("s9", base + kImuKeys + kRobotKeys + "Robot.WheelNoiseTranslation: -1\n")
+                .find("Robot.WheelNoiseTranslation"),
             std::string::npos);
   // With a setup that needs them, a flag's choice is checked the same way.
   MotionSensorSettings plain = read_settings(tum1()).motion;

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "pvb/geometry/se3.hpp"
+#include "pvb/slam/inertial/wheel_preintegration.hpp"
 #include "pvb/sensor/motion.hpp"
 
 namespace pvb::slam {
@@ -47,6 +48,11 @@ struct RobotSettings {
   double encoder_rate_hz = 50;     ///< Robot.EncoderFrequency
   geom::SE3d T_base_c = geom::SE3d::Identity();    ///< Robot.T_base_c1: the camera in the base frame
   geom::SE3d T_base_imu = geom::SE3d::Identity();  ///< Robot.T_base_imu
+  /// Robot.WheelNoiseTranslation, WheelNoiseYaw, WheelNoiseYawTurn (ours,
+  /// optional): what the wheel increments are weighed with. The defaults
+  /// suit wheels whose radii may differ by a few tenths of a percent;
+  /// wheels of equal radius hold their heading far better on a straight.
+  WheelNoise wheel_noise;
 };
 
 /// The motion sensors a system fuses and what the settings say of them.
