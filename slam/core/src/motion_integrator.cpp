@@ -11,16 +11,15 @@ MotionIntegrator::MotionIntegrator(const MotionSensorSettings& sensors)
       robot_(sensors.robot),
       period_ns_(static_cast<std::int64_t>(std::llround(1e9 / sensors.imu.rate_hz))),
       encoder_period_ns_(static_cast<std::int64_t>(std::llround(1e9 / sensors.robot.encoder_rate_hz))),
-      wheel_noise_(sensors.robot.wheel_noise),
       imu_frame_(ImuBias{}, imu_noise_),
       imu_kf_(ImuBias{}, imu_noise_),
-      wheel_frame_(sensors.robot.drive, wheel_noise_),
-      wheel_kf_(sensors.robot.drive, wheel_noise_) {}
+      wheel_frame_(sensors.robot.drive, sensors.robot.wheel_noise),
+      wheel_kf_(sensors.robot.drive, sensors.robot.wheel_noise) {}
 
 void MotionIntegrator::add_frame(std::int64_t t_ns, const std::vector<sensor::ImuSample>& imu,
                                  const std::vector<sensor::WheelTicks>& ticks) {
   imu_frame_ = ImuPreintegration(bias_, imu_noise_);
-  wheel_frame_ = WheelPreintegration(robot_.drive, wheel_noise_);
+  wheel_frame_ = WheelPreintegration(robot_.drive, robot_.wheel_noise);
   if (uses_accel(setup_))
     for (const auto& s : imu) add_imu(s);
   if (uses_imu(setup_)) integrate_up_to(t_ns);
@@ -100,7 +99,7 @@ KeyframeInterval MotionIntegrator::take_keyframe_interval() {
   out.f_c_mps2 = recent_specific_force_c();
   out.f_spread_mps2 = recent_spread_mps2();
   imu_kf_ = ImuPreintegration(bias_, imu_noise_);
-  wheel_kf_ = WheelPreintegration(robot_.drive, wheel_noise_);
+  wheel_kf_ = WheelPreintegration(robot_.drive, robot_.wheel_noise);
   return out;
 }
 

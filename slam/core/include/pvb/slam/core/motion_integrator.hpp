@@ -84,7 +84,6 @@ class MotionIntegrator {
   RobotSettings robot_;
   std::int64_t period_ns_;          ///< the IMU's reading period
   std::int64_t encoder_period_ns_;  ///< the encoders' reading period
-  WheelNoise wheel_noise_;
   ImuBias bias_;
   ImuPreintegration imu_frame_, imu_kf_;
   WheelPreintegration wheel_frame_, wheel_kf_;
