@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <numeric>
 
 #include "pvb/common/text.hpp"
@@ -118,10 +119,48 @@ std::string dense_map_json(const DenseMapReport& d, const std::string& in) {
   return out + "}";
 }
 
+namespace {
+
+/// "refusals": {"kept", "dropped", "by_reason": {reason: n}, "verified", "verified_true"} and
+/// "refusal_events": [{"t_s", "ref_t_s", "reason", "verified", "correction_m", "drift_bound_m",
+/// "correct", "error_m", "error_deg"}] (the last three null unless verified and judged).
+std::string refusals_json(const PlaceRecognition& p) {
+  std::map<std::string, int> by_reason;
+  std::string events = "[";
+  std::size_t labelled = 0;
+  int verified = 0, verified_true = 0;
+  for (std::size_t i = 0; i < p.refusals.size(); ++i) {
+    const PlaceRecognition::Refusal& r = p.refusals[i];
+    ++by_reason[r.reason];
+    const eval::LabelledPlaceEvent* l = nullptr;
+    if (r.verified && labelled < p.refusal_labels.size()) l = &p.refusal_labels[labelled++];
+    if (l && l->judged) verified_true += l->correct ? 1 : 0;
+    verified += r.verified ? 1 : 0;
+    const bool judged = l && l->judged;
+    events += std::string(i ? ", " : "") + "{\"t_s\": " + json_number(r.event.t_ns * 1e-9, 12) +
+              ", \"ref_t_s\": " + json_number(r.event.ref_t_ns * 1e-9, 12) + ", \"reason\": \"" + r.reason +
+              "\", \"verified\": " + (r.verified ? "true" : "false") +
+              ", \"correction_m\": " + num(r.correction_m) + ", \"drift_bound_m\": " + num(r.drift_bound_m) +
+              ", \"correct\": " + (judged ? (l->correct ? "true" : "false") : "null") +
+              ", \"error_m\": " + (judged ? num(l->error_m) : "null") +
+              ", \"error_deg\": " + (judged ? num(l->error_deg) : "null") + "}";
+  }
+  std::string reasons = "{";
+  for (const auto& [reason, n] : by_reason)
+    reasons += std::string(reasons.size() > 1 ? ", " : "") + "\"" + reason + "\": " + std::to_string(n);
+  return "\"refusals\": {\"kept\": " + std::to_string(p.refusals.size()) +
+         ", \"dropped\": " + std::to_string(p.refusals_dropped) + ", \"by_reason\": " + reasons +
+         "}, \"verified\": " + std::to_string(verified) + ", \"verified_true\": " +
+         (p.refusal_labels.empty() && verified > 0 ? std::string("null") : std::to_string(verified_true)) +
+         "}, \"refusal_events\": " + events + "]";
+}
+
+}  // namespace
+
 std::string place_json(const PlaceRecognition& p) {
   std::string out = "{\"loops_proposed\": " + std::to_string(p.loops_proposed) +
                     ", \"loops_accepted\": " + std::to_string(p.loops_accepted) +
-                    ", \"relocalisations\": " + std::to_string(p.relocalisations);
+                    ", \"relocalisations\": " + std::to_string(p.relocalisations) + ", " + refusals_json(p);
   if (p.labels) {
     const std::string labels = eval::to_json(*p.labels, p.label_options);  // "{...}": merged into this object
     out += ", " + labels.substr(1, labels.size() - 2);

@@ -224,6 +224,7 @@ std::string to_json(const LoopClosingStats& stats) {
          ", \"refused_ransac\": " + std::to_string(stats.refused_ransac) +
          ", \"refused_inliers\": " + std::to_string(stats.refused_inliers) +
          ", \"refused_correction\": " + std::to_string(stats.refused_correction) +
+         ", \"refusals\": " + std::to_string(stats.refusals.size() + static_cast<std::size_t>(stats.refusals_dropped)) +
          ", \"verify_ms_total\": " + num(stats.verify_ms_total) +
          ", \"detect_ms_median\": " + num(quantile(stats.detect_ms, 0.5)) +
          ", \"detect_ms_p95\": " + num(quantile(stats.detect_ms, 0.95)) + ", \"detect_ms_total\": " +
@@ -317,66 +318,102 @@ double LoopClosing::drift_bound_m(const KeyFrame& kf, const KeyFrame& cand, doub
   return options_.drift_floor_m + options_.max_drift_rate * path_length_m(cand.id(), kf.id()) + swing_m;
 }
 
+namespace {
+
+/// What refused `cand` for `kf`; a verified candidate carries its pose.
+LoopRefusal refusal_of(const KeyFrame& kf, const KeyFrame& cand, const char* reason, const LoopMatch& m,
+                       bool verified, double dist_m = 0, double angle_deg = 0, double bound_m = 0) {
+  LoopRefusal r;
+  r.keyframe_id = kf.id();
+  r.loop_keyframe_id = cand.id();
+  r.t_ns = kf.t_ns();
+  r.loop_t_ns = cand.t_ns();
+  r.reason = reason;
+  r.verified = verified;
+  if (verified) r.T_cur_loop = m.T_c_w * cand.T_c_w().inverse();
+  r.inliers = m.inliers;
+  r.correction_m = dist_m;
+  r.correction_deg = angle_deg;
+  r.drift_bound_m = bound_m;
+  return r;
+}
+
+}  // namespace
+
 std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& kf,
                                               const std::vector<std::shared_ptr<KeyFrame>>& consistent,
                                               bool merge, LoopMatch* best) {
+  static constexpr const char* kStageNames[3] = {"matches", "ransac", "inliers"};
   std::shared_ptr<KeyFrame> loop_kf;
   std::vector<Eigen::Vector3d> verified_centres_w;
-  int drift = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  std::array<int, 3> refused_at{};  // by LoopMatch::Stage: matches, RANSAC, inliers
-  int verified = 0, refused_correction = 0;
-  double best_dist_m = 0;
+  VerifyTally tally;
+  double best_dist_m = 0, best_angle_deg = 0;
+  // The candidate that got furthest (rank: geometry's stage, then the caps, then the drift bound).
+  const auto refuse = [&](int rank, LoopRefusal r) {
+    if (rank > tally.refusal_rank) tally.refusal_rank = rank, tally.refusal = std::move(r);
+  };
   for (const auto& cand : consistent) {
-    ++verified;
+    ++tally.verified;
     LoopMatch m = verify_loop(*kf, cand, options_);
     if (!m.accepted) {
-      ++refused_at[static_cast<std::size_t>(m.stage)];
+      const auto stage = static_cast<std::size_t>(m.stage);
+      ++tally.refused_at[stage];
+      refuse(static_cast<int>(stage), refusal_of(*kf, *cand, kStageNames[stage], m, false));
       continue;
     }
     double dist_m = 0, angle_deg = 0;
     pose_difference(m.T_c_w, kf->T_c_w(), &dist_m, &angle_deg);
     if (!merge && (dist_m > options_.max_correction_m || angle_deg > options_.max_correction_deg)) {
-      ++refused_correction;
+      ++tally.refused_correction;
+      refuse(3, refusal_of(*kf, *cand, "correction", m, true, dist_m, angle_deg));
       continue;
     }
     verified_centres_w.push_back(m.T_c_w.inverse().translation());
     const double bound_m = drift_bound_m(*kf, *cand, angle_deg);
     if (!merge && options_.max_drift_rate > 0 && dist_m > bound_m) {
-      ++drift;
+      ++tally.drift;
+      refuse(4, refusal_of(*kf, *cand, "drift", m, true, dist_m, angle_deg, bound_m));
       continue;
     }
     if (!loop_kf || m.inliers > best->inliers) {
       *best = std::move(m);
       loop_kf = cand;
       best_dist_m = dist_m;
+      best_angle_deg = angle_deg;
     }
     if (!options_.ambiguity_check) break;  // ORB-SLAM2: the first verified candidate
   }
-  const bool large = !merge && loop_kf && best_dist_m > options_.lookalike_check_above_m;
-  if (loop_kf && (merge || large) && options_.ambiguity_check && place_)
+  tally.lookalike_checked = !merge && loop_kf && best_dist_m > options_.lookalike_check_above_m;
+  if (loop_kf && (merge || tally.lookalike_checked) && options_.ambiguity_check && place_)
     add_lookalikes(*place_, map_, options_, *kf, consistent, merge ? 0 : map_.map_of(*kf),
                    merge ? std::function<bool(std::uint64_t)>{}
                          : own_neighbourhood(*kf, kf->best_covisibles(-1), options_.min_keyframe_gap),
                    &verified_centres_w);
-  bool ambiguous = false;
   for (std::size_t i = 0; i < verified_centres_w.size() && options_.ambiguity_check; ++i)
     for (std::size_t j = i + 1; j < verified_centres_w.size(); ++j)
-      ambiguous = ambiguous || (verified_centres_w[i] - verified_centres_w[j]).norm() > options_.ambiguity_distance_m;
+      tally.ambiguous = tally.ambiguous || (verified_centres_w[i] - verified_centres_w[j]).norm() > options_.ambiguity_distance_m;
+  if (tally.ambiguous && loop_kf)
+    tally.refusal = refusal_of(*kf, *loop_kf, "ambiguous", *best, true, best_dist_m, best_angle_deg);
+  tally.verify_ms = ms_since(t0);
+  add_tally(tally, loop_kf != nullptr);
+  return tally.ambiguous ? nullptr : loop_kf;
+}
+
+void LoopClosing::add_tally(const VerifyTally& t, bool found) {
   std::lock_guard<std::mutex> s(stats_mutex_);
-  stats_.verified += verified;
-  stats_.refused_matches += refused_at[0];
-  stats_.refused_ransac += refused_at[1];
-  stats_.refused_inliers += refused_at[2];
-  stats_.refused_correction += refused_correction;
-  stats_.lookalike_checked += large ? 1 : 0;
-  stats_.verify_ms_total += ms_since(t0);
-  if (ambiguous) {
-    ++stats_.refused_ambiguous;
-    return nullptr;
-  }
-  if (!loop_kf && drift > 0) ++stats_.refused_drift;
-  return loop_kf;
+  stats_.verified += t.verified;
+  stats_.refused_matches += t.refused_at[0];
+  stats_.refused_ransac += t.refused_at[1];
+  stats_.refused_inliers += t.refused_at[2];
+  stats_.refused_correction += t.refused_correction;
+  stats_.lookalike_checked += t.lookalike_checked ? 1 : 0;
+  stats_.verify_ms_total += t.verify_ms;
+  if (t.ambiguous) ++stats_.refused_ambiguous;
+  if (!found && t.drift > 0) ++stats_.refused_drift;
+  if (!t.ambiguous && (found || t.refusal_rank < 0)) return;
+  if (stats_.refusals.size() < LoopClosingStats::kMaxRefusals) stats_.refusals.push_back(t.refusal);
+  else ++stats_.refusals_dropped;
 }
 
 std::shared_ptr<KeyFrame> LoopClosing::find(const std::shared_ptr<KeyFrame>& kf, LoopMatch* best, bool* merge,

@@ -335,5 +335,39 @@ TEST(RunReport, PlaceRecognitionInMetricsAndReport) {
   EXPECT_NE(index_html(r, {}).find("<th>loops true / false / missed</th><td>1 / 1 / 0"), std::string::npos);
 }
 
+TEST(RunReport, RefusedLoopsAreCountedByCheckAndTheVerifiedOnesJudged) {
+  RunReport r = hand_report();
+  PlaceRecognition p;
+  p.refusals.push_back({{10'000'000'000, 1'000'000'000, geom::SE3d::Identity()}, "inliers", false, 0, 0});
+  p.refusals.push_back({{20'000'000'000, 2'000'000'000, geom::SE3d::Identity()}, "drift", true, 2.5, 1.9});
+  p.refusals.push_back({{30'000'000'000, 3'000'000'000, geom::SE3d::Identity()}, "drift", true, 6.0, 2.0});
+  p.refusals_dropped = 7;
+  r.primary.place = p;
+  YAML::Node m = YAML::Load(metrics_json(r))["place_recognition"];
+  EXPECT_EQ(m["refusals"]["kept"].as<int>(), 3);
+  EXPECT_EQ(m["refusals"]["dropped"].as<int>(), 7);
+  EXPECT_EQ(m["refusals"]["by_reason"]["drift"].as<int>(), 2);
+  EXPECT_EQ(m["refusals"]["by_reason"]["inliers"].as<int>(), 1);
+  EXPECT_EQ(m["refusals"]["verified"].as<int>(), 2);
+  EXPECT_TRUE(m["refusals"]["verified_true"].IsNull());  // no ground truth yet
+  ASSERT_EQ(m["refusal_events"].size(), 3u);
+  EXPECT_EQ(m["refusal_events"][1]["reason"].as<std::string>(), "drift");
+  EXPECT_NEAR(m["refusal_events"][1]["drift_bound_m"].as<double>(), 1.9, 1e-9);
+  EXPECT_TRUE(m["refusal_events"][1]["correct"].IsNull());
+
+  // With ground truth: the first verified refusal was a true loop thrown away, the second a look-alike.
+  eval::LabelledPlaceEvent right, wrong;
+  right.judged = wrong.judged = true;
+  right.correct = true;
+  wrong.error_m = 4.1;
+  r.primary.place->refusal_labels = {right, wrong};
+  m = YAML::Load(metrics_json(r))["place_recognition"];
+  EXPECT_EQ(m["refusals"]["verified_true"].as<int>(), 1);
+  EXPECT_TRUE(m["refusal_events"][0]["correct"].IsNull());  // refused before verification: not judged
+  EXPECT_TRUE(m["refusal_events"][1]["correct"].as<bool>());
+  EXPECT_FALSE(m["refusal_events"][2]["correct"].as<bool>());
+  EXPECT_NEAR(m["refusal_events"][2]["error_m"].as<double>(), 4.1, 1e-9);
+}
+
 }  // namespace
 }  // namespace pvb::run

@@ -283,6 +283,17 @@ TEST(LoopClosing, CountsAVerifiedPlaceBeyondTheCorrectionBound) {
   EXPECT_EQ(s.refused_correction, 1);
   EXPECT_EQ(s.refused_matches + s.refused_ransac + s.refused_inliers, 0);
   EXPECT_EQ(s.rejected, 1);
+  // The refusal names its check and keeps the verified pose for ground truth to judge.
+  ASSERT_EQ(s.refusals.size(), 1u);
+  const LoopRefusal& r = s.refusals[0];
+  EXPECT_EQ(r.reason, "correction");
+  EXPECT_TRUE(r.verified);
+  EXPECT_EQ(r.keyframe_id, kf1->id());
+  EXPECT_EQ(r.loop_keyframe_id, 0u);
+  EXPECT_GT(r.correction_m, 0.001);
+  // The first keyframe was placed true, so the verified relative pose is the true one.
+  const geom::SE3d T_true = T * pose(0, 0, 0).inverse();
+  EXPECT_LT((r.T_cur_loop.translation() - T_true.translation()).norm(), 0.01);
 }
 
 /// The estimate of a camera whose tracking drifted by `deg` in rotation:
@@ -318,6 +329,7 @@ TEST(LoopClosing, DriftBoundAllowsTheSwingOfARotationDrift) {
   const LoopClosingStats s = close_twice(map, kf1);
   EXPECT_EQ(s.refused_drift, 0);
   ASSERT_EQ(s.loops.size(), 1u);
+  EXPECT_TRUE(s.refusals.empty());  // a closed loop is no refusal
   EXPECT_NEAR(s.loops[0].correction_deg, 4.0, 0.5);
   EXPECT_LT(centre_error_m(kf1->T_c_w(), T), 0.005);
 }
@@ -336,6 +348,10 @@ TEST(LoopClosing, DriftBoundRefusesTheSameCentreMoveWithoutATurn) {
   EXPECT_EQ(s.verified, 1);
   EXPECT_EQ(s.refused_drift, 1);
   EXPECT_TRUE(s.loops.empty());
+  ASSERT_EQ(s.refusals.size(), 1u);
+  EXPECT_EQ(s.refusals[0].reason, "drift");
+  EXPECT_NEAR(s.refusals[0].correction_m, 0.14, 0.01);
+  EXPECT_LT(s.refusals[0].drift_bound_m, s.refusals[0].correction_m);
 }
 
 /// A wall whose texture repeats every 2 m along x: the views from x and
@@ -401,6 +417,9 @@ TEST(LoopClosing, ALargeCorrectionIsRefusedWhenTheViewVerifiesAtALookalike) {
   EXPECT_EQ(checked.lookalike_checked, 1);
   EXPECT_EQ(checked.refused_ambiguous, 1);
   EXPECT_TRUE(checked.loops.empty());
+  ASSERT_EQ(checked.refusals.size(), 1u);
+  EXPECT_EQ(checked.refusals[0].reason, "ambiguous");
+  EXPECT_NEAR(checked.refusals[0].correction_m, 0.8, 0.02);
   const LoopClosingStats unchecked = run(10000);
   EXPECT_EQ(unchecked.lookalike_checked, 0);
   EXPECT_EQ(unchecked.loops.size(), 1u);

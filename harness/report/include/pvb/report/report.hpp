@@ -90,6 +90,18 @@ struct PlaceRecognition {
   int loops_accepted = 0;   ///< loops closed
   int relocalisations = 0;
   std::vector<eval::PlaceEvent> loops, relocalisation_events;  ///< as the system reported them
+  /// Consistent detections the checks refused (the first ones kept by the
+  /// system), each with the check; `verified` ones carry their pose and
+  /// are judged like loops: a correct one is a true loop thrown away.
+  struct Refusal {
+    eval::PlaceEvent event;
+    std::string reason;
+    bool verified = false;
+    double correction_m = 0, drift_bound_m = 0;
+  };
+  std::vector<Refusal> refusals;
+  int refusals_dropped = 0;
+  std::vector<eval::LabelledPlaceEvent> refusal_labels;  ///< verified refusals, with ground truth
   std::vector<std::int64_t> keyframe_t_ns;                     ///< every keyframe made, in order
   eval::PlaceLabelOptions label_options;
   std::optional<eval::PlaceLabels> labels;  ///< with ground truth

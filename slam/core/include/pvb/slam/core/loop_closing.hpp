@@ -54,6 +54,7 @@
 // correction is implausible for the path driven or when two candidates
 // verify at different places (docs/place_recognition.md).  Pose proximity
 // only works while the drift is small compared with the search radius.
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -154,6 +155,16 @@ class LoopClosing {
   std::shared_ptr<KeyFrame> verify(const std::shared_ptr<KeyFrame>& kf,
                                    const std::vector<std::shared_ptr<KeyFrame>>& consistent, bool merge,
                                    LoopMatch* best);
+  /// What one verify() saw, added to the stats at its end.
+  struct VerifyTally {
+    int verified = 0, refused_correction = 0, drift = 0;
+    std::array<int, 3> refused_at{};  ///< by LoopMatch::Stage: matches, RANSAC, inliers
+    bool lookalike_checked = false, ambiguous = false;
+    double verify_ms = 0;
+    int refusal_rank = -1;  ///< how far the furthest refused candidate got (-1: none refused)
+    LoopRefusal refusal;
+  };
+  void add_tally(const VerifyTally& t, bool found);
   /// Camera path length (current estimates) over the keyframes from `from` to `to` by id.
   double path_length_m(std::uint64_t from, std::uint64_t to) const;
   /// The drift bound on moving `kf`'s camera centre to close a loop with

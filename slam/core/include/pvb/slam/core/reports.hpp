@@ -189,8 +189,25 @@ struct LoopEvent {
   bool merge = false;         ///< a provisional map merged into the map (correction_m: how far it moved)
 };
 
+/// A consistent detection that closed no loop: the candidate that got
+/// furthest through the checks, and the check that refused it.
+struct LoopRefusal {
+  std::uint64_t keyframe_id = 0, loop_keyframe_id = 0;
+  std::int64_t t_ns = 0, loop_t_ns = 0;
+  /// "matches", "ransac", "inliers" (geometry), "correction" (the hard
+  /// caps), "drift" (the drift bound) or "ambiguous" (verified at two places).
+  std::string reason;
+  bool verified = false;  ///< it passed geometry: T_cur_loop and the correction are its own
+  geom::SE3d T_cur_loop;  ///< as LoopEvent's (verified only)
+  int inliers = 0;
+  double correction_m = 0, correction_deg = 0;
+  double drift_bound_m = 0;  ///< the bound a "drift" refusal exceeded
+};
+
 /// Running totals (all keyframes).
 struct LoopClosingStats {
+  /// Refusals are kept up to this many; later ones are only counted.
+  static constexpr std::size_t kMaxRefusals = 5000;
   std::vector<LoopEvent> loops;
   int keyframes = 0;              ///< keyframes examined
   int candidates = 0;             ///< pose candidates that passed the appearance check
@@ -211,6 +228,8 @@ struct LoopClosingStats {
   double verify_ms_total = 0;     ///< the part of detect_ms_total spent in step 3
   double detect_ms_total = 0;     ///< all detection work
   std::vector<double> detect_ms;  ///< detection and verification per keyframe examined
+  std::vector<LoopRefusal> refusals;  ///< the first kMaxRefusals consistent detections refused
+  int refusals_dropped = 0;           ///< refused past kMaxRefusals
 };
 
 /// The stats as one JSON object for stats.json / metrics.json:
