@@ -198,6 +198,7 @@ void read_robot(MapReader& r, Robot& rb) {
     rb.max_wheel_accel_radps2 = r.number("max_wheel_accel_radps2", 0, 0.1, 1000);
   rb.radius_error = r.number("radius_error", rb.radius_error, 0, 0.2);
   rb.track_error = r.number("track_error", rb.track_error, 0, 0.2);
+  rb.radius_difference = r.number("radius_difference", rb.radius_difference, -0.05, 0.05);
 }
 
 /// The camera.stereo: section (the d435 model).

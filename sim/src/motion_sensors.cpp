@@ -81,7 +81,7 @@ MotionSensors::MotionSensors(const mjModel* m, const scenes::Scenario& s, int ro
       wheel_steps_(static_cast<int>(std::lround(scenes::physics_rate_hz(s) / wheel_rate_hz_))),
       free_qpos_(m->jnt_qposadr[m->body_jntadr[robot_body]]),
       free_dof_(m->jnt_dofadr[m->body_jntadr[robot_body]]),
-      wheel_radius_m_(s.robot.wheel_radius_m),
+      wheel_radius_m_{s.robot.left_radius_m(), s.robot.right_radius_m()},
       track_m_(s.robot.track_m),
       ticks_per_rev_(s.wheels.ticks_per_rev),
       gyro_noise_(s.imu.gyro, 1.0 / imu_rate_hz_, s.seed, 0x1A0001),
@@ -169,7 +169,7 @@ void MotionSensors::emit_wheels(const mjData* d) {
     truth.wheel_radps[side] = wheel;
     truth.ground_mps[side] = ground;
     truth.commanded_radps[side] = wheel_act_[side] >= 0 ? d->ctrl[wheel_act_[side]] : 0.0;
-    const double rolled = wheel * wheel_radius_m_;
+    const double rolled = wheel * wheel_radius_m_[side];
     truth.slip[side] = (rolled - ground) / std::max({std::abs(rolled), std::abs(ground), 1e-3});
   }
   out_.ticks.push_back(ticks);

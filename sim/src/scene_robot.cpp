@@ -43,7 +43,8 @@ void add_robot_parts(XmlWriter& x, const scenes::Scenario& s) {
     const std::string n = side == 0 ? kLeftActuator : kRightActuator;
     x.open("<body name=\"" + n + "\" pos=\"" + v3(0, y, 0) + "\">");
     x.line("<joint name=\"" + n + "\" type=\"hinge\" axis=\"0 1 0\" armature=\"0.01\" damping=\"0.02\"/>");
-    x.line("<geom type=\"cylinder\" size=\"" + f(r) + " 0.025\" euler=\"90 0 0\" mass=\"1.5\" condim=\"3\" "
+    const double r_side = side == 0 ? rb.left_radius_m() : rb.right_radius_m();
+    x.line("<geom type=\"cylinder\" size=\"" + f(r_side) + " 0.025\" euler=\"90 0 0\" mass=\"1.5\" condim=\"3\" "
            "friction=\"1.2 0.01 0.001\" material=\"tyre\"/>");
     x.close("</body>");
   }

@@ -79,6 +79,9 @@ TEST(ScenarioBody, BadInputIsOneLineNamingFileLineAndKey) {
   EXPECT_NE(e.find("wheels.rate_hz"), std::string::npos) << e;
   e = body_error_of("robot: {radius_error: 0.5}\n");
   EXPECT_NE(e.find("robot.radius_error"), std::string::npos) << e;
+  e = body_error_of("robot: {radius_difference: 0.1}\n");
+  EXPECT_NE(e.find("robot.radius_difference"), std::string::npos) << e;
+  EXPECT_NE(e.find("[-0.05, 0.05]"), std::string::npos) << e;
   e = body_error_of("imu: {part: mpu6050}\n");
   EXPECT_NE(e.find("bmi088"), std::string::npos) << e;
   EXPECT_EQ(std::count(e.begin(), e.end(), '\n'), 0) << e;

@@ -34,6 +34,22 @@ std::string biases_json(const BiasComparison& b) {
   return out;
 }
 
+std::string wheels_json(const slam::MapWheels& w, const std::optional<slam::WheelCalibration>& truth) {
+  const auto known = [](bool b) { return std::string(b ? "true" : "false"); };
+  const auto true_num = [&](double slam::WheelCalibration::*f) {
+    return truth ? bias_num((*truth).*f) : std::string("null");
+  };
+  return "{\"left_scale\": " + bias_num(w.calibration.left_scale) +
+         ", \"right_scale\": " + bias_num(w.calibration.right_scale) +
+         ", \"track_scale\": " + bias_num(w.calibration.track_scale) + ", \"radii_known\": " +
+         known(w.radii_known) + ", \"track_known\": " + known(w.track_known) +
+         ", \"intervals\": " + std::to_string(w.intervals) + ", \"refused\": " + std::to_string(w.refused) +
+         ", \"rolled_m\": " + bias_num(w.rolled_m) + ", \"turned_rad\": " + bias_num(w.turned_rad) +
+         ", \"true_left_scale\": " + true_num(&slam::WheelCalibration::left_scale) +
+         ", \"true_right_scale\": " + true_num(&slam::WheelCalibration::right_scale) +
+         ", \"true_track_scale\": " + true_num(&slam::WheelCalibration::track_scale) + "}";
+}
+
 }  // namespace
 
 std::string inertial_json(const InertialReport& r) {
@@ -44,7 +60,8 @@ std::string inertial_json(const InertialReport& r) {
          ", \"gravity_tilt_deg\": " + when(bias_num(r.gravity_tilt_deg)) + ", \"gravity_true_deg\": " +
          (r.gravity_true_deg ? bias_num(*r.gravity_true_deg) : std::string("null")) +
          ", \"init_rms\": " + when(bias_num(r.init_rms)) +
-         ", \"biases\": " + (r.biases ? biases_json(*r.biases) : std::string("null")) + "}";
+         ", \"biases\": " + (r.biases ? biases_json(*r.biases) : std::string("null")) +
+         ", \"wheels\": " + (r.wheels ? wheels_json(*r.wheels, r.wheels_true) : std::string("null")) + "}";
 }
 
 }  // namespace pvb::run

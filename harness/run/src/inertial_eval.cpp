@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <fstream>
 
+#include <yaml-cpp/yaml.h>
+
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 
@@ -118,6 +120,43 @@ std::optional<double> gravity_error_at_deg(const eval::Trajectory& gt, const eva
   const eval::GravityError g = eval::gravity_error(gt, one, down_w, "", estimates);
   if (g.angle_deg.empty()) return std::nullopt;
   return g.angle_deg.front();
+}
+
+slam::WheelCalibration read_wheels_true(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw IoError(path, e.what());
+  }
+  const auto number = [&](const char* key) {
+    const YAML::Node n = root[key];
+    double v = 0;
+    if (!n || !n.IsScalar() || !parse_field(n.as<std::string>(), &v) || !(v > 0))
+      throw IoError(path, std::string(key) + ": expected a positive number");
+    return v;
+  };
+  const double radius = number("effective_wheel_radius_m") / number("nominal_wheel_radius_m");
+  double half = 0;  // radius_difference: written only when the wheels differ
+  if (const YAML::Node d = root["radius_difference"]) {
+    if (!d.IsScalar() || !parse_field(d.as<std::string>(), &half) || std::abs(half) > 0.5)
+      throw IoError(path, "radius_difference: expected a number in [-0.5, 0.5]");
+    half *= 0.5;
+  }
+  return {radius * (1 - half), radius * (1 + half), number("effective_track_m") / number("nominal_track_m")};
+}
+
+std::string wheels_text(const slam::MapWheels& w, const std::optional<slam::WheelCalibration>& truth) {
+  const auto x = [](double v, int digits) { return "x" + format_fixed(v, digits); };
+  std::string out = "wheel calibration over " + std::to_string(w.intervals) + " keyframe intervals (" +
+                    format_fixed(w.rolled_m, 1) + " m rolled, " + format_fixed(w.turned_rad, 1) + " rad turned, " +
+                    std::to_string(w.refused) + " refused): left " + x(w.calibration.left_scale, 5) + ", right " +
+                    x(w.calibration.right_scale, 5) + (w.radii_known ? "" : " (not yet observed)") + ", track " +
+                    x(w.calibration.track_scale, 4) + (w.track_known ? "" : " (not yet observed)");
+  if (truth)
+    out += "; the robot: " + x(truth->left_scale, 5) + ", " + x(truth->right_scale, 5) + ", track " +
+           x(truth->track_scale, 4);
+  return out + "\n";
 }
 
 InertialReport inertial_report(const slam::MapGravity& g, std::int64_t t0_ns) {

@@ -22,7 +22,11 @@ std::string robot_truth_yaml(const scenes::Scenario& s, const sim::DriveKinemati
          "nominal_wheel_radius_m: " + format_real(nominal.wheel_radius_m) + "\n"
          "nominal_track_m: " + format_real(nominal.track_m) + "\n"
          "radius_error: " + format_real(nominal.wheel_radius_m / s.robot.wheel_radius_m - 1) + "  # nominal / built - 1\n"
-         "track_error: " + format_real(nominal.track_m / s.robot.track_m - 1) + "\n";
+         "track_error: " + format_real(nominal.track_m / s.robot.track_m - 1) + "\n" +
+         (s.robot.radius_difference != 0
+              ? "radius_difference: " + format_real(s.robot.radius_difference) +
+                    "  # the right wheel's radius over the left's, less one, as built\n"
+              : std::string());
 }
 
 }  // namespace

@@ -93,6 +93,16 @@ void OfflineSlam::Impl::evaluate_inertial(std::ostringstream* js) {
       warn(std::string("warning: biases not compared: ") + e.what());
     }
   }
+  if (system_->calibrates_wheels()) {
+    r.wheels = system_->wheels();
+    const std::string robot_truth = a_.sequence + "/robot_truth.yaml";
+    try {
+      if (std::ifstream(robot_truth)) r.wheels_true = read_wheels_true(robot_truth);
+    } catch (const IoError& e) {
+      warn(std::string("warning: wheel calibration not compared: ") + e.what());
+    }
+    text(wheels_text(*r.wheels, r.wheels_true));
+  }
   const std::string truth =
       r.gravity_true_deg ? strf(", %.2f deg off the true down (ground truth)", *r.gravity_true_deg) : "";
   text(

@@ -125,7 +125,16 @@ class GroundTruthSink {
         "# timestamp tx ty tz qx qy qz qw (T_w_c: camera optical frame in the site frame, ground truth)\n");
     trajectory_.source = dir + "/groundtruth.txt";
   }
-  void started(const SimInfo& info) { write_robot_truth(dir_, scenario_, info.kinematics); }
+  void started(const SimInfo& info) {
+    write_robot_truth(dir_, scenario_, info.kinematics);
+    const sensor::DriveDescription described = sim::nominal_description(scenario_);
+    const double radius = info.kinematics.wheel_radius_m / described.wheel_radius_m;
+    const double half = 0.5 * scenario_.robot.radius_difference;
+    wheels_true_ = slam::WheelCalibration{radius * (1 - half), radius * (1 + half),
+                                          info.kinematics.track_m / described.track_m};
+  }
+  /// The simulated robot's effective radius and track over its description.
+  const std::optional<slam::WheelCalibration>& wheels_true() const { return wheels_true_; }
   void add(const FrameItem& item) {
     file_.append(geom::format_tum_line(item.gt) + "\n");
     trajectory_.poses.push_back(item.gt);
@@ -149,6 +158,7 @@ class GroundTruthSink {
   MotionReportBuilder motion_report_;
   eval::Trajectory trajectory_;
   std::vector<BiasTruth> bias_truth_;
+  std::optional<slam::WheelCalibration> wheels_true_;
 };
 
 /// Stage times the consumer adds up: the producer's, from each frame, and
@@ -495,7 +505,7 @@ RunReport run_scenario(const RunOptions& opt) {
   fail_if_never_initialised(sinks.front()->run, report, log);
   gt.close();
   const double eval_ms = evaluate_systems(sinks, gt.trajectory());
-  for (auto& sink : sinks) sink->evaluate_inertial(gt.bias_truth());
+  for (auto& sink : sinks) sink->evaluate_inertial(gt.bias_truth(), gt.wheels_true());
   evaluate_blind_stretch(scenario, sinks, gt.trajectory(), log);
   if (!opt.map.save_path.empty()) log.line("saving the map to " + opt.map.save_path);
   for (auto& sink : sinks) sink->finish_map(gt.trajectory(), scenario.name, opt.scenario_file);

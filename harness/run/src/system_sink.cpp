@@ -247,7 +247,8 @@ void SystemSink::evaluate_gravity(const eval::Trajectory& gt) {
     gravity_true_deg = gravity_error_at_deg(gt, est, geom::Vec3d(0, 0, -1), gravity_estimates, g.ready_t_ns);
 }
 
-void SystemSink::evaluate_inertial(const std::vector<BiasTruth>& truth) {
+void SystemSink::evaluate_inertial(const std::vector<BiasTruth>& truth,
+                                   const std::optional<slam::WheelCalibration>& wheels_true) {
   const sensor::SensorSetup setup = system->sensors();
   if (!sensor::uses_accel(setup)) return;
   const std::int64_t t0_ns = first_t_ns.value_or(0);
@@ -258,6 +259,10 @@ void SystemSink::evaluate_inertial(const std::vector<BiasTruth>& truth) {
     kfs.push_back({k.id, k.t_ns, k.bias});
   if (!truth.empty() && !kfs.empty())
     r.biases = compare_biases(std::move(kfs), truth, t0_ns, sensor::uses_imu(setup));
+  if (system->calibrates_wheels()) {
+    r.wheels = system->wheels();
+    r.wheels_true = wheels_true;
+  }
   run.inertial = std::move(r);
 }
 

@@ -69,7 +69,10 @@ struct SystemSink {
   void evaluate(const eval::Trajectory& gt);
   /// A setup with an IMU: the inertial state (run.inertial) after finish(),
   /// its keyframes' biases against `truth` when it is not empty.
-  void evaluate_inertial(const std::vector<BiasTruth>& truth);
+  /// The inertial state and biases against `truth`; the wheels' online
+  /// calibration against `wheels_true` where given.
+  void evaluate_inertial(const std::vector<BiasTruth>& truth,
+                         const std::optional<slam::WheelCalibration>& wheels_true = std::nullopt);
   /// The localisation in a loaded map against `gt`, and the final map
   /// saved when the options say so (run::finish_map).
   void finish_map(const eval::Trajectory& gt, const std::string& scenario, const std::string& scenario_file);

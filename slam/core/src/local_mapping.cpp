@@ -60,7 +60,11 @@ bool is_redundant_keyframe(const KeyFrame& kf, double th_depth_m, double ratio, 
 }
 
 LocalMapping::LocalMapping(Map& map, std::shared_ptr<const CameraModel> cam, const LocalMappingOptions& options)
-    : map_(map), cam_(std::move(cam)), options_(options) {}
+    : map_(map), cam_(std::move(cam)), options_(options) {
+  const RobotSettings& robot = options_.motion.robot;
+  if (uses_wheels(options_.motion.setup) && robot.wheel_calibration.enabled)
+    wheel_calibrator_.emplace(robot.drive.track_m, robot.wheel_calibration);
+}
 
 LocalMapping::~LocalMapping() { stop(); }
 
@@ -150,6 +154,7 @@ void LocalMapping::process(const std::shared_ptr<KeyFrame>& kf) {
     cull_keyframes(kf);
   }
   if (options_.motion.setup != sensor::SensorSetup::kCamera) initialize_inertial(kf);
+  if (wheel_calibrator_) calibrate_wheels(kf);
   if (options_.align_patches) {
     std::lock_guard<std::mutex> lock(map_.mutex());
     release_pyramids(kf);

@@ -174,4 +174,34 @@ bool LocalMapping::may_cull_in_time(const KeyFrame& kf) const {
   return !prev || seconds_between(*prev, *next) <= options_.max_inertial_gap_s;
 }
 
+void LocalMapping::calibrate_wheels(const std::shared_ptr<KeyFrame>& kf) {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  std::shared_ptr<KeyFrame> to = kf;
+  for (int i = 0; i < kWheelLag && to; ++i) to = to->motion().prev.lock();
+  if (!to || to->bad() || to->id() <= wheels_fitted_to_) return;
+  wheels_fitted_to_ = to->id();
+  const std::shared_ptr<KeyFrame> from = to->motion().prev.lock();
+  const std::shared_ptr<const WheelPreintegration> wheels = to->motion().from_prev.wheels;
+  // Across a provisional map's edge or a long gap the poses say nothing of the wheels.
+  if (!from || from->bad() || !wheels || map_.map_of(*from) != map_.map_of(*to) ||
+      seconds_between(*from, *to) > options_.max_inertial_gap_s)
+    return;
+  const geom::SE3d& T_base_c = options_.motion.robot.T_base_c;
+  const geom::SE3d T_from_to = T_base_c * from->T_c_w() * to->T_c_w().inverse() * T_base_c.inverse();
+  const Eigen::Matrix3d& R = T_from_to.linear();
+  const double yaw_rad = std::atan2(R(1, 0), R(0, 0));
+  // The arc along the chord, as wheel_step lays it: at half the turn.
+  const Eigen::Vector3d& t = T_from_to.translation();
+  const double arc_m = t.x() * std::cos(0.5 * yaw_rad) + t.y() * std::sin(0.5 * yaw_rad);
+  wheel_calibrator_->add(wheels->described_left_m(), wheels->described_right_m(), arc_m, yaw_rad);
+  MapWheels& w = map_.wheels();
+  w.calibration = wheel_calibrator_->estimate();
+  w.radii_known = wheel_calibrator_->radii_known();
+  w.track_known = wheel_calibrator_->track_known();
+  w.intervals = wheel_calibrator_->intervals();
+  w.refused = wheel_calibrator_->refused();
+  w.rolled_m = wheel_calibrator_->rolled_m();
+  w.turned_rad = wheel_calibrator_->turned_rad();
+}
+
 }  // namespace pvb::slam

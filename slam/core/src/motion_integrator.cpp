@@ -19,7 +19,7 @@ MotionIntegrator::MotionIntegrator(const MotionSensorSettings& sensors)
 void MotionIntegrator::add_frame(std::int64_t t_ns, const std::vector<sensor::ImuSample>& imu,
                                  const std::vector<sensor::WheelTicks>& ticks) {
   imu_frame_ = ImuPreintegration(bias_, imu_noise_);
-  wheel_frame_ = WheelPreintegration(robot_.drive, robot_.wheel_noise);
+  wheel_frame_ = WheelPreintegration(robot_.drive, robot_.wheel_noise, wheel_calibration_);
   if (uses_accel(setup_))
     for (const auto& s : imu) add_imu(s);
   if (uses_imu(setup_)) integrate_up_to(t_ns);
@@ -99,8 +99,15 @@ KeyframeInterval MotionIntegrator::take_keyframe_interval() {
   out.f_c_mps2 = recent_specific_force_c();
   out.f_spread_mps2 = recent_spread_mps2();
   imu_kf_ = ImuPreintegration(bias_, imu_noise_);
-  wheel_kf_ = WheelPreintegration(robot_.drive, robot_.wheel_noise);
+  wheel_kf_ = WheelPreintegration(robot_.drive, robot_.wheel_noise, wheel_calibration_);
   return out;
+}
+
+void MotionIntegrator::set_wheel_calibration(const WheelCalibration& c) {
+  wheel_calibration_ = c;
+  const auto unmoved = [](const WheelPreintegration& w) { return w.distance_m() == 0 && w.turn_rad() == 0; };
+  if (unmoved(wheel_frame_)) wheel_frame_ = WheelPreintegration(robot_.drive, robot_.wheel_noise, c);
+  if (unmoved(wheel_kf_)) wheel_kf_ = WheelPreintegration(robot_.drive, robot_.wheel_noise, c);
 }
 
 void MotionIntegrator::set_bias(const ImuBias& b) {

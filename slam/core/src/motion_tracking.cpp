@@ -26,6 +26,8 @@ void Tracking::add_motion(std::int64_t t_ns, const std::vector<sensor::ImuSample
   if (g.ready && uses_imu(motion_->setup()) &&
       (g.bias.gyro_radps != motion_->bias().gyro_radps || g.bias.accel_mps2 != motion_->bias().accel_mps2))
     motion_->set_bias(g.bias);
+  if (map_.wheels().calibration != motion_->wheel_calibration())
+    motion_->set_wheel_calibration(map_.wheels().calibration);
   motion_->add_frame(t_ns, imu, ticks);
 }
 

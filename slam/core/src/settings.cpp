@@ -201,6 +201,7 @@ void read_robot(Reader& r, const cv::FileStorage& fs, RobotSettings* robot) {
       r.real("Robot.WheelNoiseTranslation", false, n.translation_per_sqrt_m, above(0, 1), "m/sqrt(m)");
   n.yaw_per_sqrt_m = r.real("Robot.WheelNoiseYaw", false, n.yaw_per_sqrt_m, above(0, 1), "rad/sqrt(m)");
   n.yaw_per_sqrt_rad = r.real("Robot.WheelNoiseYawTurn", false, n.yaw_per_sqrt_rad, above(0, 1), "rad/sqrt(rad)");
+  robot->wheel_calibration.enabled = r.flag("Robot.CalibrateWheels", false, robot->wheel_calibration.enabled);
 }
 
 /// System.Sensors (checked against the sections it needs by the caller).

@@ -416,6 +416,11 @@ MapGravity System::gravity() {
   return map_->gravity();
 }
 
+MapWheels System::wheels() {
+  std::lock_guard<std::mutex> lock(map_->mutex());
+  return map_->wheels();
+}
+
 std::vector<System::KeyFrameState> System::keyframe_states() {
   std::lock_guard<std::mutex> lock(map_->mutex());
   std::vector<KeyFrameState> out;

@@ -32,14 +32,18 @@ Eigen::Vector3d wheel_step(double left_m, double right_m, double track_m) {
   return {ds * std::cos(0.5 * dyaw), ds * std::sin(0.5 * dyaw), dyaw};
 }
 
-WheelPreintegration::WheelPreintegration(const sensor::DriveDescription& drive, const WheelNoise& noise)
-    : drive_(drive), noise_(noise) {
+WheelPreintegration::WheelPreintegration(const sensor::DriveDescription& drive, const WheelNoise& noise,
+                                         const WheelCalibration& calibration)
+    : drive_(drive), noise_(noise), calibration_(calibration) {
   if (!(drive.wheel_radius_m > 0) || !(drive.track_m > 0) || drive.ticks_per_rev <= 0) {
     throw std::invalid_argument("WheelPreintegration: wheel radius, track and ticks per revolution must be positive");
   }
   if (!(noise.translation_per_sqrt_m >= 0) || !(noise.yaw_per_sqrt_m >= 0) || !(noise.yaw_per_sqrt_rad >= 0) ||
       !(noise.planar_z_per_m >= 0) || !(noise.planar_tilt_per_m >= 0) || !(noise.planar_floor > 0)) {
     throw std::invalid_argument("WheelPreintegration: noise terms must be >= 0 and planar_floor > 0");
+  }
+  if (!(calibration.left_scale > 0) || !(calibration.right_scale > 0) || !(calibration.track_scale > 0)) {
+    throw std::invalid_argument("WheelPreintegration: calibration factors must be positive");
   }
 }
 
@@ -48,9 +52,11 @@ double WheelPreintegration::metres_per_tick() const {
 }
 
 void WheelPreintegration::add(double d_left_ticks, double d_right_ticks) {
-  const double left_m = d_left_ticks * metres_per_tick();
-  const double right_m = d_right_ticks * metres_per_tick();
-  const Eigen::Vector3d step = wheel_step(left_m, right_m, drive_.track_m);
+  described_left_m_ += d_left_ticks * metres_per_tick();
+  described_right_m_ += d_right_ticks * metres_per_tick();
+  const double left_m = d_left_ticks * metres_per_tick() * calibration_.left_scale;
+  const double right_m = d_right_ticks * metres_per_tick() * calibration_.right_scale;
+  const Eigen::Vector3d step = wheel_step(left_m, right_m, drive_.track_m * calibration_.track_scale);
   const double ds = std::abs(0.5 * (left_m + right_m)), dyaw = std::abs(step.z());
   // Noise of this step in its own frame: isotropic in the plane (along and
   // across the chord alike), yaw from the distance and the turn.
@@ -72,6 +78,8 @@ void WheelPreintegration::append(const WheelPreintegration& next) {
   delta_ = delta;
   distance_m_ += next.distance_m_;
   turn_rad_ += next.turn_rad_;
+  described_left_m_ += next.described_left_m_;
+  described_right_m_ += next.described_right_m_;
 }
 
 Eigen::Vector3d WheelPreintegration::planar_sigma() const {

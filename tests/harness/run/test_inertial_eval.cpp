@@ -122,7 +122,7 @@ TEST(InertialEval, KeyframeBiasErrorsOfKnownSize) {
   EXPECT_NEAR(compare_biases(exact, truth, t0_ns, true).gyro_rms_radps, 0.0, 1e-15);
   EXPECT_NEAR(compare_biases(exact, truth, t0_ns, true).accel_rms_mps2, 0.0, 1e-15);
 
-  const YAML::Node j = YAML::Load(inertial_json({true, 0.5, 12, 1.0, 0.8, c, std::nullopt}))["biases"];
+  const YAML::Node j = YAML::Load(inertial_json({true, 0.5, 12, 1.0, 0.8, c, std::nullopt, std::nullopt, std::nullopt}))["biases"];
   EXPECT_EQ(j["keyframes"].as<int>(), 4);
   EXPECT_NEAR(j["gyro_rms_radps"].as<double>(), 2.5e-3, 1e-9);
   EXPECT_NEAR(j["accel_rms_mps2"].as<double>(), std::sqrt(0.025), 1e-9);
@@ -132,7 +132,7 @@ TEST(InertialEval, KeyframeBiasErrorsOfKnownSize) {
   EXPECT_NEAR(j["accel_true_mps2"][0][1].as<double>(), 0.1, 1e-12);  // [keyframe][axis]
   // An accelerometer alone: no gyro bias to compare.
   const YAML::Node a =
-      YAML::Load(inertial_json({true, 0.5, 12, 1.0, 0.8, compare_biases(kfs, truth, t0_ns, false), std::nullopt}));
+      YAML::Load(inertial_json({true, 0.5, 12, 1.0, 0.8, compare_biases(kfs, truth, t0_ns, false), std::nullopt, std::nullopt, std::nullopt}));
   EXPECT_TRUE(a["biases"]["gyro_rms_radps"].IsNull());
   EXPECT_TRUE(a["biases"]["gyro_est_radps"].IsNull());
   EXPECT_NEAR(a["biases"]["accel_rms_mps2"].as<double>(), std::sqrt(0.025), 1e-9);
@@ -167,6 +167,55 @@ TEST(InertialEval, TrustedStateAndGravityTilt) {
   EXPECT_TRUE(y["biases"].IsNull());  // no truth
 }
 
+TEST(InertialEval, WheelCalibrationAgainstTheRobotsTruth) {
+  const std::string dir = temp_dir("wheels");
+  {
+    std::ofstream f(dir + "/robot_truth.yaml");
+    f << "wheel_radius_m: 0.1\ntrack_m: 0.42\neffective_wheel_radius_m: 0.0998\neffective_track_m: 0.4536\n"
+         "nominal_wheel_radius_m: 0.1\nnominal_track_m: 0.42\nradius_difference: 0.004\n";
+  }
+  const slam::WheelCalibration t = read_wheels_true(dir + "/robot_truth.yaml");
+  EXPECT_NEAR(t.left_scale, 0.998 * 0.998, 1e-12);
+  EXPECT_NEAR(t.right_scale, 0.998 * 1.002, 1e-12);
+  EXPECT_NEAR(t.track_scale, 1.08, 1e-12);
+  {
+    std::ofstream f(dir + "/bad.yaml");
+    f << "effective_wheel_radius_m: 0.0998\nnominal_wheel_radius_m: -1\n";
+  }
+  try {
+    read_wheels_true(dir + "/bad.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("nominal_wheel_radius_m"), std::string::npos) << e.what();
+  }
+
+  InertialReport r;
+  EXPECT_TRUE(YAML::Load(inertial_json(r))["wheels"].IsNull());  // no online calibration
+  slam::MapWheels w;
+  w.calibration = {0.9961, 0.9999, 1.079};
+  w.radii_known = true;
+  w.intervals = 800;
+  w.refused = 2;
+  w.rolled_m = 230.5;
+  w.turned_rad = 4.1;
+  r.wheels = w;
+  YAML::Node j = YAML::Load(inertial_json(r))["wheels"];
+  EXPECT_NEAR(j["left_scale"].as<double>(), 0.9961, 1e-9);
+  EXPECT_NEAR(j["track_scale"].as<double>(), 1.079, 1e-9);
+  EXPECT_TRUE(j["radii_known"].as<bool>());
+  EXPECT_FALSE(j["track_known"].as<bool>());
+  EXPECT_EQ(j["intervals"].as<int>(), 800);
+  EXPECT_EQ(j["refused"].as<int>(), 2);
+  EXPECT_TRUE(j["true_left_scale"].IsNull());
+  r.wheels_true = t;
+  j = YAML::Load(inertial_json(r))["wheels"];
+  EXPECT_NEAR(j["true_right_scale"].as<double>(), t.right_scale, 1e-9);
+  const std::string line = wheels_text(w, t);
+  EXPECT_NE(line.find("track x1.0790 (not yet observed)"), std::string::npos) << line;
+  EXPECT_NE(line.find("the robot:"), std::string::npos) << line;
+}
+
 // --- The report ---
 
 SlamRun inertial_run(const std::string& sensors, std::size_t dead_reckoned) {
@@ -194,7 +243,7 @@ SlamRun inertial_run(const std::string& sensors, std::size_t dead_reckoned) {
     const std::vector<BiasTruth> truth = ramp_truth(0, 21, 100'000'000);
     std::vector<KeyframeBias> kfs;
     for (int i = 0; i < 5; ++i) kfs.push_back({static_cast<std::uint64_t>(i), i * 300'000'000LL, {}});
-    r.inertial = InertialReport{true, 0.9, 3, 0.4, 1.1, compare_biases(kfs, truth, 0, true), std::nullopt};
+    r.inertial = InertialReport{true, 0.9, 3, 0.4, 1.1, compare_biases(kfs, truth, 0, true), std::nullopt, std::nullopt, std::nullopt};
   }
   return r;
 }

@@ -153,6 +153,32 @@ TEST(MotionIntegrator, WheelIntervalsAreWeighedWithTheSettingsWheelNoise) {
   EXPECT_NEAR(yaw_sigma_after_a_metre(0.001), 0.001, 1e-7);
 }
 
+// A calibration set between keyframes reads the next interval with it: a
+// right wheel 1 % large turns a straight by 0.01 / track radians a metre.
+TEST(MotionIntegrator, NewIntervalsAreReadWithTheWheelCalibration) {
+  Settings s = robot_settings(sensor::SensorSetup::kCameraImuWheels);
+  s.motion.robot.encoder_rate_hz = 30;
+  MotionIntegrator m(s.motion);
+  const double metres_per_tick = 2 * M_PI * s.motion.robot.drive.wheel_radius_m / s.motion.robot.drive.ticks_per_rev;
+  const auto drive = [&](int first, int last) {
+    for (int f = first; f <= last; ++f) {
+      const std::int64_t t0 = (f - 1) * kFramePeriodNs, t1 = f * kFramePeriodNs;
+      m.add_frame(t1, level_readings(t0, t1, 0),
+                  f == 0 ? std::vector<sensor::WheelTicks>{{0, 0, 0}} : straight_ticks(t0, t1, 0.5, metres_per_tick));
+      if (f == 0) m.take_keyframe_interval();
+    }
+    return m.take_keyframe_interval();
+  };
+  const KeyframeInterval described = drive(0, 60);
+  m.set_wheel_calibration({0.995, 1.005, 1.0});
+  const KeyframeInterval calibrated = drive(61, 120);
+  ASSERT_TRUE(described.wheels && calibrated.wheels);
+  EXPECT_NEAR(described.wheels->delta().z(), 0.0, 1e-9);
+  const double d = calibrated.wheels->described_left_m();
+  EXPECT_NEAR(calibrated.wheels->delta().z(), 0.01 * d / s.motion.robot.drive.track_m, 1e-3 * 0.01 * d);
+  EXPECT_EQ(calibrated.wheels->calibration(), m.wheel_calibration());
+}
+
 TEST(MotionIntegrator, KeyframeIntervalsSplitTheReadingsAndGiveTheTilt) {
   const Settings s = robot_settings(sensor::SensorSetup::kCameraImu);
   MotionIntegrator m(s.motion);

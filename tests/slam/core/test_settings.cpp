@@ -561,6 +561,11 @@ TEST(Settings, ReadsImuAndRobotKeysAndTheSensorSetup) {
   EXPECT_DOUBLE_EQ(tight.motion.robot.wheel_noise.translation_per_sqrt_m, 0.01);
   EXPECT_DOUBLE_EQ(tight.motion.robot.wheel_noise.yaw_per_sqrt_m, 0.001);
   EXPECT_DOUBLE_EQ(tight.motion.robot.wheel_noise.yaw_per_sqrt_rad, 0.02);
+  // The wheels are calibrated online unless Robot.CalibrateWheels says 0.
+  EXPECT_TRUE(s.motion.robot.wheel_calibration.enabled);
+  const Settings fixed = read_settings(
+      temp_copy("wheels_fixed", read_file(tum1()) + kImuKeys + kRobotKeys + "Robot.CalibrateWheels: 0\n"));
+  EXPECT_FALSE(fixed.motion.robot.wheel_calibration.enabled);
 }
 
 TEST(Settings, SensorSetupWithoutItsKeysOrWithABadExtrinsicIsOneConfigError) {

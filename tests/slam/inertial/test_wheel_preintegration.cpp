@@ -20,6 +20,29 @@ sensor::DriveDescription drive() {
   return d;
 }
 
+TEST(WheelPreintegration, ACalibrationScalesEachWheelAndTheTrack) {
+  // Left wheel 1 % small, right 1 % large, track 10 % wide: on the spot the
+  // counts of a described half turn turn the robot by pi (1 +- 0.01) / 1.1 on
+  // average, and a straight run curves to the left.
+  const WheelCalibration c{0.99, 1.01, 1.1};
+  WheelPreintegration spot(drive(), WheelNoise{}, c), straight(drive(), WheelNoise{}, c);
+  const double counts_half_turn = M_PI * 0.2 / (2 * M_PI * 0.1 / 1000);  // arc pi * track / 2 per wheel
+  spot.add(-counts_half_turn, counts_half_turn);
+  EXPECT_NEAR(spot.delta().z(), M_PI * (0.99 + 1.01) / 2 / 1.1, 1e-12);
+  straight.add(1000, 1000);
+  const double arc = 2 * M_PI * 0.1;
+  EXPECT_NEAR(straight.delta().z(), arc * (1.01 - 0.99) / (0.4 * 1.1), 1e-12);
+  // What the calibration is fitted to stays the described arcs.
+  EXPECT_NEAR(straight.described_left_m(), arc, 1e-12);
+  EXPECT_NEAR(straight.described_right_m(), arc, 1e-12);
+  EXPECT_NEAR(spot.described_left_m(), -M_PI * 0.2, 1e-9);
+  WheelPreintegration both(drive(), WheelNoise{}, c);
+  both.append(spot);
+  both.append(straight);
+  EXPECT_NEAR(both.described_right_m(), M_PI * 0.2 + arc, 1e-9);
+  EXPECT_THROW(WheelPreintegration(drive(), WheelNoise{}, WheelCalibration{0, 1, 1}), std::invalid_argument);
+}
+
 TEST(WheelPreintegration, StraightAhead) {
   WheelPreintegration pre(drive(), WheelNoise{});
   for (int k = 0; k < 100; ++k) pre.add(20, 20);

@@ -360,6 +360,12 @@ struct Robot {
   std::optional<double> max_wheel_accel_radps2;
   double radius_error = 0.01;  ///< largest relative error of the nominal wheel radius
   double track_error = 0.02;   ///< largest relative error of the nominal track
+  /// As built, the right wheel's radius over the left's, less one; the
+  /// wheels are wheel_radius_m * (1 -+ radius_difference / 2).  The
+  /// description gives them the same radius, as a tape would.
+  double radius_difference = 0.0;
+  double left_radius_m() const { return wheel_radius_m * (1 - 0.5 * radius_difference); }
+  double right_radius_m() const { return wheel_radius_m * (1 + 0.5 * radius_difference); }
 };
 
 /// SLAM settings the scenario asks for (the `slam:` section).  They go into

@@ -109,7 +109,7 @@ class MotionSensors {
   int imu_steps_, wheel_steps_;
   int free_qpos_, free_dof_;
   int wheel_qpos_[2], wheel_dof_[2], wheel_act_[2];
-  double wheel_radius_m_, track_m_;
+  double wheel_radius_m_[2], track_m_;  ///< as built: left, right
   int ticks_per_rev_;
   double wheel_offset_rad_[2] = {0, 0};
   long long steps_ = 0;

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "pvb/slam/core/keyframe_motion.hpp"
+
 namespace pvb::run {
 
 using Axes = std::array<std::vector<double>, 3>;  ///< x, y, z series
@@ -39,12 +41,20 @@ struct InertialReport {
   /// which measures the map against itself, it sees a map levelled upside
   /// down: 180 degrees.
   std::optional<double> gravity_true_deg;
+  /// With wheels calibrated online: the fit, and the robot as simulated
+  /// against its description (effective radius and track over the
+  /// described ones) where known.
+  std::optional<slam::MapWheels> wheels;
+  std::optional<slam::WheelCalibration> wheels_true;
 };
 
 /// {"trusted", "trusted_t_s", "trusted_keyframe", "gravity_tilt_deg", "init_rms", "biases"}: null where
 /// not trusted; "biases" null without truth, else {"keyframes", "gyro_rms_radps", "accel_rms_mps2",
 /// "gyro_final_radps", "accel_final_mps2", "keyframe_id", "t_s", "gyro_est_radps", "gyro_true_radps",
-/// "accel_est_mps2", "accel_true_mps2"} (series of [x, y, z] per keyframe; gyro ones null without a gyro).
+/// "accel_est_mps2", "accel_true_mps2"} (series of [x, y, z] per keyframe; gyro ones null without a gyro);
+/// "wheels" null without an online wheel calibration, else {"left_scale", "right_scale", "track_scale",
+/// "radii_known", "track_known", "intervals", "refused", "rolled_m", "turned_rad", "true_left_scale",
+/// "true_right_scale", "true_track_scale"} (the true ones null without truth).
 std::string inertial_json(const InertialReport& r);
 
 }  // namespace pvb::run

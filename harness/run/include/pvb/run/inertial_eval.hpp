@@ -33,6 +33,16 @@ struct BiasTruth {
 /// order.  IoError naming the file and line for a malformed line.
 std::vector<BiasTruth> read_bias_truth(const std::string& path);
 
+/// The simulated robot's effective wheel radius and track over the
+/// described ones, from a recording's robot_truth.yaml (what an online
+/// wheel calibration should find).  IoError naming the file and the key
+/// when it cannot be read.
+slam::WheelCalibration read_wheels_true(const std::string& path);
+
+/// One line for the console: the wheels' calibration so far, and the
+/// robot's where known.
+std::string wheels_text(const slam::MapWheels& w, const std::optional<slam::WheelCalibration>& truth);
+
 /// The true biases at t_ns: linear between the two readings around it, the
 /// first or last reading outside them.  `truth` non-empty, in time order.
 BiasTruth bias_truth_at(const std::vector<BiasTruth>& truth, std::int64_t t_ns);

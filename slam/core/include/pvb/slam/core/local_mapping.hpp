@@ -109,6 +109,11 @@ class LocalMapping {
   void write_motion_states(const BaProblem& problem, const std::vector<std::shared_ptr<KeyFrame>>& kfs);
   /// Culling kf keeps the IMU chain's intervals short enough.
   bool may_cull_in_time(const KeyFrame& kf) const;
+  /// Fits the wheels' calibration to one more keyframe interval, the one
+  /// that ends kWheelLag keyframes before kf (its poses have been through
+  /// several local BAs), and publishes the fit in the map.
+  void calibrate_wheels(const std::shared_ptr<KeyFrame>& kf);
+  static constexpr int kWheelLag = 5;
 
   Map& map_;
   std::shared_ptr<const CameraModel> cam_;
@@ -125,6 +130,8 @@ class LocalMapping {
   std::atomic<bool> stop_ba_{false};      ///< set by insert() in worker mode, cleared before each local BA
   std::atomic<std::int64_t> processed_{0}, ba_runs_{0}, ba_stopped_{0};
   std::function<void(const std::shared_ptr<KeyFrame>&)> after_keyframe_;
+  std::optional<WheelCalibrator> wheel_calibrator_;  ///< with the wheels and Robot.CalibrateWheels
+  std::uint64_t wheels_fitted_to_ = 0;               ///< the last interval's end keyframe
   WorkerError worker_error_;  ///< what ended the worker, for the owner's thread
   std::thread worker_;
 };

@@ -294,6 +294,9 @@ class Map {
   /// Gravity in the map's frame and whether the inertial state is trusted.
   MapGravity& gravity() { return gravity_; }
   const MapGravity& gravity() const { return gravity_; }
+  /// The wheels' calibration so far.
+  MapWheels& wheels() { return wheels_; }
+  const MapWheels& wheels() const { return wheels_; }
 
  private:
   std::mutex mutex_;
@@ -305,6 +308,7 @@ class Map {
   std::uint32_t next_provisional_ = 1;
   std::map<std::uint32_t, std::uint32_t> merged_;  ///< provisional map -> the map it was merged into
   MapGravity gravity_;
+  MapWheels wheels_;
 };
 
 /// Takes kf out of the chain in time: its next keyframe's interval then

@@ -46,6 +46,12 @@ class MotionIntegrator {
   const ImuBias& bias() const { return bias_; }
   void set_bias(const ImuBias& b);
 
+  /// The wheels' calibration encoder intervals are read with.  A new one
+  /// applies to the open intervals if the wheels have not moved in them
+  /// yet, else from the next: counts are not kept to read them again.
+  const WheelCalibration& wheel_calibration() const { return wheel_calibration_; }
+  void set_wheel_calibration(const WheelCalibration& c);
+
   /// The accelerometer's mean over the last kTiltWindowS in the camera
   /// frame (specific force, pointing up), if any: the map's first frame is
   /// levelled with it.
@@ -85,6 +91,7 @@ class MotionIntegrator {
   std::int64_t period_ns_;          ///< the IMU's reading period
   std::int64_t encoder_period_ns_;  ///< the encoders' reading period
   ImuBias bias_;
+  WheelCalibration wheel_calibration_;
   ImuPreintegration imu_frame_, imu_kf_;
   WheelPreintegration wheel_frame_, wheel_kf_;
   /// Holds the newest reading from its time up to the frame's t_ns.

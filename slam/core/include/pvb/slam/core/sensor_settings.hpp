@@ -8,6 +8,7 @@
 #include <string>
 
 #include "pvb/geometry/se3.hpp"
+#include "pvb/slam/inertial/wheel_calibration.hpp"
 #include "pvb/slam/inertial/wheel_preintegration.hpp"
 #include "pvb/sensor/motion.hpp"
 
@@ -53,6 +54,10 @@ struct RobotSettings {
   /// suit wheels whose radii may differ by a few tenths of a percent;
   /// wheels of equal radius hold their heading far better on a straight.
   WheelNoise wheel_noise;
+  /// Robot.CalibrateWheels (ours, optional, 0/1): each wheel's radius and
+  /// the track are fitted online to the keyframes' motion, and the encoders
+  /// read with the fit (docs/slam_inertial.md).
+  WheelCalibrationOptions wheel_calibration;
 };
 
 /// The motion sensors a system fuses and what the settings say of them.

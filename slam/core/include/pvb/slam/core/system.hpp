@@ -165,8 +165,14 @@ class System {
   /// Gravity in the map's frame and when the inertial state became
   /// trusted (MapGravity::ready false: not yet, or a camera-only setup).
   MapGravity gravity();
+  /// The wheels' online calibration so far (as described without wheels).
+  MapWheels wheels();
   /// The sensors this system fuses.
   sensor::SensorSetup sensors() const { return settings_.motion.setup; }
+  /// The wheels are fused and calibrated online (Robot.CalibrateWheels).
+  bool calibrates_wheels() const {
+    return sensor::uses_wheels(settings_.motion.setup) && settings_.motion.robot.wheel_calibration.enabled;
+  }
   /// Each keyframe in the map with an inertial state: its time, velocity
   /// and biases (for reports against the true biases).
   struct KeyFrameState {

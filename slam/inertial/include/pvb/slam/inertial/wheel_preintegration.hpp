@@ -23,6 +23,21 @@ struct WheelNoise {
   double planar_floor = 1e-3;               ///< m / rad added so standing still is not infinitely stiff
 };
 
+/// The wheels as measured against their description: each wheel's rolling
+/// radius and the track as factors on the described values (1: as
+/// described).  A differential drive's yaw needs the ratio of the two radii
+/// to better than 1e-3 to be any use on a straight (a ratio off by e turns
+/// the robot by e / track radians a metre).
+struct WheelCalibration {
+  double left_scale = 1.0;   ///< left wheel's rolling radius / described radius
+  double right_scale = 1.0;  ///< right wheel's rolling radius / described radius
+  double track_scale = 1.0;  ///< effective track / described track
+  bool operator==(const WheelCalibration& o) const {
+    return left_scale == o.left_scale && right_scale == o.right_scale && track_scale == o.track_scale;
+  }
+  bool operator!=(const WheelCalibration& o) const { return !(*this == o); }
+};
+
 /// Composition of planar poses [x, y, yaw]: b expressed in a's frame,
 ///   a (+) b = [a_xy + R(a_yaw) b_xy, a_yaw + b_yaw],
 /// with its Jacobians with respect to a and b (either may be null).
@@ -37,7 +52,8 @@ Eigen::Vector3d wheel_step(double left_m, double right_m, double track_m);
 class WheelPreintegration {
  public:
   WheelPreintegration() = default;
-  WheelPreintegration(const sensor::DriveDescription& drive, const WheelNoise& noise);
+  WheelPreintegration(const sensor::DriveDescription& drive, const WheelNoise& noise,
+                      const WheelCalibration& calibration = {});
 
   /// Adds one encoder interval: the count changes of the left and right
   /// wheel (positive forward), with a fraction where the interval is a
@@ -57,15 +73,22 @@ class WheelPreintegration {
   Eigen::Vector3d planar_sigma() const;
   const sensor::DriveDescription& drive() const { return drive_; }
   const WheelNoise& noise() const { return noise_; }
-  /// Distance a wheel rolls per encoder count, metres.
+  const WheelCalibration& calibration() const { return calibration_; }
+  /// Distance a wheel rolls per encoder count as described, metres.
   double metres_per_tick() const;
+  /// The arcs each wheel rolled as described (counts x metres_per_tick(),
+  /// signed, before the calibration): what a calibration is fitted to.
+  double described_left_m() const { return described_left_m_; }
+  double described_right_m() const { return described_right_m_; }
 
  private:
   sensor::DriveDescription drive_;
   WheelNoise noise_;
+  WheelCalibration calibration_;
   Eigen::Vector3d delta_ = Eigen::Vector3d::Zero();
   Eigen::Matrix3d cov_ = Eigen::Matrix3d::Zero();
   double distance_m_ = 0, turn_rad_ = 0;
+  double described_left_m_ = 0, described_right_m_ = 0;
 };
 
 }  // namespace pvb::slam

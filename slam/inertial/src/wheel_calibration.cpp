@@ -1,0 +1,82 @@
+// Online wheel calibration by linear least squares (the odometry
+// calibration of Antonelli, Caccavale, Grossi and Marino, "Simultaneous
+// calibration of odometry and camera for a differential drive mobile robot",
+// ICRA 2010, with the map's keyframe motion in place of the camera's).
+#include "pvb/slam/inertial/wheel_calibration.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+#include <stdexcept>
+
+namespace pvb::slam {
+
+WheelCalibrator::WheelCalibrator(double described_track_m, const WheelCalibrationOptions& options)
+    : track_m_(described_track_m), options_(options) {
+  if (!(described_track_m > 0) || !(options.prior_m2 > 0) || !(options.gate_arc_m > 0) ||
+      !(options.gate_yaw_rad > 0) || !(options.gate_fraction >= 0))
+    throw std::invalid_argument("WheelCalibrator: the track, the prior and the gates must be positive");
+}
+
+Eigen::Vector2d WheelCalibrator::turn_fit() const {
+  const double w = options_.prior_m2;
+  const Eigen::Matrix2d A = turn_normal_ + w * Eigen::Matrix2d::Identity();
+  const Eigen::Vector2d b = turn_rhs_ + Eigen::Vector2d(w, 0);
+  return A.lu().solve(b);
+}
+
+double WheelCalibrator::scale_fit(double rho) const {
+  const double w = options_.prior_m2;
+  return (s_am_ + rho * s_an_ + w) / (s_mm_ + 2 * rho * s_mn_ + rho * rho * s_nn_ + w);
+}
+
+Eigen::Vector2d WheelCalibrator::predict(double left_m, double right_m) const {
+  const Eigen::Vector2d uv = turn_fit();
+  const double rho = uv.x() != 0 ? uv.y() / uv.x() : 0.0;
+  const double s = scale_fit(rho);
+  const double m = 0.5 * (left_m + right_m), n = 0.5 * (right_m - left_m);
+  return {s * (m + rho * n), (uv.x() * (right_m - left_m) + uv.y() * (right_m + left_m)) / track_m_};
+}
+
+bool WheelCalibrator::add(double left_m, double right_m, double arc_m, double yaw_rad) {
+  if (!std::isfinite(left_m) || !std::isfinite(right_m) || !std::isfinite(arc_m) || !std::isfinite(yaw_rad)) {
+    ++refused_;
+    return false;
+  }
+  const Eigen::Vector2d expected = predict(left_m, right_m);
+  const bool check_arc = radii_known(), check_yaw = radii_known() || track_known();
+  if ((check_arc && std::abs(arc_m - expected.x()) > options_.gate_arc_m + options_.gate_fraction * std::abs(arc_m)) ||
+      (check_yaw &&
+       std::abs(yaw_rad - expected.y()) > options_.gate_yaw_rad + options_.gate_fraction * std::abs(yaw_rad))) {
+    ++refused_;
+    return false;
+  }
+  const Eigen::Vector2d f(right_m - left_m, right_m + left_m);
+  turn_normal_ += f * f.transpose();
+  turn_rhs_ += f * (yaw_rad * track_m_);
+  const double m = 0.5 * (left_m + right_m), n = 0.5 * (right_m - left_m);
+  s_mm_ += m * m;
+  s_mn_ += m * n;
+  s_nn_ += n * n;
+  s_am_ += arc_m * m;
+  s_an_ += arc_m * n;
+  rolled_m_ += std::abs(m);
+  turned_rad_ += std::abs(right_m - left_m) / track_m_;
+  ++intervals_;
+  return true;
+}
+
+WheelCalibration WheelCalibrator::estimate() const {
+  WheelCalibration c;
+  const Eigen::Vector2d uv = turn_fit();
+  if (!(uv.x() > 0)) return c;
+  const double rho = radii_known() ? uv.y() / uv.x() : 0.0;
+  const double s = radii_known() ? scale_fit(rho) : 1.0;
+  if (radii_known()) {
+    c.left_scale = s * (1 - rho);
+    c.right_scale = s * (1 + rho);
+  }
+  if (track_known()) c.track_scale = scale_fit(rho) / uv.x();
+  return c;
+}
+
+}  // namespace pvb::slam
