@@ -68,10 +68,13 @@ void OfflineSlam::Impl::evaluate_gravity(const eval::Trajectory& gt, const eval:
       eval::tilt_drift(gt, session_keyframes(eval::read_tum(a_.out + "/KeyFrameTrajectory.txt"), *system_), alignment);
   const slam::MapGravity core = system_->gravity();
   if (core.ready) gravity_true_deg_ = gravity_error_at_deg(gt, est, down_w, tally_.gravity, core.ready_t_ns);
-  text(strf("gravity error (map frame: %s): median %.2f deg, p95 %.2f, final %.2f; keyframe pitch error "
+  // Without an accelerometer the map's frame is the first camera's: its -z
+  // is no estimate of gravity, and the angle is that camera's tilt.
+  const bool aligned = sensor::uses_accel(settings_.motion.setup);
+  text(strf("%s (map frame: %s): median %.2f deg, p95 %.2f, final %.2f; keyframe pitch error "
             "%+.4f deg/keyframe, roll %+.4f\n",
-            g.map_frame.c_str(), g.median_deg, g.p95_deg, g.final_deg, t.pitch_slope_deg_per_kf,
-            t.roll_slope_deg_per_kf));
+            aligned ? "gravity error" : "tilt of the first camera's frame, not a gravity error", g.map_frame.c_str(),
+            g.median_deg, g.p95_deg, g.final_deg, t.pitch_slope_deg_per_kf, t.roll_slope_deg_per_kf));
   *js << ",\n  \"gravity\": " << eval::gravity_json(g) << ",\n  \"tilt\": " << eval::tilt_json(t);
 }
 
