@@ -410,7 +410,7 @@ void LoopClosing::add_tally(const VerifyTally& t, bool found) {
   stats_.lookalike_checked += t.lookalike_checked ? 1 : 0;
   stats_.verify_ms_total += t.verify_ms;
   if (t.ambiguous) ++stats_.refused_ambiguous;
-  if (!found && t.drift > 0) ++stats_.refused_drift;
+  else if (!found && t.drift > 0) ++stats_.refused_drift;  // each refused detection counts under one check
   if (!t.ambiguous && (found || t.refusal_rank < 0)) return;
   if (stats_.refusals.size() < LoopClosingStats::kMaxRefusals) stats_.refusals.push_back(t.refusal);
   else ++stats_.refusals_dropped;
