@@ -395,6 +395,8 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
       tally.ambiguous = tally.ambiguous || (verified_centres_w[i] - verified_centres_w[j]).norm() > options_.ambiguity_distance_m;
   if (tally.ambiguous && loop_kf)
     tally.refusal = refusal_of(*kf, *loop_kf, "ambiguous", *best, true, best_dist_m, best_angle_deg);
+  else if (tally.ambiguous)  // every verified candidate was over the drift bound, and they lie apart
+    tally.refusal.reason = "ambiguous";
   tally.verify_ms = ms_since(t0);
   add_tally(tally, loop_kf != nullptr);
   return tally.ambiguous ? nullptr : loop_kf;

@@ -425,6 +425,37 @@ TEST(LoopClosing, ALargeCorrectionIsRefusedWhenTheViewVerifiesAtALookalike) {
   EXPECT_EQ(unchecked.loops.size(), 1u);
 }
 
+TEST(LoopClosing, TwoPlacesBothOverTheDriftBoundAreRecordedAsAmbiguous) {
+  // The view verifies both at its own place (0.8 m of drift) and at the
+  // look-alike 2 m on, and the drift bound refuses both: the detection is
+  // refused once, as ambiguous, and recorded so.
+  Map map;
+  const cv::Mat tex = make_repeating_texture(3);
+  const geom::SE3d A = pose(0, -0.9, 0), B = pose(0, 1.1, 0);
+  add_keyframe(map, tex, A, A);
+  add_keyframe(map, tex, B, B);
+  const geom::SE3d drift = geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.8, 0, 0));
+  auto kf = add_keyframe(map, tex, A, drift * A);
+  static const auto vocabulary = place::Vocabulary::load_shared(kDefaultVocabularyPath);
+  PlaceRecognizer place(vocabulary);
+  for (const auto& [id, k] : map.keyframes()) {
+    place.compute_bow(*k);
+    if (k != kf) place.add(*k);
+  }
+  LoopClosingOptions o = test_options();
+  o.consistency = 1;
+  LoopClosing lc(map, o, &place);
+  lc.process(kf);
+  lc.process(kf);
+  const LoopClosingStats s = lc.stats();
+  EXPECT_TRUE(s.loops.empty());
+  ASSERT_EQ(s.refused_ambiguous, 1);
+  EXPECT_EQ(s.refused_drift, 0);
+  ASSERT_EQ(s.refusals.size(), 1u);
+  EXPECT_EQ(s.refusals[0].reason, "ambiguous");
+  EXPECT_TRUE(s.refusals[0].verified);
+}
+
 TEST(LoopClosing, ClosesOnlyAfterConsistentDetectionsAndRemovesTheDrift) {
   Map map;
   const cv::Mat tex = make_texture(1);
