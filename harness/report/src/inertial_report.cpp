@@ -34,7 +34,7 @@ std::string biases_json(const BiasComparison& b) {
   return out;
 }
 
-std::string wheels_json(const slam::MapWheels& w, const std::optional<slam::WheelCalibration>& truth) {
+std::string wheels_json(const slam::WheelFit& w, const std::optional<slam::WheelCalibration>& truth) {
   const auto known = [](bool b) { return std::string(b ? "true" : "false"); };
   const auto true_num = [&](double slam::WheelCalibration::*f) {
     return truth ? bias_num((*truth).*f) : std::string("null");

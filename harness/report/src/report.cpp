@@ -127,23 +127,22 @@ namespace {
 std::string refusals_json(const PlaceRecognition& p) {
   std::map<std::string, int> by_reason;
   std::string events = "[";
-  std::size_t labelled = 0;
   int verified = 0, verified_true = 0;
+  bool judged_any = false;
   for (std::size_t i = 0; i < p.refusals.size(); ++i) {
     const PlaceRecognition::Refusal& r = p.refusals[i];
     ++by_reason[r.reason];
-    const eval::LabelledPlaceEvent* l = nullptr;
-    if (r.verified && labelled < p.refusal_labels.size()) l = &p.refusal_labels[labelled++];
-    if (l && l->judged) verified_true += l->correct ? 1 : 0;
     verified += r.verified ? 1 : 0;
-    const bool judged = l && l->judged;
+    const bool judged = r.label && r.label->judged;
+    judged_any = judged_any || r.label;
+    verified_true += judged && r.label->correct ? 1 : 0;
     events += std::string(i ? ", " : "") + "{\"t_s\": " + json_number(r.event.t_ns * 1e-9, 12) +
               ", \"ref_t_s\": " + json_number(r.event.ref_t_ns * 1e-9, 12) + ", \"reason\": \"" + r.reason +
               "\", \"verified\": " + (r.verified ? "true" : "false") +
               ", \"correction_m\": " + num(r.correction_m) + ", \"drift_bound_m\": " + num(r.drift_bound_m) +
-              ", \"correct\": " + (judged ? (l->correct ? "true" : "false") : "null") +
-              ", \"error_m\": " + (judged ? num(l->error_m) : "null") +
-              ", \"error_deg\": " + (judged ? num(l->error_deg) : "null") + "}";
+              ", \"correct\": " + (judged ? (r.label->correct ? "true" : "false") : "null") +
+              ", \"error_m\": " + (judged ? num(r.label->error_m) : "null") +
+              ", \"error_deg\": " + (judged ? num(r.label->error_deg) : "null") + "}";
   }
   std::string reasons = "{";
   for (const auto& [reason, n] : by_reason)
@@ -151,7 +150,7 @@ std::string refusals_json(const PlaceRecognition& p) {
   return "\"refusals\": {\"kept\": " + std::to_string(p.refusals.size()) +
          ", \"dropped\": " + std::to_string(p.refusals_dropped) + ", \"by_reason\": " + reasons +
          "}, \"verified\": " + std::to_string(verified) + ", \"verified_true\": " +
-         (p.refusal_labels.empty() && verified > 0 ? std::string("null") : std::to_string(verified_true)) +
+         (!judged_any && verified > 0 ? std::string("null") : std::to_string(verified_true)) +
          "}, \"refusal_events\": " + events + "]";
 }
 

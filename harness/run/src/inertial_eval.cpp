@@ -122,6 +122,12 @@ std::optional<double> gravity_error_at_deg(const eval::Trajectory& gt, const eva
   return g.angle_deg.front();
 }
 
+slam::WheelCalibration wheels_true(double effective_radius_m, double effective_track_m, double described_radius_m,
+                                   double described_track_m, double radius_difference) {
+  const double radius = effective_radius_m / described_radius_m, half = 0.5 * radius_difference;
+  return {radius * (1 - half), radius * (1 + half), effective_track_m / described_track_m};
+}
+
 slam::WheelCalibration read_wheels_true(const std::string& path) {
   YAML::Node root;
   try {
@@ -136,17 +142,20 @@ slam::WheelCalibration read_wheels_true(const std::string& path) {
       throw IoError(path, std::string(key) + ": expected a positive number");
     return v;
   };
-  const double radius = number("effective_wheel_radius_m") / number("nominal_wheel_radius_m");
-  double half = 0;  // radius_difference: written only when the wheels differ
+  // Radius before track, so that the first bad key is the one named.
+  const double effective_radius_m = number("effective_wheel_radius_m");
+  const double described_radius_m = number("nominal_wheel_radius_m");
+  const double effective_track_m = number("effective_track_m");
+  const double described_track_m = number("nominal_track_m");
+  double difference = 0;  // written only when the wheels differ
   if (const YAML::Node d = root["radius_difference"]) {
-    if (!d.IsScalar() || !parse_field(d.as<std::string>(), &half) || std::abs(half) > 0.5)
-      throw IoError(path, "radius_difference: expected a number in [-0.5, 0.5]");
-    half *= 0.5;
+    if (!d.IsScalar() || !parse_field(d.as<std::string>(), &difference) || std::abs(difference) > 1)
+      throw IoError(path, "radius_difference: expected a number in [-1, 1]");
   }
-  return {radius * (1 - half), radius * (1 + half), number("effective_track_m") / number("nominal_track_m")};
+  return wheels_true(effective_radius_m, effective_track_m, described_radius_m, described_track_m, difference);
 }
 
-std::string wheels_text(const slam::MapWheels& w, const std::optional<slam::WheelCalibration>& truth) {
+std::string wheels_text(const slam::WheelFit& w, const std::optional<slam::WheelCalibration>& truth) {
   const auto x = [](double v, int digits) { return "x" + format_fixed(v, digits); };
   std::string out = "wheel calibration over " + std::to_string(w.intervals) + " keyframe intervals (" +
                     format_fixed(w.rolled_m, 1) + " m rolled, " + format_fixed(w.turned_rad, 1) + " rad turned, " +

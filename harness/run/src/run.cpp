@@ -128,10 +128,8 @@ class GroundTruthSink {
   void started(const SimInfo& info) {
     write_robot_truth(dir_, scenario_, info.kinematics);
     const sensor::DriveDescription described = sim::nominal_description(scenario_);
-    const double radius = info.kinematics.wheel_radius_m / described.wheel_radius_m;
-    const double half = 0.5 * scenario_.robot.radius_difference;
-    wheels_true_ = slam::WheelCalibration{radius * (1 - half), radius * (1 + half),
-                                          info.kinematics.track_m / described.track_m};
+    wheels_true_ = run::wheels_true(info.kinematics.wheel_radius_m, info.kinematics.track_m, described.wheel_radius_m,
+                                    described.track_m, scenario_.robot.radius_difference);
   }
   /// The simulated robot's effective radius and track over its description.
   const std::optional<slam::WheelCalibration>& wheels_true() const { return wheels_true_; }

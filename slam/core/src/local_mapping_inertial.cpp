@@ -194,14 +194,7 @@ void LocalMapping::calibrate_wheels(const std::shared_ptr<KeyFrame>& kf) {
   const Eigen::Vector3d& t = T_from_to.translation();
   const double arc_m = t.x() * std::cos(0.5 * yaw_rad) + t.y() * std::sin(0.5 * yaw_rad);
   wheel_calibrator_->add(wheels->described_left_m(), wheels->described_right_m(), arc_m, yaw_rad);
-  MapWheels& w = map_.wheels();
-  w.calibration = wheel_calibrator_->estimate();
-  w.radii_known = wheel_calibrator_->radii_known();
-  w.track_known = wheel_calibrator_->track_known();
-  w.intervals = wheel_calibrator_->intervals();
-  w.refused = wheel_calibrator_->refused();
-  w.rolled_m = wheel_calibrator_->rolled_m();
-  w.turned_rad = wheel_calibrator_->turned_rad();
+  map_.wheels() = wheel_calibrator_->fit();
 }
 
 }  // namespace pvb::slam

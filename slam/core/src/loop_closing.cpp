@@ -351,7 +351,9 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
   double best_dist_m = 0, best_angle_deg = 0;
   // The candidate that got furthest (rank: geometry's stage, then the caps, then the drift bound).
   const auto refuse = [&](int rank, LoopRefusal r) {
-    if (rank > tally.refusal_rank) tally.refusal_rank = rank, tally.refusal = std::move(r);
+    if (rank <= tally.refusal_rank) return;
+    tally.refusal_rank = rank;
+    tally.refusal = std::move(r);
   };
   for (const auto& cand : consistent) {
     ++tally.verified;

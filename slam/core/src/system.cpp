@@ -416,7 +416,7 @@ MapGravity System::gravity() {
   return map_->gravity();
 }
 
-MapWheels System::wheels() {
+WheelFit System::wheels() {
   std::lock_guard<std::mutex> lock(map_->mutex());
   return map_->wheels();
 }

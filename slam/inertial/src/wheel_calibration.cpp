@@ -79,4 +79,8 @@ WheelCalibration WheelCalibrator::estimate() const {
   return c;
 }
 
+WheelFit WheelCalibrator::fit() const {
+  return {estimate(), radii_known(), track_known(), intervals_, refused_, rolled_m_, turned_rad_};
+}
+
 }  // namespace pvb::slam

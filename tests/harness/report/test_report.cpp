@@ -338,9 +338,9 @@ TEST(RunReport, PlaceRecognitionInMetricsAndReport) {
 TEST(RunReport, RefusedLoopsAreCountedByCheckAndTheVerifiedOnesJudged) {
   RunReport r = hand_report();
   PlaceRecognition p;
-  p.refusals.push_back({{10'000'000'000, 1'000'000'000, geom::SE3d::Identity()}, "inliers", false, 0, 0});
-  p.refusals.push_back({{20'000'000'000, 2'000'000'000, geom::SE3d::Identity()}, "drift", true, 2.5, 1.9});
-  p.refusals.push_back({{30'000'000'000, 3'000'000'000, geom::SE3d::Identity()}, "drift", true, 6.0, 2.0});
+  p.refusals.push_back({{10'000'000'000, 1'000'000'000, geom::SE3d::Identity()}, "inliers", false, 0, 0, std::nullopt});
+  p.refusals.push_back({{20'000'000'000, 2'000'000'000, geom::SE3d::Identity()}, "drift", true, 2.5, 1.9, std::nullopt});
+  p.refusals.push_back({{30'000'000'000, 3'000'000'000, geom::SE3d::Identity()}, "drift", true, 6.0, 2.0, std::nullopt});
   p.refusals_dropped = 7;
   r.primary.place = p;
   YAML::Node m = YAML::Load(metrics_json(r))["place_recognition"];
@@ -357,10 +357,12 @@ TEST(RunReport, RefusedLoopsAreCountedByCheckAndTheVerifiedOnesJudged) {
 
   // With ground truth: the first verified refusal was a true loop thrown away, the second a look-alike.
   eval::LabelledPlaceEvent right, wrong;
+  right.event.T_q_r = wrong.event.T_q_r = geom::SE3d::Identity();
   right.judged = wrong.judged = true;
   right.correct = true;
   wrong.error_m = 4.1;
-  r.primary.place->refusal_labels = {right, wrong};
+  r.primary.place->refusals[1].label = right;
+  r.primary.place->refusals[2].label = wrong;
   m = YAML::Load(metrics_json(r))["place_recognition"];
   EXPECT_EQ(m["refusals"]["verified_true"].as<int>(), 1);
   EXPECT_TRUE(m["refusal_events"][0]["correct"].IsNull());  // refused before verification: not judged

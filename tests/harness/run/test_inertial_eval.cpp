@@ -192,7 +192,7 @@ TEST(InertialEval, WheelCalibrationAgainstTheRobotsTruth) {
 
   InertialReport r;
   EXPECT_TRUE(YAML::Load(inertial_json(r))["wheels"].IsNull());  // no online calibration
-  slam::MapWheels w;
+  slam::WheelFit w;
   w.calibration = {0.9961, 0.9999, 1.079};
   w.radii_known = true;
   w.intervals = 800;

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "pvb/slam/core/keyframe_motion.hpp"
+#include "pvb/slam/inertial/wheel_calibration.hpp"
 
 namespace pvb::run {
 
@@ -44,7 +44,7 @@ struct InertialReport {
   /// With wheels calibrated online: the fit, and the robot as simulated
   /// against its description (effective radius and track over the
   /// described ones) where known.
-  std::optional<slam::MapWheels> wheels;
+  std::optional<slam::WheelFit> wheels;
   std::optional<slam::WheelCalibration> wheels_true;
 };
 

@@ -98,10 +98,10 @@ struct PlaceRecognition {
     std::string reason;
     bool verified = false;
     double correction_m = 0, drift_bound_m = 0;
+    std::optional<eval::LabelledPlaceEvent> label;  ///< verified refusals, with ground truth
   };
   std::vector<Refusal> refusals;
   int refusals_dropped = 0;
-  std::vector<eval::LabelledPlaceEvent> refusal_labels;  ///< verified refusals, with ground truth
   std::vector<std::int64_t> keyframe_t_ns;                     ///< every keyframe made, in order
   eval::PlaceLabelOptions label_options;
   std::optional<eval::PlaceLabels> labels;  ///< with ground truth

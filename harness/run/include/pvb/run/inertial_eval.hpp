@@ -33,6 +33,12 @@ struct BiasTruth {
 /// order.  IoError naming the file and line for a malformed line.
 std::vector<BiasTruth> read_bias_truth(const std::string& path);
 
+/// What an online wheel calibration should find on a simulated robot: its
+/// effective (rolling-straight) radius and track over the described ones,
+/// the radius split between the wheels by `radius_difference`.
+slam::WheelCalibration wheels_true(double effective_radius_m, double effective_track_m, double described_radius_m,
+                                   double described_track_m, double radius_difference);
+
 /// The simulated robot's effective wheel radius and track over the
 /// described ones, from a recording's robot_truth.yaml (what an online
 /// wheel calibration should find).  IoError naming the file and the key
@@ -41,7 +47,7 @@ slam::WheelCalibration read_wheels_true(const std::string& path);
 
 /// One line for the console: the wheels' calibration so far, and the
 /// robot's where known.
-std::string wheels_text(const slam::MapWheels& w, const std::optional<slam::WheelCalibration>& truth);
+std::string wheels_text(const slam::WheelFit& w, const std::optional<slam::WheelCalibration>& truth);
 
 /// The true biases at t_ns: linear between the two readings around it, the
 /// first or last reading outside them.  `truth` non-empty, in time order.

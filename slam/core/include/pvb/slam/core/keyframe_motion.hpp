@@ -7,7 +7,6 @@
 #include <optional>
 
 #include "pvb/slam/inertial/imu_preintegration.hpp"
-#include "pvb/slam/inertial/wheel_calibration.hpp"
 #include "pvb/slam/inertial/wheel_preintegration.hpp"
 
 namespace pvb::slam {
@@ -45,16 +44,6 @@ struct MapGravity {
   std::uint64_t ready_keyframe_id = 0;
   std::int64_t ready_t_ns = 0;
   double init_rms = 0;
-};
-
-/// The wheels as local mapping has calibrated them so far against the
-/// keyframes' motion (WheelCalibrator); tracking integrates new encoder
-/// readings with `calibration`.
-struct MapWheels {
-  WheelCalibration calibration;  ///< as described until the drive has shown otherwise
-  bool radii_known = false, track_known = false;
-  int intervals = 0, refused = 0;  ///< keyframe intervals fitted and refused
-  double rolled_m = 0, turned_rad = 0;
 };
 
 }  // namespace pvb::slam

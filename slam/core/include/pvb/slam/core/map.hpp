@@ -19,6 +19,7 @@
 #include "pvb/slam/core/frame.hpp"
 #include "pvb/slam/core/keyframe_motion.hpp"
 #include "pvb/slam/core/reports.hpp"
+#include "pvb/slam/inertial/wheel_calibration.hpp"
 #include "pvb/slam/place/vocabulary.hpp"
 
 namespace pvb::slam {
@@ -294,9 +295,10 @@ class Map {
   /// Gravity in the map's frame and whether the inertial state is trusted.
   MapGravity& gravity() { return gravity_; }
   const MapGravity& gravity() const { return gravity_; }
-  /// The wheels' calibration so far.
-  MapWheels& wheels() { return wheels_; }
-  const MapWheels& wheels() const { return wheels_; }
+  /// The wheels' calibration so far (local mapping's WheelCalibrator;
+  /// tracking reads new encoder intervals with it).
+  WheelFit& wheels() { return wheels_; }
+  const WheelFit& wheels() const { return wheels_; }
 
  private:
   std::mutex mutex_;
@@ -308,7 +310,7 @@ class Map {
   std::uint32_t next_provisional_ = 1;
   std::map<std::uint32_t, std::uint32_t> merged_;  ///< provisional map -> the map it was merged into
   MapGravity gravity_;
-  MapWheels wheels_;
+  WheelFit wheels_;
 };
 
 /// Takes kf out of the chain in time: its next keyframe's interval then

@@ -166,7 +166,7 @@ class System {
   /// trusted (MapGravity::ready false: not yet, or a camera-only setup).
   MapGravity gravity();
   /// The wheels' online calibration so far (as described without wheels).
-  MapWheels wheels();
+  WheelFit wheels();
   /// The sensors this system fuses.
   sensor::SensorSetup sensors() const { return settings_.motion.setup; }
   /// The wheels are fused and calibrated online (Robot.CalibrateWheels).

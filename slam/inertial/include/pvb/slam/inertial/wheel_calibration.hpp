@@ -17,6 +17,14 @@ struct WheelCalibrationOptions {
   double prior_m2 = 0.01;           ///< weight of "as described" (m^2 of rolling), so that a fit always exists
 };
 
+/// A calibrator's state as others read it (the map holds the newest).
+struct WheelFit {
+  WheelCalibration calibration;  ///< as described until the drive has shown otherwise
+  bool radii_known = false, track_known = false;
+  int intervals = 0, refused = 0;  ///< intervals fitted and refused
+  double rolled_m = 0, turned_rad = 0;
+};
+
 /// Fits, with L and R each wheel's described arc over an interval and b the
 /// described track, the base's arc s_w (L + R) / 2 (1 + rho (R - L) / (R + L))
 /// and its turn (s_w / k) ((R - L) + rho (R + L)) / b, where the wheels' radii
@@ -35,6 +43,8 @@ class WheelCalibrator {
 
   /// The fit so far: 1 for a factor not yet observed.
   WheelCalibration estimate() const;
+  /// The estimate with what it rests on.
+  WheelFit fit() const;
   bool radii_known() const { return rolled_m_ >= options_.min_rolled_m; }
   bool track_known() const { return turned_rad_ >= options_.min_turned_rad; }
 
