@@ -55,18 +55,17 @@ inline std::vector<std::string> map_sections(const std::string& file) {
 
 /// The map file of `payloads` (as map_sections gives them), each section
 /// with its length and checksum: version 1 of 6 sections, version 2 of 7
-/// (INER before META).
+/// (INER before META), version 3 of 8 (INER and WHEL before META).
 inline std::string map_file_of(const std::vector<std::string>& payloads) {
-  static const char* const kTagsV1[] = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "META"};
-  static const char* const kTagsV2[] = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "INER", "META"};
-  const bool v2 = payloads.size() == 7;
+  static const char* const kTags[] = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "INER", "WHEL"};
+  const std::uint32_t version = payloads.size() == 8 ? 3 : payloads.size() == 7 ? 2 : 1;
   std::string out("PVBMAP\r\n", 8);
   out.append(8, '\0');
-  put_u32(out, 8, v2 ? slam::kMapFileVersion : slam::kMapFileVersionVisual);
+  put_u32(out, 8, version);
   put_u32(out, 12, static_cast<std::uint32_t>(payloads.size()));
   for (std::size_t s = 0; s < payloads.size(); ++s) {
     std::string head(12, '\0');
-    std::memcpy(head.data(), (v2 ? kTagsV2 : kTagsV1)[s], 4);
+    std::memcpy(head.data(), s + 1 == payloads.size() ? "META" : kTags[s], 4);
     put_u64(head, 4, payloads[s].size());
     std::string sum(8, '\0');
     put_u64(sum, 0, fnv1a64(payloads[s].data(), payloads[s].size()));
@@ -187,6 +186,25 @@ inline void give_tiny_inertial_state(slam::Map& map) {
 inline std::string tiny_inertial_map() {
   return tiny_map(tiny_inertial_settings(), "{}", give_tiny_inertial_state);
 }
+
+/// The tiny inertial map's state and a wheel fit: 12 m rolled, one turn.
+inline void give_tiny_wheel_fit(slam::Map& map) {
+  give_tiny_inertial_state(map);
+  slam::WheelFit& f = map.wheels();
+  f.calibration = {0.998, 1.002, 1.05};
+  f.radii_known = true;
+  f.intervals = 48;
+  f.refused = 2;
+  f.rolled_m = 12.0;
+  f.turned_rad = 3.5;
+  f.sums.turn_normal << 0.5, 0.125, 0.125, 24.0;
+  f.sums.turn_rhs << 0.7, 0.01;
+  f.sums.mm = 3.0, f.sums.mn = 0.02, f.sums.nn = 0.25, f.sums.am = 2.99, f.sums.an = 0.021;
+  f.described_track_m = 0.42;
+  f.described_radius_m = 0.1;
+}
+
+inline std::string tiny_wheel_map() { return tiny_map(tiny_inertial_settings(), "{}", give_tiny_wheel_fit); }
 
 /// Byte offsets in the tiny inertial map's INER payload: setup, gravity,
 /// T_b_c (rotation, translation), T_base_c, the map's bias, the keyframe

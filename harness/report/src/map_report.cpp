@@ -52,6 +52,8 @@ std::vector<std::string> map_log_lines(const MapReport& m) {
       line += "not scored: " + m.localisation_note;
     }
     lines.push_back(line);
+    if (m.load->wheel_fit_taken) lines.push_back("map's wheel calibration taken over: this run goes on fitting it");
+    if (!m.load->wheel_fit_note.empty()) lines.push_back("map's wheel calibration " + m.load->wheel_fit_note);
   }
   if (!m.save_note.empty()) lines.push_back("map " + m.saved_to + " " + m.save_note);
   if (m.save)
@@ -74,6 +76,10 @@ std::string map_report_json(const MapReport& r) {
            "\", \"sessions\": " + std::to_string(l.sessions) +
            ", \"keyframes\": " + std::to_string(l.keyframes) + ", \"points\": " + std::to_string(l.points) +
            ", \"bytes\": " + std::to_string(l.bytes) + ", \"load_ms\": " + json_number(l.load_ms) +
+           ", \"wheel_fit\": " +
+           (l.wheel_fit_taken             ? std::string("\"taken\"")
+            : l.wheel_fit_note.empty() ? std::string("null")
+                                       : "\"" + json_escape(l.wheel_fit_note) + "\"") +
            "}, \"relocalisations\": " + std::to_string(r.relocalisations) +
            ", \"merges\": " + std::to_string(r.merges);
   }

@@ -176,6 +176,10 @@ bool LocalMapping::may_cull_in_time(const KeyFrame& kf) const {
 
 void LocalMapping::calibrate_wheels(const std::shared_ptr<KeyFrame>& kf) {
   std::lock_guard<std::mutex> lock(map_.mutex());
+  if (!wheels_resumed_) {  // a loaded map's fit (System::load_map kept it only for this robot's description)
+    wheels_resumed_ = true;
+    if (map_.wheels().intervals > 0) wheel_calibrator_->resume(map_.wheels());
+  }
   std::shared_ptr<KeyFrame> to = kf;
   for (int i = 0; i < kWheelLag && to; ++i) to = to->motion().prev.lock();
   if (!to || to->bad() || to->id() <= wheels_fitted_to_) return;
@@ -195,6 +199,7 @@ void LocalMapping::calibrate_wheels(const std::shared_ptr<KeyFrame>& kf) {
   const double arc_m = t.x() * std::cos(0.5 * yaw_rad) + t.y() * std::sin(0.5 * yaw_rad);
   wheel_calibrator_->add(wheels->described_left_m(), wheels->described_right_m(), arc_m, yaw_rad);
   map_.wheels() = wheel_calibrator_->fit();
+  map_.wheels().described_radius_m = options_.motion.robot.drive.wheel_radius_m;
 }
 
 }  // namespace pvb::slam

@@ -182,6 +182,39 @@ void put_inertial(ByteWriter& w, const Map& map, const MapSettings& s,
   }
 }
 
+/// Whether the map's wheel calibration goes into the file (version 3):
+/// with the inertial state, for a setup with wheels, once an interval was
+/// fitted, and only what the reader takes.
+bool saves_wheels(const Map& map, const MapSettings& s) {
+  const WheelFit& f = map.wheels();
+  const WheelFitSums& m = f.sums;
+  const auto described = [](double v) { return v > 0 && v <= kMaxWheelDescriptionM; };
+  return uses_wheels(s.sensors) && f.intervals > 0 && f.refused >= 0 && described(f.described_track_m) &&
+         described(f.described_radius_m) && wheel_scale_in_range(f.calibration.left_scale) &&
+         wheel_scale_in_range(f.calibration.right_scale) && wheel_scale_in_range(f.calibration.track_scale) &&
+         std::isfinite(f.rolled_m) && f.rolled_m >= 0 && std::isfinite(f.turned_rad) && f.turned_rad >= 0 &&
+         m.turn_normal.allFinite() && m.turn_rhs.allFinite() &&
+         Eigen::Matrix<double, 5, 1>(m.mm, m.mn, m.nn, m.am, m.an).allFinite();
+}
+
+/// WHEL: the description the fit was taken with, the fit, what it rests
+/// on, and the calibrator's sums (to go on fitting in a later session).
+void put_wheels(ByteWriter& w, const WheelFit& f) {
+  w.f64(f.described_radius_m);
+  w.f64(f.described_track_m);
+  for (double v : {f.calibration.left_scale, f.calibration.right_scale, f.calibration.track_scale}) w.f64(v);
+  w.u8(f.radii_known ? 1 : 0);
+  w.u8(f.track_known ? 1 : 0);
+  w.u32(static_cast<std::uint32_t>(f.intervals));
+  w.u32(static_cast<std::uint32_t>(f.refused));
+  w.f64(f.rolled_m);
+  w.f64(f.turned_rad);
+  const WheelFitSums& m = f.sums;
+  for (double v : {m.turn_normal(0, 0), m.turn_normal(0, 1), m.turn_normal(1, 1), m.turn_rhs(0), m.turn_rhs(1),
+                   m.mm, m.mn, m.nn, m.am, m.an})
+    w.f64(v);
+}
+
 /// Whether the map's inertial state goes into the file (version 2).
 bool saves_inertial(const Map& map, const MapSettings& s) {
   if (!map.gravity().ready || !uses_accel(s.sensors) || !gravity_in_range(map.gravity().g_w)) return false;
@@ -237,7 +270,7 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
     if (!mp->bad() && within_map_bounds(mp->p_w()) && saved_observer(*mp, kf_ids, kNone) != kNone)
       point_ids.push_back(id);
 
-  ByteWriter head, keyf, poin, grap, bowv, iner;
+  ByteWriter head, keyf, poin, grap, bowv, iner, whel;
   put_settings(head, settings, sessions);
   keyf.reserve(8 + kfs.size() * kKeyframeHeadBytes + keypoints * kKeypointBytes);
   keyf.u64(kfs.size());
@@ -251,13 +284,19 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   std::vector<const std::string*> payloads = {&head.data(), &keyf.data(), &poin.data(), &grap.data(),
                                               &bowv.data()};
   const bool inertial = saves_inertial(map, settings);
+  const bool wheels = inertial && saves_wheels(map, settings);
   if (inertial) {
     put_inertial(iner, map, settings, kfs, kf_ids);
     payloads.push_back(&iner.data());
   }
+  if (wheels) {
+    put_wheels(whel, map.wheels());
+    payloads.push_back(&whel.data());
+  }
   payloads.push_back(&app_json);
 
-  const std::uint32_t version = inertial ? kMapFileVersion : kMapFileVersionVisual;
+  const std::uint32_t version =
+      wheels ? kMapFileVersion : inertial ? kMapFileVersionInertial : kMapFileVersionVisual;
   const std::vector<const char*> tags = section_tags(version);
   std::size_t total = kMagicBytes + 8;
   for (const std::string* p : payloads) total += 4 + 8 + p->size() + 8;  // tag, size, payload, checksum

@@ -21,18 +21,28 @@ constexpr std::uint64_t kNone = ~std::uint64_t(0);  ///< no keyframe, no point
 constexpr std::array<const char*, 6> kSectionsV1 = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "META"};
 /// The sections of a version-2 file: INER (the inertial state) before META.
 constexpr std::array<const char*, 7> kSectionsV2 = {"HEAD", "KEYF", "POIN", "GRAP", "BOWV", "INER", "META"};
-constexpr std::size_t kInerSection = 5;  ///< INER's place in a version-2 file
+constexpr std::size_t kInerSection = 5;  ///< INER's place in a version-2 or -3 file
+/// The sections of a version-3 file: WHEL (the wheels' calibration) after INER.
+constexpr std::array<const char*, 8> kSectionsV3 = {"HEAD", "KEYF", "POIN", "GRAP",
+                                                    "BOWV", "INER", "WHEL", "META"};
+constexpr std::size_t kWhelSection = 6;  ///< WHEL's place in a version-3 file
 /// A position the file may hold: within kMaxMapCoordinateM of the origin on
 /// every axis (and so finite).  The writer leaves out a point outside it;
 /// the reader refuses one.
 inline bool within_map_bounds(const Eigen::Vector3d& p) {
   return p.allFinite() && p.cwiseAbs().maxCoeff() <= kMaxMapCoordinateM;
 }
-/// The sections of a file of `version` (1 or 2), in order.
+/// The sections of a file of `version` (1 to 3), in order.
 inline std::vector<const char*> section_tags(std::uint32_t version) {
   if (version == 1) return {kSectionsV1.begin(), kSectionsV1.end()};
-  return {kSectionsV2.begin(), kSectionsV2.end()};
+  if (version == 2) return {kSectionsV2.begin(), kSectionsV2.end()};
+  return {kSectionsV3.begin(), kSectionsV3.end()};
 }
+/// What WHEL may hold: a described radius and track within 0-10 m, each
+/// factor within 0.5-2 (a wheel half or twice its described size is not
+/// the robot described), finite sums and amounts rolled and turned.
+constexpr double kMaxWheelDescriptionM = 10, kMinWheelScale = 0.5, kMaxWheelScale = 2;
+inline bool wheel_scale_in_range(double s) { return s >= kMinWheelScale && s <= kMaxWheelScale; }
 /// Bytes of one keypoint in KEYF: 7 f32, the octave, depth, point id, descriptor.
 constexpr std::size_t kKeypointBytes = 7 * 4 + 1 + 4 + 8 + 32;
 /// Bytes of a keyframe in KEYF before its keypoints: id, frame id, time,

@@ -506,7 +506,7 @@ MapFileHeader read_map_header(const std::string& bytes, const std::string& file)
 void decode_map(const std::string& bytes, const std::string& file, const MapFileHeader& h,
                 const std::shared_ptr<const CameraModel>& cam, Map* map) {
   const Sections& s = h.sections;
-  if ((h.version != 1 && h.version != 2) || s.size() != section_tags(h.version).size())
+  if (h.version < 1 || h.version > kMapFileVersion || s.size() != section_tags(h.version).size())
     throw std::logic_error("decode_map: a header not from read_map_header");
   const auto reader = [&](std::size_t i) { return reader_for(bytes, s, i, file, h.version); };
   const PointIdsByKf ids = read_keyframes(reader(1), cam, h.sessions, map);
@@ -522,6 +522,7 @@ void decode_map(const std::string& bytes, const std::string& file, const MapFile
   read_graph(reader(3), map);
   read_bows(reader(4), map);
   if (h.version >= 2) read_inertial(reader(kInerSection), map);
+  if (h.version >= 3) map->wheels() = read_wheels(reader(kWhelSection));
 }
 
 }  // namespace pvb::slam

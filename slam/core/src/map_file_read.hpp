@@ -12,5 +12,7 @@ namespace pvb::slam::mapfile {
 void read_inertial_head(ByteReader& r, MapSettings* s, MapGravity* g);
 /// INER: the map's gravity, each keyframe's state and its link in time.
 void read_inertial(ByteReader r, Map* map);
+/// WHEL: the wheels' calibration, every value checked.
+WheelFit read_wheels(ByteReader r);
 
 }  // namespace pvb::slam::mapfile

@@ -147,4 +147,56 @@ void read_inertial(ByteReader r, Map* map) {
   map->gravity() = g;
 }
 
+WheelFit read_wheels(ByteReader r) {
+  WheelFit f;
+  const auto length = [&](const char* name) {
+    const double v = r.f64();
+    if (!(v > 0 && v <= kMaxWheelDescriptionM))
+      r.fail(std::string(name) + " " + format_g(v) + " m, expected more than 0 and at most " +
+             format_g(kMaxWheelDescriptionM) + " m");
+    return v;
+  };
+  f.described_radius_m = length("described wheel radius");
+  f.described_track_m = length("described track");
+  for (double* scale : {&f.calibration.left_scale, &f.calibration.right_scale, &f.calibration.track_scale}) {
+    *scale = r.f64();
+    if (!wheel_scale_in_range(*scale))
+      r.fail("wheel factor " + format_g(*scale) + ", expected " + format_g(kMinWheelScale) + " to " +
+             format_g(kMaxWheelScale));
+  }
+  const auto flag = [&](const char* name) {
+    const std::uint8_t v = r.u8();
+    if (v > 1) r.fail(std::string(name) + " " + std::to_string(v) + ", expected 0 or 1");
+    return v == 1;
+  };
+  f.radii_known = flag("radii_known");
+  f.track_known = flag("track_known");
+  const auto count = [&](const char* name) {
+    const std::uint32_t v = r.u32();
+    if (v > 0x7fffffffu) r.fail(std::string(name) + " " + std::to_string(v) + ", expected below 2^31");
+    return static_cast<int>(v);
+  };
+  f.intervals = count("intervals fitted");
+  f.refused = count("intervals refused");
+  if (f.intervals == 0) r.fail("no interval fitted (a map without a fit has no WHEL section)");
+  const auto amount = [&](const char* name) {
+    const double v = r.f64();
+    if (!(std::isfinite(v) && v >= 0)) r.fail(std::string(name) + " " + format_g(v) + ", expected a finite value >= 0");
+    return v;
+  };
+  f.rolled_m = amount("rolled (m)");
+  f.turned_rad = amount("turned (rad)");
+  WheelFitSums& m = f.sums;
+  double v[10];
+  for (double& x : v) x = r.f64();
+  m.turn_normal << v[0], v[1], v[1], v[2];
+  m.turn_rhs << v[3], v[4];
+  m.mm = v[5], m.mn = v[6], m.nn = v[7], m.am = v[8], m.an = v[9];
+  for (double x : v)
+    if (!std::isfinite(x)) r.fail("a calibration sum that is not finite");
+  if (v[0] < 0 || v[2] < 0 || m.mm < 0 || m.nn < 0) r.fail("a sum of squares below 0");
+  if (!r.at_end()) r.fail("longer than its calibration");
+  return f;
+}
+
 }  // namespace pvb::slam::mapfile

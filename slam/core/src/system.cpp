@@ -196,6 +196,23 @@ MapSettings System::map_settings() const {
   return m;
 }
 
+void System::take_wheel_fit(MapLoadInfo* info) {
+  const WheelFit& fit = map_->wheels();
+  if (fit.intervals == 0) return;
+  const RobotSettings& robot = settings_.motion.robot;
+  if (!uses_wheels(settings_.motion.setup))
+    info->wheel_fit_note = "not used: this run reads no wheels";
+  else if (fit.described_radius_m != robot.drive.wheel_radius_m || fit.described_track_m != robot.drive.track_m)
+    info->wheel_fit_note = "not used: fitted to wheels of radius " + format_g(fit.described_radius_m) +
+                           " m and track " + format_g(fit.described_track_m) + " m as described, this run's are " +
+                           format_g(robot.drive.wheel_radius_m) + " m and " + format_g(robot.drive.track_m) + " m";
+  else if (!robot.wheel_calibration.enabled)
+    info->wheel_fit_note = "not used: Robot.CalibrateWheels is 0";
+  else
+    info->wheel_fit_taken = true;
+  if (!info->wheel_fit_taken) map_->wheels() = WheelFit{};
+}
+
 MapLoadInfo System::load_map(const std::string& path, MapStart start) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!place_) throw ConfigError(settings_.source, "Vocabulary.path", "a vocabulary to relocalise in a saved map");
@@ -212,6 +229,7 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
       map_->gravity() = MapGravity{};  // a camera-only run keeps no inertial state
     else if (start == MapStart::kExtend && uses_imu(settings_.motion.setup) && !uses_imu(head.settings.sensors))
       map_->gravity().ready = false;  // a tilt alone (camera+accel): the new keyframes initialise the IMU
+    take_wheel_fit(&info);
     std::size_t words = 0;
     for (const auto& [id, kf] : map_->keyframes()) words += kf->bow().size();
     place_->reserve(map_->num_keyframes(), words);  // an upper bound on the distinct words

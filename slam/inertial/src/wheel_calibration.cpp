@@ -19,14 +19,14 @@ WheelCalibrator::WheelCalibrator(double described_track_m, const WheelCalibratio
 
 Eigen::Vector2d WheelCalibrator::turn_fit() const {
   const double w = options_.prior_m2;
-  const Eigen::Matrix2d A = turn_normal_ + w * Eigen::Matrix2d::Identity();
-  const Eigen::Vector2d b = turn_rhs_ + Eigen::Vector2d(w, 0);
+  const Eigen::Matrix2d A = sums_.turn_normal + w * Eigen::Matrix2d::Identity();
+  const Eigen::Vector2d b = sums_.turn_rhs + Eigen::Vector2d(w, 0);
   return A.lu().solve(b);
 }
 
 double WheelCalibrator::scale_fit(double rho) const {
   const double w = options_.prior_m2;
-  return (s_am_ + rho * s_an_ + w) / (s_mm_ + 2 * rho * s_mn_ + rho * rho * s_nn_ + w);
+  return (sums_.am + rho * sums_.an + w) / (sums_.mm + 2 * rho * sums_.mn + rho * rho * sums_.nn + w);
 }
 
 Eigen::Vector2d WheelCalibrator::predict(double left_m, double right_m) const {
@@ -51,14 +51,14 @@ bool WheelCalibrator::add(double left_m, double right_m, double arc_m, double ya
     return false;
   }
   const Eigen::Vector2d f(right_m - left_m, right_m + left_m);
-  turn_normal_ += f * f.transpose();
-  turn_rhs_ += f * (yaw_rad * track_m_);
+  sums_.turn_normal += f * f.transpose();
+  sums_.turn_rhs += f * (yaw_rad * track_m_);
   const double m = 0.5 * (left_m + right_m), n = 0.5 * (right_m - left_m);
-  s_mm_ += m * m;
-  s_mn_ += m * n;
-  s_nn_ += n * n;
-  s_am_ += arc_m * m;
-  s_an_ += arc_m * n;
+  sums_.mm += m * m;
+  sums_.mn += m * n;
+  sums_.nn += n * n;
+  sums_.am += arc_m * m;
+  sums_.an += arc_m * n;
   rolled_m_ += std::abs(m);
   turned_rad_ += std::abs(right_m - left_m) / track_m_;
   ++intervals_;
@@ -80,7 +80,23 @@ WheelCalibration WheelCalibrator::estimate() const {
 }
 
 WheelFit WheelCalibrator::fit() const {
-  return {estimate(), radii_known(), track_known(), intervals_, refused_, rolled_m_, turned_rad_};
+  return {estimate(), radii_known(), track_known(), intervals_, refused_, rolled_m_, turned_rad_, sums_, track_m_};
+}
+
+bool WheelCalibrator::resume(const WheelFit& fit) {
+  const WheelFitSums& f = fit.sums;
+  const bool finite = f.turn_normal.allFinite() && f.turn_rhs.allFinite() && std::isfinite(f.mm) &&
+                      std::isfinite(f.mn) && std::isfinite(f.nn) && std::isfinite(f.am) && std::isfinite(f.an) &&
+                      std::isfinite(fit.rolled_m) && std::isfinite(fit.turned_rad);
+  if (!finite || fit.described_track_m != track_m_ || fit.intervals < 0 || fit.refused < 0 || fit.rolled_m < 0 ||
+      fit.turned_rad < 0)
+    return false;
+  sums_ = f;
+  rolled_m_ = fit.rolled_m;
+  turned_rad_ = fit.turned_rad;
+  intervals_ = fit.intervals;
+  refused_ = fit.refused;
+  return true;
 }
 
 }  // namespace pvb::slam

@@ -173,8 +173,8 @@ TEST_F(MapFile, ADamagedByteInAnySectionFailsItsChecksum) {
 TEST_F(MapFile, ForeignAndFutureFilesSaySo) {
   EXPECT_NE(load_error("PVBVOC1\nnot a map", "foreign.pvbmap").find("not a map file"), std::string::npos);
   std::string future = bytes_;
-  future[8] = 3;  // version, little-endian u32 after the magic
-  EXPECT_NE(load_error(future, "future.pvbmap").find("version 3 is newer than this build reads (2)"),
+  future[8] = 4;  // version, little-endian u32 after the magic
+  EXPECT_NE(load_error(future, "future.pvbmap").find("version 4 is newer than this build reads (3)"),
             std::string::npos);
   std::string unframed = bytes_;
   unframed[8] = 2;  // a version-2 file has an INER section
@@ -276,6 +276,63 @@ TEST_F(MapFile, ARunWithAnImuHasTheMapsGravityAtOnce) {
   const FrameResult r = camera.track(pair_frames(s).front());
   ASSERT_TRUE(r.T_w_c) << r.tracking.failure;
   EXPECT_LT(r.T_w_c->translation().norm(), 0.01);
+}
+
+std::string wheel_pair_map(const std::string& bytes, const std::string& file, const geom::SE3d& T_b_c) {
+  const MapFileHeader h = read_map_header(bytes, file);
+  Map map;
+  decode_map(bytes, file, h, camera_for(h.settings), &map);
+  std::lock_guard<std::mutex> lock(map.mutex());
+  test::give_tiny_wheel_fit(map);
+  MapSettings s = h.settings;
+  s.sensors = sensor::SensorSetup::kCameraImuWheels;
+  s.T_b_c = T_b_c;
+  return encode_map(map, s, h.sessions, h.app_json);
+}
+
+Settings wheel_settings(const geom::SE3d& T_b_c) {
+  Settings s = imu_settings(T_b_c);
+  s.motion.setup = sensor::SensorSetup::kCameraImuWheels;
+  s.motion.robot.present = true;
+  return s;
+}
+
+// A map's wheel fit is taken over by a run whose wheels are those it was
+// fitted to (the same described radius and track, the calibration on),
+// which saves it again unchanged; any other run drops it and says why.
+TEST_F(MapFile, AWheelFitIsTakenOverOnlyForTheWheelsItWasFittedTo) {
+  const geom::SE3d T_b_c = test::tiny_inertial_settings().T_b_c;
+  const std::string p = tmp_path("wheel_pair.pvbmap");
+  const std::string bytes = wheel_pair_map(bytes_, path_, T_b_c);
+  write_file(p, bytes);
+  {
+    System system(wheel_settings(T_b_c), sync_options());
+    const MapLoadInfo info = system.load_map(p, MapStart::kExtend);
+    EXPECT_TRUE(info.wheel_fit_taken);
+    EXPECT_EQ(info.wheel_fit_note, "");
+    EXPECT_EQ(system.wheels().intervals, 48);
+    EXPECT_EQ(system.wheels().calibration, (WheelCalibration{0.998, 1.002, 1.05}));
+    system.shutdown();
+    const std::string again = tmp_path("wheel_again.pvbmap");
+    system.save_map(again, R"({"station": "fr3"})");
+    EXPECT_TRUE(read_file(again) == bytes);
+  }
+  Settings wider = wheel_settings(T_b_c);
+  wider.motion.robot.drive.track_m = 0.45;
+  System other(wider, sync_options());
+  const MapLoadInfo info = other.load_map(p, MapStart::kLocalise);
+  EXPECT_FALSE(info.wheel_fit_taken);
+  EXPECT_EQ(info.wheel_fit_note,
+            "not used: fitted to wheels of radius 0.1 m and track 0.42 m as described, this run's are 0.1 m and "
+            "0.45 m");
+  EXPECT_EQ(other.wheels().intervals, 0);
+  EXPECT_EQ(other.wheels().calibration, WheelCalibration{});
+  Settings uncalibrated = wheel_settings(T_b_c);
+  uncalibrated.motion.robot.wheel_calibration.enabled = false;
+  System off(uncalibrated, sync_options());
+  EXPECT_EQ(off.load_map(p, MapStart::kLocalise).wheel_fit_note, "not used: Robot.CalibrateWheels is 0");
+  System camera(read_settings(kTum3), sync_options());
+  EXPECT_EQ(camera.load_map(p, MapStart::kLocalise).wheel_fit_note, "not used: this run reads no wheels");
 }
 
 // A map made with an accelerometer alone holds a tilt, not the IMU's full

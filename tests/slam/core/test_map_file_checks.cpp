@@ -174,6 +174,36 @@ std::vector<ImpossibleMap> impossible_inertial_maps() {
   };
 }
 
+/// The tiny map with a wheel fit, its WHEL section made impossible one way
+/// at a time.
+std::vector<ImpossibleMap> impossible_wheel_maps() {
+  using namespace test;
+  const std::string tiny = tiny_wheel_map();
+  const auto edit = [&](const std::function<void(std::string&)>& change) {
+    std::vector<std::string> p = map_sections(tiny);
+    change(p[6]);
+    return map_file_of(p);
+  };
+  constexpr std::size_t kFactors = 16, kFlags = 40, kCounts = 42, kRolled = 50, kSums = 66;
+  return {
+      {"wheels_track_20m", edit([](std::string& b) { put_f64(b, 8, 20.0); }),
+       "described track 20 m, expected more than 0 and at most 10 m"},
+      {"wheels_factor_3", edit([](std::string& b) { put_f64(b, kFactors + 8, 3.0); }),
+       "wheel factor 3, expected 0.5 to 2"},
+      {"wheels_flag_2", edit([](std::string& b) { b[kFlags + 1] = 2; }), "track_known 2, expected 0 or 1"},
+      {"wheels_no_interval", edit([](std::string& b) { put_u32(b, kCounts, 0); }),
+       "no interval fitted (a map without a fit has no WHEL section)"},
+      {"wheels_rolled_negative", edit([](std::string& b) { put_f64(b, kRolled, -1.0); }),
+       "rolled (m) -1, expected a finite value >= 0"},
+      {"wheels_sum_inf",
+       edit([](std::string& b) { put_f64(b, kSums + 8, std::numeric_limits<double>::infinity()); }),
+       "a calibration sum that is not finite"},
+      {"wheels_square_negative", edit([](std::string& b) { put_f64(b, kSums + 5 * 8, -1.0); }),
+       "a sum of squares below 0"},
+      {"wheels_longer", edit([](std::string& b) { b.append(8, '\0'); }), "longer than its calibration"},
+  };
+}
+
 const std::string kCorpus = std::string(PVB_SOURCE_DIR) + "/tests/fuzz/corpus/map_file";
 
 TEST(MapFileChecks, TheTinyMapIsWhatItsOffsetsSay) {
@@ -196,7 +226,9 @@ TEST(MapFileChecks, EveryImpossibleMapIsRefusedForItsReason) {
   if (out) write_file(std::string(out) + "/tiny.pvbmap", test::tiny_map());
   if (out) write_file(std::string(out) + "/tiny_inertial.pvbmap", test::tiny_inertial_map());
   std::vector<ImpossibleMap> maps = impossible_maps();
+  if (out) write_file(std::string(out) + "/tiny_wheel.pvbmap", test::tiny_wheel_map());
   for (ImpossibleMap& m : impossible_inertial_maps()) maps.push_back(std::move(m));
+  for (ImpossibleMap& m : impossible_wheel_maps()) maps.push_back(std::move(m));
   for (const ImpossibleMap& m : maps) {
     const std::string what = decode_error(m.bytes, "m.pvbmap");
     EXPECT_NE(what.find(m.reason), std::string::npos) << m.name << ": " << what;
@@ -227,7 +259,7 @@ void write_pair_seeds(const std::string& dir) {
 // The seeds that are whole maps are maps the reader reads.
 TEST(MapFileChecks, TheWholeMapsOfTheCorpusAreRead) {
   if (const char* out = std::getenv("PVB_WRITE_MAP_CORPUS")) write_pair_seeds(out);
-  for (const char* seed : {"tiny.pvbmap", "tiny_inertial.pvbmap", "fr3_pair_600.pvbmap"}) {
+  for (const char* seed : {"tiny.pvbmap", "tiny_inertial.pvbmap", "tiny_wheel.pvbmap", "fr3_pair_600.pvbmap"}) {
     std::ifstream in(kCorpus + "/" + seed, std::ios::binary);
     ASSERT_TRUE(in.good()) << seed;
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -378,6 +410,71 @@ TEST(MapFileInertial, AMapWithInertialStateRoundTripsAsVersion2) {
   }
   EXPECT_FALSE(kfs.at(2)->motion().next.lock());
   EXPECT_TRUE(encode_map(map, h.settings, h.sessions, h.app_json) == bytes);
+}
+
+// A map whose wheels were calibrated saves the fit as version 3 (WHEL
+// after INER) and reads it back whole; save -> load -> save gives the same
+// bytes; without a fit, or without the wheels, it is version 2 or 1 as
+// before; a value the reader refuses names WHEL and its byte.
+TEST(MapFileInertial, AMapWithAWheelFitRoundTripsAsVersion3) {
+  const std::string bytes = test::tiny_wheel_map();
+  EXPECT_EQ(version_of(bytes), 3u);
+  const auto p = test::map_sections(bytes);
+  ASSERT_EQ(p.size(), 8u);
+  EXPECT_EQ(p[6].size(), 2 * 8 + 3 * 8 + 2 + 2 * 4 + 2 * 8 + 10 * 8u);
+  const auto v2 = test::map_sections(test::tiny_inertial_map());
+  for (std::size_t s = 0; s < 6; ++s) EXPECT_TRUE(p[s] == v2[s]) << s;
+  EXPECT_EQ(p[7], v2[6]);
+  const MapFileHeader h = read_map_header(bytes, "wheels.pvbmap");
+  Map map;
+  decode_map(bytes, "wheels.pvbmap", h, camera_for(h.settings), &map);
+  Map want;
+  test::give_tiny_wheel_fit(want);
+  const WheelFit& got = map.wheels();
+  EXPECT_EQ(got.calibration, want.wheels().calibration);
+  EXPECT_TRUE(got.sums == want.wheels().sums);
+  EXPECT_EQ(got.radii_known, true);
+  EXPECT_EQ(got.track_known, false);
+  EXPECT_EQ(got.intervals, 48);
+  EXPECT_EQ(got.refused, 2);
+  EXPECT_EQ(got.rolled_m, 12.0);
+  EXPECT_EQ(got.turned_rad, 3.5);
+  EXPECT_EQ(got.described_radius_m, 0.1);
+  EXPECT_EQ(got.described_track_m, 0.42);
+  EXPECT_TRUE(encode_map(map, h.settings, h.sessions, h.app_json) == bytes);
+
+  // No interval fitted: version 2; a run without wheels: no WHEL either.
+  const auto unfitted = [](Map& m) {
+    test::give_tiny_wheel_fit(m);
+    m.wheels().intervals = 0;
+  };
+  EXPECT_TRUE(test::tiny_map(test::tiny_inertial_settings(), "{}", unfitted) == test::tiny_inertial_map());
+  MapSettings imu_only = test::tiny_inertial_settings();
+  imu_only.sensors = sensor::SensorSetup::kCameraImu;
+  EXPECT_EQ(version_of(test::tiny_map(imu_only, "{}", test::give_tiny_wheel_fit)), 2u);
+  // A factor the reader refuses is not written.
+  const auto huge = [](Map& m) {
+    test::give_tiny_wheel_fit(m);
+    m.wheels().calibration.track_scale = 3;
+  };
+  EXPECT_TRUE(test::tiny_map(test::tiny_inertial_settings(), "{}", huge) == test::tiny_inertial_map());
+
+  std::vector<std::string> bad = p;
+  test::put_f64(bad[6], 16, 3.0);  // the left wheel's factor
+  std::size_t whel = 16;           // where WHEL's tag lies in the file
+  for (std::size_t s = 0; s < 6; ++s) whel += 12 + p[s].size() + 8;
+  const std::string what = decode_error(test::map_file_of(bad));
+  EXPECT_NE(what.find("WHEL section at byte 36 (file byte " + std::to_string(whel + 36) +
+                      "): wheel factor 3, expected 0.5 to 2"),
+            std::string::npos)
+      << what;
+  bad = p;
+  test::put_f64(bad[6], 0, 0.0);  // the described radius
+  EXPECT_NE(decode_error(test::map_file_of(bad)).find("described wheel radius 0 m, expected more than 0"),
+            std::string::npos);
+  bad = p;
+  test::put_f64(bad[6], 2 * 8 + 3 * 8 + 2 + 2 * 4 + 2 * 8 + 5 * 8, std::nan(""));  // sum mm
+  EXPECT_NE(decode_error(test::map_file_of(bad)).find("a calibration sum that is not finite"), std::string::npos);
 }
 
 // What the reader would refuse is not written: a keyframe state beyond

@@ -1,6 +1,7 @@
 // WheelCalibrator: recovers each wheel's radius and the track from
 // intervals of straights and turns, stays as described for what the drive
-// has not shown it, and refuses an interval that slipped.
+// has not shown it, refuses an interval that slipped, and goes on from a
+// saved fit as if it had never stopped.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -91,6 +92,41 @@ TEST(WheelCalibrator, RefusesAnIntervalThatSlipped) {
   EXPECT_FALSE(cal.add(0.25, 0.25, std::nan(""), 0.0));
   EXPECT_NEAR(cal.estimate().track_scale, 1.05, 0.005);
   EXPECT_THROW(WheelCalibrator(0.0), std::invalid_argument);
+}
+
+// A calibrator resumed from another's fit (as a map file carries it) gives
+// exactly what one calibrator fed every interval gives, and a fit taken
+// with another described track, or not finite, is not taken.
+TEST(WheelCalibrator, GoesOnFromASavedFitAsIfItHadNeverStopped) {
+  Drive whole{{0.995, 1.003, 1.06}, 0.002, 0.001}, first = whole;
+  WheelCalibrator all(kTrackM), before(kTrackM);
+  for (int k = 0; k < 2; ++k) {
+    whole.aisle(&all, 30, 2.2);
+    first.aisle(&before, 30, 2.2);
+  }
+  const WheelFit saved = before.fit();
+  EXPECT_EQ(saved.described_track_m, kTrackM);
+  EXPECT_EQ(saved.intervals, before.intervals());
+  WheelCalibrator after(kTrackM);
+  ASSERT_TRUE(after.resume(saved));
+  EXPECT_EQ(after.fit().calibration, saved.calibration);
+  for (int k = 0; k < 2; ++k) {
+    whole.aisle(&all, 30, 2.2);
+    first.aisle(&after, 30, 2.2);
+  }
+  EXPECT_EQ(after.estimate(), all.estimate());
+  EXPECT_EQ(after.intervals(), all.intervals());
+  EXPECT_EQ(after.rolled_m(), all.rolled_m());
+  EXPECT_TRUE(after.fit().sums == all.fit().sums);
+
+  WheelCalibrator wider(kTrackM + 0.01);
+  EXPECT_FALSE(wider.resume(saved));
+  EXPECT_EQ(wider.intervals(), 0);
+  WheelFit broken = saved;
+  broken.sums.am = std::nan("");
+  WheelCalibrator fresh(kTrackM);
+  EXPECT_FALSE(fresh.resume(broken));
+  EXPECT_EQ(fresh.estimate(), WheelCalibration{});
 }
 
 }  // namespace

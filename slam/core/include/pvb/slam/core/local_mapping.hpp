@@ -132,6 +132,7 @@ class LocalMapping {
   std::function<void(const std::shared_ptr<KeyFrame>&)> after_keyframe_;
   std::optional<WheelCalibrator> wheel_calibrator_;  ///< with the wheels and Robot.CalibrateWheels
   std::uint64_t wheels_fitted_to_ = 0;               ///< the last interval's end keyframe
+  bool wheels_resumed_ = false;                      ///< a loaded map's fit taken over (or none to take)
   WorkerError worker_error_;  ///< what ended the worker, for the owner's thread
   std::thread worker_;
 };

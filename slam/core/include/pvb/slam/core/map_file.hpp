@@ -27,7 +27,7 @@ namespace pvb::slam {
 
 /// The file's header and application data, without the map itself.
 struct MapFileHeader {
-  std::uint32_t version = 0;   ///< 1 (no inertial state) or 2 (INER)
+  std::uint32_t version = 0;   ///< 1 (no inertial state), 2 (INER) or 3 (INER and WHEL)
   MapSettings settings;        ///< from HEAD, and the sensors from INER
   std::uint32_t sessions = 0;  ///< mapping sessions the map holds
   std::string app_json;        ///< the META section (the caller's JSON, "" when none)
@@ -39,7 +39,9 @@ struct MapFileHeader {
 /// The newest version written and read; a map without inertial state is
 /// still written as version 1 (kMapFileVersionVisual), byte for byte as
 /// before version 2 existed.
-constexpr std::uint32_t kMapFileVersion = 2;
+constexpr std::uint32_t kMapFileVersion = 3;
+/// A map with inertial state but no wheel calibration is version 2.
+constexpr std::uint32_t kMapFileVersionInertial = 2;
 constexpr std::uint32_t kMapFileVersionVisual = 1;
 /// The largest map file read: 4 GiB, about 30 000 keyframes (a
 /// 709-keyframe lawnmower map is 103 MB).  Reading one takes its size in

@@ -51,6 +51,11 @@ struct MapLoadInfo {
   std::size_t keyframes = 0, points = 0, bytes = 0;
   std::string app_json;        ///< the application's data saved with it
   double load_ms = 0;          ///< reading, checking, linking and bags of words
+  /// The wheels' calibration saved with the map: taken over (this run
+  /// reads its encoders with it and goes on fitting), or why not ("" when
+  /// the map holds none).
+  bool wheel_fit_taken = false;
+  std::string wheel_fit_note;
 };
 
 struct MapSaveInfo {
@@ -216,6 +221,9 @@ class System {
   std::int64_t session_offset_ns_ = 0;  ///< session_clock_offset_ns()
   /// Sets the session's first frame and its clock's offset (once).
   void start_session_clock(std::int64_t t_ns);
+  /// Keeps a loaded map's wheel fit when this run's wheels are those it
+  /// was fitted to and calibrated, else drops it; says which in *info.
+  void take_wheel_fit(MapLoadInfo* info);
   std::unique_ptr<Tracking> tracking_;
   std::unique_ptr<LoopClosing> loop_;  ///< null when loop closing is disabled; runs on the mapping thread
   std::unique_ptr<LocalMapping> mapping_;

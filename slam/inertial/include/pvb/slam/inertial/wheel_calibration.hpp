@@ -17,12 +17,28 @@ struct WheelCalibrationOptions {
   double prior_m2 = 0.01;           ///< weight of "as described" (m^2 of rolling), so that a fit always exists
 };
 
+/// The calibrator's normal equations (WheelCalibrator's model below), all
+/// a fit needs to go on where it stopped: a map saves them.
+struct WheelFitSums {
+  Eigen::Matrix2d turn_normal = Eigen::Matrix2d::Zero();  ///< sum of f f^T, f = (R - L, R + L)
+  Eigen::Vector2d turn_rhs = Eigen::Vector2d::Zero();     ///< sum of f yaw b
+  // Sums of the arc rows: m = (L + R) / 2, n = (R - L) / 2, a the arc.
+  double mm = 0, mn = 0, nn = 0, am = 0, an = 0;
+  bool operator==(const WheelFitSums& o) const {
+    return turn_normal == o.turn_normal && turn_rhs == o.turn_rhs && mm == o.mm && mn == o.mn && nn == o.nn &&
+           am == o.am && an == o.an;
+  }
+};
+
 /// A calibrator's state as others read it (the map holds the newest).
 struct WheelFit {
   WheelCalibration calibration;  ///< as described until the drive has shown otherwise
   bool radii_known = false, track_known = false;
   int intervals = 0, refused = 0;  ///< intervals fitted and refused
   double rolled_m = 0, turned_rad = 0;
+  WheelFitSums sums;
+  double described_track_m = 0;   ///< the track the sums were taken with
+  double described_radius_m = 0;  ///< the wheels' radius they were taken with (0: not said)
 };
 
 /// Fits, with L and R each wheel's described arc over an interval and b the
@@ -40,6 +56,11 @@ class WheelCalibrator {
   /// (rad).  Returns false when the interval is refused (it misfits the
   /// fit so far by more than the gates: slip, a bad pose).
   bool add(double left_m, double right_m, double arc_m, double yaw_rad);
+
+  /// Goes on from `fit` (a saved map's): its sums and counts replace this
+  /// calibrator's.  False, and nothing changed, when it was taken with
+  /// another described track or holds a value that is not finite.
+  bool resume(const WheelFit& fit);
 
   /// The fit so far: 1 for a factor not yet observed.
   WheelCalibration estimate() const;
@@ -63,10 +84,7 @@ class WheelCalibrator {
 
   double track_m_;
   WheelCalibrationOptions options_;
-  Eigen::Matrix2d turn_normal_ = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d turn_rhs_ = Eigen::Vector2d::Zero();
-  // Sums of the arc rows: m = (L + R) / 2, n = (R - L) / 2, a the arc.
-  double s_mm_ = 0, s_mn_ = 0, s_nn_ = 0, s_am_ = 0, s_an_ = 0;
+  WheelFitSums sums_;
   double rolled_m_ = 0, turned_rad_ = 0;
   int intervals_ = 0, refused_ = 0;
 };
