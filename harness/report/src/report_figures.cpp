@@ -41,6 +41,34 @@ void write_motion_figures(const MotionSensorsReport& m, const std::string& dir, 
                dir, "odometry_drift", written);
 }
 
+/// Memory and each stage's time against the map's keyframes, from the
+/// run's cost samples.
+void write_cost_figures(const SlamRun& run, const std::string& dir, std::vector<std::string>* written) {
+  if (run.costs.size() < 2) return;
+  std::vector<double> kf;
+  std::vector<double> rss, sparse, dense, track, loop, mapping;
+  for (const CostSample& c : run.costs) {
+    kf.push_back(static_cast<double>(c.keyframes));
+    rss.push_back(c.rss_mb);
+    sparse.push_back(c.sparse_mb);
+    dense.push_back(c.dense_mb);
+    track.push_back(c.tracking_ms_median);
+    loop.push_back(c.loop_detect_ms);
+    mapping.push_back(c.mapping_ms_per_keyframe);
+  }
+  write_figure(eval::make_line_chart("memory as the map grows", "keyframes in the map", "memory [MB]",
+                                     {{"process (RSS)", kf, rss, eval::series_color(0)},
+                                      {"sparse map", kf, sparse, eval::series_color(1)},
+                                      {"dense map", kf, dense, eval::series_color(2)}}),
+               dir, "cost_memory", written);
+  write_figure(eval::make_line_chart("time as the map grows (each over the frames since the sample before)",
+                                     "keyframes in the map", "time [ms]",
+                                     {{"tracking, median per frame", kf, track, eval::series_color(0)},
+                                      {"loop detection, mean per keyframe", kf, loop, eval::series_color(1)},
+                                      {"local mapping, per keyframe", kf, mapping, eval::series_color(2)}}),
+               dir, "cost_time", written);
+}
+
 std::vector<std::string> write_figures(const RunReport& r, const std::string& dir) {
   std::vector<std::string> written;
   std::vector<const SlamRun*> runs{&r.primary};
@@ -117,6 +145,7 @@ std::vector<std::string> write_figures(const RunReport& r, const std::string& di
   }
   write_inertial_figures(r, dir, &written);
   if (r.motion) write_motion_figures(*r.motion, dir, &written);
+  write_cost_figures(r.primary, dir, &written);
   return written;
 }
 

@@ -326,7 +326,7 @@ void OfflineSlam::Impl::print_loop_closing(std::ostringstream* js) {
   text(strf("loop closing: %zu loops closed (%d consistent detections, %d refused: %d by the drift bound, "
             "%d as ambiguous); detection %.2f ms median per keyframe\n",
             loops.loops.size(), loops.consistent, loops.rejected, loops.refused_drift, loops.refused_ambiguous,
-            percentile(loops.detect_ms, 0.5)));
+            loops.detect_ms.quantile(0.5)));
   text(strf("  %d candidates verified: refused %d at the descriptor matches, %d at RANSAC, %d after the guided "
             "search, %d by the correction bound; verification %.0f of %.0f ms\n",
             loops.verified, loops.refused_matches, loops.refused_ransac, loops.refused_inliers,

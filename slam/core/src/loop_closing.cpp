@@ -193,6 +193,25 @@ LoopMatch verify_at(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, c
   return out;
 }
 
+void DurationHistogram::add(double ms) {
+  const double octaves = ms > kLowestMs ? std::log2(ms / kLowestMs) : 0.0;  // NaN falls in the first bin
+  const int bin = std::clamp(static_cast<int>(octaves * kBinsPerOctave), 0, kBins - 1);
+  ++counts_[static_cast<std::size_t>(bin)];
+  ++count_;
+  total_ms_ += std::isfinite(ms) ? ms : 0.0;
+}
+
+double DurationHistogram::quantile(double q) const {
+  if (count_ == 0) return 0;
+  // Nearest rank: the ceil(q n)-th smallest value (the first for q = 0).
+  const auto rank = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(q * static_cast<double>(count_))));
+  std::size_t seen = 0;
+  int bin = 0;
+  for (; bin < kBins - 1; ++bin)
+    if ((seen += counts_[static_cast<std::size_t>(bin)]) >= rank) break;
+  return kLowestMs * std::exp2((bin + 0.5) / kBinsPerOctave);
+}
+
 std::string to_json(const LoopClosingStats& stats) {
   const auto num = [](double v) { return json_number(v, 6); };
   std::string out = "{\"loops\": " + std::to_string(stats.loops.size()) + ", \"events\": [";
@@ -226,8 +245,8 @@ std::string to_json(const LoopClosingStats& stats) {
          ", \"refused_correction\": " + std::to_string(stats.refused_correction) +
          ", \"refusals\": " + std::to_string(stats.refusals.size() + static_cast<std::size_t>(stats.refusals_dropped)) +
          ", \"verify_ms_total\": " + num(stats.verify_ms_total) +
-         ", \"detect_ms_median\": " + num(quantile(stats.detect_ms, 0.5)) +
-         ", \"detect_ms_p95\": " + num(quantile(stats.detect_ms, 0.95)) + ", \"detect_ms_total\": " +
+         ", \"detect_ms_median\": " + num(stats.detect_ms.quantile(0.5)) +
+         ", \"detect_ms_p95\": " + num(stats.detect_ms.quantile(0.95)) + ", \"detect_ms_total\": " +
          num(stats.detect_ms_total) + "}";
   return out;
 }
@@ -238,6 +257,11 @@ LoopClosing::LoopClosing(Map& map, const LoopClosingOptions& options, PlaceRecog
 LoopClosingStats LoopClosing::stats() const {
   std::lock_guard<std::mutex> lock(stats_mutex_);
   return stats_;
+}
+
+LoopDetectTotals LoopClosing::detect_totals() const {
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  return {stats_.detect_ms.count(), stats_.detect_ms_total};
 }
 
 std::vector<std::shared_ptr<KeyFrame>> LoopClosing::propose(const std::shared_ptr<KeyFrame>& kf) {
@@ -436,7 +460,7 @@ std::shared_ptr<KeyFrame> LoopClosing::find(const std::shared_ptr<KeyFrame>& kf,
   const double detect_ms = ms_since(t0);
   std::lock_guard<std::mutex> s(stats_mutex_);
   stats_.detect_ms_total += detect_ms;
-  stats_.detect_ms.push_back(detect_ms);
+  stats_.detect_ms.add(detect_ms);
   if (!consistent.empty()) ++stats_.consistent;
   if (!consistent.empty() && !loop_kf) ++stats_.rejected;
   return loop_kf;

@@ -114,6 +114,8 @@ TrackingState System::state() const { return tracking_->state(); }
 
 LoopClosingStats System::loop_stats() const { return loop_ ? loop_->stats() : LoopClosingStats{}; }
 
+LoopDetectTotals System::loop_detect_totals() const { return loop_ ? loop_->detect_totals() : LoopDetectTotals{}; }
+
 const std::vector<RelocEvent>& System::relocalisations() const { return tracking_->relocalisations(); }
 
 FrameResult System::track(const sensor::RgbdFrame& in) {

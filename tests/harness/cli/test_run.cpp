@@ -122,6 +122,15 @@ void check_report_files(const std::string& d) {
   EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 150u);
   EXPECT_EQ(data_lines(d + "/CameraTrajectory.txt").size(), 150u);
   EXPECT_EQ(data_lines(d + "/timing.csv").size(), 151u);  // header + one line per frame
+  // Costs every 300 frames and at the end: one sample of 150 frames.
+  EXPECT_EQ(data_lines(d + "/costs.csv").size(), 2u);
+  const YAML::Node costs = metrics(d)["costs"];
+  ASSERT_EQ(costs["rows"].size(), 1u);
+  EXPECT_EQ(costs["every_frames"].as<int>(), 300);
+  EXPECT_EQ(costs["columns"][4].as<std::string>(), "rss_mb");
+  EXPECT_EQ(costs["rows"][0][0].as<int>(), 149);
+  for (int c : {2, 3, 4, 5, 7}) EXPECT_GT(costs["rows"][0][c].as<double>(), 0) << c;
+  EXPECT_GT(costs["rows"][0][4].as<double>(), costs["rows"][0][5].as<double>());  // the process holds the map
   EXPECT_EQ(data_lines(d + "/KeyFrameTrajectory.txt").size(),
             static_cast<std::size_t>(metrics(d)["keyframes"].as<int>()));
   for (const char* f : {"run.log", "index.html", "contact_sheet.png", "camera.yaml", "trajectory_error.svg",

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 
@@ -333,6 +334,44 @@ TEST(RunReport, PlaceRecognitionInMetricsAndReport) {
   EXPECT_EQ(m["place_recognition"]["relocalisations_true"].as<int>(), 1);
   EXPECT_TRUE(m["place_recognition"]["loop_events"].IsSequence());
   EXPECT_NE(index_html(r, {}).find("<th>loops true / false / missed</th><td>1 / 1 / 0"), std::string::npos);
+}
+
+// The cost samples go into metrics.json as rows under named columns, and
+// into two figures against the map's keyframes.
+TEST(RunReport, CostsAreRowsUnderTheirColumnsAndTwoFigures) {
+  RunReport r = hand_report();
+  r.primary.cost_every_frames = 300;
+  for (int k = 1; k <= 3; ++k) {
+    CostSample c;
+    c.frame = 300 * k - 1;
+    c.keyframes = static_cast<std::size_t>(40 * k);
+    c.rss_mb = 300 + 10.0 * k;
+    c.sparse_mb = 5.0 * k;
+    c.loop_detect_ms = 1.5;
+    r.primary.costs.push_back(c);
+  }
+  const YAML::Node m = YAML::Load(metrics_json(r))["costs"];
+  EXPECT_EQ(m["every_frames"].as<int>(), 300);
+  ASSERT_EQ(m["columns"].size(), cost_columns().size());
+  ASSERT_EQ(m["rows"].size(), 3u);
+  const auto column = [&](const std::string& name) {
+    for (std::size_t i = 0; i < cost_columns().size(); ++i)
+      if (cost_columns()[i] == name) return static_cast<int>(i);
+    return -1;
+  };
+  EXPECT_EQ(m["columns"][column("keyframes")].as<std::string>(), "keyframes");
+  EXPECT_EQ(m["rows"][2][column("keyframes")].as<int>(), 120);
+  EXPECT_EQ(m["rows"][1][column("rss_mb")].as<double>(), 320.0);
+  EXPECT_EQ(m["rows"][0][column("frame")].as<int>(), 299);
+  EXPECT_EQ(m["rows"][0][column("loop_detect_ms")].as<double>(), 1.5);
+  const std::string dir = ::testing::TempDir() + "/cost_figures";
+  std::filesystem::create_directories(dir);
+  const std::vector<std::string> written = write_figures(r, dir);
+  for (const char* f : {"cost_memory", "cost_time"})
+    EXPECT_NE(std::find(written.begin(), written.end(), f), written.end()) << f;
+  r.primary.costs.resize(1);  // one sample draws no line
+  const std::vector<std::string> one = write_figures(r, dir);
+  EXPECT_EQ(std::find(one.begin(), one.end(), "cost_memory"), one.end());
 }
 
 TEST(RunReport, RefusedLoopsAreCountedByCheckAndTheVerifiedOnesJudged) {

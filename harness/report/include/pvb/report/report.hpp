@@ -141,6 +141,25 @@ struct DenseMapReport {
 /// The dense_map object of metrics.json.
 std::string dense_map_json(const DenseMapReport& d, const std::string& in);
 
+/// What the run costs as its map grows, sampled every CostLog::every_frames
+/// frames and at the end (costs.csv; metrics.json "costs"): memory, and
+/// each stage's time over the frames since the sample before.
+struct CostSample {
+  int frame = 0;
+  double t_s = 0;
+  std::size_t keyframes = 0, points = 0;  ///< in the map
+  double rss_mb = 0;     ///< the whole process's resident set
+  double sparse_mb = 0;  ///< keyframes (the map's and culled ones kept for the trajectory), points, bags of words
+  double dense_mb = 0;   ///< the dense mapper's keyframe clouds and voxel maps
+  double tracking_ms_median = 0, tracking_ms_p95 = 0;  ///< per frame, over the window
+  double loop_detect_ms = 0;           ///< mean per detection over the window (0: none in it)
+  double mapping_ms_per_keyframe = 0;  ///< local mapping's busy time per keyframe over the window (0: none)
+};
+/// The columns of costs.csv and of metrics.json's "costs" rows, in order.
+const std::vector<std::string>& cost_columns();
+/// A sample's values in cost_columns()' order.
+std::vector<double> cost_values(const CostSample& c);
+
 /// One SLAM system's run (PE-SLAM, or the baseline: PE-match off, ORB-SLAM2's motion model).
 struct SlamRun {
   std::string mode;  ///< eval::kPeSlamMode or eval::kBaselineMode ("pe-slam", "baseline")
@@ -177,6 +196,8 @@ struct SlamRun {
   std::optional<eval::TiltDrift> tilt;
   std::optional<InertialReport> inertial;  ///< a setup with an IMU (not camera alone)
   std::optional<BlindStretch> blind;  ///< a scenario whose camera is covered for a while
+  std::vector<CostSample> costs;      ///< as the map grew (empty: not sampled)
+  int cost_every_frames = 0;          ///< the sampling period
 };
 
 /// Closed loop: distance of the ground-truth robot (axle centre) from the

@@ -121,6 +121,8 @@ class LoopClosing {
   void suggest_merge(std::uint32_t from, const geom::SE3d& T_into_from, std::shared_ptr<KeyFrame> anchor);
 
   LoopClosingStats stats() const;
+  /// The detections so far and their time, without copying the stats.
+  LoopDetectTotals detect_totals() const;
   const LoopClosingOptions& options() const { return options_; }
 
   /// Called on the loop-closing thread while a correction's essential

@@ -163,6 +163,8 @@ class System {
   TrackingState state() const;
   /// Loops closed so far and detection totals (empty when LoopClosing.enabled is 0).
   LoopClosingStats loop_stats() const;
+  /// Loop detection's running totals (zero when loop closing is off).
+  LoopDetectTotals loop_detect_totals() const;
   bool loop_closing_enabled() const { return loop_ != nullptr; }
   /// What the map, the culled keyframes and the dense mapper hold now (call
   /// from the thread that calls track(); after shutdown() for the final figures).
