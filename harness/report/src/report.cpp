@@ -23,21 +23,6 @@ std::string num(double v) { return json_number(v, 10); }
 
 using eval::mean_of;
 
-/// "costs": the sampling period, the columns and one row per sample.
-std::string costs_json(const SlamRun& run, const std::string& in) {
-  std::string out = "{\"every_frames\": " + std::to_string(run.cost_every_frames) + ", \"columns\": [";
-  const std::vector<std::string>& cols = cost_columns();
-  for (std::size_t i = 0; i < cols.size(); ++i) out += (i ? ", " : "") + json_string(cols[i]);
-  out += "], \"rows\": [";
-  for (std::size_t k = 0; k < run.costs.size(); ++k) {
-    out += (k ? ",\n" : "\n") + in + "  [";
-    const std::vector<double> v = cost_values(run.costs[k]);
-    for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + num(v[i]);
-    out += "]";
-  }
-  return out + (run.costs.empty() ? "]}" : "\n" + in + "]}");
-}
-
 /// The keys one SLAM system contributes (shared by the top level and "baseline").
 std::string slam_fields(const SlamRun& run, const std::string& in) {
   const std::vector<double> ms = tracking_times(run);
@@ -67,7 +52,7 @@ std::string slam_fields(const SlamRun& run, const std::string& in) {
   if (run.dense_map) out += in + "\"dense_map\": " + dense_map_json(*run.dense_map, in) + ",\n";
   if (run.map) out += in + "\"map\": " + map_report_json(*run.map) + ",\n";
   if (run.blind) out += in + "\"blind\": " + blind_json(*run.blind) + ",\n";
-  if (!run.costs.empty()) out += in + "\"costs\": " + costs_json(run, in) + ",\n";
+  if (!run.costs.empty()) out += in + "\"costs\": " + costs_json(run.costs, run.cost_every_frames, in) + ",\n";
   out += in + "\"tracking_ms\": {\"median\": " + num(percentile(ms, 0.5)) +
          ", \"mean\": " + num(mean_of(ms)) + ", \"p95\": " + num(percentile(ms, 0.95)) + "},\n";
   out += in + "\"loss_events\": [";
@@ -116,6 +101,20 @@ std::vector<double> cost_values(const CostSample& c) {
   return {static_cast<double>(c.frame), c.t_s, static_cast<double>(c.keyframes), static_cast<double>(c.points),
           c.rss_mb, c.sparse_mb, c.dense_mb, c.tracking_ms_median, c.tracking_ms_p95, c.loop_detect_ms,
           c.mapping_ms_per_keyframe};
+}
+
+std::string costs_json(const std::vector<CostSample>& samples, int every_frames, const std::string& in) {
+  std::string out = "{\"every_frames\": " + std::to_string(every_frames) + ", \"columns\": [";
+  const std::vector<std::string>& cols = cost_columns();
+  for (std::size_t i = 0; i < cols.size(); ++i) out += (i ? ", " : "") + json_string(cols[i]);
+  out += "], \"rows\": [";
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    out += (k ? ",\n" : "\n") + in + "  [";
+    const std::vector<double> v = cost_values(samples[k]);
+    for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + num(v[i]);
+    out += "]";
+  }
+  return out + (samples.empty() ? "]}" : "\n" + in + "]}");
 }
 
 const MapResult* DenseMapReport::find(const std::string& name) const {

@@ -147,6 +147,7 @@ void OfflineSlam::Impl::open_outputs() {
   cam_traj_ = OutputFile(a_.out + "/CameraTrajectory.txt");
   kf_traj_ = OutputFile(a_.out + "/KeyFrameTrajectory.txt");
   timing_ = OutputFile(a_.out + "/timing.csv");
+  costs_.open(a_.out + "/costs.csv");
   cam_traj_.append("# timestamp tx ty tz qx qy qz qw (T_w_c)\n");
   kf_traj_.append("# timestamp tx ty tz qx qy qz qw (T_w_c)\n");
   timing_.append(
@@ -218,6 +219,7 @@ slam::TrackingState OfflineSlam::Impl::track_one(const sensor::RgbdFrame& frame)
     tally_.keyframe_t_ns.push_back(r.t_ns);
   }
   write_timing_line(frame, r, cpu_ms);
+  costs_.frame(*system_, static_cast<int>(frame.index), geom::ns_to_seconds(frame.t_ns), r.tracking_ms);
   if (scorer_) scorer_->add(frame, r);
   return r.state;
 }
@@ -241,6 +243,7 @@ void OfflineSlam::Impl::write_timing_line(const sensor::RgbdFrame& frame, const 
 /// refined keyframe and frame trajectories, Map.txt, PointCloud.ply).
 /// Returns the "dense" part of stats.json (empty when dense mapping is off).
 std::string OfflineSlam::Impl::write_final_outputs() {
+  costs_.finish(*system_);
   system_->shutdown();
   kf_traj_.close();
   // Rewrite the keyframe trajectory with the poses refined by local BA
@@ -306,7 +309,8 @@ std::string OfflineSlam::Impl::stats_json(StopReason stop, const std::string& de
      << ", \"mean\": " << format_g(mean_of(t.cpu_ms)) << ", \"p95\": " << format_g(percentile(t.cpu_ms, 0.95))
      << "}"
      << ",\n  \"local_mapping\": " << slam::to_json(system_->mapping_stats()) << dense_json
-     << ",\n  \"memory\": " << slam::to_json(system_->memory());
+     << ",\n  \"memory\": " << slam::to_json(system_->memory())
+     << ",\n  \"costs\": " << costs_json(costs_.samples(), costs_.every_frames(), "  ");
   const slam::LocalMappingStats mapping = system_->mapping_stats();
   text(strf("frames %zu, lost %zu, keyframes %zu, map points %zu; local BA %lld (%lld stopped by a keyframe)\n",
             t.frames, t.lost, system_->num_keyframes(), system_->num_map_points(),
@@ -372,7 +376,7 @@ int OfflineSlam::Impl::run() {
   js << "\n}\n";
   write_file(a_.out + "/stats.json", js.str());
   text(strf("PE-match seed %u (%s)\n", a_.seed, a_.seed_source.c_str()));
-  text(strf("wrote %s/{CameraTrajectory.txt,CameraTrajectoryRefined.txt,KeyFrameTrajectory.txt,timing.csv,"
+  text(strf("wrote %s/{CameraTrajectory.txt,CameraTrajectoryRefined.txt,KeyFrameTrajectory.txt,timing.csv,costs.csv,"
             "stats.json}\n",
             a_.out.c_str()));
   fail_if_incomplete(stop);

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "cost_log.hpp"
 #include "motion_match_scorer.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/common/io_paths.hpp"
@@ -25,6 +26,7 @@
 #include "pvb/eval/gravity.hpp"
 #include "pvb/eval/metrics.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
+#include "pvb/geometry/time.hpp"
 #include "pvb/run/offline_slam.hpp"
 #include "pvb/run/inertial_eval.hpp"
 #include "pvb/run/map_eval.hpp"
@@ -118,6 +120,7 @@ class OfflineSlam::Impl {
   dataset::TumSequenceReader reader_;
   std::unique_ptr<slam::System> system_;
   OutputFile cam_traj_, kf_traj_, timing_;
+  CostLog costs_;  ///< costs.csv, and "costs" in stats.json
   std::unique_ptr<MotionMatchScorer> scorer_;
   Tally tally_;
   PlaceRecognition place_;             ///< collected after the run, labelled when there is ground truth

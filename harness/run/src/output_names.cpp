@@ -12,7 +12,7 @@ const std::vector<std::string>& run_output_names() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> n = {"metrics.json",     "index.html",          "run.log",
                                   "groundtruth.txt",  "CameraTrajectory.txt", "CameraTrajectoryRefined.txt",
-                                  "KeyFrameTrajectory.txt", "timing.csv",     "camera.yaml",
+                                  "KeyFrameTrajectory.txt", "timing.csv",     "costs.csv", "camera.yaml",
                                   "PointCloud*.ply",  "map_errors.ply",       "*.png",
                                   "*.svg",            "baseline/"};
     n.insert(n.end(), motion_output_names().begin(), motion_output_names().end());
@@ -23,7 +23,7 @@ const std::vector<std::string>& run_output_names() {
 
 const std::vector<std::string>& offline_slam_output_names() {
   static const std::vector<std::string> names = {
-      "CameraTrajectory.txt", "CameraTrajectoryRefined.txt", "KeyFrameTrajectory.txt", "timing.csv", "stats.json",
+      "CameraTrajectory.txt", "CameraTrajectoryRefined.txt", "KeyFrameTrajectory.txt", "timing.csv", "costs.csv", "stats.json",
       "Map.txt",              "motion_matches.csv",          "PointCloud*.ply"};
   return names;
 }

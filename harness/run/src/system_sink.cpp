@@ -85,13 +85,7 @@ void SystemSink::open_outputs() {
       "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,inliers,"
       "keyframe,mapping_ms,features_with_depth,depth_valid\n");
   est.source = dir + "/CameraTrajectory.txt";
-  if (cost_every_frames > 0) {
-    costs_csv = OutputFile(dir + "/costs.csv");
-    std::string head;
-    for (const std::string& c : cost_columns()) head += (head.empty() ? "" : ",") + c;
-    costs_csv.append(head + "\n");
-    run.cost_every_frames = cost_every_frames;
-  }
+  costs.open(dir + "/costs.csv");
 }
 
 slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log) {
@@ -100,7 +94,7 @@ slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log)
   const int index = static_cast<int>(frame.index);
   const double t_s = geom::ns_to_seconds(frame.t_ns);
   count(r, index, t_s);
-  if (cost_every_frames > 0 && run.frames % static_cast<std::size_t>(cost_every_frames) == 0) sample_costs();
+  costs.frame(*system, index, t_s, r.tracking_ms);
   if (r.tracking.new_keyframe) keyframe_t_ns.push_back(r.t_ns);
   if (r.g_w) gravity_estimates[r.t_ns] = *r.g_w;
   write_lines(r, index);
@@ -165,8 +159,9 @@ void SystemSink::end_losses(RunLog& log) {
 }
 
 void SystemSink::finish() {
-  if (cost_every_frames > 0 && run.per_frame.size() > cost_window_.first_frame) sample_costs();
-  costs_csv.close();
+  costs.finish(*system);
+  run.costs = costs.samples();
+  run.cost_every_frames = costs.every_frames();
   system->shutdown();
   kf_traj.close();
   keyframes.source = dir + "/KeyFrameTrajectory.txt";

@@ -18,6 +18,7 @@
 #include "pvb/run/run_options.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
+#include "cost_log.hpp"
 #include "run_log.hpp"
 
 namespace pvb::run {
@@ -28,7 +29,8 @@ struct SystemSink {
   SlamRun run;
   std::unique_ptr<slam::System> system;
   std::string dir;
-  OutputFile cam_traj, kf_traj, timing, costs_csv;
+  OutputFile cam_traj, kf_traj, timing;
+  CostLog costs;  ///< costs.csv; run.costs at finish()
   eval::Trajectory est;
   eval::GravityEstimates gravity_estimates;  ///< the core's gravity per frame, once trusted
   std::optional<double>
@@ -42,9 +44,6 @@ struct SystemSink {
   LossLog loss_log{""};           ///< why each lost frame stayed lost (run.log)
   double tracking_ms = 0, orb_ms = 0, inline_mapping_ms = 0;
   std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made, for the revisit labels
-  /// Frames between cost samples (costs.csv; 0: none).
-  int cost_every_frames = kCostEveryFrames;
-  static constexpr int kCostEveryFrames = 300;
   /// The dense maps written by finish(), by name (corrected, live, and
   /// before_loop / after_loop when a loop was closed); kept for scoring.
   NamedClouds clouds;
@@ -81,14 +80,6 @@ struct SystemSink {
   void finish_map(const eval::Trajectory& gt, const std::string& scenario, const std::string& scenario_file);
 
  private:
-  /// Where the window of the next cost sample starts.
-  struct CostWindow {
-    std::size_t first_frame = 0;  ///< into run.per_frame
-    slam::LoopDetectTotals loops;
-    slam::LocalMappingStats mapping;
-  } cost_window_;
-  /// A cost sample over the frames since the last (run.costs, costs.csv).
-  void sample_costs();
   /// The dense maps into `clouds` and their PLY files; run.dense_map.
   void save_dense_maps();
   /// run.gravity and run.tilt against `gt` (site frame, z up) after run.eval.

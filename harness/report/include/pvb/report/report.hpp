@@ -159,6 +159,9 @@ struct CostSample {
 const std::vector<std::string>& cost_columns();
 /// A sample's values in cost_columns()' order.
 std::vector<double> cost_values(const CostSample& c);
+/// {"every_frames", "columns", "rows"}: the samples as rows, one a line
+/// indented by `in` (metrics.json's and stats.json's "costs").
+std::string costs_json(const std::vector<CostSample>& samples, int every_frames, const std::string& in);
 
 /// One SLAM system's run (PE-SLAM, or the baseline: PE-match off, ORB-SLAM2's motion model).
 struct SlamRun {
