@@ -254,6 +254,19 @@ std::size_t mat_heap_bytes(const cv::Mat& m) {
   return heap_block_bytes(m.u->size + kAlignSlack) + heap_block_bytes(sizeof(cv::UMatData));
 }
 
+void Frame::release_features() {
+  std::vector<cv::Point2f>().swap(keys);
+  std::vector<Keypoint>().swap(keys_un);
+  descriptors.release();
+  std::vector<float>().swap(depth_m);
+  std::vector<float>().swap(u_right);
+  std::vector<std::shared_ptr<MapPoint>>().swap(map_points);
+  std::vector<std::uint8_t>().swap(outlier);
+  std::vector<std::uint64_t>().swap(aligned_for);
+  grid_ = KeypointGrid();
+  pyramid.reset();
+}
+
 FrameMemory Frame::memory() const {
   FrameMemory m;
   if (pyramid) {

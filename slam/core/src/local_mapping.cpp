@@ -392,8 +392,9 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
 void LocalMapping::cull_keyframes(const std::shared_ptr<KeyFrame>& kf) {
   for (const auto& n : kf->best_covisibles(-1)) {
     if (n->id() == 0 || n->root() || n->bad() || !may_cull_in_time(*n)) continue;
-    if (is_redundant_keyframe(*n, cam_->th_depth_m, options_.redundant_ratio, options_.redundant_observers))
-      map_.erase_keyframe(n);
+    if (is_redundant_keyframe(*n, cam_->th_depth_m, options_.redundant_ratio, options_.redundant_observers) &&
+        map_.erase_keyframe(n))
+      culled_.push_back(n->id());
   }
 }
 

@@ -302,7 +302,6 @@ bool KeyFrame::set_bad() {
     if (auto mp = frame_.map_points[i]) mp->erase_observation(id_);
   connections_.clear();
   ordered_.clear();
-  frame_.pyramid.reset();  // no longer a patch reference
 
   // Re-attach the children (ORB-SLAM2): repeatedly pick the child with the
   // strongest covisibility link to a keyframe already in the candidate
@@ -340,6 +339,9 @@ bool KeyFrame::set_bad() {
     T_c_parent_ = frame_.T_c_w * parent->T_c_w().inverse();
   }
   children_.clear();
+  place::BowVector().swap(bow_);
+  place::FeatureVector().swap(features_by_node_);
+  frame_.release_features();
   bad_ = true;
   return true;
 }

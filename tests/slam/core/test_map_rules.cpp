@@ -131,6 +131,30 @@ TEST_F(KeyFrameCulling, ErasingAKeyFrameRepairsGraphAndTree) {
   EXPECT_FALSE(map.erase_keyframe(kfs[0]));
 }
 
+// A culled keyframe keeps its pose through its parent and frees what it
+// held for matching: its keypoints, descriptors and grid, its bag of words,
+// and its hold on the map points (a point it alone kept alive is freed).
+TEST_F(KeyFrameCulling, AnErasedKeyFrameFreesWhatItHeldForMatching) {
+  build(19);
+  for (auto& kf : kfs) kf->update_connections();
+  kfs[1]->set_bow({{3, 0.5}}, {{1, {0, 1}}});
+  const geom::SE3d T_c_w = kfs[1]->T_c_w();
+  // The twentieth point: seen by kf1 and kf4 only; when kf1 goes it has
+  // too few observations and turns bad, and nothing else holds it.
+  std::weak_ptr<MapPoint> lone = pts[19];
+  pts.pop_back();
+  const std::size_t held = kfs[1]->memory().total();
+  ASSERT_TRUE(map.erase_keyframe(kfs[1]));
+  EXPECT_EQ(kfs[1]->frame().size(), 0u);
+  EXPECT_TRUE(kfs[1]->frame().descriptors.empty());
+  EXPECT_TRUE(kfs[1]->map_points().empty());
+  EXPECT_TRUE(kfs[1]->bow().empty());
+  EXPECT_TRUE(kfs[1]->features_by_node().empty());
+  EXPECT_LT(kfs[1]->memory().total(), held / 4);
+  EXPECT_TRUE(kfs[1]->T_c_w_via_tree().isApprox(T_c_w, 1e-12));
+  EXPECT_TRUE(lone.expired());
+}
+
 TEST(Covisibility, OrderedByWeightThenIdWithThreshold15) {
   Map map;
   std::vector<std::shared_ptr<KeyFrame>> kfs;

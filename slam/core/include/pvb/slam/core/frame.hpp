@@ -142,6 +142,10 @@ class Frame {
   Eigen::Vector3d camera_center_w() const { return T_c_w.inverse().translation(); }
   /// What this frame holds, by structure.
   FrameMemory memory() const;
+  /// Frees the keypoints and all that goes with them (descriptors, depths,
+  /// map points, the grid, the pyramid): the frame keeps its pose and time
+  /// and has no keypoints (size() 0).
+  void release_features();
 
   std::uint64_t id = 0;
   std::int64_t t_ns = 0;

@@ -16,6 +16,8 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "pvb/common/closable_queue.hpp"
 #include "pvb/common/worker_error.hpp"
@@ -59,6 +61,9 @@ class LocalMapping {
   /// Work to run on the same thread after each processed keyframe (loop
   /// closing); set before start().
   void set_after_keyframe(std::function<void(const std::shared_ptr<KeyFrame>&)> hook) { after_keyframe_ = std::move(hook); }
+  /// The keyframes culled since the last call (for the place database to
+  /// forget them); on the mapping thread, as the after-keyframe hook runs.
+  std::vector<std::uint64_t> take_culled() { return std::exchange(culled_, {}); }
 
   /// Starts the worker thread (asynchronous mode).
   void start();
@@ -130,6 +135,7 @@ class LocalMapping {
   std::atomic<bool> stop_ba_{false};      ///< set by insert() in worker mode, cleared before each local BA
   std::atomic<std::int64_t> processed_{0}, ba_runs_{0}, ba_stopped_{0};
   std::function<void(const std::shared_ptr<KeyFrame>&)> after_keyframe_;
+  std::vector<std::uint64_t> culled_;  ///< culled since take_culled()
   std::optional<WheelCalibrator> wheel_calibrator_;  ///< with the wheels and Robot.CalibrateWheels
   std::uint64_t wheels_fitted_to_ = 0;               ///< the last interval's end keyframe
   bool wheels_resumed_ = false;                      ///< a loaded map's fit taken over (or none to take)

@@ -209,7 +209,10 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   void change_parent(const std::shared_ptr<KeyFrame>& kf);
 
   /// Removes the keyframe from the graph: its map points forget it, its
-  /// children are re-attached in the spanning tree (ORB-SLAM2 SetBadFlag).
+  /// children are re-attached in the spanning tree (ORB-SLAM2 SetBadFlag),
+  /// and what it held for matching is freed (keypoints, descriptors, its
+  /// map points, the grid, the bag of words): a removed keyframe keeps its
+  /// pose relative to its parent, for the trajectory, and no more.
   /// The first keyframe (id 0) and keyframes with loop edges are never
   /// removed; returns false then.
   bool set_bad();

@@ -38,9 +38,11 @@ class PlaceRecognizer {
   /// The same, stored in the keyframe.
   void compute_bow(KeyFrame& kf) const;
   /// Adds a keyframe (its bag computed) to the database, which keeps its
-  /// weights from then on: the keyframe's own bag is dropped.  Culled
-  /// keyframes stay in it; queries skip keyframes no longer in the map or bad.
+  /// weights from then on: the keyframe's own bag is dropped.  Queries skip
+  /// keyframes no longer in the map or bad.
   void add(KeyFrame& kf);
+  /// Forgets a keyframe (culled): its postings are freed.
+  void erase(std::uint64_t kf_id) { database_.erase(kf_id); }
   /// Makes room for a loaded map's keyframes and the words of their bags.
   void reserve(std::size_t keyframes, std::size_t words) { database_.reserve(keyframes, words); }
   /// A keyframe's bag: its own until add(), then the database's (the same
