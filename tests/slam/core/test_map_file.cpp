@@ -217,12 +217,13 @@ TEST_F(MapFile, LocaliseStartsLostRelocalisesAndNeverAddsKeyframes) {
 /// The pair's map with inertial state (test::give_tiny_inertial_state), as
 /// a run with an IMU whose camera sits at T_b_c saves it.
 std::string inertial_pair_map(const std::string& bytes, const std::string& file, const geom::SE3d& T_b_c,
-                              sensor::SensorSetup setup = sensor::SensorSetup::kCameraImu) {
+                              sensor::SensorSetup setup = sensor::SensorSetup::kCameraImu,
+                              const std::function<void(Map&)>& give_state = test::give_tiny_inertial_state) {
   const MapFileHeader h = read_map_header(bytes, file);
   Map map;
   decode_map(bytes, file, h, camera_for(h.settings), &map);
   std::lock_guard<std::mutex> lock(map.mutex());
-  test::give_tiny_inertial_state(map);
+  give_state(map);
   MapSettings s = h.settings;
   s.sensors = setup;
   s.T_b_c = T_b_c;
@@ -278,18 +279,6 @@ TEST_F(MapFile, ARunWithAnImuHasTheMapsGravityAtOnce) {
   EXPECT_LT(r.T_w_c->translation().norm(), 0.01);
 }
 
-std::string wheel_pair_map(const std::string& bytes, const std::string& file, const geom::SE3d& T_b_c) {
-  const MapFileHeader h = read_map_header(bytes, file);
-  Map map;
-  decode_map(bytes, file, h, camera_for(h.settings), &map);
-  std::lock_guard<std::mutex> lock(map.mutex());
-  test::give_tiny_wheel_fit(map);
-  MapSettings s = h.settings;
-  s.sensors = sensor::SensorSetup::kCameraImuWheels;
-  s.T_b_c = T_b_c;
-  return encode_map(map, s, h.sessions, h.app_json);
-}
-
 Settings wheel_settings(const geom::SE3d& T_b_c) {
   Settings s = imu_settings(T_b_c);
   s.motion.setup = sensor::SensorSetup::kCameraImuWheels;
@@ -303,7 +292,8 @@ Settings wheel_settings(const geom::SE3d& T_b_c) {
 TEST_F(MapFile, AWheelFitIsTakenOverOnlyForTheWheelsItWasFittedTo) {
   const geom::SE3d T_b_c = test::tiny_inertial_settings().T_b_c;
   const std::string p = tmp_path("wheel_pair.pvbmap");
-  const std::string bytes = wheel_pair_map(bytes_, path_, T_b_c);
+  const std::string bytes =
+      inertial_pair_map(bytes_, path_, T_b_c, sensor::SensorSetup::kCameraImuWheels, test::give_tiny_wheel_fit);
   write_file(p, bytes);
   {
     System system(wheel_settings(T_b_c), sync_options());
