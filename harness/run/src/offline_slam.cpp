@@ -153,7 +153,8 @@ void OfflineSlam::Impl::open_outputs() {
   timing_.append(
       "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,"
       "inliers,keyframe,mapping_ms,cpu_ms,align_tried,aligned,align_ms,"
-      "kf_tracked_close,kf_untracked_close,kf_ref_points,kf_ref_all,kf_ref_shared,features_with_depth,depth_valid\n");
+      "kf_tracked_close,kf_untracked_close,kf_ref_points,kf_ref_all,kf_ref_shared,features_with_depth,depth_valid,"
+      "local_keyframes,local_points\n");
   if (a_.dump_matches) {
     const std::string gt = a_.sequence + "/groundtruth.txt";
     if (!std::ifstream(gt)) throw IoError(gt, "--dump-matches needs the sequence's ground truth");
@@ -235,7 +236,8 @@ void OfflineSlam::Impl::write_timing_line(const sensor::RgbdFrame& frame, const 
        << "," << r.tracking.align_tried << "," << r.tracking.aligned << "," << format_g(r.tracking.align_ms)
        << "," << r.tracking.kf_tracked_close << "," << r.tracking.kf_untracked_close << ","
        << r.tracking.kf_ref_points << "," << r.tracking.kf_ref_all << "," << r.tracking.kf_ref_shared << ","
-       << r.features_with_depth << "," << format_fixed(r.depth_valid, 4) << "\n";
+       << r.features_with_depth << "," << format_fixed(r.depth_valid, 4) << "," << r.tracking.local_keyframes << ","
+       << r.tracking.local_points << "\n";
   timing_.append(line.str());
 }
 

@@ -83,7 +83,7 @@ void SystemSink::open_outputs() {
   kf_traj.append("# timestamp tx ty tz qx qy qz qw (T_w_c)\n");
   timing.append(
       "frame,t_s,state,method,features,tracking_ms,orb_ms,pe_match_ms,coarse_matches,matches_kept,inliers,"
-      "keyframe,mapping_ms,features_with_depth,depth_valid\n");
+      "keyframe,mapping_ms,features_with_depth,depth_valid,local_keyframes,local_points\n");
   est.source = dir + "/CameraTrajectory.txt";
   costs.open(dir + "/costs.csv");
 }
@@ -150,7 +150,8 @@ void SystemSink::write_lines(const slam::FrameResult& r, int index) {
        << format_g(r.tracking_ms) << "," << format_g(r.orb_ms) << "," << format_g(r.tracking.pe_match_ms)
        << "," << r.tracking.coarse_matches << "," << r.tracking.matches_kept << "," << r.tracking.inliers
        << "," << (r.tracking.new_keyframe ? 1 : 0) << "," << format_g(r.mapping_ms) << ","
-       << r.features_with_depth << "," << format_fixed(r.depth_valid, 4) << "\n";
+       << r.features_with_depth << "," << format_fixed(r.depth_valid, 4) << "," << r.tracking.local_keyframes
+       << "," << r.tracking.local_points << "\n";
   timing.append(line.str());
 }
 

@@ -455,6 +455,8 @@ void Tracking::update_local_map(const Frame& f) {
 
 bool Tracking::track_local_map(Frame& f) {
   update_local_map(f);
+  stats_.local_keyframes = static_cast<int>(local_kfs_.size());
+  stats_.local_points = static_cast<int>(local_points_.size());
   frame_marks_.new_pass();
   for (const auto& mp : f.map_points)
     if (mp && !mp->bad()) {

@@ -122,6 +122,17 @@ void check_report_files(const std::string& d) {
   EXPECT_EQ(data_lines(d + "/groundtruth.txt").size(), 150u);
   EXPECT_EQ(data_lines(d + "/CameraTrajectory.txt").size(), 150u);
   EXPECT_EQ(data_lines(d + "/timing.csv").size(), 151u);  // header + one line per frame
+  {  // The local map the last frame was tracked against: keyframes and points, last two columns.
+    const std::vector<std::string> timing = data_lines(d + "/timing.csv");
+    const std::string& head = timing.front();
+    const std::string tail = "local_keyframes,local_points";
+    EXPECT_EQ(head.substr(head.size() - std::min(head.size(), tail.size())), tail) << head;
+    const std::string& last = timing.back();
+    const std::size_t comma = last.rfind(',');
+    const int keyframes = std::stoi(last.substr(last.rfind(',', comma - 1) + 1));
+    EXPECT_GT(keyframes, 1);
+    EXPECT_GT(std::stoi(last.substr(comma + 1)), 10 * keyframes);  // tens of points a keyframe
+  }
   // Costs every 300 frames and at the end: one sample of 150 frames.
   EXPECT_EQ(data_lines(d + "/costs.csv").size(), 2u);
   const YAML::Node costs = metrics(d)["costs"];

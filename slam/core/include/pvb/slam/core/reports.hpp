@@ -100,6 +100,10 @@ struct TrackingStats {
   /// how many of them this frame tracks.
   int kf_ref_all = 0;
   int kf_ref_shared = 0;
+  /// The local map the frame was tracked against (0 when it was not):
+  /// its keyframes and its points, before the projection search.
+  int local_keyframes = 0;
+  int local_points = 0;
   /// The motion model's coarse matches (empty when it did not run), for
   /// scoring PE-match against ground truth: pixel pairs (last frame,
   /// this frame), undistorted and as detected, the octaves of both
