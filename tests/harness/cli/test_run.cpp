@@ -265,7 +265,7 @@ TEST(RunCli, BaselineAloneIsOrbSlam2WithoutPeMatch) {
     if (f[0] == "frame") continue;
     EXPECT_EQ(f[7], "0") << line;   // no PE-match time
     EXPECT_EQ(f[8], f[9]) << line;  // coarse == kept
-    ASSERT_EQ(f.size(), 15u) << line;
+    ASSERT_EQ(f.size(), 17u) << line;
     EXPECT_LE(std::stoi(f[13]), std::stoi(f[4])) << line;  // keypoints with depth <= keypoints
     EXPECT_GT(std::stod(f[14]), 0.3) << line;              // the station's depth covers most pixels
     EXPECT_LE(std::stod(f[14]), 1.0) << line;

@@ -158,7 +158,7 @@ TEST(SlamScenario, BaselineModeReportsNoPeMatch) {
     std::vector<std::string> f;
     std::stringstream ss(line);
     for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
-    ASSERT_EQ(f.size(), 24u) << line;
+    ASSERT_EQ(f.size(), 26u) << line;
     // keypoints with depth: at most the keypoints; the depth image's share in [0, 1]
     EXPECT_LE(std::stoi(f[22]), std::stoi(f[4])) << line;
     EXPECT_GT(std::stoi(f[22]), 0) << line;
