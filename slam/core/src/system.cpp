@@ -82,8 +82,9 @@ System::System(const Settings& settings, const SystemOptions& options)
     if (place_) place_->compute_bow(*kf);
     const bool closed = loop_ && loop_->process(kf);
     if (place_ && !kf->bad()) place_->add(*kf);
-    for (std::uint64_t id : mapping_->take_culled())  // their bags are of no use any more
-      if (place_) place_->erase(id);
+    const std::vector<std::uint64_t> culled = mapping_->take_culled();
+    if (place_)
+      for (std::uint64_t id : culled) place_->erase(id);  // their bags are of no use any more
     // Local BA (and a loop's correction) moved keyframes: the dense map follows.
     if (dense_ && settings_.dense.reassemble) post_dense_poses(closed, false);
   });
