@@ -267,6 +267,11 @@ void Frame::release_features() {
   pyramid.reset();
 }
 
+void Frame::release_pyramid() {
+  pyramid.reset();
+  std::vector<std::uint64_t>().swap(aligned_for);
+}
+
 FrameMemory Frame::memory() const {
   FrameMemory m;
   if (pyramid) {

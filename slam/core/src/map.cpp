@@ -19,9 +19,31 @@ std::shared_ptr<MapPoint> MapPoint::replaced() const {
   return r;
 }
 
+MapPoint::Observations::const_iterator MapPoint::Observations::find(std::uint64_t kf_id) const {
+  const auto it = std::lower_bound(list_.begin(), list_.end(), kf_id,
+                                   [](const value_type& o, std::uint64_t id) { return o.first < id; });
+  return it != list_.end() && it->first == kf_id ? it : list_.end();
+}
+
+bool MapPoint::Observations::insert(std::uint64_t kf_id, Obs o) {
+  const auto it = std::lower_bound(list_.begin(), list_.end(), kf_id,
+                                   [](const value_type& v, std::uint64_t id) { return v.first < id; });
+  if (it != list_.end() && it->first == kf_id) return false;
+  list_.insert(it, value_type(kf_id, std::move(o)));
+  return true;
+}
+
+bool MapPoint::Observations::erase(std::uint64_t kf_id) {
+  const auto it = find(kf_id);
+  if (it == list_.end()) return false;
+  list_.erase(it);
+  return true;
+}
+
+std::size_t MapPoint::Observations::heap_bytes() const { return vector_heap_bytes(list_); }
+
 void MapPoint::add_observation(const std::shared_ptr<KeyFrame>& kf, std::size_t idx) {
-  if (obs_.count(kf->id())) return;
-  obs_[kf->id()] = Obs{kf, idx};
+  if (!obs_.insert(kf->id(), Obs{kf, idx})) return;
   num_obs_ += kf->frame().u_right[idx] >= 0 ? 2 : 1;
 }
 
@@ -30,7 +52,7 @@ void MapPoint::erase_observation(std::uint64_t kf_id) {
   if (it == obs_.end()) return;
   if (auto kf = it->second.kf.lock()) num_obs_ -= kf->frame().u_right[it->second.idx] >= 0 ? 2 : 1;
   else num_obs_ -= 1;
-  obs_.erase(it);
+  obs_.erase(kf_id);
   if (ref_kf_.expired() || (ref_kf_.lock() && ref_kf_.lock()->id() == kf_id)) {
     ref_kf_.reset();
     for (const auto& [id, o] : obs_)
@@ -80,10 +102,10 @@ void MapPoint::replace(const std::shared_ptr<MapPoint>& other, const std::shared
 }
 
 void MapPoint::compute_distinctive_descriptor() {
-  std::vector<cv::Mat> descs;
+  std::vector<const unsigned char*> descs;  // rows of the observing keyframes' descriptors
   for (const auto& [id, o] : obs_)
     if (auto kf = o.kf.lock())
-      if (!kf->bad()) descs.push_back(kf->frame().descriptors.row(static_cast<int>(o.idx)));
+      if (!kf->bad()) descs.push_back(kf->frame().descriptors.ptr<unsigned char>(static_cast<int>(o.idx)));
   if (descs.empty()) return;
   const std::size_t n = descs.size();
   std::vector<int> dist(n * n, 0);
@@ -100,7 +122,8 @@ void MapPoint::compute_distinctive_descriptor() {
       best_i = i;
     }
   }
-  descriptor_ = descs[best_i].clone();
+  std::copy(descs[best_i], descs[best_i] + descriptor_.size(), descriptor_.begin());
+  has_descriptor_ = true;
 }
 
 void MapPoint::update_normal_and_depth() {
@@ -127,7 +150,7 @@ void MapPoint::update_normal_and_depth() {
 
 std::size_t MapPoint::memory_bytes() const {
   // make_shared puts the object after a control block of two counts and a vtable pointer.
-  return heap_block_bytes(sizeof(MapPoint) + 2 * sizeof(long)) + map_node_bytes(obs_) + mat_heap_bytes(descriptor_);
+  return heap_block_bytes(sizeof(MapPoint) + 2 * sizeof(long)) + obs_.heap_bytes();
 }
 
 // KeyFrame ------------------------------------------------------------------
@@ -362,6 +385,7 @@ std::shared_ptr<KeyFrame> Map::create_keyframe(const Frame& frame) {
 
 std::shared_ptr<KeyFrame> Map::add_loaded_keyframe(std::uint64_t id, const Frame& frame) {
   auto kf = std::make_shared<KeyFrame>(id, frame);
+  kf->release_pyramid();  // a loaded keyframe has no image: never aligned to
   if (!keyframes_.emplace(id, kf).second) throw std::logic_error("Map: keyframe id given twice");
   next_kf_id_ = std::max(next_kf_id_, id + 1);
   return kf;

@@ -84,7 +84,7 @@ std::vector<IndexMatch> search_by_projection(Frame& cur, const Frame& last, doub
     else cur.features_in_area(uv.x(), uv.y(), radius, std::max(0, last_octave - 1), last_octave + 1, &cands);
     if (cands.empty()) continue;
     const double ur = uv.x() - cam.K.bf / p_c.z();
-    const unsigned char* d_mp = mp->descriptor().empty() ? desc_row(last.descriptors, i) : mp->descriptor().ptr<unsigned char>(0);
+    const unsigned char* d_mp = mp->descriptor() ? mp->descriptor() : desc_row(last.descriptors, i);
     BestTwo b;
     for (std::size_t j : cands) {
       if (cur.map_points[j] && cur.map_points[j]->num_observations() > 0) continue;
@@ -139,7 +139,7 @@ int search_local_points(Frame& cur, const std::vector<ProjectedPoint>& points, d
     const double r = th * (p.view_cos > 0.998 ? 2.5 : 4.0) * cam.scale[p.level];
     cur.features_in_area(p.u, p.v, r, p.level - 1, p.level, &cands);
     if (cands.empty()) continue;
-    const unsigned char* d_mp = p.mp->descriptor().ptr<unsigned char>(0);
+    const unsigned char* d_mp = p.mp->descriptor();
     BestTwo b;
     for (std::size_t j : cands) {
       if (cur.map_points[j] && cur.map_points[j]->num_observations() > 0) continue;
@@ -270,7 +270,7 @@ int fuse(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::vector<std::s
     const int level = cam.predict_scale(dist, mp->max_distance());
     const double radius = th * cam.scale[level];
     const std::vector<std::size_t> cands = f.features_in_area(uv.x(), uv.y(), radius);
-    const unsigned char* d_mp = mp->descriptor().ptr<unsigned char>(0);
+    const unsigned char* d_mp = mp->descriptor();
     int best = INT_MAX;
     std::size_t best_idx = 0;
     for (std::size_t j : cands) {

@@ -3,8 +3,8 @@
 namespace pvb::slam {
 
 bool align_to_reference(Frame& f, std::size_t i, const MapPoint& mp, const PatchAlignParams& params) {
-  f.aligned_for[i] = mp.id();
   if (!f.pyramid) return false;
+  f.aligned_for[i] = mp.id();
   const auto ref = mp.reference_keyframe();
   if (!ref || ref->bad() || !ref->frame().pyramid || ref->frame_id() == f.id) return false;
   const long idx = mp.index_in(ref->id());

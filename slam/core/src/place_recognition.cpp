@@ -50,7 +50,9 @@ std::vector<KeyFramePtr> accumulate_groups(const Map& map, const std::vector<pla
 }  // namespace
 
 PlaceRecognizer::PlaceRecognizer(std::shared_ptr<const place::Vocabulary> vocabulary)
-    : vocabulary_(std::move(vocabulary)) {}
+    : vocabulary_(std::move(vocabulary)) {
+  if (vocabulary_) database_.reserve(0, vocabulary_->size());  // one list head per word, once
+}
 
 void PlaceRecognizer::transform(const Frame& f, place::BowVector* bow, place::FeatureVector* features) const {
   vocabulary_->transform(f.descriptors, bow, features, kDirectIndexLevelsUp);

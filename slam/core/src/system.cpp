@@ -235,9 +235,7 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
     else if (start == MapStart::kExtend && uses_imu(settings_.motion.setup) && !uses_imu(head.settings.sensors))
       map_->gravity().ready = false;  // a tilt alone (camera+accel): the new keyframes initialise the IMU
     take_wheel_fit(&info);
-    std::size_t words = 0;
-    for (const auto& [id, kf] : map_->keyframes()) words += kf->bow().size();
-    place_->reserve(map_->num_keyframes(), words);  // an upper bound on the distinct words
+    place_->reserve(map_->num_keyframes());
     for (const auto& [id, kf] : map_->keyframes()) {
       kf->set_fixed(start == MapStart::kExtend);
       if (kf->bow().empty()) place_->compute_bow(*kf);  // saved with the map (the same vocabulary)
@@ -372,7 +370,12 @@ SystemMemory System::memory() {
       if (r.ref->bad() && culled.insert(r.ref.get()).second) m.culled_bytes += r.ref->memory();
     m.culled_keyframes = culled.size();
   }
-  if (place_) m.place_database_bytes = place_->database_bytes();
+  if (place_) {
+    m.place_database_bytes = place_->database_bytes();
+    const place::Database::Counts c = place_->database_counts();
+    m.place_database_words = c.words;
+    m.place_database_postings = c.postings;
+  }
   if (dense_) m.dense = dense_->memory();
   return m;
 }
@@ -401,6 +404,8 @@ std::string to_json(const SystemMemory& m) {
      << ", \"culled_keyframes\": " << m.culled_keyframes
      << ", \"culled_keyframe_bytes\": " << keyframe_memory_json(m.culled_bytes)
      << ", \"place_database_bytes\": " << m.place_database_bytes
+     << ", \"place_database_words\": " << m.place_database_words
+     << ", \"place_database_postings\": " << m.place_database_postings
      << ", \"dense_keyframes\": " << m.dense.keyframes << ", \"dense_keyframe_bytes\": " << m.dense.keyframe_bytes
      << ", \"dense_map_bytes\": " << m.dense.map_bytes << "}";
   return js.str();

@@ -1,47 +1,105 @@
 #include "pvb/slam/place/database.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <utility>
 
 #include "pvb/common/memory.hpp"
 
 namespace pvb::slam::place {
 namespace {
 
-bool by_id(const Database::Posting& p, std::uint64_t id) { return p.id < id; }
+bool by_id(const Database::Posting& p, std::uint32_t id) { return p.id < id; }
 
-/// Removes `id` from a list in ascending ids (no-op when absent).
-void remove_sorted(std::vector<Database::Posting>& list, std::uint64_t id) {
-  const auto it = std::lower_bound(list.begin(), list.end(), id, by_id);
-  if (it != list.end() && it->id == id) list.erase(it);
+/// The capacity after `capacity` postings: the most that fill the next
+/// heap block of twice the size (32, 64, 128, ... bytes with malloc's 8).
+std::uint32_t grown_capacity(std::uint32_t capacity) {
+  const std::size_t block = capacity == 0 ? 32 : 2 * heap_block_bytes(capacity * sizeof(Database::Posting));
+  return static_cast<std::uint32_t>((block - 8) / sizeof(Database::Posting));
 }
 
-/// Inserts a posting into a list in ascending ids; keyframes come with
-/// growing ids, so this is mostly an append.
-void insert_sorted(std::vector<Database::Posting>& list, Database::Posting p) {
-  if (list.empty() || list.back().id < p.id) {
-    list.push_back(p);
-    return;
-  }
-  const auto it = std::lower_bound(list.begin(), list.end(), p.id, by_id);
-  if (it == list.end() || it->id != p.id) list.insert(it, p);
+std::uint32_t checked_id(std::uint64_t id) {
+  if (id > UINT32_MAX) throw std::out_of_range("keyframe database: keyframe id " + std::to_string(id) + " above 2^32 - 1");
+  return static_cast<std::uint32_t>(id);
 }
 
 }  // namespace
 
+Database::PostingList::PostingList(PostingList&& o) noexcept
+    : data_(std::exchange(o.data_, nullptr)), size_(std::exchange(o.size_, 0)),
+      capacity_(std::exchange(o.capacity_, 0)) {}
+
+Database::PostingList& Database::PostingList::operator=(PostingList&& o) noexcept {
+  if (this != &o) {
+    std::free(data_);
+    data_ = std::exchange(o.data_, nullptr);
+    size_ = std::exchange(o.size_, 0);
+    capacity_ = std::exchange(o.capacity_, 0);
+  }
+  return *this;
+}
+
+Database::PostingList::~PostingList() { std::free(data_); }
+
+const Database::Posting* Database::PostingList::find(std::uint32_t id) const {
+  const Posting* it = std::lower_bound(begin(), end(), id, by_id);
+  return it != end() && it->id == id ? it : nullptr;
+}
+
+void Database::PostingList::insert(Posting p) {
+  Posting* it = size_ == 0 || data_[size_ - 1].id < p.id ? data_ + size_ : std::lower_bound(data_, data_ + size_, p.id, by_id);
+  if (it != data_ + size_ && it->id == p.id) {
+    it->weight = p.weight;
+    return;
+  }
+  if (size_ == capacity_) {
+    const std::ptrdiff_t at = it - data_;
+    const std::uint32_t capacity = grown_capacity(capacity_);
+    void* grown = std::realloc(data_, capacity * sizeof(Posting));
+    if (!grown) throw std::bad_alloc();
+    data_ = static_cast<Posting*>(grown);
+    capacity_ = capacity;
+    it = data_ + at;
+  }
+  std::memmove(it + 1, it, static_cast<std::size_t>(data_ + size_ - it) * sizeof(Posting));
+  *it = p;
+  ++size_;
+}
+
+void Database::PostingList::remove(std::uint32_t id) {
+  Posting* it = std::lower_bound(data_, data_ + size_, id, by_id);
+  if (it == data_ + size_ || it->id != id) return;
+  std::memmove(it, it + 1, static_cast<std::size_t>(data_ + size_ - it - 1) * sizeof(Posting));
+  if (--size_ == 0) *this = PostingList();
+}
+
+std::size_t Database::PostingList::heap_bytes() const { return heap_block_bytes(capacity_ * sizeof(Posting)); }
+
+const Database::PostingList* Database::list_of(WordId word) const {
+  return word < inverted_.size() && !inverted_[word].empty() ? &inverted_[word] : nullptr;
+}
+
 void Database::add(std::uint64_t id, const BowVector& bow) {
+  const std::uint32_t id32 = checked_id(id);
   std::lock_guard<std::mutex> lock(mutex_);
   if (const auto old = words_.find(id); old != words_.end()) {
     for (WordId word : old->second) {
-      auto& ids = inverted_[word];
-      remove_sorted(ids, id);
-      if (ids.empty()) inverted_.erase(word);
+      inverted_[word].remove(id32);
+      if (inverted_[word].empty()) --listed_words_;
     }
   }
   std::vector<WordId> words;
   words.reserve(bow.size());
+  if (!bow.empty() && bow.back().first >= inverted_.size()) inverted_.resize(bow.back().first + std::size_t{1});
   for (const auto& [word, w] : bow) {
-    insert_sorted(inverted_[word], {id, w});
+    if (inverted_[word].empty()) ++listed_words_;
+    inverted_[word].insert({id32, w});
     words.push_back(word);
   }
   words_[id] = std::move(words);
@@ -50,7 +108,7 @@ void Database::add(std::uint64_t id, const BowVector& bow) {
 void Database::reserve(std::size_t keyframes, std::size_t words) {
   std::lock_guard<std::mutex> lock(mutex_);
   words_.reserve(keyframes);
-  inverted_.reserve(words);
+  if (words > inverted_.size()) inverted_.resize(words);
 }
 
 void Database::erase(std::uint64_t id) {
@@ -58,10 +116,8 @@ void Database::erase(std::uint64_t id) {
   const auto it = words_.find(id);
   if (it == words_.end()) return;
   for (WordId word : it->second) {
-    const auto list = inverted_.find(word);
-    if (list == inverted_.end()) continue;
-    remove_sorted(list->second, id);
-    if (list->second.empty()) inverted_.erase(list);
+    inverted_[word].remove(static_cast<std::uint32_t>(id));
+    if (inverted_[word].empty()) --listed_words_;
   }
   words_.erase(it);
 }
@@ -77,20 +133,26 @@ BowVector Database::bag(std::uint64_t id) const {
   const auto it = words_.find(id);
   if (it == words_.end()) return bow;
   bow.reserve(it->second.size());
-  for (WordId word : it->second) {
-    const std::vector<Posting>& list = inverted_.at(word);
-    const auto p = std::lower_bound(list.begin(), list.end(), id, by_id);
-    bow.emplace_back(word, p->weight);  // present: add() listed it under every one of its words
-  }
+  for (WordId word : it->second)  // present: add() listed it under every one of its words
+    bow.emplace_back(word, inverted_[word].find(static_cast<std::uint32_t>(id))->weight);
   return bow;
 }
 
 std::size_t Database::memory_bytes() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  std::size_t bytes = unordered_map_bytes(inverted_) + unordered_map_bytes(words_);
-  for (const auto& [word, list] : inverted_) bytes += vector_heap_bytes(list);
+  std::size_t bytes = vector_heap_bytes(inverted_) + unordered_map_bytes(words_);
+  for (const PostingList& list : inverted_) bytes += list.heap_bytes();
   for (const auto& [id, words] : words_) bytes += vector_heap_bytes(words);
   return bytes;
+}
+
+Database::Counts Database::counts() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Counts c;
+  c.keyframes = words_.size();
+  c.words = listed_words_;
+  for (const auto& [id, words] : words_) c.postings += words.size();
+  return c;
 }
 
 std::vector<Candidate> Database::query(const BowVector& query, double min_score, double min_common_ratio,
@@ -118,9 +180,9 @@ std::unordered_map<std::uint64_t, Database::Tally> Database::tally(
   // Vocabulary::score merges two bags, so the scores are the same doubles.
   std::unordered_map<std::uint64_t, Tally> tally;
   for (const auto& [word, x] : query) {
-    const auto list = inverted_.find(word);
-    if (list == inverted_.end()) continue;
-    for (const Posting& p : list->second) {
+    const PostingList* list = list_of(word);
+    if (!list) continue;
+    for (const Posting& p : *list) {
       auto [it, inserted] = tally.try_emplace(p.id);
       if (inserted && skip) it->second.skipped = skip(p.id);
       ++it->second.common;
@@ -152,8 +214,8 @@ std::vector<Candidate> Database::select(const std::unordered_map<std::uint64_t, 
 std::vector<std::uint64_t> Database::keyframes_with(WordId word) const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<std::uint64_t> ids;
-  if (const auto it = inverted_.find(word); it != inverted_.end())
-    for (const Posting& p : it->second) ids.push_back(p.id);
+  if (const PostingList* list = list_of(word))
+    for (const Posting& p : *list) ids.push_back(p.id);
   return ids;
 }
 

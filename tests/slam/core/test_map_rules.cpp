@@ -2,6 +2,8 @@
 // spanning tree bookkeeping, on small hand-built maps.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/map.hpp"
 
@@ -66,6 +68,57 @@ TEST(MapPointCulling, PointWithTooFewObservationsBecomesBad) {
   EXPECT_EQ(kf0->map_points()[0], nullptr);
   map.remove_bad_points();
   EXPECT_EQ(map.num_points(), 0u);
+}
+
+TEST(MapPointObservations, KeptInAscendingKeyFrameIdsWhateverTheOrderAdded) {
+  Map map;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  for (std::uint64_t i = 0; i < 5; ++i) kfs.push_back(map.create_keyframe(make_frame(i, 4)));
+  auto mp = map.create_point(Eigen::Vector3d(0, 0, 1), kfs[0]);
+  for (std::size_t k : {3, 0, 4, 1}) observe(mp, kfs[k], k % 4);
+  observe(mp, kfs[3], 2);  // a second observation by keyframe 3 is refused
+  std::vector<std::uint64_t> ids;
+  for (const auto& [id, o] : mp->observations()) {
+    ids.push_back(id);
+    EXPECT_EQ(o.kf.lock(), kfs[id]);
+    EXPECT_EQ(o.idx, id % 4);
+  }
+  EXPECT_EQ(ids, (std::vector<std::uint64_t>{0, 1, 3, 4}));
+  EXPECT_EQ(mp->num_observations(), 8);
+  EXPECT_EQ(mp->index_in(3), 3);
+  EXPECT_EQ(mp->index_in(2), -1);
+  EXPECT_EQ(mp->observations().count(2), 0u);
+  EXPECT_EQ(mp->observations().find(2), mp->observations().end());
+  mp->erase_observation(1);
+  mp->erase_observation(2);  // none: no change
+  ids.clear();
+  for (const auto& [id, o] : mp->observations()) ids.push_back(id);
+  EXPECT_EQ(ids, (std::vector<std::uint64_t>{0, 3, 4}));
+  EXPECT_EQ(mp->num_observations(), 6);
+  EXPECT_FALSE(mp->bad());
+}
+
+TEST(MapPointDescriptor, NoneUntilComputedThenTheLeastMedianDistanceObservation) {
+  Map map;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  // Keypoint 0 of the keyframes has its first 0, 2, 3, 4, 7 bytes set: the
+  // one with 3 is 8, 8, 24 and 32 bits from the others, the least median.
+  const int set_bytes[] = {0, 2, 3, 4, 7};
+  for (std::uint64_t k = 0; k < 5; ++k) {
+    Frame f = make_frame(k, 2);
+    f.descriptors.row(0).colRange(0, set_bytes[k]).setTo(255);
+    kfs.push_back(map.create_keyframe(f));
+  }
+  auto mp = map.create_point(Eigen::Vector3d(0, 0, 1), kfs[0]);
+  EXPECT_EQ(mp->descriptor(), nullptr);
+  mp->compute_distinctive_descriptor();  // no observation yet: still none
+  EXPECT_EQ(mp->descriptor(), nullptr);
+  for (const auto& kf : kfs) observe(mp, kf, 0);
+  mp->compute_distinctive_descriptor();
+  ASSERT_NE(mp->descriptor(), nullptr);
+  const unsigned char* row = kfs[2]->frame().descriptors.ptr<unsigned char>(0);
+  EXPECT_TRUE(std::equal(row, row + 32, mp->descriptor()));
+  EXPECT_NE(mp->descriptor(), row);  // a copy: the point keeps it when the keyframe goes
 }
 
 class KeyFrameCulling : public ::testing::Test {

@@ -1,6 +1,9 @@
 // Keyframe database: inverted index, candidates' filters and order.
 #include <gtest/gtest.h>
 
+#include <climits>
+#include <stdexcept>
+
 #include "pvb/slam/place/database.hpp"
 
 namespace {
@@ -142,6 +145,39 @@ TEST(Database, BagIsWhatWasAddedFromTheListsWeights) {
   EXPECT_TRUE(db.bag(12).empty());
   EXPECT_EQ(db.bag(9), (BowVector{{1, .25}, {2, .25}, {3, .5}}));
   EXPECT_GT(db.memory_bytes(), 0U);
+}
+
+TEST(Database, LongListsGrowAndShrinkInOrder) {
+  // 100 keyframes under word 3, added out of order: the list's buffer grows
+  // past several capacities and stays in ascending ids; erasing all but one
+  // frees them, and the emptied word leaves the counts.
+  Database db;
+  std::vector<std::uint64_t> added;
+  for (std::uint64_t k = 0; k < 100; ++k) added.push_back((k * 37) % 100);
+  for (std::uint64_t id : added) db.add(id, {{3, 0.5}, {1000 + id, 0.5}});
+  std::vector<std::uint64_t> all(100);
+  for (std::uint64_t k = 0; k < 100; ++k) all[k] = k;
+  EXPECT_EQ(db.keyframes_with(3), all);
+  EXPECT_EQ(db.counts().keyframes, 100U);
+  EXPECT_EQ(db.counts().words, 101U);
+  EXPECT_EQ(db.counts().postings, 200U);
+  const std::size_t full = db.memory_bytes();
+  for (std::uint64_t id = 0; id < 99; ++id) db.erase(id);
+  EXPECT_EQ(db.keyframes_with(3), (std::vector<std::uint64_t>{99}));
+  EXPECT_EQ(db.bag(99), (BowVector{{3, 0.5}, {1099, 0.5}}));
+  EXPECT_EQ(db.counts().words, 2U);
+  EXPECT_LT(db.memory_bytes(), full);
+  db.erase(99);
+  EXPECT_EQ(db.counts().words, 0U);
+  EXPECT_TRUE(db.query({{3, 1.0}}, 0.0).empty());
+}
+
+TEST(Database, KeyframeIdsAbove32BitsAreRefused) {
+  Database db;
+  db.add(UINT32_MAX, {{1, 1.0}});
+  EXPECT_EQ(db.keyframes_with(1), (std::vector<std::uint64_t>{UINT32_MAX}));
+  EXPECT_THROW(db.add(std::uint64_t{UINT32_MAX} + 1, {{1, 1.0}}), std::out_of_range);
+  EXPECT_EQ(db.size(), 1U);
 }
 
 }  // namespace

@@ -146,6 +146,9 @@ class Frame {
   /// map points, the grid, the pyramid): the frame keeps its pose and time
   /// and has no keypoints (size() 0).
   void release_features();
+  /// Frees the pyramid and the alignment marks, which serve only alignment
+  /// to it (a frame without a pyramid is never aligned).
+  void release_pyramid();
 
   std::uint64_t id = 0;
   std::int64_t t_ns = 0;

@@ -9,6 +9,7 @@
 // Thread safety: the tracker and the local mapper take Map::mutex() around
 // every read or write of map data; the objects themselves have no locks.
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -44,7 +45,29 @@ class MapPoint {
     std::weak_ptr<KeyFrame> kf;
     std::size_t idx = 0;
   };
-  const std::map<std::uint64_t, Obs>& observations() const { return obs_; }
+  /// The observations as a sorted array: 32 bytes each, where a std::map
+  /// node costs 80.  Read like a map (ascending ids, find, count).
+  class Observations {
+   public:
+    using value_type = std::pair<std::uint64_t, Obs>;
+    using const_iterator = std::vector<value_type>::const_iterator;
+    const_iterator begin() const { return list_.begin(); }
+    const_iterator end() const { return list_.end(); }
+    std::size_t size() const { return list_.size(); }
+    bool empty() const { return list_.empty(); }
+    const_iterator find(std::uint64_t kf_id) const;
+    std::size_t count(std::uint64_t kf_id) const { return find(kf_id) != end() ? 1 : 0; }
+    /// Adds kf_id's observation; false (and no change) when it has one.
+    bool insert(std::uint64_t kf_id, Obs o);
+    /// Removes kf_id's observation; false when it has none.
+    bool erase(std::uint64_t kf_id);
+    void clear() { std::vector<value_type>().swap(list_); }
+    std::size_t heap_bytes() const;
+
+   private:
+    std::vector<value_type> list_;
+  };
+  const Observations& observations() const { return obs_; }
   int num_observations() const { return num_obs_; }
   void add_observation(const std::shared_ptr<KeyFrame>& kf, std::size_t idx);
   /// Removes the observation of keyframe kf_id; marks the point bad (and
@@ -58,7 +81,9 @@ class MapPoint {
   /// Replaces this point by `other` in every observing keyframe.
   void replace(const std::shared_ptr<MapPoint>& other, const std::shared_ptr<MapPoint>& self);
 
-  const cv::Mat& descriptor() const { return descriptor_; }
+  /// The point's descriptor (32 bytes), null until the first
+  /// compute_distinctive_descriptor() with an observation.
+  const unsigned char* descriptor() const { return has_descriptor_ ? descriptor_.data() : nullptr; }
   /// Chooses the observation descriptor with the least median distance to
   /// the others (ORB-SLAM2 ComputeDistinctiveDescriptors).
   void compute_distinctive_descriptor();
@@ -92,9 +117,10 @@ class MapPoint {
  private:
   std::uint64_t id_;
   Eigen::Vector3d p_w_;
-  std::map<std::uint64_t, Obs> obs_;
+  Observations obs_;
   int num_obs_ = 0;
-  cv::Mat descriptor_;
+  std::array<unsigned char, 32> descriptor_{};
+  bool has_descriptor_ = false;
   Eigen::Vector3d normal_ = Eigen::Vector3d::Zero();
   double min_dist_m_ = 0, max_dist_m_ = 0;
   std::weak_ptr<KeyFrame> ref_kf_;
@@ -119,7 +145,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   Frame& frame_for_alignment() { return frame_; }
   /// Drops the grey pyramid (the keyframe has left the local map): its
   /// patches are no longer alignment references.
-  void release_pyramid() { frame_.pyramid.reset(); }
+  void release_pyramid() { frame_.release_pyramid(); }
   const geom::SE3d& T_c_w() const { return frame_.T_c_w; }
   void set_T_c_w(const geom::SE3d& T) { frame_.T_c_w = T; }
   /// A correction (loop, merge) moves the keyframe to T: its velocity

@@ -16,10 +16,10 @@ namespace pvb::slam {
 /// Aligns keypoint i of f, an observation of mp, to mp's reference-keyframe
 /// patch, warped by the affine map that f's pose and the point's depth in
 /// the reference predict (fronto-parallel patch).  On success moves
-/// keys[i], keys_un[i] and u_right[i].  Records mp as tried in
-/// f.aligned_for[i] either way.  Returns false when there is nothing to
-/// align to (no live reference keyframe with a pyramid, f is that keyframe)
-/// or align_patch fails.
+/// keys[i], keys_un[i] and u_right[i].  Returns false at once when f has
+/// no pyramid; otherwise records mp as tried in f.aligned_for[i] and
+/// returns false when there is nothing to align to (no live reference
+/// keyframe with a pyramid, f is that keyframe) or align_patch fails.
 bool align_to_reference(Frame& f, std::size_t i, const MapPoint& mp, const PatchAlignParams& params);
 
 /// Aligns every observation of kf not yet tried for its current map point.

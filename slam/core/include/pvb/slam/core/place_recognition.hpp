@@ -43,13 +43,15 @@ class PlaceRecognizer {
   void add(KeyFrame& kf);
   /// Forgets a keyframe (culled): its postings are freed.
   void erase(std::uint64_t kf_id) { database_.erase(kf_id); }
-  /// Makes room for a loaded map's keyframes and the words of their bags.
-  void reserve(std::size_t keyframes, std::size_t words) { database_.reserve(keyframes, words); }
+  /// Makes room for a loaded map's keyframes (the word lists are made for
+  /// the vocabulary at construction).
+  void reserve(std::size_t keyframes) { database_.reserve(keyframes, 0); }
   /// A keyframe's bag: its own until add(), then the database's (the same
   /// words and weights).
   place::BowVector bag_of(const KeyFrame& kf) const;
   /// Heap bytes of the database.
   std::size_t database_bytes() const { return database_.memory_bytes(); }
+  place::Database::Counts database_counts() const { return database_.counts(); }
 
   /// Loop candidates for `kf` (ORB-SLAM2 DetectLoopCandidates): older by at
   /// least min_keyframe_gap ids, not kf's covisibles, scoring at least the

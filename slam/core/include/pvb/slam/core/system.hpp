@@ -96,6 +96,8 @@ struct SystemMemory {
   std::size_t culled_keyframes = 0;
   KeyFrameMemory culled_bytes;
   std::size_t place_database_bytes = 0;  ///< the keyframes' bags of words (0 without a vocabulary)
+  std::size_t place_database_words = 0;     ///< words with a list in it
+  std::size_t place_database_postings = 0;  ///< (keyframe, word) entries
   dense::DenseMemory dense;            ///< empty when dense mapping is off
 };
 /// {"keyframes": .., "keyframe_bytes": {"pyramid": .., ...}, ...} for stats.json.

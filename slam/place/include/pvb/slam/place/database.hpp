@@ -28,14 +28,21 @@ class Database {
  public:
   /// One keyframe under a word, with the word's weight in its bag: query()
   /// scores while it walks the lists, as DBoW2's database does, instead of
-  /// merging two bags per keyframe.
+  /// merging two bags per keyframe.  12 bytes: keyframe ids up to 2^32 - 1.
+#pragma pack(push, 4)
   struct Posting {
-    std::uint64_t id;
+    std::uint32_t id;
     double weight;
   };
-  /// Adds (or replaces) a keyframe's bag.
+#pragma pack(pop)
+  Database() = default;
+  Database(const Database&) = delete;
+  Database& operator=(const Database&) = delete;
+  /// Adds (or replaces) a keyframe's bag.  Throws std::out_of_range for an
+  /// id above 2^32 - 1.
   void add(std::uint64_t id, const BowVector& bow);
-  /// Makes room for this many keyframes and words (a map's worth, added at once).
+  /// Makes room for this many keyframes and words (a map's worth, added at
+  /// once; words: the vocabulary's size, or the largest word id + 1).
   void reserve(std::size_t keyframes, std::size_t words);
   /// Removes a keyframe (no-op when absent).
   void erase(std::uint64_t id);
@@ -63,8 +70,38 @@ class Database {
   BowVector bag(std::uint64_t id) const;
   /// Heap bytes of the lists and the word lists (as malloc sizes them).
   std::size_t memory_bytes() const;
+  /// What the database holds: keyframes, words with a list, and postings
+  /// (one per keyframe and word of its bag).
+  struct Counts {
+    std::size_t keyframes = 0, words = 0, postings = 0;
+  };
+  Counts counts() const;
 
  private:
+  /// A word's postings in ascending ids, in one malloc'd buffer whose
+  /// capacity fills its heap block (2, 4, 10, 20, 42, ... postings): 16
+  /// bytes a word, where a hash-map node and a std::vector cost 80.
+  class PostingList {
+   public:
+    PostingList() = default;
+    PostingList(PostingList&& o) noexcept;
+    PostingList& operator=(PostingList&& o) noexcept;
+    PostingList(const PostingList&) = delete;
+    PostingList& operator=(const PostingList&) = delete;
+    ~PostingList();
+    const Posting* begin() const { return data_; }
+    const Posting* end() const { return data_ + size_; }
+    bool empty() const { return size_ == 0; }
+    /// The posting of keyframe `id`, or null.
+    const Posting* find(std::uint32_t id) const;
+    void insert(Posting p);  ///< keeps ids ascending; replaces the weight of a listed id
+    void remove(std::uint32_t id);  ///< frees the buffer when the list empties
+    std::size_t heap_bytes() const;
+
+   private:
+    Posting* data_ = nullptr;
+    std::uint32_t size_ = 0, capacity_ = 0;
+  };
   struct Tally {
     int common = 0;  ///< words shared with the query
     double sum = 0;  ///< DBoW2's L1 sum over them
@@ -76,9 +113,12 @@ class Database {
                                                  const std::function<bool(std::uint64_t)>& skip) const;
   static std::vector<Candidate> select(const std::unordered_map<std::uint64_t, Tally>& tally, double min_score,
                                        double min_common_ratio);
+  /// The list of `word`, or null when none holds it (mutex held).
+  const PostingList* list_of(WordId word) const;
 
   mutable std::mutex mutex_;
-  std::unordered_map<WordId, std::vector<Posting>> inverted_;  ///< word -> keyframes, ascending ids
+  std::vector<PostingList> inverted_;  ///< by word id: word -> keyframes
+  std::size_t listed_words_ = 0;       ///< words whose list is not empty
   std::unordered_map<std::uint64_t, std::vector<WordId>> words_;  ///< keyframe id -> its words, ascending
 };
 
