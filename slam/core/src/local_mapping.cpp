@@ -386,7 +386,7 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
       pts[p]->set_p_w(problem.points[p].p_w);
       pts[p]->update_normal_and_depth();
     }
-  map_.remove_bad_points();
+  map_.remove_bad_among(pts);  // the outliers' points are the only ones the adjustment makes bad
 }
 
 void LocalMapping::cull_keyframes(const std::shared_ptr<KeyFrame>& kf) {

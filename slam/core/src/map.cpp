@@ -102,11 +102,14 @@ void MapPoint::replace(const std::shared_ptr<MapPoint>& other, const std::shared
 }
 
 void MapPoint::compute_distinctive_descriptor() {
-  std::vector<const unsigned char*> descs;  // rows of the observing keyframes' descriptors
-  for (const auto& [id, o] : obs_)
+  std::vector<const unsigned char*> descs;  // rows of the observing keyframes' descriptors, newest first
+  for (auto it = obs_.end(); it != obs_.begin() && descs.size() < kMaxDescriptorViews;) {
+    const Obs& o = (--it)->second;
     if (auto kf = o.kf.lock())
       if (!kf->bad()) descs.push_back(kf->frame().descriptors.ptr<unsigned char>(static_cast<int>(o.idx)));
+  }
   if (descs.empty()) return;
+  std::reverse(descs.begin(), descs.end());  // in ascending keyframe ids, as ORB-SLAM2 takes them
   const std::size_t n = descs.size();
   std::vector<int> dist(n * n, 0);
   for (std::size_t i = 0; i < n; ++i)
@@ -440,16 +443,23 @@ void unlink_in_time(KeyFrame& kf) {
 }
 
 bool Map::erase_keyframe(const std::shared_ptr<KeyFrame>& kf) {
+  const std::vector<std::shared_ptr<MapPoint>> seen = kf->map_points();  // set_bad frees them
   if (!kf->set_bad()) return false;
   unlink_in_time(*kf);
   keyframes_.erase(kf->id());
-  remove_bad_points();
+  remove_bad_among(seen);
   return true;
 }
 
 void Map::remove_bad_points() {
   for (auto it = points_.begin(); it != points_.end();)
     it = it->second->bad() ? points_.erase(it) : std::next(it);
+}
+
+void Map::remove_bad_among(const std::vector<std::shared_ptr<MapPoint>>& points) {
+  for (const auto& mp : points)
+    if (mp && mp->bad())
+      if (const auto it = points_.find(mp->id()); it != points_.end() && it->second == mp) points_.erase(it);
 }
 
 MapMemory Map::memory() const {

@@ -256,6 +256,7 @@ int fuse(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::vector<std::s
   const CameraModel& cam = *f.cam;
   const Eigen::Vector3d center = f.camera_center_w();
   int fused = 0;
+  std::vector<std::shared_ptr<MapPoint>> replaced;
   for (const auto& mp : points) {
     if (!mp || mp->bad() || mp->index_in(kf->id()) >= 0) continue;
     const Eigen::Vector3d p_c = f.T_c_w * mp->p_w();
@@ -294,6 +295,10 @@ int fuse(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::vector<std::s
     const auto existing = f.map_points[best_idx];
     if (existing && !existing->bad()) {
       if (existing == mp) continue;
+      // Both kept before the replacement: `points` may be a keyframe's own
+      // list, whose slot `mp` refers to the replacement rewrites.
+      replaced.push_back(existing);
+      replaced.push_back(mp);
       if (policy == FusePolicy::kIncomingWins) existing->replace(mp, existing);
       else if (existing->num_observations() > mp->num_observations()) mp->replace(existing, mp);
       else existing->replace(mp, existing);
@@ -303,7 +308,7 @@ int fuse(Map& map, const std::shared_ptr<KeyFrame>& kf, const std::vector<std::s
     }
     ++fused;
   }
-  map.remove_bad_points();
+  map.remove_bad_among(replaced);  // the only points fusing makes bad
   return fused;
 }
 

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <utility>
 
 #include "pvb/slam/core/patch_refine.hpp"
 #include "pvb/slam/core/frame_pose.hpp"
@@ -402,6 +404,13 @@ bool Tracking::track_reference_keyframe(Frame& f) {
   return true;
 }
 
+std::pair<int, std::uint64_t> least_shared_kept(std::vector<std::pair<int, std::uint64_t>> shared, int n) {
+  if (n <= 0 || shared.size() <= static_cast<std::size_t>(n)) return {0, 0};
+  const auto nth = shared.begin() + (n - 1);
+  std::nth_element(shared.begin(), nth, shared.end(), std::greater<>());
+  return *nth;
+}
+
 void Tracking::update_local_map(const Frame& f) {
   // Local keyframes: those observing the frame's points, their best
   // covisibles, children and parent (ORB-SLAM2 UpdateLocalKeyFrames).
@@ -420,16 +429,22 @@ void Tracking::update_local_map(const Frame& f) {
   std::set<std::uint64_t> in_local;
   std::shared_ptr<KeyFrame> best;
   int best_n = 0;
+  std::vector<std::pair<int, std::uint64_t>> shared;
+  shared.reserve(counter.size());
+  for (const auto& [kid, c] : counter) shared.emplace_back(c.second, kid);
+  const std::pair<int, std::uint64_t> least_kept = least_shared_kept(std::move(shared), options_.max_observing_keyframes);
   for (const auto& [kid, c] : counter) {
-    local_kfs_.push_back(c.first);
-    in_local.insert(kid);
     if (c.second > best_n) {
       best_n = c.second;
       best = c.first;
     }
+    if (std::make_pair(c.second, kid) < least_kept) continue;
+    local_kfs_.push_back(c.first);
+    in_local.insert(kid);
   }
   const std::size_t direct = local_kfs_.size();
-  for (std::size_t k = 0; k < direct && local_kfs_.size() < 80; ++k) {
+  const auto max_local = static_cast<std::size_t>(std::max(0, options_.max_local_keyframes));
+  for (std::size_t k = 0; k < direct && local_kfs_.size() < max_local; ++k) {
     const auto kf = local_kfs_[k];
     for (const auto& n : kf->best_covisibles(10))
       if (in_local.insert(n->id()).second) {

@@ -6,6 +6,7 @@
 
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/map.hpp"
+#include "pvb/slam/core/matcher.hpp"
 
 namespace pvb::slam {
 namespace map_rules_test {
@@ -119,6 +120,57 @@ TEST(MapPointDescriptor, NoneUntilComputedThenTheLeastMedianDistanceObservation)
   const unsigned char* row = kfs[2]->frame().descriptors.ptr<unsigned char>(0);
   EXPECT_TRUE(std::equal(row, row + 32, mp->descriptor()));
   EXPECT_NE(mp->descriptor(), row);  // a copy: the point keeps it when the keyframe goes
+}
+
+TEST(MapPointDescriptor, ChosenAmongTheNewestViewsOnly) {
+  // 40 observations: keyframes 0-19 alike (all bits set), keyframes 20-39
+  // one bit each, 2 bits apart.  Over all 40 an old one has the least
+  // median (0); among the newest 32 (12 old, 20 new) a new one (2 against
+  // 255).
+  Map map;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  for (std::uint64_t k = 0; k < 40; ++k) {
+    Frame f = make_frame(k, 1);
+    if (k < 20) f.descriptors.row(0).setTo(255);
+    else f.descriptors.at<unsigned char>(0, static_cast<int>(k - 20)) = 1;
+    kfs.push_back(map.create_keyframe(f));
+  }
+  auto mp = map.create_point(Eigen::Vector3d(0, 0, 1), kfs[0]);
+  for (const auto& kf : kfs) observe(mp, kf, 0);
+  mp->compute_distinctive_descriptor();
+  ASSERT_NE(mp->descriptor(), nullptr);
+  const unsigned char* new_row = kfs[20]->frame().descriptors.ptr<unsigned char>(0);
+  EXPECT_TRUE(std::equal(new_row, new_row + 32, mp->descriptor()));
+  // With the newest views gone, the old ones are among the 32 again.
+  for (std::uint64_t k = 20; k < 39; ++k) mp->erase_observation(k);
+  mp->compute_distinctive_descriptor();
+  const unsigned char* old_row = kfs[0]->frame().descriptors.ptr<unsigned char>(0);
+  EXPECT_TRUE(std::equal(old_row, old_row + 32, mp->descriptor()));
+}
+
+TEST(MapPointFusion, ThePointReplacedLeavesTheMapWhenTheListFusedIsAKeyframesOwn) {
+  // Keyframes 0, 1 and 2 at one pose: point a seen by keyframe 0, point b
+  // at the same place by keyframes 1 and 2.  Fusing keyframe 0's own list
+  // into keyframe 1 replaces a by b (more observations), which rewrites
+  // that very list; a must still leave the map.
+  Map map;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  for (std::uint64_t k = 0; k < 3; ++k) kfs.push_back(map.create_keyframe(make_frame(k, 4)));
+  auto a = map.create_point(kfs[0]->frame().unproject_world(0), kfs[0]);
+  observe(a, kfs[0], 0);
+  auto b = map.create_point(kfs[1]->frame().unproject_world(0), kfs[1]);
+  observe(b, kfs[1], 0);
+  observe(b, kfs[2], 0);
+  for (const auto& mp : {a, b}) {
+    mp->compute_distinctive_descriptor();
+    mp->update_normal_and_depth();
+  }
+  EXPECT_EQ(fuse(map, kfs[1], kfs[0]->map_points()), 1);
+  EXPECT_TRUE(a->bad());
+  EXPECT_EQ(kfs[0]->map_points()[0], b);
+  EXPECT_EQ(b->num_observations(), 6);
+  ASSERT_EQ(map.num_points(), 1u);
+  EXPECT_EQ(map.points().begin()->second, b);
 }
 
 class KeyFrameCulling : public ::testing::Test {

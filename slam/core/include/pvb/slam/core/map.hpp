@@ -85,8 +85,12 @@ class MapPoint {
   /// compute_distinctive_descriptor() with an observation.
   const unsigned char* descriptor() const { return has_descriptor_ ? descriptor_.data() : nullptr; }
   /// Chooses the observation descriptor with the least median distance to
-  /// the others (ORB-SLAM2 ComputeDistinctiveDescriptors).
+  /// the others (ORB-SLAM2 ComputeDistinctiveDescriptors), among the
+  /// newest kMaxDescriptorViews observations by live keyframes: the work
+  /// grows with their square, and a point at an aisle's vanishing end is
+  /// seen by hundreds of keyframes.
   void compute_distinctive_descriptor();
+  static constexpr std::size_t kMaxDescriptorViews = 32;
   /// Mean viewing direction and the scale-invariance distance range.
   void update_normal_and_depth();
   const Eigen::Vector3d& normal() const { return normal_; }
@@ -288,7 +292,11 @@ class Map {
   /// Marks a keyframe bad and removes it from the map (not the first one).
   bool erase_keyframe(const std::shared_ptr<KeyFrame>& kf);
   /// Drops points that were marked bad elsewhere (e.g. by erase_observation).
+  /// Walks the whole map.
   void remove_bad_points();
+  /// Drops those of `points` that are bad: the points one step touched,
+  /// without walking the map.
+  void remove_bad_among(const std::vector<std::shared_ptr<MapPoint>>& points);
 
   const std::map<std::uint64_t, std::shared_ptr<KeyFrame>>& keyframes() const { return keyframes_; }
   const std::map<std::uint64_t, std::shared_ptr<MapPoint>>& points() const { return points_; }

@@ -46,6 +46,13 @@ struct TrackingOptions {
   int kf_min_tracked_close = 200;    ///< KeyFrame.minTrackedClose (ORB-SLAM2: 100)
   int kf_min_untracked_close = 70;   ///< KeyFrame.minUntrackedClose
   double kf_ref_overlap = 0.0;       ///< KeyFrame.refOverlap (0: ORB-SLAM2's 75 % rule)
+  /// The local map's keyframes that observe the frame's points: at most
+  /// this many, those sharing the most points (ties: the newer).  ORB-SLAM2
+  /// takes every one, and along a plant aisle the points at the rows'
+  /// vanishing end are seen by hundreds of keyframes, so its local map
+  /// grows with the aisle.  0: every one.
+  int max_observing_keyframes = 60;
+  int max_local_keyframes = 80;  ///< with their covisibles, children and parents (ORB-SLAM2: 80)
   /// Beyond ORB-SLAM2: before the local-map pose optimisation, move each
   /// map-point match to where the point's reference-keyframe patch,
   /// warped by the predicted pose, aligns (needs Frame::pyramid; frames

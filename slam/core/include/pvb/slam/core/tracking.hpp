@@ -32,6 +32,13 @@ struct MergeHint {
   std::shared_ptr<KeyFrame> anchor;  ///< the map's keyframe the relocalisation matched
 };
 
+/// Of the keyframes observing a frame's points, given as (points shared,
+/// keyframe id), the pair of the last one kept when at most n are kept:
+/// those sharing the most first, the newer on ties.  A keyframe is kept
+/// when its pair is not less.  (0, 0), which keeps every one, when n <= 0
+/// or no more than n are given.
+std::pair<int, std::uint64_t> least_shared_kept(std::vector<std::pair<int, std::uint64_t>> shared, int n);
+
 /// "Already seen in this pass" marks for map-point ids: a pass stamp per
 /// id, so a new pass is O(1) and a look-up an array access (map-point ids
 /// are dense from 0).  Ids from kDenseLimit up (visual-odometry points)
