@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "pvb/common/memory.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/map.hpp"
 #include "pvb/slam/core/matcher.hpp"
@@ -97,6 +98,22 @@ TEST(MapPointObservations, KeptInAscendingKeyFrameIdsWhateverTheOrderAdded) {
   EXPECT_EQ(ids, (std::vector<std::uint64_t>{0, 3, 4}));
   EXPECT_EQ(mp->num_observations(), 6);
   EXPECT_FALSE(mp->bad());
+}
+
+TEST(MapPointObservations, EightCostAboutAQuarterOfAKilobyte) {
+  // Eight observations in a sorted array: 8 x 32 bytes; the point itself
+  // with its descriptor inline about 200 more.  A std::map node per
+  // observation (80 bytes) and a cv::Mat descriptor came to about 1,150.
+  Map map;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  for (std::uint64_t i = 0; i < 8; ++i) kfs.push_back(map.create_keyframe(make_frame(i, 1)));
+  auto mp = map.create_point(Eigen::Vector3d(0, 0, 1), kfs[0]);
+  const std::size_t alone = mp->memory_bytes();
+  for (const auto& kf : kfs) observe(mp, kf, 0);
+  mp->compute_distinctive_descriptor();
+  EXPECT_EQ(mp->memory_bytes() - alone, heap_block_bytes(8 * sizeof(MapPoint::Observations::value_type)));
+  EXPECT_EQ(sizeof(MapPoint::Observations::value_type), 32u);
+  EXPECT_LT(mp->memory_bytes(), 560u);
 }
 
 TEST(MapPointDescriptor, NoneUntilComputedThenTheLeastMedianDistanceObservation) {
