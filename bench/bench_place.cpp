@@ -155,7 +155,7 @@ void BM_DatabaseQuery(benchmark::State& state) {
   }
   state.counters["candidates"] = static_cast<double>(found);
 }
-BENCHMARK(BM_DatabaseQuery)->Arg(1000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DatabaseQuery)->Arg(1000)->Arg(5000)->Unit(benchmark::kMillisecond);
 
 /// A vocabulary file, written once and removed at exit: 0 the real one,
 /// 1 one trained (k = 10, L = 6) on 1.2 million random descriptors, which

@@ -103,6 +103,7 @@ void Database::add(std::uint64_t id, const BowVector& bow) {
     words.push_back(word);
   }
   words_[id] = std::move(words);
+  max_id_ = std::max(max_id_, id32);
 }
 
 void Database::reserve(std::size_t keyframes, std::size_t words) {
@@ -140,7 +141,8 @@ BowVector Database::bag(std::uint64_t id) const {
 
 std::size_t Database::memory_bytes() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  std::size_t bytes = vector_heap_bytes(inverted_) + unordered_map_bytes(words_);
+  std::size_t bytes = vector_heap_bytes(inverted_) + unordered_map_bytes(words_) + vector_heap_bytes(tallies_) +
+                      vector_heap_bytes(met_);
   for (const PostingList& list : inverted_) bytes += list.heap_bytes();
   for (const auto& [id, words] : words_) bytes += vector_heap_bytes(words);
   return bytes;
@@ -158,53 +160,58 @@ Database::Counts Database::counts() const {
 std::vector<Candidate> Database::query(const BowVector& query, double min_score, double min_common_ratio,
                                        const std::function<bool(std::uint64_t)>& skip) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return select(tally(query, skip), min_score, min_common_ratio);
+  tally(query, skip);
+  return select(min_score, min_common_ratio);
 }
 
 std::vector<Candidate> Database::query_above(const BowVector& query, const std::vector<std::uint64_t>& reference,
                                              double min_common_ratio,
                                              const std::function<bool(std::uint64_t)>& skip) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  const std::unordered_map<std::uint64_t, Tally> t = tally(query, skip);
+  tally(query, skip);
   double min_score = 1.0;
   for (std::uint64_t id : reference) {
-    const auto it = t.find(id);
-    min_score = std::min(min_score, it == t.end() ? 0.0 : score_of(it->second));
+    const bool met = id < tallies_.size() && tallies_[id].common > 0;
+    min_score = std::min(min_score, met ? score_of(tallies_[id]) : 0.0);
   }
-  return select(t, min_score, min_common_ratio);
+  return select(min_score, min_common_ratio);
 }
 
-std::unordered_map<std::uint64_t, Database::Tally> Database::tally(
-    const BowVector& query, const std::function<bool(std::uint64_t)>& skip) const {
+void Database::tally(const BowVector& query, const std::function<bool(std::uint64_t)>& skip) const {
   // The sum runs over the query's words in ascending order, as
   // Vocabulary::score merges two bags, so the scores are the same doubles.
-  std::unordered_map<std::uint64_t, Tally> tally;
+  for (std::uint32_t id : met_) tallies_[id] = Tally{};  // left by a query a skip() threw out of
+  met_.clear();
+  if (tallies_.size() <= max_id_ && !words_.empty()) tallies_.resize(std::size_t{max_id_} + 1);
   for (const auto& [word, x] : query) {
     const PostingList* list = list_of(word);
     if (!list) continue;
     for (const Posting& p : *list) {
-      auto [it, inserted] = tally.try_emplace(p.id);
-      if (inserted && skip) it->second.skipped = skip(p.id);
-      ++it->second.common;
-      it->second.sum += std::fabs(x - p.weight) - std::fabs(x) - std::fabs(p.weight);
+      Tally& t = tallies_[p.id];
+      if (t.common++ == 0) {
+        met_.push_back(p.id);
+        if (skip) t.skipped = skip(p.id);
+      }
+      t.sum += std::fabs(x - p.weight) - std::fabs(x) - std::fabs(p.weight);
     }
   }
-  return tally;
 }
 
-std::vector<Candidate> Database::select(const std::unordered_map<std::uint64_t, Tally>& tally, double min_score,
-                                        double min_common_ratio) {
+std::vector<Candidate> Database::select(double min_score, double min_common_ratio) const {
   int max_common = 0;
-  for (const auto& [id, t] : tally)
-    if (!t.skipped) max_common = std::max(max_common, t.common);
+  for (std::uint32_t id : met_)
+    if (!tallies_[id].skipped) max_common = std::max(max_common, tallies_[id].common);
   std::vector<Candidate> out;
-  if (max_common == 0) return out;
   const double min_common = min_common_ratio * max_common;
-  for (const auto& [id, t] : tally) {
-    if (t.skipped || t.common < min_common) continue;
-    const double s = score_of(t);
-    if (s >= min_score) out.push_back({id, t.common, s});
+  for (std::uint32_t id : met_) {
+    const Tally& t = tallies_[id];
+    if (max_common > 0 && !t.skipped && t.common >= min_common) {
+      const double s = score_of(t);
+      if (s >= min_score) out.push_back({id, t.common, s});
+    }
+    tallies_[id] = Tally{};
   }
+  met_.clear();
   std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) {
     return a.score != b.score ? a.score > b.score : a.id < b.id;
   });

@@ -200,6 +200,20 @@ TEST(Database, APostingCostsItsTwelveBytesAndLittleMore) {
   EXPECT_LT(per_posting, 24.0);
 }
 
+TEST(Database, AQueryLeftByAThrowingSkipDoesNotCountInTheNext) {
+  Database db;
+  fill(db);
+  const auto throws = [](std::uint64_t id) -> bool {
+    if (id == 12) throw std::runtime_error("skip failed");
+    return false;
+  };
+  EXPECT_THROW(db.query(kQuery, 0.0, 0.0, throws), std::runtime_error);
+  const std::vector<Candidate> c = db.query(kQuery, 0.0, 0.0);
+  EXPECT_EQ(ids(c), (std::vector<std::uint64_t>{10, 9, 12, 11, 14}));
+  EXPECT_DOUBLE_EQ(c[0].score, 1.0);
+  EXPECT_EQ(c[0].common_words, 4);
+}
+
 TEST(Database, KeyframeIdsAbove32BitsAreRefused) {
   Database db;
   db.add(UINT32_MAX, {{1, 1.0}});

@@ -103,16 +103,16 @@ class Database {
     std::uint32_t size_ = 0, capacity_ = 0;
   };
   struct Tally {
-    int common = 0;  ///< words shared with the query
-    double sum = 0;  ///< DBoW2's L1 sum over them
+    double sum = 0;  ///< DBoW2's L1 sum over the words shared with the query
+    int common = 0;  ///< words shared with the query (0: not met)
     bool skipped = false;
   };
   static double score_of(const Tally& t) { return 0.0 - 0.5 * t.sum; }  // as Vocabulary::score
-  /// Walks the lists of the query's words (mutex held by the caller).
-  std::unordered_map<std::uint64_t, Tally> tally(const BowVector& query,
-                                                 const std::function<bool(std::uint64_t)>& skip) const;
-  static std::vector<Candidate> select(const std::unordered_map<std::uint64_t, Tally>& tally, double min_score,
-                                       double min_common_ratio);
+  /// Walks the lists of the query's words into tallies_ (mutex held by the
+  /// caller).
+  void tally(const BowVector& query, const std::function<bool(std::uint64_t)>& skip) const;
+  /// The candidates of the tallies, which it clears.
+  std::vector<Candidate> select(double min_score, double min_common_ratio) const;
   /// The list of `word`, or null when none holds it (mutex held).
   const PostingList* list_of(WordId word) const;
 
@@ -120,6 +120,12 @@ class Database {
   std::vector<PostingList> inverted_;  ///< by word id: word -> keyframes
   std::size_t listed_words_ = 0;       ///< words whose list is not empty
   std::unordered_map<std::uint64_t, std::vector<WordId>> words_;  ///< keyframe id -> its words, ascending
+  std::uint32_t max_id_ = 0;  ///< the largest keyframe id added
+  /// One query's tallies by keyframe id (an array up to max_id_, where a
+  /// hash map took most of a query's time) and the ids met, in the order
+  /// met; scratch under the mutex, cleared after each query.
+  mutable std::vector<Tally> tallies_;
+  mutable std::vector<std::uint32_t> met_;
 };
 
 }  // namespace pvb::slam::place
