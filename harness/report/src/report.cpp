@@ -93,14 +93,15 @@ std::string run_fields(const RunReport& r, const std::string& in) {
 const std::vector<std::string>& cost_columns() {
   static const std::vector<std::string> columns = {
       "frame",     "t_s",      "keyframes",          "points",          "rss_mb",         "sparse_mb",
-      "dense_mb",  "tracking_ms_median", "tracking_ms_p95", "loop_detect_ms", "mapping_ms_per_keyframe"};
+      "dense_mb",  "tracking_ms_median", "tracking_ms_p95", "loop_detect_ms", "mapping_ms_per_keyframe",
+      "local_ba_ms"};
   return columns;
 }
 
 std::vector<double> cost_values(const CostSample& c) {
   return {static_cast<double>(c.frame), c.t_s, static_cast<double>(c.keyframes), static_cast<double>(c.points),
           c.rss_mb, c.sparse_mb, c.dense_mb, c.tracking_ms_median, c.tracking_ms_p95, c.loop_detect_ms,
-          c.mapping_ms_per_keyframe};
+          c.mapping_ms_per_keyframe, c.local_ba_ms};
 }
 
 std::string costs_json(const std::vector<CostSample>& samples, int every_frames, const std::string& in) {

@@ -46,7 +46,7 @@ void write_motion_figures(const MotionSensorsReport& m, const std::string& dir, 
 void write_cost_figures(const SlamRun& run, const std::string& dir, std::vector<std::string>* written) {
   if (run.costs.size() < 2) return;
   std::vector<double> kf;
-  std::vector<double> rss, sparse, dense, track, loop, mapping;
+  std::vector<double> rss, sparse, dense, track, loop, mapping, ba;
   for (const CostSample& c : run.costs) {
     kf.push_back(static_cast<double>(c.keyframes));
     rss.push_back(c.rss_mb);
@@ -55,6 +55,7 @@ void write_cost_figures(const SlamRun& run, const std::string& dir, std::vector<
     track.push_back(c.tracking_ms_median);
     loop.push_back(c.loop_detect_ms);
     mapping.push_back(c.mapping_ms_per_keyframe);
+    ba.push_back(c.local_ba_ms);
   }
   write_figure(eval::make_line_chart("memory as the map grows", "keyframes in the map", "memory [MB]",
                                      {{"process (RSS)", kf, rss, eval::series_color(0)},
@@ -65,7 +66,8 @@ void write_cost_figures(const SlamRun& run, const std::string& dir, std::vector<
                                      "keyframes in the map", "time [ms]",
                                      {{"tracking, median per frame", kf, track, eval::series_color(0)},
                                       {"loop detection, mean per keyframe", kf, loop, eval::series_color(1)},
-                                      {"local mapping, per keyframe", kf, mapping, eval::series_color(2)}}),
+                                      {"local mapping, per keyframe", kf, mapping, eval::series_color(2)},
+                                      {"local BA, per adjustment", kf, ba, eval::series_color(3)}}),
                dir, "cost_time", written);
 }
 

@@ -55,6 +55,8 @@ void CostLog::sample(slam::System& system) {
     c.loop_detect_ms = (loops.detect_ms - loops_.detect_ms) / static_cast<double>(n);
   if (const std::int64_t n = mapping.keyframes - mapping_.keyframes; n > 0)
     c.mapping_ms_per_keyframe = (mapping.busy_ms - mapping_.busy_ms) / static_cast<double>(n);
+  if (const std::int64_t n = mapping.local_ba - mapping_.local_ba; n > 0)
+    c.local_ba_ms = (mapping.local_ba_ms - mapping_.local_ba_ms) / static_cast<double>(n);
   loops_ = loops;
   mapping_ = mapping;
   window_ms_.clear();

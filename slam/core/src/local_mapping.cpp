@@ -106,7 +106,8 @@ std::string to_json(const LocalMappingStats& stats) {
   return "{\"keyframes\": " + std::to_string(stats.keyframes) +
          ", \"local_ba\": " + std::to_string(stats.local_ba) +
          ", \"local_ba_stopped\": " + std::to_string(stats.local_ba_stopped) +
-         ", \"busy_ms\": " + json_number(stats.busy_ms, 6) + "}";
+         ", \"busy_ms\": " + json_number(stats.busy_ms, 6) +
+         ", \"local_ba_ms\": " + json_number(stats.local_ba_ms, 6) + "}";
 }
 
 LocalMappingStats LocalMapping::stats() const {
@@ -115,6 +116,7 @@ LocalMappingStats LocalMapping::stats() const {
   s.local_ba = ba_runs_.load();
   s.local_ba_stopped = ba_stopped_.load();
   s.busy_ms = busy_ms();
+  s.local_ba_ms = static_cast<double>(ba_us_.load()) / 1000.0;
   return s;
 }
 
@@ -373,7 +375,9 @@ void LocalMapping::local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf) 
     ++ba_stopped_;
     return;
   }
+  const auto t_ba = std::chrono::steady_clock::now();
   const BaResult result = slam::local_bundle_adjustment(&problem, cam_->K, ba_options);
+  ba_us_ += std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t_ba).count();
   if (result.stopped) ++ba_stopped_;
 
   std::lock_guard<std::mutex> lock(map_.mutex());

@@ -348,6 +348,7 @@ TEST(RunReport, CostsAreRowsUnderTheirColumnsAndTwoFigures) {
     c.rss_mb = 300 + 10.0 * k;
     c.sparse_mb = 5.0 * k;
     c.loop_detect_ms = 1.5;
+    c.local_ba_ms = 80.0 + k;
     r.primary.costs.push_back(c);
   }
   const YAML::Node m = YAML::Load(metrics_json(r))["costs"];
@@ -364,6 +365,7 @@ TEST(RunReport, CostsAreRowsUnderTheirColumnsAndTwoFigures) {
   EXPECT_EQ(m["rows"][1][column("rss_mb")].as<double>(), 320.0);
   EXPECT_EQ(m["rows"][0][column("frame")].as<int>(), 299);
   EXPECT_EQ(m["rows"][0][column("loop_detect_ms")].as<double>(), 1.5);
+  EXPECT_EQ(m["rows"][2][column("local_ba_ms")].as<double>(), 83.0);
   const std::string dir = ::testing::TempDir() + "/cost_figures";
   std::filesystem::create_directories(dir);
   const std::vector<std::string> written = write_figures(r, dir);

@@ -186,7 +186,9 @@ TEST(LocalMapping, StatsAsJson) {
   s.local_ba = 9;
   s.local_ba_stopped = 4;
   s.busy_ms = 250.5;
-  EXPECT_EQ(to_json(s), "{\"keyframes\": 12, \"local_ba\": 9, \"local_ba_stopped\": 4, \"busy_ms\": 250.5}");
+  s.local_ba_ms = 180.25;
+  EXPECT_EQ(to_json(s), "{\"keyframes\": 12, \"local_ba\": 9, \"local_ba_stopped\": 4, \"busy_ms\": 250.5, "
+                        "\"local_ba_ms\": 180.25}");
 }
 
 }  // namespace local_mapping_test

@@ -154,6 +154,7 @@ struct CostSample {
   double tracking_ms_median = 0, tracking_ms_p95 = 0;  ///< per frame, over the window
   double loop_detect_ms = 0;           ///< mean per detection over the window (0: none in it)
   double mapping_ms_per_keyframe = 0;  ///< local mapping's busy time per keyframe over the window (0: none)
+  double local_ba_ms = 0;              ///< the local BAs' solver time per BA over the window (0: none)
 };
 /// The columns of costs.csv and of metrics.json's "costs" rows, in order.
 const std::vector<std::string>& cost_columns();

@@ -128,6 +128,7 @@ class LocalMapping {
   ClosableQueue<std::shared_ptr<KeyFrame>> queue_;
   std::atomic<int> pending_{0};  ///< keyframes inserted and not yet processed
   std::atomic<std::int64_t> busy_us_{0};  ///< time in process(), microseconds
+  std::atomic<std::int64_t> ba_us_{0};    ///< of which in the local BAs' solver
   /// Between start() and the end of stop(); set before the worker exists,
   /// so the worker may read it too (insert() from a hook, its local BA).
   bool on_worker_ = false;

@@ -164,8 +164,9 @@ struct LocalMappingStats {
   std::int64_t local_ba = 0;          ///< local bundle adjustments started
   std::int64_t local_ba_stopped = 0;  ///< of which cut short by a new keyframe (worker mode only)
   double busy_ms = 0;                 ///< time spent processing keyframes
+  double local_ba_ms = 0;             ///< of which in the local BAs' solver
 };
-/// {"keyframes", "local_ba", "local_ba_stopped", "busy_ms"} for stats.json and metrics.json.
+/// {"keyframes", "local_ba", "local_ba_stopped", "busy_ms", "local_ba_ms"} for stats.json and metrics.json.
 std::string to_json(const LocalMappingStats& stats);
 
 /// One closed loop.
