@@ -134,8 +134,10 @@ BowVector Database::bag(std::uint64_t id) const {
   const auto it = words_.find(id);
   if (it == words_.end()) return bow;
   bow.reserve(it->second.size());
-  for (WordId word : it->second)  // present: add() listed it under every one of its words
-    bow.emplace_back(word, inverted_[word].find(static_cast<std::uint32_t>(id))->weight);
+  for (WordId word : it->second) {  // present: add() listed it under every one of its words
+    const double weight = inverted_[word].find(static_cast<std::uint32_t>(id))->weight;  // a copy: packed
+    bow.emplace_back(word, weight);
+  }
   return bow;
 }
 

@@ -29,6 +29,7 @@ class Database {
   /// One keyframe under a word, with the word's weight in its bag: query()
   /// scores while it walks the lists, as DBoW2's database does, instead of
   /// merging two bags per keyframe.  12 bytes: keyframe ids up to 2^32 - 1.
+  /// Packed: read `weight` by value, never bind a reference to it.
 #pragma pack(push, 4)
   struct Posting {
     std::uint32_t id;
