@@ -395,6 +395,8 @@ Settings settings_from(const cv::FileStorage& fs, const std::string& text, const
   read_orb(r, &s);
   s.align_patches = r.flag("Tracking.alignPatches", false, s.align_patches);  // ours, optional
   s.reloc_lookalikes = r.integer("Tracking.relocLookalikes", false, s.reloc_lookalikes, 0, 1000);  // ours, optional
+  s.max_observing_keyframes =
+      r.integer("Tracking.maxObservingKeyFrames", false, s.max_observing_keyframes, 0, 100000);  // ours, optional
   s.two_view_start = r.flag("Tracking.twoViewStart", false, s.two_view_start);  // ours, optional
   s.new_map_after_lost = r.integer("Tracking.newMapAfter", false, s.new_map_after_lost, 0, 100000);  // ours, optional
   s.merge_reloc_every = r.integer("Tracking.mergeRelocEvery", false, s.merge_reloc_every, 0, 100000);  // ours, optional

@@ -54,6 +54,7 @@ System::System(const Settings& settings, const SystemOptions& options)
   topt.reloc_ambiguity_check = settings.loop.ambiguity_check;
   topt.reloc_ambiguity_distance_m = settings.loop.ambiguity_distance_m;
   topt.reloc_lookalikes = settings.reloc_lookalikes;
+  topt.max_observing_keyframes = settings.max_observing_keyframes;
   topt.two_view_start = settings.two_view_start;
   topt.new_map_after_lost = settings.new_map_after_lost;
   topt.merge_reloc_every = settings.merge_reloc_every;

@@ -419,6 +419,20 @@ TEST(Settings, ReadsPlaceRecognitionKeys) {
   }
 }
 
+TEST(Settings, ReadsTheLocalMapsBound) {
+  EXPECT_EQ(read_settings(tum1()).max_observing_keyframes, 60);
+  const Settings s =
+      read_settings(temp_copy("local_map", read_file(tum1()) + "\nTracking.maxObservingKeyFrames: 0\n"));
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_EQ(s.max_observing_keyframes, 0);  // ORB-SLAM2's local map
+  try {
+    read_settings(temp_copy("bad_local_map", read_file(tum1()) + "\nTracking.maxObservingKeyFrames: -5\n"));
+    ADD_FAILURE() << "a negative Tracking.maxObservingKeyFrames was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "Tracking.maxObservingKeyFrames") << e.what();
+  }
+}
+
 TEST(Settings, ReadsMapReuseTrackingKeys) {
   const Settings d = read_settings(tum1());
   EXPECT_EQ(d.reloc_lookalikes, 10);

@@ -92,6 +92,10 @@ struct Settings {
   /// Tracking.relocLookalikes (ours, optional): best-scoring keyframes a
   /// relocalisation is also checked against (TrackingOptions::reloc_lookalikes).
   int reloc_lookalikes = 10;
+  /// Tracking.maxObservingKeyFrames (ours, optional): the local map's
+  /// keyframes that observe the frame's points, those sharing the most
+  /// (TrackingOptions::max_observing_keyframes); 0: every one (ORB-SLAM2).
+  int max_observing_keyframes = 60;
   /// Tracking.twoViewStart (ours, optional): a start from two views when a
   /// frame has too little depth (TrackingOptions::two_view_start).
   bool two_view_start = true;
