@@ -52,7 +52,7 @@ void MapPoint::erase_observation(std::uint64_t kf_id) {
   if (it == obs_.end()) return;
   if (auto kf = it->second.kf.lock()) num_obs_ -= kf->frame().u_right[it->second.idx] >= 0 ? 2 : 1;
   else num_obs_ -= 1;
-  obs_.erase(kf_id);
+  obs_.erase(it);
   if (ref_kf_.expired() || (ref_kf_.lock() && ref_kf_.lock()->id() == kf_id)) {
     ref_kf_.reset();
     for (const auto& [id, o] : obs_)

@@ -61,6 +61,7 @@ class MapPoint {
     bool insert(std::uint64_t kf_id, Obs o);
     /// Removes kf_id's observation; false when it has none.
     bool erase(std::uint64_t kf_id);
+    void erase(const_iterator it) { list_.erase(it); }
     void clear() { std::vector<value_type>().swap(list_); }
     std::size_t heap_bytes() const;
 
