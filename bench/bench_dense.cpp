@@ -63,9 +63,13 @@ BENCHMARK(BM_GlobalRebuild)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 
 /// A loop correction: n keyframes in the map, every one moved by 1 cm and
 /// re-binned (update_poses), as after the loop scenario's correction.
+/// Second argument: the mapper's memory budget, MB (0: none); a budget
+/// below the map's size makes every update read spilled clouds and blocks
+/// back and spill others.
 void BM_LoopUpdate(benchmark::State& state) {
   const Images im = make_images();
   dn::DenseMapperOptions o;
+  o.memory_budget_bytes = static_cast<std::size_t>(state.range(1)) << 20;
   dn::DenseMapper mapper(o);
   const int n = static_cast<int>(state.range(0));
   dn::PoseUpdate a, b;
@@ -84,8 +88,11 @@ void BM_LoopUpdate(benchmark::State& state) {
       static_cast<double>(mapper.stats().points) / static_cast<double>(mapper.stats().keyframes);
   state.counters["keyframes_moved_per_update"] =
       static_cast<double>(mapper.stats().keyframes_moved) / static_cast<double>(mapper.stats().pose_updates);
+  state.counters["memory_mb"] = static_cast<double>(mapper.memory().total()) / (1 << 20);
+  state.counters["spilled_mb"] =
+      static_cast<double>(mapper.memory().spilled_keyframe_bytes + mapper.memory().spilled_map_bytes) / (1 << 20);
 }
-BENCHMARK(BM_LoopUpdate)->Arg(250)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LoopUpdate)->Args({250, 0})->Args({250, 32})->Args({250, 64})->Args({250, 128})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -10,6 +10,7 @@ PKGS=(
   libegl-dev libegl-mesa0 libgl-dev libgles-dev libosmesa6-dev libgl1-mesa-dri
   libopenni2-dev
   libnanoflann-dev   # k-d trees for map accuracy
+  libzstd-dev        # compressed spill files of the dense map
   nlohmann-json3-dev # the tests parse every JSON file pvbench writes with a strict parser
   python3 python3-yaml   # the tests read the motion files back with Python's csv and yaml modules
   libfreenect-dev libfreenect0.5 libfreenect-bin   # Kinect v1 plug-in and fakenect playback

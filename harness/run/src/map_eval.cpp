@@ -9,26 +9,15 @@
 
 namespace pvb::run {
 
-NamedClouds dense_maps(slam::System& system) {
-  NamedClouds maps;
-  maps.emplace_back("corrected", system.point_cloud());
-  maps.emplace_back("live", system.live_point_cloud());
-  if (std::optional<slam::dense::LoopSnapshot> loop = system.dense_first_loop()) {
-    maps.emplace_back("before_loop", std::move(loop->before));
-    maps.emplace_back("after_loop", std::move(loop->after));
-  }
-  return maps;
-}
-
-std::string dense_map_file(const std::string& name) {
-  return name == "corrected" ? "PointCloud.ply" : "PointCloud_" + name + ".ply";
-}
-
-std::vector<std::string> write_dense_maps(const NamedClouds& maps, const std::string& dir) {
-  std::vector<std::string> files;
-  for (const auto& [name, cloud] : maps) {
-    files.push_back(dense_map_file(name));
-    slam::dense::write_ply(dir + "/" + files.back(), cloud);
+std::vector<DenseMapFile> write_dense_maps(slam::System& system, const std::string& dir) {
+  std::vector<DenseMapFile> files;
+  files.push_back({"corrected", "PointCloud.ply", 0});
+  files.back().points = system.write_point_cloud(dir + "/" + files.back().file);
+  files.push_back({"live", "PointCloud_live.ply", 0});
+  files.back().points = system.write_live_point_cloud(dir + "/" + files.back().file);
+  if (system.write_dense_first_loop(dir + "/PointCloud_before_loop.ply", dir + "/PointCloud_after_loop.ply")) {
+    files.push_back({"before_loop", "PointCloud_before_loop.ply", 0});
+    files.push_back({"after_loop", "PointCloud_after_loop.ply", 0});
   }
   return files;
 }

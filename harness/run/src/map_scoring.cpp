@@ -6,6 +6,7 @@
 #include "pvb/eval/slam_mode.hpp"
 #include "pvb/plot/contact_sheet.hpp"
 #include "pvb/plot/map_view.hpp"
+#include "pvb/slam/dense/ply.hpp"
 
 namespace pvb::run {
 namespace {
@@ -32,7 +33,9 @@ void score_sink(SystemSink& sink, const std::string& scenario, const eval::Traje
   const eval::Sim3Transform T = map_to_world(MapAlignment::kFirstFrame, *sink.run.eval, gt, sink.est);
   d.alignment = to_string(MapAlignment::kFirstFrame);
   d.surface_samples = surface.size();
-  for (const auto& [name, cloud] : sink.clouds) {
+  for (const DenseMapFile& file : sink.dense_files) {
+    const std::string& name = file.name;
+    const slam::dense::PointCloud cloud = slam::dense::read_ply(sink.dir + "/" + file.file);
     if (cloud.empty()) {  // nothing to score: never a perfect score
       log.line(sink.run.label + ": " + name + " map: not scored, it has no points");
       d.note += (d.note.empty() ? "" : "; ") + name + " map not scored: it has no points";
@@ -83,7 +86,6 @@ double score_dense_maps(const scenes::Scenario& scenario, sim::GlBackend backend
       if (failure.empty()) score_sink(*sink, scenario.name, gt, surface, log);
       else sink->run.dense_map->note = failure;
     }
-    sink->clouds.clear();
   }
   if (!failure.empty()) log.line("warning: dense maps not scored: " + failure);
   return 1000.0 * seconds_since(t0);

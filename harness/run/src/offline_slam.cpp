@@ -261,14 +261,12 @@ std::string OfflineSlam::Impl::write_final_outputs() {
   cam_traj_.close();
   if (!system_->dense_enabled()) return {};
   // The corrected map, the map as built and, after a loop, the corrected map around it.
-  const NamedClouds maps = dense_maps(*system_);
-  write_dense_maps(maps, a_.out);
-  return dense_json(maps);
+  const std::vector<DenseMapFile> maps = write_dense_maps(*system_, a_.out);
+  return dense_json(maps.front().points);
 }
 
 /// The "dense" part of stats.json, printing the dense map's line on the way.
-std::string OfflineSlam::Impl::dense_json(const NamedClouds& maps) {
-  const std::size_t cloud_points = maps.front().second.size();
+std::string OfflineSlam::Impl::dense_json(std::size_t cloud_points) {
   const slam::dense::DenseMapperStats dense = system_->dense_stats();
   const double per_kf_ms = dense.keyframes ? dense.total_ms / static_cast<double>(dense.keyframes) : 0.0;
   text(strf("dense map: %zu points from %zu keyframes (%.1f ms per keyframe) -> %s/PointCloud.ply\n",

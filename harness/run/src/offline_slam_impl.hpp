@@ -97,7 +97,7 @@ class OfflineSlam::Impl {
   slam::TrackingState track_one(const sensor::RgbdFrame& frame);
   void write_timing_line(const sensor::RgbdFrame& frame, const slam::FrameResult& r, double cpu_ms);
   std::string write_final_outputs();
-  std::string dense_json(const NamedClouds& maps);
+  std::string dense_json(std::size_t cloud_points);
   std::string stats_json(StopReason stop, const std::string& dense_json);
   void print_loop_closing(std::ostringstream* js);
   void evaluate(std::ostringstream* js);

@@ -316,7 +316,6 @@ double score_or_skip_maps(const RunOptions& opt, const scenes::Scenario& scenari
   if (opt.map_eval && !gt.empty()) return score_dense_maps(scenario, backend, gt, sinks, log);
   for (auto& sink : sinks) {
     if (sink->run.dense_map) sink->run.dense_map->note = opt.map_eval ? "no frames" : "not scored (--no-map-eval)";
-    sink->clouds.clear();
   }
   return 0.0;
 }

@@ -192,18 +192,18 @@ void SystemSink::finish() {
 }
 
 void SystemSink::save_dense_maps() {
-  clouds = dense_maps(*system);
+  dense_files = write_dense_maps(*system, dir);
   const slam::dense::DenseMapperStats st = system->dense_stats();
   DenseMapReport d;
   d.keyframes = st.keyframes;
-  d.points = clouds[0].second.size();
-  d.live_points = clouds[1].second.size();
+  d.points = dense_files[0].points;
+  d.live_points = dense_files[1].points;
   d.pose_updates = st.pose_updates;
   d.keyframes_moved = st.keyframes_moved;
   d.update_ms_median = percentile(st.update_ms, 0.5);
   d.update_ms_max = st.update_ms.empty() ? 0.0 : *std::max_element(st.update_ms.begin(), st.update_ms.end());
   d.loop_update_ms = st.loop_update_ms;
-  d.files = write_dense_maps(clouds, dir);
+  for (const DenseMapFile& f : dense_files) d.files.push_back(f.file);
   run.dense_map = std::move(d);
 }
 

@@ -44,9 +44,9 @@ struct SystemSink {
   LossLog loss_log{""};           ///< why each lost frame stayed lost (run.log)
   double tracking_ms = 0, orb_ms = 0, inline_mapping_ms = 0;
   std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made, for the revisit labels
-  /// The dense maps written by finish(), by name (corrected, live, and
-  /// before_loop / after_loop when a loop was closed); kept for scoring.
-  NamedClouds clouds;
+  /// The dense maps' files written by finish() (corrected, live, and
+  /// before_loop / after_loop when a loop was closed), read back for scoring.
+  std::vector<DenseMapFile> dense_files;
 
   /// The system, with the saved map loaded when `map` names one; nothing
   /// is written until open_outputs().
@@ -80,7 +80,7 @@ struct SystemSink {
   void finish_map(const eval::Trajectory& gt, const std::string& scenario, const std::string& scenario_file);
 
  private:
-  /// The dense maps into `clouds` and their PLY files; run.dense_map.
+  /// The dense maps' PLY files (dense_files); run.dense_map.
   void save_dense_maps();
   /// run.gravity and run.tilt against `gt` (site frame, z up) after run.eval.
   void evaluate_gravity(const eval::Trajectory& gt);

@@ -289,6 +289,8 @@ void read_point_cloud(Reader& r, PointCloudMappingSettings* pc) {
   pc->max_depth_m = r.real("PointCloudMapping.MaxDepth", false, pc->max_depth_m, above(pc->min_depth_m, 1000),
                            "metres beyond PointCloudMapping.MinDepth");
   pc->reassemble = r.flag("PointCloudMapping.Reassemble", false, pc->reassemble);
+  pc->memory_budget_mb = r.real("PointCloudMapping.MemoryBudget", false, pc->memory_budget_mb, closed(0, 1e7),
+                                "megabytes (0: no bound)");
 }
 
 void read_loop_closing(Reader& r, LoopClosingOptions* lc) {

@@ -97,6 +97,7 @@ System::System(const Settings& settings, const SystemOptions& options)
     dopt.back_projection.min_depth_m = settings.dense.min_depth_m;
     dopt.back_projection.max_depth_m = settings.dense.max_depth_m;
     dopt.leaf_m = settings.dense.resolution_m;
+    dopt.memory_budget_bytes = static_cast<std::size_t>(settings.dense.memory_budget_mb * 1024 * 1024);
     dense_ = std::make_unique<dense::DenseMapper>(dopt);
     if (!options.synchronous) dense_->start();
   }
@@ -352,6 +353,20 @@ dense::PointCloud System::point_cloud() {
   return dense_->corrected_cloud();
 }
 
+std::size_t System::write_point_cloud(const std::string& path) {
+  if (!dense_) return 0;
+  post_dense_poses(false, true);
+  return dense_->write_corrected_ply(path);
+}
+
+std::size_t System::write_live_point_cloud(const std::string& path) const {
+  return dense_ ? dense_->write_live_ply(path) : 0;
+}
+
+bool System::write_dense_first_loop(const std::string& before_path, const std::string& after_path) const {
+  return dense_ && dense_->write_first_loop_ply(before_path, after_path);
+}
+
 dense::PointCloud System::live_point_cloud() const { return dense_ ? dense_->live_cloud() : dense::PointCloud{}; }
 
 std::optional<dense::LoopSnapshot> System::dense_first_loop() const {
@@ -408,7 +423,10 @@ std::string to_json(const SystemMemory& m) {
      << ", \"place_database_words\": " << m.place_database_words
      << ", \"place_database_postings\": " << m.place_database_postings
      << ", \"dense_keyframes\": " << m.dense.keyframes << ", \"dense_keyframe_bytes\": " << m.dense.keyframe_bytes
-     << ", \"dense_map_bytes\": " << m.dense.map_bytes << "}";
+     << ", \"dense_map_bytes\": " << m.dense.map_bytes
+     << ", \"dense_keyframes_spilled\": " << m.dense.keyframes_spilled
+     << ", \"dense_spilled_keyframe_bytes\": " << m.dense.spilled_keyframe_bytes
+     << ", \"dense_spilled_map_bytes\": " << m.dense.spilled_map_bytes << "}";
   return js.str();
 }
 

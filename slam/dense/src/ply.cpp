@@ -34,11 +34,11 @@ float get_float_le(const unsigned char* src) {
 
 }  // namespace
 
-void write_ply(const std::string& path, const PointCloud& cloud) {
+void write_ply(const std::string& path, std::size_t vertices, const CloudChunks& chunks) {
   std::ostringstream header;
   header << "ply\nformat binary_little_endian 1.0\ncomment PE-SLAM Bench dense map (T_w_c of the keyframes), "
             "metres\n"
-         << "element vertex " << cloud.size() << "\n"
+         << "element vertex " << vertices << "\n"
          << "property float x\nproperty float y\nproperty float z\n"
          << "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
   // Through a temporary file: a write that fails (disk full) leaves no PLY
@@ -48,22 +48,34 @@ void write_ply(const std::string& path, const PointCloud& cloud) {
     std::vector<unsigned char> buf;
     constexpr std::size_t kChunk = 65536;
     buf.reserve(kChunk * kVertexBytes);
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-      const CloudPoint& p = cloud[i];
-      unsigned char v[kVertexBytes];
-      put_float_le(v, p.x);
-      put_float_le(v + 4, p.y);
-      put_float_le(v + 8, p.z);
-      v[12] = p.r;
-      v[13] = p.g;
-      v[14] = p.b;
-      buf.insert(buf.end(), v, v + kVertexBytes);
-      if (buf.size() >= kChunk * kVertexBytes || i + 1 == cloud.size()) {
-        f.append(reinterpret_cast<const char*>(buf.data()), buf.size());
-        buf.clear();
+    std::size_t written = 0;
+    const auto flush = [&] {
+      f.append(reinterpret_cast<const char*>(buf.data()), buf.size());
+      buf.clear();
+    };
+    chunks([&](const PointCloud& cloud) {
+      for (const CloudPoint& p : cloud) {
+        unsigned char v[kVertexBytes];
+        put_float_le(v, p.x);
+        put_float_le(v + 4, p.y);
+        put_float_le(v + 8, p.z);
+        v[12] = p.r;
+        v[13] = p.g;
+        v[14] = p.b;
+        buf.insert(buf.end(), v, v + kVertexBytes);
+        if (buf.size() >= kChunk * kVertexBytes) flush();
       }
-    }
+      written += cloud.size();
+    });
+    if (!buf.empty()) flush();
+    if (written != vertices)
+      throw IoError(path, "the header announces " + std::to_string(vertices) + " vertices but " +
+                              std::to_string(written) + " came");
   });
+}
+
+void write_ply(const std::string& path, const PointCloud& cloud) {
+  write_ply(path, cloud.size(), [&](const std::function<void(const PointCloud&)>& sink) { sink(cloud); });
 }
 
 namespace {

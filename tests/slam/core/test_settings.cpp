@@ -225,16 +225,18 @@ TEST(Settings, PointCloudMappingSection) {
   EXPECT_DOUBLE_EQ(d.dense.resolution_m, 0.02);
   EXPECT_EQ(d.dense.stride_px, 3);
   EXPECT_DOUBLE_EQ(d.dense.max_depth_m, 4.0);
+  EXPECT_DOUBLE_EQ(d.dense.memory_budget_mb, 512);
   const Settings s = read_settings(temp_copy(
       "pc", read_file(tum1()) + "\nPointCloudMapping.Enabled: 0\nPointCloudMapping.Resolution: 0.05\n"
                                 "PointCloudMapping.Stride: 2\nPointCloudMapping.MinDepth: 0.3\n"
-                                "PointCloudMapping.MaxDepth: 6.5\n"));
+                                "PointCloudMapping.MaxDepth: 6.5\nPointCloudMapping.MemoryBudget: 0\n"));
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_FALSE(s.dense.enabled);
   EXPECT_DOUBLE_EQ(s.dense.resolution_m, 0.05);
   EXPECT_EQ(s.dense.stride_px, 2);
   EXPECT_DOUBLE_EQ(s.dense.min_depth_m, 0.3);
   EXPECT_DOUBLE_EQ(s.dense.max_depth_m, 6.5);
+  EXPECT_DOUBLE_EQ(s.dense.memory_budget_mb, 0);
   // unknown key in the section: a warning naming it
   const Settings w =
       read_settings(temp_copy("pcw", read_file(tum1()) + "\nPointCloudMapping.Resolutoin: 0.05\n"));
@@ -245,7 +247,8 @@ TEST(Settings, PointCloudMappingSection) {
                                                                 {"PointCloudMapping.Resolution", "0"},
                                                                 {"PointCloudMapping.Stride", "1.5"},
                                                                 {"PointCloudMapping.Enabled", "2"},
-                                                                {"PointCloudMapping.MaxDepth", "0.05"}};
+                                                                {"PointCloudMapping.MaxDepth", "0.05"},
+                                                                {"PointCloudMapping.MemoryBudget", "-1"}};
   for (const auto& [key, value] : bad) {
     try {
       read_settings(temp_copy("pcbad", read_file(tum1()) + "\n" + key + ": " + value + "\n"));
@@ -301,6 +304,7 @@ TEST(Settings, OutOfRangeValuesAreErrorsNamingKeyAndRange) {
       {"PointCloudMapping.Resolution", "1e-300"},
       {"PointCloudMapping.MaxDepth", ".inf"},
       {"PointCloudMapping.Stride", "1e10"},
+      {"PointCloudMapping.MemoryBudget", ".inf"},
       {"LoopClosing.searchRadius", ".inf"},
       {"LoopClosing.maxCandidates", "4294967297"},
       {"LoopClosing.maxCorrectionAngle", "1e300"},

@@ -5,10 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "pvb/slam/dense/dense_mapper.hpp"
+#include "pvb/slam/dense/ply.hpp"
 #include "synthetic.hpp"
 
 namespace {
@@ -172,8 +176,10 @@ double worst_off_plane(const PointCloud& cloud) {
 
 // Keyframes inserted at poses off by a few centimetres (drift), then the
 // true poses posted as a loop correction would.
-std::unique_ptr<DenseMapper> drifted_mapper(bool worker) {
-  auto owner = std::make_unique<DenseMapper>(options());
+std::unique_ptr<DenseMapper> drifted_mapper(bool worker, std::size_t budget_bytes = 0) {
+  DenseMapperOptions o = options();
+  o.memory_budget_bytes = budget_bytes;
+  auto owner = std::make_unique<DenseMapper>(o);
   DenseMapper& mapper = *owner;
   if (worker) mapper.start();
   const std::vector<SE3d> poses = view_poses();
@@ -215,6 +221,40 @@ TEST(DenseMapper, WorkerAppliesTheSameUpdatesAsSynchronousMode) {
   const auto sync = drifted_mapper(false), worker = drifted_mapper(true);
   EXPECT_TRUE(sync->corrected_cloud() == worker->corrected_cloud());
   EXPECT_TRUE(sync->live_cloud() == worker->live_cloud());
+}
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST(DenseMapper, ABudgetSpillsAndGivesTheSameMapsAndFiles) {
+  const auto unbounded = drifted_mapper(false), bounded = drifted_mapper(true, 16 * 1024);
+  const pvb::slam::dense::DenseMemory m = bounded->memory();
+  EXPECT_GT(m.keyframes_spilled, 0u);
+  EXPECT_GT(m.spilled_keyframe_bytes, 0u);
+  EXPECT_GT(m.spilled_map_bytes, 0u);
+  EXPECT_GT(unbounded->memory().total(), 4 * m.total());
+  EXPECT_TRUE(bounded->corrected_cloud() == unbounded->corrected_cloud());
+  EXPECT_TRUE(bounded->live_cloud() == unbounded->live_cloud());
+  EXPECT_TRUE(bounded->global_cloud() == unbounded->global_cloud());
+  EXPECT_TRUE(bounded->keyframe_cloud(0) == unbounded->keyframe_cloud(0));
+  const auto loop_b = bounded->first_loop(), loop_u = unbounded->first_loop();
+  ASSERT_TRUE(loop_b && loop_u);
+  EXPECT_TRUE(loop_b->before == loop_u->before);
+  EXPECT_TRUE(loop_b->after == loop_u->after);
+  // The streamed files hold what write_ply() writes of the whole clouds.
+  const std::string dir = ::testing::TempDir();
+  EXPECT_EQ(bounded->write_corrected_ply(dir + "/c.ply"), unbounded->corrected_cloud().size());
+  pvb::slam::dense::write_ply(dir + "/c_whole.ply", unbounded->corrected_cloud());
+  EXPECT_EQ(file_bytes(dir + "/c.ply"), file_bytes(dir + "/c_whole.ply"));
+  bounded->write_live_ply(dir + "/l.ply");
+  pvb::slam::dense::write_ply(dir + "/l_whole.ply", unbounded->live_cloud());
+  EXPECT_EQ(file_bytes(dir + "/l.ply"), file_bytes(dir + "/l_whole.ply"));
+  ASSERT_TRUE(bounded->write_first_loop_ply(dir + "/b.ply", dir + "/a.ply"));
+  pvb::slam::dense::write_ply(dir + "/b_whole.ply", loop_u->before);
+  EXPECT_EQ(file_bytes(dir + "/b.ply"), file_bytes(dir + "/b_whole.ply"));
+  EXPECT_FALSE(DenseMapper(options()).write_first_loop_ply(dir + "/x.ply", dir + "/y.ply"));
 }
 
 TEST(DenseMapper, SmallMovesWaitUnlessExact) {

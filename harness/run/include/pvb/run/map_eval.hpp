@@ -21,22 +21,21 @@
 
 namespace pvb::run {
 
-/// A run's dense maps by name: "corrected" (every keyframe at its final
-/// pose), "live" (each at the pose it was made with) and, when a loop was
-/// closed, "before_loop" and "after_loop" (the corrected map around it).
-using NamedClouds = std::vector<std::pair<std::string, slam::dense::PointCloud>>;
+/// A dense map written by write_dense_maps(): "corrected" (every keyframe
+/// at its final pose), "live" (each at the pose it was made with) and, when
+/// a loop was closed, "before_loop" and "after_loop" (the corrected map
+/// around it).
+struct DenseMapFile {
+  std::string name;
+  std::string file;         ///< PointCloud.ply for the corrected map, PointCloud_<name>.ply for the others
+  std::size_t points = 0;   ///< points written (corrected and live maps; 0 for the loop's)
+};
 
-/// The maps of a stopped System with dense mapping on, corrected first
-/// (System::point_cloud() re-bins the final poses).
-NamedClouds dense_maps(slam::System& system);
-
-/// The file of map `name`: PointCloud.ply for the corrected map,
-/// PointCloud_<name>.ply for the others.
-std::string dense_map_file(const std::string& name);
-
-/// Writes every map as PLY into `dir`; returns the file names.  Throws
+/// Writes the maps of a stopped System with dense mapping on into `dir`,
+/// corrected first (System::write_point_cloud() re-bins the final poses),
+/// each streamed from the mapper without holding it whole.  Throws
 /// pvb::IoError when a file cannot be written.
-std::vector<std::string> write_dense_maps(const NamedClouds& maps, const std::string& dir);
+std::vector<DenseMapFile> write_dense_maps(slam::System& system, const std::string& dir);
 
 /// How a map goes from SLAM's world (its first camera) into the ground
 /// truth's world.

@@ -69,6 +69,11 @@ struct PointCloudMappingSettings {
   /// PointCloudMapping.Reassemble (0/1): the map follows local BA and loop
   /// corrections as they happen (0: only when the final map is asked for).
   bool reassemble = true;
+  /// PointCloudMapping.MemoryBudget: megabytes the keyframe clouds and the
+  /// voxel maps may keep in memory; past it the least recently used go to a
+  /// spill file in the temporary folder ($TMPDIR) and come back when needed
+  /// (0: no bound).
+  double memory_budget_mb = 512;
 };
 
 /// The default vocabulary, trained by the build (docs/place_recognition.md).

@@ -209,6 +209,15 @@ class System {
   std::optional<dense::LoopSnapshot> dense_first_loop() const;
   /// Keyframes processed, points and time spent (empty when disabled).
   dense::DenseMapperStats dense_stats() const;
+  /// The same maps written as PLY, streamed (never held whole in memory):
+  /// the corrected map (posting the current poses first, as point_cloud()),
+  /// the live map, and the corrected map around the first loop (false and
+  /// nothing written when there was none).  The first two return the points
+  /// written (0 when disabled).  Throw pvb::IoError when a file cannot be
+  /// written.
+  std::size_t write_point_cloud(const std::string& path);
+  std::size_t write_live_point_cloud(const std::string& path) const;
+  bool write_dense_first_loop(const std::string& before_path, const std::string& after_path) const;
 
  private:
   Settings settings_;

@@ -11,6 +11,13 @@
 //              threshold leaves the map at its old pose and re-enters at its
 //              new one, so an update costs in proportion to what moved.
 //
+// With a memory budget the mapper stays within it however long the drive:
+// the keyframe clouds and the voxel blocks used longest ago go to a spill
+// file (compressed) and come back when a pose update or the robot's return
+// needs them; the maps and the PLY files written from them are the same,
+// bit for bit, as without a budget.  The PLY writers stream the maps, so
+// exporting one never holds it whole.
+//
 // Knows nothing of the tracker: keyframes come in as images plus a pose.
 //
 // Threads: start() runs a worker that takes keyframes and pose updates, in
@@ -20,10 +27,13 @@
 // bit-identical.  Either way the same messages are applied in the same order
 // by the same code, so the maps after stop() are the same in both modes.
 #include <cstdint>
+#include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <string>
 #include <thread>
 #include <variant>
 #include <vector>
@@ -34,6 +44,7 @@
 #include "pvb/geometry/se3.hpp"
 #include "pvb/slam/dense/point_cloud.hpp"
 #include "pvb/slam/dense/reports.hpp"
+#include "pvb/slam/dense/spill_file.hpp"
 #include "pvb/slam/dense/voxel_map.hpp"
 
 namespace pvb::slam::dense {
@@ -56,6 +67,11 @@ struct DenseMapperOptions {
   /// since it was last binned (1 mm; 0.25 mrad is 1 mm at 4 m range).
   double update_min_translation_m = 0.001;
   double update_min_rotation_rad = 0.00025;
+  /// Heap bytes the keyframe clouds and the two maps may keep in memory
+  /// (a quarter for the clouds, the rest split between the maps); 0: no
+  /// bound, nothing is spilled.
+  std::size_t memory_budget_bytes = 0;
+  std::string spill_dir;  ///< spill files' folder ("": the system's temporary folder)
 };
 
 /// The keyframes' current poses, posted after bundle adjustment or a loop
@@ -100,6 +116,15 @@ class DenseMapper {
   /// The corrected map around the first loop correction, if there was one.
   std::optional<LoopSnapshot> first_loop() const;
 
+  /// The corrected map, the live map and the corrected map around the first
+  /// loop correction written as PLY (write_ply()), streamed a slab at a
+  /// time; each returns the points written.  The first-loop writer writes
+  /// nothing and returns false when no loop was corrected.  Throws
+  /// pvb::IoError when a file cannot be written.
+  std::size_t write_corrected_ply(const std::string& path) const;
+  std::size_t write_live_ply(const std::string& path) const;
+  bool write_first_loop_ply(const std::string& before_path, const std::string& after_path) const;
+
   /// Built from scratch: each keyframe cloud moved by T_w_c_by_id[id] when
   /// present, else by the pose it was inserted with; concatenated in id
   /// order and voxel-filtered.  Keyframes still queued are not included.
@@ -117,21 +142,49 @@ class DenseMapper {
     std::int64_t t_ns = 0;
     geom::SE3d T_w_c = geom::SE3d::Identity();   ///< pose at insertion (the live map's)
     geom::SE3d T_w_c_binned = geom::SE3d::Identity();  ///< pose it has in the corrected map
-    PointCloud cloud_c;  ///< voxel-filtered, camera frame
-    VoxelMap::Handle handle;  ///< its voxels in the corrected map
+    PointCloud cloud_c;  ///< voxel-filtered, camera frame; empty while out of memory
+    std::size_t points = 0;  ///< the cloud's size, in memory or not
+    /// Its copy in the spill file, once written: a cloud never changes, so
+    /// the copy stays valid when it is read back, and dropping it from
+    /// memory again costs no write.
+    std::optional<SpillFile::Extent> on_disk;
+    bool resident = true;  ///< cloud_c holds the cloud
+    std::uint64_t last_use = 0;
+  };
+  /// A cloud kept in pieces: in memory without a budget, else in the spill file.
+  struct StoredCloud {
+    std::size_t points = 0;
+    std::vector<PointCloud> pieces;
+    std::vector<SpillFile::Extent> extents;
+  };
+  struct Snapshot {
+    StoredCloud before, after;
+    std::size_t keyframes_moved = 0;
   };
   using Message = std::variant<DenseKeyFrame, PoseUpdate>;
   void run();
   void process(const DenseKeyFrame& kf);
   void apply(const PoseUpdate& update);
   bool moved(const geom::SE3d& from, const geom::SE3d& to, bool exact) const;
+  /// The entry's cloud, read back into memory when it was spilled.
+  const PointCloud& cloud_of(Entry& e);
+  /// The entry's cloud without keeping it in memory.
+  PointCloud peek_cloud(const Entry& e) const;
+  void enforce_cloud_budget();
+  StoredCloud store(const VoxelMap& map);
+  void for_each_piece(const StoredCloud& c, const std::function<void(const PointCloud&)>& sink) const;
+  std::size_t clouds_budget() const { return options_.memory_budget_bytes / 4; }
+  SpillOptions map_spill() const { return {options_.memory_budget_bytes / 8 * 3, options_.spill_dir}; }
 
   DenseMapperOptions options_;
-  mutable std::mutex mutex_;  ///< guards entries_, the maps, first_loop_ and stats_
+  mutable std::mutex mutex_;  ///< guards entries_, the maps, the spill file, first_loop_ and stats_
   std::map<std::uint64_t, Entry> entries_;
+  std::size_t cloud_bytes_ = 0;  ///< heap bytes of the clouds in memory
+  std::uint64_t tick_ = 0;       ///< one per message: an entry's last use
+  std::unique_ptr<SpillFile> spill_;  ///< keyframe clouds and the first loop's maps, once spilled
   VoxelMap live_;
   VoxelMap corrected_;
-  std::optional<LoopSnapshot> first_loop_;
+  std::optional<Snapshot> first_loop_;
   DenseMapperStats stats_;
   ClosableQueue<Message> queue_;
   WorkerError worker_error_;  ///< what ended the worker, for the owner's thread

@@ -3,6 +3,7 @@
 // with properties x y z (float) and red green blue (uchar), which
 // CloudCompare, MeshLab and Open3D read.
 #include <cstddef>
+#include <functional>
 #include <string>
 
 #include "pvb/slam/dense/point_cloud.hpp"
@@ -11,6 +12,15 @@ namespace pvb::slam::dense {
 
 /// Writes the cloud; throws pvb::IoError when the file cannot be written.
 void write_ply(const std::string& path, const PointCloud& cloud);
+
+/// A cloud handed over in pieces: it calls the sink with each piece in order.
+using CloudChunks = std::function<void(const std::function<void(const PointCloud&)>&)>;
+
+/// Writes a cloud of `vertices` points that `chunks` hands over piece by
+/// piece, holding one piece at a time (a map larger than memory streams to
+/// disk).  Throws pvb::IoError when the file cannot be written or the
+/// pieces do not add up to `vertices` (the file is then not made).
+void write_ply(const std::string& path, std::size_t vertices, const CloudChunks& chunks);
 
 /// What read_ply() left out.
 struct PlyReadStats {

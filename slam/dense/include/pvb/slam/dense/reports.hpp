@@ -3,6 +3,7 @@
 // loop correction, its running figures and the bytes it holds.  Users of
 // these need not include the mapper itself (dense_mapper.hpp).
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "pvb/slam/dense/point_cloud.hpp"
@@ -32,6 +33,11 @@ struct DenseMemory {
   std::size_t keyframe_bytes = 0;   ///< their clouds (camera frame), voxel handles and entries
   std::size_t map_bytes = 0;        ///< the live and the corrected voxel maps
   std::size_t total() const { return keyframe_bytes + map_bytes; }
+  /// What is spilled to disk (compressed bytes of live records): keyframe
+  /// clouds and the first loop's maps, and the two maps' blocks.
+  std::uint64_t spilled_keyframe_bytes = 0;
+  std::uint64_t spilled_map_bytes = 0;
+  std::size_t keyframes_spilled = 0;  ///< keyframes whose cloud is only on disk now
 };
 
 }  // namespace pvb::slam::dense
