@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <cctype>
+#include <stdexcept>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -59,6 +60,19 @@ void OutputFile::append(const char* data, std::size_t n_bytes) {
     done += static_cast<std::size_t>(n);
   }
   size_ += static_cast<long long>(n_bytes);
+}
+
+void OutputFile::patch(long long offset, const char* data, std::size_t n_bytes) {
+  if (fd_ < 0) throw IoError(path_.empty() ? "(no file)" : path_, "write to a closed file");
+  if (offset < 0 || offset + static_cast<long long>(n_bytes) > size_)
+    throw std::logic_error("OutputFile::patch: beyond what was appended");
+  std::size_t done = 0;
+  while (done < n_bytes) {
+    const ssize_t n = ::pwrite(fd_, data + done, n_bytes - done, static_cast<off_t>(offset) + static_cast<off_t>(done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw IoError(path_, std::string("write failed: ") + std::strerror(n < 0 ? errno : EIO));
+    done += static_cast<std::size_t>(n);
+  }
 }
 
 void OutputFile::close() {

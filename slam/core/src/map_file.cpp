@@ -223,12 +223,54 @@ bool saves_inertial(const Map& map, const MapSettings& s) {
   return true;
 }
 
-void put_section(ByteWriter& out, const char* tag, const std::string& payload) {
-  out.bytes(tag, 4);
-  out.u64(payload.size());
-  out.bytes(payload.data(), payload.size());
-  out.u64(fnv1a64(payload.data(), payload.size()));
-}
+/// Sections written to a sink as their payloads grow: the tag, a length
+/// patched in once the payload is done, the payload a piece at a time, its
+/// checksum.
+class SectionStream {
+ public:
+  static constexpr std::size_t kPieceBytes = std::size_t(1) << 20;
+  explicit SectionStream(const MapByteSink& sink) : sink_(sink) {}
+  /// Bytes outside any section (the file header).
+  void raw(const std::string& bytes) {
+    sink_.append(bytes.data(), bytes.size());
+    at_ += bytes.size();
+  }
+  void begin(const char* tag) {
+    ByteWriter head;
+    head.bytes(tag, 4);
+    head.u64(0);  // the length, patched by end()
+    length_at_ = at_ + 4;
+    raw(head.data());
+    length_ = 0;
+    fnv_ = kFnv1a64Offset;
+  }
+  ByteWriter& w() { return w_; }
+  void flush_if_full() {
+    if (w_.data().size() >= kPieceBytes) flush();
+  }
+  void end() {
+    flush();
+    ByteWriter n;
+    n.u64(length_);
+    sink_.patch(length_at_, n.data().data(), 8);
+    ByteWriter sum;
+    sum.u64(fnv_);
+    raw(sum.data());
+  }
+  std::uint64_t bytes() const { return at_; }
+
+ private:
+  void flush() {
+    const std::string& d = w_.data();
+    fnv_ = fnv1a64(d.data(), d.size(), fnv_);
+    length_ += d.size();
+    raw(d);
+    w_.clear();
+  }
+  const MapByteSink& sink_;
+  ByteWriter w_;
+  std::uint64_t at_ = 0, length_at_ = 0, length_ = 0, fnv_ = kFnv1a64Offset;
+};
 
 /// "NAME: the map's and this run's differ by X mm and Y deg (...)" when
 /// they differ by more than kMaxExtrinsicShiftM or kMaxExtrinsicTurnDeg;
@@ -246,16 +288,15 @@ std::string extrinsic_difference(const char* name, const char* sensor, const geo
 
 }  // namespace
 
-std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
-                       const std::string& app_json, const BagOf& bag_of, std::int64_t session_offset_ns) {
+std::uint64_t encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
+                         const std::string& app_json, const BagOf& bag_of, std::int64_t session_offset_ns,
+                         const MapByteSink& sink) {
   std::vector<std::shared_ptr<KeyFrame>> kfs;
   SortedIds kf_ids;  // the maps iterate in id order
-  std::size_t keypoints = 0;
   for (const auto& [id, kf] : map.keyframes())
     if (!kf->bad() && map.map_of(*kf) == 0) {
       kfs.push_back(kf);
       kf_ids.push_back(id);
-      keypoints += kf->frame().size();
     }
   // Each session counted holds a keyframe (the reader checks it).
   if (sessions < 1 || sessions > kfs.size())
@@ -269,44 +310,64 @@ std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_
   for (const auto& [id, mp] : map.points())
     if (!mp->bad() && within_map_bounds(mp->p_w()) && saved_observer(*mp, kf_ids, kNone) != kNone)
       point_ids.push_back(id);
-
-  ByteWriter head, keyf, poin, grap, bowv, iner, whel;
-  put_settings(head, settings, sessions);
-  keyf.reserve(8 + kfs.size() * kKeyframeHeadBytes + keypoints * kKeypointBytes);
-  keyf.u64(kfs.size());
-  for (const auto& kf : kfs)
-    put_keyframe(keyf, *kf, point_ids, kf->session() == map.session() ? session_offset_ns : 0);
-  poin.u64(point_ids.size());
-  for (std::uint64_t id : point_ids) put_point(poin, *map.points().at(id), kf_ids);
-  grap.u64(kfs.size());
-  for (const auto& kf : kfs) put_graph(grap, *kf, kf_ids);
-  for (const auto& kf : kfs) put_bow(bowv, *kf, bag_of);
-  std::vector<const std::string*> payloads = {&head.data(), &keyf.data(), &poin.data(), &grap.data(),
-                                              &bowv.data()};
   const bool inertial = saves_inertial(map, settings);
   const bool wheels = inertial && saves_wheels(map, settings);
-  if (inertial) {
-    put_inertial(iner, map, settings, kfs, kf_ids);
-    payloads.push_back(&iner.data());
-  }
-  if (wheels) {
-    put_wheels(whel, map.wheels());
-    payloads.push_back(&whel.data());
-  }
-  payloads.push_back(&app_json);
-
   const std::uint32_t version =
       wheels ? kMapFileVersion : inertial ? kMapFileVersionInertial : kMapFileVersionVisual;
   const std::vector<const char*> tags = section_tags(version);
-  std::size_t total = kMagicBytes + 8;
-  for (const std::string* p : payloads) total += 4 + 8 + p->size() + 8;  // tag, size, payload, checksum
-  ByteWriter out;
-  out.reserve(total);
-  out.bytes(kMagic, kMagicBytes);
-  out.u32(version);
-  out.u32(static_cast<std::uint32_t>(tags.size()));
-  for (std::size_t s = 0; s < tags.size(); ++s) put_section(out, tags[s], *payloads[s]);
-  return out.data();
+
+  SectionStream out(sink);
+  ByteWriter file_head;
+  file_head.bytes(kMagic, kMagicBytes);
+  file_head.u32(version);
+  file_head.u32(static_cast<std::uint32_t>(tags.size()));
+  out.raw(file_head.data());
+  ByteWriter& w = out.w();
+  out.begin("HEAD");
+  put_settings(w, settings, sessions);
+  out.end();
+  out.begin("KEYF");
+  w.u64(kfs.size());
+  for (const auto& kf : kfs) {
+    put_keyframe(w, *kf, point_ids, kf->session() == map.session() ? session_offset_ns : 0);
+    out.flush_if_full();
+  }
+  out.end();
+  out.begin("POIN");
+  w.u64(point_ids.size());
+  for (std::uint64_t id : point_ids) put_point(w, *map.points().at(id), kf_ids), out.flush_if_full();
+  out.end();
+  out.begin("GRAP");
+  w.u64(kfs.size());
+  for (const auto& kf : kfs) put_graph(w, *kf, kf_ids), out.flush_if_full();
+  out.end();
+  out.begin("BOWV");
+  for (const auto& kf : kfs) put_bow(w, *kf, bag_of), out.flush_if_full();
+  out.end();
+  if (inertial) {
+    out.begin("INER");
+    put_inertial(w, map, settings, kfs, kf_ids);
+    out.end();
+  }
+  if (wheels) {
+    out.begin("WHEL");
+    put_wheels(w, map.wheels());
+    out.end();
+  }
+  out.begin("META");
+  w.bytes(app_json.data(), app_json.size());
+  out.end();
+  return out.bytes();
+}
+
+std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
+                       const std::string& app_json, const BagOf& bag_of, std::int64_t session_offset_ns) {
+  std::string bytes;
+  MapByteSink sink;
+  sink.append = [&](const char* d, std::size_t n) { bytes.append(d, n); };
+  sink.patch = [&](std::uint64_t at, const char* d, std::size_t n) { std::memcpy(&bytes[at], d, n); };
+  encode_map(map, settings, sessions, app_json, bag_of, session_offset_ns, sink);
+  return bytes;
 }
 
 std::string MapSettings::difference(const MapSettings& run) const {

@@ -1,5 +1,6 @@
 #pragma once
 // Little-endian byte writing and bounds-checked reading for map files.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstring>
@@ -119,6 +120,7 @@ class ByteWriter {
   }
   void bytes(const void* p, std::size_t n) { data_.append(static_cast<const char*>(p), n); }
   void reserve(std::size_t n) { data_.reserve(n); }
+  void clear() { data_.clear(); }
   const std::string& data() const { return data_; }
 
  private:
@@ -132,7 +134,8 @@ class ByteWriter {
 
 /// Reads a byte range of one section; running past its end throws IoError
 /// naming the file, the section and the offset (a truncated or damaged
-/// file).  Offsets are 64-bit: a map file may be larger than 2 GiB.
+/// file).  Offsets are 64-bit: a map file may be larger than 2 GiB.  The
+/// range is in memory, or read from the file a piece at a time.
 class ByteReader {
  public:
   /// `p`, `n`: the range of the part named `label` ("KEYF section", "file
@@ -147,6 +150,14 @@ class ByteReader {
         label_(std::move(label)),
         section_base_(section_offset),
         file_base_(file_offset) {}
+  /// The `n` bytes at `file_offset` of `src` (which outlives the reader):
+  /// in place when they are in memory, else read as needed.
+  ByteReader(const MapFileBytes& src, std::uint64_t file_offset, std::uint64_t n, std::string label,
+             std::uint64_t section_offset)
+      : ByteReader(src.data() ? src.data() + file_offset : nullptr, n, src.name(), std::move(label), section_offset,
+                   file_offset) {
+    if (!p_) src_ = &src;
+  }
 
   std::uint8_t u8() { return static_cast<std::uint8_t>(le(1)); }
   std::uint32_t u32() { return static_cast<std::uint32_t>(le(4)); }
@@ -165,9 +176,9 @@ class ByteReader {
     std::memcpy(&v, &b, 8);
     return v;
   }
+  /// The next `n` bytes, valid until the next call.
   const char* bytes(std::uint64_t n) {
-    need(n);
-    const char* p = p_ + pos_;
+    const char* p = at(n);
     pos_ += n;
     return p;
   }
@@ -199,10 +210,21 @@ class ByteReader {
   void need(std::uint64_t n) const {
     if (n > n_ - pos_) fail("ends early (needs " + std::to_string(n) + " more bytes)");
   }
+  /// `n` bytes at pos_ (checked against the range), without moving on.
+  const char* at(std::uint64_t n) {
+    need(n);
+    if (p_) return p_ + pos_;
+    if (pos_ < piece_at_ || pos_ + n > piece_at_ + piece_.size()) {
+      piece_.resize(static_cast<std::size_t>(std::min(std::max(n, src_->piece_bytes()), n_ - pos_)));
+      src_->read(file_base_ + pos_, piece_.data(), piece_.size());
+      piece_at_ = pos_;
+    }
+    return piece_.data() + (pos_ - piece_at_);
+  }
   std::uint64_t le(int n) {
-    need(static_cast<std::uint64_t>(n));
+    const auto* q = reinterpret_cast<const unsigned char*>(at(static_cast<std::uint64_t>(n)));
     std::uint64_t v = 0;
-    for (int i = 0; i < n; ++i) v |= std::uint64_t(static_cast<unsigned char>(p_[pos_ + i])) << (8 * i);
+    for (int i = 0; i < n; ++i) v |= std::uint64_t(q[i]) << (8 * i);
     pos_ += static_cast<std::uint64_t>(n);
     return v;
   }
@@ -211,6 +233,9 @@ class ByteReader {
   std::uint64_t pos_ = 0;
   std::string file_, label_;
   std::uint64_t section_base_, file_base_;
+  const MapFileBytes* src_ = nullptr;  ///< where the bytes are read from when not in memory
+  std::string piece_;                   ///< the piece read last, from pos piece_at_
+  std::uint64_t piece_at_ = 0;
 };
 
 }  // namespace pvb::slam::mapfile

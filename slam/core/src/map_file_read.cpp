@@ -2,6 +2,10 @@
 // it is used, so that a truncated, damaged or hostile file gives one error
 // naming the file and what is wrong (the fuzz target tests/fuzz/
 // fuzz_map_file.cpp runs this reader).
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -100,13 +104,32 @@ Framing frame_sections(const ReadAt& read_at, std::uint64_t size, const std::str
   return framing;
 }
 
-Framing split_sections(const std::string& b, const std::string& file) {
-  const ReadAt in_memory = [&](std::uint64_t offset, std::uint64_t n) { return b.substr(offset, n); };
-  const Framing framing = frame_sections(in_memory, b.size(), file);
+/// The framing of `src`, with every section's checksum checked (read a
+/// piece at a time when the bytes are in the file).
+Framing split_sections(const MapFileBytes& src) {
+  const std::string& file = src.name();
+  const ReadAt read_at = [&](std::uint64_t offset, std::uint64_t n) {
+    std::string b(static_cast<std::size_t>(std::min(n, src.size() - std::min(offset, src.size()))), '\0');
+    src.read(offset, b.data(), b.size());
+    return b;
+  };
+  const Framing framing = frame_sections(read_at, src.size(), file);
   const std::vector<const char*> tags = section_tags(framing.version);
+  std::string piece;
   for (std::size_t s = 0; s < tags.size(); ++s) {
     const auto [payload, length] = framing.sections[s];
-    if (le64(b, payload + length) != fnv1a64(b.data() + payload, length))
+    std::uint64_t h = kFnv1a64Offset;
+    if (src.data()) {
+      h = fnv1a64(src.data() + payload, length);
+    } else {
+      for (std::uint64_t done = 0; done < length;) {
+        piece.resize(static_cast<std::size_t>(std::min(length - done, src.piece_bytes())));
+        src.read(payload + done, piece.data(), piece.size());
+        h = fnv1a64(piece.data(), piece.size(), h);
+        done += piece.size();
+      }
+    }
+    if (le64(read_at(payload + length, 8), 0) != h)
       throw IoError(file, ByteReader::where(std::string(tags[s]) + " section", kSectionHeadBytes + length,
                                             payload + length) +
                               "checksum does not match its " + std::to_string(length) +
@@ -116,10 +139,9 @@ Framing split_sections(const std::string& b, const std::string& file) {
 }
 
 /// A reader of section `i` of a file of `version`.
-ByteReader reader_for(const std::string& b, const Sections& s, std::size_t i, const std::string& file,
-                      std::uint32_t version) {
-  return ByteReader(b.data() + s[i].first, s[i].second, file,
-                    std::string(section_tags(version)[i]) + " section", kSectionHeadBytes, s[i].first);
+ByteReader reader_for(const MapFileBytes& src, const Sections& s, std::size_t i, std::uint32_t version) {
+  return ByteReader(src, s[i].first, s[i].second, std::string(section_tags(version)[i]) + " section",
+                    kSectionHeadBytes);
 }
 
 void check_settings(ByteReader& r, const MapSettings& s) {
@@ -488,27 +510,84 @@ std::string read_map_file(const std::string& path) {
   return from_file(0, size);
 }
 
-MapFileHeader read_map_header(const std::string& bytes, const std::string& file) {
-  const Framing framing = split_sections(bytes, file);
+struct MapFileBytes::File {
+  int fd = -1;
+  ~File() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+MapFileBytes MapFileBytes::open(const std::string& path, std::uint64_t piece_bytes) {
+  require_regular_file(path);
+  auto f = std::make_shared<File>();
+  f->fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (f->fd < 0) throw IoError(path, std::string("cannot open for reading: ") + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(f->fd, &st) != 0) throw IoError(path, "cannot tell its size");
+  const auto size = static_cast<std::uint64_t>(st.st_size);
+  if (size > kMaxMapFileBytes)
+    throw IoError(path, std::to_string(size) + " bytes, larger than a map file may be (" +
+                            std::to_string(kMaxMapFileBytes) + " bytes, 4 GiB)");
+  MapFileBytes m;
+  m.name_ = path;
+  m.size_ = size;
+  m.piece_bytes_ = std::max<std::uint64_t>(piece_bytes, 1);
+  m.file_ = std::move(f);
+  return m;
+}
+
+MapFileBytes MapFileBytes::in_memory(const std::string& bytes, std::string name) {
+  MapFileBytes m;
+  m.name_ = std::move(name);
+  m.size_ = bytes.size();
+  m.data_ = bytes.data();
+  return m;
+}
+
+void MapFileBytes::read(std::uint64_t offset, char* out, std::uint64_t n) const {
+  if (offset > size_ || n > size_ - offset) throw std::logic_error("MapFileBytes::read: beyond the file");
+  if (data_) {
+    std::memcpy(out, data_ + offset, static_cast<std::size_t>(n));
+    return;
+  }
+  for (std::uint64_t done = 0; done < n;) {
+    const ssize_t r = ::pread(file_->fd, out + done, static_cast<std::size_t>(n - done),
+                              static_cast<off_t>(offset + done));
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0)
+      throw IoError(name_, "cannot read " + std::to_string(n) + " bytes at file byte " + std::to_string(offset) +
+                               (r < 0 ? std::string(": ") + std::strerror(errno) : " (the file shrank)"));
+    done += static_cast<std::uint64_t>(r);
+  }
+}
+
+MapFileHeader read_map_header(const MapFileBytes& src) {
+  const Framing framing = split_sections(src);
   const Sections& s = framing.sections;
-  MapFileHeader h = parse_head(reader_for(bytes, s, 0, file, framing.version));
+  MapFileHeader h = parse_head(reader_for(src, s, 0, framing.version));
   h.version = framing.version;
   if (h.version >= 2) {
-    ByteReader iner = reader_for(bytes, s, kInerSection, file, h.version);
+    ByteReader iner = reader_for(src, s, kInerSection, h.version);
     MapGravity unused;
     read_inertial_head(iner, &h.settings, &unused);
   }
-  h.app_json.assign(bytes, s.back().first, s.back().second);
+  h.app_json.resize(static_cast<std::size_t>(s.back().second));
+  src.read(s.back().first, h.app_json.data(), s.back().second);
   h.sections = s;
   return h;
 }
 
-void decode_map(const std::string& bytes, const std::string& file, const MapFileHeader& h,
-                const std::shared_ptr<const CameraModel>& cam, Map* map) {
+MapFileHeader read_map_header(const std::string& bytes, const std::string& file) {
+  return read_map_header(MapFileBytes::in_memory(bytes, file));
+}
+
+void decode_map(const MapFileBytes& src, const MapFileHeader& h, const std::shared_ptr<const CameraModel>& cam,
+                Map* map) {
+  const std::string& file = src.name();
   const Sections& s = h.sections;
   if (h.version < 1 || h.version > kMapFileVersion || s.size() != section_tags(h.version).size())
     throw std::logic_error("decode_map: a header not from read_map_header");
-  const auto reader = [&](std::size_t i) { return reader_for(bytes, s, i, file, h.version); };
+  const auto reader = [&](std::size_t i) { return reader_for(src, s, i, h.version); };
   const PointIdsByKf ids = read_keyframes(reader(1), cam, h.sessions, map);
   if (map->keyframes().empty()) throw IoError(file, "the map has no keyframes");
   if (h.sessions > map->keyframes().size())  // every session counted made a keyframe that is kept
@@ -523,6 +602,11 @@ void decode_map(const std::string& bytes, const std::string& file, const MapFile
   read_bows(reader(4), map);
   if (h.version >= 2) read_inertial(reader(kInerSection), map);
   if (h.version >= 3) map->wheels() = read_wheels(reader(kWhelSection));
+}
+
+void decode_map(const std::string& bytes, const std::string& file, const MapFileHeader& h,
+                const std::shared_ptr<const CameraModel>& cam, Map* map) {
+  decode_map(MapFileBytes::in_memory(bytes, file), h, cam, map);
 }
 
 }  // namespace pvb::slam

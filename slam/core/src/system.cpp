@@ -8,6 +8,7 @@
 
 #include "pvb/common/clock.hpp"
 #include "pvb/common/error.hpp"
+#include "pvb/common/output_file.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/slam/core/frame.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
@@ -224,14 +225,14 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!place_) throw ConfigError(settings_.source, "Vocabulary.path", "a vocabulary to relocalise in a saved map");
   if (next_frame_id_ > 0 || map_start_) throw std::logic_error("System::load_map: after the first frame");
-  const std::string bytes = read_map_file(path);
-  const MapFileHeader head = read_map_header(bytes, path);
+  const MapFileBytes bytes = MapFileBytes::open(path);  // read a piece at a time, never whole
+  const MapFileHeader head = read_map_header(bytes);
   const std::string diff = head.settings.difference(map_settings());
   if (!diff.empty()) throw ConfigError(path, "settings", "a map made with this run's settings", diff);
   MapLoadInfo info;
   {
     std::lock_guard<std::mutex> lock(map_->mutex());
-    decode_map(bytes, path, head, cam_, map_.get());  // with a version-2 file, gravity ready and the chain
+    decode_map(bytes, head, cam_, map_.get());  // with a version-2 file, gravity ready and the chain
     if (!uses_accel(settings_.motion.setup))
       map_->gravity() = MapGravity{};  // a camera-only run keeps no inertial state
     else if (start == MapStart::kExtend && uses_imu(settings_.motion.setup) && !uses_imu(head.settings.sensors))
@@ -284,11 +285,23 @@ MapSaveInfo System::save_map(const std::string& path, const std::string& app_jso
                               " keyframes (each session holds one at least)");
     info.sessions = static_cast<std::uint32_t>(sessions);
     const BagOf bag_of = [this](const KeyFrame& kf) { return place_ ? place_->bag_of(kf) : kf.bow(); };
-    bytes = encode_map(*map_, map_settings(), info.sessions, app_json, bag_of, session_offset_ns_);
     info.points = map_->num_points();
+    if (resolve_output_target(path).kind == OutputTarget::Kind::kStream) {
+      // A stream cannot take the sections' lengths afterwards: the file is
+      // made in memory first.
+      bytes = encode_map(*map_, map_settings(), info.sessions, app_json, bag_of, session_offset_ns_);
+      info.bytes = bytes.size();
+    } else {
+      // Streamed into a temporary file beside `path`, a piece at a time.
+      write_file_via_temp(path, [&](OutputFile& f) {
+        MapByteSink sink;
+        sink.append = [&](const char* d, std::size_t n) { f.append(d, n); };
+        sink.patch = [&](std::uint64_t at, const char* d, std::size_t n) { f.patch(static_cast<long long>(at), d, n); };
+        info.bytes = encode_map(*map_, map_settings(), info.sessions, app_json, bag_of, session_offset_ns_, sink);
+      });
+    }
   }
-  write_file(path, bytes);
-  info.bytes = bytes.size();
+  if (!bytes.empty()) write_file(path, bytes);
   info.save_ms = ms_since(t0);
   return info;
 }

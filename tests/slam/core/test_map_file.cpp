@@ -16,6 +16,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <optional>
 
 #include "map_file_edit.hpp"
 #include "map_file_pair.hpp"
@@ -106,6 +107,47 @@ TEST_F(MapFile, EncodeOfADecodedMapIsTheFileItCameFrom) {
   decode_map(bytes_, path_, h, camera_for(h.settings), &map);
   std::lock_guard<std::mutex> lock(map.mutex());
   EXPECT_EQ(encode_map(map, h.settings, h.sessions, h.app_json), bytes_);
+}
+
+/// The error decoding `bytes` throws ("" when none), read in memory or from
+/// a file in pieces of `piece_bytes`.
+std::string decode_error(const std::string& bytes, const std::string& path, std::uint64_t piece_bytes) {
+  try {
+    std::optional<MapFileBytes> src;
+    if (piece_bytes == 0) {
+      src = MapFileBytes::in_memory(bytes, path);
+    } else {
+      write_file(path, bytes);
+      src = MapFileBytes::open(path, piece_bytes);
+    }
+    const MapFileHeader h = read_map_header(*src);
+    Map map;
+    decode_map(*src, h, camera_for(h.settings), &map);
+    std::lock_guard<std::mutex> lock(map.mutex());
+    EXPECT_EQ(encode_map(map, h.settings, h.sessions, h.app_json), bytes);
+  } catch (const IoError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST_F(MapFile, AFileReadInPiecesGivesTheMapAndTheErrorsOfOneReadWhole) {
+  // Pieces of 1 byte, and of an odd size that splits values and descriptors.
+  const std::string p = tmp_path("pieces.pvbmap");
+  for (std::uint64_t piece : {std::uint64_t(1), std::uint64_t(37), std::uint64_t(4093)})
+    EXPECT_EQ(decode_error(bytes_, p, piece), "") << piece;
+  // A payload byte flipped (the checksum check streams the section) and a
+  // file cut short: the same message either way.
+  std::string flipped = bytes_;
+  flipped[bytes_.size() / 2] = static_cast<char>(flipped[bytes_.size() / 2] ^ 0x40);
+  const std::string in_memory = decode_error(flipped, p, 0);
+  EXPECT_NE(in_memory.find("checksum does not match"), std::string::npos) << in_memory;
+  EXPECT_EQ(decode_error(flipped, p, 37), in_memory);
+  for (std::size_t cut : {bytes_.size() / 3, bytes_.size() - 9}) {
+    const std::string head = decode_error(bytes_.substr(0, cut), p, 0);
+    EXPECT_FALSE(head.empty());
+    EXPECT_EQ(decode_error(bytes_.substr(0, cut), p, 37), head);
+  }
 }
 
 TEST_F(MapFile, AProvisionalMapNeverMergedIsLeftOutOfTheFile) {

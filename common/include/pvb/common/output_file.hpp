@@ -40,6 +40,10 @@ class OutputFile {
   /// cutting the file back to its size before this call.
   void append(const char* data, std::size_t n);
   void append(const std::string& text) { append(text.data(), text.size()); }
+  /// Overwrites `n` bytes already appended, from `offset` (pwrite(2): a
+  /// regular file, not a stream), e.g. a length known only once what
+  /// follows it is written.  Throws IoError when the write fails.
+  void patch(long long offset, const char* data, std::size_t n);
   /// Closes the file (also done by the destructor); throws IoError when the
   /// system reports a failure.
   void close();

@@ -44,8 +44,8 @@ constexpr std::uint32_t kMapFileVersion = 3;
 constexpr std::uint32_t kMapFileVersionInertial = 2;
 constexpr std::uint32_t kMapFileVersionVisual = 1;
 /// The largest map file read: 4 GiB, about 30 000 keyframes (a
-/// 709-keyframe lawnmower map is 103 MB).  Reading one takes its size in
-/// memory, and the map about as much again.
+/// 709-keyframe lawnmower map is 103 MB).  Loading one reads it a piece
+/// at a time (MapFileBytes::open); saving writes it so (encode_map to a sink).
 constexpr std::uint64_t kMaxMapFileBytes = std::uint64_t(4) << 30;
 /// Every keyframe's camera centre and every point lies within this many
 /// metres of the map's origin on each axis, and no keypoint's depth is
@@ -63,15 +63,55 @@ constexpr double kMinGravityMps2 = 9.0, kMaxGravityMps2 = 10.6;
 constexpr double kMaxExtrinsicM = 10;
 constexpr double kMaxSpeedMps = 100, kMaxGyroBiasRadps = 1, kMaxAccelBiasMps2 = 5;
 
+/// A map file's bytes, wherever they are: in memory, or in the file and
+/// read a piece at a time as the reader goes (loading a map then holds the
+/// map, not the map and its file).  Copies share the open file.
+class MapFileBytes {
+ public:
+  /// The file at `path`, once it is a regular file no larger than
+  /// kMaxMapFileBytes; nothing else is read yet.  Readers take
+  /// `piece_bytes` at a time (at least what one value needs).  Throws
+  /// IoError naming `path`.
+  static MapFileBytes open(const std::string& path, std::uint64_t piece_bytes = std::uint64_t(1) << 20);
+  /// Bytes in memory, named `name` in errors; `bytes` must outlive this.
+  static MapFileBytes in_memory(const std::string& bytes, std::string name);
+
+  std::uint64_t size() const { return size_; }
+  const std::string& name() const { return name_; }
+  /// The bytes when they are in memory, else null.
+  const char* data() const { return data_; }
+  std::uint64_t piece_bytes() const { return piece_bytes_; }
+  /// Copies `n` bytes from `offset` (within size()) into `out`; throws
+  /// IoError naming the file when they cannot be read.
+  void read(std::uint64_t offset, char* out, std::uint64_t n) const;
+
+ private:
+  struct File;
+  std::string name_;
+  std::uint64_t size_ = 0;
+  std::uint64_t piece_bytes_ = 0;
+  const char* data_ = nullptr;
+  std::shared_ptr<File> file_;
+};
+
 /// Reads a map file whole, once its size and framing allow: a file larger
 /// than kMaxMapFileBytes, or whose sections' lengths (read from their
 /// heads, without reading the payloads) do not add up to its size, is
 /// refused before its bytes are read.  Throws IoError naming `path`.
+/// (System::load_map reads through MapFileBytes::open instead.)
 std::string read_map_file(const std::string& path);
 
 /// A keyframe's bag of words, wherever it is kept (a keyframe in the place
 /// database has handed its own to the database: PlaceRecognizer::bag_of).
 using BagOf = std::function<place::BowVector(const KeyFrame&)>;
+
+/// Where encode_map puts the file's bytes: `append` takes the next ones in
+/// order; `patch` overwrites bytes already appended (a section's length,
+/// known once its payload is written).
+struct MapByteSink {
+  std::function<void(const char* data, std::size_t n)> append;
+  std::function<void(std::uint64_t offset, const char* data, std::size_t n)> patch;
+};
 
 /// The map file's bytes for every keyframe and point in `map` (bad ones
 /// are not in it, nor a provisional map that was never merged: it lies in
@@ -85,12 +125,19 @@ using BagOf = std::function<place::BowVector(const KeyFrame&)>;
 std::string encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
                        const std::string& app_json, const BagOf& bag_of = nullptr,
                        std::int64_t session_offset_ns = 0);
+/// The same bytes handed to `sink` a piece at a time (about 1 MB), a
+/// section after another: saving holds one piece of the file, not the
+/// file.  Returns the bytes written.
+std::uint64_t encode_map(const Map& map, const MapSettings& settings, std::uint32_t sessions,
+                         const std::string& app_json, const BagOf& bag_of, std::int64_t session_offset_ns,
+                         const MapByteSink& sink);
 
 /// Checks the whole file (magic, version, sections, checksums) and returns
 /// its header.  Throws IoError naming `file` and what is wrong (truncated,
 /// damaged, not a map file, a newer version), with the section and the byte
 /// ("KEYF section at byte N (file byte M): ...", N counted from the
 /// section's tag).
+MapFileHeader read_map_header(const MapFileBytes& bytes);
 MapFileHeader read_map_header(const std::string& bytes, const std::string& file);
 
 /// The camera model of the map's settings (that read_map_header checked).
@@ -106,6 +153,8 @@ std::shared_ptr<const CameraModel> camera_for(const MapSettings& settings);
 /// a camera of the map's settings could have made (docs/map_file.md, "Bad
 /// files"); a bad one throws IoError naming `file`, the section and the
 /// item.  Point descriptors, normals and scale ranges are computed.
+void decode_map(const MapFileBytes& bytes, const MapFileHeader& header, const std::shared_ptr<const CameraModel>& cam,
+                Map* map);
 void decode_map(const std::string& bytes, const std::string& file, const MapFileHeader& header,
                 const std::shared_ptr<const CameraModel>& cam, Map* map);
 
