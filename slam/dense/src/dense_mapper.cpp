@@ -143,7 +143,7 @@ void DenseMapper::enforce_cloud_budget() {
   std::sort(by_age.begin(), by_age.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   if (!spill_) spill_ = std::make_unique<SpillFile>(options_.spill_dir);
   for (const auto& [use, e] : by_age) {
-    if (cloud_bytes_ <= clouds_budget() / 4 * 3) break;
+    if (cloud_bytes_ <= clouds_budget() / 8 * 7) break;
     if (!e->on_disk) e->on_disk = spill_->write(pack(e->cloud_c));
     cloud_bytes_ -= vector_heap_bytes(e->cloud_c);
     PointCloud().swap(e->cloud_c);

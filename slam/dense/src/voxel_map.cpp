@@ -249,7 +249,7 @@ void VoxelMap::enforce_budget() {
   by_age.reserve(resident_.size());
   for (const auto& [key, b] : resident_) by_age.emplace_back(b->last_use, key);
   std::sort(by_age.begin(), by_age.end());
-  const std::size_t target = options_.budget_bytes / 4 * 3;  // room for a while before the next round
+  const std::size_t target = options_.budget_bytes / 8 * 7;  // room for a while before the next round
   for (const auto& [use, key] : by_age) {
     if (resident_bytes_ <= target) break;
     auto it = resident_.find(key);
