@@ -17,6 +17,8 @@ namespace {
 constexpr std::uint32_t kMinHole = 64;  // smaller remainders are not worth keeping
 }
 
+std::string SpillFile::label() const { return dir_.empty() ? "spill file" : dir_; }
+
 SpillFile::SpillFile(std::string dir) : dir_(std::move(dir)) {}
 
 SpillFile::~SpillFile() {
@@ -61,7 +63,7 @@ SpillFile::Extent SpillFile::write(const std::string& raw) {
   while (done < n) {
     const ssize_t w = ::pwrite(fd_, packed.data() + done, n - done, static_cast<off_t>(e.offset + done));
     if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) throw IoError(dir_.empty() ? "spill file" : dir_, std::string("cannot write: ") + std::strerror(errno));
+    if (w <= 0) throw IoError(label(), std::string("cannot write: ") + std::strerror(errno));
     done += static_cast<std::size_t>(w);
   }
   live_ += e.stored_bytes;
@@ -76,13 +78,13 @@ std::string SpillFile::read(const Extent& e) const {
   while (done < packed.size()) {
     const ssize_t r = ::pread(fd_, packed.data() + done, packed.size() - done, static_cast<off_t>(e.offset + done));
     if (r < 0 && errno == EINTR) continue;
-    if (r <= 0) throw IoError(dir_.empty() ? "spill file" : dir_, "short read at offset " + std::to_string(e.offset));
+    if (r <= 0) throw IoError(label(), "short read at offset " + std::to_string(e.offset));
     done += static_cast<std::size_t>(r);
   }
   std::string raw(e.raw_bytes, '\0');
   const std::size_t n = ZSTD_decompress(raw.data(), raw.size(), packed.data(), packed.size());
   if (ZSTD_isError(n) || n != e.raw_bytes)
-    throw IoError(dir_.empty() ? "spill file" : dir_, "a record at offset " + std::to_string(e.offset) + " does not decompress");
+    throw IoError(label(), "a record at offset " + std::to_string(e.offset) + " does not decompress");
   ++reads_;
   return raw;
 }

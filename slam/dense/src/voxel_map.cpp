@@ -208,24 +208,15 @@ void VoxelMap::bin(const CloudPoint& p, int sign) {
   }
 }
 
-void VoxelMap::add(const PointCloud& cloud_w) {
-  ++tick_;
-  try {
-    for (const CloudPoint& p : cloud_w)
-      if (finite(p)) bin(p, +1);
-  } catch (...) {
-    account_touched();
-    throw;
-  }
-  account_touched();
-  enforce_budget();
-}
+void VoxelMap::add(const PointCloud& cloud_w) { bin_all(cloud_w, +1); }
 
-void VoxelMap::remove(const PointCloud& cloud_w) {
+void VoxelMap::remove(const PointCloud& cloud_w) { bin_all(cloud_w, -1); }
+
+void VoxelMap::bin_all(const PointCloud& cloud_w, int sign) {
   ++tick_;
   try {
     for (const CloudPoint& p : cloud_w)
-      if (finite(p)) bin(p, -1);
+      if (finite(p)) bin(p, sign);
   } catch (...) {
     account_touched();
     throw;

@@ -49,6 +49,7 @@ class SpillFile {
 
  private:
   void open();
+  std::string label() const;  ///< the name errors give: the folder, or "spill file"
   std::string dir_;
   int fd_ = -1;
   std::uint64_t end_ = 0, live_ = 0, live_raw_ = 0, writes_ = 0;

@@ -82,6 +82,8 @@ class VoxelMap {
   };
   Block& block(std::uint64_t block_key);
   void bin(const CloudPoint& p, int sign);
+  /// Every finite point of the cloud in (+1) or out (-1), then the budget.
+  void bin_all(const PointCloud& cloud_w, int sign);
   void account_touched();
   void enforce_budget();
   void spill(std::uint64_t block_key, Block& b);
