@@ -1,5 +1,7 @@
 #include "pvb/common/memory.hpp"
 
+#include <malloc.h>
+
 #include <fstream>
 #include <string>
 
@@ -24,6 +26,13 @@ std::size_t resident_bytes() {
     status.ignore(4096, '\n');
   }
   return 0;
+}
+
+std::size_t return_free_heap() {
+  const std::size_t before = resident_bytes();
+  malloc_trim(0);
+  const std::size_t after = resident_bytes();
+  return before > after ? before - after : 0;
 }
 
 }  // namespace pvb

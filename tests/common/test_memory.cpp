@@ -41,3 +41,28 @@ TEST(Memory, ResidentSetGrowsWithTouchedMemory) {
   EXPECT_GE(after, before + kBytes * 9 / 10);
   EXPECT_EQ(big[kBytes - 1], 1);
 }
+
+// Blocks freed below one still in use stay in the heap: free() returns
+// only the heap's top to the system, so the pages stay resident until
+// return_free_heap() gives them back.
+TEST(Memory, FreePagesInsideTheHeapAreGivenBack) {
+#if PVB_ADDRESS_SANITIZER
+  GTEST_SKIP() << "AddressSanitizer's allocator keeps freed blocks in quarantine";
+#else
+  constexpr std::size_t kBlock = 64u << 10, kBlocks = 1024;  // 64 MB below malloc's mmap threshold
+  std::vector<char*> blocks(kBlocks);
+  for (char*& b : blocks) {
+    b = static_cast<char*>(std::malloc(kBlock));
+    ASSERT_NE(b, nullptr);
+    std::memset(b, 1, kBlock);
+  }
+  char* pin = blocks.back();  // the newest block keeps the heap's top in use
+  blocks.pop_back();
+  for (char* b : blocks) std::free(b);
+  const std::size_t held = pvb::resident_bytes();
+  const std::size_t given = pvb::return_free_heap();
+  EXPECT_GE(given, kBlock * kBlocks / 2);
+  EXPECT_LE(pvb::resident_bytes() + given / 2, held);
+  std::free(pin);
+#endif
+}

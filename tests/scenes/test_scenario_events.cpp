@@ -65,9 +65,9 @@ TEST(Scenario, KidnapIsValidatedWithFileAndLine) {
   e = err("  at_s: 19\n  to_route_s: 2\n");  // the default cover of 2 s
   EXPECT_NE(e.find("kidnap.covered_s: expected at_s + covered_s before duration_s"), std::string::npos) << e;
   e = err("  at_s: -1\n  to_route_s: 0\n");
-  EXPECT_NE(e.find("bad.yaml:4: kidnap.at_s: expected a value in [0, 3600], got -1"), std::string::npos) << e;
+  EXPECT_NE(e.find("bad.yaml:4: kidnap.at_s: expected a value in [0, 43200], got -1"), std::string::npos) << e;
   e = err("  at_s: 10\n  to_route_s: -2\n");
-  EXPECT_NE(e.find("kidnap.to_route_s: expected a value in [0, 3600], got -2"), std::string::npos) << e;
+  EXPECT_NE(e.find("kidnap.to_route_s: expected a value in [0, 43200], got -2"), std::string::npos) << e;
   e = err("  at_s: 10\n  covered_s: 0\n  to_route_s: 2\n");
   EXPECT_NE(e.find("kidnap.covered_s: expected a value in"), std::string::npos) << e;
   e = err("  at_s: 10.001\n  covered_s: 0.02\n  to_route_s: 2\n");  // no frame between 10.001 and 10.021 s

@@ -46,6 +46,9 @@ void CostLog::sample(slam::System& system) {
   const slam::SystemMemory memory = system.memory();
   c.keyframes = system.num_keyframes();
   c.points = system.num_map_points();
+  // Free pages left in the allocator's arenas (the dense map's spills and
+  // loads, the threads' turns) go back first: the column is what the run holds.
+  return_free_heap();
   c.rss_mb = megabytes(resident_bytes());
   c.sparse_mb = megabytes(sparse_bytes(memory));
   c.dense_mb = megabytes(memory.dense.total());
