@@ -440,8 +440,18 @@ void LoopClosing::add_tally(const VerifyTally& t, bool found) {
   if (t.ambiguous) ++stats_.refused_ambiguous;
   else if (!found && t.drift > 0) ++stats_.refused_drift;  // each refused detection counts under one check
   if (!t.ambiguous && (found || t.refusal_rank < 0)) return;
-  if (stats_.refusals.size() < LoopClosingStats::kMaxRefusals) stats_.refusals.push_back(t.refusal);
-  else ++stats_.refusals_dropped;
+  stats_.keep_refusal(t.refusal);
+}
+
+void LoopClosingStats::keep_refusal(LoopRefusal r, std::size_t cap) {
+  if (refusals.size() >= cap) {
+    const auto unverified =
+        std::find_if(refusals.begin(), refusals.end(), [](const LoopRefusal& k) { return !k.verified; });
+    ++refusals_dropped;
+    if (!r.verified || unverified == refusals.end()) return;
+    refusals.erase(unverified);
+  }
+  refusals.push_back(std::move(r));
 }
 
 std::shared_ptr<KeyFrame> LoopClosing::find(const std::shared_ptr<KeyFrame>& kf, LoopMatch* best, bool* merge,

@@ -624,3 +624,29 @@ TEST(DurationHistogram, QuantilesWithinHalfABinInFixedMemory) {
 
 }  // namespace
 }  // namespace pvb::slam
+
+// Past the cap a refusal that passed geometry replaces the oldest one that
+// did not; the others are only counted.
+TEST(LoopClosingStats, PastTheCapVerifiedRefusalsReplaceUnverifiedOnes) {
+  using pvb::slam::LoopRefusal;
+  pvb::slam::LoopClosingStats s;
+  const auto refusal = [](std::uint64_t id, bool verified) {
+    LoopRefusal r;
+    r.keyframe_id = id;
+    r.verified = verified;
+    r.reason = verified ? "correction" : "matches";
+    return r;
+  };
+  s.keep_refusal(refusal(1, false), 3);
+  s.keep_refusal(refusal(2, true), 3);
+  s.keep_refusal(refusal(3, false), 3);
+  s.keep_refusal(refusal(4, false), 3);  // full: counted only
+  s.keep_refusal(refusal(5, true), 3);   // takes keyframe 1's place
+  s.keep_refusal(refusal(6, true), 3);   // takes keyframe 3's place
+  s.keep_refusal(refusal(7, true), 3);   // none unverified left: counted only
+  ASSERT_EQ(s.refusals.size(), 3u);
+  EXPECT_EQ(s.refusals[0].keyframe_id, 2u);
+  EXPECT_EQ(s.refusals[1].keyframe_id, 5u);
+  EXPECT_EQ(s.refusals[2].keyframe_id, 6u);
+  EXPECT_EQ(s.refusals_dropped, 4);
+}

@@ -260,8 +260,14 @@ struct LoopClosingStats {
   double verify_ms_total = 0;     ///< the part of detect_ms_total spent in step 3
   double detect_ms_total = 0;     ///< all detection work
   DurationHistogram detect_ms;    ///< detection and verification per keyframe examined
-  std::vector<LoopRefusal> refusals;  ///< the first kMaxRefusals consistent detections refused
-  int refusals_dropped = 0;           ///< refused past kMaxRefusals
+  /// Consistent detections refused, in order, at most kMaxRefusals: past
+  /// that, one that passed geometry takes the place of the oldest that did
+  /// not (a day's drive refuses thousands of look-alike candidates; the
+  /// verified refusals, the dock's among them, are the ones to read).
+  std::vector<LoopRefusal> refusals;
+  int refusals_dropped = 0;  ///< refused and not in `refusals`
+  /// Adds a refusal under the rule above, with `cap` for kMaxRefusals.
+  void keep_refusal(LoopRefusal r, std::size_t cap = kMaxRefusals);
 };
 
 /// The stats as one JSON object for stats.json / metrics.json:
