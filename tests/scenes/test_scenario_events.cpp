@@ -146,7 +146,7 @@ TEST(Scenario, CoverIsValidatedWithFileAndLine) {
             std::string::npos)
       << e;
   e = err("  at_s: -1\n");
-  EXPECT_NE(e.find("bad.yaml:4: cover.at_s: expected a value in [0, 3600], got -1"), std::string::npos) << e;
+  EXPECT_NE(e.find("bad.yaml:4: cover.at_s: expected a value in [0, 43200], got -1"), std::string::npos) << e;
   e = err("  at_s: 17\n  covered_s: 3\n");
   EXPECT_NE(
       e.find("bad.yaml:5: cover.covered_s: expected at_s + covered_s before duration_s (20 s), got 20 s"),
