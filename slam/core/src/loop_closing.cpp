@@ -333,6 +333,11 @@ double LoopClosing::path_length_m(std::uint64_t from, std::uint64_t to) const {
   return length;
 }
 
+double LoopClosing::max_correction_deg(const KeyFrame& kf, const KeyFrame& cand) const {
+  if (options_.max_correction_deg_per_km <= 0) return options_.max_correction_deg;
+  return options_.max_correction_deg + options_.max_correction_deg_per_km * path_length_m(cand.id(), kf.id()) / 1000.0;
+}
+
 double LoopClosing::drift_bound_m(const KeyFrame& kf, const KeyFrame& cand, double angle_deg) const {
   // Drift along the path, plus the swing of a rotation drift: a small
   // rotation and a sideways move look alike in the image, so tracking that
@@ -390,7 +395,7 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
     }
     double dist_m = 0, angle_deg = 0;
     pose_difference(m.T_c_w, kf->T_c_w(), &dist_m, &angle_deg);
-    if (!merge && (dist_m > options_.max_correction_m || angle_deg > options_.max_correction_deg)) {
+    if (!merge && (dist_m > options_.max_correction_m || angle_deg > max_correction_deg(*kf, *cand))) {
       ++tally.refused_correction;
       refuse(3, refusal_of(*kf, *cand, "correction", m, true, dist_m, angle_deg));
       continue;

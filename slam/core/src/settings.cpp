@@ -307,6 +307,8 @@ void read_loop_closing(Reader& r, LoopClosingOptions* lc) {
       r.real("LoopClosing.maxCorrection", false, lc->max_correction_m, above(0, 1e4), "metres");
   lc->max_correction_deg =
       r.real("LoopClosing.maxCorrectionAngle", false, lc->max_correction_deg, above(0, 180), "degrees");
+  lc->max_correction_deg_per_km = r.real("LoopClosing.maxCorrectionAnglePerKm", false, lc->max_correction_deg_per_km,
+                                         Range{0, 180}, "degrees a kilometre");
   lc->lookalike_check_above_m = r.real("LoopClosing.lookalikeCheckAbove", false, lc->lookalike_check_above_m,
                                        above(0, 1e4), "metres");
   lc->essential_weight = r.integer("LoopClosing.essentialWeight", false, lc->essential_weight, 1, 1000000);

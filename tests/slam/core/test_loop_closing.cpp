@@ -338,6 +338,30 @@ TEST(LoopClosing, DriftBoundAllowsTheSwingOfARotationDrift) {
   EXPECT_LT(centre_error_m(kf1->T_c_w(), T), 0.005);
 }
 
+TEST(LoopClosing, TheAngleCapGrowsWithThePathBetweenTheKeyframes) {
+  // The 4 deg swing again, against a cap of 3 deg: refused with a fixed cap,
+  // closed when the cap grows with the few centimetres between the two
+  // keyframes' estimated centres (10^5 deg a kilometre standing in for a
+  // day route's kilometres at a few degrees each).
+  for (const double per_km : {0.0, 1e5}) {
+    Map map;
+    const cv::Mat tex = make_texture(1);
+    add_keyframe(map, tex, pose(0, 0, 0), pose(0, 0, 0));
+    const geom::SE3d T = pose(3, 0.10, 0);
+    auto kf1 = add_keyframe(map, tex, T, swung(T, 4.0));
+    LoopClosingOptions o = test_options();
+    o.consistency = 1;
+    o.max_correction_deg = 3;
+    o.max_correction_deg_per_km = per_km;
+    LoopClosing lc(map, o);
+    lc.process(kf1);
+    lc.process(kf1);
+    const LoopClosingStats s = lc.stats();
+    EXPECT_EQ(s.refused_correction, per_km > 0 ? 0 : 1) << per_km;
+    EXPECT_EQ(s.loops.size(), per_km > 0 ? 1u : 0u) << per_km;
+  }
+}
+
 TEST(LoopClosing, DriftBoundRefusesTheSameCentreMoveWithoutATurn) {
   // The same 14 cm moved sideways with no turn (a place one step along, or
   // drift the path does not explain) is still refused.

@@ -155,6 +155,7 @@ TEST(Settings, ReadsLoopClosingSection) {
                             "LoopClosing.maxCandidates: 3\nLoopClosing.minMatches: 25\n"
                             "LoopClosing.consistency: 3\nLoopClosing.minInliers: 60\n"
                             "LoopClosing.maxCorrection: 0.2\nLoopClosing.maxCorrectionAngle: 5\n"
+                            "LoopClosing.maxCorrectionAnglePerKm: 2.5\n"
                             "LoopClosing.lookalikeCheckAbove: 0.3\n"
                             "LoopClosing.essentialWeight: 80\nLoopClosing.globalBA: 1\n"
                             "LoopClosing.rotationWeight: 3\n");
@@ -170,6 +171,8 @@ TEST(Settings, ReadsLoopClosingSection) {
   EXPECT_EQ(s.loop.min_inliers, 60);
   EXPECT_DOUBLE_EQ(s.loop.max_correction_m, 0.2);
   EXPECT_DOUBLE_EQ(s.loop.max_correction_deg, 5);
+  EXPECT_DOUBLE_EQ(d.loop.max_correction_deg_per_km, 5);
+  EXPECT_DOUBLE_EQ(s.loop.max_correction_deg_per_km, 2.5);
   EXPECT_DOUBLE_EQ(d.loop.lookalike_check_above_m, 0.5);
   EXPECT_DOUBLE_EQ(s.loop.lookalike_check_above_m, 0.3);
   EXPECT_EQ(s.loop.essential_weight, 80);
@@ -308,6 +311,7 @@ TEST(Settings, OutOfRangeValuesAreErrorsNamingKeyAndRange) {
       {"LoopClosing.searchRadius", ".inf"},
       {"LoopClosing.maxCandidates", "4294967297"},
       {"LoopClosing.maxCorrectionAngle", "1e300"},
+      {"LoopClosing.maxCorrectionAnglePerKm", "-1"},
       {"LoopClosing.lookalikeCheckAbove", "0"},
       {"LoopClosing.essentialWeight", "-7"},
       {"LoopClosing.rotationWeight", ".nan"}};

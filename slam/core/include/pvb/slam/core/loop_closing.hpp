@@ -16,7 +16,8 @@
 //   3. geometric verification: EPnP RANSAC on the brute-force matches, pose
 //      optimisation, guided search by projection of the candidate's
 //      neighbourhood, pose optimisation again; >= `min_inliers` inliers and
-//      a correction within `max_correction_m` / `max_correction_deg`; a
+//      a correction within `max_correction_m` / `max_correction_deg` (plus
+//      `max_correction_deg_per_km` a kilometre of path between the two); a
 //      correction over `lookalike_check_above_m` also verifies the keyframe
 //      against the map's best-scoring keyframes one by one, and any that
 //      verifies at another place makes it ambiguous;
@@ -169,6 +170,9 @@ class LoopClosing {
   void add_tally(const VerifyTally& t, bool found);
   /// Camera path length (current estimates) over the keyframes from `from` to `to` by id.
   double path_length_m(std::uint64_t from, std::uint64_t to) const;
+  /// The cap on a loop correction's angle between `kf` and `cand`:
+  /// max_correction_deg + max_correction_deg_per_km x the path between them.
+  double max_correction_deg(const KeyFrame& kf, const KeyFrame& cand) const;
   /// The drift bound on moving `kf`'s camera centre to close a loop with
   /// `cand` by a correction turning it through `angle_deg`.
   double drift_bound_m(const KeyFrame& kf, const KeyFrame& cand, double angle_deg) const;

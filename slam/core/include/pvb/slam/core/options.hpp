@@ -176,6 +176,11 @@ struct LoopClosingOptions {
   /// (the ambiguity check); 10000 turns the look-alike check off.
   double lookalike_check_above_m = 0.5;
   double max_correction_deg = 10;  ///< LoopClosing.maxCorrectionAngle, degrees
+  /// LoopClosing.maxCorrectionAnglePerKm: the angle cap grows by this much
+  /// a kilometre of path driven between the two keyframes (as estimated),
+  /// as the drift bound does: heading drifts with distance (12° on a 2 km
+  /// day route with camera, IMU and wheels).  0: a fixed cap.
+  double max_correction_deg_per_km = 5;
   int essential_weight = 100;      ///< LoopClosing.essentialWeight: covisibility edges in the essential graph
   int keyframes_between_loops = 10;  ///< no detection for this many keyframes after a loop (ORB-SLAM2: 10)
   double rotation_weight = 1.0;    ///< LoopClosing.rotationWeight: pose-graph rotation rows (rad) against translation (m)
