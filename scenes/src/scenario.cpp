@@ -16,7 +16,7 @@ void read_top(detail::MapReader& top, Scenario& s) {
   s.description = top.string("description", s.description);
   s.seed = top.seed("seed", s.seed);
   if (top.has("station_seed")) s.station_seed = top.seed("station_seed", 0);
-  s.duration_s = top.number("duration_s", s.duration_s, 0.1, 43200);
+  s.duration_s = top.number("duration_s", s.duration_s, 0.1, detail::kMaxScenarioTime_s);
   detail::with_map(top, "ground", [&](detail::MapReader& r) { detail::read_ground(r, s.ground); });
   detail::read_arrays(top, s.pv_arrays);
   detail::read_walls(top, s.walls);

@@ -351,7 +351,7 @@ namespace {
 /// A covered lens's at_s and covered_s (of kidnap: or cover:).
 Cover read_cover_times(MapReader& r) {
   Cover c;
-  c.at_s = r.number("at_s", c.at_s, 0, 43200);
+  c.at_s = r.number("at_s", c.at_s, 0, kMaxScenarioTime_s);
   c.covered_s = r.number("covered_s", c.covered_s, 1e-3, 3600);
   return c;
 }
@@ -388,7 +388,7 @@ void read_kidnap(MapReader& top, Scenario& s) {
     if (!r.has(key)) r.fail(r.full(key), n, "a time in seconds (required in kidnap)");
   const Cover c = read_cover_times(r);
   Kidnap k{c.at_s, c.covered_s, 0};
-  k.to_route_s = r.number("to_route_s", k.to_route_s, 0, 43200);
+  k.to_route_s = r.number("to_route_s", k.to_route_s, 0, kMaxScenarioTime_s);
   r.finish();
   check_cover_times(r, n, c, s);
   const KidnapFrames f = kidnap_frames(k, s.camera.fps);

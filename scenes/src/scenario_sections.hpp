@@ -19,6 +19,9 @@ inline constexpr long long kMaxSceneGeoms = 20000;
 /// file of 200 000 walls took 20 s and 1.1 GB (a plant's inverter stations
 /// are walls it makes, not a list).
 inline constexpr long long kMaxListEntries = 3800;
+/// The longest a scenario runs, and the latest time an event in it may
+/// start: 12 h, a robot's working day.
+inline constexpr double kMaxScenarioTime_s = 43200;
 
 /// The ground: section (type, size, tiling, relief, the soil's friction).
 void read_ground(MapReader& r, Ground& g);

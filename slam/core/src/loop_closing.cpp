@@ -333,18 +333,17 @@ double LoopClosing::path_length_m(std::uint64_t from, std::uint64_t to) const {
   return length;
 }
 
-double LoopClosing::max_correction_deg(const KeyFrame& kf, const KeyFrame& cand) const {
-  if (options_.max_correction_deg_per_km <= 0) return options_.max_correction_deg;
-  return options_.max_correction_deg + options_.max_correction_deg_per_km * path_length_m(cand.id(), kf.id()) / 1000.0;
+double LoopClosing::max_correction_deg(double path_m) const {
+  return options_.max_correction_deg + options_.max_correction_deg_per_km * path_m / 1000.0;
 }
 
-double LoopClosing::drift_bound_m(const KeyFrame& kf, const KeyFrame& cand, double angle_deg) const {
+double LoopClosing::drift_bound_m(const KeyFrame& kf, double path_m, double angle_deg) const {
   // Drift along the path, plus the swing of a rotation drift: a small
   // rotation and a sideways move look alike in the image, so tracking that
   // drifts in rotation turns the camera about the scene it holds, and the
   // correction moves the camera centre by 2 sin(angle / 2) x the scene depth.
   const double swing_m = 2.0 * std::sin(angle_deg / kRadToDeg / 2.0) * scene_median_depth_m(kf);
-  return options_.drift_floor_m + options_.max_drift_rate * path_length_m(cand.id(), kf.id()) + swing_m;
+  return options_.drift_floor_m + options_.max_drift_rate * path_m + swing_m;
 }
 
 namespace {
@@ -395,13 +394,14 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
     }
     double dist_m = 0, angle_deg = 0;
     pose_difference(m.T_c_w, kf->T_c_w(), &dist_m, &angle_deg);
-    if (!merge && (dist_m > options_.max_correction_m || angle_deg > max_correction_deg(*kf, *cand))) {
+    const double path_m = path_length_m(cand->id(), kf->id());  // both bounds grow with it
+    if (!merge && (dist_m > options_.max_correction_m || angle_deg > max_correction_deg(path_m))) {
       ++tally.refused_correction;
       refuse(3, refusal_of(*kf, *cand, "correction", m, true, dist_m, angle_deg));
       continue;
     }
     verified_centres_w.push_back(m.T_c_w.inverse().translation());
-    const double bound_m = drift_bound_m(*kf, *cand, angle_deg);
+    const double bound_m = drift_bound_m(*kf, path_m, angle_deg);
     if (!merge && options_.max_drift_rate > 0 && dist_m > bound_m) {
       ++tally.drift;
       refuse(4, refusal_of(*kf, *cand, "drift", m, true, dist_m, angle_deg, bound_m));

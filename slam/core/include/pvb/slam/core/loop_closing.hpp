@@ -170,12 +170,13 @@ class LoopClosing {
   void add_tally(const VerifyTally& t, bool found);
   /// Camera path length (current estimates) over the keyframes from `from` to `to` by id.
   double path_length_m(std::uint64_t from, std::uint64_t to) const;
-  /// The cap on a loop correction's angle between `kf` and `cand`:
-  /// max_correction_deg + max_correction_deg_per_km x the path between them.
-  double max_correction_deg(const KeyFrame& kf, const KeyFrame& cand) const;
-  /// The drift bound on moving `kf`'s camera centre to close a loop with
-  /// `cand` by a correction turning it through `angle_deg`.
-  double drift_bound_m(const KeyFrame& kf, const KeyFrame& cand, double angle_deg) const;
+  /// The cap on a loop correction's angle over `path_m` of path between
+  /// the two keyframes: max_correction_deg + max_correction_deg_per_km x it.
+  double max_correction_deg(double path_m) const;
+  /// The drift bound on moving `kf`'s camera centre to close a loop with a
+  /// keyframe `path_m` of path away by a correction turning it through
+  /// `angle_deg`.
+  double drift_bound_m(const KeyFrame& kf, double path_m, double angle_deg) const;
   /// Step 5 (optional): bundle adjustment of every keyframe and point,
   /// keyframe 0 fixed, map locked throughout.
   void global_bundle_adjustment(LoopEvent* event, std::uint32_t map_id);
