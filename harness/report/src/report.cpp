@@ -94,14 +94,14 @@ const std::vector<std::string>& cost_columns() {
   static const std::vector<std::string> columns = {
       "frame",     "t_s",      "keyframes",          "points",          "rss_mb",         "sparse_mb",
       "dense_mb",  "tracking_ms_median", "tracking_ms_p95", "loop_detect_ms", "mapping_ms_per_keyframe",
-      "local_ba_ms", "dense_disk_mb"};
+      "local_ba_ms", "dense_disk_mb", "sparse_disk_mb"};
   return columns;
 }
 
 std::vector<double> cost_values(const CostSample& c) {
   return {static_cast<double>(c.frame), c.t_s, static_cast<double>(c.keyframes), static_cast<double>(c.points),
           c.rss_mb, c.sparse_mb, c.dense_mb, c.tracking_ms_median, c.tracking_ms_p95, c.loop_detect_ms,
-          c.mapping_ms_per_keyframe, c.local_ba_ms, c.dense_disk_mb};
+          c.mapping_ms_per_keyframe, c.local_ba_ms, c.dense_disk_mb, c.sparse_disk_mb};
 }
 
 std::string costs_json(const std::vector<CostSample>& samples, int every_frames, const std::string& in) {

@@ -46,13 +46,14 @@ void write_motion_figures(const MotionSensorsReport& m, const std::string& dir, 
 void write_cost_figures(const SlamRun& run, const std::string& dir, std::vector<std::string>* written) {
   if (run.costs.size() < 2) return;
   std::vector<double> kf;
-  std::vector<double> rss, sparse, dense, disk, track, loop, mapping, ba;
+  std::vector<double> rss, sparse, dense, disk, sparse_disk, track, loop, mapping, ba;
   for (const CostSample& c : run.costs) {
     kf.push_back(static_cast<double>(c.keyframes));
     rss.push_back(c.rss_mb);
     sparse.push_back(c.sparse_mb);
     dense.push_back(c.dense_mb);
     disk.push_back(c.dense_disk_mb);
+    sparse_disk.push_back(c.sparse_disk_mb);
     track.push_back(c.tracking_ms_median);
     loop.push_back(c.loop_detect_ms);
     mapping.push_back(c.mapping_ms_per_keyframe);
@@ -62,7 +63,8 @@ void write_cost_figures(const SlamRun& run, const std::string& dir, std::vector<
                                      {{"process (RSS)", kf, rss, eval::series_color(0)},
                                       {"sparse map", kf, sparse, eval::series_color(1)},
                                       {"dense map", kf, dense, eval::series_color(2)},
-                                      {"dense map spilled to disk", kf, disk, eval::series_color(3)}}),
+                                      {"dense map spilled to disk", kf, disk, eval::series_color(3)},
+                                      {"keyframe features on disk", kf, sparse_disk, eval::series_color(4)}}),
                dir, "cost_memory", written);
   write_figure(eval::make_line_chart("time as the map grows (each over the frames since the sample before)",
                                      "keyframes in the map", "time [ms]",

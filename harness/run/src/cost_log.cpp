@@ -53,6 +53,7 @@ void CostLog::sample(slam::System& system) {
   c.sparse_mb = megabytes(sparse_bytes(memory));
   c.dense_mb = megabytes(memory.dense.total());
   c.dense_disk_mb = megabytes(memory.dense.spilled_keyframe_bytes + memory.dense.spilled_map_bytes);
+  c.sparse_disk_mb = megabytes(memory.feature_spill.live_bytes());
   const slam::LoopDetectTotals loops = system.loop_detect_totals();
   const slam::LocalMappingStats mapping = system.mapping_stats();
   if (const std::size_t n = loops.detections - loops_.detections; n > 0)

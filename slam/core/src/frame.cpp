@@ -80,7 +80,7 @@ namespace {
 /// Counting sort of the keypoints by cell: start[c] is where cell c's
 /// indices begin in `index`, each cell's in ascending order.
 template <typename T>
-void group_by_cell(const std::vector<int>& cell_of, int num_cells, std::vector<T>* start, std::vector<T>* index) {
+void group_by_cell(const std::vector<int>& cell_of, int num_cells, FeatureArray<T>* start, FeatureArray<T>* index) {
   start->assign(static_cast<std::size_t>(num_cells) + 1, 0);
   for (int c : cell_of)
     if (c >= 0) ++(*start)[static_cast<std::size_t>(c) + 1];
@@ -101,8 +101,20 @@ KeypointGrid::KeypointGrid(const std::vector<int>& cell_of, int num_cells) {
 }
 
 std::size_t KeypointGrid::memory_bytes() const {
-  return vector_heap_bytes(start16_) + vector_heap_bytes(index16_) + vector_heap_bytes(start32_) +
-         vector_heap_bytes(index32_);
+  return feature_heap_bytes(start16_) + feature_heap_bytes(index16_) + feature_heap_bytes(start32_) +
+         feature_heap_bytes(index32_);
+}
+
+std::size_t KeypointGrid::spilled_bytes() const {
+  return feature_spilled_bytes(start16_) + feature_spilled_bytes(index16_) + feature_spilled_bytes(start32_) +
+         feature_spilled_bytes(index32_);
+}
+
+void KeypointGrid::spill_to(FeatureSpill* spill) {
+  start16_ = spilled_copy(start16_, spill);
+  index16_ = spilled_copy(index16_, spill);
+  start32_ = spilled_copy(start32_, spill);
+  index32_ = spilled_copy(index32_, spill);
 }
 
 Frame::Frame(std::uint64_t frame_id, std::int64_t time_ns, OrbFeatures features, const cv::Mat& depth,
@@ -118,8 +130,9 @@ Frame::Frame(std::uint64_t frame_id, std::int64_t time_ns, OrbFeatures features,
     keys_un[i] = Keypoint{k.pt, k.angle, k.octave};
   }
   if (!cam->dist_cv.empty() && n > 0) {
+    const std::vector<cv::Point2f> detected(keys.begin(), keys.end());
     std::vector<cv::Point2f> un;
-    cv::undistortPoints(keys, un, cam->K_cv, cam->dist_cv, cv::noArray(), cam->K_cv);
+    cv::undistortPoints(detected, un, cam->K_cv, cam->dist_cv, cv::noArray(), cam->K_cv);
     for (std::size_t i = 0; i < n; ++i) keys_un[i].pt = un[i];
   }
   depth_m.assign(n, -1.0f);
@@ -145,10 +158,10 @@ Frame Frame::from_saved(std::uint64_t frame_id, std::int64_t time_ns, std::vecto
   f.id = frame_id;
   f.t_ns = time_ns;
   f.cam = std::move(camera);
-  f.keys = std::move(keys_detected);
-  f.keys_un = std::move(keys_undistorted);
+  f.keys.assign(keys_detected.begin(), keys_detected.end());
+  f.keys_un.assign(keys_undistorted.begin(), keys_undistorted.end());
   f.descriptors = std::move(descriptors);
-  f.depth_m = std::move(depth);
+  f.depth_m.assign(depth.begin(), depth.end());
   f.u_right.assign(f.keys_un.size(), -1.0f);
   for (std::size_t i = 0; i < f.keys_un.size(); ++i)
     if (f.depth_m[i] > 0) f.u_right[i] = f.right_coordinate(f.keys_un[i].pt.x, f.depth_m[i]);
@@ -244,6 +257,7 @@ FrameMemory& FrameMemory::operator+=(const FrameMemory& o) {
   per_keypoint += o.per_keypoint;
   grid += o.grid;
   object += o.object;
+  spilled += o.spilled;
   return *this;
 }
 
@@ -255,16 +269,35 @@ std::size_t mat_heap_bytes(const cv::Mat& m) {
 }
 
 void Frame::release_features() {
-  std::vector<cv::Point2f>().swap(keys);
-  std::vector<Keypoint>().swap(keys_un);
+  FeatureArray<cv::Point2f>().swap(keys);
+  FeatureArray<Keypoint>().swap(keys_un);
   descriptors.release();
-  std::vector<float>().swap(depth_m);
-  std::vector<float>().swap(u_right);
+  FeatureArray<float>().swap(depth_m);
+  FeatureArray<float>().swap(u_right);
   std::vector<std::shared_ptr<MapPoint>>().swap(map_points);
   std::vector<std::uint8_t>().swap(outlier);
   std::vector<std::uint64_t>().swap(aligned_for);
   grid_ = KeypointGrid();
   pyramid.reset();
+  spill_.reset();
+}
+
+void Frame::spill_features(const std::shared_ptr<FeatureSpill>& spill) {
+  if (!spill || spill_ || keys_un.empty()) return;
+  FeatureSpill* s = spill.get();
+  keys = spilled_copy(keys, s);
+  keys_un = spilled_copy(keys_un, s);
+  depth_m = spilled_copy(depth_m, s);
+  u_right = spilled_copy(u_right, s);
+  grid_.spill_to(s);
+  if (!descriptors.empty()) {
+    cv::Mat d;
+    d.allocator = s->mat_allocator();
+    d.create(descriptors.rows, descriptors.cols, descriptors.type());
+    descriptors.copyTo(d);
+    descriptors = d;
+  }
+  spill_ = spill;
 }
 
 void Frame::release_pyramid() {
@@ -279,11 +312,15 @@ FrameMemory Frame::memory() const {
     m.pyramid = heap_block_bytes(sizeof(ImagePyramid) + 2 * sizeof(long)) + vector_heap_bytes(*pyramid);
     for (const cv::Mat& level : *pyramid) m.pyramid += mat_heap_bytes(level);
   }
-  m.keypoints = vector_heap_bytes(keys) + vector_heap_bytes(keys_un);
-  m.descriptors = mat_heap_bytes(descriptors);
-  m.per_keypoint = vector_heap_bytes(depth_m) + vector_heap_bytes(u_right) + vector_heap_bytes(map_points) +
+  m.keypoints = feature_heap_bytes(keys) + feature_heap_bytes(keys_un);
+  const bool descriptors_spilled = spill_ && descriptors.u && descriptors.u->currAllocator == spill_->mat_allocator();
+  m.descriptors = descriptors_spilled ? 0 : mat_heap_bytes(descriptors);
+  m.per_keypoint = feature_heap_bytes(depth_m) + feature_heap_bytes(u_right) + vector_heap_bytes(map_points) +
                    vector_heap_bytes(outlier) + vector_heap_bytes(aligned_for);
   m.grid = grid_.memory_bytes();
+  m.spilled = feature_spilled_bytes(keys) + feature_spilled_bytes(keys_un) + feature_spilled_bytes(depth_m) +
+              feature_spilled_bytes(u_right) + grid_.spilled_bytes() +
+              (descriptors_spilled ? descriptors.u->size : 0);
   m.object = sizeof(Frame);
   return m;
 }

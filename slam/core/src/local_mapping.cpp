@@ -157,35 +157,49 @@ void LocalMapping::process(const std::shared_ptr<KeyFrame>& kf) {
   }
   if (options_.motion.setup != sensor::SensorSetup::kCamera) initialize_inertial(kf);
   if (wheel_calibrator_) calibrate_wheels(kf);
-  if (options_.align_patches) {
+  if (options_.align_patches || spill_) {
     std::lock_guard<std::mutex> lock(map_.mutex());
-    release_pyramids(kf);
+    leave_local_map(kf);
+  }
+  if (spill_ && spilled_since_release_ >= options_.spill_release_every) {
+    spill_->release_resident();
+    spilled_since_release_ = 0;
   }
   if (after_keyframe_) after_keyframe_(kf);
   ++processed_;
   --pending_;
 }
 
-/// The pyramids of keyframes that have left the local map go: neither
-/// among the newest options_.pyramid_window keyframes nor covisible with
-/// kf.  A released pyramid is not rebuilt (the image is gone), so a point
-/// whose reference keyframe has lost it is matched without alignment.
-void LocalMapping::release_pyramids(const std::shared_ptr<KeyFrame>& kf) {
-  if (kf->frame().pyramid) with_pyramid_.push_back(kf);
+/// Keyframes that have left the local map (neither among the newest
+/// options_.pyramid_window keyframes nor covisible with kf) release their
+/// pyramid and put their features into the spill.  A released pyramid is
+/// not rebuilt (the image is gone), so a point whose reference keyframe has
+/// lost it is matched without alignment; spilled features are read from
+/// the spill's file wherever the keyframe is used again.
+void LocalMapping::leave_local_map(const std::shared_ptr<KeyFrame>& kf) {
+  const auto holds_local_data = [&](const KeyFrame& k) {
+    return k.frame().pyramid || (spill_ && !k.frame().features_spilled());
+  };
+  if (holds_local_data(*kf)) in_window_.push_back(kf);
   std::set<std::uint64_t> covisible;
   for (const auto& k : kf->best_covisibles(-1)) covisible.insert(k->id());
-  const std::size_t n = with_pyramid_.size();
+  const std::size_t n = in_window_.size();
   const std::size_t window = static_cast<std::size_t>(std::max(0, options_.pyramid_window));
   std::deque<std::weak_ptr<KeyFrame>> kept;
   for (std::size_t i = 0; i < n; ++i) {
-    const auto k = with_pyramid_[i].lock();
-    if (!k || !k->frame().pyramid) continue;
-    if (i + window >= n || (!k->bad() && covisible.count(k->id())))
+    const auto k = in_window_[i].lock();
+    if (!k || k->bad() || !holds_local_data(*k)) continue;
+    if (i + window >= n || covisible.count(k->id())) {
       kept.push_back(k);
-    else
-      k->release_pyramid();
+      continue;
+    }
+    k->release_pyramid();
+    if (spill_) {
+      k->spill_features(spill_);
+      ++spilled_since_release_;
+    }
   }
-  with_pyramid_.swap(kept);
+  in_window_.swap(kept);
 }
 
 void LocalMapping::process_new_keyframe(const std::shared_ptr<KeyFrame>& kf) {

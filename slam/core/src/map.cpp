@@ -468,6 +468,7 @@ MapMemory Map::memory() const {
   for (const auto& [id, kf] : keyframes_) {
     const KeyFrameMemory k = kf->memory();
     m.keyframe_bytes += k;
+    if (kf->frame().features_spilled()) ++m.keyframes_spilled;
     if (kf->frame().pyramid) continue;
     ++m.keyframes_outside;
     m.outside_bytes += k;

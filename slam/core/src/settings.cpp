@@ -398,6 +398,7 @@ Settings settings_from(const cv::FileStorage& fs, const std::string& text, const
   read_camera(r, &s);
   read_orb(r, &s);
   s.align_patches = r.flag("Tracking.alignPatches", false, s.align_patches);  // ours, optional
+  s.spill_features = r.flag("Map.spillFeatures", false, s.spill_features);  // ours, optional
   s.reloc_lookalikes = r.integer("Tracking.relocLookalikes", false, s.reloc_lookalikes, 0, 1000);  // ours, optional
   s.max_observing_keyframes =
       r.integer("Tracking.maxObservingKeyFrames", false, s.max_observing_keyframes, 0, 100000);  // ours, optional

@@ -75,6 +75,10 @@ System::System(const Settings& settings, const SystemOptions& options)
   mopt.patch_align = topt.patch_align;
   mopt.motion = settings.motion;
   mapping_ = std::make_unique<LocalMapping>(*map_, cam_, mopt);
+  if (settings.spill_features) {
+    feature_spill_ = std::make_shared<FeatureSpill>();
+    mapping_->set_feature_spill(feature_spill_);
+  }
   if (settings.loop.enabled) loop_ = std::make_unique<LoopClosing>(*map_, settings.loop, place_.get());
   // After local mapping: the keyframe's bag of words, loop detection
   // against the older keyframes, then the keyframe joins the database.
@@ -406,6 +410,10 @@ SystemMemory System::memory() {
     m.place_database_postings = c.postings;
   }
   if (dense_) m.dense = dense_->memory();
+  if (feature_spill_) {
+    m.feature_spill = feature_spill_->stats();
+    m.feature_spill_resident_bytes = feature_spill_->resident_bytes();
+  }
   return m;
 }
 
@@ -413,7 +421,8 @@ namespace {
 std::string frame_memory_json(const FrameMemory& f) {
   std::ostringstream js;
   js << "\"pyramid\": " << f.pyramid << ", \"keypoints\": " << f.keypoints << ", \"descriptors\": " << f.descriptors
-     << ", \"per_keypoint\": " << f.per_keypoint << ", \"grid\": " << f.grid << ", \"frame_object\": " << f.object;
+     << ", \"per_keypoint\": " << f.per_keypoint << ", \"grid\": " << f.grid << ", \"frame_object\": " << f.object
+     << ", \"spilled\": " << f.spilled;
   return js.str();
 }
 std::string keyframe_memory_json(const KeyFrameMemory& k) {
@@ -439,7 +448,12 @@ std::string to_json(const SystemMemory& m) {
      << ", \"dense_map_bytes\": " << m.dense.map_bytes
      << ", \"dense_keyframes_spilled\": " << m.dense.keyframes_spilled
      << ", \"dense_spilled_keyframe_bytes\": " << m.dense.spilled_keyframe_bytes
-     << ", \"dense_spilled_map_bytes\": " << m.dense.spilled_map_bytes << "}";
+     << ", \"dense_spilled_map_bytes\": " << m.dense.spilled_map_bytes
+     << ", \"keyframes_spilled\": " << m.map.keyframes_spilled
+     << ", \"feature_spill_bytes\": " << m.feature_spill.live_bytes()
+     << ", \"feature_spill_file_bytes\": " << m.feature_spill.file_bytes
+     << ", \"feature_spill_resident_bytes\": " << m.feature_spill_resident_bytes
+     << ", \"feature_spill_releases\": " << m.feature_spill.releases << "}";
   return js.str();
 }
 

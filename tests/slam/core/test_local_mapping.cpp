@@ -7,6 +7,7 @@
 #include <mutex>
 #include <thread>
 
+#include "pvb/slam/core/feature_spill.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/map.hpp"
 
@@ -178,6 +179,41 @@ TEST(LocalMapping, KeyframesLeavingTheLocalMapReleaseTheirPyramid) {
   EXPECT_EQ(m.keyframes_outside, 3u);
   EXPECT_EQ(m.outside_bytes.frame.pyramid, 0u);
   EXPECT_GT(m.keyframe_bytes.frame.pyramid, 0u);
+}
+
+// With a feature spill, a keyframe leaving the local map moves its
+// features into it (the same values, off the heap); the spill's pages are
+// dropped from memory every spill_release_every keyframes and read back
+// where the keyframe is used again.
+TEST(LocalMapping, KeyframesLeavingTheLocalMapSpillTheirFeatures) {
+  Map map;
+  LocalMappingOptions opt = options();
+  opt.pyramid_window = 1;
+  opt.spill_release_every = 1;
+  LocalMapping mapping(map, camera(), opt);
+  const auto spill = std::make_shared<FeatureSpill>();
+  mapping.set_feature_spill(spill);
+  std::vector<std::shared_ptr<MapPoint>> a, b;
+  const auto kf0 = keyframe(map, 0, a);
+  const std::vector<Keypoint> keys0(kf0->frame().keys_un.begin(), kf0->frame().keys_un.end());
+  const cv::Mat descriptors0 = kf0->frame().descriptors.clone();
+  mapping.insert(kf0);
+  EXPECT_FALSE(kf0->frame().features_spilled()) << "the newest keyframe";
+  const auto kf1 = keyframe(map, 1, b);  // sees none of kf0's points
+  mapping.insert(kf1);
+  ASSERT_TRUE(kf0->frame().features_spilled());
+  EXPECT_FALSE(kf1->frame().features_spilled());
+  EXPECT_GT(spill->stats().live_bytes(), 0u);
+  EXPECT_EQ(spill->stats().releases, 1u);
+  EXPECT_EQ(spill->resident_bytes(), 0u);
+  ASSERT_EQ(kf0->frame().keys_un.size(), keys0.size());
+  for (std::size_t i = 0; i < keys0.size(); ++i) EXPECT_EQ(kf0->frame().keys_un[i].pt, keys0[i].pt);
+  EXPECT_EQ(cv::norm(kf0->frame().descriptors, descriptors0, cv::NORM_HAMMING), 0.0);
+  EXPECT_EQ(kf0->frame().features_in_area(100.0f, 200.0f, 5.0f).size(), 1u);
+  const FrameMemory f = kf0->frame().memory();
+  EXPECT_EQ(f.keypoints + f.descriptors, 0u);
+  EXPECT_GE(f.spilled, keys0.size() * 2 * sizeof(Keypoint) + descriptors0.total());
+  EXPECT_EQ(map.memory().keyframes_spilled, 1u);
 }
 
 TEST(LocalMapping, StatsAsJson) {

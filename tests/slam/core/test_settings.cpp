@@ -144,6 +144,10 @@ TEST(Settings, ReadsTrackingAlignPatchesFlag) {
   expect_optional_flag("Tracking.alignPatches", "yes", [](const Settings& s) { return s.align_patches; });
 }
 
+TEST(Settings, ReadsMapSpillFeaturesFlag) {
+  expect_optional_flag("Map.spillFeatures", "2", [](const Settings& s) { return s.spill_features; });
+}
+
 TEST(Settings, ReadsLoopClosingSection) {
   const Settings d = read_settings(tum1());  // absent: on, with the documented defaults
   EXPECT_TRUE(d.loop.enabled);

@@ -156,6 +156,7 @@ struct CostSample {
   double mapping_ms_per_keyframe = 0;  ///< local mapping's busy time per keyframe over the window (0: none)
   double local_ba_ms = 0;              ///< the local BAs' solver time per BA over the window (0: none)
   double dense_disk_mb = 0;  ///< what the dense mapper spilled to disk (compressed), over its memory budget
+  double sparse_disk_mb = 0;  ///< far keyframes' features in the feature file (Map.spillFeatures)
 };
 /// The columns of costs.csv and of metrics.json's "costs" rows, in order.
 const std::vector<std::string>& cost_columns();

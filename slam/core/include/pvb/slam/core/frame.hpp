@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "pvb/geometry/se3.hpp"
+#include "pvb/slam/core/feature_spill.hpp"
 #include "pvb/slam/core/reports.hpp"
 #include "pvb/slam/features/orb_extractor.hpp"
 #include "pvb/slam/features/patch_align.hpp"
@@ -91,11 +92,14 @@ class KeypointGrid {
       for (std::uint32_t k = start32_[c]; k < start32_[c + 1]; ++k) f(static_cast<std::size_t>(index32_[k]));
     }
   }
-  std::size_t memory_bytes() const;
+  std::size_t memory_bytes() const;   ///< on the heap
+  std::size_t spilled_bytes() const;  ///< in a FeatureSpill
+  /// Moves the index into `spill`.
+  void spill_to(FeatureSpill* spill);
 
  private:
-  std::vector<std::uint16_t> start16_, index16_;  ///< fewer than 65536 keypoints
-  std::vector<std::uint32_t> start32_, index32_;  ///< otherwise
+  FeatureArray<std::uint16_t> start16_, index16_;  ///< fewer than 65536 keypoints
+  FeatureArray<std::uint32_t> start32_, index32_;  ///< otherwise
 };
 
 /// Heap bytes of the buffer a cv::Mat refers to (0 for a view of memory
@@ -149,19 +153,33 @@ class Frame {
   /// Frees the pyramid and the alignment marks, which serve only alignment
   /// to it (a frame without a pyramid is never aligned).
   void release_pyramid();
+  /// Moves the keypoints, descriptors, depths and the grid into `spill`
+  /// (a keyframe that has left the local map): the values and every
+  /// reader stay the same, the memory is the spill's file.  Once only;
+  /// a frame without features stays as it is.
+  void spill_features(const std::shared_ptr<FeatureSpill>& spill);
+  bool features_spilled() const { return spill_ != nullptr; }
 
   std::uint64_t id = 0;
   std::int64_t t_ns = 0;
   std::shared_ptr<const CameraModel> cam;
+
+ private:
+  /// Where the features lie, when spilled; kept alive while they do.
+  /// Declared before every array it may hold, so it is destroyed after
+  /// them (a frame may outlive the System that made the spill).
+  std::shared_ptr<FeatureSpill> spill_;
+
+ public:
   /// Positions as detected (distorted image px); level and orientation are
   /// keys_un's.  Without distortion these are keys_un's positions, but a
   /// keypoint moved by patch alignment may differ from its keys_un in the
   /// last bit (move_keypoint), so both are kept.
-  std::vector<cv::Point2f> keys;
-  std::vector<Keypoint> keys_un;  ///< undistorted
+  FeatureArray<cv::Point2f> keys;
+  FeatureArray<Keypoint> keys_un;  ///< undistorted
   cv::Mat descriptors;                ///< N x 32 CV_8U
-  std::vector<float> depth_m;         ///< per keypoint, <= 0 invalid
-  std::vector<float> u_right;         ///< u - bf / depth, < 0 when no depth
+  FeatureArray<float> depth_m;        ///< per keypoint, <= 0 invalid
+  FeatureArray<float> u_right;        ///< u - bf / depth, < 0 when no depth
   std::vector<std::shared_ptr<MapPoint>> map_points;  ///< per keypoint, may be null
   std::vector<std::uint8_t> outlier;  ///< per keypoint, set by pose optimisation
   geom::SE3d T_c_w = geom::SE3d::Identity();

@@ -64,6 +64,9 @@ class LocalMapping {
   /// The keyframes culled since the last call (for the place database to
   /// forget them); on the mapping thread, as the after-keyframe hook runs.
   std::vector<std::uint64_t> take_culled() { return std::exchange(culled_, {}); }
+  /// Where keyframes that leave the local map put their features (none:
+  /// they stay on the heap); set before start().
+  void set_feature_spill(std::shared_ptr<FeatureSpill> spill) { spill_ = std::move(spill); }
 
   /// Starts the worker thread (asynchronous mode).
   void start();
@@ -102,7 +105,7 @@ class LocalMapping {
   void fuse_with_neighbors(const std::shared_ptr<KeyFrame>& kf);
   void local_bundle_adjustment(const std::shared_ptr<KeyFrame>& kf);
   void cull_keyframes(const std::shared_ptr<KeyFrame>& kf);
-  void release_pyramids(const std::shared_ptr<KeyFrame>& kf);
+  void leave_local_map(const std::shared_ptr<KeyFrame>& kf);
   // Motion sensors (local_mapping_inertial.cpp)
   /// Estimates gravity, velocities and biases from the keyframes so far,
   /// once there are enough of them (MapGravity::ready).
@@ -124,7 +127,9 @@ class LocalMapping {
   std::shared_ptr<const CameraModel> cam_;
   LocalMappingOptions options_;
   std::list<std::shared_ptr<MapPoint>> recent_points_;  ///< points on trial
-  std::deque<std::weak_ptr<KeyFrame>> with_pyramid_;   ///< keyframes still holding one, oldest first
+  std::deque<std::weak_ptr<KeyFrame>> in_window_;  ///< keyframes with a pyramid or features not yet spilled, oldest first
+  std::shared_ptr<FeatureSpill> spill_;
+  int spilled_since_release_ = 0;
   ClosableQueue<std::shared_ptr<KeyFrame>> queue_;
   std::atomic<int> pending_{0};  ///< keyframes inserted and not yet processed
   std::atomic<std::int64_t> busy_us_{0};  ///< time in process(), microseconds

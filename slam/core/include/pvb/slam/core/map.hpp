@@ -151,6 +151,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   /// Drops the grey pyramid (the keyframe has left the local map): its
   /// patches are no longer alignment references.
   void release_pyramid() { frame_.release_pyramid(); }
+  /// Its features into `spill` (Frame::spill_features), under the map's mutex.
+  void spill_features(const std::shared_ptr<FeatureSpill>& spill) { frame_.spill_features(spill); }
   const geom::SE3d& T_c_w() const { return frame_.T_c_w; }
   void set_T_c_w(const geom::SE3d& T) { frame_.T_c_w = T; }
   /// A correction (loop, merge) moves the keyframe to T: its velocity

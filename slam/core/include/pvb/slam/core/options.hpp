@@ -131,8 +131,12 @@ struct LocalMappingOptions {
   /// A keyframe's grey pyramid (about 1 MB at 640 x 480) is kept while it
   /// is in the local map, that is among the newest `pyramid_window`
   /// keyframes or covisible with the newest; then it is released, and its
-  /// points are no longer aligned to its patches (release_pyramids).
+  /// points are no longer aligned to its patches (leave_local_map).  Its
+  /// features go to the feature spill then, when there is one.
   int pyramid_window = 10;
+  /// The spill's pages are written out and dropped from memory after this
+  /// many keyframes have gone into it.
+  int spill_release_every = 32;
   /// Local BA iterations and gates; its abort_flag is local mapping's own
   /// (set on the worker thread only), whatever is given here.
   BaOptions ba;

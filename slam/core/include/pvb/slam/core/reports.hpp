@@ -25,6 +25,7 @@ struct FrameMemory {
   std::size_t per_keypoint = 0;  ///< depth, u_right, map-point links, outlier flags, aligned_for
   std::size_t grid = 0;          ///< the area-search index
   std::size_t object = 0;        ///< sizeof(Frame)
+  std::size_t spilled = 0;       ///< keypoints, descriptors, depths and grid in the feature file (not in total)
   std::size_t total() const { return pyramid + keypoints + descriptors + per_keypoint + grid + object; }
   FrameMemory& operator+=(const FrameMemory& o);
 };
@@ -50,6 +51,7 @@ struct MapMemory {
   KeyFrameMemory outside_bytes;
   std::size_t points = 0;
   std::size_t point_bytes = 0;
+  std::size_t keyframes_spilled = 0;  ///< their features in the feature file (FrameMemory::spilled)
 };
 
 /// kDeadReckoning: vision has failed and the IMU (and wheels) carry the

@@ -94,6 +94,11 @@ struct Settings {
   /// to their reference keyframe's patch before the local-map pose
   /// optimisation (TrackingOptions::align_patches).
   bool align_patches = true;
+  /// Map.spillFeatures (0/1, ours, optional): a keyframe that leaves the
+  /// local map puts its keypoints, descriptors, depths and grid into a file
+  /// in the temporary folder ($TMPDIR), read back where it is used again
+  /// (FeatureSpill).  Values and results are the same either way.
+  bool spill_features = true;
   /// Tracking.relocLookalikes (ours, optional): best-scoring keyframes a
   /// relocalisation is also checked against (TrackingOptions::reloc_lookalikes).
   int reloc_lookalikes = 10;

@@ -16,6 +16,7 @@
 #include "pvb/geometry/se3.hpp"
 #include "pvb/geometry/stamped_pose.hpp"
 #include "pvb/sensor/rgbd_frame.hpp"
+#include "pvb/slam/core/feature_spill.hpp"
 #include "pvb/slam/core/keyframe_motion.hpp"
 #include "pvb/slam/core/map_settings.hpp"
 #include "pvb/slam/core/map_snapshot.hpp"
@@ -99,6 +100,10 @@ struct SystemMemory {
   std::size_t place_database_words = 0;     ///< words with a list in it
   std::size_t place_database_postings = 0;  ///< (keyframe, word) entries
   dense::DenseMemory dense;            ///< empty when dense mapping is off
+  /// Far keyframes' features in the feature file (Map.spillFeatures), and
+  /// how much of it is in memory now (in the process or the page cache).
+  FeatureSpillStats feature_spill;
+  std::size_t feature_spill_resident_bytes = 0;
 };
 /// {"keyframes": .., "keyframe_bytes": {"pyramid": .., ...}, ...} for stats.json.
 std::string to_json(const SystemMemory& m);
@@ -224,6 +229,9 @@ class System {
   SystemOptions options_;
   std::shared_ptr<const CameraModel> cam_;
   std::unique_ptr<OrbExtractor> extractor_;
+  /// Far keyframes' features (Map.spillFeatures); before the map, so it
+  /// is destroyed after every keyframe.
+  std::shared_ptr<FeatureSpill> feature_spill_;
   std::unique_ptr<Map> map_;
   std::unique_ptr<PlaceRecognizer> place_;  ///< null with Vocabulary.path none
   std::uint64_t vocabulary_fingerprint_ = 0;
