@@ -130,7 +130,7 @@ Frame::Frame(std::uint64_t frame_id, std::int64_t time_ns, OrbFeatures features,
     keys_un[i] = Keypoint{k.pt, k.angle, k.octave};
   }
   if (!cam->dist_cv.empty() && n > 0) {
-    const std::vector<cv::Point2f> detected(keys.begin(), keys.end());
+    const cv::Mat detected(static_cast<int>(n), 1, CV_32FC2, keys.data());  // a view, no copy
     std::vector<cv::Point2f> un;
     cv::undistortPoints(detected, un, cam->K_cv, cam->dist_cv, cv::noArray(), cam->K_cv);
     for (std::size_t i = 0; i < n; ++i) keys_un[i].pt = un[i];

@@ -4,13 +4,11 @@
 
 #include <gtest/gtest.h>
 
-#include <sys/resource.h>
-
-#include <csignal>
 #include <cstring>
 #include <random>
 #include <vector>
 
+#include "file_size_limit.hpp"
 #include "pvb/common/error.hpp"
 #include "pvb/slam/core/frame.hpp"
 
@@ -49,21 +47,16 @@ TEST(FeatureSpill, BlocksKeepTheirBytesWhenTheirPagesLeaveMemory) {
 TEST(FeatureSpill, AFileThatCannotBeMadeOrGrownIsAnIoError) {
   EXPECT_THROW(FeatureSpill("/nonexistent-folder-for-features"), IoError);
   FeatureSpill spill({}, kChunk);
-  rlimit old{};
-  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
-  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
-  rlimit small = old;
-  small.rlim_cur = kChunk + kChunk / 2;
-  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
-  EXPECT_NE(spill.allocate(kChunk / 2), nullptr);  // the first chunk fits
   std::string message;
-  try {
-    spill.allocate(kChunk);  // a second chunk does not
-  } catch (const IoError& e) {
-    message = e.what();
+  {
+    const test::FileSizeLimit limit(kChunk + kChunk / 2);
+    EXPECT_NE(spill.allocate(kChunk / 2), nullptr);  // the first chunk fits
+    try {
+      spill.allocate(kChunk);  // a second chunk does not
+    } catch (const IoError& e) {
+      message = e.what();
+    }
   }
-  ::setrlimit(RLIMIT_FSIZE, &old);
-  std::signal(SIGXFSZ, old_handler);
   EXPECT_NE(message.find("cannot grow the keyframe feature file"), std::string::npos) << message;
   EXPECT_EQ(spill.stats().file_bytes, kChunk);
 }
