@@ -2,17 +2,28 @@
 // place database) and System::save_map (encode, atomic write) on a saved map
 // (PVB_BENCH_MAP) with the settings of the run that made it
 // (PVB_BENCH_SETTINGS, e.g. the run's camera.yaml).  Without them it skips.
-// The file size per keyframe is reported as a counter.  Run pinned:
+// The file size per keyframe is reported as a counter, and so are the
+// resident set after a load and before a save and its peak during each
+// (the peak is reset through /proc/self/clear_refs).  Map.spillFeatures in
+// the settings decides whether the keyframes' features lie in the spill
+// file (loaded into it, and read back from it by the save).  Run pinned:
 //   PVB_BENCH_MAP=DIR/maps/noon.pvbmap PVB_BENCH_SETTINGS=DIR/noon/camera.yaml
 //   taskset -c 1 build/bin/bench_map_file --benchmark_repetitions=5
 // (the two lines as one command).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <memory>
 #include <string>
 
+#include "pvb/common/memory.hpp"
+
+#include "pvb/slam/core/map_file.hpp"
+#include "pvb/slam/core/place_recognition.hpp"
 #include "pvb/slam/core/settings.hpp"
 #include "pvb/slam/core/system.hpp"
 
@@ -22,6 +33,26 @@ const char* env(const char* name) {
   const char* v = std::getenv(name);
   return v && *v ? v : nullptr;
 }
+
+/// Sets the process's peak resident set back to its resident set now.
+void reset_peak_resident() { std::ofstream("/proc/self/clear_refs") << "5"; }
+
+/// VmHWM of /proc/self/status, MB (0 where it cannot be read).
+double peak_resident_mb() {
+  std::ifstream in("/proc/self/status");
+  std::string key;
+  double kb = 0;
+  while (in >> key) {
+    if (key == "VmHWM:") {
+      in >> kb;
+      break;
+    }
+    std::getline(in, key);
+  }
+  return kb / 1e3;
+}
+
+double resident_mb() { return static_cast<double>(pvb::resident_bytes()) / 1e6; }
 
 std::unique_ptr<pvb::slam::System> make_system() {
   pvb::slam::SystemOptions o;
@@ -38,9 +69,15 @@ void BM_LoadMap(benchmark::State& state) {
   for (auto _ : state) {
     state.PauseTiming();
     auto system = make_system();  // the vocabulary's load is not the map's
+    const double before_mb = resident_mb();
+    reset_peak_resident();
     state.ResumeTiming();
     info = system->load_map(env("PVB_BENCH_MAP"), pvb::slam::MapStart::kExtend);
     state.PauseTiming();
+    if (!state.counters.count("rss_added_MB")) {  // later rounds reuse the heap the first one freed
+      state.counters["rss_added_MB"] = resident_mb() - before_mb;
+      state.counters["peak_added_MB"] = peak_resident_mb() - before_mb;
+    }
     system.reset();
     state.ResumeTiming();
   }
@@ -58,12 +95,59 @@ void BM_SaveMap(benchmark::State& state) {
   system->load_map(env("PVB_BENCH_MAP"), pvb::slam::MapStart::kExtend);
   system->shutdown();
   const std::string out = std::string(env("PVB_BENCH_MAP")) + ".bench_copy";
-  for (auto _ : state) benchmark::DoNotOptimize(system->save_map(out, "{}"));
+  double before_mb = 0, peak_mb = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    before_mb = resident_mb();
+    reset_peak_resident();
+    state.ResumeTiming();
+    benchmark::DoNotOptimize(system->save_map(out, "{}"));
+    state.PauseTiming();
+    peak_mb = std::max(peak_mb, peak_resident_mb());
+    state.ResumeTiming();
+  }
+  state.counters["rss_before_MB"] = before_mb;
+  state.counters["peak_MB"] = peak_mb;
+  state.counters["peak_ratio"] = peak_mb / before_mb;
   std::remove(out.c_str());
+}
+
+/// Loop-candidate queries (PlaceRecognizer::loop_candidates, the bag-of-words
+/// part of loop detection) against the saved map's first N keyframes, for
+/// growing N: the 100 keyframes after the first N are asked, one each,
+/// before they are added.  Counters: ms a query at each N.
+void BM_LoopQuery(benchmark::State& state) {
+  if (!env("PVB_BENCH_MAP") || !env("PVB_BENCH_SETTINGS")) {
+    state.SkipWithError("set PVB_BENCH_MAP and PVB_BENCH_SETTINGS");
+    return;
+  }
+  const pvb::slam::Settings settings = pvb::slam::read_settings(env("PVB_BENCH_SETTINGS"));
+  const pvb::slam::MapFileBytes bytes = pvb::slam::MapFileBytes::open(env("PVB_BENCH_MAP"));
+  const pvb::slam::MapFileHeader head = pvb::slam::read_map_header(bytes);
+  pvb::slam::Map map;
+  pvb::slam::decode_map(bytes, head, pvb::slam::camera_for(head.settings), &map);
+  std::vector<std::shared_ptr<pvb::slam::KeyFrame>> kfs;
+  for (const auto& [id, kf] : map.keyframes()) kfs.push_back(kf);
+  constexpr std::size_t kQueries = 100;
+  for (auto _ : state) {
+    pvb::slam::PlaceRecognizer place(pvb::slam::place::Vocabulary::load_shared(settings.vocabulary_path));
+    std::size_t added = 0;
+    for (std::size_t n : {std::size_t(1000), std::size_t(2500), std::size_t(5000), std::size_t(10000)}) {
+      if (n + kQueries > kfs.size()) break;
+      for (; added < n; ++added) place.add(*kfs[added]);
+      std::size_t candidates = 0;
+      const auto t0 = std::chrono::steady_clock::now();
+      for (std::size_t q = n; q < n + kQueries; ++q) candidates += place.loop_candidates(map, *kfs[q], 30).size();
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      state.counters["ms_at_" + std::to_string(n)] = ms / kQueries;
+      state.counters["cands_at_" + std::to_string(n)] = static_cast<double>(candidates) / kQueries;
+    }
+  }
 }
 
 BENCHMARK(BM_LoadMap)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_SaveMap)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_LoopQuery)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
 

@@ -4,6 +4,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -105,8 +106,30 @@ void* FeatureSpill::allocate(std::size_t n) {
   if (chunks_.empty() || used_in_last_ + size > chunk_bytes_) add_chunk();
   char* p = chunks_.back().base + used_in_last_;
   used_in_last_ += size;
+
   stats_.allocated_bytes += size;
   return p;
+}
+
+void FeatureSpill::store(void* block, const void* src, std::size_t n) {
+  std::uint64_t at = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const char* c = static_cast<const char*>(block);
+    const auto k = std::find_if(chunks_.begin(), chunks_.end(),
+                                [&](const Chunk& x) { return c >= x.base && c + n <= x.base + chunk_bytes_; });
+    if (k == chunks_.end()) throw Error("FeatureSpill::store: not a block of this spill");
+    at = k->offset + static_cast<std::uint64_t>(c - k->base);
+  }
+  const char* from = static_cast<const char*>(src);
+  while (n > 0) {
+    const ssize_t w = ::pwrite(fd_, from, n, static_cast<off_t>(at));
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) throw IoError(dir_, std::string("cannot write the keyframe feature file: ") + std::strerror(errno));
+    from += w;
+    at += static_cast<std::uint64_t>(w);
+    n -= static_cast<std::size_t>(w);
+  }
 }
 
 void FeatureSpill::deallocate(void* p, std::size_t n) {
@@ -114,6 +137,7 @@ void FeatureSpill::deallocate(void* p, std::size_t n) {
   const std::size_t size = (std::max<std::size_t>(n, 1) + kAlign - 1) / kAlign * kAlign;
   std::lock_guard<std::mutex> lock(mutex_);
   stats_.freed_bytes += size;
+  if (discarding_) return;
   const char* c = static_cast<const char*>(p);
   for (const Chunk& k : chunks_) {
     if (c < k.base || c >= k.base + chunk_bytes_) continue;
@@ -139,6 +163,29 @@ void FeatureSpill::release_resident() {
   }
   if (fd_ >= 0) ::posix_fadvise(fd_, 0, 0, POSIX_FADV_DONTNEED);
   ++stats_.releases;
+}
+
+void FeatureSpill::drop_from_process() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const Chunk& c : chunks_) ::madvise(c.base, chunk_bytes_, MADV_DONTNEED);
+}
+
+void FeatureSpill::read_ahead() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  // posix_fadvise(WILLNEED) reads only one read-ahead window of a range
+  // this long, so the file is read through a small buffer instead.
+  std::vector<char> buffer(std::size_t(4) << 20);
+  for (std::uint64_t at = 0; at < stats_.file_bytes;) {
+    const ssize_t n = ::pread(fd_, buffer.data(), buffer.size(), static_cast<off_t>(at));
+    if (n <= 0) break;  // a read error only costs the read-ahead
+    at += static_cast<std::uint64_t>(n);
+  }
+  for (const Chunk& c : chunks_) ::madvise(c.base, chunk_bytes_, MADV_SEQUENTIAL);
+}
+
+void FeatureSpill::end_read_ahead() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const Chunk& c : chunks_) ::madvise(c.base, chunk_bytes_, MADV_RANDOM);
 }
 
 std::size_t FeatureSpill::resident_bytes() const {

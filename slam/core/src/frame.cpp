@@ -294,7 +294,10 @@ void Frame::spill_features(const std::shared_ptr<FeatureSpill>& spill) {
     cv::Mat d;
     d.allocator = s->mat_allocator();
     d.create(descriptors.rows, descriptors.cols, descriptors.type());
-    descriptors.copyTo(d);
+    if (descriptors.isContinuous())
+      s->store(d.data, descriptors.data, descriptors.total() * descriptors.elemSize());  // through the file
+    else
+      descriptors.copyTo(d);
     descriptors = d;
   }
   spill_ = spill;

@@ -242,7 +242,7 @@ Frame read_frame(ByteReader& r, std::uint64_t frame_id, std::int64_t t_ns,
 using PointIdsByKf = std::map<std::uint64_t, std::vector<std::uint64_t>>;
 
 PointIdsByKf read_keyframes(ByteReader r, const std::shared_ptr<const CameraModel>& cam, std::uint32_t sessions,
-                            Map* map) {
+                            Map* map, const std::shared_ptr<FeatureSpill>& spill) {
   PointIdsByKf ids;
   const std::uint64_t n = r.count(kKeyframeHeadBytes, "keyframes");
   for (std::uint64_t k = 0; k < n; ++k) {
@@ -263,6 +263,7 @@ PointIdsByKf read_keyframes(ByteReader r, const std::shared_ptr<const CameraMode
     auto kf = map->add_loaded_keyframe(id, f);
     kf->set_session(session);
     ids[id] = std::move(point_ids);
+    if (spill) kf->spill_features(spill);  // written through the file: nothing of it stays in the process
   }
   if (!r.at_end()) r.fail("longer than its keyframes");
   return ids;
@@ -320,7 +321,8 @@ std::map<std::uint64_t, SavedPoint> read_points(ByteReader r, const Map& map) {
 
 /// Creates the points and their observations from the keyframes' side;
 /// a point's reference keyframe must be one of them.
-void link_points(ByteReader r, const PointIdsByKf& ids, const std::map<std::uint64_t, SavedPoint>& saved, Map* map) {
+void link_points(ByteReader r, const PointIdsByKf& ids, const std::map<std::uint64_t, SavedPoint>& saved, Map* map,
+                 FeatureSpill* spill) {
   std::unordered_map<std::uint64_t, std::uint64_t> first_observer;
   first_observer.reserve(saved.size());
   for (const auto& [kf_id, pids] : ids)
@@ -353,9 +355,11 @@ void link_points(ByteReader r, const PointIdsByKf& ids, const std::map<std::uint
     if (p.ref != kNone && !map->points().at(id)->observations().count(p.ref))
       r.fail("point " + std::to_string(id) + ": its reference keyframe " + std::to_string(p.ref) +
              " does not observe it");
+  std::size_t n = 0;
   for (const auto& [id, mp] : map->points()) {
-    mp->compute_distinctive_descriptor();
+    mp->compute_distinctive_descriptor();  // reads its observers' descriptors
     mp->update_normal_and_depth();
+    if (spill && ++n % kLoadSpillDropPoints == 0) spill->drop_from_process();
   }
 }
 
@@ -527,13 +531,13 @@ MapFileHeader read_map_header(const std::string& bytes, const std::string& file)
 }
 
 void decode_map(const MapFileBytes& src, const MapFileHeader& h, const std::shared_ptr<const CameraModel>& cam,
-                Map* map) {
+                Map* map, const std::shared_ptr<FeatureSpill>& spill) {
   const std::string& file = src.name();
   const Sections& s = h.sections;
   if (h.version < 1 || h.version > kMapFileVersion || s.size() != section_tags(h.version).size())
     throw std::logic_error("decode_map: a header not from read_map_header");
   const auto reader = [&](std::size_t i) { return reader_for(src, s, i, h.version); };
-  const PointIdsByKf ids = read_keyframes(reader(1), cam, h.sessions, map);
+  const PointIdsByKf ids = read_keyframes(reader(1), cam, h.sessions, map, spill);
   if (map->keyframes().empty()) throw IoError(file, "the map has no keyframes");
   if (h.sessions > map->keyframes().size())  // every session counted made a keyframe that is kept
     throw IoError(
@@ -542,7 +546,7 @@ void decode_map(const MapFileBytes& src, const MapFileHeader& h, const std::shar
             std::to_string(h.sessions) + " sessions in a map of " + std::to_string(map->keyframes().size()) +
             " keyframes (each session holds one at least)");
   const auto saved = read_points(reader(2), *map);
-  link_points(reader(2), ids, saved, map);
+  link_points(reader(2), ids, saved, map, spill.get());
   read_graph(reader(3), map);
   read_bows(reader(4), map);
   if (h.version >= 2) read_inertial(reader(kInerSection), map);

@@ -21,6 +21,33 @@
 #include "pvb/slam/features/orb_extractor.hpp"
 
 namespace pvb::slam {
+namespace {
+
+/// A map's save drops the spilled features it has read from the process
+/// each time it has written this much (the keyframe section is about 1.3 ×
+/// the features it reads).
+constexpr std::size_t kSaveSpillDropBytes = std::size_t(32) << 20;
+
+/// The spill read ahead for one pass over every keyframe, and let go of
+/// (written out, dropped from the process and the cache) when it ends.
+class SpillReadAhead {
+ public:
+  explicit SpillReadAhead(FeatureSpill* spill) : spill_(spill) {
+    if (spill_) spill_->read_ahead();
+  }
+  ~SpillReadAhead() {
+    if (!spill_) return;
+    spill_->end_read_ahead();
+    spill_->release_resident();
+  }
+  SpillReadAhead(const SpillReadAhead&) = delete;
+  SpillReadAhead& operator=(const SpillReadAhead&) = delete;
+
+ private:
+  FeatureSpill* spill_;
+};
+
+}  // namespace
 
 System::System(const Settings& settings, const SystemOptions& options)
     : settings_(settings),
@@ -108,7 +135,10 @@ System::System(const Settings& settings, const SystemOptions& options)
   }
 }
 
-System::~System() { shutdown(); }
+System::~System() {
+  if (feature_spill_) feature_spill_->discard();  // the map's keyframes go with the file
+  shutdown();
+}
 
 void System::shutdown() {
   if (mapping_) mapping_->stop();
@@ -236,7 +266,8 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
   MapLoadInfo info;
   {
     std::lock_guard<std::mutex> lock(map_->mutex());
-    decode_map(bytes, head, cam_, map_.get());  // with a version-2 file, gravity ready and the chain
+    // With a version-2 file, gravity ready and the chain; features into the spill.
+    decode_map(bytes, head, cam_, map_.get(), feature_spill_);
     if (!uses_accel(settings_.motion.setup))
       map_->gravity() = MapGravity{};  // a camera-only run keeps no inertial state
     else if (start == MapStart::kExtend && uses_imu(settings_.motion.setup) && !uses_imu(head.settings.sensors))
@@ -248,6 +279,7 @@ MapLoadInfo System::load_map(const std::string& path, MapStart start) {
       if (kf->bow().empty()) place_->compute_bow(*kf);  // saved with the map (the same vocabulary)
       place_->add(*kf);
     }
+    if (feature_spill_) feature_spill_->drop_from_process();  // the pages linking and the bags read
     map_->set_session(head.sessions);
     for (const auto& [id, kf] : map_->keyframes())
       loaded_last_t_ns_ = std::max(loaded_last_t_ns_.value_or(kf->t_ns()), kf->t_ns());
@@ -297,9 +329,19 @@ MapSaveInfo System::save_map(const std::string& path, const std::string& app_jso
       info.bytes = bytes.size();
     } else {
       // Streamed into a temporary file beside `path`, a piece at a time.
+      // The keyframes' features come back from the spill: read ahead in
+      // large reads, and out of the process again every kSaveSpillDropBytes.
+      const SpillReadAhead read_ahead(feature_spill_.get());
+      std::size_t since_drop = 0;
       write_file_via_temp(path, [&](OutputFile& f) {
         MapByteSink sink;
-        sink.append = [&](const char* d, std::size_t n) { f.append(d, n); };
+        sink.append = [&](const char* d, std::size_t n) {
+          f.append(d, n);
+          if (feature_spill_ && (since_drop += n) >= kSaveSpillDropBytes) {
+            feature_spill_->drop_from_process();
+            since_drop = 0;
+          }
+        };
         sink.patch = [&](std::uint64_t at, const char* d, std::size_t n) { f.patch(static_cast<long long>(at), d, n); };
         info.bytes = encode_map(*map_, map_settings(), info.sessions, app_json, bag_of, session_offset_ns_, sink);
       });

@@ -3,6 +3,7 @@
 #include "pvb/slam/core/feature_spill.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstring>
 #include <random>
@@ -10,6 +11,7 @@
 
 #include "file_size_limit.hpp"
 #include "pvb/common/error.hpp"
+#include "pvb/common/memory.hpp"
 #include "pvb/slam/core/frame.hpp"
 
 namespace pvb::slam {
@@ -40,6 +42,38 @@ TEST(FeatureSpill, BlocksKeepTheirBytesWhenTheirPagesLeaveMemory) {
   for (std::size_t b = 0; b < blocks.size(); ++b)
     ASSERT_EQ(std::memcmp(blocks[b], want[b].data(), want[b].size()), 0) << "block " << b;
   EXPECT_GT(spill.resident_bytes(), 0u);  // read back
+}
+
+// A map's load and save: pages dropped from the process without being
+// written out first keep their bytes (the page cache holds them), and a
+// read-ahead pass reads them all back.
+TEST(FeatureSpill, PagesDroppedFromTheProcessOnlyKeepTheirBytesAndReadAheadReadsThemBack) {
+  constexpr std::size_t kBlock = std::size_t(2) << 20;
+  FeatureSpill spill({}, 4 * kBlock);
+  std::vector<unsigned char*> blocks;
+  const std::size_t rss_before = resident_bytes();
+  for (int b = 0; b < 4; ++b) {  // 8 MB, written, not synced
+    auto* p = static_cast<unsigned char*>(spill.allocate(kBlock));
+    for (std::size_t i = 0; i < kBlock; ++i) p[i] = static_cast<unsigned char>(i * 31 + b);
+    blocks.push_back(p);
+  }
+  const std::size_t rss_written = resident_bytes();
+  EXPECT_GT(rss_written, rss_before + 6 * (kBlock / 2));
+  spill.drop_from_process();
+  EXPECT_LT(resident_bytes(), rss_written - 6 * (kBlock / 2));
+  const auto same = [&] {
+    for (int b = 0; b < 4; ++b)
+      for (std::size_t i = 0; i < kBlock; i += 4093)
+        if (blocks[b][i] != static_cast<unsigned char>(i * 31 + b)) return false;
+    return true;
+  };
+  EXPECT_TRUE(same());
+  spill.release_resident();  // now on disk only
+  spill.read_ahead();
+  EXPECT_EQ(spill.resident_bytes(), spill.stats().file_bytes);  // all in the page cache
+  EXPECT_TRUE(same());
+  spill.end_read_ahead();
+  EXPECT_TRUE(same());
 }
 
 // A folder it cannot write, and a file that cannot grow (a full disk, here
@@ -79,6 +113,23 @@ TEST(FeatureSpill, AFreedBlockLeavesTheNeighboursIntact) {
   EXPECT_EQ(s.allocated_bytes - s.freed_bytes, 10048u + 10048u);  // 64-byte granules
 }
 
+// A freed block's whole pages are punched out (they read as zeros), but
+// not once the spill is discarded: tearing a map down costs no syscalls.
+TEST(FeatureSpill, FreedPagesArePunchedOutUntilTheSpillIsDiscarded) {
+  FeatureSpill spill({}, kChunk);
+  const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  const auto freed_then_read = [&] {
+    auto* p = static_cast<unsigned char*>(spill.allocate(4 * page));
+    std::memset(p, 0xab, 4 * page);
+    spill.deallocate(p, 4 * page);
+    return p[2 * page];  // a whole page inside the block, still mapped
+  };
+  EXPECT_EQ(freed_then_read(), 0);
+  spill.discard();
+  EXPECT_EQ(freed_then_read(), 0xab);
+  EXPECT_EQ(spill.stats().live_bytes(), 0u);  // counted either way
+}
+
 TEST(FeatureSpill, ContainersMoveIntoItAndCopiesGoBackToTheHeap) {
   FeatureSpill spill({}, kChunk);
   FeatureArray<float> heap = {1.5f, -2.0f, 3.25f};
@@ -93,6 +144,23 @@ TEST(FeatureSpill, ContainersMoveIntoItAndCopiesGoBackToTheHeap) {
   moved = std::move(spilled);  // the spill travels with the buffer
   EXPECT_EQ(moved.get_allocator().spill(), &spill);
   EXPECT_EQ(moved, heap);
+}
+
+// A copy into the spill is written through the file: the process maps
+// none of its pages until it reads them, and then reads the same values.
+// On the heap, resize() still value-initialises.
+TEST(FeatureSpill, ACopyGoesThroughTheFileWithoutFaultingItsPagesIn) {
+  FeatureSpill spill({}, std::size_t(16) << 20);
+  FeatureArray<cv::Point2f> heap(std::size_t(1) << 20);  // 8 MB
+  for (std::size_t i = 0; i < heap.size(); ++i) heap[i] = {static_cast<float>(i), -static_cast<float>(i) / 2};
+  const std::size_t rss_before = resident_bytes();
+  const FeatureArray<cv::Point2f> spilled = spilled_copy(heap, &spill);
+  EXPECT_LT(resident_bytes(), rss_before + (std::size_t(2) << 20));  // not 8 MB more
+  spill.release_resident();
+  EXPECT_EQ(spilled, heap);
+  FeatureArray<float> zeros;
+  zeros.resize(1000);
+  for (float z : zeros) ASSERT_EQ(z, 0.0f);
 }
 
 std::shared_ptr<const CameraModel> plain_camera() {

@@ -109,6 +109,42 @@ TEST_F(MapFile, EncodeOfADecodedMapIsTheFileItCameFrom) {
   EXPECT_EQ(encode_map(map, h.settings, h.sessions, h.app_json), bytes_);
 }
 
+TEST_F(MapFile, AMapDecodedIntoASpillHoldsItsFeaturesThereAndEncodesTheFileItCameFrom) {
+  const MapFileHeader h = read_map_header(bytes_, path_);
+  auto spill = std::make_shared<FeatureSpill>();
+  Map map;
+  decode_map(MapFileBytes::in_memory(bytes_, path_), h, camera_for(h.settings), &map, spill);
+  std::lock_guard<std::mutex> lock(map.mutex());
+  ASSERT_FALSE(map.keyframes().empty());
+  for (const auto& [id, kf] : map.keyframes()) {
+    EXPECT_TRUE(kf->frame().features_spilled()) << id;
+    const FrameMemory m = kf->frame().memory();
+    EXPECT_EQ(m.keypoints + m.descriptors + m.grid, 0u) << id;  // nothing of them left on the heap
+    EXPECT_GT(m.spilled, 0u) << id;
+  }
+  EXPECT_EQ(map.memory().keyframes_spilled, map.keyframes().size());
+  EXPECT_GT(spill->stats().live_bytes(), 0u);
+  EXPECT_EQ(encode_map(map, h.settings, h.sessions, h.app_json), bytes_);
+}
+
+TEST_F(MapFile, ARunWithTheSpillLoadsTheMapIntoItAndSavesTheSameBytesFromIt) {
+  Settings with = read_settings(kTum3), without = with;
+  with.spill_features = true;
+  without.spill_features = false;
+  System spilled(with, sync_options()), in_memory(without, sync_options());
+  spilled.load_map(path_, MapStart::kExtend);
+  in_memory.load_map(path_, MapStart::kExtend);
+  const SystemMemory a = spilled.memory(), b = in_memory.memory();
+  EXPECT_EQ(a.map.keyframes_spilled, a.map.keyframes);
+  EXPECT_EQ(b.map.keyframes_spilled, 0u);
+  EXPECT_GT(a.feature_spill.live_bytes(), 0u);
+  EXPECT_LT(a.map.keyframe_bytes.total(), b.map.keyframe_bytes.total());
+  spilled.shutdown();
+  const std::string again = tmp_path("from_spill.pvbmap");
+  spilled.save_map(again, R"({"station": "fr3"})");
+  EXPECT_TRUE(read_file(again) == bytes_);
+}
+
 /// The error decoding `bytes` throws ("" when none), read in memory or from
 /// a file in pieces of `piece_bytes`.
 std::string decode_error(const std::string& bytes, const std::string& path, std::uint64_t piece_bytes) {

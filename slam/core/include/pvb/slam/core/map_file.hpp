@@ -152,9 +152,14 @@ std::shared_ptr<const CameraModel> camera_for(const MapSettings& settings);
 /// (ids, keypoint indices, the spanning tree) and every value against what
 /// a camera of the map's settings could have made (docs/map_file.md, "Bad
 /// files"); a bad one throws IoError naming `file`, the section and the
-/// item.  Point descriptors, normals and scale ranges are computed.
+/// item.  Point descriptors, normals and scale ranges are computed.  With
+/// a `spill`, each keyframe's features go into it as the keyframe is read,
+/// and the pages that linking the points reads leave the process again
+/// every kLoadSpillDropPoints points, so the features never all lie in
+/// memory at once.
 void decode_map(const MapFileBytes& bytes, const MapFileHeader& header, const std::shared_ptr<const CameraModel>& cam,
-                Map* map);
+                Map* map, const std::shared_ptr<FeatureSpill>& spill = nullptr);
+inline constexpr std::size_t kLoadSpillDropPoints = 16384;
 void decode_map(const std::string& bytes, const std::string& file, const MapFileHeader& header,
                 const std::shared_ptr<const CameraModel>& cam, Map* map);
 
