@@ -10,6 +10,7 @@
 #include "landmark_classes.hpp"
 #include "map_scoring.hpp"
 #include "motion_report.hpp"
+#include "pvb/common/error.hpp"
 #include "pvb/common/io_paths.hpp"
 #include "pvb/common/output_folder.hpp"
 #include "pvb/common/text.hpp"
@@ -194,7 +195,15 @@ class RunConsumer : public FrameConsumer {
     costs_.sensor_ms += item.times.sensor_ms;
     std::vector<slam::FrameResult> results;
     dataset::round_as_written(&item.frame);  // as a replay of the recording reads them
-    for (auto& sink : sinks_) results.push_back(sink->track(item.frame, log_));
+    for (auto& sink : sinks_) {
+      try {
+        results.push_back(sink->track(item.frame, log_));
+      } catch (const IoError& e) {  // a worker's full disk, passed on by the next keyframe's hand-over
+        sink->failure = e.what();
+        aborted_ = true;
+        return false;
+      }
+    }
     const auto t0 = Clock::now();
     gt_.add(item);
     keep_thumbnail(item);
@@ -261,6 +270,19 @@ void finish_loop(const RunOptions& opt, const LoopTimes& loop, bool aborted, int
     report.status_detail = "interrupted after " + std::to_string(sinks.front()->run.frames) + " of " +
                            std::to_string(frames) + " frames";
     log.line("interrupted: " + report.status_detail + "; writing the partial report");
+  }
+}
+
+/// A run whose system stopped working (a worker's IoError: the disk under
+/// its spill files filled) failed; what it tracked until then is reported.
+void fail_on_system_error(const SystemSinks& sinks, RunReport& report, RunLog& log) {
+  for (const auto& sink : sinks) {
+    if (sink->failure.empty()) continue;
+    report.status = RunStatus::kFailed;
+    report.status_detail = sink->run.mode + " stopped after " + std::to_string(sink->run.frames) +
+                           " frames: " + sink->failure;
+    log.line("failed: " + report.status_detail);
+    return;
   }
 }
 
@@ -499,13 +521,18 @@ RunReport run_scenario(const RunOptions& opt) {
 
   // Results and metrics.
   finish_loop(opt, loop, consumer.aborted(), n, sinks, report, log);
+  fail_on_system_error(sinks, report, log);
   fail_if_never_initialised(sinks.front()->run, report, log);
   gt.close();
   const double eval_ms = evaluate_systems(sinks, gt.trajectory());
   for (auto& sink : sinks) sink->evaluate_inertial(gt.bias_truth(), gt.wheels_true());
   evaluate_blind_stretch(scenario, sinks, gt.trajectory(), log);
-  if (!opt.map.save_path.empty()) log.line("saving the map to " + opt.map.save_path);
-  for (auto& sink : sinks) sink->finish_map(gt.trajectory(), scenario.name, opt.scenario_file);
+  if (report.status == RunStatus::kFailed && !opt.map.save_path.empty())
+    log.line("the map is not saved: the run failed (" + opt.map.save_path + " is as it was)");
+  else if (!opt.map.save_path.empty())
+    log.line("saving the map to " + opt.map.save_path);
+  if (report.status != RunStatus::kFailed)
+    for (auto& sink : sinks) sink->finish_map(gt.trajectory(), scenario.name, opt.scenario_file);
   if (SlamRun& p = sinks.front()->run; p.map && p.map->localisation)
     classify_matched_landmarks(*sinks.front()->system, backend, &*p.map);
   const double map_ms = score_or_skip_maps(opt, scenario, backend, gt.trajectory(), sinks, log);

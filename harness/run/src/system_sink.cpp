@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/dataset/tum_sequence.hpp"
 #include "pvb/eval/gravity.hpp"
@@ -163,7 +164,11 @@ void SystemSink::finish() {
   costs.finish(*system);
   run.costs = costs.samples();
   run.cost_every_frames = costs.every_frames();
-  system->shutdown();
+  try {
+    system->shutdown();
+  } catch (const IoError& e) {  // a worker's full disk: the trajectories so far are still written
+    if (failure.empty()) failure = e.what();
+  }
   kf_traj.close();
   keyframes.source = dir + "/KeyFrameTrajectory.txt";
   keyframes.poses = system->keyframe_trajectory();

@@ -47,6 +47,9 @@ struct SystemSink {
   /// The dense maps' files written by finish() (corrected, live, and
   /// before_loop / after_loop when a loop was closed), read back for scoring.
   std::vector<DenseMapFile> dense_files;
+  /// What stopped the system's work (a worker's IoError: the disk under its
+  /// spill files filled); empty while it works.
+  std::string failure;
 
   /// The system, with the saved map loaded when `map` names one; nothing
   /// is written until open_outputs().
@@ -63,7 +66,8 @@ struct SystemSink {
   void end_losses(RunLog& log);
 
   /// Stops mapping, rewrites the keyframe trajectory with refined poses,
-  /// writes the dense maps.
+  /// writes the dense maps.  A worker's IoError is kept in `failure`, and
+  /// what it left is written all the same.
   void finish();
 
   /// ATE/RPE of the trajectory (and of the refined one) against `gt`,

@@ -486,6 +486,26 @@ TEST(RunCli, ARunThatNeverInitialisesFailsAndSavesNoMap) {
   EXPECT_FALSE(exists(map));
 }
 
+// The disk under the keyframe feature file fills mid-run (every file the
+// run writes capped at 32 MiB, below the file's first 64 MB chunk): one
+// error line, exit 1, the report written with the run failed and the
+// frames tracked until then, and no map saved.
+TEST(RunCli, AFeatureFileThatCannotGrowFailsTheRunWithItsReport) {
+  const std::string d = fresh("fullspill");
+  const std::string map = d + "_map.pvbmap";
+  std::remove(map.c_str());
+  const test::RunResult r = test::run_pvbench_with_file_limit(
+      "run --scenario " + kStation + " --out " + d + " --frames 200 --sync --no-map-eval --save-map " + map, 32768);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("pvbench: error: " + kStation + ": pe-slam stopped after "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("cannot grow the keyframe feature file by 64 MB"), std::string::npos) << r.output;
+  EXPECT_EQ(metrics(d)["status"].as<std::string>(), "failed");
+  EXPECT_TRUE(exists(d + "/index.html"));
+  EXPECT_GE(data_lines(d + "/CameraTrajectory.txt").size(), 20u);  // what was tracked is kept
+  EXPECT_LT(metrics(d)["frames"].as<int>(), 200);
+  EXPECT_FALSE(exists(map));
+}
+
 // The default station's Kinect in the sun: depth on a few keypoints per
 // frame, far from the 500 a one-frame start needs; the core starts from
 // two views, scaled by those few, and tracks on without a loss.
