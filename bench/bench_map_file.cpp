@@ -22,6 +22,7 @@
 
 #include "pvb/common/memory.hpp"
 
+#include "pvb/slam/core/loop_closing.hpp"
 #include "pvb/slam/core/map_file.hpp"
 #include "pvb/slam/core/place_recognition.hpp"
 #include "pvb/slam/core/settings.hpp"
@@ -145,9 +146,55 @@ void BM_LoopQuery(benchmark::State& state) {
   }
 }
 
+/// Loop detection replayed on the saved map (LoopClosing::process, then
+/// the keyframe into the database, as the mapping thread does): the 200
+/// keyframes after the first 5,000, with those 5,000 in the database.
+/// Counters: detection ms a keyframe (mean), candidates and verifications
+/// a keyframe, and the verification's share of the time.
+void BM_LoopDetect(benchmark::State& state) {
+  if (!env("PVB_BENCH_MAP") || !env("PVB_BENCH_SETTINGS")) {
+    state.SkipWithError("set PVB_BENCH_MAP and PVB_BENCH_SETTINGS");
+    return;
+  }
+  const pvb::slam::Settings settings = pvb::slam::read_settings(env("PVB_BENCH_SETTINGS"));
+  const pvb::slam::MapFileBytes bytes = pvb::slam::MapFileBytes::open(env("PVB_BENCH_MAP"));
+  const pvb::slam::MapFileHeader head = pvb::slam::read_map_header(bytes);
+  constexpr std::size_t kFirst = 5000, kReplayed = 200;
+  for (auto _ : state) {
+    state.PauseTiming();
+    pvb::slam::Map map;
+    pvb::slam::decode_map(bytes, head, pvb::slam::camera_for(head.settings), &map);
+    std::vector<std::shared_ptr<pvb::slam::KeyFrame>> kfs;
+    for (const auto& [id, kf] : map.keyframes()) kfs.push_back(kf);
+    if (kfs.size() < kFirst + kReplayed) {
+      state.SkipWithError("a map of 5,200 keyframes at least");
+      return;
+    }
+    pvb::slam::PlaceRecognizer place(pvb::slam::place::Vocabulary::load_shared(settings.vocabulary_path));
+    for (std::size_t i = 0; i < kFirst; ++i) place.add(*kfs[i]);
+    pvb::slam::LoopClosing loop(map, settings.loop, &place);
+    state.ResumeTiming();
+    for (std::size_t i = kFirst; i < kFirst + kReplayed; ++i) {
+      loop.process(kfs[i]);
+      std::lock_guard<std::mutex> lock(map.mutex());
+      if (!kfs[i]->bad()) place.add(*kfs[i]);
+    }
+    state.PauseTiming();
+    const pvb::slam::LoopDetectTotals t = loop.detect_totals();
+    const pvb::slam::LoopClosingStats st = loop.stats();
+    state.counters["detect_ms"] = t.detect_ms / static_cast<double>(t.detections);
+    state.counters["candidates"] = static_cast<double>(st.candidates) / kReplayed;
+    state.counters["verified"] = static_cast<double>(st.verified) / kReplayed;
+    state.counters["verify_share"] = st.verify_ms_total / t.detect_ms;
+    state.counters["loops"] = static_cast<double>(st.loops.size());
+    state.ResumeTiming();
+  }
+}
+
 BENCHMARK(BM_LoadMap)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_SaveMap)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_LoopQuery)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_LoopDetect)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
 

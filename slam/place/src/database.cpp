@@ -162,24 +162,24 @@ Database::Counts Database::counts() const {
 std::vector<Candidate> Database::query(const BowVector& query, double min_score, double min_common_ratio,
                                        const std::function<bool(std::uint64_t)>& skip) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  tally(query, skip);
-  return select(min_score, min_common_ratio);
+  tally(query);
+  return select(min_score, min_common_ratio, skip);
 }
 
 std::vector<Candidate> Database::query_above(const BowVector& query, const std::vector<std::uint64_t>& reference,
                                              double min_common_ratio,
                                              const std::function<bool(std::uint64_t)>& skip) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  tally(query, skip);
+  tally(query);
   double min_score = 1.0;
   for (std::uint64_t id : reference) {
     const bool met = id < tallies_.size() && tallies_[id].common > 0;
     min_score = std::min(min_score, met ? score_of(tallies_[id]) : 0.0);
   }
-  return select(min_score, min_common_ratio);
+  return select(min_score, min_common_ratio, skip);
 }
 
-void Database::tally(const BowVector& query, const std::function<bool(std::uint64_t)>& skip) const {
+void Database::tally(const BowVector& query) const {
   // The sum runs over the query's words in ascending order, as
   // Vocabulary::score merges two bags, so the scores are the same doubles.
   for (std::uint32_t id : met_) tallies_[id] = Tally{};  // left by a query a skip() threw out of
@@ -190,29 +190,37 @@ void Database::tally(const BowVector& query, const std::function<bool(std::uint6
     if (!list) continue;
     for (const Posting& p : *list) {
       Tally& t = tallies_[p.id];
-      if (t.common++ == 0) {
-        met_.push_back(p.id);
-        if (skip) t.skipped = skip(p.id);
-      }
+      if (t.common++ == 0) met_.push_back(p.id);
       t.sum += std::fabs(x - p.weight) - std::fabs(x) - std::fabs(p.weight);
     }
   }
 }
 
-std::vector<Candidate> Database::select(double min_score, double min_common_ratio) const {
-  int max_common = 0;
-  for (std::uint32_t id : met_)
-    if (!tallies_[id].skipped) max_common = std::max(max_common, tallies_[id].common);
+void Database::order_by_common() const {
+  int top = 0;
+  for (std::uint32_t id : met_) top = std::max(top, tallies_[id].common);
+  // Bucket starts from the top count down; ids keep the order met within a count.
+  common_counts_.assign(static_cast<std::size_t>(top) + 2, 0);
+  for (std::uint32_t id : met_) ++common_counts_[static_cast<std::size_t>(top - tallies_[id].common) + 1];
+  for (std::size_t c = 1; c < common_counts_.size(); ++c) common_counts_[c] += common_counts_[c - 1];
+  by_common_.resize(met_.size());
+  for (std::uint32_t id : met_) by_common_[common_counts_[static_cast<std::size_t>(top - tallies_[id].common)]++] = id;
+}
+
+std::vector<Candidate> Database::select(double min_score, double min_common_ratio,
+                                        const std::function<bool(std::uint64_t)>& skip) const {
+  order_by_common();
   std::vector<Candidate> out;
-  const double min_common = min_common_ratio * max_common;
-  for (std::uint32_t id : met_) {
+  int max_common = 0;  // the largest count among the keyframes not skipped
+  for (std::uint32_t id : by_common_) {
     const Tally& t = tallies_[id];
-    if (max_common > 0 && !t.skipped && t.common >= min_common) {
-      const double s = score_of(t);
-      if (s >= min_score) out.push_back({id, t.common, s});
-    }
-    tallies_[id] = Tally{};
+    if (max_common > 0 && t.common < min_common_ratio * max_common) break;
+    if (skip && skip(id)) continue;
+    if (max_common == 0) max_common = t.common;
+    const double s = score_of(t);
+    if (s >= min_score) out.push_back({id, t.common, s});
   }
+  for (std::uint32_t id : met_) tallies_[id] = Tally{};
   met_.clear();
   std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) {
     return a.score != b.score ? a.score > b.score : a.id < b.id;

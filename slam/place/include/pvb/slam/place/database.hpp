@@ -52,8 +52,10 @@ class Database {
   /// which `skip(id)` is true; of those, the ones sharing at least
   /// min_common_ratio x the largest count, scored, and kept when score >=
   /// min_score.  Ordered by descending score, then ascending id
-  /// (deterministic).  `skip` is asked at most once per keyframe, with the
-  /// database's mutex held: it must not call back into the database.
+  /// (deterministic).  `skip` is asked at most once per keyframe, only of
+  /// keyframes that share enough words to be candidates (from the most
+  /// shared down), with the database's mutex held: it must not call back
+  /// into the database.
   std::vector<Candidate> query(const BowVector& query, double min_score, double min_common_ratio = 0.8,
                                const std::function<bool(std::uint64_t)>& skip = {}) const;
   /// query() with min_score the least score among the `reference`
@@ -106,14 +108,19 @@ class Database {
   struct Tally {
     double sum = 0;  ///< DBoW2's L1 sum over the words shared with the query
     int common = 0;  ///< words shared with the query (0: not met)
-    bool skipped = false;
   };
   static double score_of(const Tally& t) { return 0.0 - 0.5 * t.sum; }  // as Vocabulary::score
   /// Walks the lists of the query's words into tallies_ (mutex held by the
   /// caller).
-  void tally(const BowVector& query, const std::function<bool(std::uint64_t)>& skip) const;
-  /// The candidates of the tallies, which it clears.
-  std::vector<Candidate> select(double min_score, double min_common_ratio) const;
+  void tally(const BowVector& query) const;
+  /// The candidates of the tallies, which it clears.  `skip` is asked of the
+  /// keyframes met in descending shared words until one is not skipped (the
+  /// largest count), then down to min_common_ratio x that count: a query
+  /// meets thousands of keyframes, and only tens share that many words.
+  std::vector<Candidate> select(double min_score, double min_common_ratio,
+                                const std::function<bool(std::uint64_t)>& skip) const;
+  /// met_ ordered by descending shared words (a counting sort), into by_common_.
+  void order_by_common() const;
   /// The list of `word`, or null when none holds it (mutex held).
   const PostingList* list_of(WordId word) const;
 
@@ -127,6 +134,8 @@ class Database {
   /// met; scratch under the mutex, cleared after each query.
   mutable std::vector<Tally> tallies_;
   mutable std::vector<std::uint32_t> met_;
+  mutable std::vector<std::uint32_t> by_common_;  ///< met_ by descending shared words
+  mutable std::vector<std::uint32_t> common_counts_;  ///< scratch of order_by_common()
 };
 
 }  // namespace pvb::slam::place
