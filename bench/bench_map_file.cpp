@@ -19,6 +19,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "pvb/common/memory.hpp"
 
@@ -55,6 +56,24 @@ double peak_resident_mb() {
 
 double resident_mb() { return static_cast<double>(pvb::resident_bytes()) / 1e6; }
 
+/// False (the benchmark skipped) without a saved map and its settings.
+bool inputs_set(benchmark::State& state) {
+  if (env("PVB_BENCH_MAP") && env("PVB_BENCH_SETTINGS")) return true;
+  state.SkipWithError("set PVB_BENCH_MAP and PVB_BENCH_SETTINGS");
+  return false;
+}
+
+/// The saved map decoded into `map` (no System, no spill); its keyframes
+/// in id order.
+std::vector<std::shared_ptr<pvb::slam::KeyFrame>> decode_saved_map(pvb::slam::Map* map) {
+  const pvb::slam::MapFileBytes bytes = pvb::slam::MapFileBytes::open(env("PVB_BENCH_MAP"));
+  const pvb::slam::MapFileHeader head = pvb::slam::read_map_header(bytes);
+  pvb::slam::decode_map(bytes, head, pvb::slam::camera_for(head.settings), map);
+  std::vector<std::shared_ptr<pvb::slam::KeyFrame>> kfs;
+  for (const auto& [id, kf] : map->keyframes()) kfs.push_back(kf);
+  return kfs;
+}
+
 std::unique_ptr<pvb::slam::System> make_system() {
   pvb::slam::SystemOptions o;
   o.synchronous = true;
@@ -62,10 +81,7 @@ std::unique_ptr<pvb::slam::System> make_system() {
 }
 
 void BM_LoadMap(benchmark::State& state) {
-  if (!env("PVB_BENCH_MAP") || !env("PVB_BENCH_SETTINGS")) {
-    state.SkipWithError("set PVB_BENCH_MAP and PVB_BENCH_SETTINGS");
-    return;
-  }
+  if (!inputs_set(state)) return;
   pvb::slam::MapLoadInfo info;
   for (auto _ : state) {
     state.PauseTiming();
@@ -88,10 +104,7 @@ void BM_LoadMap(benchmark::State& state) {
 }
 
 void BM_SaveMap(benchmark::State& state) {
-  if (!env("PVB_BENCH_MAP") || !env("PVB_BENCH_SETTINGS")) {
-    state.SkipWithError("set PVB_BENCH_MAP and PVB_BENCH_SETTINGS");
-    return;
-  }
+  if (!inputs_set(state)) return;
   auto system = make_system();
   system->load_map(env("PVB_BENCH_MAP"), pvb::slam::MapStart::kExtend);
   system->shutdown();
@@ -118,17 +131,10 @@ void BM_SaveMap(benchmark::State& state) {
 /// growing N: the 100 keyframes after the first N are asked, one each,
 /// before they are added.  Counters: ms a query at each N.
 void BM_LoopQuery(benchmark::State& state) {
-  if (!env("PVB_BENCH_MAP") || !env("PVB_BENCH_SETTINGS")) {
-    state.SkipWithError("set PVB_BENCH_MAP and PVB_BENCH_SETTINGS");
-    return;
-  }
+  if (!inputs_set(state)) return;
   const pvb::slam::Settings settings = pvb::slam::read_settings(env("PVB_BENCH_SETTINGS"));
-  const pvb::slam::MapFileBytes bytes = pvb::slam::MapFileBytes::open(env("PVB_BENCH_MAP"));
-  const pvb::slam::MapFileHeader head = pvb::slam::read_map_header(bytes);
   pvb::slam::Map map;
-  pvb::slam::decode_map(bytes, head, pvb::slam::camera_for(head.settings), &map);
-  std::vector<std::shared_ptr<pvb::slam::KeyFrame>> kfs;
-  for (const auto& [id, kf] : map.keyframes()) kfs.push_back(kf);
+  const auto kfs = decode_saved_map(&map);
   constexpr std::size_t kQueries = 100;
   for (auto _ : state) {
     pvb::slam::PlaceRecognizer place(pvb::slam::place::Vocabulary::load_shared(settings.vocabulary_path));
@@ -152,20 +158,13 @@ void BM_LoopQuery(benchmark::State& state) {
 /// Counters: detection ms a keyframe (mean), candidates and verifications
 /// a keyframe, and the verification's share of the time.
 void BM_LoopDetect(benchmark::State& state) {
-  if (!env("PVB_BENCH_MAP") || !env("PVB_BENCH_SETTINGS")) {
-    state.SkipWithError("set PVB_BENCH_MAP and PVB_BENCH_SETTINGS");
-    return;
-  }
+  if (!inputs_set(state)) return;
   const pvb::slam::Settings settings = pvb::slam::read_settings(env("PVB_BENCH_SETTINGS"));
-  const pvb::slam::MapFileBytes bytes = pvb::slam::MapFileBytes::open(env("PVB_BENCH_MAP"));
-  const pvb::slam::MapFileHeader head = pvb::slam::read_map_header(bytes);
   constexpr std::size_t kFirst = 5000, kReplayed = 200;
   for (auto _ : state) {
     state.PauseTiming();
     pvb::slam::Map map;
-    pvb::slam::decode_map(bytes, head, pvb::slam::camera_for(head.settings), &map);
-    std::vector<std::shared_ptr<pvb::slam::KeyFrame>> kfs;
-    for (const auto& [id, kf] : map.keyframes()) kfs.push_back(kf);
+    const auto kfs = decode_saved_map(&map);
     if (kfs.size() < kFirst + kReplayed) {
       state.SkipWithError("a map of 5,200 keyframes at least");
       return;
