@@ -106,7 +106,6 @@ void* FeatureSpill::allocate(std::size_t n) {
   if (chunks_.empty() || used_in_last_ + size > chunk_bytes_) add_chunk();
   char* p = chunks_.back().base + used_in_last_;
   used_in_last_ += size;
-
   stats_.allocated_bytes += size;
   return p;
 }

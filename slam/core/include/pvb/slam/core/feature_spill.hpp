@@ -175,12 +175,11 @@ std::size_t feature_spilled_bytes(const FeatureArray<T>& v) {
 template <typename T>
 FeatureArray<T> spilled_copy(const FeatureArray<T>& v, FeatureSpill* spill) {
   FeatureArray<T> out{SpillAllocator<T>(spill)};
+  out.reserve(v.size());
   if constexpr (kPlainBytes<T>) {
-    out.reserve(v.size());
     out.resize(v.size());  // not touched (SpillAllocator::construct)
     if (!v.empty()) spill->store(out.data(), v.data(), v.size() * sizeof(T));
   } else {
-    out.reserve(v.size());
     out.assign(v.begin(), v.end());
   }
   return out;
