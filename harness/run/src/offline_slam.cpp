@@ -18,6 +18,8 @@ const char* stop_name(StopReason r) {
       return "missing_frames";
     case StopReason::kImageSize:
       return "image_size";
+    case StopReason::kSystemError:
+      return "system_error";
   }
   return "?";
 }
@@ -186,17 +188,27 @@ StopReason OfflineSlam::Impl::track_frames() {
       stop = StopReason::kImageSize;
       break;
     }
-    const slam::TrackingState state = track_one(*frame);
-    if (a_.on_progress) a_.on_progress(tally_.frames, slam::to_string(state));
+    const std::optional<slam::TrackingState> state = track_one(*frame);
+    if (!state) {
+      stop = StopReason::kSystemError;
+      break;
+    }
+    if (a_.on_progress) a_.on_progress(tally_.frames, slam::to_string(*state));
   }
   if (stop == StopReason::kEnd && stop_requested()) stop = StopReason::kSignal;
   if (a_.on_progress_end) a_.on_progress_end();
   return stop;
 }
 
-slam::TrackingState OfflineSlam::Impl::track_one(const sensor::RgbdFrame& frame) {
+std::optional<slam::TrackingState> OfflineSlam::Impl::track_one(const sensor::RgbdFrame& frame) {
   const double cpu0_ms = thread_cpu_ms();
-  const slam::FrameResult r = system_->track(frame);
+  slam::FrameResult r;
+  try {
+    r = system_->track(frame);
+  } catch (const IoError& e) {  // a worker's full disk, passed on by the next keyframe's hand-over
+    system_error_ = e.what();
+    return std::nullopt;
+  }
   const double cpu_ms = thread_cpu_ms() - cpu0_ms;
   tally_.cpu_ms.push_back(cpu_ms);
   tally_.frame_t_ns.push_back(frame.t_ns);
@@ -246,7 +258,7 @@ void OfflineSlam::Impl::write_timing_line(const sensor::RgbdFrame& frame, const 
 /// Returns the "dense" part of stats.json (empty when dense mapping is off).
 std::string OfflineSlam::Impl::write_final_outputs() {
   costs_.finish(*system_);
-  system_->shutdown();
+  shutdown_system();
   kf_traj_.close();
   // Rewrite the keyframe trajectory with the poses refined by local BA
   // (culled keyframes are left out, as ORB-SLAM2 does).
@@ -263,6 +275,14 @@ std::string OfflineSlam::Impl::write_final_outputs() {
   // The corrected map, the map as built and, after a loop, the corrected map around it.
   const std::vector<DenseMapFile> maps = write_dense_maps(*system_, a_.out);
   return dense_json(maps.front().points);
+}
+
+void OfflineSlam::Impl::shutdown_system() {
+  try {
+    system_->shutdown();
+  } catch (const IoError& e) {  // the trajectories so far are still written
+    if (system_error_.empty()) system_error_ = e.what();
+  }
 }
 
 /// The "dense" part of stats.json, printing the dense map's line on the way.
@@ -294,7 +314,9 @@ std::string OfflineSlam::Impl::stats_json(StopReason stop, const std::string& de
      << ",\n  \"sync\": " << (a_.sync ? "true" : "false") << ",\n  \"seed\": " << a_.seed
      << ",\n  \"seed_source\": \"" << json_escape(a_.seed_source) << "\""
      << ",\n  \"interrupted\": " << (stop == StopReason::kSignal ? "true" : "false") << ",\n  \"stop\": \""
-     << stop_name(stop) << "\",\n  \"frames\": " << t.frames << ",\n  \"lost_frames\": " << t.lost
+     << stop_name(stop) << "\""
+     << (system_error_.empty() ? "" : ",\n  \"failure\": \"" + json_escape(system_error_) + "\"")
+     << ",\n  \"frames\": " << t.frames << ",\n  \"lost_frames\": " << t.lost
      << ",\n  \"not_initialized_frames\": " << t.not_init
      << ",\n  \"dead_reckoned_frames\": " << t.dead_reckoned
      << ",\n  \"skipped_frames\": " << reader_.skipped()
@@ -348,6 +370,12 @@ void OfflineSlam::Impl::print_loop_closing(std::ostringstream* js) {
 /// initialised is an error (one line, exit 1).
 void OfflineSlam::Impl::fail_if_incomplete(StopReason stop) const {
   const std::string kept = "; what was tracked is in " + a_.out;
+  if (stop == StopReason::kSystemError)
+    throw IoError(a_.sequence, "the SLAM core stopped after " + std::to_string(tally_.frames) + " frames: " +
+                                   system_error_ + kept +
+                                   (a_.map.save_path.empty() ? ""
+                                                             : "; the map is not saved (" + a_.map.save_path +
+                                                                   " is as it was)"));
   if (stop == StopReason::kImageSize)
     throw ConfigError(a_.settings, "Camera.width/height", image_size_error_,
                       std::to_string(settings_.K.width) + "x" + std::to_string(settings_.K.height));
@@ -361,16 +389,17 @@ void OfflineSlam::Impl::fail_if_incomplete(StopReason stop) const {
 }
 
 int OfflineSlam::Impl::run() {
-  const StopReason stop = track_frames();
+  StopReason stop = track_frames();
   if (stop == StopReason::kSignal)
     text(strf("slam: stopped by a signal after %zu frames; writing what was tracked\n", tally_.frames));
   const std::string dense = write_final_outputs();
+  if (!system_error_.empty()) stop = StopReason::kSystemError;  // also when stopping the workers failed
   std::ostringstream js;
   js << stats_json(stop, dense);
   place_ = collect_place_recognition(*system_, tally_.keyframe_t_ns);
   evaluate(&js);
   evaluate_inertial(&js);
-  finish_map(&js);
+  if (stop != StopReason::kSystemError) finish_map(&js);  // a failed core's map is not saved
   js << ",\n  \"place_recognition\": " << place_json(place_);
   if (scorer_) js << ",\n  " << scorer_->json();
   js << "\n}\n";

@@ -47,6 +47,7 @@ enum class StopReason {
   kSignal,          ///< a stop request (Ctrl-C or SIGTERM)
   kTooManyMissing,  ///< more than max_missing of the frames skipped
   kImageSize,       ///< an image differs from Camera.width x Camera.height
+  kSystemError,     ///< the core stopped working (a worker's IoError: the disk under its files filled)
 };
 
 const char* stop_name(StopReason r);
@@ -94,9 +95,13 @@ class OfflineSlam::Impl {
     if (a_.on_warning) a_.on_warning(line);
   }
   StopReason track_frames();
-  slam::TrackingState track_one(const sensor::RgbdFrame& frame);
+  /// Tracks one frame and writes its lines; none when the core stopped
+  /// working (system_error_ says why).
+  std::optional<slam::TrackingState> track_one(const sensor::RgbdFrame& frame);
   void write_timing_line(const sensor::RgbdFrame& frame, const slam::FrameResult& r, double cpu_ms);
   std::string write_final_outputs();
+  /// Stops the workers; a worker's IoError becomes the run's system error.
+  void shutdown_system();
   std::string dense_json(std::size_t cloud_points);
   std::string stats_json(StopReason stop, const std::string& dense_json);
   void print_loop_closing(std::ostringstream* js);
@@ -125,6 +130,7 @@ class OfflineSlam::Impl {
   Tally tally_;
   PlaceRecognition place_;             ///< collected after the run, labelled when there is ground truth
   std::string image_size_error_;       ///< set when the loop stopped on an image of the wrong size
+  std::string system_error_;           ///< why the core stopped working (StopReason::kSystemError)
   std::optional<MapReport> map_;       ///< with --map or --save-map
   std::optional<double>
       gravity_true_deg_;  ///< the core's gravity at its trusted time against the ground truth

@@ -377,3 +377,32 @@ TEST(SlamInput, ExtendingAMapGivesEverySessionItsOwnStamps) {
   ASSERT_TRUE(std::regex_search(stats, m, std::regex("\"tilt\": \\{\"keyframes\": ([0-9]+)"))) << stats;
   EXPECT_EQ(std::stoul(m[1]), both.size() - one.size());
 }
+
+// The disk under the keyframe feature file fills mid-run (every file the
+// run writes capped at 32 MiB, below the file's first 64 MB chunk): the
+// core stops, and the run still writes what it tracked and its stats.json,
+// says "system_error" there, saves no map, and ends on one error line.
+TEST(SlamInput, AFeatureFileThatCannotGrowEndsTheRunWithItsStats) {
+  const std::string station = std::string(PVB_SOURCE_DIR) + "/scenes/pv_station.yaml";
+  const std::string seq = fresh("fullspill_seq"), out = fresh("fullspill_out");
+  const std::string map = out + "_map.pvbmap";
+  std::remove(map.c_str());
+  const Result rec = test::run_pvbench("record --scenario " + station + " --out " + seq + " --frames 200");
+  ASSERT_EQ(rec.code, 0) << rec.output;
+  const Result r = test::run_pvbench_with_file_limit("slam --sequence " + seq + " --settings " + seq +
+                                                         "/camera.yaml --out " + out + " --sync --no-dense --save-map " +
+                                                         map,
+                                                     32768);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(count(r.output, "pvbench: error: "), 1u) << r.output;
+  EXPECT_NE(r.output.find("pvbench: error: " + seq + ": the SLAM core stopped after "), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("cannot grow the keyframe feature file by 64 MB"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("the map is not saved"), std::string::npos) << r.output;
+  const std::string stats = read_file(out + "/stats.json");
+  EXPECT_NE(stats.find("\"stop\": \"system_error\""), std::string::npos) << stats;
+  EXPECT_NE(stats.find("\"failure\": \""), std::string::npos) << stats;
+  EXPECT_LT(stat(out, "frames"), 200);
+  EXPECT_GE(stat(out, "frames"), 20);  // what was tracked before the disk filled is kept
+  EXPECT_FALSE(std::filesystem::exists(map));
+}
