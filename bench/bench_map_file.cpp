@@ -23,6 +23,7 @@
 
 #include "pvb/common/memory.hpp"
 
+#include "pvb/slam/core/feature_spill.hpp"
 #include "pvb/slam/core/loop_closing.hpp"
 #include "pvb/slam/core/map_file.hpp"
 #include "pvb/slam/core/place_recognition.hpp"
@@ -63,12 +64,13 @@ bool inputs_set(benchmark::State& state) {
   return false;
 }
 
-/// The saved map decoded into `map` (no System, no spill); its keyframes
-/// in id order.
-std::vector<std::shared_ptr<pvb::slam::KeyFrame>> decode_saved_map(pvb::slam::Map* map) {
+/// The saved map decoded into `map` (no System; the features in `spill`
+/// when one is given); its keyframes in id order.
+std::vector<std::shared_ptr<pvb::slam::KeyFrame>> decode_saved_map(
+    pvb::slam::Map* map, const std::shared_ptr<pvb::slam::FeatureSpill>& spill = nullptr) {
   const pvb::slam::MapFileBytes bytes = pvb::slam::MapFileBytes::open(env("PVB_BENCH_MAP"));
   const pvb::slam::MapFileHeader head = pvb::slam::read_map_header(bytes);
-  pvb::slam::decode_map(bytes, head, pvb::slam::camera_for(head.settings), map);
+  pvb::slam::decode_map(bytes, head, pvb::slam::camera_for(head.settings), map, spill);
   std::vector<std::shared_ptr<pvb::slam::KeyFrame>> kfs;
   for (const auto& [id, kf] : map->keyframes()) kfs.push_back(kf);
   return kfs;
@@ -190,10 +192,42 @@ void BM_LoopDetect(benchmark::State& state) {
   }
 }
 
+/// What a loop's correction does to every point of the map once the poses
+/// are written back (MapPoint::update_normal_and_depth, under the map's
+/// lock): here on the saved map with its features in a spill let go of
+/// (written out, dropped from the process and the page cache), as a long
+/// drive's far keyframes lie.  Counters: the resident set the pass adds
+/// (feature pages read back), the map's points.
+void BM_PointUpdate(benchmark::State& state) {
+  if (!inputs_set(state)) return;
+  auto spill = std::make_shared<pvb::slam::FeatureSpill>();
+  pvb::slam::Map map;
+  decode_saved_map(&map, spill);
+  double added_mb = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    spill->release_resident();
+    const double before_mb = resident_mb();
+    state.ResumeTiming();
+    {
+      std::lock_guard<std::mutex> lock(map.mutex());
+      for (const auto& [id, mp] : map.points())
+        if (!mp->bad()) mp->update_normal_and_depth();
+    }
+    state.PauseTiming();
+    added_mb = std::max(added_mb, resident_mb() - before_mb);
+    state.ResumeTiming();
+  }
+  state.counters["rss_added_MB"] = added_mb;
+  state.counters["points"] = static_cast<double>(map.num_points());
+  spill->discard();
+}
+
 BENCHMARK(BM_LoadMap)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_SaveMap)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_LoopQuery)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_LoopDetect)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_PointUpdate)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 
