@@ -43,15 +43,17 @@ bool MapPoint::Observations::erase(std::uint64_t kf_id) {
 std::size_t MapPoint::Observations::heap_bytes() const { return vector_heap_bytes(list_); }
 
 void MapPoint::add_observation(const std::shared_ptr<KeyFrame>& kf, std::size_t idx) {
-  if (!obs_.insert(kf->id(), Obs{kf, idx})) return;
-  num_obs_ += kf->frame().u_right[idx] >= 0 ? 2 : 1;
+  const Frame& f = kf->frame();
+  const Obs o{kf, static_cast<std::uint32_t>(idx), static_cast<std::int16_t>(f.keys_un[idx].octave),
+              f.u_right[idx] >= 0};
+  if (!obs_.insert(kf->id(), o)) return;
+  num_obs_ += o.stereo ? 2 : 1;
 }
 
 void MapPoint::erase_observation(std::uint64_t kf_id) {
   auto it = obs_.find(kf_id);
   if (it == obs_.end()) return;
-  if (auto kf = it->second.kf.lock()) num_obs_ -= kf->frame().u_right[it->second.idx] >= 0 ? 2 : 1;
-  else num_obs_ -= 1;
+  num_obs_ -= !it->second.kf.expired() && it->second.stereo ? 2 : 1;
   obs_.erase(it);
   if (ref_kf_.expired() || (ref_kf_.lock() && ref_kf_.lock()->id() == kf_id)) {
     ref_kf_.reset();
@@ -142,10 +144,10 @@ void MapPoint::update_normal_and_depth() {
     }
   if (n == 0) return;
   normal_ = normal / n;
-  const long idx = index_in(ref->id());
-  if (idx < 0) return;
+  const auto ref_obs = obs_.find(ref->id());
+  if (ref_obs == obs_.end()) return;
   const double dist = (p_w_ - ref->camera_center_w()).norm();
-  const int level = ref->frame().keys_un[idx].octave;
+  const int level = ref_obs->second.octave;
   const auto& cam = *ref->frame().cam;
   max_dist_m_ = dist * cam.scale[level];
   min_dist_m_ = max_dist_m_ / cam.scale[cam.num_levels - 1];

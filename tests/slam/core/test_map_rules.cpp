@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "pvb/common/memory.hpp"
+#include "pvb/slam/core/feature_spill.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/map.hpp"
 #include "pvb/slam/core/matcher.hpp"
@@ -114,6 +115,29 @@ TEST(MapPointObservations, EightCostAboutAQuarterOfAKilobyte) {
   EXPECT_EQ(mp->memory_bytes() - alone, heap_block_bytes(8 * sizeof(MapPoint::Observations::value_type)));
   EXPECT_EQ(sizeof(MapPoint::Observations::value_type), 32u);
   EXPECT_LT(mp->memory_bytes(), 560u);
+}
+
+// A loop's correction updates every point of the map, and most of their
+// keyframes hold their keypoints in the feature file: the point keeps what
+// it needs of each observation (pyramid level, depth or not), so updating
+// it or dropping an observation reads none of them back into memory.
+TEST(MapPointObservations, UpdatingAPointReadsNoneOfItsKeyframesSpilledFeatures) {
+  Map map;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  for (std::uint64_t i = 0; i < 3; ++i) kfs.push_back(map.create_keyframe(make_frame(i, 100, 2)));
+  auto mp = map.create_point(Eigen::Vector3d(0, 0, 2), kfs[0]);
+  for (const auto& kf : kfs) observe(mp, kf, 7);
+  EXPECT_EQ(mp->num_observations(), 6);
+  auto spill = std::make_shared<FeatureSpill>(std::string(), std::size_t(1) << 20);
+  for (const auto& kf : kfs) kf->spill_features(spill);
+  spill->release_resident();
+  ASSERT_EQ(spill->resident_bytes(), 0u);
+
+  mp->update_normal_and_depth();
+  EXPECT_NEAR(mp->max_distance(), 1.2 * 2.0 * 1.2 * 1.2, 1e-9);  // 2 m from its reference, seen at level 2
+  mp->erase_observation(kfs[2]->id());
+  EXPECT_EQ(mp->num_observations(), 4);
+  EXPECT_EQ(spill->resident_bytes(), 0u);
 }
 
 TEST(MapPointDescriptor, NoneUntilComputedThenTheLeastMedianDistanceObservation) {

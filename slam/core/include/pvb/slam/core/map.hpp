@@ -41,9 +41,15 @@ class MapPoint {
   std::shared_ptr<MapPoint> replaced() const;
 
   /// Observations: keyframe id -> (keyframe, keypoint index), ordered by id.
+  /// The keypoint's pyramid level and whether it has depth are kept with
+  /// it: a keyframe far behind the robot holds its keypoints in the feature
+  /// file, and a loop's correction, which updates every point, would read
+  /// them all back.
   struct Obs {
     std::weak_ptr<KeyFrame> kf;
-    std::size_t idx = 0;
+    std::uint32_t idx = 0;
+    std::int16_t octave = 0;  ///< the keypoint's pyramid level
+    bool stereo = false;      ///< the keypoint has depth (counts twice in num_observations)
   };
   /// The observations as a sorted array: 32 bytes each, where a std::map
   /// node costs 80.  Read like a map (ascending ids, find, count).
