@@ -52,7 +52,7 @@ bool is_redundant_keyframe(const KeyFrame& kf, double th_depth_m, double ratio, 
       if (kid == kf.id()) continue;
       auto other = o.kf.lock();
       if (!other || other->bad()) continue;
-      if (other->frame().keys_un[o.idx].octave <= level + 1 && ++n >= observers) break;
+      if (o.octave <= level + 1 && ++n >= observers) break;
     }
     if (n >= observers) ++redundant;
   }
