@@ -149,6 +149,17 @@ LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand,
   return out;
 }
 
+bool places_apart(const std::vector<VerifiedPlace>& places, double distance_m, double inlier_share) {
+  int most = 0;
+  for (const auto& p : places) most = std::max(most, p.inliers);
+  const auto rival = [&](const VerifiedPlace& p) { return !p.lookalike || p.inliers >= inlier_share * most; };
+  for (std::size_t i = 0; i < places.size(); ++i)
+    for (std::size_t j = i + 1; j < places.size(); ++j)
+      if (rival(places[i]) && rival(places[j]) && (places[i].centre_w - places[j].centre_w).norm() > distance_m)
+        return true;
+  return false;
+}
+
 namespace {
 
 /// The grouped candidates of a merge can all lie at one of two look-alike
@@ -156,16 +167,15 @@ namespace {
 /// tells them apart; a loop that corrects the keyframe by metres may have
 /// found the next row instead of its own.  The map's best-scoring keyframes
 /// one by one (those of map `map_id` that `skip` leaves) are verified too,
-/// and the camera centre of each that verifies is added to `centres_w` for
-/// the ambiguity check.
+/// and each that verifies is added to `places` for the ambiguity check.
 void add_lookalikes(const PlaceRecognizer& place, const Map& map, const LoopClosingOptions& options,
                     const KeyFrame& kf, const std::vector<std::shared_ptr<KeyFrame>>& tried,
                     std::uint32_t map_id, const std::function<bool(std::uint64_t)>& skip,
-                    std::vector<Eigen::Vector3d>* centres_w) {
+                    std::vector<VerifiedPlace>* places) {
   for (const auto& c : place.lookalike_candidates(map, place.bag_of(kf), kLookalikes, skip)) {
     if (map.map_of(*c) != map_id || std::find(tried.begin(), tried.end(), c) != tried.end()) continue;
     const LoopMatch m = verify_loop(kf, c, options);
-    if (m.accepted) centres_w->push_back(m.T_c_w.inverse().translation());
+    if (m.accepted) places->push_back({m.T_c_w.inverse().translation(), m.inliers, true});
   }
 }
 
@@ -373,7 +383,7 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
                                               bool merge, LoopMatch* best) {
   static constexpr const char* kStageNames[3] = {"matches", "ransac", "inliers"};
   std::shared_ptr<KeyFrame> loop_kf;
-  std::vector<Eigen::Vector3d> verified_centres_w;
+  std::vector<VerifiedPlace> verified_places;
   const auto t0 = std::chrono::steady_clock::now();
   VerifyTally tally;
   double best_dist_m = 0, best_angle_deg = 0;
@@ -400,7 +410,7 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
       refuse(3, refusal_of(*kf, *cand, "correction", m, true, dist_m, angle_deg));
       continue;
     }
-    verified_centres_w.push_back(m.T_c_w.inverse().translation());
+    verified_places.push_back({m.T_c_w.inverse().translation(), m.inliers, false});
     const double bound_m = drift_bound_m(*kf, path_m, angle_deg);
     if (!merge && options_.max_drift_rate > 0 && dist_m > bound_m) {
       ++tally.drift;
@@ -420,10 +430,9 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
     add_lookalikes(*place_, map_, options_, *kf, consistent, merge ? 0 : map_.map_of(*kf),
                    merge ? std::function<bool(std::uint64_t)>{}
                          : own_neighbourhood(*kf, kf->best_covisibles(-1), options_.min_keyframe_gap),
-                   &verified_centres_w);
-  for (std::size_t i = 0; i < verified_centres_w.size() && options_.ambiguity_check; ++i)
-    for (std::size_t j = i + 1; j < verified_centres_w.size(); ++j)
-      tally.ambiguous = tally.ambiguous || (verified_centres_w[i] - verified_centres_w[j]).norm() > options_.ambiguity_distance_m;
+                   &verified_places);
+  tally.ambiguous = options_.ambiguity_check &&
+                    places_apart(verified_places, options_.ambiguity_distance_m, options_.ambiguity_inlier_share);
   if (tally.ambiguous && loop_kf)
     tally.refusal = refusal_of(*kf, *loop_kf, "ambiguous", *best, true, best_dist_m, best_angle_deg);
   else if (tally.ambiguous)  // every verified candidate was over the drift bound, and they lie apart

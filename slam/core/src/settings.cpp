@@ -320,6 +320,8 @@ void read_loop_closing(Reader& r, LoopClosingOptions* lc) {
   lc->ambiguity_check = r.flag("LoopClosing.ambiguityCheck", false, lc->ambiguity_check);
   lc->ambiguity_distance_m =
       r.real("LoopClosing.ambiguityDistance", false, lc->ambiguity_distance_m, above(0, 1e4), "metres");
+  lc->ambiguity_inlier_share = r.real("LoopClosing.ambiguityInlierShare", false, lc->ambiguity_inlier_share,
+                                      Range{0, 1}, "a share of the best candidate's inliers");
   lc->merge_confirmations =
       r.integer("LoopClosing.mergeConfirmations", false, lc->merge_confirmations, 1, 1000);
 }

@@ -463,6 +463,67 @@ TEST(LoopClosing, ALargeCorrectionIsRefusedWhenTheViewVerifiesAtALookalike) {
   EXPECT_EQ(unchecked.loops.size(), 1u);
 }
 
+TEST(AmbiguityCheck, ALookalikeWithAFewOfTheBestInliersIsNoRival) {
+  const Eigen::Vector3d here(0, 0, 0), there(5, 0, 0), elsewhere(-5, 0, 0);
+  const std::vector<VerifiedPlace> weak = {{here, 200, false}, {there, 60, true}};
+  EXPECT_FALSE(places_apart(weak, 0.3, 0.5));
+  EXPECT_TRUE(places_apart(weak, 0.3, 0.0));  // every look-alike a rival
+  const std::vector<VerifiedPlace> even = {{here, 200, false}, {there, 150, true}};
+  EXPECT_TRUE(places_apart(even, 0.3, 0.5));
+  EXPECT_FALSE(places_apart(even, 6.0, 0.5));
+  // Two weak look-alikes apart do not make the strong place ambiguous.
+  const std::vector<VerifiedPlace> two_weak = {{here, 200, false}, {there, 60, true}, {elsewhere, 70, true}};
+  EXPECT_FALSE(places_apart(two_weak, 0.3, 0.5));
+  // A consistent candidate is a rival with however few inliers.
+  const std::vector<VerifiedPlace> weak_candidate = {{here, 200, false}, {there, 60, false}};
+  EXPECT_TRUE(places_apart(weak_candidate, 0.3, 0.5));
+}
+
+/// Moves the points of `kf` seen in the middle and the bottom third of
+/// its image 0.3 m along +x and -x: its view matches a new view patch for
+/// patch, but its points agree with one pose a third at a time.
+void split_into_bands(KeyFrame& kf) {
+  const auto& keys = kf.frame().keys_un;
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const auto& mp = kf.map_points()[i];
+    if (!mp) continue;
+    const int band = static_cast<int>(keys[i].pt.y / 160.0f);  // 480 rows: 0, 1, 2
+    mp->set_p_w(mp->p_w() + Eigen::Vector3d(band == 1 ? 0.3 : band == 2 ? -0.3 : 0.0, 0, 0));
+  }
+}
+
+TEST(LoopClosing, ALookalikeMatchingAThirdOfTheViewDoesNotHoldBackALargeCorrection) {
+  // Only one candidate is verified as a loop (maxCandidates 1); the view
+  // also verifies at its look-alike 2 m on, with one band of its points, a
+  // third of the inliers it has at its own place: no rival place.
+  // Counted as one (share 0), it refuses the loop.
+  const auto run = [](double inlier_share, double* error_m) {
+    Map map;
+    const cv::Mat tex = make_repeating_texture(3);
+    const geom::SE3d A = pose(0, -0.9, 0), B = pose(0, 1.1, 0);
+    add_keyframe(map, tex, A, A);
+    split_into_bands(*add_keyframe(map, tex, B, B));
+    const geom::SE3d drift = geom::make_se3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.8, 0, 0));
+    auto kf = add_keyframe(map, tex, A, drift * A);
+    LoopClosingOptions o = test_options();
+    o.max_candidates = 1;
+    o.ambiguity_inlier_share = inlier_share;
+    const LoopClosingStats stats = close_with_words(map, kf, o);
+    *error_m = centre_error_m(kf->T_c_w(), A);
+    return stats;
+  };
+  double error_m = 0;
+  const LoopClosingStats shared = run(0.5, &error_m);
+  EXPECT_EQ(shared.lookalike_checked, 1);
+  EXPECT_EQ(shared.refused_ambiguous, 0);
+  ASSERT_EQ(shared.loops.size(), 1u);
+  EXPECT_NEAR(shared.loops[0].correction_m, 0.8, 0.02);
+  EXPECT_LT(error_m, 0.01);
+  const LoopClosingStats every = run(0.0, &error_m);
+  EXPECT_EQ(every.refused_ambiguous, 1);
+  EXPECT_TRUE(every.loops.empty());
+}
+
 TEST(LoopClosing, TwoPlacesBothOverTheDriftBoundAreRecordedAsAmbiguous) {
   // The view verifies both at its own place (0.8 m of drift) and at the
   // look-alike 2 m on, and the drift bound refuses both: the detection is

@@ -408,7 +408,7 @@ TEST(Settings, ReadsPlaceRecognitionKeys) {
                              "\nVocabulary.path: \"voc/ORBvoc.txt\"\n"
                              "LoopClosing.poseProximity: 1\nLoopClosing.maxDriftRate: 0\n"
                              "LoopClosing.driftFloor: 0.1\nLoopClosing.ambiguityCheck: 0\n"
-                             "LoopClosing.ambiguityDistance: 0.5\n");
+                             "LoopClosing.ambiguityDistance: 0.5\nLoopClosing.ambiguityInlierShare: 0.25\n");
   const Settings s = read_settings(path);
   EXPECT_TRUE(s.warnings.empty());
   // relative to the settings file's folder
@@ -418,9 +418,12 @@ TEST(Settings, ReadsPlaceRecognitionKeys) {
   EXPECT_DOUBLE_EQ(s.loop.drift_floor_m, 0.1);
   EXPECT_FALSE(s.loop.ambiguity_check);
   EXPECT_DOUBLE_EQ(s.loop.ambiguity_distance_m, 0.5);
+  EXPECT_DOUBLE_EQ(s.loop.ambiguity_inlier_share, 0.25);
+  EXPECT_DOUBLE_EQ(d.loop.ambiguity_inlier_share, 0.5);
   EXPECT_EQ(read_settings(temp_copy("none", read_file(tum1()) + "\nVocabulary.path: none\n")).vocabulary_path,
             "none");
-  for (const std::string bad : {"Vocabulary.path: 3", "LoopClosing.maxDriftRate: 2", "LoopClosing.ambiguityDistance: 0"}) {
+  for (const std::string bad : {"Vocabulary.path: 3", "LoopClosing.maxDriftRate: 2", "LoopClosing.ambiguityDistance: 0",
+                            "LoopClosing.ambiguityInlierShare: 1.5"}) {
     const std::string key = bad.substr(0, bad.find(':'));
     try {
       read_settings(temp_copy("bad_place", read_file(tum1()) + "\n" + bad + "\n"));

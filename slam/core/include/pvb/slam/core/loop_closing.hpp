@@ -20,7 +20,8 @@
 //      `max_correction_deg_per_km` a kilometre of path between the two); a
 //      correction over `lookalike_check_above_m` also verifies the keyframe
 //      against the map's best-scoring keyframes one by one, and any that
-//      verifies at another place makes it ambiguous;
+//      verifies at another place, with at least `ambiguity_inlier_share`
+//      of the best one's inliers, makes it ambiguous;
 //   4. correction: the new keyframe's covisibility neighbourhood is moved
 //      with it, duplicated points fused (the loop side replaces the current
 //      side), loop edges added, the essential graph (spanning tree, loop
@@ -86,6 +87,23 @@ struct LoopMatch {
   int ransac_inliers = 0;
   int inliers = 0;          ///< after the guided search and pose optimisation
 };
+
+/// Where a verified candidate put the new keyframe's camera, with how many
+/// inliers, and whether it was a look-alike (a best-scoring keyframe tried
+/// one by one) rather than a consistent candidate.
+struct VerifiedPlace {
+  Eigen::Vector3d centre_w;
+  int inliers = 0;
+  bool lookalike = false;
+};
+
+/// The ambiguity check: two rival places among `places` lie more than
+/// `distance_m` apart.  Every consistent candidate is a rival; a
+/// look-alike is one only with at least `inlier_share` x the most inliers
+/// among them.  A view that shares a part of its scene with a keyframe
+/// elsewhere (the far end of an aisle, seen from along it) verifies there
+/// with a few inliers at a pose those few hardly fix: no rival place.
+bool places_apart(const std::vector<VerifiedPlace>& places, double distance_m, double inlier_share);
 
 /// Pose-proximity candidates for `kf` (step 1 without the appearance
 /// check), closest first, at most options.max_candidates.  Call with the
