@@ -206,10 +206,10 @@ struct LoopClosingOptions {
   /// apart, the place is ambiguous (a repeated structure) and the loop is refused.
   bool ambiguity_check = true;
   double ambiguity_distance_m = 0.3;
-  /// LoopClosing.ambiguityInlierShare: a look-alike of a large correction
-  /// that verifies is a rival place only with at least this share of the
-  /// best verified candidate's inliers; 0: every one is.  Consistent
-  /// candidates are always rivals.
+  /// LoopClosing.ambiguityInlierShare: a look-alike (checked for a large
+  /// correction or a merge) that verifies is a rival place only with at
+  /// least this share of the best verified candidate's inliers; 0: every
+  /// one is.  Consistent candidates are always rivals.
   double ambiguity_inlier_share = 0.5;
   /// LoopClosing.mergeConfirmations: keyframes of a provisional map in a
   /// row (the first match included) verified at the pose the merge
