@@ -178,7 +178,8 @@ void BM_LoopDetect(benchmark::State& state) {
     pvb::slam::Map map;
     const auto kfs = decode_saved_map(&map);
     if (kReplayed == 0 || kfs.size() < kFirst + kReplayed) {
-      state.SkipWithError("a map of PVB_BENCH_LOOP_FIRST + PVB_BENCH_LOOP_REPLAYED keyframes at least (5,200)");
+      state.SkipWithError(
+          "a map of PVB_BENCH_LOOP_FIRST + PVB_BENCH_LOOP_REPLAYED keyframes at least (5,200 by default)");
       return;
     }
     pvb::slam::PlaceRecognizer place(pvb::slam::place::Vocabulary::load_shared(settings.vocabulary_path));

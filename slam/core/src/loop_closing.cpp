@@ -152,11 +152,12 @@ LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand,
 bool places_apart(const std::vector<VerifiedPlace>& places, double distance_m, double inlier_share) {
   int most = 0;
   for (const auto& p : places) most = std::max(most, p.inliers);
-  const auto rival = [&](const VerifiedPlace& p) { return !p.lookalike || p.inliers >= inlier_share * most; };
-  for (std::size_t i = 0; i < places.size(); ++i)
-    for (std::size_t j = i + 1; j < places.size(); ++j)
-      if (rival(places[i]) && rival(places[j]) && (places[i].centre_w - places[j].centre_w).norm() > distance_m)
-        return true;
+  std::vector<Eigen::Vector3d> rivals_w;
+  for (const auto& p : places)
+    if (!p.lookalike || p.inliers >= inlier_share * most) rivals_w.push_back(p.centre_w);
+  for (std::size_t i = 0; i < rivals_w.size(); ++i)
+    for (std::size_t j = i + 1; j < rivals_w.size(); ++j)
+      if ((rivals_w[i] - rivals_w[j]).norm() > distance_m) return true;
   return false;
 }
 
@@ -431,8 +432,8 @@ std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& k
                    merge ? std::function<bool(std::uint64_t)>{}
                          : own_neighbourhood(*kf, kf->best_covisibles(-1), options_.min_keyframe_gap),
                    &verified_places);
-  tally.ambiguous = options_.ambiguity_check &&
-                    places_apart(verified_places, options_.ambiguity_distance_m, options_.ambiguity_inlier_share);
+  tally.ambiguous = options_.ambiguity_check && places_apart(verified_places, options_.ambiguity_distance_m,
+                                                             options_.ambiguity_inlier_share);
   if (tally.ambiguous && loop_kf)
     tally.refusal = refusal_of(*kf, *loop_kf, "ambiguous", *best, true, best_dist_m, best_angle_deg);
   else if (tally.ambiguous)  // every verified candidate was over the drift bound, and they lie apart

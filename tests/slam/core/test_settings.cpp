@@ -422,8 +422,9 @@ TEST(Settings, ReadsPlaceRecognitionKeys) {
   EXPECT_DOUBLE_EQ(d.loop.ambiguity_inlier_share, 0.5);
   EXPECT_EQ(read_settings(temp_copy("none", read_file(tum1()) + "\nVocabulary.path: none\n")).vocabulary_path,
             "none");
-  for (const std::string bad : {"Vocabulary.path: 3", "LoopClosing.maxDriftRate: 2", "LoopClosing.ambiguityDistance: 0",
-                            "LoopClosing.ambiguityInlierShare: 1.5"}) {
+  for (const std::string bad :
+       {"Vocabulary.path: 3", "LoopClosing.maxDriftRate: 2", "LoopClosing.ambiguityDistance: 0",
+        "LoopClosing.ambiguityInlierShare: 1.5"}) {
     const std::string key = bad.substr(0, bad.find(':'));
     try {
       read_settings(temp_copy("bad_place", read_file(tum1()) + "\n" + bad + "\n"));
