@@ -353,10 +353,12 @@ void OfflineSlam::Impl::print_loop_closing(std::ostringstream* js) {
             "%d as ambiguous); detection %.2f ms median per keyframe\n",
             loops.loops.size(), loops.consistent, loops.rejected, loops.refused_drift, loops.refused_ambiguous,
             loops.detect_ms.quantile(0.5)));
-  text(strf("  %d candidates verified: refused %d at the descriptor matches, %d at RANSAC, %d after the guided "
-            "search, %d by the correction bound; verification %.0f of %.0f ms\n",
-            loops.verified, loops.refused_matches, loops.refused_ransac, loops.refused_inliers,
-            loops.refused_correction, loops.verify_ms_total, loops.detect_ms_total));
+  text(strf(
+      "  %d candidates verified: refused %d at the descriptor matches, %d at RANSAC, %d after the guided "
+      "search, %d by the correction bound; %d on their first pose, without the guided search; "
+      "verification %.0f of %.0f ms\n",
+      loops.verified, loops.refused_matches, loops.refused_ransac, loops.refused_inliers,
+      loops.refused_correction, loops.refused_first_pose, loops.verify_ms_total, loops.detect_ms_total));
   for (const slam::LoopEvent& e : loops.loops)
     text(strf("  frame %llu (keyframe %llu) -> frame %llu (keyframe %llu): %d inliers, moved %.3f m / %.2f deg, "
               "%.0f ms\n",

@@ -8,15 +8,16 @@
 #include <map>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <unordered_set>
 
 #include "loop_correction.hpp"
 #include "pvb/common/clock.hpp"
 #include "pvb/common/text.hpp"
 #include "pvb/geometry/angles.hpp"
+#include "pvb/slam/core/frame_pose.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/matcher.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
-#include "pvb/slam/core/frame_pose.hpp"
 
 namespace pvb::slam {
 namespace {
@@ -70,10 +71,11 @@ void pose_difference(const geom::SE3d& a, const geom::SE3d& b, double* dist_m, d
 
 /// Matches by projection, at the probe's pose, the points of `root`, its
 /// covisibles and, with two rings, theirs, that the probe does not hold yet.
+/// Covisible keyframes share most of their points, so each is projected
+/// once (hashed sets: a group's tens of thousands of observations made the
+/// ordered sets half of a verification's time).
 void search_around(Frame* probe, const std::shared_ptr<KeyFrame>& root, int rings) {
-  std::set<std::uint64_t> have, in_group = {root->id()};
-  for (const auto& mp : probe->map_points)
-    if (mp) have.insert(mp->id());
+  std::unordered_set<std::uint64_t> in_group = {root->id()};
   std::vector<std::shared_ptr<KeyFrame>> group = {root};
   for (std::size_t begin = 0, ring = 0; ring < static_cast<std::size_t>(rings); ++ring) {
     const std::size_t end = group.size();
@@ -82,6 +84,12 @@ void search_around(Frame* probe, const std::shared_ptr<KeyFrame>& root, int ring
         if (in_group.insert(n->id()).second) group.push_back(n);
     begin = end;
   }
+  std::size_t observations = probe->size();
+  for (const auto& g : group) observations += g->map_points().size();
+  std::unordered_set<std::uint64_t> have;
+  have.reserve(observations);
+  for (const auto& mp : probe->map_points)
+    if (mp) have.insert(mp->id());
   std::vector<ProjectedPoint> proj;
   for (const auto& g : group)
     for (const auto& mp : g->map_points()) {
@@ -120,32 +128,51 @@ std::vector<std::shared_ptr<KeyFrame>> pose_candidates(const Map& map, const Key
   return out;
 }
 
-LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, const LoopClosingOptions& options) {
-  LoopMatch out;
+Frame loop_probe(const KeyFrame& kf) {
   Frame probe = kf.frame();  // a copy: its map_points become the loop-side matches
   std::fill(probe.map_points.begin(), probe.map_points.end(), nullptr);
+  return probe;
+}
+
+bool verify_by_descriptors(const KeyFrame& kf, const KeyFrame& cand, const LoopClosingOptions& options,
+                           Frame* probe, LoopMatch* out) {
   // Through the direct index when both have one (ORB-SLAM2 SearchByBoW):
   // only descriptors under the same vocabulary node are compared.
-  const bool by_bow = !cand->features_by_node().empty() && !kf.features_by_node().empty();
-  out.initial_matches = by_bow ? search_keyframe_by_bow(*cand, probe, kf.features_by_node(), kThLow, 0.75)
-                               : search_keyframe_bruteforce(*cand, probe, kThLow, 0.75);
-  if (out.initial_matches < options.min_matches) return out;
-  out.stage = LoopMatch::Stage::kRansac;
+  const bool by_bow = !cand.features_by_node().empty() && !kf.features_by_node().empty();
+  out->initial_matches = by_bow ? search_keyframe_by_bow(cand, *probe, kf.features_by_node(), kThLow, 0.75)
+                                : search_keyframe_bruteforce(cand, *probe, kThLow, 0.75);
+  if (out->initial_matches < options.min_matches) return false;
+  out->stage = LoopMatch::Stage::kRansac;
 
   // EPnP RANSAC on the loop-side points against the new keyframe's keypoints.
-  out.ransac_inliers = pnp_ransac_on_matches(probe, options.min_matches / 2);
-  if (out.ransac_inliers < options.min_matches / 2) return out;
-  if (optimize_and_prune(probe) < options.min_matches / 2) return out;
-  out.stage = LoopMatch::Stage::kInliers;
+  out->ransac_inliers = pnp_ransac_on_matches(*probe, options.min_matches / 2);
+  if (out->ransac_inliers < options.min_matches / 2) return false;
+  const int inliers = optimize_and_prune(*probe);
+  if (inliers < options.min_matches / 2) return false;
+  out->stage = LoopMatch::Stage::kInliers;
+  out->inliers = inliers;
+  out->T_c_w = probe->T_c_w;
+  return true;
+}
 
+void verify_by_projection(const std::shared_ptr<KeyFrame>& cand, const LoopClosingOptions& options,
+                          Frame* probe, LoopMatch* out) {
   // Guided search: the points of the candidate and its covisibles, projected
   // with the verified pose (ORB-SLAM2 SearchByProjection of mvpLoopMapPoints).
-  search_around(&probe, cand, 1);
-  out.inliers = optimize_and_prune(probe);
-  out.T_c_w = probe.T_c_w;
-  out.points = probe.map_points;
-  out.accepted = out.inliers >= options.min_inliers;
-  if (out.accepted) out.stage = LoopMatch::Stage::kAccepted;
+  search_around(probe, cand, 1);
+  out->inliers = optimize_and_prune(*probe);
+  out->T_c_w = probe->T_c_w;
+  out->points = probe->map_points;
+  out->accepted = out->inliers >= options.min_inliers;
+  if (out->accepted) out->stage = LoopMatch::Stage::kAccepted;
+}
+
+LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand,
+                      const LoopClosingOptions& options) {
+  LoopMatch out;
+  Frame probe = loop_probe(kf);
+  if (verify_by_descriptors(kf, *cand, options, &probe, &out))
+    verify_by_projection(cand, options, &probe, &out);
   return out;
 }
 
@@ -240,8 +267,9 @@ std::string to_json(const LoopClosingStats& stats) {
            ", \"global_ba_outliers\": " + std::to_string(e.global_ba_outliers) +
            ", \"merge\": " + (e.merge ? "true" : "false") + "}";
   }
-  out += "], \"keyframes\": " + std::to_string(stats.keyframes) + ", \"candidates\": " +
-         std::to_string(stats.candidates) + ", \"consistent\": " + std::to_string(stats.consistent) +
+  out += "], \"keyframes\": " + std::to_string(stats.keyframes) +
+         ", \"candidates\": " + std::to_string(stats.candidates) +
+         ", \"consistent\": " + std::to_string(stats.consistent) +
          ", \"rejected\": " + std::to_string(stats.rejected) +
          ", \"refused_drift\": " + std::to_string(stats.refused_drift) +
          ", \"refused_ambiguous\": " + std::to_string(stats.refused_ambiguous) +
@@ -254,11 +282,12 @@ std::string to_json(const LoopClosingStats& stats) {
          ", \"refused_ransac\": " + std::to_string(stats.refused_ransac) +
          ", \"refused_inliers\": " + std::to_string(stats.refused_inliers) +
          ", \"refused_correction\": " + std::to_string(stats.refused_correction) +
-         ", \"refusals\": " + std::to_string(stats.refusals.size() + static_cast<std::size_t>(stats.refusals_dropped)) +
+         ", \"refused_first_pose\": " + std::to_string(stats.refused_first_pose) + ", \"refusals\": " +
+         std::to_string(stats.refusals.size() + static_cast<std::size_t>(stats.refusals_dropped)) +
          ", \"verify_ms_total\": " + num(stats.verify_ms_total) +
          ", \"detect_ms_median\": " + num(stats.detect_ms.quantile(0.5)) +
-         ", \"detect_ms_p95\": " + num(stats.detect_ms.quantile(0.95)) + ", \"detect_ms_total\": " +
-         num(stats.detect_ms_total) + "}";
+         ", \"detect_ms_p95\": " + num(stats.detect_ms.quantile(0.95)) +
+         ", \"detect_ms_total\": " + num(stats.detect_ms_total) + "}";
   return out;
 }
 
@@ -379,68 +408,116 @@ LoopRefusal refusal_of(const KeyFrame& kf, const KeyFrame& cand, const char* rea
 
 }  // namespace
 
-std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& kf,
-                                              const std::vector<std::shared_ptr<KeyFrame>>& consistent,
-                                              bool merge, LoopMatch* best) {
-  static constexpr const char* kStageNames[3] = {"matches", "ransac", "inliers"};
-  std::shared_ptr<KeyFrame> loop_kf;
-  std::vector<VerifiedPlace> verified_places;
-  const auto t0 = std::chrono::steady_clock::now();
+struct LoopClosing::VerifyState {
   VerifyTally tally;
+  std::vector<VerifiedPlace> places;
+  std::shared_ptr<KeyFrame> loop_kf;
+  LoopMatch* best = nullptr;
   double best_dist_m = 0, best_angle_deg = 0;
-  // The candidate that got furthest (rank: geometry's stage, then the caps, then the drift bound).
-  const auto refuse = [&](int rank, LoopRefusal r) {
+  /// Keeps the refusal of the candidate that got furthest (rank: the
+  /// geometry's stage, then the caps, then the drift bound).
+  void refuse(int rank, LoopRefusal r) {
     if (rank <= tally.refusal_rank) return;
     tally.refusal_rank = rank;
     tally.refusal = std::move(r);
-  };
-  for (const auto& cand : consistent) {
-    ++tally.verified;
-    LoopMatch m = verify_loop(*kf, cand, options_);
-    if (!m.accepted) {
-      const auto stage = static_cast<std::size_t>(m.stage);
-      ++tally.refused_at[stage];
-      refuse(static_cast<int>(stage), refusal_of(*kf, *cand, kStageNames[stage], m, false));
-      continue;
-    }
-    double dist_m = 0, angle_deg = 0;
-    pose_difference(m.T_c_w, kf->T_c_w(), &dist_m, &angle_deg);
-    const double path_m = path_length_m(cand->id(), kf->id());  // both bounds grow with it
-    if (!merge && (dist_m > options_.max_correction_m || angle_deg > max_correction_deg(path_m))) {
-      ++tally.refused_correction;
-      refuse(3, refusal_of(*kf, *cand, "correction", m, true, dist_m, angle_deg));
-      continue;
-    }
-    verified_places.push_back({m.T_c_w.inverse().translation(), m.inliers, false});
-    const double bound_m = drift_bound_m(*kf, path_m, angle_deg);
-    if (!merge && options_.max_drift_rate > 0 && dist_m > bound_m) {
-      ++tally.drift;
-      refuse(4, refusal_of(*kf, *cand, "drift", m, true, dist_m, angle_deg, bound_m));
-      continue;
-    }
-    if (!loop_kf || m.inliers > best->inliers) {
-      *best = std::move(m);
-      loop_kf = cand;
-      best_dist_m = dist_m;
-      best_angle_deg = angle_deg;
-    }
-    if (!options_.ambiguity_check) break;  // ORB-SLAM2: the first verified candidate
   }
-  tally.lookalike_checked = !merge && loop_kf && best_dist_m > options_.lookalike_check_above_m;
-  if (loop_kf && (merge || tally.lookalike_checked) && options_.ambiguity_check && place_)
+};
+
+bool LoopClosing::far_beyond_bounds(const KeyFrame& kf, const LoopMatch& first, double path_m) const {
+  double dist_m = 0, angle_deg = 0;
+  pose_difference(first.T_c_w, kf.T_c_w(), &dist_m, &angle_deg);
+  const auto far = [](double value_m, double bound_m) { return value_m > 1.5 * bound_m + 0.5; };
+  if (far(dist_m, options_.max_correction_m)) return true;
+  return options_.max_drift_rate > 0 && far(dist_m, drift_bound_m(kf, path_m, angle_deg));
+}
+
+bool LoopClosing::judge(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, LoopMatch m, double path_m,
+                        bool merge, bool first_pose, VerifyState* st) const {
+  static constexpr const char* kStageNames[3] = {"matches", "ransac", "inliers"};
+  VerifyTally& tally = st->tally;
+  if (!m.accepted && !first_pose) {
+    const auto stage = static_cast<std::size_t>(m.stage);
+    ++tally.refused_at[stage];
+    st->refuse(static_cast<int>(stage), refusal_of(kf, *cand, kStageNames[stage], m, false));
+    return false;
+  }
+  if (first_pose) ++tally.refused_first_pose;
+  double dist_m = 0, angle_deg = 0;
+  pose_difference(m.T_c_w, kf.T_c_w(), &dist_m, &angle_deg);
+  if (!merge && (dist_m > options_.max_correction_m || angle_deg > max_correction_deg(path_m))) {
+    ++tally.refused_correction;
+    st->refuse(3, refusal_of(kf, *cand, "correction", m, true, dist_m, angle_deg));
+    return false;
+  }
+  if (!first_pose) st->places.push_back({m.T_c_w.inverse().translation(), m.inliers, false});
+  const double bound_m = drift_bound_m(kf, path_m, angle_deg);
+  if (!merge && options_.max_drift_rate > 0 && dist_m > bound_m) {
+    ++tally.drift;
+    st->refuse(4, refusal_of(kf, *cand, "drift", m, true, dist_m, angle_deg, bound_m));
+    return false;
+  }
+  if (first_pose) return false;  // far beyond a bound: not reached
+  if (!st->loop_kf || m.inliers > st->best->inliers) {
+    *st->best = std::move(m);
+    st->loop_kf = cand;
+    st->best_dist_m = dist_m;
+    st->best_angle_deg = angle_deg;
+  }
+  return !options_.ambiguity_check;  // ORB-SLAM2: the first verified candidate
+}
+
+std::shared_ptr<KeyFrame> LoopClosing::verify(const std::shared_ptr<KeyFrame>& kf,
+                                              const std::vector<std::shared_ptr<KeyFrame>>& consistent,
+                                              bool merge, LoopMatch* best) {
+  const auto t0 = std::chrono::steady_clock::now();
+  VerifyState st;
+  st.best = best;
+  // Candidates whose first pose lies far beyond a bound: on a plant most
+  // verified candidates are rows away, and the guided search is most of a
+  // verification.  They are rival places only beside a loop in reach.
+  struct Waiting {
+    std::shared_ptr<KeyFrame> cand;
+    Frame probe;
+    LoopMatch m;
+    double path_m;
+  };
+  std::vector<Waiting> waiting;
+  for (const auto& cand : consistent) {
+    ++st.tally.verified;
+    Frame probe = loop_probe(*kf);
+    LoopMatch m;
+    double path_m = 0;  // both bounds grow with it
+    if (verify_by_descriptors(*kf, *cand, options_, &probe, &m)) {
+      path_m = path_length_m(cand->id(), kf->id());
+      if (!merge && far_beyond_bounds(*kf, m, path_m)) {
+        waiting.push_back({cand, std::move(probe), std::move(m), path_m});
+        continue;
+      }
+      verify_by_projection(cand, options_, &probe, &m);
+    }
+    if (judge(*kf, cand, std::move(m), path_m, merge, false, &st)) break;
+  }
+  const bool finish = st.loop_kf && options_.ambiguity_check;
+  for (auto& w : waiting) {
+    if (finish) verify_by_projection(w.cand, options_, &w.probe, &w.m);
+    judge(*kf, w.cand, std::move(w.m), w.path_m, merge, !finish, &st);
+  }
+  VerifyTally& tally = st.tally;
+  tally.lookalike_checked = !merge && st.loop_kf && st.best_dist_m > options_.lookalike_check_above_m;
+  if (st.loop_kf && (merge || tally.lookalike_checked) && options_.ambiguity_check && place_)
     add_lookalikes(*place_, map_, options_, *kf, consistent, merge ? 0 : map_.map_of(*kf),
                    merge ? std::function<bool(std::uint64_t)>{}
                          : own_neighbourhood(*kf, kf->best_covisibles(-1), options_.min_keyframe_gap),
-                   &verified_places);
-  tally.ambiguous = options_.ambiguity_check && places_apart(verified_places, options_.ambiguity_distance_m,
-                                                             options_.ambiguity_inlier_share);
-  if (tally.ambiguous && loop_kf)
-    tally.refusal = refusal_of(*kf, *loop_kf, "ambiguous", *best, true, best_dist_m, best_angle_deg);
+                   &st.places);
+  tally.ambiguous = options_.ambiguity_check &&
+                    places_apart(st.places, options_.ambiguity_distance_m, options_.ambiguity_inlier_share);
+  if (tally.ambiguous && st.loop_kf)
+    tally.refusal = refusal_of(*kf, *st.loop_kf, "ambiguous", *best, true, st.best_dist_m, st.best_angle_deg);
   else if (tally.ambiguous)  // every verified candidate was over the drift bound, and they lie apart
     tally.refusal.reason = "ambiguous";
   tally.verify_ms = ms_since(t0);
-  add_tally(tally, loop_kf != nullptr);
-  return tally.ambiguous ? nullptr : loop_kf;
+  add_tally(tally, st.loop_kf != nullptr);
+  return tally.ambiguous ? nullptr : st.loop_kf;
 }
 
 void LoopClosing::add_tally(const VerifyTally& t, bool found) {
@@ -450,6 +527,7 @@ void LoopClosing::add_tally(const VerifyTally& t, bool found) {
   stats_.refused_ransac += t.refused_at[1];
   stats_.refused_inliers += t.refused_at[2];
   stats_.refused_correction += t.refused_correction;
+  stats_.refused_first_pose += t.refused_first_pose;
   stats_.lookalike_checked += t.lookalike_checked ? 1 : 0;
   stats_.verify_ms_total += t.verify_ms;
   if (t.ambiguous) ++stats_.refused_ambiguous;

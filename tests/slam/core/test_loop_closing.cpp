@@ -524,19 +524,42 @@ TEST(LoopClosing, ALookalikeMatchingAThirdOfTheViewDoesNotHoldBackALargeCorrecti
   EXPECT_TRUE(every.loops.empty());
 }
 
-TEST(LoopClosing, TwoPlacesBothOverTheDriftBoundAreRecordedAsAmbiguous) {
-  // The view verifies both at its own place (0.8 m of drift) and at the
-  // look-alike 2 m on, and the drift bound refuses both: the detection is
-  // refused once, as ambiguous, and recorded so.
+TEST(LoopClosing, TwoPlacesFarOverTheDriftBoundAreRefusedOnTheirFirstPoses) {
+  // The view matches both at its own place (0.8 m of drift) and at the
+  // look-alike 2 m on, and the drift bound (5 cm here) is far below both:
+  // no loop is in reach, so neither gets the guided search, and the
+  // detection is refused once, by the drift bound, with the first pose.
   Map map;
   auto kf = drifted_view_between_lookalikes(map);
   const LoopClosingStats s = close_with_words(map, kf, test_options(), true);
   EXPECT_TRUE(s.loops.empty());
-  ASSERT_EQ(s.refused_ambiguous, 1);
-  EXPECT_EQ(s.refused_drift, 0);
+  EXPECT_EQ(s.refused_first_pose, 2);
+  EXPECT_EQ(s.refused_inliers, 0);
+  ASSERT_EQ(s.refused_drift, 1);
+  EXPECT_EQ(s.refused_ambiguous, 0);
+  ASSERT_EQ(s.refusals.size(), 1u);
+  EXPECT_EQ(s.refusals[0].reason, "drift");
+  EXPECT_TRUE(s.refusals[0].verified);
+  EXPECT_GT(s.refusals[0].correction_m, 0.7);
+}
+
+TEST(LoopClosing, AFarPlaceIsStillARivalBesideALoopInReach) {
+  // The view from A again, without drift, and its look-alike 2 m on: A is a
+  // loop within the drift bound, so the look-alike, far over it, gets its
+  // guided search after all and makes the place ambiguous.
+  Map map;
+  const cv::Mat tex = make_repeating_texture(3);
+  const geom::SE3d A = pose(0, -0.9, 0), B = pose(0, 1.1, 0);
+  add_keyframe(map, tex, A, A);
+  add_keyframe(map, tex, B, B);
+  auto kf = add_keyframe(map, tex, A, A);
+  const LoopClosingStats s = close_with_words(map, kf, test_options(), true);
+  EXPECT_EQ(s.refused_first_pose, 0);
+  EXPECT_EQ(s.refused_ambiguous, 1);
+  EXPECT_TRUE(s.loops.empty());
   ASSERT_EQ(s.refusals.size(), 1u);
   EXPECT_EQ(s.refusals[0].reason, "ambiguous");
-  EXPECT_TRUE(s.refusals[0].verified);
+  EXPECT_LT(s.refusals[0].correction_m, 0.05);
 }
 
 TEST(LoopClosing, ClosesOnlyAfterConsistentDetectionsAndRemovesTheDrift) {

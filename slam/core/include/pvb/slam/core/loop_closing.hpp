@@ -114,6 +114,16 @@ std::vector<std::shared_ptr<KeyFrame>> pose_candidates(const Map& map, const Key
 /// Geometric verification of `cand` for `kf` (step 3).  Call with the map
 /// mutex held.  Deterministic (fixed RANSAC seed).
 LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, const LoopClosingOptions& options);
+/// verify_loop in two steps.  `probe` starts as `kf`'s frame without map
+/// points (loop_probe).  The first step matches descriptors, runs EPnP
+/// RANSAC and optimises the pose: false when that refuses `cand`
+/// (out->stage says where), else probe->T_c_w is the first pose.  The
+/// second adds the guided search and the final pose and inliers.
+Frame loop_probe(const KeyFrame& kf);
+bool verify_by_descriptors(const KeyFrame& kf, const KeyFrame& cand, const LoopClosingOptions& options,
+                           Frame* probe, LoopMatch* out);
+void verify_by_projection(const std::shared_ptr<KeyFrame>& cand, const LoopClosingOptions& options,
+                          Frame* probe, LoopMatch* out);
 /// Verification of `kf` at a predicted pose `T_c_w` in `cand`'s map (a
 /// held-back merge): the points of `cand`, its covisibles and theirs,
 /// projected and matched, then a pose optimisation; accepted with
@@ -178,7 +188,7 @@ class LoopClosing {
                                    LoopMatch* best);
   /// What one verify() saw, added to the stats at its end.
   struct VerifyTally {
-    int verified = 0, refused_correction = 0, drift = 0;
+    int verified = 0, refused_correction = 0, drift = 0, refused_first_pose = 0;
     std::array<int, 3> refused_at{};  ///< by LoopMatch::Stage: matches, RANSAC, inliers
     bool lookalike_checked = false, ambiguous = false;
     double verify_ms = 0;
@@ -186,6 +196,17 @@ class LoopClosing {
     LoopRefusal refusal;
   };
   void add_tally(const VerifyTally& t, bool found);
+  /// What verify() has found so far: the verified places, the best loop.
+  struct VerifyState;
+  /// A candidate past RANSAC whose first pose lies this far beyond the hard
+  /// cap or the drift bound (1.5 x + 0.5 m; the guided search moves a pose
+  /// by centimetres): its guided search waits until a loop is in reach.
+  bool far_beyond_bounds(const KeyFrame& kf, const LoopMatch& first, double path_m) const;
+  /// Judges a verified `cand` (or one refused on its first pose,
+  /// `first_pose`) against the caps, the drift bound and the best so far;
+  /// true when verification stops (the ambiguity check off).
+  bool judge(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, LoopMatch m, double path_m,
+             bool merge, bool first_pose, VerifyState* st) const;
   /// Camera path length (current estimates) over the keyframes from `from` to `to` by id.
   double path_length_m(std::uint64_t from, std::uint64_t to) const;
   /// The cap on a loop correction's angle over `path_m` of path between

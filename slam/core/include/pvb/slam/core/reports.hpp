@@ -259,6 +259,10 @@ struct LoopClosingStats {
   int refused_ransac = 0;         ///< too few EPnP RANSAC / pose-optimisation inliers
   int refused_inliers = 0;        ///< fewer than min_inliers after the guided search
   int refused_correction = 0;     ///< a correction over max_correction_m / max_correction_deg (hard caps)
+  /// Of the candidates past RANSAC, those refused on the pose RANSAC gave,
+  /// without the guided search: a correction that far beyond the hard cap
+  /// or the drift bound (1.5 x the bound + 0.5 m), with no loop in reach.
+  int refused_first_pose = 0;
   double verify_ms_total = 0;     ///< the part of detect_ms_total spent in step 3
   double detect_ms_total = 0;     ///< all detection work
   DurationHistogram detect_ms;    ///< detection and verification per keyframe examined
