@@ -1,20 +1,15 @@
 #include "pvb/slam/core/loop_closing.hpp"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <functional>
 #include <map>
-#include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
-#include <unordered_set>
 
 #include "loop_correction.hpp"
+#include "loop_verification.hpp"
 #include "pvb/common/clock.hpp"
-#include "pvb/common/text.hpp"
 #include "pvb/geometry/angles.hpp"
-#include "pvb/slam/core/frame_pose.hpp"
 #include "pvb/slam/core/local_mapping.hpp"
 #include "pvb/slam/core/matcher.hpp"
 #include "pvb/slam/optim/optimizer.hpp"
@@ -22,173 +17,11 @@
 namespace pvb::slam {
 namespace {
 
-using geom::kRadToDeg;
+using detail::pose_difference;
 /// Best-scoring keyframes of the map, one by one, that a merge or a large
 /// loop correction is also verified against (as a relocalisation is,
 /// Tracking.relocLookalikes).
 constexpr std::size_t kLookalikes = 10;
-/// A keyframe confirms a held-back merge when it verifies this close to the
-/// pose the transform predicts (or within maxCorrection, if smaller).
-constexpr double kMergeConfirmTolerance_m = 0.5;
-
-/// Nearest-rank quantile q of the values (0 for none).
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
-/// Optical axis (z) of a keyframe in the world frame.
-Eigen::Vector3d optical_axis_w(const KeyFrame& kf) { return kf.T_c_w().linear().row(2).transpose(); }
-
-/// Pose-only optimisation of `f` against its map points (all keypoints with
-/// a point); drops the outliers.  Returns the inlier count.
-int optimize_and_prune(Frame& f) {
-  const int inliers = optimize_frame_pose(f);
-  for (std::size_t i = 0; i < f.size(); ++i)
-    if (f.outlier[i]) {
-      f.map_points[i] = nullptr;
-      f.outlier[i] = 0;
-    }
-  return inliers;
-}
-
-/// Median depth of the keyframe's map points in its camera (ORB-SLAM2
-/// ComputeSceneMedianDepth); 0 without points.
-double scene_median_depth_m(const KeyFrame& kf) {
-  std::vector<double> z;
-  for (const auto& mp : kf.map_points())
-    if (mp && !mp->bad()) z.push_back((kf.T_c_w() * mp->p_w()).z());
-  return quantile(std::move(z), 0.5);
-}
-
-/// Rotation angle (degrees) and camera-centre distance (metres) between two poses T_c_w.
-void pose_difference(const geom::SE3d& a, const geom::SE3d& b, double* dist_m, double* angle_deg) {
-  *dist_m = (a.inverse().translation() - b.inverse().translation()).norm();
-  *angle_deg = geom::rotation_angle_rad(a.linear() * b.linear().transpose()) * kRadToDeg;
-}
-
-/// Matches by projection, at the probe's pose, the points of `root`, its
-/// covisibles and, with two rings, theirs, that the probe does not hold yet.
-/// Covisible keyframes share most of their points, so each is projected
-/// once (hashed sets: with ordered ones, the group's tens of thousands of
-/// observations took a fifth of loop detection's time on a plant).
-void search_around(Frame* probe, const std::shared_ptr<KeyFrame>& root, int rings) {
-  std::unordered_set<std::uint64_t> in_group = {root->id()};
-  std::vector<std::shared_ptr<KeyFrame>> group = {root};
-  for (std::size_t begin = 0, ring = 0; ring < static_cast<std::size_t>(rings); ++ring) {
-    const std::size_t end = group.size();
-    for (std::size_t i = begin; i < end; ++i)
-      for (const auto& n : group[i]->best_covisibles(-1))
-        if (in_group.insert(n->id()).second) group.push_back(n);
-    begin = end;
-  }
-  std::size_t observations = probe->size();
-  for (const auto& g : group) observations += g->map_points().size();
-  std::unordered_set<std::uint64_t> have;
-  have.reserve(observations);
-  for (const auto& mp : probe->map_points)
-    if (mp) have.insert(mp->id());
-  std::vector<ProjectedPoint> proj;
-  for (const auto& g : group)
-    for (const auto& mp : g->map_points()) {
-      if (!mp || mp->bad() || !have.insert(mp->id()).second) continue;
-      ProjectedPoint p;
-      if (project_in_frustum(*probe, mp, &p)) proj.push_back(p);
-    }
-  search_local_points(*probe, proj, 10.0 / 4.0);
-}
-
-}  // namespace
-
-std::vector<std::shared_ptr<KeyFrame>> pose_candidates(const Map& map, const KeyFrame& kf,
-                                                       const LoopClosingOptions& options) {
-  std::set<std::uint64_t> connected = {kf.id()};
-  for (const auto& n : kf.best_covisibles(-1)) connected.insert(n->id());
-  const Eigen::Vector3d c = kf.camera_center_w();
-  const Eigen::Vector3d axis = optical_axis_w(kf);
-  const double min_cos = std::cos(options.max_angle_deg / kRadToDeg);
-  const std::uint32_t own = map.map_of(kf);
-  std::vector<std::pair<double, std::shared_ptr<KeyFrame>>> found;
-  for (const auto& [id, k] : map.keyframes()) {
-    if (id + static_cast<std::uint64_t>(options.min_keyframe_gap) > kf.id()) break;  // ordered by id
-    if (k->bad() || connected.count(id) || map.map_of(*k) != own) continue;
-    const double d = (k->camera_center_w() - c).norm();
-    if (d > options.search_radius_m) continue;
-    if (optical_axis_w(*k).dot(axis) < min_cos) continue;
-    found.emplace_back(d, k);
-  }
-  std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<std::shared_ptr<KeyFrame>> out;
-  for (const auto& [d, k] : found) {
-    if (static_cast<int>(out.size()) >= options.max_candidates) break;
-    out.push_back(k);
-  }
-  return out;
-}
-
-Frame loop_probe(const KeyFrame& kf) {
-  Frame probe = kf.frame();  // a copy: its map_points become the loop-side matches
-  std::fill(probe.map_points.begin(), probe.map_points.end(), nullptr);
-  return probe;
-}
-
-bool verify_by_descriptors(const KeyFrame& kf, const KeyFrame& cand, const LoopClosingOptions& options,
-                           Frame* probe, LoopMatch* out) {
-  // Through the direct index when both have one (ORB-SLAM2 SearchByBoW):
-  // only descriptors under the same vocabulary node are compared.
-  const bool by_bow = !cand.features_by_node().empty() && !kf.features_by_node().empty();
-  out->initial_matches = by_bow ? search_keyframe_by_bow(cand, *probe, kf.features_by_node(), kThLow, 0.75)
-                                : search_keyframe_bruteforce(cand, *probe, kThLow, 0.75);
-  if (out->initial_matches < options.min_matches) return false;
-  out->stage = LoopMatch::Stage::kRansac;
-
-  // EPnP RANSAC on the loop-side points against the new keyframe's keypoints.
-  out->ransac_inliers = pnp_ransac_on_matches(*probe, options.min_matches / 2);
-  if (out->ransac_inliers < options.min_matches / 2) return false;
-  const int inliers = optimize_and_prune(*probe);
-  if (inliers < options.min_matches / 2) return false;
-  out->stage = LoopMatch::Stage::kInliers;
-  out->inliers = inliers;
-  out->T_c_w = probe->T_c_w;
-  return true;
-}
-
-void verify_by_projection(const std::shared_ptr<KeyFrame>& cand, const LoopClosingOptions& options,
-                          Frame* probe, LoopMatch* out) {
-  // Guided search: the points of the candidate and its covisibles, projected
-  // with the verified pose (ORB-SLAM2 SearchByProjection of mvpLoopMapPoints).
-  search_around(probe, cand, 1);
-  out->inliers = optimize_and_prune(*probe);
-  out->T_c_w = probe->T_c_w;
-  out->points = probe->map_points;
-  out->accepted = out->inliers >= options.min_inliers;
-  if (out->accepted) out->stage = LoopMatch::Stage::kAccepted;
-}
-
-LoopMatch verify_loop(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand,
-                      const LoopClosingOptions& options) {
-  LoopMatch out;
-  Frame probe = loop_probe(kf);
-  if (verify_by_descriptors(kf, *cand, options, &probe, &out))
-    verify_by_projection(cand, options, &probe, &out);
-  return out;
-}
-
-bool places_apart(const std::vector<VerifiedPlace>& places, double distance_m, double inlier_share) {
-  int most = 0;
-  for (const auto& p : places) most = std::max(most, p.inliers);
-  std::vector<Eigen::Vector3d> rivals_w;
-  for (const auto& p : places)
-    if (!p.lookalike || p.inliers >= inlier_share * most) rivals_w.push_back(p.centre_w);
-  for (std::size_t i = 0; i < rivals_w.size(); ++i)
-    for (std::size_t j = i + 1; j < rivals_w.size(); ++j)
-      if ((rivals_w[i] - rivals_w[j]).norm() > distance_m) return true;
-  return false;
-}
-
-namespace {
 
 /// The grouped candidates of a merge can all lie at one of two look-alike
 /// places (a ground texture repeating along the route), and no later check
@@ -208,88 +41,6 @@ void add_lookalikes(const PlaceRecognizer& place, const Map& map, const LoopClos
 }
 
 }  // namespace
-
-LoopMatch verify_at(const KeyFrame& kf, const std::shared_ptr<KeyFrame>& cand, const geom::SE3d& T_c_w,
-                    const LoopClosingOptions& options) {
-  LoopMatch out;
-  out.stage = LoopMatch::Stage::kInliers;
-  Frame probe = kf.frame();
-  std::fill(probe.map_points.begin(), probe.map_points.end(), nullptr);
-  probe.T_c_w = T_c_w;
-  search_around(&probe, cand, 2);
-  out.initial_matches = static_cast<int>(
-      std::count_if(probe.map_points.begin(), probe.map_points.end(), [](const auto& mp) { return mp != nullptr; }));
-  out.inliers = out.initial_matches > 0 ? optimize_and_prune(probe) : 0;
-  out.T_c_w = probe.T_c_w;
-  out.points = probe.map_points;
-  double dist_m = 0, angle_deg = 0;
-  pose_difference(probe.T_c_w, T_c_w, &dist_m, &angle_deg);
-  out.accepted = out.inliers >= options.min_inliers &&
-                 dist_m <= std::min(options.max_correction_m, kMergeConfirmTolerance_m) &&
-                 angle_deg <= options.max_correction_deg;
-  if (out.accepted) out.stage = LoopMatch::Stage::kAccepted;
-  return out;
-}
-
-void DurationHistogram::add(double ms) {
-  const double octaves = ms > kLowestMs ? std::log2(ms / kLowestMs) : 0.0;  // NaN falls in the first bin
-  const int bin = std::clamp(static_cast<int>(octaves * kBinsPerOctave), 0, kBins - 1);
-  ++counts_[static_cast<std::size_t>(bin)];
-  ++count_;
-  total_ms_ += std::isfinite(ms) ? ms : 0.0;
-}
-
-double DurationHistogram::quantile(double q) const {
-  if (count_ == 0) return 0;
-  // Nearest rank: the ceil(q n)-th smallest value (the first for q = 0).
-  const auto rank = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(q * static_cast<double>(count_))));
-  std::size_t seen = 0;
-  int bin = 0;
-  for (; bin < kBins - 1; ++bin)
-    if ((seen += counts_[static_cast<std::size_t>(bin)]) >= rank) break;
-  return kLowestMs * std::exp2((bin + 0.5) / kBinsPerOctave);
-}
-
-std::string to_json(const LoopClosingStats& stats) {
-  const auto num = [](double v) { return json_number(v, 6); };
-  std::string out = "{\"loops\": " + std::to_string(stats.loops.size()) + ", \"events\": [";
-  for (std::size_t k = 0; k < stats.loops.size(); ++k) {
-    const LoopEvent& e = stats.loops[k];
-    out += std::string(k ? ", " : "") + "{\"keyframe\": " + std::to_string(e.keyframe_id) +
-           ", \"frame\": " + std::to_string(e.frame_id) + ", \"loop_keyframe\": " + std::to_string(e.loop_keyframe_id) +
-           ", \"loop_frame\": " + std::to_string(e.loop_frame_id) + ", \"inliers\": " + std::to_string(e.inliers) +
-           ", \"correction_m\": " + num(e.correction_m) + ", \"correction_deg\": " + num(e.correction_deg) +
-           ", \"fused_points\": " + std::to_string(e.fused_points) +
-           ", \"graph_keyframes\": " + std::to_string(e.graph_keyframes) +
-           ", \"graph_edges\": " + std::to_string(e.graph_edges) + ", \"detect_ms\": " + num(e.detect_ms) +
-           ", \"correct_ms\": " + num(e.correct_ms) + ", \"correct_locked_ms\": " + num(e.correct_locked_ms) +
-           ", \"global_ba_ms\": " + num(e.global_ba_ms) +
-           ", \"global_ba_outliers\": " + std::to_string(e.global_ba_outliers) +
-           ", \"merge\": " + (e.merge ? "true" : "false") + "}";
-  }
-  out += "], \"keyframes\": " + std::to_string(stats.keyframes) +
-         ", \"candidates\": " + std::to_string(stats.candidates) +
-         ", \"consistent\": " + std::to_string(stats.consistent) +
-         ", \"rejected\": " + std::to_string(stats.rejected) +
-         ", \"refused_drift\": " + std::to_string(stats.refused_drift) +
-         ", \"refused_ambiguous\": " + std::to_string(stats.refused_ambiguous) +
-         ", \"lookalike_checked\": " + std::to_string(stats.lookalike_checked) +
-         ", \"merge_confirmed\": " + std::to_string(stats.merge_confirmed) +
-         ", \"merge_unconfirmed\": " + std::to_string(stats.merge_unconfirmed) +
-         ", \"merge_suggested\": " + std::to_string(stats.merge_suggested) +
-         ", \"verified\": " + std::to_string(stats.verified) +
-         ", \"refused_matches\": " + std::to_string(stats.refused_matches) +
-         ", \"refused_ransac\": " + std::to_string(stats.refused_ransac) +
-         ", \"refused_inliers\": " + std::to_string(stats.refused_inliers) +
-         ", \"refused_correction\": " + std::to_string(stats.refused_correction) +
-         ", \"refused_first_pose\": " + std::to_string(stats.refused_first_pose) + ", \"refusals\": " +
-         std::to_string(stats.refusals.size() + static_cast<std::size_t>(stats.refusals_dropped)) +
-         ", \"verify_ms_total\": " + num(stats.verify_ms_total) +
-         ", \"detect_ms_median\": " + num(stats.detect_ms.quantile(0.5)) +
-         ", \"detect_ms_p95\": " + num(stats.detect_ms.quantile(0.95)) +
-         ", \"detect_ms_total\": " + num(stats.detect_ms_total) + "}";
-  return out;
-}
 
 LoopClosing::LoopClosing(Map& map, const LoopClosingOptions& options, PlaceRecognizer* place)
     : map_(map), options_(options), place_(place) {}
@@ -382,7 +133,7 @@ double LoopClosing::drift_bound_m(const KeyFrame& kf, double path_m, double angl
   // rotation and a sideways move look alike in the image, so tracking that
   // drifts in rotation turns the camera about the scene it holds, and the
   // correction moves the camera centre by 2 sin(angle / 2) x the scene depth.
-  const double swing_m = 2.0 * std::sin(angle_deg / kRadToDeg / 2.0) * scene_median_depth_m(kf);
+  const double swing_m = 2.0 * std::sin(angle_deg / geom::kRadToDeg / 2.0) * detail::scene_median_depth_m(kf);
   return options_.drift_floor_m + options_.max_drift_rate * path_m + swing_m;
 }
 
@@ -534,17 +285,6 @@ void LoopClosing::add_tally(const VerifyTally& t, bool found) {
   else if (!found && t.drift > 0) ++stats_.refused_drift;  // each refused detection counts under one check
   if (!t.ambiguous && (found || t.refusal_rank < 0)) return;
   stats_.keep_refusal(t.refusal);
-}
-
-void LoopClosingStats::keep_refusal(LoopRefusal r, std::size_t cap) {
-  if (refusals.size() >= cap) {
-    const auto unverified =
-        std::find_if(refusals.begin(), refusals.end(), [](const LoopRefusal& k) { return !k.verified; });
-    ++refusals_dropped;
-    if (!r.verified || unverified == refusals.end()) return;
-    refusals.erase(unverified);
-  }
-  refusals.push_back(std::move(r));
 }
 
 std::shared_ptr<KeyFrame> LoopClosing::find(const std::shared_ptr<KeyFrame>& kf, LoopMatch* best, bool* merge,
