@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <iterator>
 
 #include "pvb/common/text.hpp"
 #include "pvb/eval/associate.hpp"
@@ -17,10 +18,18 @@ double seconds_between(std::int64_t from_ns, std::int64_t to_ns) {
   return static_cast<double>(to_ns - from_ns) * 1e-9;
 }
 
+/// The estimate held at t_ns: the last entry made at or before it, less
+/// a millisecond (trajectory files keep microseconds).
+const geom::Vec3d* held_at(const GravityEstimates& estimates, std::int64_t t_ns) {
+  constexpr std::int64_t kTolNs = 1000000;
+  auto it = estimates.upper_bound(t_ns + kTolNs);
+  if (it == estimates.begin()) return nullptr;
+  return &std::prev(it)->second;
+}
+
 geom::Vec3d estimated_down(const GravityEstimates& estimates, std::int64_t t_ns) {
-  constexpr std::int64_t kTolNs = 1000000;  // trajectory files keep microseconds
-  auto it = estimates.lower_bound(t_ns - kTolNs);
-  if (it != estimates.end() && it->first <= t_ns + kTolNs && it->second.norm() > 0) return it->second.normalized();
+  const geom::Vec3d* g = held_at(estimates, t_ns);
+  if (g != nullptr && g->norm() > 0) return g->normalized();
   return geom::Vec3d(0, 0, -1);
 }
 
@@ -33,6 +42,13 @@ std::string json_list(const std::vector<double>& v) {
 }
 
 }  // namespace
+
+void record_gravity(GravityEstimates* estimates, std::int64_t t_ns, const std::optional<geom::Vec3d>& g_w) {
+  const geom::Vec3d g = g_w.value_or(geom::Vec3d::Zero());
+  const geom::Vec3d* held = held_at(*estimates, t_ns);
+  const geom::Vec3d none = geom::Vec3d::Zero();
+  if (g != (held != nullptr ? *held : none)) (*estimates)[t_ns] = g;
+}
 
 GravityError gravity_error(const Trajectory& gt, const Trajectory& est, const geom::Vec3d& down_w,
                            const std::string& map_frame, const GravityEstimates& estimates) {

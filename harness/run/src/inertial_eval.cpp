@@ -69,12 +69,19 @@ BiasTruth bias_truth_at(const std::vector<BiasTruth>& truth, std::int64_t t_ns) 
                                       [](const BiasTruth& b, std::int64_t t) { return b.t_ns < t; });
   if (after == truth.begin()) return {t_ns, truth.front().gyro_radps, truth.front().accel_mps2};
   if (after == truth.end()) return {t_ns, truth.back().gyro_radps, truth.back().accel_mps2};
+  if (after->t_ns == t_ns) return *after;  // a reading at that time: its own biases, not a blend
   const BiasTruth& a = *(after - 1);
   const BiasTruth& b = *after;
   const double s =
       b.t_ns > a.t_ns ? static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns) : 0.0;
   return {t_ns, a.gyro_radps + s * (b.gyro_radps - a.gyro_radps),
           a.accel_mps2 + s * (b.accel_mps2 - a.accel_mps2)};
+}
+
+void keep_frame_ends(const std::vector<BiasTruth>& frame_readings, std::vector<BiasTruth>* kept) {
+  if (frame_readings.empty()) return;
+  kept->push_back(frame_readings.front());
+  if (frame_readings.size() > 1) kept->push_back(frame_readings.back());
 }
 
 BiasComparison compare_biases(std::vector<KeyframeBias> keyframes, const std::vector<BiasTruth>& truth,

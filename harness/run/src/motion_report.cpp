@@ -6,36 +6,47 @@
 
 namespace pvb::run {
 
+namespace {
+/// Rows kept of each series: 82 s of IMU readings (200 Hz), 5.5 minutes
+/// of wheel readings (50 Hz) at full rate, evenly thinned past that.
+constexpr std::size_t kMaxRows = 16384;
+}  // namespace
+
 MotionReportBuilder::MotionReportBuilder(const geom::SE3d& T_b_i, const sensor::DriveDescription& drive)
-    : R_b_i_(T_b_i.linear()), odometry_(drive) {}
+    : R_b_i_(T_b_i.linear()), odometry_(drive), imu_(3, kMaxRows), odo_(7, kMaxRows) {}
 
 void MotionReportBuilder::add(const FrameItem& item) {
-  for (std::size_t k = 0; k < item.frame.imu.size() && k < item.imu_truth.size(); ++k) {
-    r_.imu_t_s.push_back(geom::ns_to_seconds(item.frame.imu[k].t_ns));
-    r_.yaw_rate_measured.push_back((R_b_i_ * item.frame.imu[k].gyro_radps).z());
-    r_.yaw_rate_true.push_back((R_b_i_ * item.imu_truth[k].gyro_radps).z());
-  }
+  for (std::size_t k = 0; k < item.frame.imu.size() && k < item.imu_truth.size(); ++k)
+    imu_.add({geom::ns_to_seconds(item.frame.imu[k].t_ns), (R_b_i_ * item.frame.imu[k].gyro_radps).z(),
+              (R_b_i_ * item.imu_truth[k].gyro_radps).z()});
   for (std::size_t k = 0; k < item.frame.wheel_ticks.size() && k < item.wheel_truth.size(); ++k) {
     const sim::WheelTruth& truth = item.wheel_truth[k];
     if (!T_w_b0_) T_w_b0_ = truth.T_w_b;
     odometry_.add(item.frame.wheel_ticks[k]);
     const Eigen::Vector2d p_true = sensor::odometry_frame_position(*T_w_b0_, truth.T_w_b);
     const sensor::OdometryState& o = odometry_.state();
-    const double step = r_.distance_m.empty() ? 0.0 : (p_true - last_true_).norm();
+    if (moved_) distance_m_ += (p_true - last_true_).norm();
+    moved_ = true;
     last_true_ = p_true;
-    r_.odo_t_s.push_back(geom::ns_to_seconds(o.t_ns));
-    r_.odo_x_m.push_back(o.x_m);
-    r_.odo_y_m.push_back(o.y_m);
-    r_.true_x_m.push_back(p_true.x());
-    r_.true_y_m.push_back(p_true.y());
-    r_.distance_m.push_back((r_.distance_m.empty() ? 0.0 : r_.distance_m.back()) + step);
-    r_.drift_m.push_back((Eigen::Vector2d(o.x_m, o.y_m) - p_true).norm());
+    odo_.add({geom::ns_to_seconds(o.t_ns), o.x_m, o.y_m, p_true.x(), p_true.y(), distance_m_,
+              (Eigen::Vector2d(o.x_m, o.y_m) - p_true).norm()});
     if (!truth.carried) {
       slip_sum_ += std::abs(truth.slip.x()) + std::abs(truth.slip.y());
       slip_count_ += 2;
     }
   }
-  r_.mean_abs_slip = slip_count_ > 0 ? slip_sum_ / slip_count_ : 0.0;
+}
+
+MotionSensorsReport MotionReportBuilder::report() const {
+  MotionSensorsReport r;
+  r.imu_t_s = imu_.column(0);
+  r.yaw_rate_measured = imu_.column(1);
+  r.yaw_rate_true = imu_.column(2);
+  std::vector<double>* odo[] = {&r.odo_t_s,  &r.odo_x_m,    &r.odo_y_m, &r.true_x_m,
+                                &r.true_y_m, &r.distance_m, &r.drift_m};
+  for (std::size_t c = 0; c < 7; ++c) *odo[c] = odo_.column(c);
+  r.mean_abs_slip = slip_count_ > 0 ? slip_sum_ / static_cast<double>(slip_count_) : 0.0;
+  return r;
 }
 
 }  // namespace pvb::run

@@ -1,8 +1,10 @@
 #pragma once
 // Gathers a run's motion sensor readings and their truth, frame by frame,
-// into the report's MotionSensorsReport.
+// into the report's MotionSensorsReport; an hour's readings are thinned to
+// a figure's worth (ThinnedSeries).
 #include "frame_producer.hpp"
 #include "pvb/report/report.hpp"
+#include "pvb/report/thinned_series.hpp"
 #include "pvb/sensor/wheel_odometry.hpp"
 
 namespace pvb::run {
@@ -12,7 +14,8 @@ class MotionReportBuilder {
   /// T_b_i: the IMU in the base; drive: the description odometry uses.
   MotionReportBuilder(const geom::SE3d& T_b_i, const sensor::DriveDescription& drive);
   void add(const FrameItem& item);
-  const MotionSensorsReport& report() const { return r_; }
+  /// The series so far, each ending with its latest reading.
+  MotionSensorsReport report() const;
 
  private:
   Eigen::Matrix3d R_b_i_;
@@ -21,7 +24,10 @@ class MotionReportBuilder {
   Eigen::Vector2d last_true_ = Eigen::Vector2d::Zero();
   double slip_sum_ = 0;
   long slip_count_ = 0;
-  MotionSensorsReport r_;
+  double distance_m_ = 0;
+  bool moved_ = false;  ///< a wheel reading has been added
+  ThinnedSeries imu_;   ///< t, measured and true yaw rate
+  ThinnedSeries odo_;   ///< t, odometry x y, true x y, distance, drift
 };
 
 }  // namespace pvb::run

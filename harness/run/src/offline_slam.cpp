@@ -222,7 +222,7 @@ std::optional<slam::TrackingState> OfflineSlam::Impl::track_one(const sensor::Rg
   tally_.tracking_ms.push_back(r.tracking_ms);
   if (settings_.pe_match.enabled && r.tracking.method == slam::TrackingMethod::kMotionModel)
     tally_.pe_ms.push_back(r.tracking.pe_match_ms);
-  if (r.g_w) tally_.gravity[r.t_ns] = *r.g_w;
+  eval::record_gravity(&tally_.gravity, r.t_ns, r.g_w);
   if (r.T_w_c) {
     cam_traj_.append(geom::format_tum_line({r.t_ns, *r.T_w_c}) + "\n");
     ++tally_.poses;

@@ -64,7 +64,7 @@ struct Tally {
   std::string init_failure;    ///< why the last frame failed to initialise
   std::vector<std::int64_t> keyframe_t_ns;  ///< every keyframe made
   std::vector<std::int64_t> frame_t_ns;     ///< every frame tracked
-  eval::GravityEstimates gravity;           ///< the core's gravity per frame, once trusted
+  eval::GravityEstimates gravity;           ///< the core's gravity where it changed (eval::record_gravity)
 };
 }  // namespace offline_detail
 

@@ -140,15 +140,22 @@ class GroundTruthSink {
     motion_.write(item.frame);
     motion_truth_.write(item.imu_truth, item.wheel_truth);
     motion_report_.add(item);
-    for (const sim::ImuTruth& t : item.imu_truth) bias_truth_.push_back({t.t_ns, t.gyro_bias, t.accel_bias});
+    add_bias_truth(item.imu_truth);
   }
-  /// The biases in every IMU reading so far (imu0/truth.csv's).
+  /// The biases in the first and the last IMU reading of every frame
+  /// (keep_frame_ends; imu0/truth.csv has them all).
   const std::vector<BiasTruth>& bias_truth() const { return bias_truth_; }
-  const MotionSensorsReport& motion_report() const { return motion_report_.report(); }
+  MotionSensorsReport motion_report() const { return motion_report_.report(); }
   void close() { file_.close(); }
   const eval::Trajectory& trajectory() const { return trajectory_; }
 
  private:
+  void add_bias_truth(const std::vector<sim::ImuTruth>& readings) {
+    std::vector<BiasTruth> frame;
+    for (const sim::ImuTruth& t : readings) frame.push_back({t.t_ns, t.gyro_bias, t.accel_bias});
+    keep_frame_ends(frame, &bias_truth_);
+  }
+
   std::string dir_;
   const scenes::Scenario& scenario_;
   OutputFile file_;

@@ -97,7 +97,7 @@ slam::FrameResult SystemSink::track(const sensor::RgbdFrame& frame, RunLog& log)
   count(r, index, t_s);
   costs.frame(*system, index, t_s, r.tracking_ms);
   if (r.tracking.new_keyframe) keyframe_t_ns.push_back(r.t_ns);
-  if (r.g_w) gravity_estimates[r.t_ns] = *r.g_w;
+  eval::record_gravity(&gravity_estimates, r.t_ns, r.g_w);
   write_lines(r, index);
   for (const std::string& l : loss_log.frame(index, t_s, r.state == slam::TrackingState::kLost, r.tracking.failure,
                                              slam::to_string(r.tracking.reloc_failure)))

@@ -32,7 +32,7 @@ struct SystemSink {
   OutputFile cam_traj, kf_traj, timing;
   CostLog costs;  ///< costs.csv; run.costs at finish()
   eval::Trajectory est;
-  eval::GravityEstimates gravity_estimates;  ///< the core's gravity per frame, once trusted
+  eval::GravityEstimates gravity_estimates;  ///< the core's gravity where it changed (eval::record_gravity)
   std::optional<double>
       gravity_true_deg;      ///< at the trusted time, against the ground truth (evaluate_gravity)
   eval::Trajectory refined;  ///< filled by finish()

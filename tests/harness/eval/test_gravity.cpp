@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <optional>
 
 #include "pvb/eval/gravity.hpp"
 
@@ -68,6 +69,34 @@ TEST(Gravity, TheCoresOwnGravityCountsWhereItHasOne) {
   EXPECT_NEAR(g.angle_deg[1], 3.0, 1e-9);
   EXPECT_NEAR(g.angle_deg[2], 0.0, 1e-6);
   EXPECT_NEAR(g.angle_deg[3], 0.5, 1e-9);
+}
+
+TEST(Gravity, EstimatesRecordedWhereTheyChangeHoldUntilTheNextChange) {
+  // Frames 0-1 untrusted, 2-4 one estimate, 5-6 a refined one, 7-8 none
+  // again (a provisional map): three changes, so three entries, and each
+  // frame judged by the estimate the core held for it.
+  eval::Trajectory gt, est;
+  drifting(9, 0.0, 0.0, &gt, &est);
+  const geom::Mat3d R_map_w = Eigen::AngleAxisd(rad(3.0), geom::Vec3d::UnitY()).toRotationMatrix();
+  for (auto& p : est.poses) p.T_w_c.linear() = R_map_w * p.T_w_c.linear();
+  const geom::Vec3d first = R_map_w * geom::Vec3d(0, 0, -9.81);
+  const geom::Vec3d refined = Eigen::AngleAxisd(rad(1.0), geom::Vec3d::UnitX()) * first;
+  eval::GravityEstimates recorded;
+  for (int i = 0; i < 9; ++i) {
+    std::optional<geom::Vec3d> g;
+    if (i >= 2 && i <= 4) g = first;
+    if (i == 5 || i == 6) g = refined;
+    eval::record_gravity(&recorded, est.poses[i].t_ns, g);
+  }
+  EXPECT_EQ(recorded.size(), 3u);
+  const eval::GravityError g =
+      eval::gravity_error(gt, est, geom::Vec3d(0, 0, -1), "gravity_aligned", recorded);
+  // The refined estimate is off the true down by the angle between the two.
+  const double refined_deg = std::atan2(first.cross(refined).norm(), first.dot(refined)) * 180.0 / kPi;
+  const double expected[] = {3,           3,           0, 0, 0,
+                             refined_deg, refined_deg, 3, 3};  // untrusted or none: the map's -z
+  ASSERT_EQ(g.angle_deg.size(), 9u);
+  for (int i = 0; i < 9; ++i) EXPECT_NEAR(g.angle_deg[i], expected[i], 1e-6) << "frame " << i;
 }
 
 TEST(Gravity, AMapInTheFirstCameraFrameIsNinetyDegreesOffForALevelCamera) {

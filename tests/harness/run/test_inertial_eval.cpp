@@ -13,11 +13,12 @@
 #include <cstdlib>
 #include <fstream>
 #include <optional>
+#include <random>
 
 #include "pvb/common/error.hpp"
 #include "pvb/common/text.hpp"
-#include "pvb/run/inertial_eval.hpp"
 #include "pvb/report/report.hpp"
+#include "pvb/run/inertial_eval.hpp"
 
 namespace pvb::run {
 namespace {
@@ -82,6 +83,38 @@ TEST(InertialEval, InterpolatesTheTrueBiasBetweenReadings) {
   EXPECT_NEAR(bias_truth_at(truth, 9'000'000'000).gyro_radps.y(), -2e-3, 1e-15);
   // On a reading exactly.
   EXPECT_NEAR(bias_truth_at(truth, 1'300'000'000).accel_mps2.x(), 0.015, 1e-15);
+}
+
+TEST(InertialEval, EachFramesFirstAndLastReadingGiveTheBiasesAtEveryFrameTime) {
+  // Readings at 200 Hz on a seeded random walk, frames at 30 Hz; a frame's
+  // readings taken either up to and including its time or up to before it.
+  std::mt19937 rng(7);
+  std::normal_distribution<double> step(0.0, 1e-4);
+  std::vector<BiasTruth> all;
+  Eigen::Vector3d g = Eigen::Vector3d::Zero(), a = Eigen::Vector3d::Zero();
+  for (int i = 0; i <= 400; ++i) {
+    g += Eigen::Vector3d(step(rng), step(rng), step(rng));
+    a += 10 * Eigen::Vector3d(step(rng), step(rng), step(rng));
+    all.push_back({i * 5'000'000LL, g, a});
+  }
+  std::vector<std::int64_t> frame_ns;
+  for (int k = 0; k <= 59; ++k) frame_ns.push_back((k * 1'000'000'000LL + 15) / 30);
+  for (const bool up_to_and_including : {true, false}) {
+    std::vector<BiasTruth> delivered, kept, batch;
+    std::size_t r = 0;
+    for (const std::int64_t t_ns : frame_ns) {
+      batch.clear();
+      while (r < all.size() && (up_to_and_including ? all[r].t_ns <= t_ns : all[r].t_ns < t_ns))
+        batch.push_back(all[r++]);
+      delivered.insert(delivered.end(), batch.begin(), batch.end());
+      keep_frame_ends(batch, &kept);
+    }
+    EXPECT_LT(kept.size(), delivered.size() / 2);
+    for (const std::int64_t t_ns : frame_ns) {
+      EXPECT_EQ(bias_truth_at(kept, t_ns).gyro_radps, bias_truth_at(delivered, t_ns).gyro_radps) << t_ns;
+      EXPECT_EQ(bias_truth_at(kept, t_ns).accel_mps2, bias_truth_at(delivered, t_ns).accel_mps2) << t_ns;
+    }
+  }
 }
 
 TEST(InertialEval, KeyframeBiasErrorsOfKnownSize) {

@@ -15,6 +15,7 @@
 //    towards +y, down); degrees.  Their least-squares slope over the
 //    keyframe index, in degrees per keyframe, and its sign.
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,11 +32,20 @@ struct GravityError {
   double median_deg = 0, p95_deg = 0, final_deg = 0;
 };
 
-/// The core's gravity per frame: at each time (ns), gravity's direction
-/// in the map's frame as the core held it.  A frame without an entry
-/// within a millisecond takes the map's -z (before the inertial state is
-/// trusted, the map's frame is all the core says about gravity).
+/// The core's gravity over time: each entry (time in ns, gravity's
+/// direction in the map's frame) holds from its time, less a millisecond
+/// (trajectory files keep microseconds), until the next entry.  A zero
+/// vector, or a frame before the first entry, takes the map's -z (before
+/// the inertial state is trusted, the map's frame is all the core says
+/// about gravity).  Entries are made only where the estimate changes
+/// (`record_gravity`), so a long run keeps one per refinement, not one per
+/// frame.
 using GravityEstimates = std::map<std::int64_t, geom::Vec3d>;
+
+/// Adds the core's estimate at t_ns (none: not trusted, or not given) to
+/// `estimates` when it differs from the one held at that time; estimates
+/// are recorded in time order.
+void record_gravity(GravityEstimates* estimates, std::int64_t t_ns, const std::optional<geom::Vec3d>& g_w);
 
 /// The gravity error of `est` (T_map_c) against `gt` (T_w_c) with gravity
 /// down_w in gt's world (normalised here): per frame, the angle between the

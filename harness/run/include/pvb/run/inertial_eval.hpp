@@ -53,6 +53,13 @@ std::string wheels_text(const slam::WheelFit& w, const std::optional<slam::Wheel
 /// first or last reading outside them.  `truth` non-empty, in time order.
 BiasTruth bias_truth_at(const std::vector<BiasTruth>& truth, std::int64_t t_ns);
 
+/// Keeps, of one frame's readings (in time order), the first and the last
+/// in `kept`.  A frame's time lies between its last reading and the next
+/// frame's first, so `bias_truth_at` at any frame time gives from what is
+/// kept the biases it gives from every reading: a long run keeps two
+/// readings a frame, not the IMU's rate.
+void keep_frame_ends(const std::vector<BiasTruth>& frame_readings, std::vector<BiasTruth>* kept);
+
 /// One keyframe's estimated biases (slam::System::keyframe_states()).
 struct KeyframeBias {
   std::uint64_t id = 0;
