@@ -1,6 +1,7 @@
 #include "motion_report.hpp"
 
 #include <cmath>
+#include <iterator>
 
 #include "pvb/geometry/time.hpp"
 
@@ -25,8 +26,7 @@ void MotionReportBuilder::add(const FrameItem& item) {
     odometry_.add(item.frame.wheel_ticks[k]);
     const Eigen::Vector2d p_true = sensor::odometry_frame_position(*T_w_b0_, truth.T_w_b);
     const sensor::OdometryState& o = odometry_.state();
-    if (moved_) distance_m_ += (p_true - last_true_).norm();
-    moved_ = true;
+    if (odo_.rows_added() > 0) distance_m_ += (p_true - last_true_).norm();
     last_true_ = p_true;
     odo_.add({geom::ns_to_seconds(o.t_ns), o.x_m, o.y_m, p_true.x(), p_true.y(), distance_m_,
               (Eigen::Vector2d(o.x_m, o.y_m) - p_true).norm()});
@@ -44,7 +44,7 @@ MotionSensorsReport MotionReportBuilder::report() const {
   r.yaw_rate_true = imu_.column(2);
   std::vector<double>* odo[] = {&r.odo_t_s,  &r.odo_x_m,    &r.odo_y_m, &r.true_x_m,
                                 &r.true_y_m, &r.distance_m, &r.drift_m};
-  for (std::size_t c = 0; c < 7; ++c) *odo[c] = odo_.column(c);
+  for (std::size_t c = 0; c < std::size(odo); ++c) *odo[c] = odo_.column(c);
   r.mean_abs_slip = slip_count_ > 0 ? slip_sum_ / static_cast<double>(slip_count_) : 0.0;
   return r;
 }

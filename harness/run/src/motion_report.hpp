@@ -25,7 +25,6 @@ class MotionReportBuilder {
   double slip_sum_ = 0;
   long slip_count_ = 0;
   double distance_m_ = 0;
-  bool moved_ = false;  ///< a wheel reading has been added
   ThinnedSeries imu_;   ///< t, measured and true yaw rate
   ThinnedSeries odo_;   ///< t, odometry x y, true x y, distance, drift
 };
