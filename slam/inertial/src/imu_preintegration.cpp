@@ -3,6 +3,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
@@ -99,18 +100,98 @@ void ImuPreintegration::integrate(const Eigen::Vector3d& gyro_radps, const Eigen
   dv_ += dR_h * a * dt_s;
   dR_ = orthonormalised(dR_ * dR_k);
   dt_s_ += dt_s;
+  if (readings_.size() >= kFoldAt) fold_oldest(kFoldCount);
 }
 
 void ImuPreintegration::append(const ImuPreintegration& next) {
   // Copy first: next may be *this.
-  const std::vector<Reading> more = next.readings_;
-  for (const Reading& r : more) integrate(r.gyro_radps, r.accel_mps2, r.dt_s);
+  const ImuPreintegration more = next;
+  if (more.folded_) {
+    // The folded part has no readings to integrate at this bias: it is
+    // joined by its increments, and everything up to its end is folded.
+    ImuPreintegration head(bias_, noise_);
+    head.start_from(*more.folded_, bias_);
+    compose(head.increments());
+    folded_ = increments();
+    folded_count_ += readings_.size() + more.folded_count_;
+    readings_.clear();
+  }
+  for (const Reading& r : more.readings_) integrate(r.gyro_radps, r.accel_mps2, r.dt_s);
 }
 
 void ImuPreintegration::reintegrate(const ImuBias& bias) {
-  const std::vector<Reading> all = std::move(readings_);
+  const std::vector<Reading> kept = std::move(readings_);
+  const std::optional<Increments> folded = folded_;
+  const std::size_t folded_count = folded_count_;
   *this = ImuPreintegration(bias, noise_);
-  for (const Reading& r : all) integrate(r.gyro_radps, r.accel_mps2, r.dt_s);
+  folded_ = folded;
+  folded_count_ = folded_count;
+  if (folded_) start_from(*folded_, bias);
+  for (const Reading& r : kept) integrate(r.gyro_radps, r.accel_mps2, r.dt_s);
+}
+
+ImuPreintegration::Increments ImuPreintegration::increments() const {
+  return Increments{bias_, dt_s_, dR_, J_R_bg_, J_v_bg_, J_v_ba_, J_p_bg_, J_p_ba_, dv_, dp_, cov_};
+}
+
+void ImuPreintegration::start_from(const Increments& f, const ImuBias& b) {
+  bias_ = b;
+  readings_.clear();
+  const Eigen::Vector3d dbg = b.gyro_radps - f.bias.gyro_radps;
+  const Eigen::Vector3d dba = b.accel_mps2 - f.bias.accel_mps2;
+  dR_ = orthonormalised(f.dR * geom::so3_exp(f.J_R_bg * dbg));
+  dv_ = f.dv + f.J_v_bg * dbg + f.J_v_ba * dba;
+  dp_ = f.dp + f.J_p_bg * dbg + f.J_p_ba * dba;
+  J_R_bg_ = f.J_R_bg;
+  J_v_bg_ = f.J_v_bg;
+  J_v_ba_ = f.J_v_ba;
+  J_p_bg_ = f.J_p_bg;
+  J_p_ba_ = f.J_p_ba;
+  cov_ = f.cov;
+  dt_s_ = f.dt_s;
+}
+
+void ImuPreintegration::compose(const Increments& s) {
+  // This stretch P, then s: dR = dR_P dR_s, dv = dv_P + dR_P dv_s,
+  // dp = dp_P + T_s dv_P + dR_P dp_s.  The errors of P (right-perturbed
+  // rotation) and of s are independent, each carried to the end.
+  const Eigen::Matrix3d dR_P = dR_;
+  const Eigen::Matrix3d dR_P_dv_x = dR_P * geom::skew(s.dv), dR_P_dp_x = dR_P * geom::skew(s.dp);
+  Eigen::Matrix<double, 9, 9> A = Eigen::Matrix<double, 9, 9>::Identity();
+  A.block<3, 3>(0, 0) = s.dR.transpose();
+  A.block<3, 3>(3, 0) = -dR_P_dv_x;
+  A.block<3, 3>(6, 0) = -dR_P_dp_x;
+  A.block<3, 3>(6, 3) = Eigen::Matrix3d::Identity() * s.dt_s;
+  Eigen::Matrix<double, 9, 9> B = Eigen::Matrix<double, 9, 9>::Zero();
+  B.block<3, 3>(0, 0) = Eigen::Matrix3d::Identity();
+  B.block<3, 3>(3, 3) = dR_P;
+  B.block<3, 3>(6, 6) = dR_P;
+  cov_ = A * cov_ * A.transpose() + B * s.cov * B.transpose();
+
+  // Bias Jacobians: dR_P moves with the gyro bias by J_R_bg (right).
+  J_p_bg_ += J_v_bg_ * s.dt_s - dR_P_dp_x * J_R_bg_ + dR_P * s.J_p_bg;
+  J_p_ba_ += J_v_ba_ * s.dt_s + dR_P * s.J_p_ba;
+  J_v_bg_ += -dR_P_dv_x * J_R_bg_ + dR_P * s.J_v_bg;
+  J_v_ba_ += dR_P * s.J_v_ba;
+  J_R_bg_ = s.dR.transpose() * J_R_bg_ + s.J_R_bg;
+
+  dp_ += dv_ * s.dt_s + dR_P * s.dp;
+  dv_ += dR_P * s.dv;
+  dR_ = orthonormalised(dR_P * s.dR);
+  dt_s_ += s.dt_s;
+}
+
+void ImuPreintegration::fold_oldest(std::size_t n) {
+  // The increments up to the n-th kept reading, at this bias: the folded
+  // part (already corrected to it when the kept readings were integrated)
+  // and the n readings after it.
+  ImuPreintegration head(bias_, noise_);
+  if (folded_) head.start_from(*folded_, bias_);
+  for (std::size_t k = 0; k < n; ++k)
+    head.integrate(readings_[k].gyro_radps, readings_[k].accel_mps2, readings_[k].dt_s);
+  folded_ = head.increments();
+  folded_count_ += n;
+  readings_.erase(readings_.begin(), readings_.begin() + static_cast<std::ptrdiff_t>(n));
 }
 
 Eigen::Matrix3d ImuPreintegration::delta_R(const ImuBias& b) const {

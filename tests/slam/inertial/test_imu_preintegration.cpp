@@ -4,6 +4,7 @@
 // Jacobian.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -236,6 +237,88 @@ TEST(ImuPreintegration, ReintegrateEqualsAFreshIntegration) {
   EXPECT_LT((pre.covariance() - fresh.covariance()).norm(), 1e-14);
   // At its own bias the corrected increments are the plain ones.
   EXPECT_LT((pre.delta_v(b) - pre.delta_v()).norm(), 1e-15);
+}
+
+/// Largest difference between two preintegrations' increments, bias
+/// Jacobians and covariance, each relative to the size of `ref`'s.
+double largest_relative_difference(const ImuPreintegration& a, const ImuPreintegration& ref) {
+  const auto rel = [](const auto& x, const auto& y) { return (x - y).norm() / std::max(1.0, y.norm()); };
+  return std::max({rel(a.delta_R(), ref.delta_R()), rel(a.delta_v(), ref.delta_v()),
+                   rel(a.delta_p(), ref.delta_p()), rel(a.J_R_bg(), ref.J_R_bg()),
+                   rel(a.J_v_bg(), ref.J_v_bg()), rel(a.J_v_ba(), ref.J_v_ba()),
+                   rel(a.J_p_bg(), ref.J_p_bg()), rel(a.J_p_ba(), ref.J_p_ba()),
+                   rel(a.covariance(), ref.covariance()), std::abs(a.dt_s() - ref.dt_s())});
+}
+
+TEST(ImuPreintegration, FoldsTheOldestReadingsPastTheCap) {
+  const int n = 2 * static_cast<int>(ImuPreintegration::kFoldAt) + 100;
+  const auto readings = random_readings(n, 8);
+  const ImuPreintegration pre = integrate_all(readings, some_bias());
+  EXPECT_EQ(pre.size(), static_cast<std::size_t>(n));
+  EXPECT_LT(pre.readings().size(), ImuPreintegration::kFoldAt);
+  EXPECT_GT(pre.folded_count(), 0u);
+  EXPECT_EQ(pre.folded_count() + pre.readings().size(), static_cast<std::size_t>(n));
+  EXPECT_EQ(pre.readings().back().gyro_radps, readings.back().gyro_radps);  // the newest are kept
+  EXPECT_EQ(pre.readings().front().gyro_radps, readings[pre.folded_count()].gyro_radps);
+}
+
+TEST(ImuPreintegration, ReintegratingFoldedReadingsAtTheirBiasChangesNothing) {
+  const auto readings = random_readings(static_cast<int>(ImuPreintegration::kFoldAt) + 700, 9);
+  const ImuBias b = some_bias();
+  ImuPreintegration pre = integrate_all(readings, b);
+  ASSERT_GT(pre.folded_count(), 0u);
+  const ImuPreintegration before = pre;
+  pre.reintegrate(b);
+  EXPECT_EQ(pre.size(), before.size());
+  EXPECT_EQ(pre.folded_count(), before.folded_count());
+  EXPECT_LT(largest_relative_difference(pre, before), 1e-12);
+}
+
+TEST(ImuPreintegration, ReintegratingFoldedReadingsIsSecondOrderAccurate) {
+  const auto readings = random_readings(static_cast<int>(ImuPreintegration::kFoldAt) + 700, 10);
+  const ImuBias b0 = some_bias();
+  const ImuPreintegration at_b0 = integrate_all(readings, b0);
+  ASSERT_GT(at_b0.folded_count(), 0u);
+  double prev_err = 0;
+  for (double scale : {1e-3, 1e-4}) {
+    ImuBias b = b0;
+    b.gyro_radps += scale * Eigen::Vector3d(1, -1, 0.5);
+    b.accel_mps2 += scale * Eigen::Vector3d(-2, 1, 3);
+    ImuPreintegration pre = at_b0;
+    pre.reintegrate(b);
+    const ImuPreintegration exact = integrate_all(readings, b);  // folds at b: exact
+    const double err = geom::so3_log(exact.delta_R().transpose() * pre.delta_R()).norm() +
+                       (exact.delta_v() - pre.delta_v()).norm() + (exact.delta_p() - pre.delta_p()).norm();
+    const double err0 = geom::so3_log(exact.delta_R().transpose() * at_b0.delta_R()).norm() +
+                        (exact.delta_v() - at_b0.delta_v()).norm() +
+                        (exact.delta_p() - at_b0.delta_p()).norm();
+    EXPECT_LT(err, 0.05 * err0) << "scale " << scale;
+    if (prev_err > 0) {
+      EXPECT_LT(err, 0.03 * prev_err);  // 10x smaller step: ~100x smaller error
+    }
+    prev_err = err;
+  }
+}
+
+TEST(ImuPreintegration, AppendingAFoldedIntervalEqualsIntegratingEverything) {
+  const int n_first = 1000, n_next = static_cast<int>(ImuPreintegration::kFoldAt) + 300;
+  const auto readings = random_readings(n_first + n_next, 11);
+  const ImuBias b = some_bias();
+  const ImuPreintegration all = integrate_all(readings, b);
+  const std::vector<ImuPreintegration::Reading> first(readings.begin(), readings.begin() + n_first),
+      second(readings.begin() + n_first, readings.end());
+  ImuPreintegration a = integrate_all(first, b);
+  const ImuPreintegration next = integrate_all(second, b);
+  ASSERT_GT(next.folded_count(), 0u);
+  a.append(next);
+  EXPECT_EQ(a.size(), all.size());
+  EXPECT_EQ(a.readings().size(), next.readings().size());
+  EXPECT_LT(largest_relative_difference(a, all), 1e-9);
+  // What is left can still be integrated again at another bias.
+  ImuBias b1 = b;
+  b1.gyro_radps.x() += 1e-4;
+  a.reintegrate(b1);
+  EXPECT_LT(largest_relative_difference(a, integrate_all(readings, b1)), 1e-3);
 }
 
 TEST(ImuPreintegration, RejectsNonPositiveDt) {

@@ -9,8 +9,14 @@
 // Frames: b is the IMU's frame, w a world frame whose gravity is g_w.
 // Readings are means over their period (sensor::ImuSample): one reading is
 // held constant over its dt.
+//
+// Memory stays bounded however long the interval (a robot parked for an
+// hour makes no keyframe): past kFoldAt readings the oldest kFoldCount are
+// folded into increments of their own, which a new bias corrects to first
+// order instead of integrating them again.
 #include <Eigen/Core>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "pvb/sensor/motion.hpp"
@@ -39,6 +45,11 @@ class ImuPreintegration {
     double dt_s = 0;
   };
 
+  /// Readings kept to integrate again; reaching this many folds the oldest
+  /// kFoldCount (about 10 s at 200 Hz).
+  static constexpr std::size_t kFoldAt = 4096;
+  static constexpr std::size_t kFoldCount = 2048;
+
   ImuPreintegration() = default;
   /// Empty: identity increments at linearisation bias `bias`.
   ImuPreintegration(const ImuBias& bias, const sensor::ImuNoise& noise);
@@ -50,14 +61,19 @@ class ImuPreintegration {
   /// for dt_s <= 0.
   void integrate(const Eigen::Vector3d& gyro_radps, const Eigen::Vector3d& accel_mps2, double dt_s);
   /// Appends the readings of `next` (which starts where this one ends),
-  /// integrated at this one's bias.
+  /// integrated at this one's bias; the part `next` has folded is joined
+  /// by its increments, corrected to this one's bias.
   void append(const ImuPreintegration& next);
-  /// Integrates every reading again at a new linearisation bias.
+  /// Integrates every kept reading again at a new linearisation bias,
+  /// after the folded ones corrected to it to first order.
   void reintegrate(const ImuBias& bias);
 
   double dt_s() const { return dt_s_; }
-  std::size_t size() const { return readings_.size(); }
+  /// Readings integrated, folded ones included.
+  std::size_t size() const { return folded_count_ + readings_.size(); }
+  /// The readings kept (the newest; at most kFoldAt - 1).
   const std::vector<Reading>& readings() const { return readings_; }
+  std::size_t folded_count() const { return folded_count_; }
   const ImuBias& bias() const { return bias_; }
   const sensor::ImuNoise& noise() const { return noise_; }
 
@@ -86,9 +102,27 @@ class ImuPreintegration {
   NavState predict(const NavState& start, const Eigen::Vector3d& g_w, const ImuBias& b) const;
 
  private:
+  /// The increments, their bias Jacobians and covariance of a stretch of
+  /// readings at linearisation bias `bias`.
+  struct Increments {
+    ImuBias bias;
+    double dt_s = 0;
+    Eigen::Matrix3d dR, J_R_bg, J_v_bg, J_v_ba, J_p_bg, J_p_ba;
+    Eigen::Vector3d dv, dp;
+    Eigen::Matrix<double, 9, 9> cov;
+  };
+  Increments increments() const;
+  /// Empty but for `f`, corrected to first order to bias `b`.
+  void start_from(const Increments& f, const ImuBias& b);
+  /// Composes `s` (at this bias, starting where this ends) onto the end.
+  void compose(const Increments& s);
+  void fold_oldest(std::size_t n);
+
   ImuBias bias_;
   sensor::ImuNoise noise_;
   std::vector<Reading> readings_;
+  std::optional<Increments> folded_;  ///< the readings before readings_, if any were folded
+  std::size_t folded_count_ = 0;
   double dt_s_ = 0;
   Eigen::Matrix3d dR_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d dv_ = Eigen::Vector3d::Zero(), dp_ = Eigen::Vector3d::Zero();
