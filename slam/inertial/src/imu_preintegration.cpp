@@ -109,9 +109,7 @@ void ImuPreintegration::append(const ImuPreintegration& next) {
   if (more.folded_) {
     // The folded part has no readings to integrate at this bias: it is
     // joined by its increments, and everything up to its end is folded.
-    ImuPreintegration head(bias_, noise_);
-    head.start_from(*more.folded_, bias_);
-    compose(head.increments());
+    compose(corrected(*more.folded_, bias_));
     folded_ = increments();
     folded_count_ += readings_.size() + more.folded_count_;
     readings_.clear();
@@ -121,12 +119,10 @@ void ImuPreintegration::append(const ImuPreintegration& next) {
 
 void ImuPreintegration::reintegrate(const ImuBias& bias) {
   const std::vector<Reading> kept = std::move(readings_);
-  const std::optional<Increments> folded = folded_;
-  const std::size_t folded_count = folded_count_;
-  *this = ImuPreintegration(bias, noise_);
-  folded_ = folded;
-  folded_count_ = folded_count;
-  if (folded_) start_from(*folded_, bias);
+  if (folded_)
+    start_from(corrected(*folded_, bias));
+  else
+    *this = ImuPreintegration(bias, noise_);
   for (const Reading& r : kept) integrate(r.gyro_radps, r.accel_mps2, r.dt_s);
 }
 
@@ -134,14 +130,23 @@ ImuPreintegration::Increments ImuPreintegration::increments() const {
   return Increments{bias_, dt_s_, dR_, J_R_bg_, J_v_bg_, J_v_ba_, J_p_bg_, J_p_ba_, dv_, dp_, cov_};
 }
 
-void ImuPreintegration::start_from(const Increments& f, const ImuBias& b) {
-  bias_ = b;
-  readings_.clear();
+ImuPreintegration::Increments ImuPreintegration::corrected(const Increments& f, const ImuBias& b) {
+  Increments out = f;
+  out.bias = b;
   const Eigen::Vector3d dbg = b.gyro_radps - f.bias.gyro_radps;
   const Eigen::Vector3d dba = b.accel_mps2 - f.bias.accel_mps2;
-  dR_ = orthonormalised(f.dR * geom::so3_exp(f.J_R_bg * dbg));
-  dv_ = f.dv + f.J_v_bg * dbg + f.J_v_ba * dba;
-  dp_ = f.dp + f.J_p_bg * dbg + f.J_p_ba * dba;
+  out.dR = orthonormalised(f.dR * geom::so3_exp(f.J_R_bg * dbg));
+  out.dv = f.dv + f.J_v_bg * dbg + f.J_v_ba * dba;
+  out.dp = f.dp + f.J_p_bg * dbg + f.J_p_ba * dba;
+  return out;
+}
+
+void ImuPreintegration::start_from(const Increments& f) {
+  bias_ = f.bias;
+  readings_.clear();
+  dR_ = f.dR;
+  dv_ = f.dv;
+  dp_ = f.dp;
   J_R_bg_ = f.J_R_bg;
   J_v_bg_ = f.J_v_bg;
   J_v_ba_ = f.J_v_ba;
@@ -186,7 +191,7 @@ void ImuPreintegration::fold_oldest(std::size_t n) {
   // part (already corrected to it when the kept readings were integrated)
   // and the n readings after it.
   ImuPreintegration head(bias_, noise_);
-  if (folded_) head.start_from(*folded_, bias_);
+  if (folded_) head.start_from(corrected(*folded_, bias_));
   for (std::size_t k = 0; k < n; ++k)
     head.integrate(readings_[k].gyro_radps, readings_[k].accel_mps2, readings_[k].dt_s);
   folded_ = head.increments();

@@ -112,8 +112,11 @@ class ImuPreintegration {
     Eigen::Matrix<double, 9, 9> cov;
   };
   Increments increments() const;
-  /// Empty but for `f`, corrected to first order to bias `b`.
-  void start_from(const Increments& f, const ImuBias& b);
+  /// f's increments at bias b, corrected to first order (eq. 44); its
+  /// Jacobians and covariance are kept.
+  static Increments corrected(const Increments& f, const ImuBias& b);
+  /// No readings kept: the state is f's.
+  void start_from(const Increments& f);
   /// Composes `s` (at this bias, starting where this ends) onto the end.
   void compose(const Increments& s);
   void fold_oldest(std::size_t n);
