@@ -6,12 +6,12 @@
 //   render_scene --scene REC/scene.xml --gl egl --frames 600 --out DIR
 // prints the backend, frames/s over the timed frames and the median render
 // time, and writes the first and last frame to DIR as PPM images.
-#include <CLI/CLI.hpp>
 #include <mujoco/mujoco.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -20,6 +20,7 @@
 
 #include "pvb/common/error.hpp"
 #include "pvb/sim/renderer.hpp"
+#include "pvb/sim/scene_builder.hpp"
 
 namespace {
 
@@ -69,6 +70,11 @@ int run(const Options& o) {
   char err[1024] = {0};
   mjModel* m = mj_loadXML(o.scene.c_str(), nullptr, err, sizeof err);
   if (m == nullptr) throw pvb::Error(o.scene + ": " + err);
+  // A relief under a varied ground keeps its tiles' heights beside scene.xml.
+  const std::string dir = o.scene.substr(0, o.scene.find_last_of('/') + 1);
+  std::ifstream tiles(dir + pvb::sim::kReliefTilesFile, std::ios::binary);
+  if (tiles)
+    pvb::sim::fill_relief_tiles(m, std::vector<unsigned char>(std::istreambuf_iterator<char>(tiles), {}));
   mjData* d = mj_makeData(m);
   const int camera = mj_name2id(m, mjOBJ_CAMERA, "rgbd");
   if (camera < 0) throw pvb::Error(o.scene + ": no camera named rgbd");

@@ -79,10 +79,27 @@ Eigen::Vector2i relief_samples(const Eigen::Vector2d& size_m, double cell_m) {
 }
 
 GroundRelief::GroundRelief(const Scenario& s) {
-  if (s.ground.relief) *this = GroundRelief(*s.ground.relief, s.ground.size_m, s.station_seed_or_seed());
+  if (s.ground.relief)
+    *this = GroundRelief(*s.ground.relief, s.ground.size_m, s.station_seed_or_seed(),
+                         s.ground.tiling == GroundTiling::kVaried);
 }
 
-GroundRelief::GroundRelief(const Relief& r, const Eigen::Vector2d& size_m, std::uint64_t station_seed) {
+GroundRelief::GroundRelief(const Relief& r, const Eigen::Vector2d& size_m, std::uint64_t station_seed,
+                           bool tiled)
+    : relief_(true), tiled_(tiled) {
+  const double az = r.slope_azimuth_deg * M_PI / 180.0, grade = r.slope_percent / 100.0;
+  if (tiled) {  // the field itself, sampled when asked for
+    if (r.amplitude_cm > 0)
+      for (const Wave& w : draw_waves(r.scale_m, station_seed)) waves_.emplace_back(w.kx, w.ky, w.phase);
+    amp_m_ = r.amplitude_cm / 100.0 * std::sqrt(2.0 / kReliefWaves);
+    grade_x_ = grade * std::cos(az);
+    grade_y_ = grade * std::sin(az);
+    half_x_m_ = size_m.x() / 2;
+    half_y_m_ = size_m.y() / 2;
+    cells_per_tile_ = static_cast<int>(std::ceil(kReliefTileM / r.cell_m - 1e-9));
+    lattice_m_ = kReliefTileM / cells_per_tile_;
+    return;
+  }
   const Eigen::Vector2i n = relief_samples(size_m, r.cell_m);
   grid_.ncol = n.x();
   grid_.nrow = n.y();
@@ -90,7 +107,6 @@ GroundRelief::GroundRelief(const Relief& r, const Eigen::Vector2d& size_m, std::
   grid_.half_y_m = size_m.y() / 2;
   grid_.z_m.assign(static_cast<std::size_t>(grid_.nrow) * static_cast<std::size_t>(grid_.ncol), 0.0);
   if (r.amplitude_cm > 0) add_roughness(draw_waves(r.scale_m, station_seed), r.amplitude_cm / 100.0, &grid_);
-  const double az = r.slope_azimuth_deg * M_PI / 180.0, grade = r.slope_percent / 100.0;
   const double dx = size_m.x() / (grid_.ncol - 1), dy = size_m.y() / (grid_.nrow - 1);
   for (int row = 0; row < grid_.nrow; ++row)
     for (int c = 0; c < grid_.ncol; ++c) {
@@ -98,6 +114,27 @@ GroundRelief::GroundRelief(const Relief& r, const Eigen::Vector2d& size_m, std::
       grid_.z_m[static_cast<std::size_t>(row) * static_cast<std::size_t>(grid_.ncol) +
                 static_cast<std::size_t>(c)] += grade * (x * std::cos(az) + y * std::sin(az));
     }
+}
+
+double GroundRelief::sample_m(long long i, long long j) const {
+  const double x = -half_x_m_ + static_cast<double>(i) * lattice_m_;
+  const double y = -half_y_m_ + static_cast<double>(j) * lattice_m_;
+  double z = grade_x_ * x + grade_y_ * y;
+  for (const Eigen::Vector3d& w : waves_) z += amp_m_ * std::cos(w.x() * x + w.y() * y + w.z());
+  return z;
+}
+
+GroundPoint GroundRelief::at(double x, double y) const {
+  if (!relief_) return {};
+  if (!tiled_) return grid_.at(x, y);
+  // The lattice cell under (x, y) as a 2 x 2 grid, interpolated as MuJoCo does.
+  const auto i = static_cast<long long>(std::floor((x + half_x_m_) / lattice_m_));
+  const auto j = static_cast<long long>(std::floor((y + half_y_m_) / lattice_m_));
+  const double z[4] = {sample_m(i, j), sample_m(i + 1, j), sample_m(i, j + 1), sample_m(i + 1, j + 1)};
+  const double cx = -half_x_m_ + (static_cast<double>(i) + 0.5) * lattice_m_;
+  const double cy = -half_y_m_ + (static_cast<double>(j) + 0.5) * lattice_m_;
+  const double h = lattice_m_ / 2;
+  return grid_surface(z, 1.0, 2, 2, h, h, x - cx, y - cy);
 }
 
 std::optional<RouteGradeFault> find_route_grade_fault(const GroundRelief& g,

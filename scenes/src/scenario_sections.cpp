@@ -465,8 +465,9 @@ void check_route(const Scenario& s, const ReadContext& ctx) {
   }
 }
 
-/// ground.relief: roughness and slope, checked against the ground's
-/// tiling and the samples the height field may have.
+/// ground.relief: roughness and slope; under a repeated soil, checked
+/// against the samples its one height field may have (a varied soil's
+/// relief is drawn tile by tile).
 void read_relief(MapReader& q, Ground& g) {
   Relief rl;
   rl.amplitude_cm = q.number("amplitude_cm", rl.amplitude_cm, 0, 20);
@@ -479,7 +480,7 @@ void read_relief(MapReader& q, Ground& g) {
            "a cell of at most half of scale_m (" + format_exact(rl.scale_m / 2) + " m), to draw the bumps",
            format_exact(rl.cell_m));
   const Eigen::Vector2i n = relief_samples(g.size_m, rl.cell_m);
-  if (static_cast<long long>(n.x()) * n.y() > kMaxReliefSamples)
+  if (g.tiling == GroundTiling::kRepeat && static_cast<long long>(n.x()) * n.y() > kMaxReliefSamples)
     q.fail(q.full("cell_m"), YAML::Node(),
            "a cell that samples ground.size_m in at most " + std::to_string(kMaxReliefSamples) + " points",
            format_exact(rl.cell_m) + " m (" + std::to_string(n.x()) + " x " + std::to_string(n.y()) + " points)");
@@ -501,11 +502,6 @@ void read_ground(MapReader& r, Ground& g) {
     r.fail(r.full("unique_within_m"), r.child("unique_within_m"), "unique_within_m with soil_images only",
            format_exact(g.unique_within_m));
   with_map(r, "relief", [&](MapReader& q) { read_relief(q, g); });
-  // Blamed on the tiling, where it was written (a day file's over its
-  // base's relief): a relief takes one repeated image.
-  if (g.relief && g.tiling == GroundTiling::kVaried)
-    r.fail(r.full("tiling"), r.child("tiling"),
-           "repeat under a relief (ground.relief is given; a varied ground's tiles are flat planes)", "varied");
   if (r.has("friction")) g.friction = r.number("friction", 0.0, 0.05, 2);
   g.softness = r.number("softness", g.softness, 0, 1);
 }

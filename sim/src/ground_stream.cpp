@@ -23,12 +23,15 @@ GroundStream::GroundStream(mjModel* model, const scenes::Scenario& s)
   tile_slot_.assign(tiles_.size(), -1);
   tile_near_.assign(tiles_.size(), 0);
   if (tiles_.empty()) return;
-  // The tiles follow the ground's two planes, in ground_tiles order.
+  // The tiles follow the ground's two planes, in ground_tiles order; on a
+  // tiled relief they are height fields, the first one named.
   const int ground = mj_name2id(model, mjOBJ_GEOM, "ground");
-  first_tile_geom_ = ground + 2;
+  const int first_field = mj_name2id(model, mjOBJ_GEOM, "groundtile0");
+  first_tile_geom_ = first_field >= 0 ? first_field : ground + 2;
+  const int type = first_field >= 0 ? mjGEOM_HFIELD : mjGEOM_PLANE;
   for (std::size_t k = 0; k < tiles_.size(); ++k) {
     const int g = first_tile_geom_ + static_cast<int>(k);
-    const bool tile = ground >= 0 && g < model->ngeom && model->geom_type[g] == mjGEOM_PLANE &&
+    const bool tile = (first_field >= 0 || ground >= 0) && g < model->ngeom && model->geom_type[g] == type &&
                       std::abs(model->geom_pos[3 * g] - tiles_[k].centre_m.x()) < 1e-6 &&
                       std::abs(model->geom_pos[3 * g + 1] - tiles_[k].centre_m.y()) < 1e-6;
     if (!tile) throw Error("the scene's ground tiles are not where its tile list puts tile " + std::to_string(k));

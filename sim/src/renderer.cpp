@@ -104,7 +104,8 @@ void snap_to_shadow_texels(float pos[3], const float dir[3], double texel_m) {
 namespace {
 
 /// The sphere that holds a primitive geom, its radius; -1 for a geom that is
-/// not culled (a plane, a height field, a mesh, decor).
+/// not culled (an infinite plane, decor) or whose model gives the radius
+/// (a height field, a mesh).
 double bounding_radius(const mjvGeom& g) {
   const double a = g.size[0], b = g.size[1], c = g.size[2];
   switch (g.type) {
@@ -117,6 +118,14 @@ double bounding_radius(const mjvGeom& g) {
       return a > 0 && b > 0 ? std::sqrt(a * a + b * b) : -1;
     default: return -1;
   }
+}
+
+/// The sphere about a height field geom's frame that holds it, its radius
+/// (MuJoCo 2.2.2 leaves geom_rbound 0 for a height field): half its
+/// extent across, and its top or its base below.
+double hfield_radius(const mjModel* m, int geom) {
+  const mjtNum* s = m->hfield_size + 4 * m->geom_dataid[geom];
+  return std::sqrt(s[0] * s[0] + s[1] * s[1] + std::max(s[2], s[3]) * std::max(s[2], s[3]));
 }
 
 /// The beam of the first shadow-casting directional light (unit, pointing
@@ -132,7 +141,9 @@ std::optional<Eigen::Vector3d> shadow_beam(const mjvScene& scn) {
 
 }  // namespace
 
-int cull_to_view(mjvScene* scn, double aspect, double far_tile_m, const double* geom_rbound) {
+int cull_to_view(mjvScene* scn, double aspect, double far_tile_m, const mjModel* model,
+                 double shadow_floor_z_m) {
+  const int backdrop_matid = model ? mj_name2id(model, mjOBJ_MATERIAL, "ground") : -1;
   const mjvGLCamera& cam = scn->camera[0];
   const Eigen::Vector3d pos(cam.pos[0], cam.pos[1], cam.pos[2]), fwd(cam.forward[0], cam.forward[1], cam.forward[2]);
   const Eigen::Vector3d up(cam.up[0], cam.up[1], cam.up[2]);
@@ -149,17 +160,22 @@ int cull_to_view(mjvScene* scn, double aspect, double far_tile_m, const double* 
   for (int i = 0; i < scn->ngeom; ++i) {
     const mjvGeom g = scn->geoms[i];
     double r = g.category == mjCAT_STATIC && g.objtype == mjOBJ_GEOM ? bounding_radius(g) : -1;
-    if (g.type == mjGEOM_MESH && geom_rbound && g.category == mjCAT_STATIC && g.objtype == mjOBJ_GEOM)
-      r = geom_rbound[g.objid];
+    const bool model_geom = model && g.category == mjCAT_STATIC && g.objtype == mjOBJ_GEOM;
+    if (g.type == mjGEOM_MESH && model_geom) r = model->geom_rbound[g.objid];
+    if (g.type == mjGEOM_HFIELD && model_geom) r = hfield_radius(model, g.objid);
     Eigen::Vector3d c(g.pos[0], g.pos[1], g.pos[2]);
-    if (r >= 0 && beam && beam->z() < -1e-3) {
-      // Its shadow: swept along the beam down to 2 m below its foot.
-      const double len = std::min((c.z() + r + 2.0) / -beam->z(), 500.0);
+    const bool relief_tile =
+        g.type == mjGEOM_HFIELD && model_geom && model->geom_matid[g.objid] != backdrop_matid;
+    if (r >= 0 && beam && beam->z() < -1e-3 && !relief_tile) {  // a relief's tile takes shadows, casts none
+      // Its shadow: swept along the beam down to 2 m below the lowest ground
+      // that takes shadows (none for a geom lower than that).
+      const double len = std::clamp((c.z() - shadow_floor_z_m + r + 2.0) / -beam->z(), 0.0, 500.0);
       c += 0.5 * len * *beam;
       r += 0.5 * len;
     }
     bool visible = r < 0;
-    if (!visible && far_tile_m > 0 && g.type == mjGEOM_PLANE && (c - pos).norm() > far_tile_m + r) continue;
+    const bool tile = g.type == mjGEOM_PLANE || relief_tile;
+    if (!visible && far_tile_m > 0 && tile && (c - pos).norm() > far_tile_m + r) continue;
     if (!visible) {
       const Eigen::Vector3d d = c - pos;
       const Eigen::Vector3d q(d.dot(right), d.dot(up), d.dot(fwd));
@@ -203,7 +219,9 @@ void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat
   camera_.type = mjCAMERA_FIXED;
   camera_.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
-  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_, model->geom_rbound) : 0;
+  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_, model,
+                                 shadow_floor_z_m_)
+                  : 0;
   apply_ground_stream();
   if (stable_shadows_) {
     const double texel_m = shadow_texel_m(con_.shadowClip, con_.shadowSize);
@@ -244,7 +262,9 @@ void Renderer::render_geom_ids(const mjModel* model, mjData* data, int camera_id
   camera_.type = mjCAMERA_FIXED;
   camera_.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
-  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_, model->geom_rbound) : 0;
+  culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_, model,
+                                 shadow_floor_z_m_)
+                  : 0;
   const unsigned char shadow = scene_.flags[mjRND_SHADOW];
   scene_.flags[mjRND_SEGMENT] = 1;
   scene_.flags[mjRND_IDCOLOR] = 1;

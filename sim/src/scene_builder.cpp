@@ -38,16 +38,6 @@ namespace pvb::sim {
 namespace mjcf {
 namespace {
 
-/// Depth of the height field's base below its lowest point.
-constexpr double kReliefBaseM = 0.5;
-
-/// Ten digits, for the height field's placement and size (to a micrometre).
-std::string exact(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", std::abs(v) < 1e-12 ? 0.0 : v);
-  return buf;
-}
-
 constexpr const char* kGroundTilePrefix = "textures/groundt";
 
 /// zlib's level for a texture file as recordings write it: level 6 for the
@@ -225,9 +215,12 @@ std::string hfield_line(const scenes::Scenario& s, const scenes::GroundRelief& g
 }
 
 /// Textures and materials (and the relief's height field).
-void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& out, const scenes::GroundRelief& ground) {
+void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& out,
+                  const scenes::GroundRelief& ground, const ReliefTiles& relief_tiles) {
   x.open("<asset>");
-  if (!ground.flat()) x.line(hfield_line(s, ground));
+  if (!ground.flat() && !ground.tiled()) x.line(hfield_line(s, ground));
+  for (const auto* set : {&relief_tiles.backdrop, &relief_tiles.tiles})
+    for (const RuntimeHField& h : *set) x.line(hfield_asset_line(h));
   const auto rgb = [](const Eigen::Vector3f& c) {  // two decimals, as the sky was always written
     char buf[48];
     std::snprintf(buf, sizeof buf, "%.2f %.2f %.2f", c.x(), c.y(), c.z());
@@ -294,22 +287,6 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
   x.close("</asset>");
 }
 
-/// The ground's contact: MuJoCo's default combination with the tyres (the
-/// larger friction) unless the day gives the soil's friction or softness;
-/// then the ground's govern (a priority above the tyres'): its friction
-/// (the tyres' 1.2 when only the softness is given) and, for a soft soil,
-/// a softer, slower contact in which the tyres sink and creep.
-std::string ground_friction(const scenes::Ground& g) {
-  if (!g.governs_contact()) return "friction=\"1 0.005 0.0001\"";
-  std::string out = "priority=\"1\" friction=\"" + f(g.friction.value_or(1.2)) + " 0.005 0.0001\"";
-  if (g.softness > 0) {  // MuJoCo's defaults at 0: solref 0.02 1, solimp 0.9 0.95 0.001
-    const double k = g.softness;
-    out += " solref=\"" + f(0.02 + 0.08 * k) + " 1\" solimp=\"" + f(0.9 - 0.4 * k) + " " + f(0.95 - 0.25 * k) + " " +
-           f(0.001 + 0.009 * k) + "\"";
-  }
-  return out;
-}
-
 /// The ground: one plane that the robot drives on, with the soil image
 /// repeated every kGroundTileM.  A varied ground hides that plane (group 3,
 /// still colliding) and draws its tiles, each with its own image, over a
@@ -318,7 +295,11 @@ std::string ground_friction(const scenes::Ground& g) {
 /// soil image (MuJoCo maps a 2-D texture onto a height field as onto a
 /// plane: by x and y, texrepeat per metre with texuniform).
 void add_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<GroundTile>& tiles,
-                const scenes::GroundRelief& ground) {
+                const scenes::GroundRelief& ground, const ReliefTiles& relief_tiles) {
+  if (ground.tiled()) {
+    add_tiled_relief_ground(x, s, tiles, relief_tiles);
+    return;
+  }
   if (!ground.flat()) {
     x.line("<geom name=\"ground\" type=\"hfield\" hfield=\"ground\" pos=\"0 0 " + exact(ground.grid().min_m()) +
            "\" material=\"ground\" condim=\"3\" " + ground_friction(s.ground) + "/>");
@@ -340,6 +321,23 @@ void add_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<Groun
 }
 
 }  // namespace
+
+/// The ground's contact: MuJoCo's default combination with the tyres (the
+/// larger friction) unless the day gives the soil's friction or softness;
+/// then the ground's govern (a priority above the tyres'): its friction
+/// (the tyres' 1.2 when only the softness is given) and, for a soft soil,
+/// a softer, slower contact in which the tyres sink and creep.
+std::string ground_friction(const scenes::Ground& g) {
+  if (!g.governs_contact()) return "friction=\"1 0.005 0.0001\"";
+  std::string out = "priority=\"1\" friction=\"" + f(g.friction.value_or(1.2)) + " 0.005 0.0001\"";
+  if (g.softness > 0) {  // MuJoCo's defaults at 0: solref 0.02 1, solimp 0.9 0.95 0.001
+    const double k = g.softness;
+    out += " solref=\"" + f(0.02 + 0.08 * k) + " 1\" solimp=\"" + f(0.9 - 0.4 * k) + " " +
+           f(0.95 - 0.25 * k) + " " + f(0.001 + 0.009 * k) + "\"";
+  }
+  return out;
+}
+
 }  // namespace mjcf
 
 ShadowMap shadow_map_for(const scenes::Light& light, const std::vector<Eigen::Vector2d>& route_xy_m) {
@@ -390,14 +388,18 @@ SceneAssets build_scene(const scenes::Scenario& s, SceneDetail detail, TextureEn
   const std::vector<GroundTile> tiles = varied_ground_tiles(s, route);
   add_textures(s, tiles, detail, &out);
   const scenes::GroundRelief ground(s);
-  if (!ground.flat()) out.files.emplace_back(kReliefFile, hfield_file(ground.grid()));
+  const ReliefTiles tiled = relief_tiles(s, tiles, ground);
+  if (ground.tiled())
+    out.files.emplace_back(kReliefTilesFile, relief_tiles_file(tiled));
+  else if (!ground.flat())
+    out.files.emplace_back(kReliefFile, hfield_file(ground.grid()));
 
   XmlWriter x;
   x.open("<mujoco model=\"" + s.name + "\">");
   write_settings(x, s, out, shadow);
-  write_assets(x, s, out, ground);
+  write_assets(x, s, out, ground, tiled);
   x.open("<worldbody>");
-  add_ground(x, s, tiles, ground);
+  add_ground(x, s, tiles, ground, tiled);
   for (std::size_t i = 0; i < s.pv_arrays.size(); ++i)
     add_array(x, s.pv_arrays[i], static_cast<int>(i), s.seed, s.station_seed_or_seed(), ground);
   add_walls(x, s, ground);
@@ -507,6 +509,8 @@ ModelPtr compile_scene(const SceneAssets& assets) {
   if (m == nullptr) throw Error(std::string("MuJoCo could not compile the generated scene: ") + err);
   ModelPtr model(m);
   if (pixels) fill_textures(m, assets);
+  for (const auto& file : assets.files)
+    if (file.first == kReliefTilesFile) fill_relief_tiles(m, file.second);
   return model;
 }
 

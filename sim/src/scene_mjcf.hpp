@@ -24,11 +24,19 @@ constexpr int kDirtVariants = 4;
 /// On a relief, posts, walls and trunks reach this far into the ground, so
 /// that no gap shows where the ground under them is uneven.
 constexpr double kIntoReliefM = 0.15;
+/// Depth of a height field's base below its lowest point.
+constexpr double kReliefBaseM = 0.5;
 
 // Fixed-precision number formatting so the XML is byte-identical everywhere.
 inline std::string f(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.6g", std::abs(v) < 1e-12 ? 0.0 : v);
+  return buf;
+}
+/// Ten digits, for a height field's placement and size (to a micrometre).
+inline std::string exact(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", std::abs(v) < 1e-12 ? 0.0 : v);
   return buf;
 }
 inline std::string v3(double a, double b, double c) { return f(a) + " " + f(b) + " " + f(c); }
@@ -71,6 +79,29 @@ void add_vegetation(XmlWriter& x, const scenes::Scenario& s, const std::vector<E
 /// station's seed and the cell alone, so the route picks which cells are
 /// drawn, never how one looks.
 std::vector<GroundTile> varied_ground_tiles(const scenes::Scenario& s, const std::vector<Eigen::Vector2d>& route);
+
+// scene_builder.cpp
+/// The ground's contact attributes (friction, priority, softness).
+std::string ground_friction(const scenes::Ground& g);
+
+// scene_relief_tiles.cpp
+/// A tiled relief's height fields (relief_tiles()): the tiles along the
+/// route, then the coarse backdrop's pieces.
+struct ReliefTiles {
+  std::vector<RuntimeHField> tiles, backdrop;
+};
+/// A tiled relief's height fields (none for a grid relief or flat ground).
+ReliefTiles relief_tiles(const scenes::Scenario& s, const std::vector<GroundTile>& tiles,
+                         const scenes::GroundRelief& ground);
+/// kReliefTilesFile's bytes: for each field its name's length, rows and
+/// columns (int32), the name, then rows x columns float samples in [0, 1].
+std::vector<unsigned char> relief_tiles_file(const ReliefTiles& r);
+/// An <hfield> asset whose samples are filled in after compiling.
+std::string hfield_asset_line(const RuntimeHField& h);
+/// The ground of a tiled relief: the backdrop's pieces (scenery), then each
+/// tile, collidable, with its image.
+void add_tiled_relief_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<GroundTile>& tiles,
+                             const ReliefTiles& r);
 
 // scene_plant.cpp
 /// A plant's materials and its fence's meshes (nothing without a plant).

@@ -42,6 +42,8 @@ Simulator::Simulator(scenes::Scenario scenario, SceneDetail detail) : scenario_(
   if (GroundStream::wanted(scenario_, detail)) ground_stream_ = std::make_unique<GroundStream>(model_.get(), scenario_);
   phys_model_ = compile_scene(physics_assets(assets_));
   phys_data_.reset(mj_makeData(phys_model_.get()));
+  relief_ = scenes::GroundRelief(scenario_);
+  shadow_map_ = shadow_map_for(scenario_.light, scenes::route_polyline(scenario_));
   const mjModel* m = phys_model_.get();
   if (m->nq != model_->nq || m->nv != model_->nv || m->nu != model_->nu || m->nbody != model_->nbody ||
       m->ncam != model_->ncam)
@@ -291,6 +293,21 @@ ShadeRegion shade_region(const geom::SE3d& T_w_c, const geom::PinholeIntrinsics&
 
 }  // namespace
 
+double Simulator::shadow_floor_z_m() const {
+  if (relief_.flat()) return 0.0;
+  const Eigen::Vector2d centre =
+      shadow_map_.follows_robot ? Eigen::Vector2d(T_w_c().translation().head<2>()) : shadow_map_.centre_xy_m;
+  const double reach = shadow_map_.half_width_m * std::sqrt(2.0);
+  constexpr int kAcross = 9;
+  double lowest = relief_.height_m(centre);
+  for (int i = 0; i < kAcross; ++i)
+    for (int j = 0; j < kAcross; ++j) {
+      const Eigen::Vector2d d(-1.0 + 2.0 * i / (kAcross - 1), -1.0 + 2.0 * j / (kAcross - 1));
+      lowest = std::min(lowest, relief_.height_m(centre + reach * d));
+    }
+  return lowest - 0.1;
+}
+
 StereoRender RgbdCamera::render_infrared(Simulator& sim, const geom::SE3d& T_w_c, const Eigen::Vector3d& to_sun_c) {
   const scenes::Scenario& s = sim.scenario();
   const scenes::ActiveStereo& p = s.camera.stereo;
@@ -306,6 +323,7 @@ StereoRender RgbdCamera::render_infrared(Simulator& sim, const geom::SE3d& T_w_c
   for (int k = 0; k < 2; ++k) {
     InfraredView& v = k == 0 ? out.left : out.right;
     cv::Mat rgb;
+    ir_renderer_->set_shadow_floor_z_m(sim.shadow_floor_z_m());
     ir_renderer_->render(sim.model(), sim.data(), k == 0 ? ir_left_id_ : ir_right_id_, &rgb, &v.depth_m);
     v.depth_m.setTo(0.0f, v.depth_m > sky);
     cv::cvtColor(rgb, v.grey, cv::COLOR_RGB2GRAY);
@@ -321,6 +339,7 @@ RenderedFrame RgbdCamera::render(Simulator& sim) {
   using Clock = std::chrono::steady_clock;
   RenderedFrame out;
   const auto t0 = Clock::now();
+  renderer_.set_shadow_floor_z_m(sim.shadow_floor_z_m());
   renderer_.render(sim.model(), sim.data(), sim.camera_id(), &out.rgb, &out.depth_gt_m);
   // Sky: beyond every scene distance (the skybox is drawn far away).
   const float sky = static_cast<float>(sim.assets().max_scene_depth_m);

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "pvb/scenes/ground_relief.hpp"
 #include "pvb/scenes/plant.hpp"
 #include "pvb/scenes/route.hpp"
 #include "scenario_errors.hpp"
@@ -133,7 +134,7 @@ namespace plant_test {
 // The shipped plants: a 10 MWdc block each, of at least 150 rows of at least
 // 100 m, and a day's route of at least a kilometre through their aisles.
 TEST(Plant, ShippedPlantsAreTenMegawattBlocksWithAKilometreRoute) {
-  for (const char* name : {"plant_10mw_fixed", "plant_10mw_tracker"}) {
+  for (const char* name : {"plant_10mw_fixed", "plant_10mw_tracker", "plant_10mw_tracker_rough"}) {
     const Scenario s = load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/plants/" + name + ".yaml");
     ASSERT_TRUE(s.plant.has_value()) << name;
     EXPECT_EQ(s.name, name);
@@ -148,6 +149,25 @@ TEST(Plant, ShippedPlantsAreTenMegawattBlocksWithAKilometreRoute) {
     // are slower than the route's speed (the slow PlantRoutes test drives it).
     EXPECT_GE(s.duration_s * s.route.speed_mps, 1.04 * route_m) << name;
   }
+}
+
+// The rough tracker plant is the tracker plant, route and all, on a relief
+// drawn tile by tile under its varied soil.
+TEST(Plant, TheRoughTrackerPlantIsTheTrackerPlantOnARelief) {
+  const std::string dir = std::string(PVB_SOURCE_DIR) + "/scenes/plants/";
+  const Scenario flat = load_scenario(dir + "plant_10mw_tracker.yaml");
+  const Scenario rough = load_scenario(dir + "plant_10mw_tracker_rough.yaml");
+  ASSERT_TRUE(rough.ground.relief.has_value());
+  EXPECT_FALSE(flat.ground.relief.has_value());
+  EXPECT_TRUE(GroundRelief(rough).tiled());
+  EXPECT_EQ(rough.pv_arrays.size(), flat.pv_arrays.size());
+  EXPECT_EQ(rough.plant->rows_per_block, flat.plant->rows_per_block);
+  const std::vector<Eigen::Vector2d> a = route_polyline(flat), b = route_polyline(rough);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i], b[i]) << i;
+  // The rows rise 2 % to the east: 25 m from the first to the last.
+  const GroundRelief g(rough);
+  EXPECT_NEAR(g.height_m(600, 0) - g.height_m(-600, 0), 24.0, 0.2);
 }
 
 }  // namespace plant_test

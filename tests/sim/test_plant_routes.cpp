@@ -16,7 +16,8 @@
 namespace pvb::test {
 namespace plant_routes_test {
 
-constexpr const char* kPlants[] = {"plants/plant_10mw_fixed", "plants/plant_10mw_tracker"};
+constexpr const char* kPlants[] = {"plants/plant_10mw_fixed", "plants/plant_10mw_tracker",
+                                   "plants/plant_10mw_tracker_rough"};
 /// The colour tolerance of a culled frame (far ground tiles left out):
 /// mean absolute difference, and the share of pixels off by more than 30 levels.
 constexpr double kMeanAbsLevels = 1.0, kShareOver30 = 0.01;
@@ -69,6 +70,7 @@ TEST(PlantRoutes, CulledFramesMatchFramesDrawnWholeAlongTheKilometre) {
       whole.set_ground_stream(sim.ground_stream());
       for (int frame = 0; frame < 10; ++frame) {
         cv::Mat rgb_c, depth_c, rgb_w, depth_w;
+        culled.set_shadow_floor_z_m(sim.shadow_floor_z_m());
         culled.render(sim.model(), sim.data(), sim.camera_id(), &rgb_c, &depth_c);
         whole.render(sim.model(), sim.data(), sim.camera_id(), &rgb_w, &depth_w);
         const FrameDiff d = compare(rgb_c, depth_c, rgb_w, depth_w, static_cast<float>(s.camera.depth_range_m.y()));

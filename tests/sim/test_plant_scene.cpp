@@ -4,13 +4,13 @@
 
 #include <algorithm>
 #include <map>
+#include <opencv2/imgproc.hpp>
 #include <regex>
 #include <set>
 #include <string>
 #include <vector>
 
-#include <opencv2/imgproc.hpp>
-
+#include "pvb/scenes/ground_relief.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sim/renderer.hpp"
 #include "pvb/sim/scene_builder.hpp"
@@ -48,37 +48,69 @@ TEST(PlantScene, EachTableIsOneSlab) {
   EXPECT_EQ(slabs, 2 * 8 * 3);  // blocks x rows x tables, not a geom a module
 }
 
-TEST(PlantScene, CulledFramesMatchFramesDrawnWhole) {
-  sim::Simulator sim(small_plant());
+namespace {
+
+/// Renders `sim`'s camera every 12th of 240 frames culled and drawn whole,
+/// which must agree exactly: a geom left out lay wholly outside the view
+/// and its shadow with it.  Returns the most geoms one frame left out.
+int expect_culled_matches_whole(sim::Simulator& sim, int* fence_pixels) {
   sim::Renderer culled(sim.model(), sim::GlBackend::kAuto, 320, 240), whole(sim.model(), sim::GlBackend::kAuto, 320, 240);
   whole.set_culling(false);
+  culled.set_ground_stream(sim.ground_stream());
+  whole.set_ground_stream(sim.ground_stream());
   // The fence's sections are meshes, culled by their bounding spheres.
   std::vector<int> fence;
   for (int g = 0; g < sim.model()->ngeom; ++g) {
     const char* name = mj_id2name(sim.model(), mjOBJ_GEOM, g);
     if (name && std::string(name).rfind("fence", 0) == 0) fence.push_back(g);
   }
-  ASSERT_FALSE(fence.empty());
-  int most_culled = 0, fence_pixels = 0;
+  int most_culled = 0;
   for (int i = 0; i < 240; ++i) {
     if (i % 12 == 0) {
       cv::Mat rgb_c, depth_c, ids_c, rgb_w, depth_w, ids_w;
+      culled.set_shadow_floor_z_m(sim.shadow_floor_z_m());
       culled.render(sim.model(), sim.data(), sim.camera_id(), &rgb_c, &depth_c);
       most_culled = std::max(most_culled, culled.culled_geoms());
       culled.render_geom_ids(sim.model(), sim.data(), sim.camera_id(), &ids_c);
       whole.render(sim.model(), sim.data(), sim.camera_id(), &rgb_w, &depth_w);
       whole.render_geom_ids(sim.model(), sim.data(), sim.camera_id(), &ids_w);
-      // Exact: a geom left out lay wholly outside the view and its shadow with it.
       EXPECT_EQ(cv::norm(rgb_c, rgb_w, cv::NORM_INF), 0.0) << "frame " << i;
       EXPECT_EQ(cv::norm(depth_c, depth_w, cv::NORM_INF), 0.0) << "frame " << i;
       EXPECT_EQ(cv::norm(ids_c, ids_w, cv::NORM_INF), 0.0) << "frame " << i;
       EXPECT_EQ(whole.culled_geoms(), 0);
-      for (const int g : fence) fence_pixels += cv::countNonZero(ids_c == g);
+      for (const int g : fence) *fence_pixels += cv::countNonZero(ids_c == g);
     }
     sim.advance();
   }
-  EXPECT_GT(most_culled, sim.model()->ngeom / 2);
+  return most_culled;
+}
+
+}  // namespace
+
+TEST(PlantScene, CulledFramesMatchFramesDrawnWhole) {
+  sim::Simulator sim(small_plant());
+  int fence_pixels = 0;
+  EXPECT_GT(expect_culled_matches_whole(sim, &fence_pixels), sim.model()->ngeom / 2);
   EXPECT_GT(fence_pixels, 100);  // the fence was in view, and matched
+}
+
+// On a relief under varied soil, tiles and backdrop pieces are height
+// fields culled by their size, and the sun's shadows are swept down to the
+// ground under the shadow map, metres below z = 0 on this 8 % slope.
+TEST(PlantScene, CulledFramesOnARoughPlantMatchFramesDrawnWhole) {
+  scenes::Scenario s = small_plant();
+  s.ground.tiling = scenes::GroundTiling::kVaried;
+  s.ground.soil_images = 4;
+  scenes::Relief r;
+  r.slope_percent = 8;
+  r.slope_azimuth_deg = 0;
+  s.ground.relief = r;
+  sim::Simulator sim(s);
+  const scenes::GroundRelief ground(s);
+  ASSERT_TRUE(ground.tiled());
+  EXPECT_LT(sim.shadow_floor_z_m(), -3.0);
+  int fence_pixels = 0;
+  EXPECT_GT(expect_culled_matches_whole(sim, &fence_pixels), sim.model()->ngeom / 2);
 }
 
 /// The dust variant of each slab of array 0, by row, from the scene's MJCF.

@@ -77,31 +77,54 @@ struct HeightGrid {
 /// wave vectors are drawn from that spectrum (N(0, 1 / scale_m^2) per
 /// component) and phases uniform, from the station's seed (random-phase
 /// spectral synthesis; Shinozuka and Deodatis, Appl. Mech. Rev. 44(4),
-/// 1991).  It is sampled every cell_m (at most) over ground.size_m, and
-/// between samples interpolated as MuJoCo interpolates its height field.
+/// 1991).  Under a repeated soil it is sampled every cell_m (at most) over
+/// ground.size_m into one grid; under a varied soil (tiled) it is sampled
+/// on a lattice from the ground's -x -y corner whose spacing divides
+/// kReliefTileM (at most cell_m), one sample computed when asked for, so
+/// that a ground of any extent holds no grid.  Between samples it is
+/// interpolated as MuJoCo interpolates its height field.
 class GroundRelief {
  public:
   /// Flat ground: z = 0 everywhere.
   GroundRelief() = default;
-  /// The scenario's ground: flat without ground.relief.
+  /// The scenario's ground: flat without ground.relief, tiled under a
+  /// varied tiling.
   explicit GroundRelief(const Scenario& s);
-  /// The relief `r` over a ground of `size_m` from a station seed.
-  GroundRelief(const Relief& r, const Eigen::Vector2d& size_m, std::uint64_t station_seed);
+  /// The relief `r` over a ground of `size_m` from a station seed, one grid
+  /// or (`tiled`) a lattice.
+  GroundRelief(const Relief& r, const Eigen::Vector2d& size_m, std::uint64_t station_seed,
+               bool tiled = false);
 
-  bool flat() const { return grid_.z_m.empty(); }
-  double height_m(double x, double y) const { return flat() ? 0.0 : grid_.at(x, y).z_m; }
+  bool flat() const { return !relief_; }
+  bool tiled() const { return tiled_; }
+  double height_m(double x, double y) const { return at(x, y).z_m; }
   double height_m(const Eigen::Vector2d& p) const { return height_m(p.x(), p.y()); }
   /// Upward unit normal.
-  Eigen::Vector3d normal(double x, double y) const {
-    return flat() ? Eigen::Vector3d::UnitZ() : grid_.at(x, y).normal;
-  }
-  /// The samples (empty for flat ground).
+  Eigen::Vector3d normal(double x, double y) const { return at(x, y).normal; }
+  /// The samples of a grid relief (empty for flat ground and a tiled one).
   const HeightGrid& grid() const { return grid_; }
 
+  /// A tiled relief's lattice: its spacing, the cells along a tile's side,
+  /// and the height of sample (i, j) at x = -size_x / 2 + i cell,
+  /// y = -size_y / 2 + j cell (any i, j: the field has no edge).
+  double lattice_m() const { return lattice_m_; }
+  int cells_per_tile() const { return cells_per_tile_; }
+  double sample_m(long long i, long long j) const;
+
  private:
+  GroundPoint at(double x, double y) const;
+  bool relief_ = false, tiled_ = false;
   HeightGrid grid_;
+  // A tiled relief's field and lattice.
+  std::vector<Eigen::Vector3d> waves_;  ///< kx, ky (rad/m) and phase of each cosine
+  double amp_m_ = 0, grade_x_ = 0, grade_y_ = 0;
+  double half_x_m_ = 0, half_y_m_ = 0, lattice_m_ = 0;
+  int cells_per_tile_ = 0;
 };
 
+/// The side of a tile of a varied ground, which a tiled relief's lattice
+/// divides (the simulator's kGroundTileM).
+inline constexpr double kReliefTileM = 3.0;
 /// Cosines summed for the roughness.
 inline constexpr int kReliefWaves = 64;
 /// Grid samples a relief may have (MuJoCo draws two triangles per cell

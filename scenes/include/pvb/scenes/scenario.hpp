@@ -54,8 +54,9 @@ struct Relief {
 struct Ground {
   GroundType type = GroundType::kSoil;
   Eigen::Vector2d size_m{60.0, 60.0};  ///< extent along x and y, centred at origin
-  /// Varied: every 3 m of soil near the route an image of its own.  A
-  /// relief takes one repeated image (a height field has one texture).
+  /// Varied: every 3 m of soil near the route an image of its own (under a
+  /// relief each such tile is a height field of its own).  Repeat: one
+  /// image over the whole ground, the default under a relief.
   GroundTiling tiling = GroundTiling::kVaried;
   /// Varied tiling: 0 gives every tile an image of its own (at most 200
   /// tiles); N > 0 draws N images, and each tile takes one of them with a
@@ -67,8 +68,8 @@ struct Ground {
   /// places of the route look alike up close (0: the shared images only).
   double unique_within_m = 12.0;
   std::optional<Relief> relief;  ///< none: the flat plane z = 0
-  /// The tiling the ground is drawn with: repeated under a relief.
-  GroundTiling drawn_tiling() const { return relief ? GroundTiling::kRepeat : tiling; }
+  /// The tiling the ground is drawn with.
+  GroundTiling drawn_tiling() const { return tiling; }
   /// Sliding friction of the soil against the tyres (the day's: wet soil
   /// slips).  None: MuJoCo's default combination (the larger of soil 1 and
   /// tyre 1.2).  Given: the ground's friction governs every contact with it.

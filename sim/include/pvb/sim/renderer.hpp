@@ -54,10 +54,14 @@ class Renderer {
   /// Whether geoms that neither lie in the camera's view nor shadow it are
   /// left out before drawing (cull_to_view; on by default).
   void set_culling(bool on) { cull_ = on; }
-  /// Ground tiles (finite planes) farther than this from the camera are
-  /// left out too, where the base plane's repeated soil shows instead
+  /// Ground tiles (finite planes, a relief's tiles) farther than this from
+  /// the camera are left out too, where the base plane's repeated soil shows instead
   /// (0: none; cull_to_view).
   void set_far_tile_cull_m(double m) { far_tile_m_ = m; }
+  /// The lowest ground a shadow can fall on (z = 0 by default, flat
+  /// ground): the cull sweeps each geom's sphere along the sun's beam down
+  /// to 2 m below it.
+  void set_shadow_floor_z_m(double z) { shadow_floor_z_m_ = z; }
   /// Draws the ground's tiles near the camera with their own images, as
   /// `stream` holds them at each render (null: every tile its material's).
   /// The stream must outlive the renderer or be unset first.
@@ -86,6 +90,7 @@ class Renderer {
   bool stable_shadows_ = true;
   bool cull_ = true;
   double far_tile_m_ = 0;
+  double shadow_floor_z_m_ = 0;
   const GroundStream* stream_ = nullptr;
   std::vector<std::uint64_t> uploaded_;  ///< the stream's slot versions this context holds
   int culled_ = 0;
@@ -107,13 +112,17 @@ void snap_to_shadow_texels(float pos[3], const float dir[3], double texel_m);
 /// Leaves out of `scn` (after mjv_updateScene) every static geom
 /// whose bounding sphere lies outside the view frustum of its first
 /// camera, the sphere swept first along the beam of the shadow-casting sun
-/// (when shadows are on) so that a geom whose shadow falls in view stays.
+/// (when shadows are on), down to 2 m below `shadow_floor_z_m`, so that a
+/// geom whose shadow falls in view stays.
 /// `aspect` is the image's width over its height.  With far_tile_m > 0, a
-/// finite plane (a ground tile) farther than that is left out as well: the
-/// one cull that changes pixels (colour only, beyond the depth range).
-/// A mesh (a plant's fence section) is culled by its model's bounding
-/// sphere (`geom_rbound`, when given).  Returns the geoms left out.
-int cull_to_view(mjvScene* scn, double aspect, double far_tile_m = 0, const double* geom_rbound = nullptr);
+/// ground tile (a finite plane, or a height field not of the ground's
+/// repeated image, material "ground") farther than that is left out as
+/// well: the one cull that changes pixels (colour only, beyond the depth
+/// range).  A mesh (a plant's fence section) and a height field are culled
+/// by their model's bounding sphere (when `model` is given).  Returns the
+/// geoms left out.
+int cull_to_view(mjvScene* scn, double aspect, double far_tile_m = 0, const mjModel* model = nullptr,
+                 double shadow_floor_z_m = 0);
 
 /// Converts one standard-Z-buffer value to metric depth (0 for d >= 1).
 inline float depth_from_buffer(float d, double znear_m, double zfar_m) {

@@ -77,6 +77,22 @@ struct GroundTile {
   std::uint64_t own_seed = 0;
   bool gravel = false;  ///< on a plant's service road: its images are gravel
 };
+/// A height field whose samples are not in a file of their own: a tiled
+/// relief's tile or backdrop piece (kReliefTilesFile holds them all).
+struct RuntimeHField {
+  std::string name;
+  int nrow = 0, ncol = 0;
+  double half_x_m = 0, half_y_m = 0;
+  double z0_m = 0, range_m = 0;  ///< the lowest sample, and the highest's height above it
+  Eigen::Vector2d centre_m = Eigen::Vector2d::Zero();
+  int quarter_turns = 0;
+  std::vector<float> data;  ///< row-major, in [0, 1] of range_m
+};
+/// Writes the samples of kReliefTilesFile's bytes into the model's height
+/// fields of the same names.  Throws Error when one is missing or of
+/// another size.
+void fill_relief_tiles(mjModel* m, const std::vector<unsigned char>& file);
+
 /// The tiles of a varied ground along the scenario's route (none for a
 /// repeated one), as the scene lays them.
 std::vector<GroundTile> ground_tiles(const scenes::Scenario& s);
@@ -126,5 +142,7 @@ inline constexpr const char* kLeftActuator = "wheel_left";
 inline constexpr const char* kRightActuator = "wheel_right";
 /// The ground relief's height field, in MuJoCo's binary hfield format.
 inline constexpr const char* kReliefFile = "ground_relief.bin";
+/// A tiled relief's height fields, one after the other (fill_relief_tiles).
+inline constexpr const char* kReliefTilesFile = "ground_tiles.bin";
 
 }  // namespace pvb::sim

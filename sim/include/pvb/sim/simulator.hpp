@@ -4,11 +4,12 @@
 // it never travels with the frames.
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 
 #include "pvb/geometry/pinhole.hpp"
 #include "pvb/geometry/se3.hpp"
+#include "pvb/scenes/ground_relief.hpp"
 #include "pvb/scenes/scenario.hpp"
 #include "pvb/sensor/rgbd_frame.hpp"
 #include "pvb/sim/active_stereo.hpp"
@@ -88,6 +89,10 @@ class Simulator {
   /// The images of the ground's tiles near the camera, kept up to date with
   /// every frame (GroundStream), or null where the ground has none.
   const GroundStream* ground_stream() const { return ground_stream_.get(); }
+  /// The lowest ground a shadow can fall on in the sun's shadow map now
+  /// (around the camera, or over the route): z = 0 on flat ground; on a
+  /// relief, the lowest of its heights sampled over the map, 0.1 m lower.
+  double shadow_floor_z_m() const;
 
  private:
   void step_physics(int steps);
@@ -123,6 +128,8 @@ class Simulator {
   std::unique_ptr<MotionSensors> motion_;         ///< from frame 0 on
   std::unique_ptr<GroundStream> ground_stream_;  ///< follows camera_id_ in sync_scene
   std::unique_ptr<CarryPath> carry_;        ///< while the kidnap carries the robot
+  scenes::GroundRelief relief_;             ///< what the ground under the sun's shadow map is
+  ShadowMap shadow_map_;
   int carry_step_ = 0;
 };
 
