@@ -154,15 +154,15 @@ std::string hfield_asset_line(const RuntimeHField& h) {
 void add_tiled_relief_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<GroundTile>& tiles,
                              const ReliefTiles& r) {
   for (const RuntimeHField& h : r.backdrop)
-    x.line("<geom class=\"scenery\" type=\"hfield\" hfield=\"" + h.name + "\" pos=\"" + f(h.centre_m.x()) +
-           " " + f(h.centre_m.y()) + " " + exact(h.z0_m) + "\" material=\"ground\"/>");
+    x.line("<geom class=\"scenery\" type=\"hfield\" hfield=\"" + h.name + "\" pos=\"" + exact(h.centre_m.x()) +
+           " " + exact(h.centre_m.y()) + " " + exact(h.z0_m) + "\" material=\"ground\"/>");
   for (std::size_t k = 0; k < r.tiles.size(); ++k) {
     const RuntimeHField& h = r.tiles[k];
     const GroundTile& t = tiles[k];
     const std::string turn =
         t.quarter_turns > 0 ? "\" euler=\"0 0 " + std::to_string(90 * t.quarter_turns) : "";
     x.line("<geom name=\"" + h.name + "\" type=\"hfield\" hfield=\"" + h.name + "\" pos=\"" +
-           f(h.centre_m.x()) + " " + f(h.centre_m.y()) + " " + exact(h.z0_m) + turn +
+           exact(h.centre_m.x()) + " " + exact(h.centre_m.y()) + " " + exact(h.z0_m) + turn +
            "\" material=\"groundt" + std::to_string(t.image >= 0 ? static_cast<std::size_t>(t.image) : k) +
            "\" condim=\"3\" " + ground_friction(s.ground) + "/>");
   }
