@@ -26,7 +26,8 @@ GroundStream::GroundStream(mjModel* model, const scenes::Scenario& s)
   // The tiles follow the ground's two planes, in ground_tiles order; on a
   // tiled relief they are height fields, the first one named.
   const int ground = mj_name2id(model, mjOBJ_GEOM, "ground");
-  const int first_field = mj_name2id(model, mjOBJ_GEOM, "groundtile0");
+  const int first_field = mj_name2id(model, mjOBJ_GEOM, (std::string(kReliefTilePrefix) + "0").c_str());
+  first_far_geom_ = mj_name2id(model, mjOBJ_GEOM, (std::string(kReliefFarTilePrefix) + "0").c_str());
   first_tile_geom_ = first_field >= 0 ? first_field : ground + 2;
   const int type = first_field >= 0 ? mjGEOM_HFIELD : mjGEOM_PLANE;
   for (std::size_t k = 0; k < tiles_.size(); ++k) {
@@ -102,7 +103,8 @@ void GroundStream::draw(const std::vector<int>& slots) {
 }
 
 int GroundStream::texture_of_geom(int geom_id) const {
-  const int k = geom_id - first_tile_geom_;
+  const bool far = first_far_geom_ >= 0 && geom_id >= first_far_geom_;  // a relief tile's far version
+  const int k = geom_id - (far ? first_far_geom_ : first_tile_geom_);
   if (first_tile_geom_ < 0 || k < 0 || k >= static_cast<int>(tiles_.size())) return -1;
   if (!tile_near_[static_cast<std::size_t>(k)]) return -1;
   return slot_tex_[static_cast<std::size_t>(tile_slot_[static_cast<std::size_t>(k)])];

@@ -2,9 +2,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <optional>
 
 #include "pvb/common/error.hpp"
@@ -139,7 +139,33 @@ std::optional<Eigen::Vector3d> shadow_beam(const mjvScene& scn) {
   return std::nullopt;
 }
 
+/// Whether `name` starts with `prefix`.
+bool named(const char* name, const char* prefix) {
+  return std::strncmp(name, prefix, std::strlen(prefix)) == 0;
+}
+
 }  // namespace
+
+void select_relief_detail(mjvScene* scn, const mjModel* model, double detail_m) {
+  const mjvGLCamera& cam = scn->camera[0];
+  int kept = 0;
+  for (int i = 0; i < scn->ngeom; ++i) {
+    const mjvGeom g = scn->geoms[i];
+    bool keep = true;
+    if (g.type == mjGEOM_HFIELD && g.objtype == mjOBJ_GEOM && g.category == mjCAT_STATIC) {
+      const char* name = model->names + model->name_geomadr[g.objid];
+      const bool far = named(name, kReliefFarTilePrefix), tile = !far && named(name, kReliefTilePrefix);
+      const double dx = g.pos[0] - cam.pos[0], dy = g.pos[1] - cam.pos[1], dz = g.pos[2] - cam.pos[2];
+      const bool near = detail_m <= 0 || std::sqrt(dx * dx + dy * dy + dz * dz) <= detail_m;
+      keep = far ? !near : (!tile || near);
+    }
+    if (!keep) continue;
+    scn->geoms[kept] = g;
+    if (scn->geoms[kept].segid >= 0) scn->geoms[kept].segid = kept;
+    ++kept;
+  }
+  scn->ngeom = kept;
+}
 
 int cull_to_view(mjvScene* scn, double aspect, double far_tile_m, const mjModel* model,
                  double shadow_floor_z_m) {
@@ -222,6 +248,7 @@ void Renderer::render(const mjModel* model, mjData* data, int camera_id, cv::Mat
   culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_, model,
                                  shadow_floor_z_m_)
                   : 0;
+  select_relief_detail(&scene_, model, relief_detail_m_);
   apply_ground_stream();
   if (stable_shadows_) {
     const double texel_m = shadow_texel_m(con_.shadowClip, con_.shadowSize);
@@ -265,6 +292,7 @@ void Renderer::render_geom_ids(const mjModel* model, mjData* data, int camera_id
   culled_ = cull_ ? cull_to_view(&scene_, static_cast<double>(width_) / height_, far_tile_m_, model,
                                  shadow_floor_z_m_)
                   : 0;
+  select_relief_detail(&scene_, model, relief_detail_m_);
   const unsigned char shadow = scene_.flags[mjRND_SHADOW];
   scene_.flags[mjRND_SEGMENT] = 1;
   scene_.flags[mjRND_IDCOLOR] = 1;

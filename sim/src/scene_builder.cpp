@@ -219,7 +219,7 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
                   const scenes::GroundRelief& ground, const ReliefTiles& relief_tiles) {
   x.open("<asset>");
   if (!ground.flat() && !ground.tiled()) x.line(hfield_line(s, ground));
-  for (const auto* set : {&relief_tiles.backdrop, &relief_tiles.tiles})
+  for (const auto* set : {&relief_tiles.backdrop, &relief_tiles.tiles, &relief_tiles.far_tiles})
     for (const RuntimeHField& h : *set) x.line(hfield_asset_line(h));
   const auto rgb = [](const Eigen::Vector3f& c) {  // two decimals, as the sky was always written
     char buf[48];

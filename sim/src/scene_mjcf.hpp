@@ -86,9 +86,10 @@ std::string ground_friction(const scenes::Ground& g);
 
 // scene_relief_tiles.cpp
 /// A tiled relief's height fields (relief_tiles()): the tiles along the
-/// route, then the coarse backdrop's pieces.
+/// route, their far versions (a cell of at least 1 m at 0.25 m), then the
+/// coarse backdrop's pieces.
 struct ReliefTiles {
-  std::vector<RuntimeHField> tiles, backdrop;
+  std::vector<RuntimeHField> tiles, far_tiles, backdrop;
 };
 /// A tiled relief's height fields (none for a grid relief or flat ground).
 ReliefTiles relief_tiles(const scenes::Scenario& s, const std::vector<GroundTile>& tiles,
@@ -99,7 +100,7 @@ std::vector<unsigned char> relief_tiles_file(const ReliefTiles& r);
 /// An <hfield> asset whose samples are filled in after compiling.
 std::string hfield_asset_line(const RuntimeHField& h);
 /// The ground of a tiled relief: the backdrop's pieces (scenery), then each
-/// tile, collidable, with its image.
+/// tile, collidable, with its image, then each tile's far version (scenery).
 void add_tiled_relief_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<GroundTile>& tiles,
                              const ReliefTiles& r);
 

@@ -46,14 +46,23 @@ void normalise(const std::vector<double>& z_m, RuntimeHField* h) {
   for (std::size_t k = 0; k < z_m.size(); ++k) h->data[k] = static_cast<float>((z_m[k] - *lo) / h->range_m);
 }
 
-/// Tile `t`'s height field: the lattice's samples over the tile, in the
-/// frame of its geom (turned by its quarter turns, so its image turns too).
-RuntimeHField tile_field(const scenes::Scenario& s, const scenes::GroundRelief& g, const GroundTile& t, int k,
-                         double* lowest_m) {
-  const int n = g.cells_per_tile();
+/// The cells along a tile's side of its far version: the largest divisor
+/// of the lattice's cells a tile that is at most 3 (1 m cells at 0.25 m).
+int far_cells_per_tile(const scenes::GroundRelief& g) {
+  for (int d = 3; d > 1; --d)
+    if (g.cells_per_tile() % d == 0) return d;
+  return 1;
+}
+
+/// Tile `t`'s height field: the lattice's samples over the tile, every
+/// `step`th, in the frame of its geom (turned by its quarter turns, so its
+/// image turns too).
+RuntimeHField tile_field(const scenes::Scenario& s, const scenes::GroundRelief& g, const GroundTile& t,
+                         const std::string& name, int step, double* lowest_m) {
+  const int n = g.cells_per_tile() / step;
   const Eigen::Matrix<long long, 2, 1> c0 = corner_index(s, g, t.centre_m);
   RuntimeHField h;
-  h.name = "groundtile" + std::to_string(k);
+  h.name = name;
   h.nrow = h.ncol = n + 1;
   h.half_x_m = h.half_y_m = kGroundTileM / 2;
   h.centre_m = t.centre_m;
@@ -65,7 +74,7 @@ RuntimeHField tile_field(const scenes::Scenario& s, const scenes::GroundRelief& 
       const int q = ((t.quarter_turns % 4) + 4) % 4;
       const int di = q == 0 ? c : q == 1 ? n - r : q == 2 ? n - c : r;
       const int dj = q == 0 ? r : q == 1 ? c : q == 2 ? n - r : n - c;
-      z[static_cast<std::size_t>(r * h.ncol + c)] = g.sample_m(c0.x() + di, c0.y() + dj);
+      z[static_cast<std::size_t>(r * h.ncol + c)] = g.sample_m(c0.x() + step * di, c0.y() + step * dj);
     }
   normalise(z, &h);
   *lowest_m = h.z0_m;
@@ -119,9 +128,12 @@ ReliefTiles relief_tiles(const scenes::Scenario& s, const std::vector<GroundTile
   ReliefTiles out;
   if (!ground.tiled()) return out;
   std::map<std::pair<long long, long long>, double> tile_low_m;  // by the tile's 3 m cell
+  const int far_step = ground.cells_per_tile() / far_cells_per_tile(ground);
   for (std::size_t k = 0; k < tiles.size(); ++k) {
-    double lowest = 0;
-    out.tiles.push_back(tile_field(s, ground, tiles[k], static_cast<int>(k), &lowest));
+    double lowest = 0, far_lowest = 0;
+    out.tiles.push_back(tile_field(s, ground, tiles[k], kReliefTilePrefix + std::to_string(k), 1, &lowest));
+    out.far_tiles.push_back(
+        tile_field(s, ground, tiles[k], kReliefFarTilePrefix + std::to_string(k), far_step, &far_lowest));
     const Eigen::Matrix<long long, 2, 1> c0 = corner_index(s, ground, tiles[k].centre_m);
     tile_low_m[{c0.x() / ground.cells_per_tile(), c0.y() / ground.cells_per_tile()}] = lowest;
   }
@@ -135,7 +147,7 @@ std::vector<unsigned char> relief_tiles_file(const ReliefTiles& r) {
     const auto* b = static_cast<const unsigned char*>(p);
     out.insert(out.end(), b, b + n);
   };
-  for (const auto* set : {&r.tiles, &r.backdrop})
+  for (const auto* set : {&r.tiles, &r.far_tiles, &r.backdrop})
     for (const RuntimeHField& h : *set) {
       const std::int32_t head[3] = {static_cast<std::int32_t>(h.name.size()), h.nrow, h.ncol};
       put(head, sizeof head);
@@ -156,16 +168,20 @@ void add_tiled_relief_ground(XmlWriter& x, const scenes::Scenario& s, const std:
   for (const RuntimeHField& h : r.backdrop)
     x.line("<geom class=\"scenery\" type=\"hfield\" hfield=\"" + h.name + "\" pos=\"" + exact(h.centre_m.x()) +
            " " + exact(h.centre_m.y()) + " " + exact(h.z0_m) + "\" material=\"ground\"/>");
-  for (std::size_t k = 0; k < r.tiles.size(); ++k) {
-    const RuntimeHField& h = r.tiles[k];
-    const GroundTile& t = tiles[k];
-    const std::string turn =
-        t.quarter_turns > 0 ? "\" euler=\"0 0 " + std::to_string(90 * t.quarter_turns) : "";
-    x.line("<geom name=\"" + h.name + "\" type=\"hfield\" hfield=\"" + h.name + "\" pos=\"" +
-           exact(h.centre_m.x()) + " " + exact(h.centre_m.y()) + " " + exact(h.z0_m) + turn +
-           "\" material=\"groundt" + std::to_string(t.image >= 0 ? static_cast<std::size_t>(t.image) : k) +
-           "\" condim=\"3\" " + ground_friction(s.ground) + "/>");
-  }
+  // The tiles, collidable, then their far versions, scenery; the renderer
+  // draws one of the two (Renderer::set_relief_detail_m).
+  for (const auto* set : {&r.tiles, &r.far_tiles})
+    for (std::size_t k = 0; k < set->size(); ++k) {
+      const RuntimeHField& h = (*set)[k];
+      const GroundTile& t = tiles[k];
+      const std::string turn =
+          t.quarter_turns > 0 ? "\" euler=\"0 0 " + std::to_string(90 * t.quarter_turns) : "";
+      const std::string contact = set == &r.tiles ? "\" condim=\"3\" " + ground_friction(s.ground) : "\"";
+      x.line("<geom name=\"" + h.name + "\"" + (set == &r.tiles ? "" : " class=\"scenery\"") +
+             " type=\"hfield\" hfield=\"" + h.name + "\" pos=\"" + exact(h.centre_m.x()) + " " +
+             exact(h.centre_m.y()) + " " + exact(h.z0_m) + turn + "\" material=\"groundt" +
+             std::to_string(t.image >= 0 ? static_cast<std::size_t>(t.image) : k) + contact + "/>");
+    }
 }
 
 }  // namespace mjcf

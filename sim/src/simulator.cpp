@@ -251,6 +251,13 @@ double far_tile_cull_m(const scenes::Scenario& s) {
   return s.ground.soil_images > 0 ? s.camera.fx * kSoilFeatureM / 0.5 : 0.0;
 }
 
+/// A tiled relief's tiles are drawn in full where the camera can measure
+/// depth (its range, plus half a tile's diagonal and a metre), as their far
+/// versions beyond.
+double relief_detail_m(const scenes::Scenario& s) {
+  return s.ground.relief ? s.camera.depth_range_m.y() + kGroundTileM / std::sqrt(2.0) + 1.0 : 0.0;
+}
+
 const Simulator& textured(const Simulator& sim) {
   if (sim.assets().detail != SceneDetail::kFull)
     throw Error("a simulator built for its geometry only gives no colour frames (build it with SceneDetail::kFull)");
@@ -263,6 +270,7 @@ RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
       sensor_(sim) {
   renderer_.set_shadows(sim.scenario().light.shadows);
   renderer_.set_far_tile_cull_m(far_tile_cull_m(sim.scenario()));
+  renderer_.set_relief_detail_m(relief_detail_m(sim.scenario()));
   renderer_.set_ground_stream(sim.ground_stream());
   std::vector<bool> specular;
   for (const auto& a : sim.scenario().pv_arrays) specular.push_back(a.specular_glass);
@@ -273,6 +281,7 @@ RgbdCamera::RgbdCamera(const Simulator& sim, GlBackend backend)
   ir_renderer_ = std::make_unique<Renderer>(sim.model(), renderer_.backend(), cam.stereo.ir_width, cam.stereo.ir_height);
   ir_renderer_->set_shadows(sim.scenario().light.shadows);
   ir_renderer_->set_far_tile_cull_m(far_tile_cull_m(sim.scenario()));
+  ir_renderer_->set_relief_detail_m(relief_detail_m(sim.scenario()));
   ir_renderer_->set_ground_stream(sim.ground_stream());
   ir_left_id_ = mj_name2id(sim.model(), mjOBJ_CAMERA, kIrLeftCameraName);
   ir_right_id_ = mj_name2id(sim.model(), mjOBJ_CAMERA, kIrRightCameraName);

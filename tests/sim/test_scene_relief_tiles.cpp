@@ -25,6 +25,21 @@ scenes::Scenario rough_varied(int soil_images) {
   return s;
 }
 
+/// A scenario's relief, tiles and compiled scene, its data forwarded.
+struct Compiled {
+  explicit Compiled(const scenes::Scenario& s)
+      : relief(s),
+        tiles(sim::ground_tiles(s)),
+        m(sim::compile_scene(sim::build_scene(s))),
+        d(mj_makeData(m.get())) {
+    mj_forward(m.get(), d.get());
+  }
+  scenes::GroundRelief relief;
+  std::vector<sim::GroundTile> tiles;
+  sim::ModelPtr m;
+  sim::DataPtr d;
+};
+
 /// Where a ray cast down from 10 m above (x, y) meets geom `g` (NaN: misses).
 double ray_down(const mjModel* m, const mjData* d, int g, double x, double y) {
   const mjtNum from[3] = {x, y, 10.0}, down[3] = {0, 0, -1};
@@ -95,23 +110,46 @@ TEST(SceneReliefTiles, EveryTileIsAHeightFieldThatMujocoAgreesWith) {
   }
 }
 
+// Each tile has a far version of 1 m cells, scenery, on the same lattice:
+// at the tile's corners both lie on the field.
+TEST(SceneReliefTiles, EachTileHasAFarVersionOnTheSameLattice) {
+  const scenes::Scenario s = rough_varied(6);
+  const Compiled c(s);
+  const scenes::GroundRelief& relief = c.relief;
+  const std::vector<sim::GroundTile>& tiles = c.tiles;
+  const mjModel* m = c.m.get();
+  mjData* d = c.d.get();
+  for (std::size_t k = 0; k < tiles.size(); ++k) {
+    const int g = mj_name2id(m, mjOBJ_GEOM, (sim::kReliefFarTilePrefix + std::to_string(k)).c_str());
+    ASSERT_GE(g, 0) << k;
+    EXPECT_EQ(m->hfield_nrow[m->geom_dataid[g]], 4);  // 3 cells of 1 m
+    EXPECT_EQ(m->geom_contype[g], 0);
+    EXPECT_EQ(m->geom_matid[g],
+              m->geom_matid[mj_name2id(m, mjOBJ_GEOM, (sim::kReliefTilePrefix + std::to_string(k)).c_str())]);
+    for (const double cx : {-1.499, 1.499})
+      for (const double cy : {-1.499, 1.499}) {
+        const double x = tiles[k].centre_m.x() + cx, y = tiles[k].centre_m.y() + cy;
+        EXPECT_NEAR(ray_down(m, d, g, x, y), relief.height_m(x, y), 2e-3) << k;
+      }
+  }
+}
+
 // The backdrop, the rest of the ground in coarse pieces, lies at least
 // 5 mm under every tile, and away from the tiles on the field itself.
 TEST(SceneReliefTiles, TheBackdropLiesUnderTheTilesAndOnTheFieldBeyond) {
   const scenes::Scenario s = rough_varied(0);
-  const scenes::GroundRelief relief(s);
-  const std::vector<sim::GroundTile> tiles = sim::ground_tiles(s);
-  const sim::ModelPtr m = sim::compile_scene(sim::build_scene(s));
-  sim::DataPtr d(mj_makeData(m.get()));
-  mj_forward(m.get(), d.get());
-  const int ground_mat = mj_name2id(m.get(), mjOBJ_MATERIAL, "ground");
+  const Compiled c(s);
+  const std::vector<sim::GroundTile>& tiles = c.tiles;
+  const mjModel* m = c.m.get();
+  mjData* d = c.d.get();
+  const int ground_mat = mj_name2id(m, mjOBJ_MATERIAL, "ground");
   std::vector<int> pieces;
   for (int g = 0; g < m->ngeom; ++g)
     if (m->geom_type[g] == mjGEOM_HFIELD && m->geom_matid[g] == ground_mat) pieces.push_back(g);
   ASSERT_FALSE(pieces.empty());
   const auto backdrop = [&](double x, double y) {
     for (int g : pieces) {
-      const double z = ray_down(m.get(), d.get(), g, x, y);
+      const double z = ray_down(m, d, g, x, y);
       if (!std::isnan(z)) return z;
     }
     return std::nan("");
@@ -122,13 +160,13 @@ TEST(SceneReliefTiles, TheBackdropLiesUnderTheTilesAndOnTheFieldBeyond) {
   for (const sim::GroundTile& t : tiles)
     for (int n = 0; n < 8; ++n) {
       const double x = t.centre_m.x() + u(rng), y = t.centre_m.y() + u(rng);
-      const double below = relief.height_m(x, y) - backdrop(x, y);
+      const double below = c.relief.height_m(x, y) - backdrop(x, y);
       ASSERT_FALSE(std::isnan(below)) << x << " " << y;
       closest = std::min(closest, below);
     }
   EXPECT_GT(closest, 0.005 - 1e-4);
   // Far from the route, at the 3 m lattice's points, the backdrop is the field.
-  const int n = relief.cells_per_tile();
+  const int n = c.relief.cells_per_tile();
   int far_points = 0;
   for (long long i = 1; i < 20; i += 3)
     for (long long j = 1; j < 13; j += 3) {
@@ -138,7 +176,8 @@ TEST(SceneReliefTiles, TheBackdropLiesUnderTheTilesAndOnTheFieldBeyond) {
       });
       if (near) continue;
       ++far_points;
-      EXPECT_NEAR(backdrop(p.x() + 1e-6, p.y() + 1e-6), relief.sample_m(i * n, j * n), 1e-4) << p.transpose();
+      EXPECT_NEAR(backdrop(p.x() + 1e-6, p.y() + 1e-6), c.relief.sample_m(i * n, j * n), 1e-4)
+          << p.transpose();
     }
   EXPECT_GT(far_points, 10);
 }

@@ -38,7 +38,7 @@ class GroundStream {
   int update(const Eigen::Vector3d& eye_w);
 
   /// The texture model geom `geom_id` shows now instead of its material's
-  /// (a near tile's slot), or -1.
+  /// (a near tile's slot, for the tile or its far version), or -1.
   int texture_of_geom(int geom_id) const;
   /// The slot textures, and how many times each was drawn: a renderer
   /// uploads a slot whose count changed since it last drew.
@@ -60,6 +60,7 @@ class GroundStream {
   scenes::GroundType type_;
   std::vector<GroundTile> tiles_;
   int first_tile_geom_ = -1;
+  int first_far_geom_ = -1;  ///< a tiled relief's first far tile (after the tiles), or -1
   double near_m_ = 0;
   std::vector<int> slot_tex_;
   std::vector<std::uint64_t> slot_version_;

@@ -62,6 +62,10 @@ class Renderer {
   /// ground): the cull sweeps each geom's sphere along the sun's beam down
   /// to 2 m below it.
   void set_shadow_floor_z_m(double z) { shadow_floor_z_m_ = z; }
+  /// A tiled relief's tiles farther than this from the camera are drawn as
+  /// their far versions (select_relief_detail; 0, the default: every tile
+  /// in full).
+  void set_relief_detail_m(double m) { relief_detail_m_ = m; }
   /// Draws the ground's tiles near the camera with their own images, as
   /// `stream` holds them at each render (null: every tile its material's).
   /// The stream must outlive the renderer or be unset first.
@@ -91,6 +95,7 @@ class Renderer {
   bool cull_ = true;
   double far_tile_m_ = 0;
   double shadow_floor_z_m_ = 0;
+  double relief_detail_m_ = 0;
   const GroundStream* stream_ = nullptr;
   std::vector<std::uint64_t> uploaded_;  ///< the stream's slot versions this context holds
   int culled_ = 0;
@@ -123,6 +128,13 @@ void snap_to_shadow_texels(float pos[3], const float dir[3], double texel_m);
 /// geoms left out.
 int cull_to_view(mjvScene* scn, double aspect, double far_tile_m = 0, const mjModel* model = nullptr,
                  double shadow_floor_z_m = 0);
+
+/// Keeps in `scn` one version of each tile of a tiled relief: the tile
+/// itself (kReliefTilePrefix) where its centre lies within `detail_m` of
+/// the first camera, or everywhere with detail_m <= 0; its far version
+/// (kReliefFarTilePrefix, 1 m cells) beyond.  Every render draws one or the
+/// other, whether it culls or not.
+void select_relief_detail(mjvScene* scn, const mjModel* model, double detail_m);
 
 /// Converts one standard-Z-buffer value to metric depth (0 for d >= 1).
 inline float depth_from_buffer(float d, double znear_m, double zfar_m) {

@@ -144,5 +144,9 @@ inline constexpr const char* kRightActuator = "wheel_right";
 inline constexpr const char* kReliefFile = "ground_relief.bin";
 /// A tiled relief's height fields, one after the other (fill_relief_tiles).
 inline constexpr const char* kReliefTilesFile = "ground_tiles.bin";
+/// The names of a tiled relief's tile K and of its far version (geom and
+/// height field alike): prefix then K.
+inline constexpr const char* kReliefTilePrefix = "groundtile";
+inline constexpr const char* kReliefFarTilePrefix = "groundtilefar";
 
 }  // namespace pvb::sim
