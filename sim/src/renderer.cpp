@@ -120,14 +120,6 @@ double bounding_radius(const mjvGeom& g) {
   }
 }
 
-/// The sphere about a height field geom's frame that holds it, its radius
-/// (MuJoCo 2.2.2 leaves geom_rbound 0 for a height field): half its
-/// extent across, and its top or its base below.
-double hfield_radius(const mjModel* m, int geom) {
-  const mjtNum* s = m->hfield_size + 4 * m->geom_dataid[geom];
-  return std::sqrt(s[0] * s[0] + s[1] * s[1] + std::max(s[2], s[3]) * std::max(s[2], s[3]));
-}
-
 /// The beam of the first shadow-casting directional light (unit, pointing
 /// down from the light), or none.
 std::optional<Eigen::Vector3d> shadow_beam(const mjvScene& scn) {
@@ -188,7 +180,7 @@ int cull_to_view(mjvScene* scn, double aspect, double far_tile_m, const mjModel*
     double r = g.category == mjCAT_STATIC && g.objtype == mjOBJ_GEOM ? bounding_radius(g) : -1;
     const bool model_geom = model && g.category == mjCAT_STATIC && g.objtype == mjOBJ_GEOM;
     if (g.type == mjGEOM_MESH && model_geom) r = model->geom_rbound[g.objid];
-    if (g.type == mjGEOM_HFIELD && model_geom) r = hfield_radius(model, g.objid);
+    if (g.type == mjGEOM_HFIELD && model_geom) r = hfield_bounding_radius(model, g.objid);
     Eigen::Vector3d c(g.pos[0], g.pos[1], g.pos[2]);
     const bool relief_tile =
         g.type == mjGEOM_HFIELD && model_geom && model->geom_matid[g.objid] != backdrop_matid;

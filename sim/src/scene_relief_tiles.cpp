@@ -207,11 +207,13 @@ void fill_relief_tiles(mjModel* m, const std::vector<unsigned char>& file) {
   // MuJoCo 2.2.2 leaves a height field's bounding radius 0, and a geom of
   // radius 0 is tested against every other geom in every step; a tile's
   // sphere lets the collision filter skip the tiles far from the robot.
-  for (int g = 0; g < m->ngeom; ++g) {
-    if (m->geom_type[g] != mjGEOM_HFIELD || m->geom_rbound[g] > 0) continue;
-    const mjtNum* s = m->hfield_size + 4 * m->geom_dataid[g];
-    m->geom_rbound[g] = std::sqrt(s[0] * s[0] + s[1] * s[1] + std::max(s[2], s[3]) * std::max(s[2], s[3]));
-  }
+  for (int g = 0; g < m->ngeom; ++g)
+    if (m->geom_type[g] == mjGEOM_HFIELD && m->geom_rbound[g] <= 0) m->geom_rbound[g] = hfield_bounding_radius(m, g);
+}
+
+double hfield_bounding_radius(const mjModel* m, int geom) {
+  const mjtNum* s = m->hfield_size + 4 * m->geom_dataid[geom];
+  return std::sqrt(s[0] * s[0] + s[1] * s[1] + std::max(s[2], s[3]) * std::max(s[2], s[3]));
 }
 
 }  // namespace pvb::sim

@@ -329,10 +329,10 @@ StereoRender RgbdCamera::render_infrared(Simulator& sim, const geom::SE3d& T_w_c
   if (s.light.sun_elevation_deg > 0)
     caster.emplace(sim.model(), sim.data(), sim.to_sun_w(),
                    shade_region(T_w_c, K_ir, p.ir_width, p.ir_height, pattern_range_m + p.baseline_m + p.colour_offset_m));
+  ir_renderer_->set_shadow_floor_z_m(sim.shadow_floor_z_m());
   for (int k = 0; k < 2; ++k) {
     InfraredView& v = k == 0 ? out.left : out.right;
     cv::Mat rgb;
-    ir_renderer_->set_shadow_floor_z_m(sim.shadow_floor_z_m());
     ir_renderer_->render(sim.model(), sim.data(), k == 0 ? ir_left_id_ : ir_right_id_, &rgb, &v.depth_m);
     v.depth_m.setTo(0.0f, v.depth_m > sky);
     cv::cvtColor(rgb, v.grey, cv::COLOR_RGB2GRAY);

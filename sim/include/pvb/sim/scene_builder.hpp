@@ -92,6 +92,10 @@ struct RuntimeHField {
 /// fields of the same names.  Throws Error when one is missing or of
 /// another size.
 void fill_relief_tiles(mjModel* m, const std::vector<unsigned char>& file);
+/// The sphere about height field geom `geom`'s frame that holds it, its
+/// radius (MuJoCo 2.2.2 leaves geom_rbound 0 for a height field): half its
+/// extent across, and its top or its base below.
+double hfield_bounding_radius(const mjModel* m, int geom);
 
 /// The tiles of a varied ground along the scenario's route (none for a
 /// repeated one), as the scene lays them.
