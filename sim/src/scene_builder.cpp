@@ -39,6 +39,9 @@ namespace mjcf {
 namespace {
 
 constexpr const char* kGroundTilePrefix = "textures/groundt";
+/// A drawn plane's grid quads along its longer side, at most (MuJoCo adds
+/// one narrower quad at each end).
+constexpr int kMaxPlaneGridQuads = 30;
 
 /// zlib's level for a texture file as recordings write it: level 6 for the
 /// station's few images (their bytes are pinned, tests/sim/test_old_bytes.cpp);
@@ -287,6 +290,18 @@ void write_assets(XmlWriter& x, const scenes::Scenario& s, const SceneAssets& ou
   x.close("</asset>");
 }
 
+/// The spacing of the grid that MuJoCo draws a ground plane as (its size's
+/// third number, half a quad's side): 1 m, or coarser on a ground longer
+/// than 60 m, so that no side has more than kMaxPlaneGridQuads quads.  The
+/// corners of every quad are lit and transformed in each pass of every
+/// frame: a plant's 300 x 1400 m plane at 1 m was about 150 x 200 quads,
+/// which cost more than the rest of the scene's ground.  The picture
+/// changes only in the soil's faint specular highlight, lit at the corners
+/// and interpolated between them.
+double plane_grid_m(const Eigen::Vector2d& size_m) {
+  return std::max(1.0, 0.5 * size_m.maxCoeff() / kMaxPlaneGridQuads);
+}
+
 /// The ground: one plane that the robot drives on, with the soil image
 /// repeated every kGroundTileM.  A varied ground hides that plane (group 3,
 /// still colliding) and draws its tiles, each with its own image, over a
@@ -305,7 +320,8 @@ void add_ground(XmlWriter& x, const scenes::Scenario& s, const std::vector<Groun
            "\" material=\"ground\" condim=\"3\" " + ground_friction(s.ground) + "/>");
     return;
   }
-  const std::string size = v3(s.ground.size_m.x() / 2, s.ground.size_m.y() / 2, 1);
+  const std::string size =
+      v3(s.ground.size_m.x() / 2, s.ground.size_m.y() / 2, plane_grid_m(s.ground.size_m));
   const bool varied = s.ground.drawn_tiling() == scenes::GroundTiling::kVaried;
   x.line("<geom name=\"ground\" type=\"plane\" size=\"" + size + "\" material=\"ground\" condim=\"3\" " +
          std::string(varied ? "group=\"3\" " : "") + ground_friction(s.ground) + "/>");

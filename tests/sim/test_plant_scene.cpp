@@ -128,6 +128,49 @@ TEST(PlantScene, CulledFramesOnARoughPlantMatchFramesDrawnWhole) {
   EXPECT_GT(expect_culled_matches_whole(sim, &fence_pixels, 7.6), sim.model()->ngeom / 2);
 }
 
+// A ground longer than 60 m is drawn as a coarser grid of quads (5 m on
+// this 300 m ground, against 1 m before): its soil's faint specular
+// highlight, lit at the quads' corners, is all that changes.
+TEST(PlantScene, AWideGroundsCoarseGridChangesOnlyItsHighlight) {
+  const scenes::Scenario s = small_plant();
+  sim::Simulator sim(s);
+  const sim::SceneAssets coarse = sim::build_scene(s, sim::SceneDetail::kFull, sim::TextureEncoding::kPixels);
+  sim::SceneAssets fine = coarse;
+  const std::string before = "name=\"ground\" type=\"plane\" size=\"150 150 5\"";
+  const std::size_t at = fine.xml.find(before);
+  ASSERT_NE(at, std::string::npos) << "the ground's grid is not 5 m";
+  fine.xml.replace(at, before.size(), "name=\"ground\" type=\"plane\" size=\"150 150 1\"");
+  const sim::ModelPtr fine_model = sim::compile_scene(fine);
+  sim::DataPtr fine_data(mj_makeData(fine_model.get()));
+  sim::Renderer a(sim.model(), sim::GlBackend::kAuto, 320, 240),
+      b(fine_model.get(), sim::GlBackend::kAuto, 320, 240);
+  const float range_m = static_cast<float>(s.camera.depth_range_m.y());
+  double worst_mean = 0, worst_max = 0;
+  for (int i = 0; i < 240; ++i) {
+    if (i % 40 == 0) {
+      std::copy(sim.data()->qpos, sim.data()->qpos + sim.model()->nq, fine_data->qpos);
+      mj_forward(fine_model.get(), fine_data.get());
+      cv::Mat rgb_a, depth_a, rgb_b, depth_b;
+      a.render(sim.model(), sim.data(), sim.camera_id(), &rgb_a, &depth_a);
+      b.render(fine_model.get(), fine_data.get(), sim.camera_id(), &rgb_b, &depth_b);
+      cv::Mat diff;
+      cv::absdiff(rgb_a, rgb_b, diff);
+      const cv::Scalar mean = cv::mean(diff);
+      worst_mean = std::max(worst_mean, (mean[0] + mean[1] + mean[2]) / 3);
+      worst_max = std::max(worst_max, cv::norm(diff, cv::NORM_INF));
+      // Depth: the same plane in other triangles, to the depth buffer's
+      // precision within the camera's range (0.09 mm measured).
+      const cv::Mat in_range = (depth_a <= range_m) | (depth_b <= range_m);
+      EXPECT_LT(cv::norm(depth_a, depth_b, cv::NORM_INF, in_range), 2e-4) << "frame " << i;
+    }
+    sim.advance();
+  }
+  // Colour: 0.033 levels on average and 2 at most, measured.
+  EXPECT_GT(worst_max, 0.0);  // the highlight did change
+  EXPECT_LE(worst_max, 3.0);
+  EXPECT_LT(worst_mean, 0.1);
+}
+
 /// The dust variant of each slab of array 0, by row, from the scene's MJCF.
 std::map<int, std::set<int>> slab_variants_by_row(const std::string& yaml) {
   const scenes::Scenario s = scenes::parse_scenario(yaml, "rows.yaml");
