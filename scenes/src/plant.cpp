@@ -96,7 +96,8 @@ void add_dock(const Plant& p, const PvArray& base, double aisle_m, PlantLayout* 
 }
 
 /// The service roads: between blocks along the rows, behind each line of
-/// blocks, and (with a fence) around the plant, 1 m inside the fence.
+/// blocks, and (with a fence) around the plant, 1 m inside the fence; with
+/// a fence also the loop of roads around each block.
 void add_roads(const Plant& p, double stride_u, double stride_v, double rows_depth_m, int columns, int lines,
                PlantLayout* out) {
   const Eigen::Vector4d e = out->extent_uv;
@@ -111,6 +112,16 @@ void add_roads(const Plant& p, double stride_u, double stride_v, double rows_dep
   out->roads_uv.emplace_back(e[0] - b, e[1] - a, e[0] - a, e[3] + a);  // west
   out->roads_uv.emplace_back(e[2] + a, e[1] - a, e[2] + b, e[3] + a);  // east
   out->perimeter_road_m = 1.0 + w / 2;
+  // Around each block: the perimeter road on the plant's edges, the roads
+  // between blocks elsewhere (the road behind its line on the far side).
+  const double d = out->perimeter_road_m;
+  for (int k = 0; k < p.blocks; ++k) {
+    const int c = k % p.blocks_along, l = k / p.blocks_along;
+    const double west = c == 0 ? e[0] - d : c * stride_u - p.headland_m - w / 2;
+    const double east = c == columns - 1 ? e[2] + d : (c + 1) * stride_u - p.headland_m - w / 2;
+    const double south = l == 0 ? e[1] - d : (l - 1) * stride_v + rows_depth_m + w / 2;
+    out->block_loops_uv.emplace_back(west, south, east, l * stride_v + rows_depth_m + w / 2);
+  }
 }
 
 /// The fence around the extent at its setback, counter-clockwise, with a

@@ -81,14 +81,21 @@ void append_return(std::vector<Eigen::Vector2d>* uv, double u0, double u1, doubl
 /// Radius of the corners of a loop along a plant's perimeter road.
 constexpr double kRoadCornerRadiusM = 3.0;
 
-/// Around a plant along its perimeter road, `laps` times, counter-clockwise
+/// Around a plant along its perimeter road (block 0), or around its block
+/// `block` along the roads that bound it, `laps` times, counter-clockwise
 /// seen from above, from the side before the rows' start (-u) level with
 /// the dock (or that side's middle), heading -v; in the first block's frame.
-void append_road_loop(std::vector<Eigen::Vector2d>* uv, const PlantSummary& plant, int laps, double spacing) {
+void append_road_loop(std::vector<Eigen::Vector2d>* uv, const PlantSummary& plant, int block, int laps,
+                      double spacing) {
   const Eigen::Vector4d& e = plant.extent_uv;
   const double d = plant.perimeter_road_m, r = kRoadCornerRadiusM;
-  const double u0 = e[0] - d, v0 = e[1] - d, u1 = e[2] + d, v1 = e[3] + d;
-  const double vs = plant.dock_aisle ? std::clamp(plant.dock_v_m, v0 + r, v1 - r) : 0.5 * (v0 + v1);
+  const Eigen::Vector4d c = block > 0 ? plant.block_loops_uv.at(static_cast<std::size_t>(block - 1))
+                                      : Eigen::Vector4d(e[0] - d, e[1] - d, e[2] + d, e[3] + d);
+  const double u0 = c[0], v0 = c[1], u1 = c[2], v1 = c[3];
+  // Level with the dock where the loop passes it, else half-way along.
+  const bool by_dock =
+      plant.dock_aisle && (block == 0 || (u0 < e[0] && plant.dock_v_m > v0 + r && plant.dock_v_m < v1 - r));
+  const double vs = by_dock ? std::clamp(plant.dock_v_m, v0 + r, v1 - r) : 0.5 * (v0 + v1);
   for (int lap = 0; lap < laps; ++lap) {
     if (uv->empty()) uv->push_back({u0, vs});
     append_segment_if_long(uv, {u0, vs}, {u0, v0 + r}, spacing);
@@ -206,7 +213,7 @@ std::vector<Eigen::Vector2d> route_polyline(const Scenario& s, double spacing_m)
       break;
     }
     case RoutePattern::kRoads:
-      if (s.plant) append_road_loop(&uv, *s.plant, rt.laps, spacing_m);
+      if (s.plant) append_road_loop(&uv, *s.plant, rt.block, rt.laps, spacing_m);
       break;
     case RoutePattern::kLoop: {
       const double v0 = -rt.offset_m;

@@ -44,6 +44,7 @@ Scenario read_scenario(const detail::ScenarioDocument& doc) {
   top.finish();
   detail::refuse_station_keys(doc);  // after the reader named any unknown key as one
   detail::check_scene_size(s, ctx);
+  detail::check_plant_pattern(s, ctx);
   detail::check_route(s, ctx);
   detail::check_plant_route(s, ctx);
   detail::check_blind_bounds(s, ctx);

@@ -239,6 +239,7 @@ void read_plant(MapReader& top, Scenario& s) {
   sum.dock_front_u_m = layout.dock_front_u_m;
   sum.dock_v_m = layout.dock_v_m;
   sum.roads_uv = layout.roads_uv;
+  sum.block_loops_uv = layout.block_loops_uv;
   sum.tracked_aisles = static_cast<int>(std::lround(p.tyre_tracks * (p.rows_per_block + 1)));
   sum.grass_rows = static_cast<int>(std::lround(p.vegetation_strips * p.rows_per_block));
   if ((sum.tracked_aisles > 0 || sum.grass_rows > 0) && s.ground.relief)
@@ -336,6 +337,8 @@ class KeepOutGrid {
   std::unordered_map<std::int64_t, std::vector<std::size_t>> cells_;
 };
 
+}  // namespace
+
 /// The checks of a route that needs a plant: a loop along its roads, a
 /// route from its dock.
 void check_plant_pattern(const Scenario& s, const ReadContext& ctx) {
@@ -344,6 +347,10 @@ void check_plant_pattern(const Scenario& s, const ReadContext& ctx) {
   if (rt.pattern == RoutePattern::kRoads && (!s.plant || !s.plant->fence))
     throw ConfigError(at("pattern"), "route.pattern",
                       "roads only in a plant with a fence (the loop follows the perimeter road inside it)", "roads");
+  if (rt.block > 0 && rt.block > s.plant->blocks)
+    throw ConfigError(at("block"), "route.block",
+                      "a block of the plant, from 1 to " + std::to_string(s.plant->blocks),
+                      std::to_string(rt.block));
   if (!rt.from_dock) return;
   if (!s.plant || !s.plant->dock_aisle)
     throw ConfigError(at("from_dock"), "route.from_dock", "false unless the plant has a dock (plant.dock)", "true");
@@ -363,10 +370,7 @@ void check_plant_pattern(const Scenario& s, const ReadContext& ctx) {
                       format_exact(rt.margin_m));
 }
 
-}  // namespace
-
 void check_plant_route(const Scenario& s, const ReadContext& ctx) {
-  check_plant_pattern(s, ctx);
   if (!s.plant) return;
   const PlantSummary& plant = *s.plant;
   const std::string key = s.route.pattern == RoutePattern::kWaypoints ? "route.waypoints_m" : "route.pattern";

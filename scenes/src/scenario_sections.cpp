@@ -164,6 +164,10 @@ void read_route(MapReader& r, Route& rt) {
     r.fail(r.full("laps"), r.child("laps"), "no laps unless route.pattern is loop or roads (it would be ignored)",
            r.child("laps").Scalar());
   rt.laps = r.integer("laps", rt.laps, 1, 100);
+  if (r.has("block") && rt.pattern != RoutePattern::kRoads)
+    r.fail(r.full("block"), r.child("block"), "no block unless route.pattern is roads (it would be ignored)",
+           r.child("block").Scalar());
+  rt.block = r.integer("block", rt.block, 1, 10000);
   for (const char* key : {"first_aisle", "from_dock"})
     if (r.has(key) && rt.pattern != RoutePattern::kLawnmower)
       r.fail(r.full(key), r.child(key), "no " + std::string(key) + " unless route.pattern is lawnmower (it would be ignored)",

@@ -38,6 +38,9 @@ void read_plant(MapReader& top, Scenario& s);
 inline constexpr double kRouteTableClearanceM = 0.30;
 /// Refuses a plant's route that leaves the plant or runs through a table.
 void check_plant_route(const Scenario& s, const ReadContext& ctx);
+/// The keys of a route that needs a plant (a loop along its roads, a route
+/// from its dock), checked before the route is drawn.
+void check_plant_pattern(const Scenario& s, const ReadContext& ctx);
 void read_vegetation(MapReader& r, Vegetation& v);
 void read_light(MapReader& r, Light& l);
 void read_route(MapReader& r, Route& rt);

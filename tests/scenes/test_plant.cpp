@@ -125,6 +125,23 @@ TEST(PlantErrors, RowsAndATargetPowerTogetherAreRefused) {
   EXPECT_NE(e.find("plant.block_mwdc: expected rows or block_mwdc, not both"), std::string::npos) << e;
 }
 
+// The shipped patrol: four blocks of the tracker plant's rows, and a loop
+// around the fourth along its roads, driven within the scenario's time.
+TEST(Plant, TheBlocksPlantPatrolsItsFourthBlockAlongItsRoads) {
+  const Scenario s =
+      load_scenario(std::string(PVB_SOURCE_DIR) + "/scenes/plants/plant_tracker_blocks_roads.yaml");
+  ASSERT_TRUE(s.plant.has_value());
+  EXPECT_EQ(s.plant->blocks, 4);
+  EXPECT_EQ(s.plant->block_loops_uv.size(), 4u);
+  EXPECT_EQ(s.route.pattern, RoutePattern::kRoads);
+  EXPECT_EQ(s.route.block, 4);
+  EXPECT_GE(s.plant->dc_mw, 10.0);
+  const double route_m = polyline_length(route_polyline(s));
+  const Eigen::Vector4d& c = s.plant->block_loops_uv[3];
+  EXPECT_NEAR(route_m, 2 * (c[2] - c[0] + c[3] - c[1]), 0.01 * route_m);  // its corners rounded
+  EXPECT_GE(s.duration_s * s.route.speed_mps, 1.04 * route_m);
+}
+
 }  // namespace plant_test
 }  // namespace pvb::scenes
 

@@ -117,6 +117,60 @@ TEST(PlantRouteShapes, ALoopAlongThePerimeterRoadStaysOnTheRoad) {
   EXPECT_NEAR(polyline_length(route), 2 * lap, 2 * lap * 0.02);  // corners rounded
 }
 
+// Around each block of a 2 x 2 plant along the roads that bound it: the
+// perimeter road on the plant's edges, the roads between blocks elsewhere.
+TEST(PlantRouteShapes, ALoopAroundABlockFollowsTheRoadsAroundIt) {
+  const std::string plant = "{rows: 6, blocks: 4, blocks_along: 2, modules_per_table: 20}";
+  for (int k = 1; k <= 4; ++k) {
+    const Scenario s = plant_scenario(plant, "{pattern: roads, block: " + std::to_string(k) + "}");
+    const std::vector<Eigen::Vector2d> route = route_polyline(s, 0.25);
+    // On a road, or on the metre between the plant's extent and the
+    // perimeter road where the roads inside end.
+    for (const Eigen::Vector2d& p : route) {
+      const Eigen::Vector2d q = uv(s, p);
+      double nearest = 1e9;
+      for (const Eigen::Vector4d& r : s.plant->roads_uv)
+        nearest = std::min(nearest, std::hypot(std::max({r[0] - q.x(), q.x() - r[2], 0.0}),
+                                               std::max({r[1] - q.y(), q.y() - r[3], 0.0})));
+      EXPECT_LE(nearest, 1.0 + 1e-9) << "block " << k << ": " << q.transpose();
+    }
+    EXPECT_NEAR((route.front() - route.back()).norm(), 0, 1e-9);
+    // The loop holds its block's rows and no other block's.
+    Eigen::Vector2d lo(1e9, 1e9), hi(-1e9, -1e9);
+    for (const Eigen::Vector2d& p : route) lo = lo.cwiseMin(uv(s, p)), hi = hi.cwiseMax(uv(s, p));
+    for (int b = 0; b < 4; ++b) {
+      const PvArray& a = s.pv_arrays[static_cast<std::size_t>(s.plant->first_array + b)];
+      int inside = 0;
+      for (const auto& [du, dv] : {std::pair{0.0, 0.0},
+                                   {row_length_m(a), 0.0},
+                                   {0.0, a.rows * a.row_pitch_m},
+                                   {row_length_m(a), a.rows * a.row_pitch_m}}) {
+        const Eigen::Vector2d q = uv(s, array_to_world(a, du, dv));
+        inside += (q.array() > lo.array()).all() && (q.array() < hi.array()).all();
+      }
+      EXPECT_EQ(inside, b == k - 1 ? 4 : 0) << "block " << k << ", block " << b + 1 << "'s corners";
+    }
+  }
+  // The dock's block starts level with the dock, the others half-way along their west side.
+  const Scenario first = plant_scenario(plant, "{pattern: roads, block: 1}");
+  EXPECT_NEAR(uv(first, route_polyline(first).front()).y(), first.plant->dock_v_m, 1e-9);
+}
+
+TEST(PlantErrors, ALoopAroundABlockThePlantLacksIsRefused) {
+  const std::string ground = "ground: {size_m: [600, 600]}\n";
+  std::string e = error_of(ground + "plant: {rows: 6, blocks: 2}\nroute: {pattern: roads, block: 3}\n");
+  EXPECT_NE(e.find("bad.yaml:3: route.block: expected a block of the plant, from 1 to 2, got 3"),
+            std::string::npos)
+      << e;
+  // Before the route is drawn (a start part-way measures it).
+  e = error_of(ground + "plant: {rows: 6, blocks: 2}\nroute: {pattern: roads, block: 3, start_m: 10}\n");
+  EXPECT_NE(e.find("bad.yaml:3: route.block: expected a block of the plant"), std::string::npos) << e;
+  e = error_of(ground + "plant: {rows: 6}\nroute: {pattern: lawnmower, block: 1}\n");
+  EXPECT_NE(e.find("bad.yaml:3: route.block: expected no block unless route.pattern is roads"),
+            std::string::npos)
+      << e;
+}
+
 TEST(PlantErrors, RowsThatCrossTheFenceOrARoadAreRefused) {
   const std::string plant = "plant:\n  origin_m: [-40, -20]\n  rows: 6\n  tables_per_row: 2\n  modules_per_table: 20\n";
   const auto with_array_at = [&](double y) {

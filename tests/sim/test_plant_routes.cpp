@@ -1,4 +1,4 @@
-// The shipped plants' day routes, whole (label slow, minutes each): the
+// The shipped plants' routes, whole (label slow, minutes each): the
 // robot's physics over an hour's drive, and culled frames against frames
 // drawn whole at 100 places along each kilometre.
 #include <gtest/gtest.h>
@@ -17,7 +17,7 @@ namespace pvb::test {
 namespace plant_routes_test {
 
 constexpr const char* kPlants[] = {"plants/plant_10mw_fixed", "plants/plant_10mw_tracker",
-                                   "plants/plant_10mw_tracker_rough"};
+                                   "plants/plant_10mw_tracker_rough", "plants/plant_tracker_blocks_roads"};
 /// The colour tolerance of a culled frame (far ground tiles left out):
 /// mean absolute difference, and the share of pixels off by more than 30 levels.
 constexpr double kMeanAbsLevels = 1.0, kShareOver30 = 0.01;

@@ -129,6 +129,11 @@ struct PlantLayout {
   /// block's frame): between blocks, behind each line of blocks, around the
   /// plant inside the fence.
   std::vector<Eigen::Vector4d> roads_uv;
+  /// With a fence: for each block, the centre lines of the roads around
+  /// it, as a rectangle [u0, v0, u1, v1] in the first block's frame (the
+  /// perimeter road where the block lies at the plant's edge, else the road
+  /// between it and its neighbour).
+  std::vector<Eigen::Vector4d> block_loops_uv;
 };
 
 /// The array a plant's blocks share (rows, origin and azimuth aside).

@@ -72,6 +72,8 @@ struct PlantSummary {
   int tracked_aisles = 0;
   int grass_rows = 0;
   std::vector<Eigen::Vector4d> roads_uv;  ///< the service roads, [u0, v0, u1, v1] in the first block's frame
+  /// With a fence: the road centre lines around each block (PlantLayout).
+  std::vector<Eigen::Vector4d> block_loops_uv;
 };
 
 }  // namespace pvb::scenes

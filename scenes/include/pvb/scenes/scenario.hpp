@@ -219,6 +219,9 @@ struct Route {
   int aisle = 0;                             ///< along_row: aisle in front of this row
   int aisles = 2;                            ///< lawnmower: number of aisles driven
   int laps = 1;                              ///< loop: times around the array
+  /// roads: 0 for the perimeter road, k for the roads around the plant's
+  /// block k (from 1, as its row signs count).
+  int block = 0;
   /// lawnmower: after the last aisle, drive back to the start beyond the row
   /// ends and re-drive the first aisle's first return_overlap_m metres in
   /// the direction of the start.
