@@ -192,7 +192,10 @@ int cull_to_view(mjvScene* scn, double aspect, double far_tile_m, const mjModel*
       r += 0.5 * len;
     }
     bool visible = r < 0;
-    const bool tile = g.type == mjGEOM_PLANE || relief_tile;
+    // A plant's road is seen far along it; ground tiles are not drawn that far.
+    const bool road = g.type == mjGEOM_PLANE && model_geom &&
+                      named(model->names + model->name_geomadr[g.objid], kRoadPlanePrefix);
+    const bool tile = (g.type == mjGEOM_PLANE && !road) || relief_tile;
     if (!visible && far_tile_m > 0 && tile && (c - pos).norm() > far_tile_m + r) continue;
     if (!visible) {
       const Eigen::Vector3d d = c - pos;

@@ -112,8 +112,9 @@ void add_textures(const scenes::Scenario& s, const std::vector<GroundTile>& tile
   // Shared images: image k is groundtK; else tile k's own image is.
   // A plant's roads add their gravel images after the soil's.
   std::vector<std::uint64_t> seeds;
-  const bool gravel = std::any_of(tiles.begin(), tiles.end(),
-                                  [&](const GroundTile& t) { return t.image >= s.ground.soil_images; }) &&
+  const bool gravel = (std::any_of(tiles.begin(), tiles.end(),
+                                   [&](const GroundTile& t) { return t.image >= s.ground.soil_images; }) ||
+                       mjcf::draws_road_planes(s)) &&
                       s.ground.soil_images > 0;
   const int shared = s.ground.soil_images + (gravel ? kRoadGravelImages : 0);
   for (int k = 0; k < shared && !tiles.empty(); ++k) seeds.push_back(shared_soil_image_seed(station_seed, k));

@@ -107,8 +107,11 @@ void add_tiled_relief_ground(XmlWriter& x, const scenes::Scenario& s, const std:
 // scene_plant.cpp
 /// A plant's materials and its fence's meshes (nothing without a plant).
 void add_plant_assets(XmlWriter& x, const scenes::Scenario& s, const scenes::GroundRelief& ground);
-/// A plant's fence sections, dock and combiner boxes.
+/// A plant's fence sections, road pieces, dock and combiner boxes.
 void add_plant_fixtures(XmlWriter& x, const scenes::Scenario& s, const scenes::GroundRelief& ground);
+/// Whether the scene draws a plant's roads as planes of gravel wherever
+/// they run: a plant with roads on a flat ground of shared soil images.
+bool draws_road_planes(const scenes::Scenario& s);
 
 // scene_robot.cpp
 /// The robot (differential drive, two driven wheels and a caster) at the

@@ -163,6 +163,35 @@ void add_cover_band(XmlWriter& x, const scenes::PvArray& block, double v, double
          material + "\"/>");
 }
 
+/// Road pieces are at most this long, so that the view cull leaves out
+/// those out of sight; they lie between the soil's backdrop (5 mm down) and
+/// the route's tiles (at 0), which cover them near the route.
+constexpr double kRoadPieceM = 48.0, kRoadPlaneZM = -0.0025;
+
+/// A plant's service roads, gravel wherever they run: planes with the
+/// first of the roads' gravel images, in pieces along each road.
+void add_road_planes(XmlWriter& x, const scenes::Scenario& s) {
+  if (!draws_road_planes(s)) return;
+  const scenes::PvArray& base = s.pv_arrays[static_cast<std::size_t>(s.plant->first_array)];
+  const std::string material = "groundt" + std::to_string(s.ground.soil_images);
+  int k = 0;
+  for (const Eigen::Vector4d& r : s.plant->roads_uv) {
+    const bool along_u = r[2] - r[0] >= r[3] - r[1];
+    const double length = along_u ? r[2] - r[0] : r[3] - r[1];
+    const int pieces = std::max(1, static_cast<int>(std::ceil(length / kRoadPieceM - 1e-9)));
+    const double step = length / pieces;
+    for (int i = 0; i < pieces; ++i) {
+      const double u0 = along_u ? r[0] + i * step : r[0], u1 = along_u ? u0 + step : r[2];
+      const double v0 = along_u ? r[1] : r[1] + i * step, v1 = along_u ? r[3] : v0 + step;
+      const Eigen::Vector2d c = scenes::array_to_world(base, 0.5 * (u0 + u1), 0.5 * (v0 + v1));
+      x.line("<geom name=\"" + std::string(kRoadPlanePrefix) + std::to_string(k++) +
+             "\" class=\"scenery\" type=\"plane\" size=\"" + v3((u1 - u0) / 2, (v1 - v0) / 2, 1) +
+             "\" pos=\"" + v3(c.x(), c.y(), kRoadPlaneZM) + "\" euler=\"0 0 " + f(base.azimuth_deg) +
+             "\" material=\"" + material + "\"/>");
+    }
+  }
+}
+
 /// Tyre tracks in a share of each block's aisles, grass under a share of
 /// its rows, which ones from the station's seed.
 void add_ground_cover(XmlWriter& x, const scenes::Scenario& s) {
@@ -249,6 +278,11 @@ void add_plant_assets(XmlWriter& x, const scenes::Scenario& s, const scenes::Gro
     if (!meshes[k].second.faces.empty()) x.line(mesh_line("fence" + std::to_string(k), meshes[k].second));
 }
 
+bool draws_road_planes(const scenes::Scenario& s) {
+  return s.plant && !s.plant->roads_uv.empty() && !s.ground.relief && s.ground.soil_images > 0 &&
+         s.ground.drawn_tiling() == scenes::GroundTiling::kVaried;
+}
+
 void add_plant_fixtures(XmlWriter& x, const scenes::Scenario& s, const scenes::GroundRelief& ground) {
   if (!s.plant) return;
   const scenes::PlantSummary& plant = *s.plant;
@@ -261,6 +295,7 @@ void add_plant_fixtures(XmlWriter& x, const scenes::Scenario& s, const scenes::G
              std::to_string(k) + "\" pos=\"" + v3(p.x(), p.y(), 0) + "\" material=\"fence\"/>");
     }
   }
+  add_road_planes(x, s);
   add_ground_cover(x, s);
   for (std::size_t k = 0; k < plant.row_signs.size(); ++k) {
     const scenes::RowSign& r = plant.row_signs[k];

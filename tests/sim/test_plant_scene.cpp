@@ -171,6 +171,101 @@ TEST(PlantScene, AWideGroundsCoarseGridChangesOnlyItsHighlight) {
   EXPECT_LT(worst_mean, 0.1);
 }
 
+/// The small plant on varied soil of shared images: roads drawn as planes.
+scenes::Scenario small_plant_on_varied_soil() {
+  scenes::Scenario s = small_plant();
+  s.ground.tiling = scenes::GroundTiling::kVaried;
+  s.ground.soil_images = 4;
+  return s;
+}
+
+// A plant's roads are gravel beyond the route's tiles too: planes between
+// the soil's backdrop and the tiles, as wide as the roads.
+TEST(PlantScene, RoadsAreGravelWhereverTheyRun) {
+  const scenes::Scenario s = small_plant_on_varied_soil();
+  sim::Simulator sim(s);
+  const mjModel* m = sim.model();
+  const scenes::PvArray& frame = s.pv_arrays[static_cast<std::size_t>(s.plant->first_array)];
+  const std::vector<sim::GroundTile> tiles = sim::ground_tiles(s);
+  const auto off_the_tiles = [&](const Eigen::Vector2d& p) {
+    return std::all_of(tiles.begin(), tiles.end(), [&](const sim::GroundTile& t) {
+      return (t.centre_m - p).lpNorm<Eigen::Infinity>() > sim::kGroundTileM / 2 + 0.01;
+    });
+  };
+  // Straight down from a metre up: the first geom drawn that the ray meets,
+  // by its material's name.  MuJoCo's rays meet every plane whatever its
+  // group, so the ground's collision plane is made invisible to them.
+  const sim::ModelPtr drawn(mj_copyModel(nullptr, m));
+  const int ground = mj_name2id(m, mjOBJ_GEOM, "ground");
+  drawn->geom_matid[ground] = -1;
+  drawn->geom_rgba[4 * ground + 3] = 0;
+  const auto material_below = [&](const Eigen::Vector2d& p) {
+    const mjtNum pnt[3] = {p.x(), p.y(), 1.0}, down[3] = {0, 0, -1};
+    int g = -1;
+    mj_ray(drawn.get(), sim.data(), pnt, down, nullptr, 1, -1, &g);
+    return g < 0 || m->geom_matid[g] < 0 ? std::string()
+                                         : std::string(mj_id2name(m, mjOBJ_MATERIAL, m->geom_matid[g]));
+  };
+  const std::string gravel = "groundt" + std::to_string(s.ground.soil_images);
+  int on_road = 0, soil_beside = 0;
+  for (const Eigen::Vector4d& r : s.plant->roads_uv) {
+    const bool along_u = r[2] - r[0] >= r[3] - r[1];
+    for (double t = 1.0; t < (along_u ? r[2] - r[0] : r[3] - r[1]) - 1.0; t += 5.0) {
+      const Eigen::Vector2d centre = along_u ? Eigen::Vector2d(r[0] + t, 0.5 * (r[1] + r[3]))
+                                             : Eigen::Vector2d(0.5 * (r[0] + r[2]), r[1] + t);
+      const Eigen::Vector2d p = scenes::array_to_world(frame, centre.x(), centre.y());
+      if (!off_the_tiles(p)) continue;
+      EXPECT_EQ(material_below(p), gravel) << "road at (" << p.transpose() << ")";
+      ++on_road;
+      // Half a metre beside the road, clear of every road: no gravel.
+      const Eigen::Vector2d beside =
+          along_u ? Eigen::Vector2d(centre.x(), r[3] + 0.5) : Eigen::Vector2d(r[2] + 0.5, centre.y());
+      const Eigen::Vector2d q = scenes::array_to_world(frame, beside.x(), beside.y());
+      bool clear = off_the_tiles(q);
+      for (const Eigen::Vector4d& o : s.plant->roads_uv)
+        clear = clear && !(beside.x() >= o[0] - 0.1 && beside.x() <= o[2] + 0.1 && beside.y() >= o[1] - 0.1 &&
+                           beside.y() <= o[3] + 0.1);
+      if (!clear) continue;
+      const std::string beside_road = material_below(q);
+      EXPECT_NE(beside_road, gravel) << "beside the road at (" << q.transpose() << ")";
+      soil_beside += beside_road == "ground";
+    }
+  }
+  EXPECT_GT(on_road, 100);
+  EXPECT_GT(soil_beside, 50);  // the soil's backdrop half a metre off the road
+}
+
+// The cull leaves out ground tiles beyond 10 m here, but keeps road pieces
+// in view however far: pixels of pieces wholly beyond 10 m.
+TEST(PlantScene, TheCullKeepsRoadsFarAlongThem) {
+  sim::Simulator sim(small_plant_on_varied_soil());
+  const mjModel* m = sim.model();
+  sim::Renderer culled(m, sim::GlBackend::kAuto, 320, 240);
+  const double far_m = 10.0;
+  culled.set_far_tile_cull_m(far_m);
+  culled.set_ground_stream(sim.ground_stream());
+  std::vector<int> roads;
+  for (int g = 0; g < m->ngeom; ++g) {
+    const char* name = mj_id2name(m, mjOBJ_GEOM, g);
+    if (name && std::string(name).rfind(sim::kRoadPlanePrefix, 0) == 0) roads.push_back(g);
+  }
+  int far_road_pixels = 0;
+  for (int i = 0; i < 240; ++i) {
+    if (i % 40 == 0) {
+      cv::Mat ids;
+      culled.render_geom_ids(m, sim.data(), sim.camera_id(), &ids);
+      const Eigen::Map<const Eigen::Vector3d> eye(sim.data()->cam_xpos + 3 * sim.camera_id());
+      for (const int g : roads) {
+        const Eigen::Map<const Eigen::Vector3d> c(sim.data()->geom_xpos + 3 * g);
+        if ((c - eye).norm() > far_m + std::hypot(m->geom_size[3 * g], m->geom_size[3 * g + 1]))
+          far_road_pixels += cv::countNonZero(ids == g);
+      }
+    }
+    sim.advance();
+  }
+  EXPECT_GT(far_road_pixels, 100);
+}
+
 /// The dust variant of each slab of array 0, by row, from the scene's MJCF.
 std::map<int, std::set<int>> slab_variants_by_row(const std::string& yaml) {
   const scenes::Scenario s = scenes::parse_scenario(yaml, "rows.yaml");

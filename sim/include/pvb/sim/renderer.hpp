@@ -120,8 +120,9 @@ void snap_to_shadow_texels(float pos[3], const float dir[3], double texel_m);
 /// (when shadows are on), down to 2 m below `shadow_floor_z_m`, so that a
 /// geom whose shadow falls in view stays.
 /// `aspect` is the image's width over its height.  With far_tile_m > 0, a
-/// ground tile (a finite plane, or a height field not of the ground's
-/// repeated image, material "ground") farther than that is left out as
+/// ground tile (a finite plane but a plant's road piece, kRoadPlanePrefix,
+/// or a height field not of the ground's repeated image, material
+/// "ground") farther than that is left out as
 /// well: the one cull that changes pixels (colour only, beyond the depth
 /// range).  A mesh (a plant's fence section) and a height field are culled
 /// by their model's bounding sphere (when `model` is given).  Returns the

@@ -152,5 +152,7 @@ inline constexpr const char* kReliefTilesFile = "ground_tiles.bin";
 /// height field alike): prefix then K.
 inline constexpr const char* kReliefTilePrefix = "groundtile";
 inline constexpr const char* kReliefFarTilePrefix = "groundtilefar";
+/// The names of a plant's road pieces (flat varied soil): prefix then K.
+inline constexpr const char* kRoadPlanePrefix = "road";
 
 }  // namespace pvb::sim
