@@ -318,7 +318,7 @@ TEST(ScenarioDays, ShippedDaysKeepTheirStation) {
 // A plant's days: the same plant (blocks, fence, dock, boxes) under the
 // day's sun and dust.
 TEST(PlantDays, KeepThePlantAndChangeTheDay) {
-  for (const char* plant : {"plant_10mw_fixed", "plant_10mw_tracker"}) {
+  for (const char* plant : {"plant_10mw_fixed", "plant_10mw_tracker", "plant_10mw_tracker_rough"}) {
     const Scenario base = load_scenario(kScenes + "plants/" + plant + ".yaml");
     for (const char* day : {"_0800", "_1200", "_1600", "_dusty"}) {
       const Scenario s = load_scenario(kScenes + "days/" + plant + day + ".yaml");
@@ -336,4 +336,11 @@ TEST(PlantDays, KeepThePlantAndChangeTheDay) {
     EXPECT_DOUBLE_EQ(dusty.pv_arrays[0].dirt, 0.8);
     EXPECT_LT(base.pv_arrays[0].dirt, 0.5);
   }
+  // The rough plant's day after rain: the same relief, wet soft earth.
+  const Scenario rough = load_scenario(kScenes + "plants/plant_10mw_tracker_rough.yaml");
+  const Scenario wet = load_scenario(kScenes + "days/plant_10mw_tracker_rough_wet.yaml");
+  ASSERT_TRUE(wet.ground.relief && rough.ground.relief);
+  EXPECT_EQ(wet.ground.relief->slope_percent, rough.ground.relief->slope_percent);
+  EXPECT_EQ(wet.ground.friction, 0.4);
+  EXPECT_FALSE(rough.ground.friction.has_value());
 }

@@ -21,9 +21,11 @@ namespace plant_routes_test {
 /// along which both lines of blocks lie in view).
 constexpr const char* kKilometrePlants[] = {"plants/plant_10mw_fixed", "plants/plant_10mw_tracker",
                                             "plants/plant_10mw_tracker_rough"};
-/// Every shipped plant: the kilometre plants and the patrol of four blocks.
+/// Every shipped plant (the kilometre plants and the patrol of four
+/// blocks), and the rough plant's day on wet, soft earth.
 constexpr const char* kPlants[] = {"plants/plant_10mw_fixed", "plants/plant_10mw_tracker",
-                                   "plants/plant_10mw_tracker_rough", "plants/plant_tracker_blocks_roads"};
+                                   "plants/plant_10mw_tracker_rough", "plants/plant_tracker_blocks_roads",
+                                   "days/plant_10mw_tracker_rough_wet"};
 /// The colour tolerance of a culled frame (far ground tiles left out):
 /// mean absolute difference, and the share of pixels off by more than 30 levels.
 constexpr double kMeanAbsLevels = 1.0, kShareOver30 = 0.01;

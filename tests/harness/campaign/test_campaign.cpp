@@ -38,7 +38,8 @@ std::string error_of(const std::string& text) {
 }  // namespace
 
 TEST(Campaign, ShippedCampaignsLoad) {
-  for (const char* name : {"daily", "trackers", "same_day", "plant_10mw_fixed_daily", "plant_10mw_tracker_daily"}) {
+  for (const char* name : {"daily", "trackers", "same_day", "plant_10mw_fixed_daily",
+                           "plant_10mw_tracker_daily", "plant_10mw_tracker_rough_daily"}) {
     const run::Campaign c = run::load_campaign(kCampaigns + name + ".yaml");
     EXPECT_EQ(c.name, name);
     ASSERT_GE(c.sessions.size(), 3u) << name;
@@ -50,7 +51,8 @@ TEST(Campaign, ShippedCampaignsLoad) {
     }
   }
   // A growing map: each day extends the map of the day before.
-  for (const char* name : {"growing", "plant_10mw_fixed_growing", "plant_10mw_tracker_growing"}) {
+  for (const char* name : {"growing", "plant_10mw_fixed_growing", "plant_10mw_tracker_growing",
+                           "plant_10mw_tracker_rough_growing"}) {
     const run::Campaign c = run::load_campaign(kCampaigns + name + ".yaml");
     ASSERT_GE(c.sessions.size(), 5u) << name;
     EXPECT_EQ(c.sessions[0].mode, run::SessionMode::kMap) << name;
