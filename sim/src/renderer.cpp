@@ -192,11 +192,14 @@ int cull_to_view(mjvScene* scn, double aspect, double far_tile_m, const mjModel*
       r += 0.5 * len;
     }
     bool visible = r < 0;
-    // A plant's road is seen far along it; ground tiles are not drawn that far.
-    const bool road = g.type == mjGEOM_PLANE && model_geom &&
-                      named(model->names + model->name_geomadr[g.objid], kRoadPlanePrefix);
-    const bool tile = (g.type == mjGEOM_PLANE && !road) || relief_tile;
-    if (!visible && far_tile_m > 0 && tile && (c - pos).norm() > far_tile_m + r) continue;
+    const bool tile = g.type == mjGEOM_PLANE || relief_tile;
+    // A plant's road is seen far along it; ground tiles are not drawn that
+    // far (its name asked only of a plane the far cull would leave out).
+    const auto road = [&] {
+      return g.type == mjGEOM_PLANE && model_geom &&
+             named(model->names + model->name_geomadr[g.objid], kRoadPlanePrefix);
+    };
+    if (!visible && far_tile_m > 0 && tile && (c - pos).norm() > far_tile_m + r && !road()) continue;
     if (!visible) {
       const Eigen::Vector3d d = c - pos;
       const Eigen::Vector3d q(d.dot(right), d.dot(up), d.dot(fwd));
