@@ -106,7 +106,7 @@ bool mirror_depth_wins(double cos_i) { return std::abs(cos_i) < fresnel_table().
 GlassFinder::GlassFinder(const mjModel* m, const std::vector<bool>& specular_arrays) : m_(m) {
   for (int g = 0; g < m->ngeom; ++g) {
     if (m->geom_type[g] != mjGEOM_BOX || classify_geom(m, g) != SurfaceClass::kPanel) continue;
-    // Panel materials are "a<array>panel<variant>".
+    // Panel materials are "a<array>panel<variant>", slabs "a<array>slab<variant>".
     const char* name = mj_id2name(m, mjOBJ_MATERIAL, m->geom_matid[g]);
     const int array = name && name[0] == 'a' ? std::atoi(name + 1) : -1;
     if (array >= 0 && static_cast<std::size_t>(array) < specular_arrays.size() &&

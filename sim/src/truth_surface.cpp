@@ -36,7 +36,9 @@ SurfaceClass classify_geom(const mjModel* m, int g) {
   if (mat < 0) return SurfaceClass::kOther;
   const std::string name = mj_id2name(m, mjOBJ_MATERIAL, mat) ? mj_id2name(m, mjOBJ_MATERIAL, mat) : "";
   if (name.rfind("ground", 0) == 0) return SurfaceClass::kGround;  // "ground", or a varied ground's tiles "groundtK"
-  if (name.find("panel") != std::string::npos) return SurfaceClass::kPanel;
+  // "a<array>panel<variant>" a module, "a<array>slab<variant>" a table's modules as one slab
+  if (name.find("panel") != std::string::npos || name.find("slab") != std::string::npos)
+    return SurfaceClass::kPanel;
   if (name == "backsheet") return SurfaceClass::kFrame;
   if (name == "steel") return m->geom_size[3 * g + 2] > 0.2 ? SurfaceClass::kPost : SurfaceClass::kFrame;
   if (name == "brick" || name == "plaster") return SurfaceClass::kWall;
