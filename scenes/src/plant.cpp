@@ -185,6 +185,7 @@ PvArray plant_block_array(const Plant& p) {
   a.dirt = p.dirt;
   a.row_soiling = p.row_soiling;
   a.broken_modules = p.broken_modules;
+  a.missing_modules = p.missing_modules;
   a.specular_glass = p.specular_glass;
   a.identical_tables = p.identical_tables;
   a.panel_slabs = true;

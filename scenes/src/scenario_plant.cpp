@@ -137,6 +137,8 @@ Plant read_plant_section(MapReader& r) {
   const long long block_modules =
       static_cast<long long>(p.rows_per_block) * p.tables_per_row * p.modules_per_table * p.modules_high;
   p.broken_modules = r.integer("broken_modules", 0, 0, static_cast<int>(std::min<long long>(block_modules, 1000)));
+  p.missing_modules = r.integer(
+      "missing_modules", 0, 0, static_cast<int>(std::min<long long>(block_modules - p.broken_modules, 1000)));
   p.specular_glass = r.choice<bool>("glass", p.specular_glass, {{"diffuse", false}, {"specular", true}});
   p.identical_tables = r.boolean("identical_tables", p.identical_tables);
   return p;

@@ -1,5 +1,7 @@
 // The scene-size check of a scenario: the geoms the scene builder will make
 // for what the file asks for, against what MuJoCo's renderer draws.
+#include <algorithm>
+
 #include "pvb/common/error.hpp"
 #include "pvb/scenes/plant.hpp"
 #include "scenario_sections.hpp"
@@ -18,6 +20,23 @@ long long table_geoms(const PvArray& a) {
   return panels + backsheet + rails + posts;
 }
 
+/// At most the geoms that missing modules add: a table that lost one is
+/// drawn a module at a time, each module with its backsheet, instead of
+/// one slab and one backsheet (every missing module in a table of its own
+/// at worst).
+long long missing_module_geoms(const PvArray& a) {
+  if (a.missing_modules == 0) return 0;
+  const long long modules = static_cast<long long>(a.panels_per_table) * a.panel_lines;
+  return static_cast<long long>(a.missing_modules) * std::max(2 * (modules - 1) - 2, 0LL);
+}
+
+/// ", up to N more for M missing modules a block" where a plant's blocks miss modules.
+std::string missing_modules_part(const PlantSummary& p, const PvArray& block) {
+  if (block.missing_modules == 0) return "";
+  return ", up to " + std::to_string(p.blocks * missing_module_geoms(block)) + " more for " +
+         std::to_string(block.missing_modules) + " missing modules a block";
+}
+
 /// At most kMaxSceneGeoms geoms: what MuJoCo's compiler builds in seconds
 /// (scenario_sections.hpp); the renderer draws the ones in view.
 ///
@@ -34,7 +53,8 @@ void check_scene_size(const Scenario& s, const ReadContext& ctx) {
   std::size_t largest_index = 0;
   for (std::size_t i = 0; i < s.pv_arrays.size(); ++i) {
     const PvArray& a = s.pv_arrays[i];
-    const long long n = static_cast<long long>(a.rows) * a.tables_per_row * table_geoms(a) + a.broken_modules;
+    const long long n = static_cast<long long>(a.rows) * a.tables_per_row * table_geoms(a) +
+                        a.broken_modules + missing_module_geoms(a);
     total += n;
     if (n > largest) {
       largest = n;
@@ -45,13 +65,14 @@ void check_scene_size(const Scenario& s, const ReadContext& ctx) {
   std::string got = std::to_string(total);
   if (s.plant) {
     const PvArray& b = s.pv_arrays[static_cast<std::size_t>(s.plant->first_array)];
-    throw ConfigError(ctx.origins->where("plant", ctx.file), "plant",
-                      "at most " + std::to_string(kMaxSceneGeoms) +
-                          " geoms in the scene (a plant's table is its slab and up to 7 parts; a wall, a fixture or "
-                          "40 m of fence 1, a shrub, a tree or a row sign 2): fewer blocks or rows",
-                      got + " (" + std::to_string(s.plant->blocks) + " blocks x " + std::to_string(b.rows) +
-                          " rows x " + std::to_string(b.tables_per_row) + " tables x " +
-                          std::to_string(table_geoms(b)) + " geoms)");
+    throw ConfigError(
+        ctx.origins->where("plant", ctx.file), "plant",
+        "at most " + std::to_string(kMaxSceneGeoms) +
+            " geoms in the scene (a plant's table is its slab and up to 7 parts; a wall, a fixture or "
+            "40 m of fence 1, a shrub, a tree or a row sign 2): fewer blocks or rows",
+        got + " (" + std::to_string(s.plant->blocks) + " blocks x " + std::to_string(b.rows) + " rows x " +
+            std::to_string(b.tables_per_row) + " tables x " + std::to_string(table_geoms(b)) + " geoms" +
+            missing_modules_part(*s.plant, b) + ")");
   }
   if (largest >= 0) {
     const PvArray& a = s.pv_arrays[largest_index];

@@ -52,42 +52,92 @@ int row_dust_variant(std::uint64_t station_seed, int index, int row) {
   return static_cast<int>(pick.next() % kDirtVariants);
 }
 
-/// A table's panels as one slab: its material repeats the module texture
-/// once per module (`PREslabK`, scene_builder.cpp); one dust variant a
-/// table, the row's with row_soiling (`row_variant` >= 0).
-std::string table_slab_geom(const std::string& table, const scenes::PvArray& a, const Eigen::Vector3d& centre,
-                            const std::string& axes, const std::string& pre, Placer& rng, int row_variant) {
-  const int variant =
-      row_variant >= 0 ? row_variant : static_cast<int>(rng.uniform(0, kDirtVariants)) % kDirtVariants;
-  return panel_geom(table + "slab", a.table_length_m(), a.table_depth_m(), centre, axes,
-                    pre + "slab" + std::to_string(variant));
-}
+/// The marked modules of a slab array, each (row, table, line, column):
+/// those shown broken and those gone, drawn from the station's seed.
+struct ModuleMarks {
+  std::set<std::array<int, 4>> broken, missing;
 
-/// The modules of a slab array shown broken: a.broken_modules distinct
-/// (row, table, line, column), drawn from the station's seed.
-std::set<std::array<int, 4>> broken_modules(const scenes::PvArray& a, std::uint64_t station_seed, int index) {
+  /// Whether table `t` of `row` lost any module.
+  bool lost_any(int row, int t) const {
+    const auto it = missing.lower_bound({row, t, 0, 0});
+    return it != missing.end() && (*it)[0] == row && (*it)[1] == t;
+  }
+};
+
+/// `n` distinct modules of a slab array outside `taken`, from the station's seed and `stream`.
+std::set<std::array<int, 4>> seeded_modules(const scenes::PvArray& a, std::uint64_t station_seed,
+                                            std::uint64_t stream, int n,
+                                            const std::set<std::array<int, 4>>& taken) {
   std::set<std::array<int, 4>> out;
-  SplitMix pick(station_seed, 0xB40C0000ULL + static_cast<std::uint64_t>(index));
-  const auto draw = [&](int n) { return static_cast<int>(pick.next() % static_cast<std::uint64_t>(n)); };
-  while (static_cast<int>(out.size()) < a.broken_modules)
-    out.insert({draw(a.rows), draw(a.tables_per_row), draw(a.panel_lines), draw(a.panels_per_table)});
+  SplitMix pick(station_seed, stream);
+  const auto draw = [&](int k) { return static_cast<int>(pick.next() % static_cast<std::uint64_t>(k)); };
+  while (static_cast<int>(out.size()) < n) {
+    const std::array<int, 4> m{draw(a.rows), draw(a.tables_per_row), draw(a.panel_lines),
+                               draw(a.panels_per_table)};
+    if (taken.count(m) == 0) out.insert(m);
+  }
   return out;
 }
 
-/// The broken modules of one table of a slab array: a pane of shattered
-/// glass just over each, `point(u, s)` the slab's surface, `normal` its face.
-void add_broken_modules(XmlWriter& x, const scenes::PvArray& a, const std::set<std::array<int, 4>>& broken, int row,
-                        int table, double u_start, const std::function<Eigen::Vector3d(double, double)>& point,
-                        const Eigen::Vector3d& normal, const std::string& axes, const std::string& tname) {
-  const double mw = a.table_length_m() / a.panels_per_table, mh = a.table_depth_m() / a.panel_lines;
-  for (auto it = broken.lower_bound({row, table, 0, 0}); it != broken.end() && (*it)[0] == row && (*it)[1] == table;
-       ++it) {
-    const Eigen::Vector3d c = point(u_start + ((*it)[3] + 0.5) * mw, ((*it)[2] + 0.5) * mh) +
-                              normal * (kPanelHalfThicknessM + 0.002);
-    x.line("<geom name=\"" + tname + "broken" + std::to_string((*it)[2]) + "_" + std::to_string((*it)[3]) +
-           "\" class=\"scenery\" type=\"box\" size=\"" + v3(0.49 * mw, 0.49 * mh, 0.001) + "\" pos=\"" + v3(c) +
-           "\" xyaxes=\"" + axes + "\" material=\"broken\"/>");
+ModuleMarks module_marks(const scenes::PvArray& a, std::uint64_t station_seed, int index) {
+  ModuleMarks m;
+  const auto i = static_cast<std::uint64_t>(index);
+  m.broken = seeded_modules(a, station_seed, 0xB40C0000ULL + i, a.broken_modules, {});
+  m.missing = seeded_modules(a, station_seed, 0x6A900000ULL + i, a.missing_modules, m.broken);
+  return m;
+}
+
+/// Where one table of a slab array lies: `point(u, s)` on its panels'
+/// surface (u along the row from the array's start, s across the table
+/// from its lower edge), `normal` their face.
+struct SlabTable {
+  int row = 0, table = 0;
+  double u_start = 0;
+  std::function<Eigen::Vector3d(double, double)> point;
+  Eigen::Vector3d normal;
+  std::string axes, name;
+};
+
+std::string backsheet_geom(const Eigen::Vector3d& panel_centre, const SlabTable& t, double length_m,
+                           double depth_m) {
+  return "<geom class=\"scenery\" type=\"box\" size=\"" + v3(length_m / 2, depth_m / 2, 0.015) + "\" pos=\"" +
+         v3(panel_centre - t.normal * (kPanelHalfThicknessM + 0.016)) + "\" xyaxes=\"" + t.axes +
+         "\" material=\"backsheet\"/>";
+}
+
+/// A slab array's table: one slab whose material repeats the module texture
+/// once per module (`PREslabK`, scene_builder.cpp), the broken modules'
+/// panes just over it, and the backsheet under it.  A table that lost a
+/// module is drawn a module at a time (`PREpanelK`), each with its own
+/// backsheet, so the gap shows what is under the table.  One dust variant a
+/// table: the row's with row_soiling (`row_variant` >= 0), else the day's.
+void add_slab_table(XmlWriter& x, const scenes::PvArray& a, const ModuleMarks& marks, const SlabTable& t,
+                    const std::string& pre, Placer& rng, int row_variant) {
+  const int variant =
+      row_variant >= 0 ? row_variant : static_cast<int>(rng.uniform(0, kDirtVariants)) % kDirtVariants;
+  const double tl = a.table_length_m(), td = a.table_depth_m();
+  const double mw = tl / a.panels_per_table, mh = td / a.panel_lines;
+  const bool holed = marks.lost_any(t.row, t.table);
+  if (!holed)
+    x.line(panel_geom(t.name + "slab", tl, td, t.point(t.u_start + tl / 2, td / 2), t.axes,
+                      pre + "slab" + std::to_string(variant)));
+  for (int line = 0; holed && line < a.panel_lines; ++line)
+    for (int c = 0; c < a.panels_per_table; ++c) {
+      if (marks.missing.count({t.row, t.table, line, c}) != 0) continue;
+      const Eigen::Vector3d centre = t.point(t.u_start + (c + 0.5) * mw, (line + 0.5) * mh);
+      x.line(panel_geom(t.name + "p" + std::to_string(line) + "_" + std::to_string(c), mw, mh, centre, t.axes,
+                        pre + "panel" + std::to_string(variant)));
+      x.line(backsheet_geom(centre, t, mw, mh));
+    }
+  for (auto it = marks.broken.lower_bound({t.row, t.table, 0, 0});
+       it != marks.broken.end() && (*it)[0] == t.row && (*it)[1] == t.table; ++it) {
+    const Eigen::Vector3d c = t.point(t.u_start + ((*it)[3] + 0.5) * mw, ((*it)[2] + 0.5) * mh) +
+                              t.normal * (kPanelHalfThicknessM + 0.002);
+    x.line("<geom name=\"" + t.name + "broken" + std::to_string((*it)[2]) + "_" + std::to_string((*it)[3]) +
+           "\" class=\"scenery\" type=\"box\" size=\"" + v3(0.49 * mw, 0.49 * mh, 0.001) + "\" pos=\"" +
+           v3(c) + "\" xyaxes=\"" + t.axes + "\" material=\"broken\"/>");
   }
+  if (!holed) x.line(backsheet_geom(t.point(t.u_start + tl / 2, td / 2), t, tl, td));
 }
 
 /// Where a post under `top` starts: on flat ground at z = 0, on a relief
@@ -109,7 +159,7 @@ void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uin
   Placer rng = dust_placer(day_seed, index);
   const std::string pre = "a" + std::to_string(index);
   const Placer first_table_rng = rng;  // identical_tables: every table draws the first one's variants
-  const std::set<std::array<int, 4>> broken = broken_modules(a, station_seed, index);
+  const ModuleMarks marks = module_marks(a, station_seed, index);
   for (int row = 0; row < a.rows; ++row) {
     for (int t = 0; t < a.tables_per_row; ++t) {
       if (a.identical_tables) rng = first_table_rng;
@@ -124,9 +174,8 @@ void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uin
       };
       const std::string tname = pre + "r" + std::to_string(row) + "t" + std::to_string(t);
       if (a.panel_slabs) {
-        x.line(table_slab_geom(tname, a, slope_point(u_start + tl / 2, td / 2), axes, pre, rng,
-                               a.row_soiling > 0 ? row_dust_variant(station_seed, index, row) : -1));
-        add_broken_modules(x, a, broken, row, t, u_start, slope_point, normal, axes, tname);
+        add_slab_table(x, a, marks, {row, t, u_start, slope_point, normal, axes, tname}, pre, rng,
+                       a.row_soiling > 0 ? row_dust_variant(station_seed, index, row) : -1);
       } else {
         for (int line = 0; line < a.panel_lines; ++line) {
           for (int c = 0; c < a.panels_per_table; ++c) {
@@ -137,12 +186,12 @@ void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uin
                               axes, pre + "panel" + std::to_string(variant)));
           }
         }
+        // backsheet and frame structure under the panels, one box per table
+        const Eigen::Vector3d centre = slope_point(u_start + tl / 2, td / 2);
+        x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2, td / 2, 0.015) + "\" pos=\"" +
+               v3(centre - normal * (kPanelHalfThicknessM + 0.016)) + "\" xyaxes=\"" + axes +
+               "\" material=\"backsheet\"/>");
       }
-      // backsheet and frame structure under the panels, one box per table
-      const Eigen::Vector3d centre = slope_point(u_start + tl / 2, td / 2);
-      x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2, td / 2, 0.015) + "\" pos=\"" +
-             v3(centre - normal * (kPanelHalfThicknessM + 0.016)) + "\" xyaxes=\"" + axes +
-             "\" material=\"backsheet\"/>");
       if (a.rails) {
         for (double sf : {0.22, 0.78}) {
           const Eigen::Vector3d p = slope_point(u_start + tl / 2, td * sf) - normal * 0.09;
@@ -181,7 +230,7 @@ void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::u
   Placer rng = dust_placer(day_seed, index);
   const Placer first_table_rng = rng;
   const std::string pre = "a" + std::to_string(index);
-  const std::set<std::array<int, 4>> broken = broken_modules(a, station_seed, index);
+  const ModuleMarks marks = module_marks(a, station_seed, index);
   for (int row = 0; row < a.rows; ++row) {
     for (int t = 0; t < a.tables_per_row; ++t) {
       if (a.identical_tables) rng = first_table_rng;
@@ -199,9 +248,8 @@ void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::u
       };
       const std::string tname = pre + "r" + std::to_string(row) + "t" + std::to_string(t);
       if (a.panel_slabs) {
-        x.line(table_slab_geom(tname, a, plane_point(u_start + tl / 2, td / 2), axes, pre, rng,
-                               a.row_soiling > 0 ? row_dust_variant(station_seed, index, row) : -1));
-        add_broken_modules(x, a, broken, row, t, u_start, plane_point, normal, axes, tname);
+        add_slab_table(x, a, marks, {row, t, u_start, plane_point, normal, axes, tname}, pre, rng,
+                       a.row_soiling > 0 ? row_dust_variant(station_seed, index, row) : -1);
       } else {
         for (int line = 0; line < a.panel_lines; ++line)
           for (int c = 0; c < a.panels_per_table; ++c) {
@@ -210,11 +258,11 @@ void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::u
                               plane_point(u_start + c * (pw + gap) + pw / 2, line * (ph + gap) + ph / 2), axes,
                               pre + "panel" + std::to_string(variant)));
           }
+        x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2, td / 2, 0.015) + "\" pos=\"" +
+               v3(plane_point(u_start + tl / 2, td / 2) - normal * (kPanelHalfThicknessM + 0.016)) +
+               "\" xyaxes=\"" + axes + "\" material=\"backsheet\"/>");
       }
       const Eigen::Vector3d mid = axis_point(u_start + tl / 2);
-      x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2, td / 2, 0.015) + "\" pos=\"" +
-             v3(plane_point(u_start + tl / 2, td / 2) - normal * (kPanelHalfThicknessM + 0.016)) + "\" xyaxes=\"" +
-             axes + "\" material=\"backsheet\"/>");
       x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2 + 0.1, 0.06, 0.06) + "\" pos=\"" + v3(mid) +
              "\" xyaxes=\"" + axes + "\" material=\"steel\"/>");
       if (a.posts)

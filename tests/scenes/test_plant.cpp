@@ -201,5 +201,15 @@ TEST(PlantErrors, APlantLargerThanTheSceneLimitIsRefusedAtItsKey) {
   EXPECT_NE(e.find("(1 blocks x 100 rows x 30 tables x 8 geoms)"), std::string::npos) << e;
 }
 
+// A table that lost a module is drawn a module at a time: the limit counts
+// its modules and backsheets (2 x 56 - 4 more geoms for the default table of 2 x 28).
+TEST(PlantErrors, MissingModulesCountInTheSceneLimit) {
+  const std::string plant = "ground: {size_m: [2000, 2000]}\nplant:\n  rows: 20\n  origin_m: [-700, -600]\n";
+  EXPECT_NO_THROW(parse_scenario(plant + "  missing_modules: 100\nroute: {pattern: along_row}\n", "ok.yaml"));
+  const std::string e = error_of(plant + "  missing_modules: 200\nroute: {pattern: along_row}\n");
+  EXPECT_NE(e.find("bad.yaml:2: plant: expected at most 20000 geoms in the scene"), std::string::npos) << e;
+  EXPECT_NE(e.find(", up to 21600 more for 200 missing modules a block)"), std::string::npos) << e;
+}
+
 }  // namespace plant_test
 }  // namespace pvb::scenes

@@ -16,6 +16,7 @@
 #include "pvb/sim/scene_builder.hpp"
 #include "pvb/sim/simulator.hpp"
 #include "pvb/sim/textures.hpp"
+#include "pvb/sim/truth_surface.hpp"
 
 namespace pvb::test {
 namespace plant_scene_test {
@@ -316,6 +317,95 @@ TEST(PlantScene, BrokenModulesAreShatteredPanesWhereTheStationPutsThem) {
   ASSERT_TRUE(drawn);
   EXPECT_EQ(day1.size(), 2u * 7u);  // two blocks of 7
   EXPECT_EQ(day1, panes(2).first);
+}
+
+/// A plant of one block of 10 rows with `missing` modules gone.
+scenes::Scenario holed_plant(int seed, int station_seed, int missing) {
+  return scenes::parse_scenario(
+      "seed: " + std::to_string(seed) + "\nstation_seed: " + std::to_string(station_seed) +
+          "\nground: {size_m: [300, 200], tiling: repeat}\nduration_s: 2\n"
+          "plant: {origin_m: [-60, -40], rows: 10, broken_modules: 5, missing_modules: " +
+          std::to_string(missing) + "}\nroute: {pattern: along_row, aisle: 1}\n",
+      "missing.yaml");
+}
+
+/// The modules gone from each table drawn a module at a time: every
+/// (line, column) of the table that has no geom of its own.
+std::map<std::string, std::set<std::pair<int, int>>> gone_modules(const mjModel* m,
+                                                                  const scenes::PvArray& a) {
+  std::map<std::string, std::set<std::pair<int, int>>> present;
+  const std::regex module("(a[0-9]+r[0-9]+t[0-9]+)p([0-9]+)_([0-9]+)");
+  for (int g = 0; g < m->ngeom; ++g) {
+    const char* name = mj_id2name(m, mjOBJ_GEOM, g);
+    std::cmatch hit;
+    if (name && std::regex_match(name, hit, module))
+      present[hit[1]].insert({std::stoi(hit[2]), std::stoi(hit[3])});
+  }
+  std::map<std::string, std::set<std::pair<int, int>>> gone;
+  for (const auto& [table, modules] : present)
+    for (int line = 0; line < a.panel_lines; ++line)
+      for (int c = 0; c < a.panels_per_table; ++c)
+        if (modules.count({line, c}) == 0) gone[table].insert({line, c});
+  return gone;
+}
+
+/// The first geom a ray meets, from `from` along `dir`, the robot excluded.
+int first_geom_hit(const mjModel* m, mjData* d, const Eigen::Vector3d& from, const Eigen::Vector3d& dir) {
+  int geom = -1;
+  mj_ray(m, d, from.data(), dir.data(), nullptr, 1, -1, &geom);
+  return geom;
+}
+
+// A missing module leaves a gap where the station's seed puts it: its table
+// is drawn a module at a time without the module and its backsheet, so a
+// ray down through the gap meets what lies under the table (a rail, the
+// ground), while one through the next module meets that module.  The same
+// station on another day has the same gaps; another station has others.
+TEST(PlantScene, MissingModulesLeaveGapsWhereTheStationPutsThem) {
+  const scenes::Scenario s = holed_plant(1, 4, 6);
+  const scenes::PvArray& a = s.pv_arrays.at(0);
+  sim::Simulator sim(s);
+  const mjModel* m = sim.model();
+  const auto gone = gone_modules(m, a);
+  std::size_t holes = 0;
+  for (const auto& [table, modules] : gone) holes += modules.size();
+  EXPECT_EQ(holes, 6u);
+  for (const auto& [table, modules] : gone) {
+    EXPECT_EQ(mj_name2id(m, mjOBJ_GEOM, (table + "slab").c_str()), -1) << table;
+    const auto [line, col] = *modules.begin();
+    // The module beside the gap, in the same line.
+    const int next_col = col + 1 < a.panels_per_table ? col + 1 : col - 1;
+    ASSERT_EQ(modules.count({line, next_col}), 0u) << table;
+    const std::string next = table + "p" + std::to_string(line) + "_" + std::to_string(next_col);
+    const int g = mj_name2id(m, mjOBJ_GEOM, next.c_str());
+    ASSERT_GE(g, 0) << next;
+    const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> R(sim.data()->geom_xmat + 9 * g);
+    const Eigen::Vector3d centre = Eigen::Map<const Eigen::Vector3d>(sim.data()->geom_xpos + 3 * g);
+    const Eigen::Vector3d up = R.col(2).z() > 0 ? R.col(2) : Eigen::Vector3d(-R.col(2));
+    const Eigen::Vector3d hole = centre + (col - next_col) * 2 * m->geom_size[3 * g] * R.col(0);
+    EXPECT_EQ(first_geom_hit(m, sim.data(), centre + up, -up), g) << next;
+    const int under = first_geom_hit(m, sim.data(), hole + up, -up);
+    EXPECT_NE(under, -1) << table;
+    EXPECT_NE(sim::classify_geom(m, under), sim::SurfaceClass::kPanel) << table;
+    EXPECT_NE(std::string(mj_id2name(m, mjOBJ_MATERIAL, m->geom_matid[under])), "backsheet") << table;
+  }
+  // A whole table's slab is a panel surface too.
+  const int slab = mj_name2id(m, mjOBJ_GEOM, "a0r0t0slab");
+  ASSERT_GE(slab, 0);
+  EXPECT_EQ(sim::classify_geom(m, slab), sim::SurfaceClass::kPanel);
+  // The gaps are the station's: the same on another day, others elsewhere.
+  const auto gone_on = [](const scenes::Scenario& other) {
+    const sim::SceneAssets assets = sim::build_scene(other, sim::SceneDetail::kGeometry);
+    std::set<std::string> tables;
+    const std::regex module("<geom name=\"(a[0-9]+r[0-9]+t[0-9]+)p[0-9]+_[0-9]+\"");
+    for (std::sregex_iterator it(assets.xml.begin(), assets.xml.end(), module), end; it != end; ++it)
+      tables.insert((*it)[1]);
+    return tables;
+  };
+  std::set<std::string> tables;
+  for (const auto& [table, modules] : gone) tables.insert(table);
+  EXPECT_EQ(gone_on(holed_plant(2, 4, 6)), tables);
+  EXPECT_NE(gone_on(holed_plant(1, 5, 6)), tables);
 }
 
 /// How well two grey images of one size agree: their normalised correlation.

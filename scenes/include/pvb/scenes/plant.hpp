@@ -98,6 +98,7 @@ struct Plant {
   double dirt = 0.2;
   double row_soiling = 0.0;  ///< the spread of the rows' dust (PvArray::row_soiling); 0: rows alike
   int broken_modules = 0;    ///< modules shown broken in each block (PvArray::broken_modules)
+  int missing_modules = 0;   ///< modules gone from each block (PvArray::missing_modules)
   bool specular_glass = false;
   bool identical_tables = false;
 };

@@ -128,6 +128,11 @@ struct PvArray {
   /// Modules shown broken (slabs only): shattered glass over this many
   /// modules of the array, where the station's seed puts them.
   int broken_modules = 0;
+  /// Modules gone (slabs only): this many modules of the array, none of
+  /// them broken, where the station's seed puts them.  A table that lost
+  /// one is drawn a module at a time, its backsheet too, so the rails and
+  /// the ground show through the gap.
+  int missing_modules = 0;
   Mount mount = Mount::kFixed;
   TrackerMount tracker;  ///< mount single_axis only
   /// The tracker's rotation on the day (degrees; 0 for a fixed mount),
