@@ -27,7 +27,7 @@ long long table_geoms(const PvArray& a) {
 long long missing_module_geoms(const PvArray& a) {
   if (a.missing_modules == 0) return 0;
   const long long modules = static_cast<long long>(a.panels_per_table) * a.panel_lines;
-  return static_cast<long long>(a.missing_modules) * std::max(2 * (modules - 1) - 2, 0LL);
+  return static_cast<long long>(a.missing_modules) * std::max(2 * modules - 4, 0LL);
 }
 
 /// ", up to N more for M missing modules a block" where a plant's blocks miss modules.

@@ -98,10 +98,11 @@ struct SlabTable {
   std::string axes, name;
 };
 
-std::string backsheet_geom(const Eigen::Vector3d& panel_centre, const SlabTable& t, double length_m,
-                           double depth_m) {
+/// The backsheet and frame under panels centred at `panel_centre`, facing `normal`.
+std::string backsheet_geom(const Eigen::Vector3d& panel_centre, const Eigen::Vector3d& normal,
+                           const std::string& axes, double length_m, double depth_m) {
   return "<geom class=\"scenery\" type=\"box\" size=\"" + v3(length_m / 2, depth_m / 2, 0.015) + "\" pos=\"" +
-         v3(panel_centre - t.normal * (kPanelHalfThicknessM + 0.016)) + "\" xyaxes=\"" + t.axes +
+         v3(panel_centre - normal * (kPanelHalfThicknessM + 0.016)) + "\" xyaxes=\"" + axes +
          "\" material=\"backsheet\"/>";
 }
 
@@ -127,7 +128,7 @@ void add_slab_table(XmlWriter& x, const scenes::PvArray& a, const ModuleMarks& m
       const Eigen::Vector3d centre = t.point(t.u_start + (c + 0.5) * mw, (line + 0.5) * mh);
       x.line(panel_geom(t.name + "p" + std::to_string(line) + "_" + std::to_string(c), mw, mh, centre, t.axes,
                         pre + "panel" + std::to_string(variant)));
-      x.line(backsheet_geom(centre, t, mw, mh));
+      x.line(backsheet_geom(centre, t.normal, t.axes, mw, mh));
     }
   for (auto it = marks.broken.lower_bound({t.row, t.table, 0, 0});
        it != marks.broken.end() && (*it)[0] == t.row && (*it)[1] == t.table; ++it) {
@@ -137,7 +138,7 @@ void add_slab_table(XmlWriter& x, const scenes::PvArray& a, const ModuleMarks& m
            "\" class=\"scenery\" type=\"box\" size=\"" + v3(0.49 * mw, 0.49 * mh, 0.001) + "\" pos=\"" +
            v3(c) + "\" xyaxes=\"" + t.axes + "\" material=\"broken\"/>");
   }
-  if (!holed) x.line(backsheet_geom(t.point(t.u_start + tl / 2, td / 2), t, tl, td));
+  if (!holed) x.line(backsheet_geom(t.point(t.u_start + tl / 2, td / 2), t.normal, t.axes, tl, td));
 }
 
 /// Where a post under `top` starts: on flat ground at z = 0, on a relief
@@ -186,11 +187,8 @@ void add_fixed_array(XmlWriter& x, const scenes::PvArray& a, int index, std::uin
                               axes, pre + "panel" + std::to_string(variant)));
           }
         }
-        // backsheet and frame structure under the panels, one box per table
-        const Eigen::Vector3d centre = slope_point(u_start + tl / 2, td / 2);
-        x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2, td / 2, 0.015) + "\" pos=\"" +
-               v3(centre - normal * (kPanelHalfThicknessM + 0.016)) + "\" xyaxes=\"" + axes +
-               "\" material=\"backsheet\"/>");
+        x.line(
+            backsheet_geom(slope_point(u_start + tl / 2, td / 2), normal, axes, tl, td));  // one box a table
       }
       if (a.rails) {
         for (double sf : {0.22, 0.78}) {
@@ -258,9 +256,7 @@ void add_tracker_array(XmlWriter& x, const scenes::PvArray& a, int index, std::u
                               plane_point(u_start + c * (pw + gap) + pw / 2, line * (ph + gap) + ph / 2), axes,
                               pre + "panel" + std::to_string(variant)));
           }
-        x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2, td / 2, 0.015) + "\" pos=\"" +
-               v3(plane_point(u_start + tl / 2, td / 2) - normal * (kPanelHalfThicknessM + 0.016)) +
-               "\" xyaxes=\"" + axes + "\" material=\"backsheet\"/>");
+        x.line(backsheet_geom(plane_point(u_start + tl / 2, td / 2), normal, axes, tl, td));
       }
       const Eigen::Vector3d mid = axis_point(u_start + tl / 2);
       x.line("<geom class=\"scenery\" type=\"box\" size=\"" + v3(tl / 2 + 0.1, 0.06, 0.06) + "\" pos=\"" + v3(mid) +
